@@ -1,0 +1,88 @@
+#include "bake/atmosphere.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace skybake {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}
+
+double DensityProfile::At(double altitude_m) const {
+  if (kind == Kind::kTabulated) {
+    if (altitudes_m.empty()) return 0.0;
+    if (altitude_m <= altitudes_m.front()) return densities.front();
+    if (altitude_m >= altitudes_m.back()) return densities.back();
+    auto upper = std::upper_bound(altitudes_m.begin(), altitudes_m.end(), altitude_m);
+    size_t i = static_cast<size_t>(upper - altitudes_m.begin());
+    double t = (altitude_m - altitudes_m[i - 1]) / (altitudes_m[i] - altitudes_m[i - 1]);
+    return densities[i - 1] + t * (densities[i] - densities[i - 1]);
+  }
+  double layer_base = 0.0;
+  for (size_t i = 0; i < layers.size(); ++i) {
+    const DensityLayer& layer = layers[i];
+    bool last = i + 1 == layers.size();
+    if (last || altitude_m < layer_base + layer.width_m) {
+      double d = layer.exp_term * std::exp(layer.exp_scale_per_m * altitude_m) +
+                 layer.linear_term_per_m * altitude_m + layer.constant_term;
+      return std::clamp(d, 0.0, 1.0);
+    }
+    layer_base += layer.width_m;
+  }
+  return 0.0;
+}
+
+std::vector<double> DensityProfile::Breakpoints() const {
+  if (kind == Kind::kTabulated) return altitudes_m;
+  std::vector<double> result;
+  double layer_base = 0.0;
+  for (size_t i = 0; i + 1 < layers.size(); ++i) {
+    layer_base += layers[i].width_m;
+    result.push_back(layer_base);
+  }
+  return result;
+}
+
+double PhaseFunction::Evaluate(double cos_theta) const {
+  switch (kind) {
+    case PhaseKind::kIsotropic:
+      return 1.0 / (4.0 * kPi);
+    case PhaseKind::kRayleigh:
+      return 3.0 / (16.0 * kPi) * (1.0 + cos_theta * cos_theta);
+    case PhaseKind::kHenyeyGreenstein: {
+      double denom = 1.0 + g * g - 2.0 * g * cos_theta;
+      return (1.0 - g * g) / (4.0 * kPi * denom * std::sqrt(denom));
+    }
+    case PhaseKind::kCornetteShanks: {
+      double denom = 1.0 + g * g - 2.0 * g * cos_theta;
+      double k = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
+      return k * (1.0 + cos_theta * cos_theta) / (denom * std::sqrt(denom));
+    }
+  }
+  return 0.0;
+}
+
+const char* ToString(PhaseKind kind) {
+  switch (kind) {
+    case PhaseKind::kIsotropic: return "isotropic";
+    case PhaseKind::kRayleigh: return "rayleigh";
+    case PhaseKind::kHenyeyGreenstein: return "henyey-greenstein";
+    case PhaseKind::kCornetteShanks: return "cornette-shanks";
+  }
+  return "unknown";
+}
+
+Spectrum Atmosphere::ScatteringAt(double altitude_m) const {
+  Spectrum sum(0.0);
+  for (const Constituent& c : constituents) sum += c.scattering_per_m * c.density.At(altitude_m);
+  return sum;
+}
+
+Spectrum Atmosphere::ExtinctionAt(double altitude_m) const {
+  Spectrum sum(0.0);
+  for (const Constituent& c : constituents) sum += c.Extinction() * c.density.At(altitude_m);
+  return sum;
+}
+
+}  // namespace skybake

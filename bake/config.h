@@ -1,0 +1,42 @@
+// Atmosphere files (TOML) and the built-in presets.
+//
+// Every error names the source, the key path and the problem on one line,
+// e.g. "mars.toml: constituents.dust.phase.g = 1.2 is outside (-1, 1)", and is
+// thrown as InputError (exit code 2). Unknown keys are errors. The file format
+// is documented in examples/atmospheres/README.md.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bake/atmosphere.h"
+
+namespace skybake {
+
+// Parses and validates an atmosphere description. `source_name` prefixes
+// error messages (usually the file's base name).
+Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name);
+
+// Reads FILE if it exists, otherwise looks up a built-in preset of that name.
+// A missing file that is not a preset name is an InputError; an unreadable
+// file is an IoError.
+Atmosphere LoadAtmosphere(const std::string& file_or_preset);
+
+struct PresetInfo {
+  std::string name;
+  std::string description;
+};
+std::vector<PresetInfo> ListPresets();
+Atmosphere LoadPreset(const std::string& name);  // InputError if unknown
+
+// The resolved atmosphere as canonical TOML in SI keys; parsing it back gives
+// the same Atmosphere (tested), so `skybake validate` output is a valid input.
+std::string ToToml(const Atmosphere& atmosphere);
+
+// Throws InputError if the atmosphere is not physically meaningful (negative
+// or non-finite coefficients, top radius <= ground radius, |g| >= 1, ...).
+// ParseAtmosphere calls it; code that builds an Atmosphere by hand should too.
+void Validate(const Atmosphere& atmosphere, const std::string& source_name);
+
+}  // namespace skybake

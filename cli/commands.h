@@ -1,0 +1,17 @@
+// The `skybake` subcommands. Each Add*Command registers one subcommand on the
+// application; its callback does the work and reports failure by throwing a
+// skybake::Error, which main() turns into a one-line message and exit code.
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+namespace skybake::cli {
+
+void AddPresetsCommand(CLI::App& app);
+void AddValidateCommand(CLI::App& app);
+void AddBakeCommand(CLI::App& app);
+void AddEvalCommand(CLI::App& app);
+
+}  // namespace skybake::cli

@@ -1,0 +1,2 @@
+// Placeholder: the manifest and writers land with the bake.
+#pragma once

@@ -1,0 +1,20 @@
+// Text files compiled into the program from the source tree (see
+// cmake/EmbedText.cmake): the atmosphere presets and the GLSL runtime.
+#pragma once
+
+#include <string_view>
+#include <vector>
+
+namespace skybake {
+
+struct EmbeddedText {
+  std::string_view name;  // file name, e.g. "earth.toml"
+  std::string_view text;
+};
+
+// examples/atmospheres/*.toml
+extern const std::vector<EmbeddedText> kPresetFiles;
+// shaders_runtime/*.glsl
+extern const std::vector<EmbeddedText> kRuntimeShaderFiles;
+
+}  // namespace skybake
