@@ -1,1 +1,0 @@
-#include "formats/manifest.h"

@@ -1,2 +1,0 @@
-// Placeholder: the manifest and writers land with the bake.
-#pragma once
