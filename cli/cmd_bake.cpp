@@ -1,21 +1,124 @@
-// `skybake bake` and `skybake eval` (being written).
-#include <CLI/CLI.hpp>
+// `skybake bake`: atmosphere → tables on disk.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
 
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "bake/config.h"
 #include "bake/errors.h"
 #include "cli/commands.h"
+#include "cli/command_line.h"
+#include "formats/file_io.h"
+#include "formats/lut_files.h"
 
 namespace skybake::cli {
 
-void AddBakeCommand(CLI::App& app) {
-  app.add_subcommand("bake", "Bake the lookup tables")->callback([] {
-    throw InternalError("bake is not implemented yet");
-  });
+namespace {
+
+struct BakeOptions {
+  std::string atmosphere;
+  std::string output_dir;
+  BakeSettings settings;
+  std::vector<int> transmittance_size, irradiance_size, scattering_size;
+  bool half = false;
+  bool json = false;
+  bool quiet = false;
+};
+
+void RunBake(const BakeOptions& o) {
+  Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
+  BakeSettings settings = o.settings;
+  if (!o.transmittance_size.empty()) {
+    settings.transmittance_width = o.transmittance_size[0];
+    settings.transmittance_height = o.transmittance_size[1];
+  }
+  if (!o.irradiance_size.empty()) {
+    settings.irradiance_width = o.irradiance_size[0];
+    settings.irradiance_height = o.irradiance_size[1];
+  }
+  if (!o.scattering_size.empty()) {
+    settings.scattering_r_size = o.scattering_size[0];
+    settings.scattering_mu_size = o.scattering_size[1];
+    settings.scattering_mu_s_size = o.scattering_size[2];
+    settings.scattering_nu_size = o.scattering_size[3];
+  }
+  settings.Validate();
+  EnsureWritableDirectory(o.output_dir);
+
+  BakeReport report;
+  auto print_phase = [&](const BakeTiming& t) {
+    if (!o.quiet) std::fprintf(stderr, "  %-36s %8.3f s\n", t.phase.c_str(), t.seconds);
+  };
+  if (!o.quiet) std::fprintf(stderr, "baking %s\n", atmosphere.name.c_str());
+  LutSet luts = Bake(atmosphere, settings, &report, print_phase);
+
+  auto write_start = std::chrono::steady_clock::now();
+  WriteLutSet(luts, o.output_dir, WriteOptions{o.half, CommandLine()});
+  BakeTiming write{"write files", std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count()};
+  print_phase(write);
+  report.timings.push_back(write);
+  report.total_seconds += write.seconds;
+  if (!o.quiet) std::fprintf(stderr, "  %-36s %8.3f s\n", "total", report.total_seconds);
+
+  if (o.json) {
+    nlohmann::json timings = nlohmann::json::array();
+    for (const BakeTiming& t : report.timings) timings.push_back({{"phase", t.phase}, {"seconds", t.seconds}});
+    const BakeSettings& s = luts.settings;
+    nlohmann::json j = {
+        {"atmosphere", atmosphere.name},
+        {"output_dir", o.output_dir},
+        {"orders", s.orders},
+        {"pixel_type", o.half ? "half" : "float"},
+        {"tables",
+         {{"transmittance", {s.transmittance_width, s.transmittance_height}},
+          {"irradiance", {s.irradiance_width, s.irradiance_height}},
+          {"scattering", {s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size}},
+          {"single_mie_scattering",
+           s.pack_single_mie_in_alpha ? nlohmann::json(nullptr)
+                                      : nlohmann::json({s.scattering_r_size, s.scattering_mu_size,
+                                                        s.scattering_mu_s_size, s.scattering_nu_size})}}},
+        {"samples",
+         {{"transmittance", s.transmittance_samples}, {"ray", s.ray_samples}, {"sphere", s.sphere_samples}}},
+        {"timings", timings},
+        {"total_seconds", report.total_seconds}};
+    std::printf("%s\n", j.dump(2).c_str());
+  }
 }
 
-void AddEvalCommand(CLI::App& app) {
-  app.add_subcommand("eval", "Evaluate queries against baked tables")->callback([] {
-    throw InternalError("eval is not implemented yet");
-  });
+}  // namespace
+
+void AddBakeCommand(CLI::App& app) {
+  auto o = std::make_shared<BakeOptions>();
+  CLI::App* cmd = app.add_subcommand("bake", "Bake transmittance, irradiance and scattering tables");
+  cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
+  cmd->add_option("-o,--output", o->output_dir, "Output directory (created if missing)")->required();
+  cmd->add_option("--orders", o->settings.orders, "Scattering orders (1 = single scattering)")
+      ->capture_default_str();
+  cmd->add_option("--transmittance-size", o->transmittance_size, "Transmittance table: MU R (default 256 64)")
+      ->expected(2);
+  cmd->add_option("--irradiance-size", o->irradiance_size, "Irradiance table: MU_S R (default 64 16)")->expected(2);
+  cmd->add_option("--scattering-size", o->scattering_size,
+                  "Scattering table: R MU MU_S NU (default 32 128 32 8; MU even)")
+      ->expected(4);
+  cmd->add_option("--transmittance-samples", o->settings.transmittance_samples,
+                  "Quadrature nodes per optical-depth integral")
+      ->capture_default_str();
+  cmd->add_option("--ray-samples", o->settings.ray_samples, "Intervals per ray for inscattering integrals")
+      ->capture_default_str();
+  cmd->add_option("--sphere-samples", o->settings.sphere_samples,
+                  "Polar directions for integrals over the sphere (azimuths: twice as many)")
+      ->capture_default_str();
+  cmd->add_flag("--pack-mie", o->settings.pack_single_mie_in_alpha,
+                "Store single Mie's red channel in the scattering table's alpha instead of a separate table");
+  cmd->add_flag("--half", o->half, "Store half floats instead of float32");
+  cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
+  cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");
+  cmd->callback([o] { RunBake(*o); });
 }
 
 }  // namespace skybake::cli

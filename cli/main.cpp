@@ -8,6 +8,7 @@
 
 #include "bake/errors.h"
 #include "bake/version.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 
 int main(int argc, char** argv) {
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
       "skybake bakes physically based atmospheric-scattering data for real-time renderers.\n"
       "Exit codes: 0 ok, 1 usage, 2 invalid input, 3 I/O error, 4 internal error."};
   app.name("skybake");
+  skybake::cli::SetCommandLine(argc, argv);
   app.set_version_flag("--version", "skybake " SKYBAKE_VERSION);
   app.require_subcommand(1, 1);
   skybake::cli::AddPresetsCommand(app);

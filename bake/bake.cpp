@@ -1,0 +1,531 @@
+// The CPU bake. The structure follows Bruneton's precomputation (transmittance,
+// single scattering, then per order: scattering density, indirect irradiance,
+// multiple scattering), with two CPU-specific choices:
+//
+// * Rays are shared. Every texel of the 4D table with the same (r, mu) looks
+//   along the same ray, so the samples along it, the densities and the
+//   optical depth from the camera are computed once per ray and reused by all
+//   (mu_s, nu) texels; only the sun's transmittance and the looked-up source
+//   differ.
+// * Incoming radiance is shared. The radiance arriving at a point depends on
+//   its altitude and the sun's zenith angle, not on the view direction, so
+//   the scattering density gathers the incoming radiance once per (r, mu_s)
+//   slice and reuses it for all (mu, nu) view texels of the slice.
+//
+// Integrals along rays use the exponential trapezoid rule (exact when the
+// integrand varies exponentially between samples, as densities and
+// transmittances do), so a thin haze layer seen on a steep ray needs no more
+// samples than the thick Rayleigh layer.
+#include "bake/bake.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include "bake/errors.h"
+#include "bake/medium.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake {
+
+namespace {
+
+using glsl::AtmosphereParameters;
+using glsl::Texture;
+using glsl::vec3;
+using glsl::vec4;
+constexpr double kPi = 3.14159265358979323846;
+
+// Integral over an interval of width h of a positive function that takes the
+// values a and b at its ends, assuming it is exponential in between; the
+// ordinary trapezoid where that assumption cannot hold (a zero end).
+double ExponentialTrapezoid(double a, double b, double h) {
+  if (a <= 0.0 || b <= 0.0) return 0.5 * h * (a + b);
+  double ratio = b / a;
+  if (std::abs(ratio - 1.0) < 1e-4) return 0.5 * h * (a + b);
+  return h * (b - a) / std::log(ratio);
+}
+
+Spectrum ExponentialTrapezoid(const Spectrum& a, const Spectrum& b, double h) {
+  return Spectrum(ExponentialTrapezoid(a.x, b.x, h), ExponentialTrapezoid(a.y, b.y, h),
+                  ExponentialTrapezoid(a.z, b.z, h));
+}
+
+// Samples along one ray of the scattering table, shared by its (mu_s, nu) texels.
+struct RaySamples {
+  double r = 0.0, mu = 0.0;
+  bool intersects_ground = false;
+  double dt = 0.0;
+  std::vector<double> t, radius;
+  std::vector<Spectrum> optical_depth;           // from the camera to each sample
+  std::vector<std::vector<Spectrum>> scattering;  // [group][sample] scattering coefficient
+};
+
+class Baker {
+ public:
+  Baker(const Atmosphere& atmosphere, const BakeSettings& settings)
+      : medium_(atmosphere), settings_(settings), params_(MakeAtmosphereParameters(atmosphere, settings)) {}
+
+  LutSet Run(BakeReport* report, const BakeProgress& progress);
+
+ private:
+  template <typename F>
+  void Phase(const std::string& name, F&& work);
+
+  void ComputeTransmittance();
+  void ComputeSingleScattering();
+  void ComputeScatteringDensity(int order);
+  void ComputeIndirectIrradiance(int order);
+  void ComputeMultipleScattering();
+
+  // Geometry of scattering texel (x = nu * MU_S + mu_s, y = mu, z = r), with nu
+  // clamped to the range that mu and mu_s allow.
+  void ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
+                               bool& intersects_ground) const;
+  RaySamples SampleRay(int mu_index, int r_index) const;
+
+  // Radiance of scattering order `order` arriving at radius r from direction
+  // (mu, nu) with the sun at mu_s, excluding light reflected by the ground.
+  vec3 IncidentRadiance(int order, double r, double mu, double mu_s, double nu, bool intersects_ground) const;
+  // Irradiance of order `order` on the ground where the sun is at mu_s.
+  vec3 GroundIrradiance(int order, double mu_s) const;
+  vec3 DirectIrradiance(double r, double mu_s) const;
+
+  Medium medium_;
+  BakeSettings settings_;
+  AtmosphereParameters params_;
+  BakeReport report_;
+  BakeProgress progress_;
+
+  Texture transmittance_;
+  Texture irradiance_;
+  Texture scattering_;            // accumulated result (divided by the Rayleigh phase)
+  Texture single_mie_;            // single scattering of the Mie group, phase free
+  Texture single_rayleigh_;       // single scattering of the other groups / Rayleigh phase
+  Texture delta_multiple_;        // radiance of the latest order >= 2
+  Texture scattering_density_;    // J of the current order
+  Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
+};
+
+template <typename F>
+void Baker::Phase(const std::string& name, F&& work) {
+  auto start = std::chrono::steady_clock::now();
+  work();
+  BakeTiming timing{name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+  report_.timings.push_back(timing);
+  if (progress_) progress_(timing);
+}
+
+LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
+  progress_ = progress;
+  auto start = std::chrono::steady_clock::now();
+  const BakeSettings& s = settings_;
+  int scattering_width = s.scattering_nu_size * s.scattering_mu_s_size;
+  transmittance_ = Texture(s.transmittance_width, s.transmittance_height);
+  irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
+  scattering_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+  single_mie_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+  single_rayleigh_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+
+  Phase("transmittance", [&] { ComputeTransmittance(); });
+  Phase("single scattering", [&] { ComputeSingleScattering(); });
+  scattering_.texels = single_rayleigh_.texels;
+  if (s.orders >= 2) {
+    scattering_density_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+    delta_multiple_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+    delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
+  }
+  for (int order = 2; order <= s.orders; ++order) {
+    std::string prefix = "order " + std::to_string(order) + ": ";
+    Phase(prefix + "scattering density", [&] { ComputeScatteringDensity(order); });
+    Phase(prefix + "indirect irradiance", [&] { ComputeIndirectIrradiance(order - 1); });
+    Phase(prefix + "multiple scattering", [&] { ComputeMultipleScattering(); });
+  }
+
+  LutSet result;
+  result.atmosphere = medium_.atmosphere();
+  result.settings = settings_;
+  result.parameters = params_;
+  result.transmittance = std::move(transmittance_);
+  result.irradiance = std::move(irradiance_);
+  if (params_.single_mie_in_scattering_alpha == 1) {
+    for (size_t i = 0; i < scattering_.texels.size(); i += 4) scattering_.texels[i + 3] = single_mie_.texels[i];
+  } else {
+    result.single_mie_scattering = std::move(single_mie_);
+  }
+  result.scattering = std::move(scattering_);
+  report_.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (report) *report = report_;
+  return result;
+}
+
+void Baker::ComputeTransmittance() {
+  const int width = transmittance_.width, height = transmittance_.height;
+  tbb::parallel_for(0, height, [&](int y) {
+    for (int x = 0; x < width; ++x) {
+      double r, mu;
+      glsl::GetRMuFromTransmittanceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu);
+      double d = glsl::DistanceToTopAtmosphereBoundary(params_, r, mu);
+      Spectrum tau = medium_.OpticalDepth(r, mu, d, settings_.transmittance_samples);
+      transmittance_.Store(x, y, 0, vec4(tau, 0.0));
+    }
+  });
+}
+
+void Baker::ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
+                                    bool& intersects_ground) const {
+  const int mu_s_size = params_.scattering_mu_s_size;
+  int nu_index = x / mu_s_size, mu_s_index = x % mu_s_size;
+  vec4 uvwz(double(nu_index) / (params_.scattering_nu_size - 1), (mu_s_index + 0.5) / mu_s_size,
+            (y + 0.5) / params_.scattering_mu_size, (z + 0.5) / params_.scattering_r_size);
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(params_, uvwz, r, mu, mu_s, nu, intersects_ground);
+  double spread = std::sqrt(std::max(0.0, (1.0 - mu * mu) * (1.0 - mu_s * mu_s)));
+  nu = std::clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
+}
+
+RaySamples Baker::SampleRay(int mu_index, int r_index) const {
+  RaySamples ray;
+  double mu_s, nu;
+  ScatteringTexelGeometry(0, mu_index, r_index, ray.r, ray.mu, mu_s, nu, ray.intersects_ground);
+  double d = glsl::DistanceToNearestAtmosphereBoundary(params_, ray.r, ray.mu, ray.intersects_ground);
+  const int n = settings_.ray_samples;
+  const int constituents = medium_.constituent_count();
+  const int groups = static_cast<int>(medium_.groups().size());
+  ray.dt = d / n;
+  ray.t.resize(n + 1);
+  ray.radius.resize(n + 1);
+  ray.optical_depth.assign(n + 1, Spectrum(0.0));
+  ray.scattering.assign(groups, std::vector<Spectrum>(n + 1));
+  std::vector<double> densities(constituents), previous(constituents);
+  for (int k = 0; k <= n; ++k) {
+    double t = k * ray.dt;
+    ray.t[k] = t;
+    ray.radius[k] = glsl::RadiusAtDistance(params_, ray.r, ray.mu, t);
+    medium_.Densities(ray.radius[k] - params_.bottom_radius, densities.data());
+    for (int g = 0; g < groups; ++g) ray.scattering[g][k] = medium_.GroupScattering(g, densities.data());
+    if (k > 0) {
+      Spectrum tau = ray.optical_depth[k - 1];
+      for (int c = 0; c < constituents; ++c) {
+        tau += medium_.atmosphere().constituents[c].Extinction() *
+               ExponentialTrapezoid(previous[c], densities[c], ray.dt);
+      }
+      ray.optical_depth[k] = tau;
+    }
+    std::swap(densities, previous);
+  }
+  return ray;
+}
+
+void Baker::ComputeSingleScattering() {
+  const int mu_size = params_.scattering_mu_size, r_size = params_.scattering_r_size;
+  const int width = scattering_.width;
+  const int groups = static_cast<int>(medium_.groups().size());
+  const int mie = medium_.mie_group();
+  const glsl::sampler2D transmittance{&transmittance_};
+  tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
+    int z = ray_index / mu_size, y = ray_index % mu_size;
+    RaySamples ray = SampleRay(y, z);
+    const int n = settings_.ray_samples;
+    std::vector<double> phase_ratio(groups);
+    std::vector<Spectrum> rayleigh(n + 1), mie_samples(n + 1);
+    for (int x = 0; x < width; ++x) {
+      double r, mu, mu_s, nu;
+      bool intersects;
+      ScatteringTexelGeometry(x, y, z, r, mu, mu_s, nu, intersects);
+      // The table divides out the Rayleigh phase; other phases are applied here.
+      for (int g = 0; g < groups; ++g) {
+        phase_ratio[g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
+      }
+      for (int k = 0; k <= n; ++k) {
+        double r_k = ray.radius[k];
+        double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / r_k);
+        Spectrum tau_sun = glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance, r_k, mu_s_k);
+        Spectrum attenuation = glm::exp(-(ray.optical_depth[k] + tau_sun)) *
+                               glsl::SunVisibleFraction(params_, r_k, mu_s_k);
+        Spectrum other(0.0);
+        for (int g = 0; g < groups; ++g) {
+          if (g != mie) other += ray.scattering[g][k] * phase_ratio[g];
+        }
+        rayleigh[k] = other * attenuation;
+        mie_samples[k] = mie >= 0 ? ray.scattering[mie][k] * attenuation : Spectrum(0.0);
+      }
+      Spectrum rayleigh_sum(0.0), mie_sum(0.0);
+      for (int k = 0; k < n; ++k) {
+        rayleigh_sum += ExponentialTrapezoid(rayleigh[k], rayleigh[k + 1], ray.dt);
+        mie_sum += ExponentialTrapezoid(mie_samples[k], mie_samples[k + 1], ray.dt);
+      }
+      single_rayleigh_.Store(x, y, z, vec4(rayleigh_sum * params_.solar_irradiance, 0.0));
+      single_mie_.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
+    }
+  });
+}
+
+vec3 Baker::DirectIrradiance(double r, double mu_s) const {
+  // Cosine factor averaged over the sun's disc when it straddles the horizon.
+  double alpha = params_.sun_angular_radius;
+  double cosine = mu_s < -alpha ? 0.0 : (mu_s > alpha ? mu_s : (mu_s + alpha) * (mu_s + alpha) / (4.0 * alpha));
+  return params_.solar_irradiance *
+         glsl::GetTransmittanceToTopAtmosphereBoundary(params_, glsl::sampler2D{&transmittance_}, r, mu_s) * cosine;
+}
+
+vec3 Baker::GroundIrradiance(int order, double mu_s) const {
+  if (order == 1) return DirectIrradiance(params_.bottom_radius, mu_s);
+  return glsl::GetIrradiance(params_, glsl::sampler2D{&delta_irradiance_}, params_.bottom_radius, mu_s);
+}
+
+vec3 Baker::IncidentRadiance(int order, double r, double mu, double mu_s, double nu, bool intersects_ground) const {
+  if (order == 1) {
+    vec3 rayleigh(glsl::GetScattering(params_, glsl::sampler3D{&single_rayleigh_}, r, mu, mu_s, nu, intersects_ground));
+    vec3 mie(glsl::GetScattering(params_, glsl::sampler3D{&single_mie_}, r, mu, mu_s, nu, intersects_ground));
+    return rayleigh * glsl::RayleighPhaseFunction(nu) + mie * glsl::MiePhaseFunction(params_, nu);
+  }
+  return vec3(glsl::GetScattering(params_, glsl::sampler3D{&delta_multiple_}, r, mu, mu_s, nu, intersects_ground));
+}
+
+void Baker::ComputeScatteringDensity(int order) {
+  const int mu_s_size = params_.scattering_mu_s_size, r_size = params_.scattering_r_size;
+  const int nu_size = params_.scattering_nu_size, mu_size = params_.scattering_mu_size;
+  const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
+  const double d_angle = kPi / polar;
+  const int groups = static_cast<int>(medium_.groups().size());
+  const vec3 albedo_over_pi = medium_.atmosphere().ground_albedo / kPi;
+  const glsl::sampler2D transmittance{&transmittance_};
+
+  tbb::parallel_for(0, r_size * mu_s_size, [&](int slice) {
+    int z = slice / mu_s_size, mu_s_index = slice % mu_s_size;
+    double r, mu_unused, mu_s, nu_unused;
+    bool intersects_unused;
+    ScatteringTexelGeometry(mu_s_index, 0, z, r, mu_unused, mu_s, nu_unused, intersects_unused);
+    // Local frame: zenith along z, sun in the x-z plane.
+    const vec3 zenith(0.0, 0.0, 1.0);
+    const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+
+    // Incoming radiance (of the previous order) from every direction.
+    std::vector<vec3> directions, radiance;
+    std::vector<double> solid_angles;
+    directions.reserve(polar * azimuths);
+    for (int l = 0; l < polar; ++l) {
+      double theta = (l + 0.5) * d_angle;
+      double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+      bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
+      double ground_distance = 0.0;
+      vec3 ground_transmittance(0.0);
+      if (intersects) {
+        ground_distance = glsl::DistanceToBottomAtmosphereBoundary(params_, r, cos_theta);
+        ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
+      }
+      for (int m = 0; m < azimuths; ++m) {
+        double phi = (m + 0.5) * d_angle;
+        vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+        double nu = glsl::ClampCosine(glm::dot(omega, sun));
+        vec3 incident = IncidentRadiance(order - 1, r, cos_theta, mu_s, nu, intersects);
+        if (intersects) {
+          vec3 ground_normal = glm::normalize(zenith * r + omega * ground_distance);
+          double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
+          incident += ground_transmittance * albedo_over_pi * GroundIrradiance(order - 1, ground_mu_s);
+        }
+        directions.push_back(omega);
+        radiance.push_back(incident);
+        solid_angles.push_back(d_angle * d_angle * sin_theta);
+      }
+    }
+
+    std::vector<double> densities(medium_.constituent_count());
+    medium_.Densities(r - params_.bottom_radius, densities.data());
+    std::vector<Spectrum> group_scattering(groups);
+    for (int g = 0; g < groups; ++g) group_scattering[g] = medium_.GroupScattering(g, densities.data());
+
+    const size_t count = directions.size();
+    for (int y = 0; y < mu_size; ++y) {
+      for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+        int x = nu_index * mu_s_size + mu_s_index;
+        double r_texel, mu, mu_s_texel, nu;
+        bool intersects;
+        ScatteringTexelGeometry(x, y, z, r_texel, mu, mu_s_texel, nu, intersects);
+        // View direction with zenith cosine mu and sun cosine nu.
+        double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+        double sin_mu_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+        double cos_phi = sin_mu * sin_mu_s > 0.0 ? std::clamp((nu - mu * mu_s) / (sin_mu * sin_mu_s), -1.0, 1.0) : 1.0;
+        vec3 view(sin_mu * cos_phi, sin_mu * std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi)), mu);
+        vec3 density(0.0);
+        for (int g = 0; g < groups; ++g) {
+          if (group_scattering[g] == Spectrum(0.0)) continue;
+          const PhaseFunction& phase = medium_.groups()[g].phase;
+          // The discrete phase weights are normalised to sum to one, so the
+          // quadrature neither creates nor loses energy for sharp lobes.
+          vec3 sum(0.0);
+          double weight_sum = 0.0;
+          for (size_t i = 0; i < count; ++i) {
+            double w = phase.Evaluate(glm::dot(view, directions[i])) * solid_angles[i];
+            sum += radiance[i] * w;
+            weight_sum += w;
+          }
+          if (weight_sum > 0.0) density += group_scattering[g] * sum / weight_sum;
+        }
+        scattering_density_.Store(x, y, z, vec4(density, 0.0));
+      }
+    }
+  });
+}
+
+void Baker::ComputeIndirectIrradiance(int order) {
+  const int width = irradiance_.width, height = irradiance_.height;
+  const int polar = settings_.sphere_samples, azimuths = 4 * settings_.sphere_samples;
+  const double d_theta = 0.5 * kPi / polar, d_phi = 2.0 * kPi / azimuths;
+  tbb::parallel_for(0, height, [&](int y) {
+    for (int x = 0; x < width; ++x) {
+      double r, mu_s;
+      glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu_s);
+      const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+      vec3 result(0.0);
+      for (int l = 0; l < polar; ++l) {
+        double theta = (l + 0.5) * d_theta;
+        double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+        for (int m = 0; m < azimuths; ++m) {
+          double phi = (m + 0.5) * d_phi;
+          vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+          double nu = glsl::ClampCosine(glm::dot(omega, sun));
+          result += IncidentRadiance(order, r, cos_theta, mu_s, nu, false) * (cos_theta * sin_theta * d_theta * d_phi);
+        }
+      }
+      delta_irradiance_.Store(x, y, 0, vec4(result, 0.0));
+      vec4 total = irradiance_.Fetch(x, y) + vec4(result, 0.0);
+      irradiance_.Store(x, y, 0, total);
+    }
+  });
+}
+
+void Baker::ComputeMultipleScattering() {
+  const int mu_size = params_.scattering_mu_size, r_size = params_.scattering_r_size;
+  const int width = scattering_.width;
+  const glsl::sampler3D density{&scattering_density_};
+  tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
+    int z = ray_index / mu_size, y = ray_index % mu_size;
+    RaySamples ray = SampleRay(y, z);
+    const int n = settings_.ray_samples;
+    std::vector<double> mu_k(n + 1);
+    std::vector<Spectrum> attenuation(n + 1), samples(n + 1);
+    for (int k = 0; k <= n; ++k) {
+      mu_k[k] = glsl::CosineAtDistance(ray.r, ray.mu, ray.t[k], ray.radius[k]);
+      attenuation[k] = glm::exp(-ray.optical_depth[k]);
+    }
+    for (int x = 0; x < width; ++x) {
+      double r, mu, mu_s, nu;
+      bool intersects;
+      ScatteringTexelGeometry(x, y, z, r, mu, mu_s, nu, intersects);
+      for (int k = 0; k <= n; ++k) {
+        double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / ray.radius[k]);
+        vec3 j(glsl::GetScattering(params_, density, ray.radius[k], mu_k[k], mu_s_k, nu, intersects));
+        samples[k] = j * attenuation[k];
+      }
+      Spectrum sum(0.0);
+      for (int k = 0; k < n; ++k) sum += ExponentialTrapezoid(samples[k], samples[k + 1], ray.dt);
+      delta_multiple_.Store(x, y, z, vec4(sum, 0.0));
+      vec4 total = scattering_.Fetch(x, y, z) + vec4(sum / glsl::RayleighPhaseFunction(nu), 0.0);
+      scattering_.Store(x, y, z, total);
+    }
+  });
+}
+
+}  // namespace
+
+void BakeSettings::Validate() const {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw InputError(message);
+  };
+  auto size = [&](int value, int minimum, const char* name) {
+    require(value >= minimum && value <= 4096,
+            std::string(name) + " = " + std::to_string(value) + " must be in [" + std::to_string(minimum) + ", 4096]");
+  };
+  size(transmittance_width, 2, "transmittance width");
+  size(transmittance_height, 2, "transmittance height");
+  size(irradiance_width, 2, "irradiance width");
+  size(irradiance_height, 2, "irradiance height");
+  size(scattering_r_size, 2, "scattering r size");
+  size(scattering_mu_size, 4, "scattering mu size");
+  size(scattering_mu_s_size, 2, "scattering mu_s size");
+  size(scattering_nu_size, 2, "scattering nu size");
+  require(scattering_mu_size % 2 == 0,
+          "scattering mu size = " + std::to_string(scattering_mu_size) + " must be even");
+  require(orders >= 1 && orders <= 100, "orders = " + std::to_string(orders) + " must be in [1, 100]");
+  require(transmittance_samples >= 8 && transmittance_samples <= 100000,
+          "transmittance samples = " + std::to_string(transmittance_samples) + " must be in [8, 100000]");
+  require(ray_samples >= 2 && ray_samples <= 100000,
+          "ray samples = " + std::to_string(ray_samples) + " must be in [2, 100000]");
+  require(sphere_samples >= 2 && sphere_samples <= 1024,
+          "sphere samples = " + std::to_string(sphere_samples) + " must be in [2, 1024]");
+  require(threads >= 0, "threads = " + std::to_string(threads) + " must be >= 0");
+}
+
+glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings) {
+  glsl::AtmosphereParameters p;
+  p.solar_irradiance = atmosphere.solar_irradiance;
+  p.sun_angular_radius = atmosphere.sun_angular_radius_rad;
+  p.bottom_radius = atmosphere.bottom_radius_m;
+  p.top_radius = atmosphere.top_radius_m;
+  p.mu_s_min = atmosphere.mu_s_min;
+  Medium medium(atmosphere);
+  Spectrum mie_scattering(0.0), other_scattering(0.0);
+  for (int g = 0; g < static_cast<int>(medium.groups().size()); ++g) {
+    for (int c : medium.groups()[g].constituents) {
+      const Constituent& constituent = atmosphere.constituents[c];
+      Spectrum ground = constituent.scattering_per_m * constituent.density.At(0.0);
+      (g == medium.mie_group() ? mie_scattering : other_scattering) += ground;
+    }
+  }
+  if (medium.mie_group() >= 0) {
+    const PhaseFunction& phase = medium.groups()[medium.mie_group()].phase;
+    p.mie_phase = phase.kind == PhaseKind::kHenyeyGreenstein ? glsl::PHASE_HENYEY_GREENSTEIN
+                                                              : glsl::PHASE_CORNETTE_SHANKS;
+    p.mie_g = phase.g;
+  }
+  if (settings.pack_single_mie_in_alpha) {
+    bool ratio_defined = mie_scattering.x > 0.0 && other_scattering.x > 0.0 && other_scattering.y > 0.0 &&
+                         other_scattering.z > 0.0;
+    if (!ratio_defined) {
+      throw InputError(atmosphere.name +
+                       ": single Mie can only be packed into alpha when both the Mie and the other scattering "
+                       "constituents scatter red light at the ground");
+    }
+    p.mie_to_rayleigh_scattering_ratio = mie_scattering / other_scattering;
+    p.single_mie_in_scattering_alpha = 1;
+  }
+  p.transmittance_width = settings.transmittance_width;
+  p.transmittance_height = settings.transmittance_height;
+  p.scattering_r_size = settings.scattering_r_size;
+  p.scattering_mu_size = settings.scattering_mu_size;
+  p.scattering_mu_s_size = settings.scattering_mu_s_size;
+  p.scattering_nu_size = settings.scattering_nu_size;
+  p.irradiance_width = settings.irradiance_width;
+  p.irradiance_height = settings.irradiance_height;
+  return p;
+}
+
+LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report,
+            const BakeProgress& progress) {
+  settings.Validate();
+  std::unique_ptr<tbb::global_control> thread_limit;
+  if (settings.threads > 0) {
+    thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                         static_cast<size_t>(settings.threads));
+  }
+  Baker baker(atmosphere, settings);
+  return baker.Run(report, progress);
+}
+
+}  // namespace skybake
+
+#include "shaders_runtime/twin.h"
+
+namespace skybake {
+TwinTables MakeTwinTables(const LutSet& luts) {
+  return TwinTables{luts.parameters, &luts.transmittance, &luts.scattering, &luts.single_mie_scattering,
+                    &luts.irradiance};
+}
+}  // namespace skybake

@@ -1,0 +1,82 @@
+// The CPU bake: from a resolved Atmosphere to the lookup tables of Bruneton &
+// Neyret 2008 (transmittance, ground irradiance, 4D inscattering with all
+// orders, single Mie), integrated in double precision and stored as float.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bake/atmosphere.h"
+#include "shaders_runtime/glsl_shim.h"
+
+namespace skybake {
+
+struct BakeSettings {
+  // Table sizes. The scattering mu size must be even (two halves: rays that
+  // hit the ground and rays that do not).
+  int transmittance_width = 256;  // mu
+  int transmittance_height = 64;  // r
+  int irradiance_width = 64;      // mu_s
+  int irradiance_height = 16;     // r
+  int scattering_r_size = 32;
+  int scattering_mu_size = 128;
+  int scattering_mu_s_size = 32;
+  int scattering_nu_size = 8;
+  // Scattering orders: 1 = single scattering only.
+  int orders = 4;
+  // Integration: Gauss-Legendre nodes per optical-depth integral, intervals
+  // per ray for the inscattering integrals, and polar directions for the
+  // integrals over the sphere (twice as many azimuths).
+  int transmittance_samples = 64;
+  int ray_samples = 64;
+  int sphere_samples = 16;
+  // Store single Mie's red channel in the scattering table's alpha instead of
+  // a separate table (Bruneton 2017's approximation, halves the memory).
+  bool pack_single_mie_in_alpha = false;
+  // Worker threads; 0 = all cores.
+  int threads = 0;
+
+  // InputError naming the setting if a value is out of range.
+  void Validate() const;
+};
+
+// The baked tables and the constants the runtime needs to sample them.
+struct LutSet {
+  Atmosphere atmosphere;
+  BakeSettings settings;
+  glsl::AtmosphereParameters parameters;
+  glsl::Texture transmittance;  // 2D, rgb = optical depth to the top boundary
+  glsl::Texture irradiance;     // 2D, rgb = indirect ground irradiance
+  glsl::Texture scattering;     // 3D, rgb = single Rayleigh + all higher orders / Rayleigh phase;
+                                // alpha = single Mie red if packed
+  glsl::Texture single_mie_scattering;  // 3D, rgb; empty if packed
+};
+
+struct BakeTiming {
+  std::string phase;
+  double seconds = 0.0;
+};
+
+struct BakeReport {
+  std::vector<BakeTiming> timings;  // in the order the phases ran
+  double total_seconds = 0.0;
+};
+
+// Called after each phase with its name and duration.
+using BakeProgress = std::function<void(const BakeTiming&)>;
+
+LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report = nullptr,
+            const BakeProgress& progress = nullptr);
+
+// The runtime constants for an atmosphere and table sizes (also used by
+// loaders that rebuild a LutSet from files).
+glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings);
+
+}  // namespace skybake
+
+namespace skybake {
+// The tables of a LutSet as the twin samples them (the LutSet must outlive it).
+struct TwinTables;
+TwinTables MakeTwinTables(const LutSet& luts);
+}  // namespace skybake

@@ -1,0 +1,52 @@
+// skybake GLSL runtime: types shared by the functions in functions.glsl.
+// The C++ twin defines the same names in shaders_runtime/glsl_shim.h, so the
+// function bodies compile unchanged as GLSL and as C++.
+#ifdef GL_ES
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp sampler3D;
+#endif
+
+#define Number float
+#define IN(type) in type
+#define OUT(type) out type
+#define TransmittanceTexture sampler2D
+#define ScatteringTexture sampler3D
+#define IrradianceTexture sampler2D
+
+const Number PI = 3.14159265358979323846;
+
+// Phase function applied at run time to the single Mie scattering table.
+const int PHASE_NONE = 0;
+const int PHASE_HENYEY_GREENSTEIN = 1;
+const int PHASE_CORNETTE_SHANKS = 2;
+
+struct AtmosphereParameters {
+  // Solar irradiance at the top of the atmosphere, W m^-2 nm^-1 per channel.
+  vec3 solar_irradiance;
+  Number sun_angular_radius;  // radians
+  Number bottom_radius;       // metres
+  Number top_radius;          // metres
+  // Cosine of the lowest sun zenith angle the tables cover.
+  Number mu_s_min;
+  // Phase function of the "Mie" constituents (those sharing the first
+  // Henyey-Greenstein or Cornette-Shanks phase function), whose single
+  // scattering is kept in its own table: PHASE_* and asymmetry g.
+  int mie_phase;
+  Number mie_g;
+  // Ratio of the Mie constituents' scattering to the others', per channel at
+  // the ground; only used to rebuild single Mie from alpha when the
+  // bake packed its red channel into the scattering table.
+  vec3 mie_to_rayleigh_scattering_ratio;
+  int single_mie_in_scattering_alpha;  // 1 if packed, 0 if a separate table
+  // Table sizes.
+  int transmittance_width;   // mu
+  int transmittance_height;  // r
+  int scattering_r_size;
+  int scattering_mu_size;
+  int scattering_mu_s_size;
+  int scattering_nu_size;
+  int irradiance_width;   // mu_s
+  int irradiance_height;  // r
+};

@@ -1,0 +1,390 @@
+// skybake GLSL runtime: geometry, table parameterization and lookups, and the
+// functions an engine calls (sky radiance, aerial perspective, irradiance).
+//
+// This file is compiled twice: as GLSL by the engine, after definitions.glsl
+// and the generated constants, and as C++ in double precision by the bake and
+// the CPU twin (see glsl_shim.h). Keep it to the common subset: Number for
+// scalars, literals written as 1.0 (never 1 for a Number), explicit Number()
+// around ints, IN()/OUT() for parameters.
+//
+// Conventions: positions are relative to the planet centre, in metres; r is a
+// distance to the centre, mu the cosine of a view zenith angle, mu_s of the sun
+// zenith angle, nu the cosine of the angle between view and sun directions.
+// The parameterization follows Bruneton & Neyret 2008 as refined in Bruneton's
+// 2017 reference implementation: texels are concentrated near the horizon and
+// the ground, and the mu axis is split in two halves (rays that hit the ground
+// and rays that do not), so the table is discontinuous at the horizon on purpose.
+
+// ---------------------------------------------------------------------------
+// Defensive numerics
+
+Number ClampCosine(Number mu) {
+  return clamp(mu, -1.0, 1.0);
+}
+
+Number ClampDistance(Number d) {
+  return max(d, 0.0);
+}
+
+Number ClampRadius(IN(AtmosphereParameters) atmosphere, Number r) {
+  return clamp(r, atmosphere.bottom_radius, atmosphere.top_radius);
+}
+
+Number SafeSqrt(Number a) {
+  return sqrt(max(a, 0.0));
+}
+
+// ---------------------------------------------------------------------------
+// Ray-sphere geometry. Each distance is written in the form that avoids
+// catastrophic cancellation: of the two roots -r mu +/- sqrt(disc), the one
+// that would subtract nearly equal numbers is computed as c / q instead
+// (c = product of the roots), which stays accurate for observers a
+// millimetre above the ground or rays a microradian off the horizon.
+
+// Distance from radius r along direction cosine mu to the top boundary
+// (r <= top_radius).
+Number DistanceToTopAtmosphereBoundary(IN(AtmosphereParameters) atmosphere, Number r, Number mu) {
+  Number c = (atmosphere.top_radius - r) * (atmosphere.top_radius + r);  // >= 0
+  Number r_mu = r * mu;
+  Number s = SafeSqrt(r_mu * r_mu + c);
+  return ClampDistance(r_mu > 0.0 ? c / (r_mu + s) : s - r_mu);
+}
+
+// Distance from radius r along mu to the ground, for a ray that hits it
+// (see RayIntersectsGround).
+Number DistanceToBottomAtmosphereBoundary(IN(AtmosphereParameters) atmosphere, Number r, Number mu) {
+  Number r_mu = r * mu;
+  Number c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);  // >= 0
+  Number s = SafeSqrt(r_mu * r_mu - c);
+  return ClampDistance(c / max(s - r_mu, 1e-30));
+}
+
+bool RayIntersectsGround(IN(AtmosphereParameters) atmosphere, Number r, Number mu) {
+  Number c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
+  return mu < 0.0 && r * r * mu * mu >= c;
+}
+
+// Distance to the boundary the ray leaves through: the ground if it hits it,
+// else the top of the atmosphere.
+Number DistanceToNearestAtmosphereBoundary(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
+                                           bool ray_r_mu_intersects_ground) {
+  return ray_r_mu_intersects_ground ? DistanceToBottomAtmosphereBoundary(atmosphere, r, mu)
+                                    : DistanceToTopAtmosphereBoundary(atmosphere, r, mu);
+}
+
+// Radius and direction cosine at distance d along the ray (r, mu).
+Number RadiusAtDistance(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number d) {
+  return ClampRadius(atmosphere, sqrt(d * d + 2.0 * r * mu * d + r * r));
+}
+
+Number CosineAtDistance(Number r, Number mu, Number d, Number r_d) {
+  return ClampCosine((r * mu + d) / r_d);
+}
+
+// ---------------------------------------------------------------------------
+// Texture coordinates. A table of n texels samples the unit range at texel
+// centres, so [0, 1] maps to [0.5 / n, 1 - 0.5 / n].
+
+Number GetTextureCoordFromUnitRange(Number x, int texture_size) {
+  return 0.5 / Number(texture_size) + x * (1.0 - 1.0 / Number(texture_size));
+}
+
+Number GetUnitRangeFromTextureCoord(Number u, int texture_size) {
+  return (u - 0.5 / Number(texture_size)) / (1.0 - 1.0 / Number(texture_size));
+}
+
+// Distance from the ground to the top boundary along the horizon ray from the
+// top boundary, i.e. the length of a ray tangent to the ground.
+Number HorizonDistanceAtTop(IN(AtmosphereParameters) atmosphere) {
+  return sqrt((atmosphere.top_radius - atmosphere.bottom_radius) *
+              (atmosphere.top_radius + atmosphere.bottom_radius));
+}
+
+// Distance from radius r to the horizon (0 on the ground).
+Number HorizonDistance(IN(AtmosphereParameters) atmosphere, Number r) {
+  return SafeSqrt((r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius));
+}
+
+// Transmittance table: x = mu through the distance to the top boundary
+// (rays above the horizon only), y = r through the distance to the horizon.
+vec2 GetTransmittanceTextureUvFromRMu(IN(AtmosphereParameters) atmosphere, Number r, Number mu) {
+  Number H = HorizonDistanceAtTop(atmosphere);
+  Number rho = HorizonDistance(atmosphere, r);
+  Number d = DistanceToTopAtmosphereBoundary(atmosphere, r, mu);
+  Number d_min = atmosphere.top_radius - r;
+  Number d_max = rho + H;
+  Number x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+  Number x_r = rho / H;
+  return vec2(GetTextureCoordFromUnitRange(x_mu, atmosphere.transmittance_width),
+              GetTextureCoordFromUnitRange(x_r, atmosphere.transmittance_height));
+}
+
+// 4D scattering table, stored as a 3D texture: x packs nu (slowest) and mu_s,
+// y is mu, z is r. Returns (u_nu, u_mu_s, u_mu, u_r) in [0, 1].
+vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
+                                          Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
+  Number H = HorizonDistanceAtTop(atmosphere);
+  Number rho = HorizonDistance(atmosphere, r);
+  Number u_r = GetTextureCoordFromUnitRange(rho / H, atmosphere.scattering_r_size);
+
+  Number half_mu_size = Number(atmosphere.scattering_mu_size / 2);
+  Number u_mu;
+  if (ray_r_mu_intersects_ground) {
+    // Distance to the ground, between r - bottom (looking straight down) and
+    // rho (the horizon), mapped to the lower half.
+    Number d = DistanceToBottomAtmosphereBoundary(atmosphere, r, mu);
+    Number d_min = r - atmosphere.bottom_radius;
+    Number d_max = rho;
+    Number x = d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min);
+    u_mu = 0.5 - 0.5 * (0.5 / half_mu_size + x * (1.0 - 1.0 / half_mu_size));
+  } else {
+    // Distance to the top boundary, between top - r (straight up) and
+    // rho + H (the horizon), mapped to the upper half.
+    Number d = DistanceToTopAtmosphereBoundary(atmosphere, r, mu);
+    Number d_min = atmosphere.top_radius - r;
+    Number d_max = rho + H;
+    Number x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+    u_mu = 0.5 + 0.5 * (0.5 / half_mu_size + x * (1.0 - 1.0 / half_mu_size));
+  }
+
+  // mu_s through the distance to the top boundary from the ground, rescaled so
+  // that mu_s_min maps to 0 and more texels go to low suns.
+  Number d = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, mu_s);
+  Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+  Number d_max = H;
+  Number a = (d - d_min) / (d_max - d_min);
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.mu_s_min);
+  Number A = (D - d_min) / (d_max - d_min);
+  Number u_mu_s = GetTextureCoordFromUnitRange(max(1.0 - a / A, 0.0) / (1.0 + a),
+                                               atmosphere.scattering_mu_s_size);
+  Number u_nu = (nu + 1.0) / 2.0;
+  return vec4(u_nu, u_mu_s, u_mu, u_r);
+}
+
+// Irradiance table: x = mu_s (linear over [-1, 1]), y = r (linear).
+vec2 GetIrradianceTextureUvFromRMuS(IN(AtmosphereParameters) atmosphere, Number r, Number mu_s) {
+  Number x_r = (r - atmosphere.bottom_radius) / (atmosphere.top_radius - atmosphere.bottom_radius);
+  Number x_mu_s = mu_s * 0.5 + 0.5;
+  return vec2(GetTextureCoordFromUnitRange(x_mu_s, atmosphere.irradiance_width),
+              GetTextureCoordFromUnitRange(x_r, atmosphere.irradiance_height));
+}
+
+// ---------------------------------------------------------------------------
+// Table lookups.
+
+// The transmittance table stores optical depth to the top boundary, so the
+// transmittance between two points is exp(-(tau_x - tau_y)): it cannot form
+// 0/0 when both transmittances underflow, and it is never above 1.
+vec3 GetOpticalDepthToTopAtmosphereBoundary(IN(AtmosphereParameters) atmosphere,
+                                            IN(TransmittanceTexture) transmittance_texture,
+                                            Number r, Number mu) {
+  vec2 uv = GetTransmittanceTextureUvFromRMu(atmosphere, r, mu);
+  return vec3(texture(transmittance_texture, uv));
+}
+
+vec3 GetTransmittanceToTopAtmosphereBoundary(IN(AtmosphereParameters) atmosphere,
+                                             IN(TransmittanceTexture) transmittance_texture,
+                                             Number r, Number mu) {
+  return exp(-GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, mu));
+}
+
+// Optical depth between the point at radius r and the point at distance d
+// along mu. Rays that hit the ground are looked up reversed (pointing up), as
+// the table only covers rays above the horizon.
+vec3 GetOpticalDepth(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                     Number r, Number mu, Number d, bool ray_r_mu_intersects_ground) {
+  Number r_d = RadiusAtDistance(atmosphere, r, mu, d);
+  Number mu_d = CosineAtDistance(r, mu, d, r_d);
+  vec3 tau;
+  if (ray_r_mu_intersects_ground) {
+    tau = GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r_d, -mu_d) -
+          GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, -mu);
+  } else {
+    tau = GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, mu) -
+          GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r_d, mu_d);
+  }
+  return max(tau, vec3(0.0));
+}
+
+vec3 GetTransmittance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                      Number r, Number mu, Number d, bool ray_r_mu_intersects_ground) {
+  return exp(-GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground));
+}
+
+// Fraction of the sun's disc above the horizon seen from radius r, by a
+// smooth step over the disc's angular size (Bruneton 2017).
+Number SunVisibleFraction(IN(AtmosphereParameters) atmosphere, Number r, Number mu_s) {
+  Number sin_theta_h = atmosphere.bottom_radius / r;
+  Number cos_theta_h = -SafeSqrt(1.0 - sin_theta_h * sin_theta_h);
+  return smoothstep(-sin_theta_h * atmosphere.sun_angular_radius,
+                    sin_theta_h * atmosphere.sun_angular_radius, mu_s - cos_theta_h);
+}
+
+vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                           Number r, Number mu_s) {
+  return GetTransmittanceToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, mu_s) *
+         SunVisibleFraction(atmosphere, r, mu_s);
+}
+
+// 4D lookup: trilinear in (mu_s, mu, r) by the texture unit, linear in nu
+// between the two neighbouring nu slices.
+vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                   Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
+  vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
+  Number tex_coord_x = uvwz.x * Number(atmosphere.scattering_nu_size - 1);
+  Number tex_x = floor(tex_coord_x);
+  Number lerp = tex_coord_x - tex_x;
+  Number nu_size = Number(atmosphere.scattering_nu_size);
+  vec3 uvw0 = vec3((tex_x + uvwz.y) / nu_size, uvwz.z, uvwz.w);
+  vec3 uvw1 = vec3((tex_x + 1.0 + uvwz.y) / nu_size, uvwz.z, uvwz.w);
+  return texture(scattering_texture, uvw0) * (1.0 - lerp) + texture(scattering_texture, uvw1) * lerp;
+}
+
+vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) irradiance_texture,
+                   Number r, Number mu_s) {
+  vec2 uv = GetIrradianceTextureUvFromRMuS(atmosphere, r, mu_s);
+  return vec3(texture(irradiance_texture, uv));
+}
+
+// ---------------------------------------------------------------------------
+// Phase functions, per steradian.
+
+Number RayleighPhaseFunction(Number nu) {
+  Number k = 3.0 / (16.0 * PI);
+  return k * (1.0 + nu * nu);
+}
+
+Number MiePhaseFunction(IN(AtmosphereParameters) atmosphere, Number nu) {
+  Number g = atmosphere.mie_g;
+  Number denom = 1.0 + g * g - 2.0 * g * nu;
+  if (atmosphere.mie_phase == PHASE_HENYEY_GREENSTEIN) {
+    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom));
+  }
+  if (atmosphere.mie_phase == PHASE_CORNETTE_SHANKS) {
+    Number k = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
+    return k * (1.0 + nu * nu) / (denom * sqrt(denom));
+  }
+  return 0.0;
+}
+
+// ---------------------------------------------------------------------------
+// Run-time functions.
+
+// Scattering-table radiance (divided by the Rayleigh phase function) and
+// single Mie radiance (phase free) along the ray (r, mu) for the sun at (mu_s, nu).
+vec3 GetCombinedScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                           IN(ScatteringTexture) single_mie_scattering_texture, Number r, Number mu,
+                           Number mu_s, Number nu, bool ray_r_mu_intersects_ground,
+                           OUT(vec3) single_mie_scattering) {
+  vec4 scattering = GetScattering(atmosphere, scattering_texture, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
+  if (atmosphere.single_mie_in_scattering_alpha == 1) {
+    // Only the red channel of single Mie was stored; rebuild the others from the
+    // main table's colour (Bruneton 2017, Section "Combined scattering").
+    single_mie_scattering = scattering.r > 0.0
+        ? vec3(scattering) * scattering.a / scattering.r * (atmosphere.mie_to_rayleigh_scattering_ratio /
+                                                             atmosphere.mie_to_rayleigh_scattering_ratio.r)
+        : vec3(0.0);
+  } else {
+    single_mie_scattering = vec3(GetScattering(atmosphere, single_mie_scattering_texture, r, mu, mu_s, nu,
+                                               ray_r_mu_intersects_ground));
+  }
+  return vec3(scattering);
+}
+
+// Sky radiance seen from `camera` along the unit vector `view_ray`, without
+// the sun disc and without ground reflection, and the transmittance to the
+// top of the atmosphere (0 if the ray hits the ground). A camera in space is
+// moved to where the ray enters the atmosphere.
+vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                    IN(ScatteringTexture) scattering_texture, IN(ScatteringTexture) single_mie_scattering_texture,
+                    vec3 camera, IN(vec3) view_ray, IN(vec3) sun_direction, OUT(vec3) transmittance) {
+  Number r = length(camera);
+  Number r_mu = dot(camera, view_ray);
+  if (r > atmosphere.top_radius) {
+    // Distance to the entry point: the near root of the ray / top-sphere quadratic.
+    Number c = (r - atmosphere.top_radius) * (r + atmosphere.top_radius);
+    Number disc = r_mu * r_mu - c;
+    if (r_mu >= 0.0 || disc < 0.0) {
+      transmittance = vec3(1.0);
+      return vec3(0.0);
+    }
+    Number distance_to_top = c / (SafeSqrt(disc) - r_mu);
+    camera = camera + view_ray * distance_to_top;
+    r = atmosphere.top_radius;
+    r_mu += distance_to_top;
+  }
+  Number mu = ClampCosine(r_mu / r);
+  Number mu_s = ClampCosine(dot(camera, sun_direction) / r);
+  Number nu = ClampCosine(dot(view_ray, sun_direction));
+  bool ray_r_mu_intersects_ground = RayIntersectsGround(atmosphere, r, mu);
+  transmittance = ray_r_mu_intersects_ground
+      ? vec3(0.0)
+      : GetTransmittanceToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, mu);
+  vec3 single_mie_scattering;
+  vec3 scattering = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r, mu,
+                                          mu_s, nu, ray_r_mu_intersects_ground, single_mie_scattering);
+  return scattering * RayleighPhaseFunction(nu) + single_mie_scattering * MiePhaseFunction(atmosphere, nu);
+}
+
+// In-scattered radiance between `camera` and `point` (aerial perspective),
+// and the transmittance between them: S(camera) - T * S(point).
+vec3 GetSkyRadianceToPoint(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                           IN(ScatteringTexture) scattering_texture,
+                           IN(ScatteringTexture) single_mie_scattering_texture, vec3 camera, IN(vec3) point,
+                           IN(vec3) sun_direction, OUT(vec3) transmittance) {
+  vec3 view_ray = normalize(point - camera);
+  Number r = length(camera);
+  Number r_mu = dot(camera, view_ray);
+  if (r > atmosphere.top_radius) {
+    Number c = (r - atmosphere.top_radius) * (r + atmosphere.top_radius);
+    Number disc = r_mu * r_mu - c;
+    if (r_mu >= 0.0 || disc < 0.0) {
+      transmittance = vec3(1.0);
+      return vec3(0.0);
+    }
+    Number distance_to_top = c / (SafeSqrt(disc) - r_mu);
+    camera = camera + view_ray * distance_to_top;
+    r = atmosphere.top_radius;
+    r_mu += distance_to_top;
+  }
+  Number mu = ClampCosine(r_mu / r);
+  Number mu_s = ClampCosine(dot(camera, sun_direction) / r);
+  Number nu = ClampCosine(dot(view_ray, sun_direction));
+  Number d = max(length(point - camera), 0.0);
+  bool ray_r_mu_intersects_ground = RayIntersectsGround(atmosphere, r, mu);
+
+  transmittance = GetTransmittance(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground);
+
+  vec3 single_mie_scattering;
+  vec3 scattering = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r, mu,
+                                          mu_s, nu, ray_r_mu_intersects_ground, single_mie_scattering);
+  Number r_p = RadiusAtDistance(atmosphere, r, mu, d);
+  Number mu_p = CosineAtDistance(r, mu, d, r_p);
+  Number mu_s_p = ClampCosine((r * mu_s + d * nu) / r_p);
+  vec3 single_mie_scattering_p;
+  vec3 scattering_p = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r_p,
+                                            mu_p, mu_s_p, nu, ray_r_mu_intersects_ground,
+                                            single_mie_scattering_p);
+  scattering = max(scattering - transmittance * scattering_p, vec3(0.0));
+  single_mie_scattering = max(single_mie_scattering - transmittance * single_mie_scattering_p, vec3(0.0));
+  return scattering * RayleighPhaseFunction(nu) + single_mie_scattering * MiePhaseFunction(atmosphere, nu);
+}
+
+// Direct sun irradiance on a surface at `point` with unit `normal`, and (out)
+// the sky irradiance, from the table for a horizontal surface scaled by the
+// fraction of the sky the tilted surface sees.
+vec3 GetSunAndSkyIrradiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                            IN(IrradianceTexture) irradiance_texture, IN(vec3) point, IN(vec3) normal,
+                            IN(vec3) sun_direction, OUT(vec3) sky_irradiance) {
+  Number r = ClampRadius(atmosphere, length(point));
+  Number mu_s = ClampCosine(dot(point, sun_direction) / length(point));
+  sky_irradiance = GetIrradiance(atmosphere, irradiance_texture, r, mu_s) *
+                   (1.0 + dot(normal, point) / length(point)) * 0.5;
+  return atmosphere.solar_irradiance * GetTransmittanceToSun(atmosphere, transmittance_texture, r, mu_s) *
+         max(dot(normal, sun_direction), 0.0);
+}
+
+// Radiance of the sun's disc at the top of the atmosphere.
+vec3 GetSolarRadiance(IN(AtmosphereParameters) atmosphere) {
+  return atmosphere.solar_irradiance / (PI * atmosphere.sun_angular_radius * atmosphere.sun_angular_radius);
+}

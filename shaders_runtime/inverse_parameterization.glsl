@@ -1,0 +1,64 @@
+// Inverses of the table parameterizations in functions.glsl: from a texel's
+// texture coordinates back to the physical (r, mu, mu_s, nu) it stands for.
+// The bake evaluates these at texel centres; engines never need them, so this
+// file is not part of the shipped snippet. Round trips are tested.
+
+void GetRMuFromTransmittanceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2) uv, OUT(Number) r,
+                                      OUT(Number) mu) {
+  Number x_mu = GetUnitRangeFromTextureCoord(uv.x, atmosphere.transmittance_width);
+  Number x_r = GetUnitRangeFromTextureCoord(uv.y, atmosphere.transmittance_height);
+  Number H = HorizonDistanceAtTop(atmosphere);
+  Number rho = H * x_r;
+  r = sqrt(rho * rho + atmosphere.bottom_radius * atmosphere.bottom_radius);
+  Number d_min = atmosphere.top_radius - r;
+  Number d_max = rho + H;
+  Number d = d_min + x_mu * (d_max - d_min);
+  // top^2 = r^2 + 2 r mu d + d^2, with top^2 - r^2 = H^2 - rho^2.
+  mu = d == 0.0 ? 1.0 : ClampCosine((H * H - rho * rho - d * d) / (2.0 * r * d));
+}
+
+// uvwz = (u_nu, u_mu_s, u_mu, u_r) as returned by
+// GetScatteringTextureUvwzFromRMuMuSNu. nu is not clamped to the range that
+// (mu, mu_s) allow; callers that need a physical direction clamp it.
+void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, IN(vec4) uvwz, OUT(Number) r,
+                                          OUT(Number) mu, OUT(Number) mu_s, OUT(Number) nu,
+                                          OUT(bool) ray_r_mu_intersects_ground) {
+  Number H = HorizonDistanceAtTop(atmosphere);
+  Number rho = H * GetUnitRangeFromTextureCoord(uvwz.w, atmosphere.scattering_r_size);
+  Number bottom = atmosphere.bottom_radius;
+  r = sqrt(rho * rho + bottom * bottom);
+
+  int half_mu_size = atmosphere.scattering_mu_size / 2;
+  if (uvwz.z < 0.5) {
+    Number d_min = r - bottom;
+    Number d_max = rho;
+    Number d = d_min + (d_max - d_min) * GetUnitRangeFromTextureCoord(1.0 - 2.0 * uvwz.z, half_mu_size);
+    // bottom^2 = r^2 + 2 r mu d + d^2.
+    mu = d == 0.0 ? -1.0 : ClampCosine(-(rho * rho + d * d) / (2.0 * r * d));
+    ray_r_mu_intersects_ground = true;
+  } else {
+    Number d_min = atmosphere.top_radius - r;
+    Number d_max = rho + H;
+    Number d = d_min + (d_max - d_min) * GetUnitRangeFromTextureCoord(2.0 * uvwz.z - 1.0, half_mu_size);
+    mu = d == 0.0 ? 1.0 : ClampCosine((H * H - rho * rho - d * d) / (2.0 * r * d));
+    ray_r_mu_intersects_ground = false;
+  }
+
+  Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size);
+  Number d_min = atmosphere.top_radius - bottom;
+  Number d_max = H;
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.mu_s_min);
+  Number A = (D - d_min) / (d_max - d_min);
+  Number a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
+  Number d = d_min + min(a, A) * (d_max - d_min);
+  mu_s = d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * bottom * d));
+  nu = ClampCosine(uvwz.x * 2.0 - 1.0);
+}
+
+void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2) uv, OUT(Number) r,
+                                    OUT(Number) mu_s) {
+  Number x_mu_s = GetUnitRangeFromTextureCoord(uv.x, atmosphere.irradiance_width);
+  Number x_r = GetUnitRangeFromTextureCoord(uv.y, atmosphere.irradiance_height);
+  r = atmosphere.bottom_radius + x_r * (atmosphere.top_radius - atmosphere.bottom_radius);
+  mu_s = ClampCosine(2.0 * x_mu_s - 1.0);
+}

@@ -1,0 +1,30 @@
+// The GLSL runtime compiled as C++ (double precision): every function of
+// functions.glsl and inverse_parameterization.glsl, in namespace
+// skybake::glsl. The bake uses the parameterization and lookups; the CPU twin
+// (twin.h) uses the run-time functions. Each translation unit gets its own
+// internal copy, as GLSL functions cannot be declared inline.
+#pragma once
+
+#include "shaders_runtime/glsl_shim.h"
+
+#define IN(type) const type&
+#define OUT(type) type&
+#define TransmittanceTexture sampler2D
+#define ScatteringTexture sampler3D
+#define IrradianceTexture sampler2D
+
+namespace skybake::glsl {
+namespace {
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#include "shaders_runtime/functions.glsl"
+#include "shaders_runtime/inverse_parameterization.glsl"
+#pragma GCC diagnostic pop
+}  // namespace
+}  // namespace skybake::glsl
+
+#undef IN
+#undef OUT
+#undef TransmittanceTexture
+#undef ScatteringTexture
+#undef IrradianceTexture

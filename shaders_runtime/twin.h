@@ -1,0 +1,47 @@
+// The CPU twin of the GLSL runtime: the run-time functions of
+// functions.glsl, compiled from the same source, sampling tables held in
+// memory. It is the reference behaviour for the GLSL snippet and what
+// `skybake eval` answers with.
+#pragma once
+
+#include "shaders_runtime/glsl_shim.h"
+
+namespace skybake {
+
+struct TwinTables {
+  glsl::AtmosphereParameters parameters;
+  const glsl::Texture* transmittance = nullptr;
+  const glsl::Texture* scattering = nullptr;
+  const glsl::Texture* single_mie_scattering = nullptr;  // may be empty when packed into alpha
+  const glsl::Texture* irradiance = nullptr;
+};
+
+class Twin {
+ public:
+  explicit Twin(const TwinTables& tables);
+
+  const glsl::AtmosphereParameters& parameters() const { return tables_.parameters; }
+
+  // Positions relative to the planet centre in metres; directions unit length.
+  glsl::vec3 SkyRadiance(const glsl::vec3& camera, const glsl::vec3& view_ray, const glsl::vec3& sun_direction,
+                         glsl::vec3* transmittance) const;
+  glsl::vec3 SkyRadianceToPoint(const glsl::vec3& camera, const glsl::vec3& point,
+                                const glsl::vec3& sun_direction, glsl::vec3* transmittance) const;
+  glsl::vec3 SunAndSkyIrradiance(const glsl::vec3& point, const glsl::vec3& normal,
+                                 const glsl::vec3& sun_direction, glsl::vec3* sky_irradiance) const;
+  glsl::vec3 SolarRadiance() const;
+
+  // Raw table lookups in the table's own coordinates.
+  glsl::vec4 Scattering(double r, double mu, double mu_s, double nu, bool ray_intersects_ground) const;
+  glsl::vec3 OpticalDepthToTop(double r, double mu) const;
+  glsl::vec3 Irradiance(double r, double mu_s) const;
+
+ private:
+  TwinTables tables_;
+  glsl::sampler2D transmittance_;
+  glsl::sampler3D scattering_;
+  glsl::sampler3D single_mie_;
+  glsl::sampler2D irradiance_;
+};
+
+}  // namespace skybake
