@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace skybake {
 
@@ -37,10 +38,21 @@ std::vector<double> DensityProfile::Breakpoints() const {
   if (kind == Kind::kTabulated) return altitudes_m;
   std::vector<double> result;
   double layer_base = 0.0;
-  for (size_t i = 0; i + 1 < layers.size(); ++i) {
-    layer_base += layers[i].width_m;
-    result.push_back(layer_base);
+  for (size_t i = 0; i < layers.size(); ++i) {
+    const DensityLayer& layer = layers[i];
+    bool last = i + 1 == layers.size();
+    double layer_top = last ? std::numeric_limits<double>::infinity() : layer_base + layer.width_m;
+    // The clamp to [0, 1] puts a kink where a linear layer crosses 0 or 1.
+    if (layer.exp_term == 0.0 && layer.linear_term_per_m != 0.0) {
+      for (double level : {0.0, 1.0}) {
+        double h = (level - layer.constant_term) / layer.linear_term_per_m;
+        if (h > layer_base && h < layer_top) result.push_back(h);
+      }
+    }
+    if (!last) result.push_back(layer_top);
+    layer_base = layer_top;
   }
+  std::sort(result.begin(), result.end());
   return result;
 }
 

@@ -39,8 +39,9 @@ struct DensityProfile {
   std::vector<double> densities;
 
   double At(double altitude_m) const;
-  // Altitudes where the profile has a kink or jump (layer boundaries,
-  // tabulated samples), for integrators that must not step across them blindly.
+  // Altitudes where the profile has a kink or jump (layer boundaries, where a
+  // linear layer is clamped at 0 or 1, tabulated samples), sorted, for
+  // integrators that must not step across them blindly.
   std::vector<double> Breakpoints() const;
 };
 

@@ -84,10 +84,12 @@ class Baker {
   void ComputeIndirectIrradiance(int order);
   void ComputeMultipleScattering();
 
-  // Geometry of scattering texel (x = nu * MU_S + mu_s, y = mu, z = r), with nu
-  // clamped to the range that mu and mu_s allow.
   void ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
-                               bool& intersects_ground) const;
+                               bool& intersects_ground) const {
+    ScatteringTexel texel = GetScatteringTexel(params_, x, y, z);
+    r = texel.r, mu = texel.mu, mu_s = texel.mu_s, nu = texel.nu;
+    intersects_ground = texel.ray_intersects_ground;
+  }
   RaySamples SampleRay(int mu_index, int r_index) const;
 
   // Radiance of scattering order `order` arriving at radius r from direction
@@ -176,17 +178,6 @@ void Baker::ComputeTransmittance() {
       transmittance_.Store(x, y, 0, vec4(tau, 0.0));
     }
   });
-}
-
-void Baker::ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
-                                    bool& intersects_ground) const {
-  const int mu_s_size = params_.scattering_mu_s_size;
-  int nu_index = x / mu_s_size, mu_s_index = x % mu_s_size;
-  vec4 uvwz(double(nu_index) / (params_.scattering_nu_size - 1), (mu_s_index + 0.5) / mu_s_size,
-            (y + 0.5) / params_.scattering_mu_size, (z + 0.5) / params_.scattering_r_size);
-  glsl::GetRMuMuSNuFromScatteringTextureUvwz(params_, uvwz, r, mu, mu_s, nu, intersects_ground);
-  double spread = std::sqrt(std::max(0.0, (1.0 - mu * mu) * (1.0 - mu_s * mu_s)));
-  nu = std::clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
 }
 
 RaySamples Baker::SampleRay(int mu_index, int r_index) const {
@@ -434,6 +425,19 @@ void Baker::ComputeMultipleScattering() {
 }
 
 }  // namespace
+
+ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z) {
+  const int mu_s_size = parameters.scattering_mu_s_size;
+  int nu_index = x / mu_s_size, mu_s_index = x % mu_s_size;
+  vec4 uvwz(double(nu_index) / (parameters.scattering_nu_size - 1), (mu_s_index + 0.5) / mu_s_size,
+            (y + 0.5) / parameters.scattering_mu_size, (z + 0.5) / parameters.scattering_r_size);
+  ScatteringTexel t;
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(parameters, uvwz, t.r, t.mu, t.mu_s, t.grid_nu,
+                                             t.ray_intersects_ground);
+  double spread = std::sqrt(std::max(0.0, (1.0 - t.mu * t.mu) * (1.0 - t.mu_s * t.mu_s)));
+  t.nu = std::clamp(t.grid_nu, t.mu * t.mu_s - spread, t.mu * t.mu_s + spread);
+  return t;
+}
 
 void BakeSettings::Validate() const {
   auto require = [](bool ok, const std::string& message) {

@@ -69,6 +69,16 @@ using BakeProgress = std::function<void(const BakeTiming&)>;
 LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report = nullptr,
             const BakeProgress& progress = nullptr);
 
+// The physical coordinates a scattering texel stands for. Texel
+// (x = nu_index * mu_s_size + mu_s_index, y = mu_index, z = r_index) sits at
+// the centre of its (mu_s, mu, r) cell and on the nu grid (nu = -1 .. 1
+// inclusive); `nu` is clamped to the range (mu, mu_s) allow, `grid_nu` is not.
+struct ScatteringTexel {
+  double r = 0.0, mu = 0.0, mu_s = 0.0, nu = 0.0, grid_nu = 0.0;
+  bool ray_intersects_ground = false;
+};
+ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z);
+
 // The runtime constants for an atmosphere and table sizes (also used by
 // loaders that rebuild a LutSet from files).
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings);
