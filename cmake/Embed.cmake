@@ -6,5 +6,8 @@ function(skybake_embed_text output variable)
     COMMAND ${CMAKE_COMMAND} -DOUTPUT=${output} -DVARIABLE=${variable} "-DINPUTS=${ARGN}"
             -P ${PROJECT_SOURCE_DIR}/cmake/EmbedText.cmake
     DEPENDS ${ARGN} ${PROJECT_SOURCE_DIR}/cmake/EmbedText.cmake
-    COMMENT "Embedding ${variable}")
+    COMMENT "Embedding ${variable}"
+    # Without VERBATIM the ';' of the INPUTS list reaches the shell unquoted
+    # and splits the command as soon as there is more than one file.
+    VERBATIM)
 endfunction()
