@@ -1,15 +1,882 @@
-// Placeholder until the TOML reader lands.
+// Atmosphere files: TOML text -> validated Atmosphere (SI units), and back.
+//
+// Checks happen in two places on purpose. While reading, each value is checked
+// against the key the user wrote, in the unit the user wrote it in, so that
+// "planet.top_radius_km = 6300 must exceed planet.ground_radius_km = 6360"
+// quotes the file rather than its SI translation. Validate() then checks the
+// resolved model with the same rules under the canonical SI keys; it is the
+// only check a hand-built Atmosphere gets. Both use the intervals below, so a
+// rule is written once.
 #include "bake/config.h"
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
+
 #include "bake/errors.h"
+#include "bake/physics.h"
+#include "bake/version.h"
+#include "shaders_runtime/embedded_text.h"
 
 namespace skybake {
-Atmosphere ParseAtmosphere(std::string_view, const std::string& source_name) {
-  throw InputError(source_name + ": atmosphere files are not supported yet");
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr Spectrum kDefaultWavelengthsNm{680.0, 550.0, 440.0};
+
+// ---------------------------------------------------------------------------
+// Formatting shared by error messages and the TOML writer.
+
+// The shortest decimal that reads back as the same double (17 significant
+// digits at most), in fixed notation for everyday magnitudes and scientific
+// otherwise: messages quote "1.2" and "6360000", and ToToml round-trips.
+std::string FormatNumber(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[48];
+  int digits = 0;  // after the point in scientific notation; 16 always round-trips
+  for (;; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*e", digits, value);
+    if (digits == 16 || std::strtod(buffer, nullptr) == value) break;
+  }
+  int exponent = std::atoi(std::strchr(buffer, 'e') + 1);
+  if (exponent >= -4 && exponent < 16)
+    std::snprintf(buffer, sizeof buffer, "%.*f", std::max(0, digits - exponent), value);
+  return buffer;
 }
-Atmosphere LoadAtmosphere(const std::string& f) { return ParseAtmosphere({}, f); }
-std::vector<PresetInfo> ListPresets() { return {}; }
-Atmosphere LoadPreset(const std::string& name) { return ParseAtmosphere({}, name); }
-std::string ToToml(const Atmosphere&) { return {}; }
-void Validate(const Atmosphere&, const std::string&) {}
+
+// A TOML float literal: FormatNumber plus ".0" where it would read as an integer.
+std::string TomlFloat(double value) {
+  std::string text = FormatNumber(value);
+  if (text.find_first_of(".eni") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string TomlString(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    unsigned char u = static_cast<unsigned char>(c);
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (u < 0x20 || u == 0x7f) {
+          char escape[8];
+          std::snprintf(escape, sizeof escape, "\\u%04x", u);
+          out += escape;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+// A key as TOML spells it: bare where allowed, quoted otherwise. Used both in
+// the writer and in key paths of error messages.
+std::string TomlKey(std::string_view key) {
+  bool bare = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+           c == '_' || c == '-';
+  });
+  return bare ? std::string(key) : TomlString(key);
+}
+
+std::string Join(const std::string& path, std::string_view key) {
+  return path.empty() ? TomlKey(key) : path + "." + TomlKey(key);
+}
+
+std::string Index(const std::string& path, size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+std::string OneLine(std::string text) {
+  std::replace_if(text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  return text;
+}
+
+// ---------------------------------------------------------------------------
+// Error reporting: every message is "<source>: <key path>: <problem>" or
+// "<source>: <key path> = <value> <problem>", on one line.
+
+class Reporter {
+ public:
+  explicit Reporter(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& path, const std::string& problem) const {
+    throw InputError(OneLine(source_ + ": " + (path.empty() ? "" : path + ": ") + problem));
+  }
+  [[noreturn]] void FailValue(const std::string& path, double value,
+                              const std::string& problem) const {
+    throw InputError(OneLine(source_ + ": " + path + " = " + FormatNumber(value) + " " + problem));
+  }
+
+ private:
+  std::string source_;
+};
+
+// An interval of acceptable values. Non-finite numbers are always rejected.
+struct Interval {
+  double lo;
+  double hi;
+  bool lo_closed;
+  bool hi_closed;
+  const char* text = nullptr;  // how to print it, where the bounds are not round numbers
+
+  bool Contains(double v) const {
+    return (lo_closed ? v >= lo : v > lo) && (hi_closed ? v <= hi : v < hi);
+  }
+  std::string Problem() const {
+    if (hi == kInf && lo == 0.0) return lo_closed ? "must be >= 0" : "must be > 0";
+    std::string range = text ? text
+                             : std::string(lo_closed ? "[" : "(") + FormatNumber(lo) + ", " +
+                                   FormatNumber(hi) + (hi_closed ? "]" : ")");
+    return "is outside " + range;
+  }
+};
+
+constexpr Interval kFinite{-kInf, kInf, false, false};
+constexpr Interval kPositive{0.0, kInf, false, false};
+constexpr Interval kNonNegative{0.0, kInf, true, false};
+constexpr Interval kUnit{0.0, 1.0, true, true};
+constexpr Interval kAsymmetry{-1.0, 1.0, false, false};
+constexpr Interval kSunRadiusRad{0.0, kPi / 2, false, false, "(0, pi/2)"};
+constexpr Interval kSunRadiusDeg{0.0, 90.0, false, false};
+constexpr Interval kLowestZenithDeg{0.0, 180.0, false, true};
+constexpr Interval kMuSMin{-1.0, 1.0, true, false};
+// Depolarization ratio of natural light by anisotropic molecules is at most
+// 1/2; beyond 6/7 the King factor changes sign.
+constexpr Interval kDepolarization{0.0, 0.5, true, true};
+
+void CheckNumber(const Reporter& report, const std::string& path, double value,
+                 const Interval& interval) {
+  if (!std::isfinite(value)) report.FailValue(path, value, "is not a finite number");
+  if (!interval.Contains(value)) report.FailValue(path, value, interval.Problem());
+}
+
+void CheckSpectrum(const Reporter& report, const std::string& path, const Spectrum& value,
+                   const Interval& interval) {
+  for (int i = 0; i < kWavelengthCount; ++i) CheckNumber(report, Index(path, i), value[i], interval);
+}
+
+// Evaluates one layer's unclamped expression.
+double LayerExpression(const DensityLayer& layer, double altitude_m) {
+  return layer.exp_term * std::exp(layer.exp_scale_per_m * altitude_m) +
+         layer.linear_term_per_m * altitude_m + layer.constant_term;
+}
+
+// Layered profiles are clamped to [0, 1] by definition (that is how the ozone
+// tent is written: negative parts clamp to 0). The clamp at 1, though, would
+// silently cut a profile the user meant to exceed 1, so that is an error, as
+// is an expression that overflows inside the atmosphere. Inside one layer the
+// expression a e^(b h) + c h + d is convex or concave, so its extremes lie at
+// the layer's ends or at the one stationary point.
+void CheckLayer(const Reporter& report, const std::string& path, const DensityLayer& layer,
+                double base_m, double end_m) {
+  std::vector<double> probes = {base_m, end_m};
+  double ab = layer.exp_term * layer.exp_scale_per_m;
+  if (ab != 0.0 && -layer.linear_term_per_m / ab > 0.0) {
+    double h = std::log(-layer.linear_term_per_m / ab) / layer.exp_scale_per_m;
+    if (h > base_m && h < end_m) probes.push_back(h);
+  }
+  for (double h : probes) {
+    double d = LayerExpression(layer, h);
+    if (!std::isfinite(d))
+      report.Fail(path, "density is not finite at altitude " + FormatNumber(h) + " m");
+    if (d > 1.0 + 1e-9)
+      report.Fail(path, "density reaches " + FormatNumber(d) + " at altitude " + FormatNumber(h) +
+                            " m, but layer densities are clamped to [0, 1]; scale the "
+                            "constituent's coefficients instead");
+  }
+}
+
+void CheckDensityProfile(const Reporter& report, const std::string& path,
+                         const DensityProfile& profile, double thickness_m) {
+  if (profile.kind == DensityProfile::Kind::kLayers) {
+    std::string layers_path = path + ".layers";
+    if (profile.layers.empty()) report.Fail(layers_path, "needs at least one layer");
+    double base = 0.0;
+    for (size_t i = 0; i < profile.layers.size(); ++i) {
+      const DensityLayer& layer = profile.layers[i];
+      std::string layer_path = Index(layers_path, i);
+      CheckNumber(report, layer_path + ".width_m", layer.width_m, kNonNegative);
+      CheckNumber(report, layer_path + ".exp_term", layer.exp_term, kFinite);
+      CheckNumber(report, layer_path + ".exp_scale_per_m", layer.exp_scale_per_m, kFinite);
+      CheckNumber(report, layer_path + ".linear_term_per_m", layer.linear_term_per_m, kFinite);
+      CheckNumber(report, layer_path + ".constant_term", layer.constant_term, kFinite);
+      bool last = i + 1 == profile.layers.size();
+      double end = last ? thickness_m : std::min(base + layer.width_m, thickness_m);
+      if (base < thickness_m) CheckLayer(report, layer_path, layer, base, end);
+      base += layer.width_m;
+    }
+    return;
+  }
+  std::string table_path = path + ".tabulated";
+  const std::vector<double>& h = profile.altitudes_m;
+  const std::vector<double>& d = profile.densities;
+  if (h.size() != d.size())
+    report.Fail(table_path, "altitude_m has " + std::to_string(h.size()) +
+                                " values but density has " + std::to_string(d.size()));
+  if (h.size() < 2)
+    report.Fail(table_path + ".altitude_m",
+                "needs at least 2 samples, got " + std::to_string(h.size()));
+  for (size_t i = 0; i < h.size(); ++i) {
+    std::string altitude_path = Index(table_path + ".altitude_m", i);
+    CheckNumber(report, altitude_path, h[i], kFinite);
+    if (i > 0 && !(h[i] > h[i - 1]))
+      report.FailValue(altitude_path, h[i],
+                       "must exceed altitude_m[" + std::to_string(i - 1) + "] = " +
+                           FormatNumber(h[i - 1]) + " (altitudes must strictly increase)");
+    CheckNumber(report, Index(table_path + ".density", i), d[i], kNonNegative);
+  }
+}
+
+void CheckPhase(const Reporter& report, const std::string& path, const PhaseFunction& phase) {
+  bool takes_g = phase.kind == PhaseKind::kHenyeyGreenstein ||
+                 phase.kind == PhaseKind::kCornetteShanks;
+  if (takes_g) {
+    CheckNumber(report, path + ".g", phase.g, kAsymmetry);
+  } else if (phase.g != 0.0) {
+    report.FailValue(path + ".g", phase.g,
+                     std::string("is not used by the ") + ToString(phase.kind) +
+                         " phase function (only henyey-greenstein and cornette-shanks take g)");
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Reading the TOML tree.
+
+std::string TypeName(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array:
+      return "an array of " + std::to_string(node.as_array()->size());
+    case toml::node_type::string: return "string";
+    case toml::node_type::integer: return "integer";
+    case toml::node_type::floating_point: return "float";
+    case toml::node_type::boolean: return "boolean";
+    case toml::node_type::date: return "date";
+    case toml::node_type::time: return "time";
+    case toml::node_type::date_time: return "date-time";
+    case toml::node_type::none: break;
+  }
+  return "nothing";
+}
+
+std::string KeyList(std::initializer_list<std::string_view> keys) {
+  std::string text;
+  for (std::string_view key : keys) text += (text.empty() ? "" : ", ") + std::string(key);
+  return text;
+}
+
+struct PhaseName {
+  std::string_view name;
+  PhaseKind kind;
+};
+constexpr PhaseName kPhaseNames[] = {
+    {"rayleigh", PhaseKind::kRayleigh},
+    {"isotropic", PhaseKind::kIsotropic},
+    {"henyey-greenstein", PhaseKind::kHenyeyGreenstein},
+    {"cornette-shanks", PhaseKind::kCornetteShanks},
+};
+
+// The three table forms of a coefficient (see examples/atmospheres/README.md).
+enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex };
+struct CoefficientFormKeys {
+  CoefficientForm form;
+  std::vector<std::string_view> keys;
+};
+const CoefficientFormKeys kCoefficientForms[] = {
+    {CoefficientForm::kRayleighLaw, {"rayleigh_at_1um"}},
+    {CoefficientForm::kAngstrom, {"angstrom_reference", "reference_nm", "exponent"}},
+    {CoefficientForm::kRefractiveIndex,
+     {"refractive_index", "number_density_per_m3", "depolarization"}},
+};
+constexpr const char* kCoefficientFormsText =
+    "{ rayleigh_at_1um }, { angstrom_reference, reference_nm, exponent } or "
+    "{ refractive_index, number_density_per_m3, depolarization }";
+
+// A length given as <base>_km or <base>_m, as written and in metres.
+struct Length {
+  std::string path;
+  double written;
+  double metres;
+};
+
+class FileReader {
+ public:
+  explicit FileReader(const std::string& source) : report_(source) {}
+
+  Atmosphere Read(const toml::table& root) {
+    CheckKeys(root, "", {"name", "description", "planet", "spectrum", "sun", "constituents"});
+    Atmosphere atmosphere;
+    atmosphere.name = RequireString(root, "", "name");
+    if (atmosphere.name.empty()) report_.Fail("name", "must not be empty");
+    if (const toml::node* node = root.get("description"))
+      atmosphere.description = ReadString(*node, "description");
+
+    ReadPlanet(RequireTable(root, "", "planet"), atmosphere);
+
+    atmosphere.wavelengths_nm = kDefaultWavelengthsNm;
+    if (const toml::table* spectrum = OptionalTable(root, "", "spectrum")) {
+      CheckKeys(*spectrum, "spectrum", {"wavelengths_nm"});
+      if (const toml::node* node = spectrum->get("wavelengths_nm"))
+        atmosphere.wavelengths_nm = ReadArray3(*node, "spectrum.wavelengths_nm", kPositive);
+    }
+
+    ReadSun(RequireTable(root, "", "sun"), atmosphere);
+
+    if (const toml::table* constituents = OptionalTable(root, "", "constituents")) {
+      // toml++ keeps keys sorted; keep the file's order instead, so that a file
+      // and its ToToml() output list constituents alike.
+      std::vector<std::tuple<uint32_t, uint32_t, std::string, const toml::node*>> entries;
+      for (auto&& [key, node] : *constituents) {
+        entries.emplace_back(key.source().begin.line, key.source().begin.column,
+                             std::string(key.str()), &node);
+      }
+      std::sort(entries.begin(), entries.end());
+      for (const auto& [line, column, name, node] : entries) {
+        std::string path = Join("constituents", name);
+        const toml::table* table = node->as_table();
+        if (!table) report_.Fail(path, "expected a table, got " + TypeName(*node));
+        atmosphere.constituents.push_back(ReadConstituent(*table, path, name, atmosphere));
+      }
+    }
+    return atmosphere;
+  }
+
+ private:
+  // --- generic access ---
+
+  void CheckKeys(const toml::table& table, const std::string& path,
+                 std::initializer_list<std::string_view> allowed) const {
+    for (auto&& [key, node] : table) {
+      if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end())
+        report_.Fail(Join(path, key.str()), "unknown key (expected " + KeyList(allowed) + ")");
+    }
+  }
+
+  const toml::table* OptionalTable(const toml::table& parent, const std::string& path,
+                                   std::string_view key) const {
+    const toml::node* node = parent.get(key);
+    if (!node) return nullptr;
+    if (!node->is_table()) report_.Fail(Join(path, key), "expected a table, got " + TypeName(*node));
+    return node->as_table();
+  }
+
+  const toml::table& RequireTable(const toml::table& parent, const std::string& path,
+                                  std::string_view key) const {
+    const toml::table* table = OptionalTable(parent, path, key);
+    if (!table) report_.Fail(Join(path, key), "missing required table");
+    return *table;
+  }
+
+  const toml::node& Require(const toml::table& table, const std::string& path,
+                            std::string_view key) const {
+    const toml::node* node = table.get(key);
+    if (!node) report_.Fail(Join(path, key), "missing required key");
+    return *node;
+  }
+
+  // Exactly one of `keys` must be present; returns its index and node.
+  std::pair<size_t, const toml::node*> ExactlyOne(
+      const toml::table& table, const std::string& path,
+      std::initializer_list<std::string_view> keys) const {
+    std::optional<size_t> found;
+    size_t i = 0;
+    for (std::string_view key : keys) {
+      if (table.get(key)) {
+        if (found)
+          report_.Fail(Join(path, key), "conflicts with " + Join(path, keys.begin()[*found]) +
+                                            " (give exactly one of " + KeyList(keys) + ")");
+        found = i;
+      }
+      ++i;
+    }
+    if (!found) report_.Fail(path, "missing one of " + KeyList(keys));
+    return {*found, table.get(keys.begin()[*found])};
+  }
+
+  std::string ReadString(const toml::node& node, const std::string& path) const {
+    if (!node.is_string()) report_.Fail(path, "expected a string, got " + TypeName(node));
+    return node.as_string()->get();
+  }
+
+  std::string RequireString(const toml::table& table, const std::string& path,
+                            std::string_view key) const {
+    return ReadString(Require(table, path, key), Join(path, key));
+  }
+
+  // A number; TOML integers are accepted and converted.
+  double ReadNumber(const toml::node& node, const std::string& path) const {
+    if (const auto* f = node.as_floating_point()) return f->get();
+    if (const auto* i = node.as_integer()) return static_cast<double>(i->get());
+    report_.Fail(path, "expected a number, got " + TypeName(node));
+  }
+
+  double ReadNumber(const toml::node& node, const std::string& path,
+                    const Interval& interval) const {
+    double value = ReadNumber(node, path);
+    CheckNumber(report_, path, value, interval);
+    return value;
+  }
+
+  Spectrum ReadArray3(const toml::node& node, const std::string& path,
+                      const Interval& interval) const {
+    const toml::array* array = node.as_array();
+    if (!array || array->size() != kWavelengthCount)
+      report_.Fail(path, "expected an array of 3 numbers (one per wavelength), got " +
+                             TypeName(node));
+    Spectrum value;
+    for (int i = 0; i < kWavelengthCount; ++i)
+      value[i] = ReadNumber(*array->get(i), Index(path, i), interval);
+    return value;
+  }
+
+  // A per-wavelength value: one number for all wavelengths, or an array of 3.
+  Spectrum ReadSpectrum(const toml::node& node, const std::string& path,
+                        const Interval& interval) const {
+    if (node.is_number()) return Spectrum(ReadNumber(node, path, interval));
+    if (!node.is_array())
+      report_.Fail(path, "expected a number or an array of 3 numbers, got " + TypeName(node));
+    return ReadArray3(node, path, interval);
+  }
+
+  Length ReadLength(const toml::table& table, const std::string& path,
+                    const std::string& base) const {
+    auto [which, node] = ExactlyOne(table, path, {base + "_km", base + "_m"});
+    Length length;
+    length.path = Join(path, which == 0 ? base + "_km" : base + "_m");
+    length.written = ReadNumber(*node, length.path, kPositive);
+    length.metres = which == 0 ? length.written * 1000.0 : length.written;
+    return length;
+  }
+
+  // --- sections ---
+
+  void ReadPlanet(const toml::table& planet, Atmosphere& atmosphere) const {
+    CheckKeys(planet, "planet", {"ground_radius_km", "ground_radius_m", "top_radius_km",
+                                 "top_radius_m", "ground_albedo"});
+    Length ground = ReadLength(planet, "planet", "ground_radius");
+    Length top = ReadLength(planet, "planet", "top_radius");
+    if (!(top.metres > ground.metres))
+      report_.FailValue(top.path, top.written,
+                        "must exceed " + ground.path + " = " + FormatNumber(ground.written));
+    atmosphere.bottom_radius_m = ground.metres;
+    atmosphere.top_radius_m = top.metres;
+    atmosphere.ground_albedo =
+        ReadSpectrum(Require(planet, "planet", "ground_albedo"), "planet.ground_albedo", kUnit);
+  }
+
+  void ReadSun(const toml::table& sun, Atmosphere& atmosphere) const {
+    CheckKeys(sun, "sun", {"irradiance_w_m2_nm", "angular_radius_rad", "angular_radius_deg",
+                           "lowest_zenith_deg", "mu_s_min"});
+    atmosphere.solar_irradiance = ReadSpectrum(Require(sun, "sun", "irradiance_w_m2_nm"),
+                                               "sun.irradiance_w_m2_nm", kNonNegative);
+    auto [radius_key, radius] = ExactlyOne(sun, "sun", {"angular_radius_rad", "angular_radius_deg"});
+    atmosphere.sun_angular_radius_rad =
+        radius_key == 0 ? ReadNumber(*radius, "sun.angular_radius_rad", kSunRadiusRad)
+                        : ReadNumber(*radius, "sun.angular_radius_deg", kSunRadiusDeg) * kPi / 180.0;
+    // mu_s_min is what the tables use; lowest_zenith_deg is what people think
+    // in. The writer emits mu_s_min because cos(acos(x)) need not return x.
+    auto [lowest_key, lowest] = ExactlyOne(sun, "sun", {"lowest_zenith_deg", "mu_s_min"});
+    atmosphere.mu_s_min =
+        lowest_key == 0
+            ? std::cos(ReadNumber(*lowest, "sun.lowest_zenith_deg", kLowestZenithDeg) * kPi / 180.0)
+            : ReadNumber(*lowest, "sun.mu_s_min", kMuSMin);
+  }
+
+  Constituent ReadConstituent(const toml::table& table, const std::string& path,
+                              const std::string& name, const Atmosphere& atmosphere) const {
+    CheckKeys(table, path, {"phase", "scattering_per_m", "absorption_per_m", "density"});
+    Constituent constituent;
+    constituent.name = name;
+    std::string scattering_path = path + ".scattering_per_m";
+    constituent.scattering_per_m = ReadCoefficient(Require(table, path, "scattering_per_m"),
+                                                   scattering_path, atmosphere.wavelengths_nm);
+    if (const toml::node* node = table.get("absorption_per_m"))
+      constituent.absorption_per_m =
+          ReadCoefficient(*node, path + ".absorption_per_m", atmosphere.wavelengths_nm);
+
+    // A pure absorber (ozone) never scatters, so its phase function would be
+    // noise in the file; anything that scatters must say how.
+    const toml::node* phase = table.get("phase");
+    if (phase) {
+      constituent.phase = ReadPhase(*phase, path + ".phase");
+    } else if (constituent.scattering_per_m != Spectrum(0.0)) {
+      report_.Fail(path + ".phase", "missing (required for a constituent that scatters)");
+    }
+
+    constituent.density = ReadDensity(Require(table, path, "density"), path + ".density");
+    CheckDensityProfile(report_, path + ".density", constituent.density,
+                        atmosphere.top_radius_m - atmosphere.bottom_radius_m);
+    return constituent;
+  }
+
+  PhaseFunction ReadPhase(const toml::node& node, const std::string& path) const {
+    const toml::table* table = node.as_table();
+    if (!table) report_.Fail(path, "expected a table such as { function = \"rayleigh\" }, got " +
+                                       TypeName(node));
+    CheckKeys(*table, path, {"function", "g"});
+    std::string name = RequireString(*table, path, "function");
+    const PhaseName* match = std::find_if(std::begin(kPhaseNames), std::end(kPhaseNames),
+                                          [&](const PhaseName& p) { return p.name == name; });
+    if (match == std::end(kPhaseNames))
+      report_.Fail(path + ".function",
+                   TomlString(name) +
+                       " is not a phase function (expected rayleigh, isotropic, "
+                       "henyey-greenstein or cornette-shanks)");
+    PhaseFunction phase;
+    phase.kind = match->kind;
+    bool takes_g = phase.kind == PhaseKind::kHenyeyGreenstein ||
+                   phase.kind == PhaseKind::kCornetteShanks;
+    const toml::node* g = table->get("g");
+    if (takes_g) {
+      if (!g) report_.Fail(path + ".g", "missing (required by the " + name + " phase function)");
+      phase.g = ReadNumber(*g, path + ".g", kAsymmetry);
+    } else if (g) {
+      report_.Fail(path + ".g", "not allowed for the " + name +
+                                    " phase function (only henyey-greenstein and "
+                                    "cornette-shanks take g)");
+    }
+    return phase;
+  }
+
+  Spectrum ReadCoefficient(const toml::node& node, const std::string& path,
+                           const Spectrum& wavelengths_nm) const {
+    if (node.is_number() || node.is_array()) return ReadSpectrum(node, path, kNonNegative);
+    const toml::table* table = node.as_table();
+    if (!table)
+      report_.Fail(path, "expected a number, an array of 3 numbers or a table " +
+                             std::string(kCoefficientFormsText) + ", got " + TypeName(node));
+    if (table->empty())
+      report_.Fail(path, "empty table (expected " + std::string(kCoefficientFormsText) + ")");
+
+    // The first key picks the form; every other key must belong to it.
+    const CoefficientFormKeys* form = nullptr;
+    std::string_view form_key;
+    for (auto&& [key, value] : *table) {
+      const CoefficientFormKeys* owner = nullptr;
+      for (const CoefficientFormKeys& candidate : kCoefficientForms) {
+        const auto& keys = candidate.keys;
+        if (std::find(keys.begin(), keys.end(), key.str()) != keys.end()) owner = &candidate;
+      }
+      if (!owner)
+        report_.Fail(Join(path, key.str()),
+                     "unknown key (expected " + std::string(kCoefficientFormsText) + ")");
+      if (form && owner != form)
+        report_.Fail(Join(path, key.str()), "cannot be combined with " + Join(path, form_key) +
+                                                " (they belong to different forms)");
+      if (!form) form_key = key.str();
+      form = owner;
+    }
+
+    Spectrum result;
+    switch (form->form) {
+      case CoefficientForm::kRayleighLaw: {
+        double k = ReadNumber(Require(*table, path, "rayleigh_at_1um"),
+                              path + ".rayleigh_at_1um", kNonNegative);
+        for (int i = 0; i < kWavelengthCount; ++i)
+          result[i] = RayleighLawCoefficient(k, wavelengths_nm[i]);
+        break;
+      }
+      case CoefficientForm::kAngstrom: {
+        double b = ReadNumber(Require(*table, path, "angstrom_reference"),
+                              path + ".angstrom_reference", kNonNegative);
+        double l0 = ReadNumber(Require(*table, path, "reference_nm"), path + ".reference_nm",
+                               kPositive);
+        double a = ReadNumber(Require(*table, path, "exponent"), path + ".exponent", kFinite);
+        for (int i = 0; i < kWavelengthCount; ++i)
+          result[i] = AngstromCoefficient(b, l0, a, wavelengths_nm[i]);
+        break;
+      }
+      case CoefficientForm::kRefractiveIndex: {
+        double n = ReadNumber(Require(*table, path, "refractive_index"),
+                              path + ".refractive_index", kPositive);
+        double density = ReadNumber(Require(*table, path, "number_density_per_m3"),
+                                    path + ".number_density_per_m3", kPositive);
+        double p = ReadNumber(Require(*table, path, "depolarization"), path + ".depolarization",
+                              kDepolarization);
+        for (int i = 0; i < kWavelengthCount; ++i)
+          result[i] = RayleighScatteringCoefficient(n, density, p, wavelengths_nm[i] * 1e-9);
+        break;
+      }
+    }
+    for (int i = 0; i < kWavelengthCount; ++i) {
+      if (!std::isfinite(result[i]))
+        report_.Fail(path, "evaluates to " + FormatNumber(result[i]) + " at " +
+                               FormatNumber(wavelengths_nm[i]) + " nm");
+    }
+    return result;
+  }
+
+  DensityProfile ReadDensity(const toml::node& node, const std::string& path) const {
+    const toml::table* table = node.as_table();
+    if (!table) report_.Fail(path, "expected a table, got " + TypeName(node));
+    CheckKeys(*table, path, {"layers", "tabulated"});
+    auto [which, value] = ExactlyOne(*table, path, {"layers", "tabulated"});
+    DensityProfile profile;
+    if (which == 0) {
+      profile.kind = DensityProfile::Kind::kLayers;
+      std::string layers_path = path + ".layers";
+      const toml::array* layers = value->as_array();
+      if (!layers) report_.Fail(layers_path, "expected an array of tables, got " + TypeName(*value));
+      for (size_t i = 0; i < layers->size(); ++i) {
+        std::string layer_path = Index(layers_path, i);
+        const toml::table* layer = layers->get(i)->as_table();
+        if (!layer) report_.Fail(layer_path, "expected a table, got " + TypeName(*layers->get(i)));
+        CheckKeys(*layer, layer_path, {"width_m", "exp_term", "exp_scale_per_m",
+                                       "linear_term_per_m", "constant_term"});
+        auto term = [&](std::string_view key) {
+          const toml::node* n = layer->get(key);
+          return n ? ReadNumber(*n, Join(layer_path, key)) : 0.0;
+        };
+        DensityLayer l;
+        l.width_m = term("width_m");
+        l.exp_term = term("exp_term");
+        l.exp_scale_per_m = term("exp_scale_per_m");
+        l.linear_term_per_m = term("linear_term_per_m");
+        l.constant_term = term("constant_term");
+        profile.layers.push_back(l);
+      }
+    } else {
+      profile.kind = DensityProfile::Kind::kTabulated;
+      std::string table_path = path + ".tabulated";
+      const toml::table* tabulated = value->as_table();
+      if (!tabulated) report_.Fail(table_path, "expected a table, got " + TypeName(*value));
+      CheckKeys(*tabulated, table_path, {"altitude_m", "density"});
+      profile.altitudes_m = ReadNumbers(Require(*tabulated, table_path, "altitude_m"),
+                                        table_path + ".altitude_m");
+      profile.densities =
+          ReadNumbers(Require(*tabulated, table_path, "density"), table_path + ".density");
+    }
+    return profile;
+  }
+
+  std::vector<double> ReadNumbers(const toml::node& node, const std::string& path) const {
+    const toml::array* array = node.as_array();
+    if (!array) report_.Fail(path, "expected an array of numbers, got " + TypeName(node));
+    std::vector<double> values;
+    for (size_t i = 0; i < array->size(); ++i)
+      values.push_back(ReadNumber(*array->get(i), Index(path, i)));
+    return values;
+  }
+
+  Reporter report_;
+};
+
+// ---------------------------------------------------------------------------
+
+const EmbeddedText* FindPreset(const std::string& name) {
+  for (const EmbeddedText& file : kPresetFiles) {
+    if (file.name == name + ".toml") return &file;
+  }
+  return nullptr;
+}
+
+std::string PresetName(std::string_view file_name) {
+  return std::string(file_name.substr(0, file_name.rfind(".toml")));
+}
+
+std::string ReadFile(const std::filesystem::path& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw IoError(path.string() + ": is a directory, not an atmosphere file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")");
+  return text.str();
+}
+
+std::string Array3(const Spectrum& value) {
+  return "[" + TomlFloat(value[0]) + ", " + TomlFloat(value[1]) + ", " + TomlFloat(value[2]) + "]";
+}
+
+}  // namespace
+
+Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, source_name);
+  } catch (const toml::parse_error& error) {
+    throw InputError(OneLine(source_name + ":" + std::to_string(error.source().begin.line) +
+                             ": " + std::string(error.description())));
+  }
+  Atmosphere atmosphere = FileReader(source_name).Read(root);
+  Validate(atmosphere, source_name);
+  return atmosphere;
+}
+
+Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
+  std::filesystem::path path(file_or_preset);
+  std::error_code error;
+  bool exists = std::filesystem::exists(path, error);
+  if (error && error != std::errc::no_such_file_or_directory)
+    throw IoError(file_or_preset + ": " + error.message());
+  if (exists) return ParseAtmosphere(ReadFile(path), path.filename().string());
+  if (FindPreset(file_or_preset)) return LoadPreset(file_or_preset);
+  throw InputError(file_or_preset + ": no such file or preset (see skybake presets)");
+}
+
+std::vector<PresetInfo> ListPresets() {
+  std::vector<PresetInfo> presets;
+  for (const EmbeddedText& file : kPresetFiles) {
+    std::string name = PresetName(file.name);
+    presets.push_back({name, LoadPreset(name).description});
+  }
+  return presets;
+}
+
+Atmosphere LoadPreset(const std::string& name) {
+  const EmbeddedText* file = FindPreset(name);
+  if (!file) throw InputError(name + ": no such preset (see skybake presets)");
+  return ParseAtmosphere(file->text, std::string(file->name));
+}
+
+std::string ToToml(const Atmosphere& a) {
+  std::ostringstream out;
+  out << "# Resolved to SI units by skybake " SKYBAKE_VERSION "; a valid atmosphere file.\n"
+      << "name = " << TomlString(a.name) << "\n"
+      << "description = " << TomlString(a.description) << "\n"
+      << "\n[planet]\n"
+      << "ground_radius_m = " << TomlFloat(a.bottom_radius_m) << "\n"
+      << "top_radius_m = " << TomlFloat(a.top_radius_m) << "\n"
+      << "ground_albedo = " << Array3(a.ground_albedo) << "\n"
+      << "\n[spectrum]\n"
+      << "wavelengths_nm = " << Array3(a.wavelengths_nm) << "\n"
+      << "\n[sun]\n"
+      << "irradiance_w_m2_nm = " << Array3(a.solar_irradiance) << "\n"
+      << "angular_radius_rad = " << TomlFloat(a.sun_angular_radius_rad) << "\n"
+      << "mu_s_min = " << TomlFloat(a.mu_s_min);
+  char zenith[64];
+  std::snprintf(zenith, sizeof zenith, "  # lowest sun zenith %.6g deg\n",
+                std::acos(std::clamp(a.mu_s_min, -1.0, 1.0)) * 180.0 / kPi);
+  out << zenith;
+
+  for (const Constituent& c : a.constituents) {
+    std::string section = "constituents." + TomlKey(c.name);
+    out << "\n[" << section << "]\n"
+        << "phase = { function = " << TomlString(ToString(c.phase.kind));
+    if (c.phase.kind == PhaseKind::kHenyeyGreenstein || c.phase.kind == PhaseKind::kCornetteShanks)
+      out << ", g = " << TomlFloat(c.phase.g);
+    out << " }\n"
+        << "scattering_per_m = " << Array3(c.scattering_per_m) << "\n"
+        << "absorption_per_m = " << Array3(c.absorption_per_m) << "\n";
+    const DensityProfile& d = c.density;
+    if (d.kind == DensityProfile::Kind::kLayers) {
+      out << "\n[" << section << ".density]\nlayers = [\n";
+      for (const DensityLayer& l : d.layers) {
+        out << "  { width_m = " << TomlFloat(l.width_m) << ", exp_term = " << TomlFloat(l.exp_term)
+            << ", exp_scale_per_m = " << TomlFloat(l.exp_scale_per_m)
+            << ", linear_term_per_m = " << TomlFloat(l.linear_term_per_m)
+            << ", constant_term = " << TomlFloat(l.constant_term) << " },\n";
+      }
+      out << "]\n";
+    } else {
+      auto list = [](const std::vector<double>& values) {
+        std::string text = "[";
+        for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + TomlFloat(values[i]);
+        return text + "]";
+      };
+      out << "\n[" << section << ".density.tabulated]\n"
+          << "altitude_m = " << list(d.altitudes_m) << "\n"
+          << "density = " << list(d.densities) << "\n";
+    }
+  }
+  return out.str();
+}
+
+std::string ToJson(const Atmosphere& a) {
+  using Json = nlohmann::ordered_json;
+  auto array3 = [](const Spectrum& s) { return Json::array({s[0], s[1], s[2]}); };
+  Json constituents = Json::object();
+  for (const Constituent& c : a.constituents) {
+    Json phase = {{"function", ToString(c.phase.kind)}};
+    if (c.phase.kind == PhaseKind::kHenyeyGreenstein || c.phase.kind == PhaseKind::kCornetteShanks)
+      phase["g"] = c.phase.g;
+    Json density;
+    if (c.density.kind == DensityProfile::Kind::kLayers) {
+      Json layers = Json::array();
+      for (const DensityLayer& l : c.density.layers) {
+        layers.push_back({{"width_m", l.width_m},
+                          {"exp_term", l.exp_term},
+                          {"exp_scale_per_m", l.exp_scale_per_m},
+                          {"linear_term_per_m", l.linear_term_per_m},
+                          {"constant_term", l.constant_term}});
+      }
+      density["layers"] = layers;
+    } else {
+      density["tabulated"] = {{"altitude_m", c.density.altitudes_m},
+                              {"density", c.density.densities}};
+    }
+    constituents[c.name] = {{"phase", phase},
+                            {"scattering_per_m", array3(c.scattering_per_m)},
+                            {"absorption_per_m", array3(c.absorption_per_m)},
+                            {"density", density}};
+  }
+  Json json = {
+      {"name", a.name},
+      {"description", a.description},
+      {"planet",
+       {{"ground_radius_m", a.bottom_radius_m},
+        {"top_radius_m", a.top_radius_m},
+        {"ground_albedo", array3(a.ground_albedo)}}},
+      {"spectrum", {{"wavelengths_nm", array3(a.wavelengths_nm)}}},
+      {"sun",
+       {{"irradiance_w_m2_nm", array3(a.solar_irradiance)},
+        {"angular_radius_rad", a.sun_angular_radius_rad},
+        {"mu_s_min", a.mu_s_min}}},
+      {"constituents", constituents},
+  };
+  return json.dump(2) + "\n";
+}
+
+void Validate(const Atmosphere& a, const std::string& source_name) {
+  Reporter report(source_name);
+  if (a.name.empty()) report.Fail("name", "must not be empty");
+  CheckNumber(report, "planet.ground_radius_m", a.bottom_radius_m, kPositive);
+  CheckNumber(report, "planet.top_radius_m", a.top_radius_m, kPositive);
+  if (!(a.top_radius_m > a.bottom_radius_m))
+    report.FailValue("planet.top_radius_m", a.top_radius_m,
+                     "must exceed planet.ground_radius_m = " + FormatNumber(a.bottom_radius_m));
+  CheckSpectrum(report, "planet.ground_albedo", a.ground_albedo, kUnit);
+  CheckSpectrum(report, "spectrum.wavelengths_nm", a.wavelengths_nm, kPositive);
+  CheckSpectrum(report, "sun.irradiance_w_m2_nm", a.solar_irradiance, kNonNegative);
+  CheckNumber(report, "sun.angular_radius_rad", a.sun_angular_radius_rad, kSunRadiusRad);
+  CheckNumber(report, "sun.mu_s_min", a.mu_s_min, kMuSMin);
+
+  std::set<std::string> names;
+  for (const Constituent& c : a.constituents) {
+    if (c.name.empty()) report.Fail("constituents", "a constituent has an empty name");
+    std::string path = Join("constituents", c.name);
+    if (!names.insert(c.name).second) report.Fail(path, "appears more than once");
+    CheckSpectrum(report, path + ".scattering_per_m", c.scattering_per_m, kNonNegative);
+    CheckSpectrum(report, path + ".absorption_per_m", c.absorption_per_m, kNonNegative);
+    CheckPhase(report, path + ".phase", c.phase);
+    CheckDensityProfile(report, path + ".density", c.density, a.top_radius_m - a.bottom_radius_m);
+  }
+}
+
 }  // namespace skybake

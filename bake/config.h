@@ -34,6 +34,10 @@ Atmosphere LoadPreset(const std::string& name);  // InputError if unknown
 // the same Atmosphere (tested), so `skybake validate` output is a valid input.
 std::string ToToml(const Atmosphere& atmosphere);
 
+// The same canonical model as a JSON object with the same keys, for tools that
+// would rather not parse TOML (`skybake validate --json`).
+std::string ToJson(const Atmosphere& atmosphere);
+
 // Throws InputError if the atmosphere is not physically meaningful (negative
 // or non-finite coefficients, top radius <= ground radius, |g| >= 1, ...).
 // ParseAtmosphere calls it; code that builds an Atmosphere by hand should too.
