@@ -1,0 +1,259 @@
+// Cross-checks skybake's KTX2 writer with an independent parser, ktx-parse
+// (pinned in package.json / package-lock.json).
+//
+//   node crosscheck.mjs --tests-exe <skybake_tests> --work-dir <dir>
+//
+// 1. Runs the gtest case Ktx2CrossCheck.WritesSampleSet, which writes one
+//    sample per format, 2D and 3D, with extra keys, plus the raw level bytes
+//    and a manifest of what each file is meant to hold.
+// 2. Installs ktx-parse into <dir> with `npm ci` (reused when already there).
+// 3. Reads every sample with ktx-parse and compares the header, the Data
+//    Format Descriptor (expected values derived here from the KTX 2.0 and
+//    Khronos Data Format specifications, not from skybake), the key/value
+//    data and the level, then re-serialises it with ktx-parse and requires
+//    the same bytes: an independent writer lays out the file identically.
+//
+// Exit codes: 0 all agree, 1 a disagreement or error, 77 skipped because npm
+// or the npm registry is unavailable (ctest SKIP_RETURN_CODE).
+
+import { spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+const SKIP = 77;
+
+function skip(message) {
+  console.log(`SKIPPED: ktx2 cross-check not run: ${message}`);
+  process.exit(SKIP);
+}
+
+function fail(message) {
+  console.error(`FAILED: ${message}`);
+  process.exit(1);
+}
+
+function parseArgs(argv) {
+  const args = {};
+  for (let i = 0; i < argv.length; i += 2) {
+    if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
+    args[argv[i].slice(2)] = argv[i + 1];
+  }
+  for (const required of ['tests-exe', 'work-dir']) {
+    if (!args[required]) fail(`missing --${required}`);
+  }
+  return args;
+}
+
+function writeSamples(testsExe, sampleDir) {
+  fs.rmSync(sampleDir, { recursive: true, force: true });
+  fs.mkdirSync(sampleDir, { recursive: true });
+  const run = spawnSync(testsExe, ['--gtest_filter=Ktx2CrossCheck.WritesSampleSet'], {
+    env: { ...process.env, SKYBAKE_KTX2_SAMPLE_DIR: sampleDir },
+    encoding: 'utf8',
+  });
+  if (run.error) fail(`cannot run ${testsExe}: ${run.error.message}`);
+  if (run.status !== 0) fail(`writing the samples failed:\n${run.stdout}\n${run.stderr}`);
+  if (!/\[ {2}PASSED {2}\] 1 test/.test(run.stdout)) fail(`the sample writer did not run:\n${run.stdout}`);
+}
+
+// npm errors that mean "no registry here", as opposed to a broken lock file.
+const NETWORK_ERROR = /ENOTFOUND|EAI_AGAIN|ECONNREFUSED|ECONNRESET|ETIMEDOUT|ENETUNREACH|EHOSTUNREACH|socket hang up|network|fetch failed|E50[234]/i;
+
+function installParser(workDir) {
+  const here = path.dirname(fileURLToPath(import.meta.url));
+  const pinned = JSON.parse(fs.readFileSync(path.join(here, 'package.json'), 'utf8')).dependencies['ktx-parse'];
+  for (const file of ['package.json', 'package-lock.json']) {
+    const source = fs.readFileSync(path.join(here, file));
+    const target = path.join(workDir, file);
+    if (!fs.existsSync(target) || !fs.readFileSync(target).equals(source)) fs.writeFileSync(target, source);
+  }
+  const installedManifest = path.join(workDir, 'node_modules', 'ktx-parse', 'package.json');
+  const installed = fs.existsSync(installedManifest)
+    ? JSON.parse(fs.readFileSync(installedManifest, 'utf8')).version
+    : null;
+  if (installed !== pinned) {
+    const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
+    const run = spawnSync(npm, ['ci', '--no-audit', '--no-fund', '--loglevel=error', '--fetch-retries=1'], {
+      cwd: workDir,
+      encoding: 'utf8',
+      timeout: 240000,
+    });
+    if (run.error && run.error.code === 'ENOENT') skip('npm is not installed');
+    if (run.error && run.error.code === 'ETIMEDOUT') skip('npm ci timed out (registry unreachable?)');
+    if (run.error) fail(`cannot run npm: ${run.error.message}`);
+    const output = `${run.stdout}\n${run.stderr}`.trim();
+    if (run.status !== 0) {
+      if (NETWORK_ERROR.test(output)) skip(`the npm registry is unavailable:\n${output}`);
+      fail(`npm ci failed:\n${output}`);
+    }
+  }
+  return pinned;
+}
+
+async function importParser(workDir) {
+  const require = createRequire(path.join(workDir, 'package.json'));
+  return import(pathToFileURL(require.resolve('ktx-parse')).href);
+}
+
+// --- What the specifications require for skybake's four formats -----------
+
+// VkFormat values (Vulkan specification, enum VkFormat).
+const FORMATS = {
+  76: { name: 'VK_FORMAT_R16_SFLOAT', channels: 1, bits: 16 },
+  97: { name: 'VK_FORMAT_R16G16B16A16_SFLOAT', channels: 4, bits: 16 },
+  100: { name: 'VK_FORMAT_R32_SFLOAT', channels: 1, bits: 32 },
+  109: { name: 'VK_FORMAT_R32G32B32A32_SFLOAT', channels: 4, bits: 32 },
+};
+
+function float32BitsAsInt32(value) {
+  const view = new DataView(new ArrayBuffer(4));
+  view.setFloat32(0, value, true);
+  return view.getInt32(0, true);
+}
+
+// Basic Data Format Descriptor for an unpacked little-endian signed float
+// format (Khronos Data Format Specification 1.4, chapter 5).
+function expectedDfd(format) {
+  const rgbsdaIds = [0, 1, 2, 15]; // R, G, B, A
+  const samples = [];
+  for (let i = 0; i < format.channels; i++) {
+    samples.push({
+      bitOffset: i * format.bits,
+      bitLength: format.bits - 1, // stored as length - 1
+      channelType: rgbsdaIds[i] | 0x80 | 0x40, // FLOAT | SIGNED qualifiers
+      samplePosition: [0, 0, 0, 0],
+      // Float channels carry float bounds; signed range -1..1. ktx-parse reads
+      // the words as int32 because the SIGNED bit is set.
+      sampleLower: float32BitsAsInt32(-1.0),
+      sampleUpper: float32BitsAsInt32(1.0),
+    });
+  }
+  return {
+    vendorId: 0,
+    descriptorType: 0,
+    versionNumber: 2,
+    colorModel: 1, // KHR_DF_MODEL_RGBSDA
+    colorPrimaries: 1, // KHR_DF_PRIMARIES_BT709
+    transferFunction: 1, // KHR_DF_TRANSFER_LINEAR
+    flags: 0, // KHR_DF_FLAG_ALPHA_STRAIGHT
+    texelBlockDimension: [0, 0, 0, 0],
+    bytesPlane: [(format.channels * format.bits) / 8, 0, 0, 0, 0, 0, 0, 0],
+    samples,
+  };
+}
+
+function gcd(a, b) {
+  return b === 0 ? a : gcd(b, a % b);
+}
+
+function compareBytes(a, b) {
+  const n = Math.min(a.length, b.length);
+  for (let i = 0; i < n; i++) if (a[i] !== b[i]) return i;
+  return a.length === b.length ? -1 : n;
+}
+
+function checkSample(parser, sampleDir, entry, problems) {
+  const problem = (what) => problems.push(`${entry.file}: ${what}`);
+  const expectEqual = (what, actual, expected) => {
+    const a = JSON.stringify(actual);
+    const e = JSON.stringify(expected);
+    if (a !== e) problem(`${what} is ${a}, expected ${e}`);
+  };
+
+  const buffer = fs.readFileSync(path.join(sampleDir, entry.file));
+  const bytes = new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength);
+  let container;
+  try {
+    container = parser.read(bytes);
+  } catch (error) {
+    problem(`ktx-parse cannot read it: ${error.message}`);
+    return;
+  }
+  const format = FORMATS[entry.vkFormat];
+  if (!format) {
+    problem(`manifest names unknown vkFormat ${entry.vkFormat}`);
+    return;
+  }
+
+  // Header (KTX 2.0 §3.2-§3.8).
+  expectEqual('vkFormat', container.vkFormat, entry.vkFormat);
+  expectEqual('typeSize', container.typeSize, format.bits / 8);
+  expectEqual('pixelWidth', container.pixelWidth, entry.pixelWidth);
+  expectEqual('pixelHeight', container.pixelHeight, entry.pixelHeight);
+  expectEqual('pixelDepth', container.pixelDepth, entry.pixelDepth);
+  expectEqual('layerCount', container.layerCount, 0);
+  expectEqual('faceCount', container.faceCount, 1);
+  expectEqual('levelCount', container.levelCount, entry.levelCount);
+  expectEqual('supercompressionScheme', container.supercompressionScheme, 0);
+  if (container.globalData) problem('has supercompression global data');
+
+  // Data Format Descriptor.
+  expectEqual('dataFormatDescriptor count', container.dataFormatDescriptor.length, 1);
+  const expected = expectedDfd(format);
+  const dfd = container.dataFormatDescriptor[0] || {};
+  for (const field of Object.keys(expected)) expectEqual(`DFD ${field}`, dfd[field], expected[field]);
+
+  // Level (KTX 2.0 §3.9.7, §3.13).
+  expectEqual('levels.length', container.levels.length, 1);
+  const level = container.levels[0];
+  if (level) {
+    expectEqual('level byteLength', level.levelData.byteLength, entry.levelByteLength);
+    expectEqual('level uncompressedByteLength', level.uncompressedByteLength, entry.levelByteLength);
+    const texelSize = (format.channels * format.bits) / 8;
+    const alignment = (texelSize * 4) / gcd(texelSize, 4); // lcm(texel size, 4)
+    const offset = level.levelData.byteOffset - bytes.byteOffset;
+    if (offset % alignment !== 0) problem(`level offset ${offset} is not a multiple of ${alignment}`);
+    const raw = fs.readFileSync(path.join(sampleDir, entry.levelData));
+    const at = compareBytes(level.levelData, raw);
+    if (at >= 0) problem(`level data differs from the texture data at byte ${at}`);
+  }
+
+  // Key/value data (KTX 2.0 §3.11): ktx-parse returns KTX* values as strings
+  // without their NUL and other values as raw bytes, NUL included.
+  const keys = Object.keys(container.keyValue);
+  const expectedKeys = Object.keys(entry.keyValue).sort((a, b) => Buffer.compare(Buffer.from(a), Buffer.from(b)));
+  expectEqual('keys in file order', keys, expectedKeys);
+  for (const key of expectedKeys) {
+    const value = container.keyValue[key];
+    if (value === undefined) continue;
+    if (/^ktx/i.test(key)) {
+      expectEqual(`value of ${key}`, value, entry.keyValue[key]);
+    } else {
+      const wanted = Buffer.concat([Buffer.from(entry.keyValue[key], 'utf8'), Buffer.from([0])]);
+      if (compareBytes(value, wanted) >= 0) problem(`value of ${key} is [${Array.from(value)}], expected [${Array.from(wanted)}]`);
+    }
+  }
+
+  // An independent writer must lay the same container out byte for byte.
+  if (problems.length === 0) {
+    const rewritten = parser.write(container, { keepWriter: true });
+    const at = compareBytes(rewritten, bytes);
+    if (at >= 0) problem(`ktx-parse re-serialises it differently from byte ${at} (${rewritten.length} vs ${bytes.length} bytes)`);
+  }
+}
+
+async function main() {
+  const args = parseArgs(process.argv.slice(2));
+  const workDir = path.resolve(args['work-dir']);
+  fs.mkdirSync(workDir, { recursive: true });
+  const sampleDir = path.join(workDir, 'samples');
+
+  writeSamples(path.resolve(args['tests-exe']), sampleDir);
+  const version = installParser(workDir);
+  const parser = await importParser(workDir);
+
+  const manifest = JSON.parse(fs.readFileSync(path.join(sampleDir, 'manifest.json'), 'utf8'));
+  if (!Array.isArray(manifest) || manifest.length === 0) fail('the sample manifest lists no files');
+  const problems = [];
+  for (const entry of manifest) {
+    const before = problems.length;
+    checkSample(parser, sampleDir, entry, problems);
+    console.log(`${problems.length === before ? 'ok  ' : 'FAIL'} ${entry.file}`);
+  }
+  if (problems.length > 0) fail(`ktx-parse ${version} disagrees:\n  ${problems.join('\n  ')}`);
+  console.log(`ktx2 cross-check: ${manifest.length} files read by ktx-parse ${version}; header, DFD, key/value data and level agree, and ktx-parse re-serialises them byte for byte`);
+}
+
+main().catch((error) => fail(error.stack || String(error)));
