@@ -53,6 +53,7 @@ std::vector<double> DensityProfile::Breakpoints() const {
     layer_base = layer_top;
   }
   std::sort(result.begin(), result.end());
+  result.erase(std::unique(result.begin(), result.end()), result.end());
   return result;
 }
 

@@ -256,7 +256,8 @@ TEST(Presets, OzoneTentProfile) {
       {25001.0, 1.0 - 1.0 / 15000}};
   for (const auto& [altitude, density] : expected)
     EXPECT_NEAR(ozone.At(altitude), density, 1e-12) << altitude << " m";
-  EXPECT_EQ(ozone.Breakpoints(), std::vector<double>{25000.0});
+  // The layer boundary and the corners where the clamp to [0, 1] bites.
+  EXPECT_EQ(ozone.Breakpoints(), (std::vector<double>{10000.0, 25000.0, 40000.0}));
 }
 
 TEST(Presets, EarthClear2008HasBrunetonNeyretParameters) {
