@@ -53,7 +53,10 @@ std::vector<double> DensityProfile::Breakpoints() const {
     layer_base = layer_top;
   }
   std::sort(result.begin(), result.end());
-  result.erase(std::unique(result.begin(), result.end()), result.end());
+  // Coefficients written in decimal put one corner at, e.g., 25000 and
+  // 24999.999999999996; report it once.
+  auto same = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(a)); };
+  result.erase(std::unique(result.begin(), result.end(), same), result.end());
   return result;
 }
 
