@@ -41,6 +41,9 @@ using glsl::Texture;
 using glsl::vec3;
 using glsl::vec4;
 constexpr double kPi = 3.14159265358979323846;
+// Intervals of a ray that the planet's shadow edge crosses are integrated on
+// this many sub-intervals (twilight rays; measured against brute force).
+constexpr int kShadowEdgeSubdivisions = 16;
 
 // Integral over an interval of width h of a positive function that takes the
 // values a and b at its ends, assuming it is exponential in between; the
@@ -57,12 +60,20 @@ Spectrum ExponentialTrapezoid(const Spectrum& a, const Spectrum& b, double h) {
                   ExponentialTrapezoid(a.z, b.z, h));
 }
 
+// Sample distances along a ray of length d: n equal intervals. (Grading them
+// toward the ray's lowest point was measured against brute force: it helped
+// no daylight case and hurt twilight rays, lit only far from the camera.)
+std::vector<double> RayDistances(double d, int n) {
+  std::vector<double> t(n + 1);
+  for (int k = 0; k <= n; ++k) t[k] = d * k / n;
+  return t;
+}
+
 // Samples along one ray of the scattering table, shared by its (mu_s, nu) texels.
 struct RaySamples {
   double r = 0.0, mu = 0.0;
   bool intersects_ground = false;
-  double dt = 0.0;
-  std::vector<double> t, radius;
+  std::vector<double> t, radius;  // t[0] = 0 ... t[n] = end of the ray
   std::vector<Spectrum> optical_depth;           // from the camera to each sample
   std::vector<std::vector<Spectrum>> scattering;  // [group][sample] scattering coefficient
 };
@@ -188,15 +199,13 @@ RaySamples Baker::SampleRay(int mu_index, int r_index) const {
   const int n = settings_.ray_samples;
   const int constituents = medium_.constituent_count();
   const int groups = static_cast<int>(medium_.groups().size());
-  ray.dt = d / n;
-  ray.t.resize(n + 1);
+  ray.t = RayDistances(d, n);
   ray.radius.resize(n + 1);
   ray.optical_depth.assign(n + 1, Spectrum(0.0));
   ray.scattering.assign(groups, std::vector<Spectrum>(n + 1));
   std::vector<double> densities(constituents), previous(constituents);
   for (int k = 0; k <= n; ++k) {
-    double t = k * ray.dt;
-    ray.t[k] = t;
+    double t = ray.t[k];
     ray.radius[k] = glsl::RadiusAtDistance(params_, ray.r, ray.mu, t);
     medium_.Densities(ray.radius[k] - params_.bottom_radius, densities.data());
     for (int g = 0; g < groups; ++g) ray.scattering[g][k] = medium_.GroupScattering(g, densities.data());
@@ -204,7 +213,7 @@ RaySamples Baker::SampleRay(int mu_index, int r_index) const {
       Spectrum tau = ray.optical_depth[k - 1];
       for (int c = 0; c < constituents; ++c) {
         tau += medium_.atmosphere().constituents[c].Extinction() *
-               ExponentialTrapezoid(previous[c], densities[c], ray.dt);
+               ExponentialTrapezoid(previous[c], densities[c], ray.t[k] - ray.t[k - 1]);
       }
       ray.optical_depth[k] = tau;
     }
@@ -225,6 +234,7 @@ void Baker::ComputeSingleScattering() {
     const int n = settings_.ray_samples;
     std::vector<double> phase_ratio(groups);
     std::vector<Spectrum> rayleigh(n + 1), mie_samples(n + 1);
+    std::vector<double> visible(n + 1), densities(medium_.constituent_count());
     for (int x = 0; x < width; ++x) {
       double r, mu, mu_s, nu;
       bool intersects;
@@ -233,23 +243,55 @@ void Baker::ComputeSingleScattering() {
       for (int g = 0; g < groups; ++g) {
         phase_ratio[g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
       }
-      for (int k = 0; k <= n; ++k) {
-        double r_k = ray.radius[k];
-        double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / r_k);
-        Spectrum tau_sun = glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance, r_k, mu_s_k);
-        Spectrum attenuation = glm::exp(-(ray.optical_depth[k] + tau_sun)) *
-                               glsl::SunVisibleFraction(params_, r_k, mu_s_k);
+      // Scattered light at distance t along the ray, per group kind.
+      auto sample = [&](double t, double r_t, const Spectrum& optical_depth, const Spectrum* scattering,
+                        Spectrum& rayleigh_out, Spectrum& mie_out, double& visible) {
+        double mu_s_t = glsl::ClampCosine((r * mu_s + t * nu) / r_t);
+        visible = glsl::SunVisibleFraction(params_, r_t, mu_s_t);
+        Spectrum tau_sun = glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance, r_t, mu_s_t);
+        Spectrum attenuation = glm::exp(-(optical_depth + tau_sun)) * visible;
         Spectrum other(0.0);
         for (int g = 0; g < groups; ++g) {
-          if (g != mie) other += ray.scattering[g][k] * phase_ratio[g];
+          if (g != mie) other += scattering[g] * phase_ratio[g];
         }
-        rayleigh[k] = other * attenuation;
-        mie_samples[k] = mie >= 0 ? ray.scattering[mie][k] * attenuation : Spectrum(0.0);
+        rayleigh_out = other * attenuation;
+        mie_out = mie >= 0 ? scattering[mie] * attenuation : Spectrum(0.0);
+      };
+      std::vector<Spectrum> scattering_k(groups);
+      for (int k = 0; k <= n; ++k) {
+        for (int g = 0; g < groups; ++g) scattering_k[g] = ray.scattering[g][k];
+        sample(ray.t[k], ray.radius[k], ray.optical_depth[k], scattering_k.data(), rayleigh[k], mie_samples[k],
+               visible[k]);
       }
       Spectrum rayleigh_sum(0.0), mie_sum(0.0);
       for (int k = 0; k < n; ++k) {
-        rayleigh_sum += ExponentialTrapezoid(rayleigh[k], rayleigh[k + 1], ray.dt);
-        mie_sum += ExponentialTrapezoid(mie_samples[k], mie_samples[k + 1], ray.dt);
+        if (visible[k] == visible[k + 1] && (visible[k] == 0.0 || visible[k] == 1.0)) {
+          rayleigh_sum += ExponentialTrapezoid(rayleigh[k], rayleigh[k + 1], ray.t[k + 1] - ray.t[k]);
+          mie_sum += ExponentialTrapezoid(mie_samples[k], mie_samples[k + 1], ray.t[k + 1] - ray.t[k]);
+          continue;
+        }
+        // The planet's shadow edge crosses this interval: the integrand
+        // switches on or off within it, so subdivide it.
+        const int pieces = kShadowEdgeSubdivisions;
+        double width = ray.t[k + 1] - ray.t[k];
+        double h = width / pieces;
+        Spectrum previous_rayleigh = rayleigh[k], previous_mie = mie_samples[k];
+        for (int i = 1; i <= pieces; ++i) {
+          Spectrum next_rayleigh = rayleigh[k + 1], next_mie = mie_samples[k + 1];
+          if (i < pieces) {
+            double f = double(i) / pieces;
+            double t = ray.t[k] + f * width;
+            double r_t = glsl::RadiusAtDistance(params_, ray.r, ray.mu, t);
+            medium_.Densities(r_t - params_.bottom_radius, densities.data());
+            for (int g = 0; g < groups; ++g) scattering_k[g] = medium_.GroupScattering(g, densities.data());
+            Spectrum optical_depth = glm::mix(ray.optical_depth[k], ray.optical_depth[k + 1], f);
+            double unused;
+            sample(t, r_t, optical_depth, scattering_k.data(), next_rayleigh, next_mie, unused);
+          }
+          rayleigh_sum += ExponentialTrapezoid(previous_rayleigh, next_rayleigh, h);
+          mie_sum += ExponentialTrapezoid(previous_mie, next_mie, h);
+          previous_rayleigh = next_rayleigh, previous_mie = next_mie;
+        }
       }
       single_rayleigh_.Store(x, y, z, vec4(rayleigh_sum * params_.solar_irradiance, 0.0));
       single_mie_.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
@@ -416,7 +458,7 @@ void Baker::ComputeMultipleScattering() {
         samples[k] = j * attenuation[k];
       }
       Spectrum sum(0.0);
-      for (int k = 0; k < n; ++k) sum += ExponentialTrapezoid(samples[k], samples[k + 1], ray.dt);
+      for (int k = 0; k < n; ++k) sum += ExponentialTrapezoid(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
       delta_multiple_.Store(x, y, z, vec4(sum, 0.0));
       vec4 total = scattering_.Fetch(x, y, z) + vec4(sum / glsl::RayleighPhaseFunction(nu), 0.0);
       scattering_.Store(x, y, z, total);

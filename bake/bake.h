@@ -29,7 +29,7 @@ struct BakeSettings {
   // per ray for the inscattering integrals, and polar directions for the
   // integrals over the sphere (twice as many azimuths).
   int transmittance_samples = 64;
-  int ray_samples = 64;
+  int ray_samples = 128;
   int sphere_samples = 16;
   // Store single Mie's red channel in the scattering table's alpha instead of
   // a separate table (Bruneton 2017's approximation, halves the memory).

@@ -4,11 +4,15 @@
 #pragma once
 
 #include <cmath>
+#include <algorithm>
 #include <functional>
 
 #include "bake/atmosphere.h"
 
 namespace skybake::testing {
+
+inline double MaxAbs(double x) { return std::abs(x); }
+inline double MaxAbs(const Spectrum& x) { return std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)}); }
 
 template <typename T, typename F>
 T AdaptiveSimpson(const F& f, double a, double b, T fa, T fm, T fb, T whole, double tolerance, int depth) {
@@ -18,12 +22,7 @@ T AdaptiveSimpson(const F& f, double a, double b, T fa, T fm, T fb, T whole, dou
   T left = (m - a) / 6.0 * (fa + 4.0 * flm + fm);
   T right = (b - m) / 6.0 * (fm + 4.0 * frm + fb);
   T delta = left + right - whole;
-  double error = 0.0;
-  if constexpr (std::is_same_v<T, double>) {
-    error = std::abs(delta);
-  } else {
-    error = std::max({std::abs(delta.x), std::abs(delta.y), std::abs(delta.z)});
-  }
+  double error = MaxAbs(delta);
   if (depth <= 0 || error <= 15.0 * tolerance) return left + right + delta / 15.0;
   return AdaptiveSimpson(f, a, m, fa, flm, fm, left, 0.5 * tolerance, depth - 1) +
          AdaptiveSimpson(f, m, b, fm, frm, fb, right, 0.5 * tolerance, depth - 1);
@@ -33,7 +32,7 @@ T AdaptiveSimpson(const F& f, double a, double b, T fa, T fm, T fb, T whole, dou
 // sub-intervals first (so narrow features are not stepped over).
 template <typename T, typename F>
 T Integrate(const F& f, double a, double b, double tolerance, int pieces = 16) {
-  T sum = T(0.0);
+  T sum = 0.0 * f(a);
   double h = (b - a) / pieces;
   for (int i = 0; i < pieces; ++i) {
     double x0 = a + i * h, x1 = x0 + h, xm = 0.5 * (x0 + x1);
