@@ -130,7 +130,7 @@ TEST(SingleScattering, MatchesBruteForceQuadratureWithinHalfPercent) {
   std::printf("single scattering vs brute force: %d values (%d texels near the horizon): max relative error "
               "%.3g with the sun up, %.3g in twilight\n",
               compared, near_horizon, worst_day, worst_twilight);
-  EXPECT_GT(compared, 1000);
+  EXPECT_GE(compared, 600);  // 6 values per texel, less those below the table's scale
 }
 
 }  // namespace
