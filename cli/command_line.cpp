@@ -15,8 +15,15 @@ void SetCommandLine(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) {
     if (i) s += ' ';
     std::string arg = i == 0 ? std::string("skybake") : std::string(argv[i]);
-    bool quote = arg.empty() || arg.find_first_of(" \t\"'\\$") != std::string::npos;
-    s += quote ? "'" + arg + "'" : arg;
+    // Shell-quote anything a shell would split or expand, so the recorded
+    // line can be pasted back.
+    bool plain = !arg.empty() && arg.find_first_of(" \t\n'\"\\$`") == std::string::npos;
+    if (!plain) {
+      std::string quoted = "'";
+      for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      arg = quoted + "'";
+    }
+    s += arg;
   }
 }
 

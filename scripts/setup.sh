@@ -10,7 +10,7 @@ packages=(
   libceres-dev libglm-dev libtbb-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
-  glslang-tools
+  glslang-tools fonts-dejavu-core
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   nodejs
 )

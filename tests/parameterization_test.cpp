@@ -50,11 +50,15 @@ TEST(Parameterization, ScatteringRoundTripBothHalves) {
         // u_mu by ~1e-7, and a numerical ground test cannot decide.
         bool tangent = y == 0 || y == p.scattering_mu_size - 1;
         double tolerance = tangent ? 1e-5 : 1e-7;
-        if (!degenerate) EXPECT_NEAR(uvwz.z, (y + 0.5) / p.scattering_mu_size, tolerance) << "z " << z << " y " << y;
+        if (!degenerate) {
+          EXPECT_NEAR(uvwz.z, (y + 0.5) / p.scattering_mu_size, tolerance) << "z " << z << " y " << y;
+        }
         EXPECT_NEAR(uvwz.w, (z + 0.5) / p.scattering_r_size, 1e-9);
         // The lower half of the mu axis holds exactly the rays that hit the ground.
         EXPECT_EQ(t.ray_intersects_ground, y < p.scattering_mu_size / 2);
-        if (!tangent) EXPECT_EQ(glsl::RayIntersectsGround(p, t.r, t.mu), t.ray_intersects_ground) << "z " << z << " y " << y;
+        if (!tangent) {
+          EXPECT_EQ(glsl::RayIntersectsGround(p, t.r, t.mu), t.ray_intersects_ground) << "z " << z << " y " << y;
+        }
         ground += t.ray_intersects_ground;
       }
     }

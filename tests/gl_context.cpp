@@ -1,0 +1,336 @@
+#include "tests/gl_context.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#if SKYBAKE_HAVE_EGL
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GLES3/gl3.h>
+#endif
+
+namespace skybake::testing {
+
+#if SKYBAKE_HAVE_EGL
+
+namespace {
+
+constexpr int kRowWidth = 1024;
+
+// The GL entry points the helper uses, loaded with eglGetProcAddress.
+struct GlFunctions {
+#define SKYBAKE_GL_FUNCTIONS(X)                                                                              \
+  X(GLuint, CreateShader, (GLenum))                                                                          \
+  X(void, ShaderSource, (GLuint, GLsizei, const GLchar* const*, const GLint*))                               \
+  X(void, CompileShader, (GLuint))                                                                           \
+  X(void, GetShaderiv, (GLuint, GLenum, GLint*))                                                             \
+  X(void, GetShaderInfoLog, (GLuint, GLsizei, GLsizei*, GLchar*))                                            \
+  X(void, DeleteShader, (GLuint))                                                                            \
+  X(GLuint, CreateProgram, ())                                                                               \
+  X(void, AttachShader, (GLuint, GLuint))                                                                    \
+  X(void, LinkProgram, (GLuint))                                                                             \
+  X(void, GetProgramiv, (GLuint, GLenum, GLint*))                                                            \
+  X(void, GetProgramInfoLog, (GLuint, GLsizei, GLsizei*, GLchar*))                                           \
+  X(void, UseProgram, (GLuint))                                                                              \
+  X(void, DeleteProgram, (GLuint))                                                                           \
+  X(GLint, GetUniformLocation, (GLuint, const GLchar*))                                                      \
+  X(void, Uniform1i, (GLint, GLint))                                                                         \
+  X(void, GenTextures, (GLsizei, GLuint*))                                                                   \
+  X(void, DeleteTextures, (GLsizei, const GLuint*))                                                          \
+  X(void, BindTexture, (GLenum, GLuint))                                                                     \
+  X(void, ActiveTexture, (GLenum))                                                                           \
+  X(void, TexImage2D, (GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum, const void*))          \
+  X(void, TexParameteri, (GLenum, GLenum, GLint))                                                            \
+  X(void, GenFramebuffers, (GLsizei, GLuint*))                                                               \
+  X(void, DeleteFramebuffers, (GLsizei, const GLuint*))                                                      \
+  X(void, BindFramebuffer, (GLenum, GLuint))                                                                 \
+  X(void, FramebufferTexture2D, (GLenum, GLenum, GLenum, GLuint, GLint))                                     \
+  X(GLenum, CheckFramebufferStatus, (GLenum))                                                                \
+  X(void, GenVertexArrays, (GLsizei, GLuint*))                                                               \
+  X(void, DeleteVertexArrays, (GLsizei, const GLuint*))                                                      \
+  X(void, BindVertexArray, (GLuint))                                                                         \
+  X(void, Viewport, (GLint, GLint, GLsizei, GLsizei))                                                        \
+  X(void, DrawArrays, (GLenum, GLint, GLsizei))                                                              \
+  X(void, PixelStorei, (GLenum, GLint))                                                                      \
+  X(void, ReadPixels, (GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, void*))                               \
+  X(void, GetIntegerv, (GLenum, GLint*))                                                                     \
+  X(const GLubyte*, GetString, (GLenum))                                                                     \
+  X(GLenum, GetError, ())                                                                                    \
+  X(void, Finish, ())
+#define SKYBAKE_GL_MEMBER(ret, name, args) ret(GL_APIENTRY* name) args = nullptr;
+  SKYBAKE_GL_FUNCTIONS(SKYBAKE_GL_MEMBER)
+#undef SKYBAKE_GL_MEMBER
+
+  // False (with the missing name) if an entry point is unavailable.
+  bool Load(std::string* missing) {
+#define SKYBAKE_GL_LOAD(ret, name, args)                                              \
+  name = reinterpret_cast<ret(GL_APIENTRY*) args>(eglGetProcAddress("gl" #name)); \
+  if (!name) {                                                                        \
+    *missing = "gl" #name;                                                            \
+    return false;                                                                     \
+  }
+    SKYBAKE_GL_FUNCTIONS(SKYBAKE_GL_LOAD)
+#undef SKYBAKE_GL_LOAD
+    return true;
+  }
+};
+
+std::string EglErrorText(const char* what) {
+  char buffer[96];
+  std::snprintf(buffer, sizeof(buffer), "%s failed (EGL error 0x%04x)", what, static_cast<unsigned>(eglGetError()));
+  return buffer;
+}
+
+}  // namespace
+
+struct GlContext::Impl {
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+  GlFunctions gl;
+
+  void Check(const char* where) {
+    GLenum error = gl.GetError();
+    if (error != GL_NO_ERROR) {
+      char buffer[128];
+      std::snprintf(buffer, sizeof(buffer), "GL error 0x%04x after %s", static_cast<unsigned>(error), where);
+      throw std::runtime_error(buffer);
+    }
+  }
+
+  GLuint Compile(GLenum type, const std::string& source) {
+    GLuint shader = gl.CreateShader(type);
+    const char* text = source.c_str();
+    gl.ShaderSource(shader, 1, &text, nullptr);
+    gl.CompileShader(shader);
+    GLint ok = 0;
+    gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      char log[4096] = {};
+      gl.GetShaderInfoLog(shader, sizeof(log), nullptr, log);
+      gl.DeleteShader(shader);
+      throw std::runtime_error(std::string(type == GL_VERTEX_SHADER ? "vertex" : "fragment") +
+                               " shader does not compile:\n" + log + "\n--- source ---\n" + source);
+    }
+    return shader;
+  }
+};
+
+GlContext::GlContext(Api api) : api_(api), impl_(std::make_unique<Impl>()) {}
+
+GlContext::~GlContext() {
+  if (impl_ && impl_->context != EGL_NO_CONTEXT) {
+    eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(impl_->display, impl_->context);
+    // No eglTerminate: the surfaceless display is shared by every context of
+    // the process, and terminating it would pull contexts from other tests.
+  }
+}
+
+std::unique_ptr<GlContext> GlContext::Create(Api api, std::string* why_not) {
+  auto fail = [&](const std::string& reason) -> std::unique_ptr<GlContext> {
+    *why_not = "no headless GL: " + reason;
+    return nullptr;
+  };
+  auto get_platform_display =
+      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  if (!get_platform_display) return fail("eglGetPlatformDisplayEXT is unavailable");
+  EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  if (display == EGL_NO_DISPLAY) return fail(EglErrorText("eglGetPlatformDisplayEXT(SURFACELESS_MESA)"));
+  EGLint major = 0, minor = 0;
+  if (!eglInitialize(display, &major, &minor)) return fail(EglErrorText("eglInitialize"));
+
+  bool es = api == Api::kGles30;
+  if (!eglBindAPI(es ? EGL_OPENGL_ES_API : EGL_OPENGL_API)) return fail(EglErrorText("eglBindAPI"));
+  // The default EGL_SURFACE_TYPE is EGL_WINDOW_BIT, which a surfaceless
+  // display has none of; ask for pbuffer configs, and fall back to
+  // EGL_KHR_no_config_context where there are none.
+  const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
+                                      es ? EGL_OPENGL_ES3_BIT : EGL_OPENGL_BIT, EGL_NONE};
+  EGLConfig config = nullptr;
+  EGLint configs = 0;
+  if (!eglChooseConfig(display, config_attributes, &config, 1, &configs) || configs < 1) {
+    const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
+    if (!extensions || !std::strstr(extensions, "EGL_KHR_no_config_context"))
+      return fail("no EGL config for " + std::string(es ? "OpenGL ES 3" : "OpenGL") + " on the surfaceless display");
+    config = EGL_NO_CONFIG_KHR;
+  }
+  const EGLint es_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0, EGL_NONE};
+  const EGLint gl_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, es ? es_attributes : gl_attributes);
+  if (context == EGL_NO_CONTEXT) return fail(EglErrorText("eglCreateContext"));
+
+  std::unique_ptr<GlContext> result(new GlContext(api));
+  result->impl_->display = display;
+  result->impl_->context = context;
+  // Surfaceless: all rendering goes to framebuffer objects.
+  if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) return fail(EglErrorText("eglMakeCurrent"));
+  std::string missing;
+  if (!result->impl_->gl.Load(&missing)) return fail(missing + " cannot be loaded");
+
+  // RGBA32F must be renderable (core in desktop 3.3; EXT_color_buffer_float in ES 3.0).
+  GlFunctions& gl = result->impl_->gl;
+  GLuint texture = 0, framebuffer = 0;
+  gl.GenTextures(1, &texture);
+  gl.BindTexture(GL_TEXTURE_2D, texture);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, 1, 1, 0, GL_RGBA, GL_FLOAT, nullptr);
+  gl.GenFramebuffers(1, &framebuffer);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+  bool complete = gl.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl.DeleteFramebuffers(1, &framebuffer);
+  gl.DeleteTextures(1, &texture);
+  gl.GetError();
+  if (!complete) return fail("RGBA32F is not renderable on " + result->Description());
+  return result;
+}
+
+std::string GlContext::VersionLine() const {
+  return api_ == Api::kGles30 ? "#version 300 es" : "#version 330 core";
+}
+
+std::string GlContext::Description() const {
+  auto text = [&](GLenum name) {
+    const GLubyte* s = impl_->gl.GetString(name);
+    return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
+  };
+  return text(GL_RENDERER) + ", " + text(GL_VERSION);
+}
+
+std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source, const std::vector<Vec4>& inputs,
+                                             int inputs_per_item) {
+  if (inputs_per_item < 1 || inputs.size() % inputs_per_item != 0)
+    throw std::runtime_error("RunFragmentPass: inputs must hold a whole number of items");
+  size_t items = inputs.size() / inputs_per_item;
+  if (items == 0) return {};
+  Impl& s = *impl_;
+  GlFunctions& gl = s.gl;
+  GLint max_size = 0;
+  gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  int width = static_cast<int>(std::min<size_t>(items, std::max(1, std::min(kRowWidth, max_size / inputs_per_item))));
+  int height = static_cast<int>((items + width - 1) / width);
+  if (height > max_size) throw std::runtime_error("RunFragmentPass: too many items for one pass");
+
+  std::string prologue = VersionLine() + "\n" +
+                         "precision highp float;\nprecision highp int;\nprecision highp sampler2D;\n";
+  // A triangle that covers the viewport, from gl_VertexID alone (no buffers).
+  std::string vertex = prologue +
+                       "void main() {\n"
+                       "  vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
+                       "  gl_Position = vec4(p, 0.0, 1.0);\n"
+                       "}\n";
+  std::string fragment = prologue + "uniform sampler2D skybake_inputs;\n" +
+                         "uniform int skybake_row_width;\n"
+                         "uniform int skybake_inputs_per_item;\n"
+                         "out vec4 skybake_output;\n"
+                         "int skybake_item() {\n"
+                         "  return int(gl_FragCoord.y) * skybake_row_width + int(gl_FragCoord.x);\n"
+                         "}\n"
+                         "vec4 skybake_input(int k) {\n"
+                         "  ivec2 texel = ivec2(int(gl_FragCoord.x) * skybake_inputs_per_item + k, int(gl_FragCoord.y));\n"
+                         "  return texelFetch(skybake_inputs, texel, 0);\n"
+                         "}\n" +
+                         "#line 1\n" + fragment_source;
+
+  GLuint vs = s.Compile(GL_VERTEX_SHADER, vertex);
+  GLuint fs = 0;
+  try {
+    fs = s.Compile(GL_FRAGMENT_SHADER, fragment);
+  } catch (...) {
+    gl.DeleteShader(vs);
+    throw;
+  }
+  GLuint program = gl.CreateProgram();
+  gl.AttachShader(program, vs);
+  gl.AttachShader(program, fs);
+  gl.LinkProgram(program);
+  gl.DeleteShader(vs);
+  gl.DeleteShader(fs);
+  GLint linked = 0;
+  gl.GetProgramiv(program, GL_LINK_STATUS, &linked);
+  if (!linked) {
+    char log[4096] = {};
+    gl.GetProgramInfoLog(program, sizeof(log), nullptr, log);
+    gl.DeleteProgram(program);
+    throw std::runtime_error(std::string("shaders do not link:\n") + log);
+  }
+
+  // Inputs, padded to whole rows.
+  std::vector<float> texels(static_cast<size_t>(width) * inputs_per_item * height * 4, 0.0f);
+  for (size_t i = 0; i < inputs.size(); ++i)
+    for (int c = 0; c < 4; ++c) texels[i * 4 + c] = inputs[i][c];
+  GLuint textures[2] = {0, 0}, framebuffer = 0, vao = 0;
+  gl.GenTextures(2, textures);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindTexture(GL_TEXTURE_2D, textures[0]);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width * inputs_per_item, height, 0, GL_RGBA, GL_FLOAT, texels.data());
+  // Float textures are not filterable in ES 3.0; texelFetch ignores filtering
+  // but the texture must still be complete.
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl.BindTexture(GL_TEXTURE_2D, textures[1]);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl.GenFramebuffers(1, &framebuffer);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, textures[1], 0);
+  GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  std::vector<float> pixels(static_cast<size_t>(width) * height * 4, 0.0f);
+  try {
+    if (status != GL_FRAMEBUFFER_COMPLETE) throw std::runtime_error("RGBA32F framebuffer is incomplete");
+    gl.BindTexture(GL_TEXTURE_2D, textures[0]);
+    gl.UseProgram(program);
+    gl.Uniform1i(gl.GetUniformLocation(program, "skybake_inputs"), 0);
+    gl.Uniform1i(gl.GetUniformLocation(program, "skybake_row_width"), width);
+    gl.Uniform1i(gl.GetUniformLocation(program, "skybake_inputs_per_item"), inputs_per_item);
+    gl.GenVertexArrays(1, &vao);  // core profiles draw nothing without a bound VAO
+    gl.BindVertexArray(vao);
+    gl.Viewport(0, 0, width, height);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, pixels.data());
+    gl.Finish();
+    s.Check("the fragment pass");
+  } catch (...) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteFramebuffers(1, &framebuffer);
+    gl.DeleteTextures(2, textures);
+    gl.DeleteVertexArrays(1, &vao);
+    gl.DeleteProgram(program);
+    throw;
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl.DeleteFramebuffers(1, &framebuffer);
+  gl.DeleteTextures(2, textures);
+  gl.DeleteVertexArrays(1, &vao);
+  gl.DeleteProgram(program);
+
+  std::vector<Vec4> outputs(items);
+  for (size_t i = 0; i < items; ++i)
+    for (int c = 0; c < 4; ++c) outputs[i][c] = pixels[i * 4 + c];
+  return outputs;
+}
+
+#else  // !SKYBAKE_HAVE_EGL
+
+struct GlContext::Impl {};
+GlContext::GlContext(Api api) : api_(api) {}
+GlContext::~GlContext() = default;
+std::unique_ptr<GlContext> GlContext::Create(Api, std::string* why_not) {
+  *why_not = "no headless GL: the tests were built without EGL and GLES 3 headers";
+  return nullptr;
+}
+std::string GlContext::VersionLine() const { return api_ == Api::kGles30 ? "#version 300 es" : "#version 330 core"; }
+std::string GlContext::Description() const { return "none"; }
+std::vector<Vec4> GlContext::RunFragmentPass(const std::string&, const std::vector<Vec4>&, int) {
+  throw std::runtime_error("no headless GL");
+}
+
+#endif
+
+}  // namespace skybake::testing
