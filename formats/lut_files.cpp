@@ -100,7 +100,6 @@ void WriteExr(const fs::path& path, const glsl::Texture& texture, const TableSpe
   char wavelengths[96];
   std::snprintf(wavelengths, sizeof(wavelengths), "%.17g,%.17g,%.17g", w.x, w.y, w.z);
   header.insert("skybake.generator", Imf::StringAttribute("skybake " SKYBAKE_VERSION));
-  header.insert("skybake.command", Imf::StringAttribute(options.command_line));
   header.insert("skybake.table", Imf::StringAttribute(spec.name));
   header.insert("skybake.encoding", Imf::StringAttribute(spec.encoding));
   header.insert("skybake.units", Imf::StringAttribute(spec.units));

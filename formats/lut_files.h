@@ -9,7 +9,9 @@
 // (x = nu * mu_s_size + mu_s, y = mu, z = r) is (nu_size * mu_s_size) wide and
 // (r_size * mu_size) tall. Attributes under "skybake." record the table kind,
 // channel encoding, units, wavelengths, the runtime parameters (JSON), the
-// resolved atmosphere (TOML), and the tool version and command line.
+// resolved atmosphere (TOML), and the tool version. The command line is
+// recorded in the manifest only, so table files depend on nothing but the
+// atmosphere and the settings (byte-identical across runs and thread counts).
 #pragma once
 
 #include <filesystem>
@@ -21,7 +23,7 @@ namespace skybake {
 
 struct WriteOptions {
   bool half = false;         // store half floats instead of float32
-  std::string command_line;  // recorded in every file
+  std::string command_line;  // recorded in the manifest
 };
 
 // Writes every table and then the manifest, each atomically. IoError on failure.

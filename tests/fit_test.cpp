@@ -28,6 +28,7 @@
 #include "bake/atmosphere.h"
 #include "bake/config.h"
 #include "bake/errors.h"
+#include "test_util.h"
 #include "fit/codegen.h"
 #include "fit/dome_mesh.h"
 #include "fit/forms.h"
@@ -566,50 +567,11 @@ TEST(Fit, IdentifiersAreSafeAndUnique) {
 
 // ---- small utilities ----
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("skybake_fit_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-void WriteText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// Runs a shell command, capturing stdout and stderr; returns the exit code.
-int RunCommand(const std::string& command, const TempDir& dir, std::string* out = nullptr, std::string* err = nullptr) {
-  fs::path out_file = dir.path() / "run.stdout", err_file = dir.path() / "run.stderr";
-  int status = std::system((command + " >" + ShellQuote(out_file) + " 2>" + ShellQuote(err_file)).c_str());
-  if (out) *out = ReadFileText(out_file);
-  if (err) *err = ReadFileText(err_file);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
-}
+using testing::Lines;
+using testing::RunCommand;
+using testing::ShellQuote;
+using testing::TempDir;
+using testing::WriteText;
 
 // ---- generated code ----
 

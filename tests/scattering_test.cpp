@@ -135,3 +135,117 @@ TEST(SingleScattering, MatchesBruteForceQuadratureWithinHalfPercent) {
 
 }  // namespace
 }  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// Small tables keep four bakes fast; the decay of orders does not depend on
+// the resolution.
+BakeSettings SmallSettings(int orders) {
+  BakeSettings s;
+  s.orders = orders;
+  s.transmittance_width = 128, s.transmittance_height = 32;
+  s.scattering_r_size = 8, s.scattering_mu_size = 32, s.scattering_mu_s_size = 8, s.scattering_nu_size = 4;
+  s.irradiance_width = 32, s.irradiance_height = 8;
+  s.ray_samples = 32;
+  s.sphere_samples = 8;
+  return s;
+}
+
+TEST(MultipleScattering, EachOrderSmallerThanThePreviousForEarth) {
+  // Order k's contribution = table(k orders) - table(k - 1 orders), summed
+  // over the daylight texels (sun above the horizon) per channel.
+  std::vector<LutSet> bakes;
+  for (int orders = 1; orders <= 4; ++orders) bakes.push_back(Bake(testing::Earth(), SmallSettings(orders)));
+  const glsl::AtmosphereParameters& p = bakes[0].parameters;
+  std::vector<Spectrum> order_sum(5, Spectrum(0.0));
+  for (int z = 0; z < p.scattering_r_size; ++z) {
+    for (int y = 0; y < p.scattering_mu_size; ++y) {
+      for (int x = 0; x < bakes[0].scattering.width; ++x) {
+        if (GetScatteringTexel(p, x, y, z).mu_s < 0.0) continue;
+        for (int k = 1; k <= 4; ++k) {
+          glsl::vec4 now = bakes[k - 1].scattering.Fetch(x, y, z);
+          glsl::vec4 before = k > 1 ? bakes[k - 2].scattering.Fetch(x, y, z) : glsl::vec4(0.0);
+          order_sum[k] += Spectrum(now - before);
+          if (k == 1) order_sum[1] += Spectrum(bakes[0].single_mie_scattering.Fetch(x, y, z));
+        }
+      }
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 2; k <= 4; ++k) {
+      EXPECT_GT(order_sum[k][c], 0.0) << "order " << k << " channel " << c;
+      EXPECT_LT(order_sum[k][c], order_sum[k - 1][c]) << "order " << k << " channel " << c;
+    }
+    double fraction = (order_sum[2][c] + order_sum[3][c] + order_sum[4][c]) / order_sum[1][c];
+    std::printf("channel %d: orders 2..4 / single = %.3f (order ratios %.3f %.3f)\n", c, fraction,
+                order_sum[3][c] / order_sum[2][c], order_sum[4][c] / order_sum[3][c]);
+    // Earth's clear sky: multiple scattering adds a few tens of percent to
+    // single scattering (more in blue, which scatters more), never more than it.
+    EXPECT_GT(fraction, 0.05);
+    EXPECT_LT(fraction, 1.0);
+  }
+}
+
+TEST(Twin, LookupAtTexelCentresReturnsStoredValues) {
+  LutSet luts = Bake(testing::Earth(), SmallSettings(2));
+  Twin twin(MakeTwinTables(luts));
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  std::mt19937 rng(5);
+  int checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    int x = rng() % luts.scattering.width, y = rng() % p.scattering_mu_size, z = rng() % p.scattering_r_size;
+    ScatteringTexel t = GetScatteringTexel(p, x, y, z);
+    bool degenerate = t.ray_intersects_ground && t.r == p.bottom_radius;  // ground slice: see parameterization_test
+    bool tangent = y == 0 || y == p.scattering_mu_size - 1;
+    if (degenerate || tangent) continue;
+    glsl::vec4 stored = luts.scattering.Fetch(x, y, z);
+    glsl::vec4 looked_up = twin.Scattering(t.r, t.mu, t.mu_s, t.grid_nu, t.ray_intersects_ground);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(looked_up[c], stored[c], 1e-5 * std::abs(stored[c]) + 1e-12);
+    ++checked;
+  }
+  EXPECT_GT(checked, 1500);
+  for (int y = 0; y < p.transmittance_height; ++y) {
+    for (int x = 0; x < p.transmittance_width; ++x) {
+      double r, mu;
+      glsl::GetRMuFromTransmittanceTextureUv(
+          p, glsl::vec2((x + 0.5) / p.transmittance_width, (y + 0.5) / p.transmittance_height), r, mu);
+      glsl::vec3 stored(luts.transmittance.Fetch(x, y));
+      glsl::vec3 looked_up = twin.OpticalDepthToTop(r, mu);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(looked_up[c], stored[c], 1e-6 * stored[c] + 1e-9);
+    }
+  }
+  for (int y = 0; y < p.irradiance_height; ++y) {
+    for (int x = 0; x < p.irradiance_width; ++x) {
+      double r, mu_s;
+      glsl::GetRMuSFromIrradianceTextureUv(
+          p, glsl::vec2((x + 0.5) / p.irradiance_width, (y + 0.5) / p.irradiance_height), r, mu_s);
+      glsl::vec3 stored(luts.irradiance.Fetch(x, y));
+      glsl::vec3 looked_up = twin.Irradiance(r, mu_s);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(looked_up[c], stored[c], 1e-6 * stored[c] + 1e-12);
+    }
+  }
+}
+
+TEST(Bake, TablesFiniteAndNonNegative) {
+  LutSet luts = Bake(testing::Earth(), SmallSettings(4));
+  for (const glsl::Texture* t : {&luts.transmittance, &luts.irradiance, &luts.scattering, &luts.single_mie_scattering}) {
+    for (float v : t->texels) {
+      ASSERT_TRUE(std::isfinite(v));
+      ASSERT_GE(v, 0.0f);
+    }
+  }
+}
+
+TEST(Bake, SameResultWithOneOrTwoThreads) {
+  BakeSettings one = SmallSettings(3), two = SmallSettings(3);
+  one.threads = 1, two.threads = 2;
+  LutSet a = Bake(testing::Earth(), one), b = Bake(testing::Earth(), two);
+  EXPECT_EQ(a.scattering.texels, b.scattering.texels);
+  EXPECT_EQ(a.single_mie_scattering.texels, b.single_mie_scattering.texels);
+  EXPECT_EQ(a.irradiance.texels, b.irradiance.texels);
+  EXPECT_EQ(a.transmittance.texels, b.transmittance.texels);
+}
+
+}  // namespace
+}  // namespace skybake
