@@ -1,9 +1,6 @@
 // Atmosphere files, presets, validation and the `presets` / `validate` commands.
 #include "bake/config.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -20,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/errors.h"
+#include "test_util.h"
 
 namespace skybake {
 namespace {
@@ -33,33 +31,11 @@ const std::set<std::string> kPresetNames = {"earth",      "earth-clear-2008", "l
                                             "heavy-haze", "light-fog",        "heavy-fog",
                                             "mars"};
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// A scratch directory for this test process, removed when it exits.
-class Scratch {
- public:
-  Scratch()
-      : dir_(fs::temp_directory_path() / ("skybake_config_test_" + std::to_string(getpid()))) {
-    fs::create_directories(dir_);
-  }
-  ~Scratch() {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-  const fs::path& dir() const { return dir_; }
-
- private:
-  fs::path dir_;
-};
+using testing::ReadText;
 
 const fs::path& ScratchDir() {
-  static const Scratch scratch;
-  return scratch.dir();
+  static const testing::TempDir scratch;
+  return scratch.path();
 }
 
 fs::path WriteScratchFile(const std::string& name, const std::string& text) {
@@ -627,15 +603,9 @@ struct CommandResult {
 };
 
 CommandResult RunSkybake(const std::string& arguments) {
-  static int counter = 0;
-  fs::path base = ScratchDir() / ("run" + std::to_string(counter++));
-  std::string command = std::string("'") + SKYBAKE_EXE + "' " + arguments + " >'" +
-                        base.string() + ".out' 2>'" + base.string() + ".err'";
-  int status = std::system(command.c_str());
+  static const testing::TempDir dir;
   CommandResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.out = ReadText(base.string() + ".out");
-  result.err = ReadText(base.string() + ".err");
+  result.exit_code = testing::RunCommand(testing::Skybake() + " " + arguments, dir, &result.out, &result.err);
   return result;
 }
 
