@@ -1,12 +1,13 @@
 // Validation of the independent reference solver (reference/): sampling
-// routines and quadrature rules. Sampling checks use fixed seeds, so they
-// are deterministic; SKYBAKE_REFERENCE_TEST_VERBOSE=1 prints the measured
-// figures.
+// routines, quadrature rules and the medium's tracking and optical depths.
+// Statistical checks use fixed seeds, so they are deterministic;
+// SKYBAKE_REFERENCE_TEST_VERBOSE=1 prints the measured figures.
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -14,15 +15,18 @@
 #include <glm/geometric.hpp>
 
 #include "bake/atmosphere.h"
+#include "reference/layered_medium.h"
 #include "reference/phase_sampling.h"
 #include "reference/quadrature.h"
 #include "reference/random.h"
+#include "shaders_runtime/runtime.h"
 
 namespace skybake::reference {
 namespace {
 
 using glm::dvec3;
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegree = kPi / 180.0;
 
 void Note(const char* format, ...) {
   if (!std::getenv("SKYBAKE_REFERENCE_TEST_VERBOSE")) return;
@@ -30,6 +34,36 @@ void Note(const char* format, ...) {
   va_start(args, format);
   std::vprintf(format, args);
   va_end(args);
+}
+
+// Earth, with the parameter values of DESIGN.md (Bruneton's 2017 set).
+Atmosphere Earth() {
+  Atmosphere a;
+  a.name = "earth";
+  a.bottom_radius_m = 6360e3;
+  a.top_radius_m = 6420e3;
+  a.ground_albedo = Spectrum(0.1);
+  a.solar_irradiance = Spectrum(1.474, 1.8504, 1.91198);
+  a.sun_angular_radius_rad = 0.004675;
+  a.mu_s_min = std::cos(102.0 * kDegree);
+  Constituent rayleigh;
+  rayleigh.name = "rayleigh";
+  rayleigh.density.layers = {DensityLayer{0.0, 1.0, -1.0 / 8000.0, 0.0, 0.0}};
+  rayleigh.scattering_per_m = Spectrum(5.802e-6, 13.558e-6, 33.1e-6);
+  rayleigh.phase = {PhaseKind::kRayleigh, 0.0};
+  Constituent mie;
+  mie.name = "mie";
+  mie.density.layers = {DensityLayer{0.0, 1.0, -1.0 / 1200.0, 0.0, 0.0}};
+  mie.scattering_per_m = Spectrum(3.996e-6);
+  mie.absorption_per_m = Spectrum(0.444e-6);
+  mie.phase = {PhaseKind::kCornetteShanks, 0.8};
+  Constituent ozone;
+  ozone.name = "ozone";
+  ozone.density.layers = {DensityLayer{25000.0, 0.0, 0.0, 1.0 / 15000.0, -2.0 / 3.0},
+                          DensityLayer{0.0, 0.0, 0.0, -1.0 / 15000.0, 8.0 / 3.0}};
+  ozone.absorption_per_m = Spectrum(0.650e-6, 1.881e-6, 0.085e-6);
+  a.constituents = {rayleigh, mie, ozone};
+  return a;
 }
 
 // ---------------------------------------------------------------------------
@@ -128,6 +162,111 @@ TEST(ReferenceQuadrature, GaussKronrodIsExactForPolynomials) {
   }
   GaussKronrodResult e = GaussKronrod15([](double t) { return Spectrum(std::exp(t)); }, 0.0, 1.0);
   EXPECT_NEAR(e.kronrod.x, std::exp(1.0) - 1.0, 1e-15);
+}
+
+TEST(ReferenceQuadrature, OpticalDepthMatchesClosedForms) {
+  Atmosphere a = Earth();
+  a.constituents.resize(1);  // Rayleigh only: exp(-h / H)
+  LayeredMedium medium(a);
+  const double H = 8000.0, sigma = 33.1e-6;
+  // Straight up from altitude h0 to the top: sigma H (e^-h0/H - e^-60km/H).
+  for (double h0 : {0.0, 1500.0, 30000.0}) {
+    double r = a.bottom_radius_m + h0;
+    OpticalDepthEstimate tau = medium.OpticalDepth(r, 1.0, 0.0, a.top_radius_m - r, 1e-12);
+    double exact = sigma * H * (std::exp(-h0 / H) - std::exp(-60000.0 / H));
+    EXPECT_NEAR(tau.value.z, exact, 1e-12 * exact) << h0;
+    EXPECT_LT(tau.error.z, 1e-9 * exact);
+  }
+  // A constant layer crossed on a grazing chord: sigma x length.
+  Atmosphere slab = Earth();
+  slab.constituents.resize(1);
+  slab.constituents[0].density.layers = {DensityLayer{20000.0, 0.0, 0.0, 0.0, 1.0},
+                                         DensityLayer{0.0, 0.0, 0.0, 0.0, 0.0}};
+  LayeredMedium slab_medium(slab);
+  double r = slab.bottom_radius_m + 5000.0, mu = -0.02;
+  double length = glsl::DistanceToTopAtmosphereBoundary(slab_medium.geometry(), r, mu);
+  // The chord inside the 20 km layer, from the ray's own sphere crossings.
+  double b = r * mu, c = r * r - std::pow(slab.bottom_radius_m + 20000.0, 2);
+  double inside = -b + std::sqrt(b * b - c);
+  OpticalDepthEstimate tau = slab_medium.OpticalDepth(r, mu, 0.0, length, 1e-12);
+  EXPECT_NEAR(tau.value.z, sigma * inside, 1e-9 * sigma * inside);
+}
+
+TEST(ReferenceMedium, MajorantsBoundTheExtinction) {
+  // Earth, plus a layer whose formula peaks inside a shell (exp + linear)
+  // and a tabulated profile.
+  Atmosphere a = Earth();
+  Constituent bump;
+  bump.name = "bump";
+  bump.density.layers = {DensityLayer{0.0, -1.0, -1.0 / 3000.0, 1.0 / 20000.0, 0.5}};
+  bump.scattering_per_m = Spectrum(2e-6);
+  a.constituents.push_back(bump);
+  Constituent table;
+  table.name = "table";
+  table.density.kind = DensityProfile::Kind::kTabulated;
+  table.density.altitudes_m = {0.0, 3000.0, 3500.0, 12000.0};
+  table.density.densities = {0.2, 1.0, 0.1, 0.0};
+  table.scattering_per_m = Spectrum(5e-6);
+  a.constituents.push_back(table);
+  LayeredMedium medium(a);
+  Pcg32 rng(3, 4);
+  for (int i = 0; i < 200000; ++i) {
+    double r = a.bottom_radius_m + (a.top_radius_m - a.bottom_radius_m) * rng.Uniform();
+    Spectrum extinction = medium.Extinction(r);
+    int s = medium.ShellIndex(r);
+    for (int w = 0; w < kWavelengthCount; ++w) ASSERT_LE(extinction[w], medium.Majorant(s, w)) << r;
+  }
+}
+
+TEST(ReferenceMedium, FreeFlightsEscapeWithTheTransmittance) {
+  // Delta tracking: the fraction of free flights that cross a ray without a
+  // collision is T = exp(-tau); binomial sigma = sqrt(T (1 - T) / n).
+  LayeredMedium medium(Earth());
+  const glsl::AtmosphereParameters& g = medium.geometry();
+  const int n = 100000;
+  struct Ray {
+    double altitude, mu;
+    int w;
+  };
+  for (Ray ray : {Ray{0.0, 1.0, 2}, Ray{0.0, 0.02, 2}, Ray{0.0, 0.02, 0}, Ray{8000.0, -0.1, 1}}) {
+    double r = g.bottom_radius + ray.altitude;
+    bool ground = glsl::RayIntersectsGround(g, r, ray.mu);
+    double length = ground ? glsl::DistanceToBottomAtmosphereBoundary(g, r, ray.mu)
+                           : glsl::DistanceToTopAtmosphereBoundary(g, r, ray.mu);
+    double transmittance = std::exp(-medium.OpticalDepth(r, ray.mu, 0.0, length, 1e-10).value[ray.w]);
+    Pcg32 rng(99, 7);
+    int crossed = 0;
+    for (int i = 0; i < n; ++i) {
+      RayEvent e = medium.SampleFreeFlight(r, ray.mu, std::numeric_limits<double>::infinity(), ray.w, rng);
+      if (e.end != RayEnd::kCollision) {
+        ++crossed;
+        EXPECT_EQ(e.end, ground ? RayEnd::kGround : RayEnd::kSpace);
+        EXPECT_NEAR(e.distance, length, 1e-6 * length);
+      }
+    }
+    double sigma = std::sqrt(transmittance * (1.0 - transmittance) / n);
+    EXPECT_NEAR(double(crossed) / n, transmittance, 4.0 * sigma) << ray.altitude << " " << ray.mu;
+  }
+}
+
+TEST(ReferenceMedium, RatioTrackingIsUnbiased) {
+  LayeredMedium medium(Earth());
+  const glsl::AtmosphereParameters& g = medium.geometry();
+  double r = g.bottom_radius + 500.0, mu = 0.05;
+  double length = glsl::DistanceToTopAtmosphereBoundary(g, r, mu);
+  Pcg32 rng(5, 6);
+  for (int w = 0; w < kWavelengthCount; ++w) {
+    double exact = std::exp(-medium.OpticalDepth(r, mu, 0.0, length, 1e-10).value[w]);
+    const int n = 50000;
+    double sum = 0.0, sum2 = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double t = medium.RatioTrackingTransmittance(r, mu, length, w, rng);
+      sum += t;
+      sum2 += t * t;
+    }
+    double mean = sum / n, sigma = std::sqrt((sum2 / n - mean * mean) / n);
+    EXPECT_NEAR(mean, exact, 4.0 * sigma + 1e-12) << w;
+  }
 }
 
 }  // namespace
