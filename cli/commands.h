@@ -13,5 +13,6 @@ void AddPresetsCommand(CLI::App& app);
 void AddValidateCommand(CLI::App& app);
 void AddBakeCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);
+void AddReferenceCommand(CLI::App& app);
 
 }  // namespace skybake::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddValidateCommand(app);
   skybake::cli::AddBakeCommand(app);
   skybake::cli::AddEvalCommand(app);
+  skybake::cli::AddReferenceCommand(app);
 
   try {
     app.parse(argc, argv);

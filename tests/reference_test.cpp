@@ -29,6 +29,7 @@
 #include "reference/path_tracer.h"
 #include "reference/phase_sampling.h"
 #include "reference/quadrature.h"
+#include "reference/query_csv.h"
 #include "reference/random.h"
 #include "shaders_runtime/runtime.h"
 
@@ -930,6 +931,69 @@ TEST(ReferenceSettings, RejectsInvalidInput) {
   a = Earth();
   a.constituents[1].phase.g = 1.0;
   EXPECT_THROW(PathTracer{a}, InputError);
+}
+
+TEST(ReferenceCsv, ParsesQueriesAndWritesResults) {
+  const std::string text =
+      "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,normal_zenith_deg\n"
+      "0,0,30,0,0\n"
+      "\n"
+      "-5,80,60,90,\n";
+  QueryTable table = ParseQueryCsv(text, "q.csv");
+  ASSERT_EQ(table.queries.size(), 2u);
+  EXPECT_TRUE(table.has_normal);
+  EXPECT_FALSE(table.has_distance);
+  EXPECT_TRUE(table.queries[0].has_normal);
+  EXPECT_FALSE(table.queries[1].has_normal);
+  EXPECT_EQ(table.queries[1].altitude_m, 0.0);  // below the ground: on it
+
+  Atmosphere a = Earth();
+  PathTracer tracer(a);
+  Settings settings;
+  settings.paths = 2 * kPathsPerBlock;
+  std::vector<Result> results;
+  for (size_t i = 0; i < table.queries.size(); ++i) results.push_back(tracer.Evaluate(table.queries[i], settings, i));
+  std::string csv = FormatResultCsv(table, results, a.wavelengths_nm);
+  std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_EQ(header,
+            "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,normal_zenith_deg,"
+            "radiance_680nm,radiance_550nm,radiance_440nm,"
+            "radiance_stderr_680nm,radiance_stderr_550nm,radiance_stderr_440nm,"
+            "transmittance_680nm,transmittance_550nm,transmittance_440nm,"
+            "sun_irradiance_680nm,sun_irradiance_550nm,sun_irradiance_440nm,"
+            "sky_irradiance_680nm,sky_irradiance_550nm,sky_irradiance_440nm,"
+            "sky_irradiance_stderr_680nm,sky_irradiance_stderr_550nm,sky_irradiance_stderr_440nm,"
+            "transmittance_error_680nm,transmittance_error_550nm,transmittance_error_440nm");
+  // Every row has as many fields as the header.
+  size_t columns = std::count(header.begin(), header.end(), ',') + 1;
+  size_t begin = csv.find('\n') + 1;
+  int rows = 0;
+  while (begin < csv.size()) {
+    size_t end = csv.find('\n', begin);
+    std::string row = csv.substr(begin, end - begin);
+    EXPECT_EQ(std::count(row.begin(), row.end(), ',') + 1, static_cast<long>(columns)) << row;
+    begin = end + 1;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2);
+
+  auto fails = [](const std::string& bad, const std::string& message) {
+    try {
+      ParseQueryCsv(bad, "q.csv");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  fails("", "empty query file");
+  fails("altitude_m,view_zenith_deg,sun_zenith_deg\n", "missing column 'view_sun_azimuth_deg'");
+  fails("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,colour\n", "q.csv:1: unknown column");
+  fails("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,190,30,0\n",
+        "q.csv:2: view_zenith_deg = 190 is outside [0, 180]");
+  fails("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,distance_m\n0,10,30,0,-1\n",
+        "distance_m = -1 is negative");
+  fails("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,x,30,0\n", "is not a number");
+  fails("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,10,30\n", "expected 4 fields, got 3");
 }
 
 }  // namespace
