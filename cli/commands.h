@@ -14,5 +14,6 @@ void AddValidateCommand(CLI::App& app);
 void AddBakeCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
+void AddReferenceCommand(CLI::App& app);
 
 }  // namespace skybake::cli

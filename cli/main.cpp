@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddBakeCommand(app);
   skybake::cli::AddEvalCommand(app);
   skybake::cli::AddFitCommand(app);
+  skybake::cli::AddReferenceCommand(app);
 
   try {
     app.parse(argc, argv);

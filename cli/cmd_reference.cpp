@@ -1,0 +1,110 @@
+// `skybake reference`: answers the queries of `skybake eval` with the
+// independent Monte Carlo reference (reference/path_tracer.h), each Monte
+// Carlo figure with its standard error. Method: docs/reference.md.
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bake/config.h"
+#include "bake/errors.h"
+#include "cli/commands.h"
+#include "formats/file_io.h"
+#include "reference/path_tracer.h"
+#include "reference/query_csv.h"
+
+namespace skybake::cli {
+
+namespace {
+
+struct ReferenceOptions {
+  std::string atmosphere;
+  std::string input;
+  std::string output;
+  std::string sun_transmittance = "quadrature";
+  reference::Settings settings;
+  bool quiet = false;
+};
+
+void RunReference(const ReferenceOptions& o) {
+  reference::Settings settings = o.settings;
+  if (o.sun_transmittance == "ratio-tracking") {
+    settings.sun_transmittance = reference::SunTransmittanceMethod::kRatioTracking;
+  } else if (o.sun_transmittance != "quadrature") {
+    throw UsageError("--sun-transmittance must be 'quadrature' or 'ratio-tracking', not '" + o.sun_transmittance +
+                     "'");
+  }
+  settings.Validate();
+  std::string text = ReadFileText(o.input);
+  reference::QueryTable table =
+      reference::ParseQueryCsv(text, std::filesystem::path(o.input).filename().string());
+  Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
+  reference::PathTracer tracer(atmosphere);
+
+  const bool progress = !o.quiet && isatty(fileno(stderr));
+  std::vector<reference::Result> results;
+  double seconds = 0.0;
+  int64_t truncated = 0;
+  for (size_t row = 0; row < table.queries.size(); ++row) {
+    // The row number separates the random streams of the rows.
+    results.push_back(tracer.Evaluate(table.queries[row], settings, row));
+    seconds += results.back().statistics.seconds;
+    truncated += results.back().statistics.truncated;
+    if (progress) {
+      std::fprintf(stderr, "\rreference: %zu/%zu queries, %.1f s", row + 1, table.queries.size(), seconds);
+      std::fflush(stderr);
+    }
+  }
+  if (progress) std::fprintf(stderr, "\n");
+  if (truncated > 0 && !o.quiet) {
+    std::fprintf(stderr,
+                 "skybake: warning: %lld paths reached %d scattering events and were stopped (optically very "
+                 "thick medium); the radiance of those paths' later orders is missing\n",
+                 static_cast<long long>(truncated), reference::kMaxEventsPerPath);
+  }
+  std::string out = reference::FormatResultCsv(table, results, atmosphere.wavelengths_nm);
+  if (o.output.empty() || o.output == "-") {
+    std::fputs(out.c_str(), stdout);
+  } else {
+    WriteFileAtomically(o.output, out);
+  }
+}
+
+}  // namespace
+
+void AddReferenceCommand(CLI::App& app) {
+  auto o = std::make_shared<ReferenceOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "reference",
+      "Answer eval's queries (CSV) with the independent Monte Carlo reference: radiance and sky irradiance "
+      "with standard errors, transmittance and sun irradiance by quadrature");
+  cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
+  cmd->add_option("--in", o->input,
+                  "Query CSV: altitude_m, view_zenith_deg, sun_zenith_deg, view_sun_azimuth_deg "
+                  "[, distance_m] [, normal_zenith_deg]")
+      ->required();
+  cmd->add_option("--out", o->output, "Result CSV (default: stdout)");
+  cmd->add_option("--paths", o->settings.paths,
+                  "Paths per wavelength for each Monte Carlo estimate (rounded up to blocks of 64); the standard "
+                  "error falls as 1/sqrt(paths)")
+      ->capture_default_str();
+  cmd->add_option("--max-order", o->settings.max_order,
+                  "Highest scattering order (scattering events + ground reflections; 1 = single scattering); "
+                  "0 = all orders")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->settings.seed, "Random seed; the results depend on it, not on --threads")
+      ->capture_default_str();
+  cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--sun-transmittance", o->sun_transmittance,
+                  "Sunlight attenuation at each path vertex: quadrature (exact, default) or ratio-tracking")
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress or warnings on stderr");
+  cmd->callback([o] { RunReference(*o); });
+}
+
+}  // namespace skybake::cli

@@ -1,0 +1,429 @@
+// The reference path tracer. One wavelength at a time: each of the three
+// wavelengths traces its own paths, with free paths sampled from its own
+// extinction, so every weight stays bounded by single-scattering albedos and
+// ground albedos and the three estimates (and their errors) are independent.
+// (A single path shared by the wavelengths would need spectral MIS to keep
+// the ratios of transmittances between 440 and 680 nm, a factor of e^-5
+// along a low horizon ray, from blowing up the variance.)
+#include "reference/path_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "bake/config.h"
+#include "bake/errors.h"
+#include "reference/phase_sampling.h"
+#include "reference/random.h"
+#include "reference/ray_segment.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake::reference {
+
+namespace {
+
+using glm::dvec3;
+constexpr double kPi = 3.14159265358979323846;
+
+// Ray segments at the start of each path that use a forced collision (more
+// were measured to cost as much time as they save variance).
+constexpr int kForcedSegments = 1;
+
+enum Estimator : uint64_t { kRadianceEstimator = 1, kIrradianceEstimator = 2 };
+
+struct Tally {
+  int64_t vertices = 0;
+  int64_t truncated = 0;
+};
+
+// The path logic at one wavelength.
+class Tracer {
+ public:
+  Tracer(const LayeredMedium& medium, const Settings& settings, const dvec3& sun, int wavelength)
+      : medium_(medium),
+        settings_(settings),
+        sun_(sun),
+        w_(wavelength),
+        solar_(medium.atmosphere().solar_irradiance[wavelength]),
+        albedo_(medium.atmosphere().ground_albedo[wavelength]),
+        sigma_(medium.constituent_count()) {}
+
+  // Sky radiance along the view segment, one path; u stratifies the distance
+  // of its first vertex.
+  double Radiance(const RaySegment& view, const dvec3& direction, double u, Pcg32& rng, Tally& tally) {
+    double t, weight;
+    if (!view.Sample(medium_, w_, u, &t, &weight)) return 0.0;
+    dvec3 x = view.origin() + t * direction;
+    double r = RadiusAlongRay(view.r(), view.mu(), t);
+    double sigma_s = medium_.Scattering(r, w_, sigma_.data());
+    ++tally.vertices;
+    return Trace(x, r, direction, weight * sigma_s, sigma_s, 1, true, rng, tally);
+  }
+
+  // Radiance arriving at `camera` from `direction`, times `weight`.
+  double Incoming(const dvec3& camera, const dvec3& direction, double weight, Pcg32& rng, Tally& tally) {
+    const glsl::AtmosphereParameters& g = medium_.geometry();
+    double r = glm::length(camera);
+    double mu = std::clamp(glm::dot(camera, direction) / r, -1.0, 1.0);
+    double t_in, t_out;
+    if (!InsideTopSphere(g, r, mu, &t_in, &t_out)) return 0.0;
+    return Trace(camera + t_in * direction, 0.0, direction, weight, 0.0, 0, false, rng, tally);
+  }
+
+  // E_sun x visible fraction of the disc x transmittance to the top, seen
+  // from radius r where the sun's zenith cosine is mu_s.
+  double Sunlight(double r, double mu_s, Pcg32& rng) const {
+    const glsl::AtmosphereParameters& g = medium_.geometry();
+    r = std::clamp(r, g.bottom_radius, g.top_radius);
+    double visible = glsl::SunVisibleFraction(g, r, mu_s);
+    if (!(visible > 0.0) || solar_ == 0.0) return 0.0;
+    // A disc centre below the horizon: its visible part is seen along the
+    // horizon, the ray that grazes the ground.
+    double mu = glsl::RayIntersectsGround(g, r, mu_s) ? HorizonCosine(g.bottom_radius, r) : mu_s;
+    double length = glsl::DistanceToTopAtmosphereBoundary(g, r, mu);
+    double transmittance =
+        settings_.sun_transmittance == SunTransmittanceMethod::kQuadrature
+            ? std::exp(-medium_.OpticalDepth(r, mu, 0.0, length, kVertexTolerance).value[w_])
+            : medium_.RatioTrackingTransmittance(r, mu, length, w_, rng);
+    return solar_ * visible * transmittance;
+  }
+
+ private:
+  bool Continues(int events, Tally& tally) const {
+    if (settings_.max_order > 0) return events < settings_.max_order;
+    if (events < kMaxEventsPerPath) return true;
+    ++tally.truncated;
+    return false;
+  }
+
+  // Russian roulette against the weight the path started with: survival
+  // probability weight / reference, so survivors carry the reference weight.
+  static bool Survives(double& weight, double reference, Pcg32& rng) {
+    if (!(weight > 0.0)) return false;
+    double q = weight / reference;
+    if (q >= 1.0) return true;
+    if (rng.Uniform() >= q) return false;
+    weight = reference;
+    return true;
+  }
+
+  double PhaseMixture(double cos_theta, double sigma_s) const {
+    double p = 0.0;
+    for (int c = 0; c < medium_.constituent_count(); ++c) {
+      if (sigma_[c] > 0.0) p += sigma_[c] * medium_.phase(c).Evaluate(cos_theta);
+    }
+    return p / sigma_s;
+  }
+
+  // Follows a path. If `at_vertex`, it starts at a scattering vertex at x
+  // (radius r) reached along `direction`, `weight` multiplying the integral
+  // of phase x incident radiance there (sigma_ holds the scattering
+  // coefficients); otherwise it starts with a ray from x along `direction`,
+  // `weight` multiplying the radiance arriving along it. `events` counts the
+  // scattering and reflection events so far.
+  double Trace(dvec3 x, double r, dvec3 direction, double weight, double sigma_s, int events, bool at_vertex,
+               Pcg32& rng, Tally& tally) {
+    const glsl::AtmosphereParameters& g = medium_.geometry();
+    const double reference = weight;
+    int forced = kForcedSegments;
+    double sum = 0.0;
+    for (;;) {
+      if (at_vertex) {
+        if (!(sigma_s > 0.0)) return sum;
+        double mu_s = std::clamp(glm::dot(x, sun_) / glm::length(x), -1.0, 1.0);
+        double sunlight = Sunlight(r, mu_s, rng);
+        if (sunlight > 0.0) sum += weight * PhaseMixture(glm::dot(sun_, direction), sigma_s) * sunlight;
+        if (!Continues(events, tally) || !Survives(weight, reference, rng)) return sum;
+        // Choose the constituent in proportion to its scattering, then its
+        // phase: the pdf is the mixture phase, so the weight is unchanged.
+        double pick = rng.Uniform() * sigma_s;
+        int c = -1;
+        for (int i = 0; i < medium_.constituent_count(); ++i) {
+          if (!(sigma_[i] > 0.0)) continue;
+          c = i;  // the last scatterer catches rounding at the top of the range
+          if (pick < sigma_[i]) break;
+          pick -= sigma_[i];
+        }
+        double cos_theta = SamplePhaseCosine(medium_.phase(c), rng);
+        direction = DirectionAround(direction, cos_theta, rng.Uniform());
+        at_vertex = false;
+      }
+
+      if (forced > 0) {
+        // Forced collision: on a ray that escapes to space, an analog free
+        // flight would find nothing with probability T (often > 0.8);
+        // sampling the distance within the segment instead multiplies the
+        // weight by 1 - T and never wastes the path. Rays toward the ground
+        // keep the analog choice between the medium and the ground.
+        --forced;
+        RaySegment segment(medium_, x, direction, 0.0, RaySegment::Table::kSampling);
+        if (!segment.hits_ground()) {
+          double t, transmittance_over_pdf;
+          if (!segment.Sample(medium_, w_, rng.Uniform(), &t, &transmittance_over_pdf)) return sum;
+          ++events;
+          ++tally.vertices;
+          x = segment.origin() + t * direction;
+          r = RadiusAlongRay(segment.r(), segment.mu(), t);
+          sigma_s = medium_.Scattering(r, w_, sigma_.data());
+          weight *= transmittance_over_pdf * sigma_s;
+          at_vertex = true;
+          continue;
+        }
+      }
+
+      double r_x = glm::length(x);
+      double mu = std::clamp(glm::dot(x, direction) / r_x, -1.0, 1.0);
+      RayEvent event = medium_.SampleFreeFlight(r_x, mu, std::numeric_limits<double>::infinity(), w_, rng);
+      if (event.end == RayEnd::kSpace || event.end == RayEnd::kLimit) return sum;
+      ++events;
+      ++tally.vertices;
+      if (event.end == RayEnd::kGround) {
+        dvec3 normal = glm::normalize(x + event.distance * direction);
+        x = normal * g.bottom_radius;
+        if (!(albedo_ > 0.0)) return sum;
+        double mu_s = std::clamp(glm::dot(normal, sun_), -1.0, 1.0);
+        if (mu_s > 0.0) sum += weight * albedo_ / kPi * Sunlight(g.bottom_radius, mu_s, rng) * mu_s;
+        if (!Continues(events, tally)) return sum;
+        weight *= albedo_;
+        if (!Survives(weight, reference, rng)) return sum;
+        double u1 = rng.Uniform(), u2 = rng.Uniform();
+        direction = SampleCosineHemisphere(normal, u1, u2);
+        continue;
+      }
+      x += event.distance * direction;
+      r = RadiusAlongRay(r_x, mu, event.distance);
+      sigma_s = medium_.Scattering(r, w_, sigma_.data());
+      weight *= sigma_s / event.extinction;
+      at_vertex = true;
+    }
+  }
+
+  const LayeredMedium& medium_;
+  const Settings& settings_;
+  dvec3 sun_;
+  int w_;
+  double solar_, albedo_;
+  std::vector<double> sigma_;  // per-constituent scattering at the current vertex
+};
+
+// Directions for the sky irradiance: a mixture of cosine-weighted sampling
+// about the normal and a lobe around the sun (the most forward-peaked phase
+// function of the atmosphere), combined by the mixture pdf (one-sample MIS,
+// balance heuristic), so the bright circumsolar sky is not left to chance.
+class IrradianceSampler {
+ public:
+  IrradianceSampler(const LayeredMedium& medium, const dvec3& normal, const dvec3& sun)
+      : normal_(normal), sun_(sun) {
+    for (int c = 0; c < medium.constituent_count(); ++c) {
+      const PhaseFunction& p = medium.phase(c);
+      bool lobed = p.kind == PhaseKind::kHenyeyGreenstein || p.kind == PhaseKind::kCornetteShanks;
+      if (lobed && p.g > 0.3 && (!has_lobe_ || p.g > lobe_.g)) {
+        lobe_ = p;
+        has_lobe_ = true;
+      }
+    }
+    lobe_probability_ = has_lobe_ ? kLobeProbability : 0.0;
+  }
+
+  // A direction from the stratified (u1, u2) and the technique choice u;
+  // `weight` = cos / pdf (0 below the surface).
+  dvec3 Sample(double u, double u1, double u2, Pcg32& rng, double* weight) const {
+    dvec3 direction = u < lobe_probability_ ? DirectionAround(sun_, SamplePhaseCosine(lobe_, rng), u2)
+                                            : SampleCosineHemisphere(normal_, u1, u2);
+    double cosine = glm::dot(normal_, direction);
+    if (!(cosine > 0.0)) {
+      *weight = 0.0;
+      return direction;
+    }
+    double pdf = (1.0 - lobe_probability_) * cosine / kPi;
+    if (has_lobe_) pdf += lobe_probability_ * lobe_.Evaluate(glm::dot(sun_, direction));
+    *weight = cosine / pdf;
+    return direction;
+  }
+
+ private:
+  static constexpr double kLobeProbability = 0.3;
+  dvec3 normal_, sun_;
+  PhaseFunction lobe_;
+  bool has_lobe_ = false;
+  double lobe_probability_ = 0.0;
+};
+
+// Mean and standard error of the mean from per-block sums.
+Estimate FromBlocks(const std::vector<Spectrum>& sums) {
+  Estimate e;
+  const double blocks = static_cast<double>(sums.size());
+  for (const Spectrum& s : sums) e.mean += s;
+  e.mean /= blocks * kPathsPerBlock;
+  Spectrum squares(0.0);
+  for (const Spectrum& s : sums) {
+    Spectrum d = s / double(kPathsPerBlock) - e.mean;
+    squares += d * d;
+  }
+  e.standard_error = glm::sqrt(squares / (blocks * (blocks - 1.0)));
+  return e;
+}
+
+}  // namespace
+
+int64_t Settings::Blocks() const { return std::max<int64_t>(2, (paths + kPathsPerBlock - 1) / kPathsPerBlock); }
+
+void Settings::Validate() const {
+  if (paths < 1 || paths > (int64_t(1) << 40)) {
+    throw InputError("paths = " + std::to_string(paths) + " must be in [1, 2^40]");
+  }
+  if (max_order < 0 || max_order > kMaxEventsPerPath) {
+    throw InputError("max order = " + std::to_string(max_order) + " must be in [0, " +
+                     std::to_string(kMaxEventsPerPath) + "] (0: all orders)");
+  }
+  if (threads < 0) throw InputError("threads = " + std::to_string(threads) + " must be >= 0");
+}
+
+RayQuery MakeRayQuery(const Query& query, double bottom_radius_m) {
+  Query q = query;
+  q.altitude_m = std::max(q.altitude_m, 0.0);
+  QueryGeometry g = MakeQueryGeometry(q, bottom_radius_m);
+  RayQuery r;
+  r.camera = g.camera;
+  r.view = g.view;
+  r.sun = g.sun;
+  r.distance_m = q.distance_m;
+  r.has_normal = q.has_normal;
+  r.normal = g.normal;
+  return r;
+}
+
+namespace {
+Atmosphere Checked(const Atmosphere& atmosphere) {
+  Validate(atmosphere, atmosphere.name.empty() ? "atmosphere" : atmosphere.name);
+  // What the solver itself relies on, whatever the configuration layer checks.
+  const std::string name = atmosphere.name.empty() ? "atmosphere" : atmosphere.name;
+  auto require = [&](bool ok, const std::string& problem) {
+    if (!ok) throw InputError(name + ": " + problem);
+  };
+  require(atmosphere.bottom_radius_m > 0.0 && std::isfinite(atmosphere.bottom_radius_m),
+          "bottom radius must be positive");
+  require(atmosphere.top_radius_m > atmosphere.bottom_radius_m && std::isfinite(atmosphere.top_radius_m),
+          "top radius must exceed the bottom radius");
+  require(atmosphere.sun_angular_radius_rad >= 0.0 && atmosphere.sun_angular_radius_rad < 1.0,
+          "sun angular radius must be in [0, 1) rad");
+  for (int w = 0; w < kWavelengthCount; ++w) {
+    require(atmosphere.ground_albedo[w] >= 0.0 && atmosphere.ground_albedo[w] <= 1.0,
+            "ground albedo must be in [0, 1]");
+    require(atmosphere.solar_irradiance[w] >= 0.0 && std::isfinite(atmosphere.solar_irradiance[w]),
+            "solar irradiance must be finite and non-negative");
+  }
+  for (const Constituent& c : atmosphere.constituents) {
+    for (int w = 0; w < kWavelengthCount; ++w) {
+      require(c.scattering_per_m[w] >= 0.0 && std::isfinite(c.scattering_per_m[w]) &&
+                  c.absorption_per_m[w] >= 0.0 && std::isfinite(c.absorption_per_m[w]),
+              c.name + ": coefficients must be finite and non-negative");
+    }
+    bool lobed = c.phase.kind == PhaseKind::kHenyeyGreenstein || c.phase.kind == PhaseKind::kCornetteShanks;
+    require(!lobed || std::abs(c.phase.g) < 1.0, c.name + ": phase g must be in (-1, 1)");
+    if (c.density.kind == DensityProfile::Kind::kTabulated) {
+      require(!c.density.altitudes_m.empty() && c.density.altitudes_m.size() == c.density.densities.size(),
+              c.name + ": tabulated density needs as many densities as altitudes");
+    }
+  }
+  return atmosphere;
+}
+}  // namespace
+
+PathTracer::PathTracer(const Atmosphere& atmosphere) : medium_(Checked(atmosphere)) {}
+
+Spectrum PathTracer::SunTransmittance(const dvec3& point, const dvec3& sun, Spectrum* error) const {
+  const glsl::AtmosphereParameters& g = medium_.geometry();
+  *error = Spectrum(0.0);
+  double r = glm::length(point);
+  double mu_s = std::clamp(glm::dot(point, sun) / r, -1.0, 1.0);
+  double visible = glsl::SunVisibleFraction(g, r, mu_s);
+  if (!(visible > 0.0)) return Spectrum(0.0);
+  double mu = glsl::RayIntersectsGround(g, r, mu_s) ? HorizonCosine(g.bottom_radius, r) : mu_s;
+  double t_in, t_out;
+  if (!InsideTopSphere(g, r, mu, &t_in, &t_out)) return Spectrum(visible);
+  OpticalDepthEstimate tau = medium_.OpticalDepth(r, mu, t_in, t_out, kReportedTolerance);
+  Spectrum transmittance = glm::exp(-tau.value);
+  *error = visible * transmittance * tau.error;
+  return visible * transmittance;
+}
+
+Result PathTracer::Evaluate(const Query& query, const Settings& settings, uint64_t stream) const {
+  return Evaluate(MakeRayQuery(query, medium_.bottom_radius()), settings, stream);
+}
+
+Result PathTracer::Evaluate(const RayQuery& query, const Settings& settings, uint64_t stream) const {
+  settings.Validate();
+  const auto start = std::chrono::steady_clock::now();
+  Result result;
+  const dvec3 view = glm::normalize(query.view), sun = glm::normalize(query.sun);
+  RaySegment segment(medium_, query.camera, view, query.distance_m, RaySegment::Table::kExact);
+  result.transmittance = segment.Transmittance(&result.transmittance_error);
+
+  dvec3 normal(0.0);
+  if (query.has_normal) {
+    result.has_irradiance = true;
+    normal = glm::normalize(query.normal);
+    Spectrum error;
+    Spectrum transmittance = SunTransmittance(query.camera, sun, &error);
+    double cosine = std::max(glm::dot(normal, sun), 0.0);
+    result.sun_irradiance = medium_.atmosphere().solar_irradiance * transmittance * cosine;
+    result.sun_irradiance_error = medium_.atmosphere().solar_irradiance * error * cosine;
+  }
+
+  const int64_t blocks = settings.Blocks();
+  std::vector<Spectrum> radiance_sums(blocks, Spectrum(0.0)), irradiance_sums(blocks, Spectrum(0.0));
+  std::vector<Tally> tallies(blocks);
+  IrradianceSampler hemisphere(medium_, normal, sun);
+  auto run_block = [&](int64_t b) {
+    Tally& tally = tallies[b];
+    for (int w = 0; w < kWavelengthCount; ++w) {
+      Tracer tracer(medium_, settings, sun, w);
+      for (int j = 0; j < kPathsPerBlock; ++j) {
+        const uint64_t path = static_cast<uint64_t>(b) * kPathsPerBlock + j;
+        Pcg32 rng = PathGenerator(settings.seed, stream, kRadianceEstimator, w, path);
+        double u = (j + rng.Uniform()) / kPathsPerBlock;  // stratified along the view ray
+        radiance_sums[b][w] += tracer.Radiance(segment, view, u, rng, tally);
+        if (!query.has_normal) continue;
+        Pcg32 irradiance_rng = PathGenerator(settings.seed, stream, kIrradianceEstimator, w, path);
+        constexpr int kSide = 8;  // kPathsPerBlock = kSide^2 strata of the hemisphere
+        static_assert(kSide * kSide == kPathsPerBlock, "2D strata must tile the block");
+        double technique = irradiance_rng.Uniform();
+        double u1 = (j % kSide + irradiance_rng.Uniform()) / kSide;
+        double u2 = (j / kSide + irradiance_rng.Uniform()) / kSide;
+        double weight;
+        dvec3 direction = hemisphere.Sample(technique, u1, u2, irradiance_rng, &weight);
+        if (weight > 0.0) {
+          irradiance_sums[b][w] += tracer.Incoming(query.camera, direction, weight, irradiance_rng, tally);
+        }
+      }
+    }
+  };
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int64_t>(0, blocks, 1), [&](const tbb::blocked_range<int64_t>& range) {
+      for (int64_t b = range.begin(); b != range.end(); ++b) run_block(b);
+    });
+  });
+
+  result.radiance = FromBlocks(radiance_sums);
+  if (query.has_normal) result.sky_irradiance = FromBlocks(irradiance_sums);
+  Statistics& stats = result.statistics;
+  stats.paths = blocks * kPathsPerBlock * kWavelengthCount * (query.has_normal ? 2 : 1);
+  for (const Tally& t : tallies) {
+    stats.vertices += t.vertices;
+    stats.truncated += t.truncated;
+  }
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace skybake::reference

@@ -1,0 +1,37 @@
+// Query files for `skybake reference`: the CSV columns of `skybake eval`
+// (altitude_m, view_zenith_deg, sun_zenith_deg, view_sun_azimuth_deg, and
+// optionally distance_m and normal_zenith_deg), and the result table: the
+// input columns, then per wavelength radiance, radiance_stderr,
+// transmittance, with normals sun_irradiance, sky_irradiance,
+// sky_irradiance_stderr, and last transmittance_error (the quadrature's
+// estimated error bound).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bake/atmosphere.h"
+#include "reference/path_tracer.h"
+#include "shaders_runtime/query.h"
+
+namespace skybake::reference {
+
+struct QueryTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> fields;  // per row, as written
+  std::vector<Query> queries;                      // per row; altitude below 0 raised to 0
+  bool has_distance = false;
+  bool has_normal = false;
+};
+
+// InputError "SOURCE:LINE: problem" on a malformed file.
+QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name);
+
+// Column names of the result table.
+std::vector<std::string> ResultColumns(const QueryTable& table, const Spectrum& wavelengths_nm);
+
+// The whole result table, one row per query (results in the same order).
+std::string FormatResultCsv(const QueryTable& table, const std::vector<Result>& results,
+                            const Spectrum& wavelengths_nm);
+
+}  // namespace skybake::reference
