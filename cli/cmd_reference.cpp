@@ -41,8 +41,8 @@ void RunReference(const ReferenceOptions& o) {
   }
   settings.Validate();
   std::string text = ReadFileText(o.input);
-  reference::QueryTable table =
-      reference::ParseQueryCsv(text, std::filesystem::path(o.input).filename().string());
+  QueryTable table =
+      ParseQueryCsv(text, std::filesystem::path(o.input).filename().string());
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
   reference::PathTracer tracer(atmosphere);
 

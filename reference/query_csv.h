@@ -12,20 +12,10 @@
 
 #include "bake/atmosphere.h"
 #include "reference/path_tracer.h"
+#include "formats/query_csv.h"
 #include "shaders_runtime/query.h"
 
 namespace skybake::reference {
-
-struct QueryTable {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> fields;  // per row, as written
-  std::vector<Query> queries;                      // per row; altitude below 0 raised to 0
-  bool has_distance = false;
-  bool has_normal = false;
-};
-
-// InputError "SOURCE:LINE: problem" on a malformed file.
-QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name);
 
 // Column names of the result table.
 std::vector<std::string> ResultColumns(const QueryTable& table, const Spectrum& wavelengths_nm);

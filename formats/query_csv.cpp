@@ -1,0 +1,119 @@
+#include "formats/query_csv.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+
+#include "bake/errors.h"
+
+namespace skybake {
+
+namespace {
+
+const std::vector<std::string> kRequiredColumns = {"altitude_m", "view_zenith_deg", "sun_zenith_deg",
+                                                   "view_sun_azimuth_deg"};
+const std::vector<std::string> kOptionalColumns = {"distance_m", "normal_zenith_deg"};
+
+std::vector<std::string> SplitCsvLine(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) {
+    size_t begin = field.find_first_not_of(" \t\r"), end = field.find_last_not_of(" \t\r");
+    fields.push_back(begin == std::string::npos ? "" : field.substr(begin, end - begin + 1));
+  }
+  if (!line.empty() && line.back() == ',') fields.push_back("");
+  return fields;
+}
+
+bool Blank(const std::string& line) { return line.find_first_not_of(" \t\r") == std::string::npos; }
+
+bool Contains(const std::vector<std::string>& list, const std::string& name) {
+  return std::find(list.begin(), list.end(), name) != list.end();
+}
+
+}  // namespace
+
+std::string WavelengthName(double nm) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), nm == std::round(nm) ? "%.0fnm" : "%gnm", nm);
+  return buffer;
+}
+
+QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name) {
+  QueryTable table;
+  std::istringstream in(text);
+  std::string line;
+  int line_number = 0;
+  while (table.header.empty() && std::getline(in, line)) {
+    ++line_number;
+    if (!Blank(line)) table.header = SplitCsvLine(line);
+  }
+  if (table.header.empty()) throw InputError(source_name + ": empty query file (expected a header line)");
+  std::map<std::string, size_t> column;
+  for (size_t i = 0; i < table.header.size(); ++i) {
+    const std::string& name = table.header[i];
+    std::string where = source_name + ":" + std::to_string(line_number) + ": ";
+    if (!Contains(kRequiredColumns, name) && !Contains(kOptionalColumns, name)) {
+      throw InputError(where + "unknown column '" + name + "'");
+    }
+    if (column.count(name)) throw InputError(where + "duplicate column '" + name + "'");
+    column[name] = i;
+  }
+  for (const std::string& name : kRequiredColumns) {
+    if (!column.count(name)) throw InputError(source_name + ": missing column '" + name + "'");
+  }
+  table.has_distance = column.count("distance_m") > 0;
+  table.has_normal = column.count("normal_zenith_deg") > 0;
+
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (Blank(line)) continue;
+    std::vector<std::string> fields = SplitCsvLine(line);
+    auto fail = [&](const std::string& problem) {
+      throw InputError(source_name + ":" + std::to_string(line_number) + ": " + problem);
+    };
+    if (fields.size() != table.header.size()) {
+      fail("expected " + std::to_string(table.header.size()) + " fields, got " + std::to_string(fields.size()));
+    }
+    auto number = [&](const std::string& name, bool optional) {
+      const std::string& field = fields[column.at(name)];
+      if (field.empty()) {
+        if (!optional) fail(name + " is empty");
+        return 0.0;
+      }
+      char* end = nullptr;
+      double value = std::strtod(field.c_str(), &end);
+      if (end == field.c_str() || *end != '\0') fail(name + " = '" + field + "' is not a number");
+      if (!std::isfinite(value)) fail(name + " = " + field + " is not finite");
+      return value;
+    };
+    auto angle = [&](const std::string& name, bool optional) {
+      double value = number(name, optional);
+      if (value < 0.0 || value > 180.0) fail(name + " = " + fields[column.at(name)] + " is outside [0, 180]");
+      return value;
+    };
+    Query q;
+    // A camera below the ground is evaluated on the ground, as by `skybake eval`.
+    q.altitude_m = std::max(number("altitude_m", false), 0.0);
+    q.view_zenith_deg = angle("view_zenith_deg", false);
+    q.sun_zenith_deg = angle("sun_zenith_deg", false);
+    q.view_sun_azimuth_deg = number("view_sun_azimuth_deg", false);
+    if (table.has_distance) {
+      q.distance_m = number("distance_m", true);
+      if (q.distance_m < 0.0) fail("distance_m = " + fields[column.at("distance_m")] + " is negative");
+    }
+    if (table.has_normal && !fields[column.at("normal_zenith_deg")].empty()) {
+      q.has_normal = true;
+      q.normal_zenith_deg = angle("normal_zenith_deg", true);
+    }
+    table.fields.push_back(fields);
+    table.queries.push_back(q);
+  }
+  return table;
+}
+
+}  // namespace skybake
