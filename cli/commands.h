@@ -15,5 +15,6 @@ void AddBakeCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
 void AddReferenceCommand(CLI::App& app);
+void AddRenderCommand(CLI::App& app);
 
 }  // namespace skybake::cli

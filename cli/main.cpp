@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddEvalCommand(app);
   skybake::cli::AddFitCommand(app);
   skybake::cli::AddReferenceCommand(app);
+  skybake::cli::AddRenderCommand(app);
 
   try {
     app.parse(argc, argv);

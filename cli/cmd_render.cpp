@@ -1,0 +1,198 @@
+// `skybake render`: preview images of a baked table set through the CPU twin
+// (render/views.h), as linear EXR and tone-mapped sRGB PNG, a contact sheet
+// of the times of day, and optionally plots of table slices.
+#include <chrono>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "bake/errors.h"
+#include "bake/version.h"
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "cli/progress.h"
+#include "formats/file_io.h"
+#include "formats/lut_files.h"
+#include "render/image_files.h"
+#include "render/lut_plots.h"
+#include "render/views.h"
+#include "shaders_runtime/twin.h"
+
+namespace skybake::cli {
+
+namespace {
+
+struct RenderArguments {
+  std::string lut_dir;
+  std::string output_dir;
+  std::vector<double> sun_zenith_deg = {30.0, 85.0};
+  double sun_azimuth_deg = 0.0;
+  int size = 512;
+  std::vector<std::string> views = {"fisheye", "panorama", "space", "aerial"};
+  double exposure_ev = 3.3;
+  double altitude_m = 100.0;
+  double ground_albedo = -1.0;  // < 0: the atmosphere's
+  bool plots = false;
+  bool quiet = false;
+  bool json = false;
+};
+
+std::string ZenithTag(double zenith_deg) {
+  char tag[32];
+  std::snprintf(tag, sizeof(tag), "sz%g", zenith_deg);
+  return tag;
+}
+
+void RunRender(const RenderArguments& args) {
+  std::vector<render::View> views;
+  for (const std::string& name : args.views) {
+    render::View view;
+    if (!render::ParseView(name, &view))
+      throw UsageError("render: unknown view '" + name + "' (fisheye, panorama, space, aerial)");
+    views.push_back(view);
+  }
+  if (views.empty() && !args.plots) throw UsageError("render: nothing to do; give --views or --plots");
+
+  LutSet luts = LoadLutSet(args.lut_dir);
+  const double lowest_sun_deg = std::acos(std::clamp(luts.parameters.mu_s_min, -1.0, 1.0)) * 180.0 / glsl::PI;
+  for (double z : args.sun_zenith_deg) {
+    if (!(z >= 0.0 && z <= lowest_sun_deg)) {
+      char message[160];
+      std::snprintf(message, sizeof(message),
+                    "render: --sun-zenith %g is outside the tables' range 0..%.2f degrees", z, lowest_sun_deg);
+      throw InputError(message);
+    }
+  }
+  if (!(args.altitude_m >= 0.0 && args.altitude_m < luts.atmosphere.top_radius_m - luts.atmosphere.bottom_radius_m))
+    throw InputError("render: --altitude-m must lie inside the atmosphere");
+  EnsureWritableDirectory(args.output_dir);
+  const std::filesystem::path out_dir(args.output_dir);
+
+  TwinTables tables = MakeTwinTables(luts);
+  Twin twin(tables);
+  render::ToneMap tone{args.exposure_ev, render::WhiteBalance(luts.parameters.solar_irradiance)};
+  const glsl::vec3 albedo = args.ground_albedo >= 0.0 ? glsl::vec3(args.ground_albedo) : luts.atmosphere.ground_albedo;
+
+  std::size_t total_rows = 0;
+  for (render::View view : views) total_rows += render::ViewHeight(view, args.size) * args.sun_zenith_deg.size();
+  ProgressBar bar("render", total_rows, args.quiet);
+  auto start = std::chrono::steady_clock::now();
+
+  const render::Attributes common = {{"Software", "skybake " SKYBAKE_VERSION},
+                                     {"skybake.command_line", CommandLine()}};
+  nlohmann::json images = nlohmann::json::array();
+  std::vector<std::vector<render::Rgb8>> columns(args.sun_zenith_deg.size());
+  std::vector<std::string> labels;
+  for (std::size_t z = 0; z < args.sun_zenith_deg.size(); ++z) {
+    double zenith = args.sun_zenith_deg[z];
+    char label[48];
+    std::snprintf(label, sizeof(label), "sun zenith %g deg", zenith);
+    labels.push_back(label);
+    for (render::View view : views) {
+      render::ViewSettings settings;
+      settings.width = args.size;
+      settings.sun_zenith_deg = zenith;
+      settings.sun_azimuth_deg = args.sun_azimuth_deg;
+      settings.camera_altitude_m = args.altitude_m;
+      settings.ground_albedo = albedo;
+      render::Image image = render::RenderView(twin, view, settings, [&](int rows) { bar.Advance(rows); });
+
+      std::string stem = std::string(render::ToString(view)) + "_" + ZenithTag(zenith);
+      render::Attributes exr_attributes = common;
+      exr_attributes.push_back({"skybake.view", render::ToString(view)});
+      exr_attributes.push_back({"skybake.sun_zenith_deg", std::to_string(zenith)});
+      exr_attributes.push_back({"skybake.units", "W m^-2 sr^-1 nm^-1 (linear radiance, R G B = the tables' wavelengths)"});
+      render::WriteLinearExr(out_dir / (stem + ".exr"), image, exr_attributes);
+      render::Rgb8 png = render::ToneMapToSrgb(image, tone);
+      render::Attributes png_attributes = common;
+      char description[160];
+      std::snprintf(description, sizeof(description),
+                    "%s view, sun zenith %g deg, exposure %g EV, tone curve 1 - exp(-x), sRGB", render::ToString(view),
+                    zenith, args.exposure_ev);
+      png_attributes.push_back({"ImageDescription", description});
+      render::WritePng(out_dir / (stem + ".png"), png, png_attributes);
+      columns[z].push_back(std::move(png));
+      images.push_back({{"view", render::ToString(view)},
+                        {"sun_zenith_deg", zenith},
+                        {"width", image.width},
+                        {"height", image.height},
+                        {"exr", (out_dir / (stem + ".exr")).string()},
+                        {"png", (out_dir / (stem + ".png")).string()}});
+    }
+  }
+  bar.Finish();
+
+  nlohmann::json report = {{"lut_dir", args.lut_dir},
+                           {"output_dir", args.output_dir},
+                           {"size", args.size},
+                           {"exposure_ev", args.exposure_ev},
+                           {"sun_azimuth_deg", args.sun_azimuth_deg},
+                           {"images", images}};
+  if (!views.empty()) {
+    std::vector<std::vector<const render::Rgb8*>> sheet_columns;
+    for (const auto& column : columns) {
+      sheet_columns.emplace_back();
+      for (const render::Rgb8& image : column) sheet_columns.back().push_back(&image);
+    }
+    std::filesystem::path sheet = out_dir / "contact_sheet.png";
+    render::WritePng(sheet, render::ContactSheet(sheet_columns, labels), common);
+    report["contact_sheet"] = sheet.string();
+  }
+  if (args.plots) {
+    render::PlotFiles plots = render::WriteLutPlots(twin, luts.atmosphere.wavelengths_nm, out_dir, CommandLine());
+    nlohmann::json files = nlohmann::json::array();
+    for (const auto& f : plots.files) files.push_back(f.string());
+    report["plots"] = files;
+    if (!plots.png_text && !args.quiet) std::fputs("render: no TrueType font found; the PNG plots have no text\n", stderr);
+  }
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report["seconds"] = seconds;
+  if (!args.quiet)
+    std::fprintf(stderr, "render: %zu images in %.1f s into %s\n", images.size(), seconds, args.output_dir.c_str());
+  if (args.json) std::printf("%s\n", report.dump(2).c_str());
+}
+
+}  // namespace
+
+void AddRenderCommand(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand(
+      "render",
+      "Render preview images of baked tables through the CPU twin: a fisheye of the sky, a panorama, the planet "
+      "from space and an aerial-perspective strip, as linear EXR and tone-mapped sRGB PNG, plus a contact sheet");
+  auto args = std::make_shared<RenderArguments>();
+  cmd->add_option("lut_dir", args->lut_dir, "Directory written by `skybake bake`")->required();
+  cmd->add_option("-o,--output", args->output_dir, "Output directory (created if needed)")->required();
+  cmd->add_option("--sun-zenith", args->sun_zenith_deg, "Sun zenith angles in degrees, comma separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--sun-azimuth", args->sun_azimuth_deg, "Sun azimuth in degrees (0: +x; see docs/gallery.md)")
+      ->capture_default_str();
+  cmd->add_option("--size", args->size, "Image width in pixels (fisheye and space: square; panorama: width/2 "
+                                        "high; aerial: width/4 high)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16384));
+  cmd->add_option("--views", args->views, "Views to render, comma separated: fisheye, panorama, space, aerial")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--exposure", args->exposure_ev,
+                  "Exposure in EV for the PNGs: radiance x 2^EV, then 1 - exp(-x), then sRGB")
+      ->capture_default_str();
+  cmd->add_option("--altitude-m", args->altitude_m, "Camera altitude of the ground views, metres")
+      ->capture_default_str();
+  cmd->add_option("--ground-albedo", args->ground_albedo,
+                  "Grey Lambertian ground albedo (default: the atmosphere's ground albedo)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--plots", args->plots, "Also plot table slices (lut_*.svg and .png)");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary on stderr");
+  cmd->add_flag("--json", args->json, "Print a JSON report of the files written on stdout");
+  cmd->callback([args] { RunRender(*args); });
+}
+
+}  // namespace skybake::cli

@@ -1,0 +1,58 @@
+// Render outputs: linear OpenEXR, tone-mapped sRGB PNG and contact sheets.
+//
+// Tone mapping (PNG only; the EXR keeps the radiance):
+//   1. white balance: each channel is divided by the solar irradiance at the
+//      top of the atmosphere relative to its channel mean, so unattenuated
+//      sunlight is neutral;
+//   2. exposure: multiplied by 2^EV (EV 3.3, about x10, suits a daylight sky
+//      in W m^-2 sr^-1 nm^-1: Bruneton's demo uses the same factor);
+//   3. tone curve: d = 1 - exp(-x) per channel (monotonic, linear near black,
+//      saturates highlights such as the sun smoothly instead of clipping);
+//   4. d, taken as linear sRGB (the three wavelengths stand for the primaries),
+//      is encoded with the sRGB transfer function by OpenImageIO's colour
+//      management (ImageBufAlgo::colorconvert "linear" -> "sRGB") and rounded
+//      to 8 bits.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "render/views.h"
+
+namespace skybake::render {
+
+struct ToneMap {
+  double exposure_ev = 3.3;
+  glsl::vec3 white{1.0};  // per-channel white balance divisor (see WhiteBalance)
+};
+
+// The white-balance divisor for a solar irradiance spectrum: irradiance / mean.
+glsl::vec3 WhiteBalance(const glsl::vec3& solar_irradiance);
+
+// 8-bit RGB, row-major from the top.
+struct Rgb8 {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;
+};
+
+Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone);
+
+// Text attributes stored in the files (e.g. the command line).
+using Attributes = std::vector<std::pair<std::string, std::string>>;
+
+// Both written atomically; IoError on failure.
+void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes);
+void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes);
+
+// Reads an 8-bit RGB PNG (tests and tools); IoError on failure.
+Rgb8 ReadPng(const std::filesystem::path& path);
+
+// Columns side by side, each column's images stacked top to bottom, with a
+// `gap`-pixel dark separator; a column's label is drawn above it when a
+// TrueType font (DejaVu Sans, Liberation Sans, FreeSans) is found.
+Rgb8 ContactSheet(const std::vector<std::vector<const Rgb8*>>& columns, const std::vector<std::string>& labels,
+                  int gap = 4);
+
+}  // namespace skybake::render

@@ -1,0 +1,126 @@
+#include "render/lut_plots.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "formats/plot.h"
+#include "shaders_runtime/twin.h"
+
+namespace skybake::render {
+
+namespace {
+
+using glsl::vec3;
+constexpr double kDegree = glsl::PI / 180.0;
+// Palette indices (formats/plot.h) that read as red, green and blue.
+constexpr int kChannelColor[3] = {2, 4, 0};
+
+std::string ChannelName(const vec3& wavelengths_nm, int c) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%.0f nm", wavelengths_nm[c]);
+  return name;
+}
+
+void Write(const LinePlot& plot, const std::filesystem::path& dir, const std::string& stem, PlotFiles* out) {
+  std::filesystem::path svg = dir / (stem + ".svg"), png = dir / (stem + ".png");
+  WritePlotSvg(svg, plot);
+  out->png_text = WritePlotPng(png, plot) && out->png_text;
+  out->files.push_back(svg);
+  out->files.push_back(png);
+}
+
+}  // namespace
+
+PlotFiles WriteLutPlots(const Twin& twin, const vec3& wavelengths_nm, const std::filesystem::path& dir,
+                        const std::string& caption) {
+  const glsl::AtmosphereParameters& p = twin.parameters();
+  PlotFiles files;
+
+  {
+    LinePlot plot;
+    plot.title = "Transmittance to the top of the atmosphere";
+    plot.caption = caption;
+    plot.x = {"view zenith angle (degrees)", false, 0.0, 90.0};
+    plot.y = {"transmittance", true, {}, 1.0};
+    const double altitudes_km[] = {0.0, 5.0, 20.0};
+    const LineStyle styles[] = {LineStyle::kSolid, LineStyle::kDashed, LineStyle::kDotted};
+    for (int a = 0; a < 3; ++a) {
+      double r = std::min(p.bottom_radius + altitudes_km[a] * 1e3, p.top_radius);
+      for (int c = 0; c < 3; ++c) {
+        PlotSeries s;
+        char name[64];
+        std::snprintf(name, sizeof(name), "%s, %g km", ChannelName(wavelengths_nm, c).c_str(), altitudes_km[a]);
+        s.name = name;
+        s.style = styles[a];
+        s.color = kChannelColor[c];
+        for (int i = 0; i <= 180; ++i) {
+          double zenith = 0.5 * i;
+          s.x.push_back(zenith);
+          s.y.push_back(std::exp(-twin.OpticalDepthToTop(r, std::cos(zenith * kDegree))[c]));
+        }
+        plot.series.push_back(std::move(s));
+      }
+    }
+    Write(plot, dir, "lut_transmittance", &files);
+  }
+
+  {
+    LinePlot plot;
+    plot.title = "Sky radiance from the ground in the sun's vertical plane (" + ChannelName(wavelengths_nm, 1) + ")";
+    plot.caption = caption;
+    plot.x = {"view zenith angle (degrees; negative: away from the sun)", false, -90.0, 90.0};
+    plot.y = {"radiance (W m^-2 sr^-1 nm^-1)", true, {}, {}};
+    const vec3 camera(0.0, 0.0, p.bottom_radius + 1.0);
+    for (double sun_zenith : {0.0, 45.0, 80.0, 90.0}) {
+      PlotSeries s;
+      char name[48];
+      std::snprintf(name, sizeof(name), "sun zenith %g deg", sun_zenith);
+      s.name = name;
+      vec3 sun(std::sin(sun_zenith * kDegree), 0.0, std::cos(sun_zenith * kDegree));
+      for (int i = 0; i <= 360; ++i) {
+        double zenith = -90.0 + 0.5 * i;
+        // Stop just above the horizon, where the ground begins.
+        double z = std::clamp(zenith, -89.5, 89.5) * kDegree;
+        vec3 view(std::sin(z), 0.0, std::cos(z));
+        s.x.push_back(zenith);
+        s.y.push_back(twin.SkyRadiance(camera, view, sun, nullptr)[1]);
+      }
+      plot.series.push_back(std::move(s));
+    }
+    Write(plot, dir, "lut_sky_radiance", &files);
+  }
+
+  {
+    LinePlot plot;
+    plot.title = "Irradiance on horizontal ground";
+    plot.caption = caption;
+    double lowest_sun_deg = std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
+    plot.x = {"sun zenith angle (degrees)", false, 0.0, lowest_sun_deg};
+    plot.y = {"irradiance (W m^-2 nm^-1)", false, 0.0, {}};
+    const vec3 point(0.0, 0.0, p.bottom_radius), normal(0.0, 0.0, 1.0);
+    for (int c = 0; c < 3; ++c) {
+      PlotSeries sun, sky;
+      sun.name = "sun, " + ChannelName(wavelengths_nm, c);
+      sky.name = "sky, " + ChannelName(wavelengths_nm, c);
+      sun.color = sky.color = kChannelColor[c];
+      sky.style = LineStyle::kDashed;
+      for (int i = 0; i <= 200; ++i) {
+        double zenith = lowest_sun_deg * i / 200.0;
+        vec3 sun_direction(std::sin(zenith * kDegree), 0.0, std::cos(zenith * kDegree));
+        vec3 sky_irradiance;
+        vec3 sun_irradiance = twin.SunAndSkyIrradiance(point, normal, sun_direction, &sky_irradiance);
+        sun.x.push_back(zenith);
+        sun.y.push_back(sun_irradiance[c]);
+        sky.x.push_back(zenith);
+        sky.y.push_back(sky_irradiance[c]);
+      }
+      plot.series.push_back(std::move(sun));
+      plot.series.push_back(std::move(sky));
+    }
+    Write(plot, dir, "lut_irradiance", &files);
+  }
+  return files;
+}
+
+}  // namespace skybake::render
