@@ -11,14 +11,15 @@
 # minute on two cores; the pictures differ from a full bake only in fine
 # detail near the horizon.
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-build="$root/build"
-work="$build/gallery"
-out="$root/docs/images/gallery"
+# Relative paths from the repository root, so the command line recorded in
+# each PNG (and so the file) is the same in every clone.
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+work=build/gallery
+out=docs/images/gallery
 
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j"${JOBS:-2}" --target skybake >&2
-skybake="$build/cli/skybake"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"${JOBS:-2}" --target skybake >&2
+skybake=build/cli/skybake
 
 bake_size=(--transmittance-size 128 32 --irradiance-size 32 8 --scattering-size 16 64 16 8
            --ray-samples 64 --sphere-samples 8 --orders 3)
