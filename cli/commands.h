@@ -14,5 +14,7 @@ void AddValidateCommand(CLI::App& app);
 void AddBakeCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
+void AddInfoCommand(CLI::App& app);
+void AddConvertCommand(CLI::App& app);
 
 }  // namespace skybake::cli

@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
   skybake::cli::AddBakeCommand(app);
   skybake::cli::AddEvalCommand(app);
   skybake::cli::AddFitCommand(app);
+  skybake::cli::AddInfoCommand(app);
+  skybake::cli::AddConvertCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -77,8 +77,7 @@ LutSet LoadLutSet(const fs::path& dir, const LoadOptions& options) {
                     " table (bake with --format " + ToString(format) + ")");
     }
     const fs::path path = dir / entry->file;
-    const std::vector<std::uint8_t> bytes = ReadFileBytes(path);
-    VerifyListedFile(*entry, bytes, path.string());
+    const std::vector<std::uint8_t> bytes = ReadListedFile(manifest, *entry);
     const TableImage image = DecodeTableImage(bytes, path.string());
     if (image.format != entry->format || image.pixel_type != entry->pixel_type) {
       throw IoError(path.string() + ": is " + ToString(image.format) + " " + ToString(image.pixel_type) +

@@ -224,6 +224,15 @@ std::optional<ManifestFile> FindListing(const fs::path& file) {
   return std::nullopt;
 }
 
+std::vector<std::uint8_t> ReadListedFile(const Manifest& manifest, const ManifestFile& entry) {
+  const fs::path path = manifest.Directory() / entry.file;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw IoError(path.string() + ": missing (listed in " + kManifestFileName + ")");
+  std::vector<std::uint8_t> bytes = ReadFileBytes(path);
+  VerifyListedFile(entry, bytes, path.string());
+  return bytes;
+}
+
 void VerifyListedFile(const ManifestFile& entry, const std::vector<std::uint8_t>& bytes, const std::string& source) {
   if (bytes.size() != entry.bytes) {
     throw IoError(source + ": " + (bytes.size() < entry.bytes ? "truncated" : "wrong size") + ": " +

@@ -77,6 +77,10 @@ Manifest ReadManifest(const std::filesystem::path& dir);
 // it does not list the file. A manifest that cannot be read is an IoError.
 std::optional<ManifestFile> FindListing(const std::filesystem::path& file);
 
+// Reads a file the manifest lists and verifies it: IoError "<path>: missing
+// (listed in skybake.json)", "...: truncated", "...: checksum mismatch".
+std::vector<std::uint8_t> ReadListedFile(const Manifest& manifest, const ManifestFile& entry);
+
 // IoError "<source>: ..." unless `bytes` has the listed size and SHA-256.
 void VerifyListedFile(const ManifestFile& entry, const std::vector<std::uint8_t>& bytes, const std::string& source);
 

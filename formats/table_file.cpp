@@ -334,6 +334,25 @@ std::string TableImage::StorageName() const {
   return std::string("EXR ") + ToString(pixel_type) + " ZIP";
 }
 
+std::vector<std::string> MeaningfulChannels(const TableImage& image, const std::string& source) {
+  auto listed = image.metadata.find(kChannelsKey);
+  if (listed == image.metadata.end()) return image.channel_names;
+  std::vector<std::string> names;
+  const std::string& list = listed->second;
+  for (std::size_t at = 0; at <= list.size();) {
+    std::size_t end = list.find(',', at);
+    if (end == std::string::npos) end = list.size();
+    names.push_back(list.substr(at, end - at));
+    at = end + 1;
+  }
+  for (const std::string& name : names) {
+    if (std::find(image.channel_names.begin(), image.channel_names.end(), name) == image.channel_names.end()) {
+      throw IoError(source + ": " + kChannelsKey + " names channel '" + name + "', which the file does not have");
+    }
+  }
+  return names;
+}
+
 std::vector<std::uint8_t> EncodeTableImage(const TableImage& image) {
   CheckShape(image);
   return image.format == FileFormat::kExr ? EncodeExr(image) : EncodeKtx2(image);

@@ -69,6 +69,11 @@ struct TableImage {
   std::string StorageName() const;
 };
 
+// The channels that carry data: those "skybake.channels" names (a KTX2 file
+// pads an RGB table with an alpha channel), else every stored channel.
+// IoError naming `source` if the list names a channel the image lacks.
+std::vector<std::string> MeaningfulChannels(const TableImage& image, const std::string& source);
+
 // Serialises `image` in image.format. For KTX2 the channels must be R,G,B or
 // R,G,B,A; for OpenEXR any distinct names. InternalError if the values do not
 // fit the dimensions, InputError for metadata the format cannot hold.

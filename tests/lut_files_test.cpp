@@ -241,7 +241,7 @@ TEST_F(LutFilesTest, DamagedFilesAreOneLineIoErrorsNamingTheFile) {
         EXPECT_EQ(error.find('\n'), std::string::npos) << what << ": " << error;
       };
       fs::remove(path);
-      expect_error("missing", "cannot read");
+      expect_error("missing", "missing (listed in skybake.json)");
       write(std::vector<std::uint8_t>(good.begin(), good.begin() + good.size() / 2));
       expect_error("truncated", "truncated");
       for (std::size_t at : {std::size_t(5), good.size() / 2, good.size() - 1}) {
