@@ -92,7 +92,7 @@ void ManifestWriter::AddTableFile(const TableDescription& table, const std::stri
                     {"pixel_type", ToString(image.pixel_type)},
                     {"storage", image.StorageName()},
                     {"size", SizeToJson(image.width, image.height, image.depth, image.is_3d)},
-                    {"stored_channels", image.channel_names}};
+                    {"stored_channels", StoredChannels(image)}};
   if (image.format == FileFormat::kExr && image.is_3d) {
     f["atlas"] = ordered_json::array({image.width, image.height * image.depth});
   }

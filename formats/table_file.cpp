@@ -334,6 +334,10 @@ std::string TableImage::StorageName() const {
   return std::string("EXR ") + ToString(pixel_type) + " ZIP";
 }
 
+std::vector<std::string> StoredChannels(const TableImage& image) {
+  return image.format == FileFormat::kKtx2 ? kRgba : image.channel_names;
+}
+
 std::vector<std::string> MeaningfulChannels(const TableImage& image, const std::string& source) {
   auto listed = image.metadata.find(kChannelsKey);
   if (listed == image.metadata.end()) return image.channel_names;

@@ -69,6 +69,10 @@ struct TableImage {
   std::string StorageName() const;
 };
 
+// The channels the file holds: R,G,B,A for every KTX2 table (RGB tables are
+// padded), the image's own channels for OpenEXR.
+std::vector<std::string> StoredChannels(const TableImage& image);
+
 // The channels that carry data: those "skybake.channels" names (a KTX2 file
 // pads an RGB table with an alpha channel), else every stored channel.
 // IoError naming `source` if the list names a channel the image lacks.

@@ -163,6 +163,7 @@ TEST_F(LutFilesTest, ManifestListsEveryFileWithMatchingChecksum) {
       EXPECT_EQ(f["pixel_type"], "float");
       EXPECT_EQ(file, kTables[t] + (f["format"] == "exr" ? ".exr" : ".ktx2"));
       EXPECT_EQ(f["size"], t < 2 ? table["size"] : json::array({32, 32, 8})) << file;
+      EXPECT_EQ(f["stored_channels"].size(), f["format"] == "ktx2" ? 4u : 3u) << file;
       ++listed;
     }
   }
