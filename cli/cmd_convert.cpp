@@ -40,6 +40,12 @@ void RunConvert(const ConvertOptions& o) {
   if (o.half && o.to_float) throw UsageError("--half and --float exclude each other");
   if (!(o.floor > 0.0)) throw UsageError("--floor must be positive");
 
+  // Writing over a file a manifest lists would leave the set failing its
+  // checksums; converted files belong beside the set, not in it.
+  if (const std::optional<ManifestFile> listed = FindListing(o.output)) {
+    throw UsageError(o.output + ": is listed in " + (fs::path(o.output).parent_path() / kManifestFileName).string() +
+                     "; write the converted file elsewhere (or re-bake with --format/--half)");
+  }
   const fs::path input = o.input;
   const std::vector<std::uint8_t> bytes = ReadFileBytes(input);
   const std::optional<ManifestFile> listing = FindListing(input);

@@ -267,6 +267,13 @@ TEST_F(BakedSetTest, ConvertErrors) {
   EXPECT_EQ(RunCommand(Skybake() + " convert " + in + " " + ShellQuote(dir.path() / "x.png"), dir, nullptr, &err), 1);
   EXPECT_NE(err.find(".exr or .ktx2"), std::string::npos) << err;
   EXPECT_EQ(RunCommand(Skybake() + " convert --half --float " + in + " " + ShellQuote(dir.path() / "x.exr"), dir), 1);
+  EXPECT_EQ(RunCommand(Skybake() + " convert --help", dir), 0);
+  EXPECT_EQ(RunCommand(Skybake() + " info --help", dir), 0);
+  EXPECT_EQ(RunCommand(Skybake() + " info", dir), 1);
+  // Converting over a file the manifest lists would break the set.
+  EXPECT_EQ(RunCommand(Skybake() + " convert --half " + in + " " + ShellQuote(Lut() / "irradiance.ktx2"), dir, nullptr,
+                       &err), 1);
+  EXPECT_NE(err.find("is listed in"), std::string::npos) << err;
   EXPECT_EQ(RunCommand(Skybake() + " convert " + ShellQuote(dir.path() / "none.exr") + " " +
                            ShellQuote(dir.path() / "x.exr"), dir, nullptr, &err), 3);
   testing::WriteText(dir.path() / "foreign.ktx2", "plain text");
