@@ -80,9 +80,11 @@ void RunBake(const BakeOptions& o) {
   if (!o.quiet) {
     std::fprintf(stderr, "  %-36s %8.3f s\n", "total", report.total_seconds);
     for (const auto& [table, error] : written.half_errors) {
-      std::fprintf(stderr, "  half: %-22s max relative error %.3g over %zu values >= %g; %zu smaller, %zu overflowed\n",
+      std::fprintf(stderr,
+                   "  half: %-22s max relative error %.3g over %zu values >= %g; %zu smaller (%zu became 0), "
+                   "%zu overflowed\n",
                    table.c_str(), error.max_relative_error, error.measured, error.floor, error.below_floor,
-                   error.overflowed);
+                   error.flushed_to_zero, error.overflowed);
     }
   }
 
