@@ -1,7 +1,9 @@
 // `skybake bake`: atmosphere → tables on disk.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +26,7 @@ struct BakeOptions {
   std::string output_dir;
   BakeSettings settings;
   std::vector<int> transmittance_size, irradiance_size, scattering_size;
+  std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
   bool json = false;
   bool quiet = false;
@@ -47,6 +50,18 @@ void RunBake(const BakeOptions& o) {
     settings.scattering_nu_size = o.scattering_size[3];
   }
   settings.Validate();
+  WriteOptions write_options;
+  write_options.formats.clear();
+  for (const std::string& name : o.formats) {
+    std::optional<FileFormat> format = ParseFileFormat(name);
+    if (!format) throw UsageError("--format: unknown format '" + name + "' (use exr, ktx2 or exr,ktx2)");
+    if (std::find(write_options.formats.begin(), write_options.formats.end(), *format) == write_options.formats.end()) {
+      write_options.formats.push_back(*format);
+    }
+  }
+  if (write_options.formats.empty()) throw UsageError("--format: name at least one format (exr, ktx2)");
+  write_options.half = o.half;
+  write_options.command_line = CommandLine();
   EnsureWritableDirectory(o.output_dir);
 
   BakeReport report;
@@ -57,22 +72,39 @@ void RunBake(const BakeOptions& o) {
   LutSet luts = Bake(atmosphere, settings, &report, print_phase);
 
   auto write_start = std::chrono::steady_clock::now();
-  WriteLutSet(luts, o.output_dir, WriteOptions{o.half, CommandLine()});
+  WriteReport written = WriteLutSet(luts, o.output_dir, write_options);
   BakeTiming write{"write files", std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count()};
   print_phase(write);
   report.timings.push_back(write);
   report.total_seconds += write.seconds;
-  if (!o.quiet) std::fprintf(stderr, "  %-36s %8.3f s\n", "total", report.total_seconds);
+  if (!o.quiet) {
+    std::fprintf(stderr, "  %-36s %8.3f s\n", "total", report.total_seconds);
+    for (const auto& [table, error] : written.half_errors) {
+      std::fprintf(stderr,
+                   "  half: %-22s max relative error %.3g over %zu values >= %g; %zu smaller (%zu became 0), "
+                   "%zu overflowed\n",
+                   table.c_str(), error.max_relative_error, error.measured, error.floor, error.below_floor,
+                   error.flushed_to_zero, error.overflowed);
+    }
+  }
 
   if (o.json) {
     nlohmann::json timings = nlohmann::json::array();
     for (const BakeTiming& t : report.timings) timings.push_back({{"phase", t.phase}, {"seconds", t.seconds}});
+    nlohmann::json files = nlohmann::json::array();
+    for (const WrittenFile& f : written.files) {
+      files.push_back({{"file", f.file}, {"table", f.table.empty() ? nlohmann::json(nullptr) : nlohmann::json(f.table)},
+                       {"bytes", f.bytes}});
+    }
+    nlohmann::json half_errors = nlohmann::json::object();
+    for (const auto& [table, error] : written.half_errors) half_errors[table] = ToJson(error);
     const BakeSettings& s = luts.settings;
     nlohmann::json j = {
         {"atmosphere", atmosphere.name},
         {"output_dir", o.output_dir},
         {"orders", s.orders},
         {"pixel_type", o.half ? "half" : "float"},
+        {"formats", o.formats},
         {"tables",
          {{"transmittance", {s.transmittance_width, s.transmittance_height}},
           {"irradiance", {s.irradiance_width, s.irradiance_height}},
@@ -83,6 +115,8 @@ void RunBake(const BakeOptions& o) {
                                                         s.scattering_mu_s_size, s.scattering_nu_size})}}},
         {"samples",
          {{"transmittance", s.transmittance_samples}, {"ray", s.ray_samples}, {"sphere", s.sphere_samples}}},
+        {"files", files},
+        {"half_error", half_errors},
         {"timings", timings},
         {"total_seconds", report.total_seconds}};
     std::printf("%s\n", j.dump(2).c_str());
@@ -114,7 +148,10 @@ void AddBakeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--pack-mie", o->settings.pack_single_mie_in_alpha,
                 "Store single Mie's red channel in the scattering table's alpha instead of a separate table");
-  cmd->add_flag("--half", o->half, "Store half floats instead of float32");
+  cmd->add_option("--format", o->formats, "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
   cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
   cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");

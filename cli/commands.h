@@ -16,5 +16,7 @@ void AddEvalCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
 void AddReferenceCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
+void AddInfoCommand(CLI::App& app);
+void AddConvertCommand(CLI::App& app);
 
 }  // namespace skybake::cli

@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
   skybake::cli::AddFitCommand(app);
   skybake::cli::AddReferenceCommand(app);
   skybake::cli::AddRenderCommand(app);
+  skybake::cli::AddInfoCommand(app);
+  skybake::cli::AddConvertCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -1,36 +1,66 @@
-// A baked table set on disk: one OpenEXR file per table plus the manifest
-// `skybake.json` that lists them with the runtime constants. This is the one
-// interface between the bake and the files; readers rebuild a LutSet from it.
+// A baked table set on disk: one file per table and format (OpenEXR and/or
+// KTX2, formats/table_file.h) plus the manifest `skybake.json`
+// (formats/manifest.h, docs/manifest.md) that lists them with checksums and
+// the runtime constants. This is the one interface between the bake and the
+// files: WriteLutSet writes a set, LoadLutSet rebuilds a LutSet from one.
 //
-// EXR conventions: channels R, G, B (and A where used) hold the three
-// wavelengths in the order of `wavelengths_nm`; ZIP compression (lossless);
-// float32 or half. 3D tables are stored as a 2D atlas of depth slices
-// stacked vertically: atlas row = z * height + y, so the 4D scattering table
-// (x = nu * mu_s_size + mu_s, y = mu, z = r) is (nu_size * mu_s_size) wide and
-// (r_size * mu_size) tall. Attributes under "skybake." record the table kind,
-// channel encoding, units, wavelengths, the runtime parameters (JSON), the
-// resolved atmosphere (TOML), and the tool version. The command line is
-// recorded in the manifest only, so table files depend on nothing but the
-// atmosphere and the settings (byte-identical across runs and thread counts).
+// Table files carry only what the atmosphere and the settings determine (no
+// command line, paths or dates), so a re-bake is byte-identical whatever the
+// thread count; the command line is recorded in the manifest only.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bake/bake.h"
+#include "formats/table_file.h"
+#include "formats/table_stats.h"
 
 namespace skybake {
 
-struct WriteOptions {
-  bool half = false;         // store half floats instead of float32
-  std::string command_line;  // recorded in the manifest
+// A text file shipped beside the tables (the generated GLSL runtime).
+struct ShaderFile {
+  std::string file;  // plain file name inside the output directory
+  std::string text;
+  std::string description;
 };
 
-// Writes every table and then the manifest, each atomically. IoError on failure.
-void WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
+struct WriteOptions {
+  std::vector<FileFormat> formats = {FileFormat::kExr, FileFormat::kKtx2};
+  bool half = false;          // store half floats instead of float32
+  std::string command_line;   // recorded in the manifest
+  std::vector<ShaderFile> shaders;  // written and listed under "shaders"
+};
 
-// Reads a set written by WriteLutSet. IoError for missing, truncated or
-// foreign files and for tables that disagree with the manifest.
-LutSet LoadLutSet(const std::filesystem::path& dir);
+struct WrittenFile {
+  std::string table;  // empty for shader files
+  std::string file;
+  std::uint64_t bytes = 0;
+};
+
+struct WriteReport {
+  std::vector<WrittenFile> files;  // in writing order, the manifest last
+  // With `half`: the error rounding each table to half introduced.
+  std::vector<std::pair<std::string, HalfError>> half_errors;
+};
+
+// Writes every table in every requested format, the shader files, and then
+// the manifest, each atomically. IoError on failure.
+WriteReport WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
+
+struct LoadOptions {
+  // The format to read. Unset: KTX2 if the manifest lists it for every table
+  // and the files exist, else OpenEXR.
+  std::optional<FileFormat> format;
+};
+
+// Reads a set written by WriteLutSet, checking every file against the
+// manifest (size, SHA-256, format, table, dimensions, channels). One-line
+// IoError naming the file for a missing, truncated, altered or foreign file.
+LutSet LoadLutSet(const std::filesystem::path& dir, const LoadOptions& options = {});
 
 }  // namespace skybake

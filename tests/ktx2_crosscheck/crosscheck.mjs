@@ -1,7 +1,7 @@
 // Cross-checks skybake's KTX2 writer with an independent parser, ktx-parse
 // (pinned in package.json / package-lock.json).
 //
-//   node crosscheck.mjs --tests-exe <skybake_tests> --work-dir <dir>
+//   node crosscheck.mjs --tests-exe <skybake_tests> --skybake-exe <skybake> --work-dir <dir>
 //
 // 1. Runs the gtest case Ktx2CrossCheck.WritesSampleSet, which writes one
 //    sample per format, 2D and 3D, with extra keys, plus the raw level bytes
@@ -12,11 +12,18 @@
 //    Khronos Data Format specifications, not from skybake), the key/value
 //    data and the level, then re-serialises it with ktx-parse and requires
 //    the same bytes: an independent writer lays out the file identically.
+// 4. Runs real bakes (`skybake bake --format ktx2`: float, half, and single
+//    Mie packed into alpha) and checks every KTX2 file their manifests list:
+//    SHA-256 and size against the manifest (node:crypto), header and DFD as
+//    above, the key/value data against the manifest's description of the
+//    table, every texel finite and non-negative (decoded here, halves too),
+//    and ktx-parse's byte-for-byte re-serialisation.
 //
 // Exit codes: 0 all agree, 1 a disagreement or error, 77 skipped because npm
 // or the npm registry is unavailable (ctest SKIP_RETURN_CODE).
 
 import { spawnSync } from 'node:child_process';
+import crypto from 'node:crypto';
 import fs from 'node:fs';
 import { createRequire } from 'node:module';
 import path from 'node:path';
@@ -40,7 +47,7 @@ function parseArgs(argv) {
     if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
     args[argv[i].slice(2)] = argv[i + 1];
   }
-  for (const required of ['tests-exe', 'work-dir']) {
+  for (const required of ['tests-exe', 'skybake-exe', 'work-dir']) {
     if (!args[required]) fail(`missing --${required}`);
   }
   return args;
@@ -234,6 +241,144 @@ function checkSample(parser, sampleDir, entry, problems) {
   }
 }
 
+// --- Files written by a real bake ----------------------------------------------
+
+const SMALL_BAKE = ['--transmittance-size', '64', '16', '--irradiance-size', '16', '4', '--scattering-size', '8', '32',
+  '8', '4', '--ray-samples', '32', '--sphere-samples', '8', '--orders', '2'];
+
+function bake(skybakeExe, outDir, extra) {
+  const run = spawnSync(skybakeExe, ['bake', 'earth', '-q', '--format', 'ktx2', '-o', outDir, ...SMALL_BAKE, ...extra], {
+    encoding: 'utf8',
+  });
+  if (run.error) fail(`cannot run ${skybakeExe}: ${run.error.message}`);
+  if (run.status !== 0) fail(`skybake bake ${extra.join(' ')} failed:\n${run.stderr}`);
+}
+
+// IEEE 754 binary16, straight from the definition.
+function halfToFloat(h) {
+  const sign = h & 0x8000 ? -1 : 1;
+  const e = (h >> 10) & 0x1f;
+  const m = h & 0x3ff;
+  if (e === 0) return sign * m * 2 ** -24;
+  if (e === 31) return m ? NaN : sign * Infinity;
+  return sign * (1 + m / 1024) * 2 ** (e - 15);
+}
+
+function checkBakedFile(parser, setDir, manifest, table, entry, problems) {
+  const problem = (what) => problems.push(`${path.basename(setDir)}/${entry.file}: ${what}`);
+  const expectEqual = (what, actual, expected) => {
+    const a = JSON.stringify(actual);
+    const e = JSON.stringify(expected);
+    if (a !== e) problem(`${what} is ${a}, expected ${e}`);
+  };
+  const buffer = fs.readFileSync(path.join(setDir, entry.file));
+  const bytes = new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength);
+  expectEqual('size in bytes', bytes.length, entry.bytes);
+  expectEqual('sha256', crypto.createHash('sha256').update(buffer).digest('hex'), entry.sha256);
+
+  let container;
+  try {
+    container = parser.read(bytes);
+  } catch (error) {
+    problem(`ktx-parse cannot read it: ${error.message}`);
+    return;
+  }
+  const half = entry.pixel_type === 'half';
+  const vkFormat = half ? 97 : 109;
+  const format = FORMATS[vkFormat];
+  const is3d = entry.size.length === 3;
+  expectEqual('vkFormat', container.vkFormat, vkFormat);
+  expectEqual('typeSize', container.typeSize, format.bits / 8);
+  expectEqual('pixelWidth', container.pixelWidth, entry.size[0]);
+  expectEqual('pixelHeight', container.pixelHeight, entry.size[1]);
+  expectEqual('pixelDepth', container.pixelDepth, is3d ? entry.size[2] : 0);
+  expectEqual('layerCount', container.layerCount, 0);
+  expectEqual('faceCount', container.faceCount, 1);
+  expectEqual('levelCount', container.levelCount, 1);
+  expectEqual('supercompressionScheme', container.supercompressionScheme, 0);
+  const expectedDescriptor = expectedDfd(format);
+  const dfd = container.dataFormatDescriptor[0] || {};
+  for (const field of Object.keys(expectedDescriptor)) expectEqual(`DFD ${field}`, dfd[field], expectedDescriptor[field]);
+
+  // Key/value data: sorted by code point, and saying what the manifest says.
+  const keys = Object.keys(container.keyValue);
+  expectEqual('keys in file order', keys, [...keys].sort((a, b) => Buffer.compare(Buffer.from(a), Buffer.from(b))));
+  const text = (key) => {
+    const value = container.keyValue[key];
+    if (value === undefined) return undefined;
+    if (typeof value === 'string') return value;
+    return new TextDecoder('utf-8', { fatal: true }).decode(value).replace(/\0$/, '');
+  };
+  expectEqual('KTXorientation', text('KTXorientation'), is3d ? 'rdi' : 'rd');
+  if (!/^skybake /.test(text('KTXwriter') || '')) problem(`KTXwriter is ${JSON.stringify(text('KTXwriter'))}`);
+  expectEqual('skybake.table', text('skybake.table'), table.name);
+  expectEqual('skybake.encoding', text('skybake.encoding'), table.encoding);
+  expectEqual('skybake.units', text('skybake.units'), table.units);
+  expectEqual('skybake.size', text('skybake.size'), entry.size.join('x'));
+  expectEqual('skybake.layout', text('skybake.layout'), table.layout);
+  expectEqual('skybake.channels', text('skybake.channels'), table.channels.map((c) => c.name).join(','));
+  expectEqual('skybake.wavelengths_nm', (text('skybake.wavelengths_nm') || '').split(',').map(Number),
+    manifest.wavelengths_nm);
+  let parameters;
+  try {
+    parameters = JSON.parse(text('skybake.parameters'));
+  } catch (error) {
+    problem(`skybake.parameters is not JSON: ${error.message}`);
+  }
+  expectEqual('skybake.parameters', parameters, manifest.parameters);
+  if (text('skybake.atmosphere') !== manifest.atmosphere_toml) problem('skybake.atmosphere differs from the manifest');
+
+  // Level: every texel finite and non-negative; an RGB table's alpha is 0.
+  const level = container.levels[0];
+  const texels = entry.size.reduce((a, b) => a * b, 1);
+  const bytesPerTexel = (format.channels * format.bits) / 8;
+  if (!level) {
+    problem('no level');
+    return;
+  }
+  expectEqual('level byteLength', level.levelData.byteLength, texels * bytesPerTexel);
+  const view = new DataView(level.levelData.buffer, level.levelData.byteOffset, level.levelData.byteLength);
+  const meaningful = table.channels.length;
+  let bad = 0;
+  for (let i = 0; i < texels * 4 && (i + 1) * (format.bits / 8) <= level.levelData.byteLength; i++) {
+    const value = half ? halfToFloat(view.getUint16(i * 2, true)) : view.getFloat32(i * 4, true);
+    const padding = i % 4 >= meaningful;
+    if (!Number.isFinite(value) || value < 0 || (padding && value !== 0)) {
+      if (bad++ < 3) problem(`texel ${Math.floor(i / 4)} channel ${i % 4} is ${value}`);
+    }
+  }
+  if (bad > 3) problem(`${bad} bad values in all`);
+
+  const rewritten = parser.write(container, { keepWriter: true });
+  const at = compareBytes(rewritten, bytes);
+  if (at >= 0) problem(`ktx-parse re-serialises it differently from byte ${at}`);
+}
+
+function checkBakedSets(parser, skybakeExe, workDir) {
+  const bakedDir = path.join(workDir, 'baked');
+  fs.rmSync(bakedDir, { recursive: true, force: true });
+  const variants = { float: [], half: ['--half'], 'pack-mie': ['--pack-mie'] };
+  const problems = [];
+  let files = 0;
+  for (const [name, extra] of Object.entries(variants)) {
+    const setDir = path.join(bakedDir, name);
+    bake(skybakeExe, setDir, extra);
+    const manifest = JSON.parse(fs.readFileSync(path.join(setDir, 'skybake.json'), 'utf8'));
+    for (const table of manifest.tables) {
+      for (const entry of table.files) {
+        if (entry.format !== 'ktx2') continue;
+        const before = problems.length;
+        checkBakedFile(parser, setDir, manifest, table, entry, problems);
+        files++;
+        console.log(`${problems.length === before ? 'ok  ' : 'FAIL'} baked/${name}/${entry.file}`);
+      }
+    }
+  }
+  // float and half: four tables each; packed single Mie: three.
+  if (files !== 11) problems.push(`expected 11 KTX2 files in the baked sets' manifests, found ${files}`);
+  return { problems, files };
+}
+
 async function main() {
   const args = parseArgs(process.argv.slice(2));
   const workDir = path.resolve(args['work-dir']);
@@ -252,8 +397,10 @@ async function main() {
     checkSample(parser, sampleDir, entry, problems);
     console.log(`${problems.length === before ? 'ok  ' : 'FAIL'} ${entry.file}`);
   }
+  const baked = checkBakedSets(parser, path.resolve(args['skybake-exe']), workDir);
+  problems.push(...baked.problems);
   if (problems.length > 0) fail(`ktx-parse ${version} disagrees:\n  ${problems.join('\n  ')}`);
-  console.log(`ktx2 cross-check: ${manifest.length} files read by ktx-parse ${version}; header, DFD, key/value data and level agree, and ktx-parse re-serialises them byte for byte`);
+  console.log(`ktx2 cross-check: ${manifest.length} sample files and ${baked.files} baked files read by ktx-parse ${version}; header, DFD, key/value data and level agree, and ktx-parse re-serialises them byte for byte`);
 }
 
 main().catch((error) => fail(error.stack || String(error)));

@@ -1,0 +1,261 @@
+#include "formats/lut_tables.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "bake/config.h"
+#include "bake/errors.h"
+
+namespace skybake {
+
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+ordered_json Vec3ToJson(const glsl::vec3& v) { return ordered_json::array({v.x, v.y, v.z}); }
+glsl::vec3 Vec3FromJson(const json& j) {
+  return glsl::vec3(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>());
+}
+
+std::string Nm(double nm) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%g nm", nm);
+  return buffer;
+}
+
+// Shared wording of the texture-coordinate mappings (functions.glsl has the code).
+constexpr const char* kTexelCentres = "; u = 0.5 / n + x * (1 - 1 / n) puts x = 0 and 1 on the first and last texel centres";
+constexpr const char* kRhoOverH =
+    "x = rho / H, rho = sqrt(r^2 - bottom_radius^2), H = sqrt(top_radius^2 - bottom_radius^2)";
+
+TableAxis RAxis(const std::string& axis, int size, const glsl::AtmosphereParameters& p, const std::string& mapping) {
+  return TableAxis{axis, "r", size, p.bottom_radius, p.top_radius, "m", mapping};
+}
+
+}  // namespace
+
+ordered_json ParametersToJson(const glsl::AtmosphereParameters& p) {
+  return ordered_json{
+      {"solar_irradiance", Vec3ToJson(p.solar_irradiance)},
+      {"sun_angular_radius", p.sun_angular_radius},
+      {"bottom_radius", p.bottom_radius},
+      {"top_radius", p.top_radius},
+      {"mu_s_min", p.mu_s_min},
+      {"mie_phase", p.mie_phase},
+      {"mie_g", p.mie_g},
+      {"mie_to_rayleigh_scattering_ratio", Vec3ToJson(p.mie_to_rayleigh_scattering_ratio)},
+      {"single_mie_in_scattering_alpha", p.single_mie_in_scattering_alpha},
+      {"transmittance_width", p.transmittance_width},
+      {"transmittance_height", p.transmittance_height},
+      {"scattering_r_size", p.scattering_r_size},
+      {"scattering_mu_size", p.scattering_mu_size},
+      {"scattering_mu_s_size", p.scattering_mu_s_size},
+      {"scattering_nu_size", p.scattering_nu_size},
+      {"irradiance_width", p.irradiance_width},
+      {"irradiance_height", p.irradiance_height},
+  };
+}
+
+glsl::AtmosphereParameters ParametersFromJson(const json& j) {
+  glsl::AtmosphereParameters p;
+  p.solar_irradiance = Vec3FromJson(j.at("solar_irradiance"));
+  p.sun_angular_radius = j.at("sun_angular_radius").get<double>();
+  p.bottom_radius = j.at("bottom_radius").get<double>();
+  p.top_radius = j.at("top_radius").get<double>();
+  p.mu_s_min = j.at("mu_s_min").get<double>();
+  p.mie_phase = j.at("mie_phase").get<int>();
+  p.mie_g = j.at("mie_g").get<double>();
+  p.mie_to_rayleigh_scattering_ratio = Vec3FromJson(j.at("mie_to_rayleigh_scattering_ratio"));
+  p.single_mie_in_scattering_alpha = j.at("single_mie_in_scattering_alpha").get<int>();
+  p.transmittance_width = j.at("transmittance_width").get<int>();
+  p.transmittance_height = j.at("transmittance_height").get<int>();
+  p.scattering_r_size = j.at("scattering_r_size").get<int>();
+  p.scattering_mu_size = j.at("scattering_mu_size").get<int>();
+  p.scattering_mu_s_size = j.at("scattering_mu_s_size").get<int>();
+  p.scattering_nu_size = j.at("scattering_nu_size").get<int>();
+  p.irradiance_width = j.at("irradiance_width").get<int>();
+  p.irradiance_height = j.at("irradiance_height").get<int>();
+  return p;
+}
+
+std::vector<TableDescription> DescribeTables(const LutSet& luts) {
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  const Spectrum& w = luts.atmosphere.wavelengths_nm;
+  const bool packed = p.single_mie_in_scattering_alpha == 1;
+  auto rgb = [&](const std::string& what) {
+    std::vector<TableChannel> channels;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) channels.push_back({names[c], w[c], what + " at " + Nm(w[c])});
+    return channels;
+  };
+  std::vector<TableDescription> tables;
+
+  TableDescription transmittance;
+  transmittance.name = "transmittance";
+  transmittance.encoding = "optical depth to the top of the atmosphere (transmittance = exp(-value))";
+  transmittance.units = "1";
+  transmittance.channels = rgb("optical depth");
+  transmittance.width = p.transmittance_width;
+  transmittance.height = p.transmittance_height;
+  transmittance.axes = {
+      {"x", "mu", p.transmittance_width, -1.0, 1.0, "1",
+       "rays above the horizon only (mu from -sqrt(1 - (bottom_radius / r)^2) to 1): x = (d - d_min) / (d_max - "
+       "d_min), d = distance to the top boundary along (r, mu), d_min = top_radius - r, d_max = rho + H" +
+           std::string(kTexelCentres)},
+      RAxis("y", p.transmittance_height, p, kRhoOverH + std::string(kTexelCentres))};
+  transmittance.layout = "x = mu (" + std::to_string(p.transmittance_width) + "), y = r (" +
+                         std::to_string(p.transmittance_height) + ")";
+  tables.push_back(transmittance);
+
+  TableDescription irradiance;
+  irradiance.name = "irradiance";
+  irradiance.encoding = "indirect irradiance on a horizontal surface (the direct sun is computed at run time)";
+  irradiance.units = "W m^-2 nm^-1";
+  irradiance.channels = rgb("indirect irradiance");
+  irradiance.width = p.irradiance_width;
+  irradiance.height = p.irradiance_height;
+  irradiance.axes = {{"x", "mu_s", p.irradiance_width, -1.0, 1.0, "1", "x = (mu_s + 1) / 2" + std::string(kTexelCentres)},
+                     RAxis("y", p.irradiance_height, p,
+                           "x = (r - bottom_radius) / (top_radius - bottom_radius)" + std::string(kTexelCentres))};
+  irradiance.layout = "x = mu_s (" + std::to_string(p.irradiance_width) + "), y = r (" +
+                      std::to_string(p.irradiance_height) + ")";
+  tables.push_back(irradiance);
+
+  // The 4D tables share their axes.
+  const std::vector<TableAxis> axes_4d = {
+      {"x", "nu", p.scattering_nu_size, -1.0, 1.0, "1",
+       "slice s = (nu + 1) / 2 * (nu_size - 1), linear between slices; texel x = floor(s) * mu_s_size + mu_s texel"},
+      {"x", "mu_s", p.scattering_mu_s_size, p.mu_s_min, 1.0, "1",
+       "a = (d - d_min) / (d_max - d_min) with d = distance from the ground to the top boundary along mu_s, "
+       "d_min = top_radius - bottom_radius, d_max = H; A = a at mu_s_min; x = max(1 - a / A, 0) / (1 + a)" +
+           std::string(kTexelCentres)},
+      {"y", "mu", p.scattering_mu_size, -1.0, 1.0, "1",
+       "two halves of n / 2 texels, discontinuous at the horizon: rays that hit the ground in the lower half, "
+       "u = 0.5 - 0.5 * (0.5 / (n / 2) + x * (1 - 1 / (n / 2))), x = (d - d_min) / (d_max - d_min), d = distance "
+       "to the ground, d_min = r - bottom_radius, d_max = rho; other rays in the upper half, u = 0.5 + 0.5 * (...), "
+       "d = distance to the top boundary, d_min = top_radius - r, d_max = rho + H"},
+      RAxis("z", p.scattering_r_size, p, kRhoOverH + std::string(kTexelCentres))};
+  const std::string layout_4d =
+      "x = nu * " + std::to_string(p.scattering_mu_s_size) + " + mu_s (nu " + std::to_string(p.scattering_nu_size) +
+      ", mu_s " + std::to_string(p.scattering_mu_s_size) + "), y = mu (" + std::to_string(p.scattering_mu_size) +
+      "), z = r (" + std::to_string(p.scattering_r_size) + "); EXR files stack the z slices vertically (row = z * " +
+      std::to_string(p.scattering_mu_size) + " + y)";
+  auto table_4d = [&](TableDescription t) {
+    t.axes = axes_4d;
+    t.layout = layout_4d;
+    t.is_3d = true;
+    t.width = p.scattering_nu_size * p.scattering_mu_s_size;
+    t.height = p.scattering_mu_size;
+    t.depth = p.scattering_r_size;
+    t.units = "W m^-2 sr^-1 nm^-1";
+    return t;
+  };
+
+  TableDescription scattering;
+  scattering.name = "scattering";
+  scattering.encoding = packed ? "single Rayleigh + multiple scattering radiance / Rayleigh phase (RGB), "
+                                 "single Mie radiance without phase function, red only (A)"
+                               : "single Rayleigh + multiple scattering radiance / Rayleigh phase";
+  scattering.channels = rgb("single Rayleigh + multiple scattering / Rayleigh phase");
+  if (packed) {
+    scattering.channels.push_back(
+        {"A", w[0], "single Mie scattering at " + Nm(w[0]) + " without phase function (other wavelengths rebuilt "
+                    "at run time from mie_to_rayleigh_scattering_ratio)"});
+  }
+  tables.push_back(table_4d(scattering));
+
+  if (!packed) {
+    TableDescription single_mie;
+    single_mie.name = "single_mie_scattering";
+    single_mie.encoding = "single Mie scattering radiance without phase function";
+    single_mie.channels = rgb("single Mie scattering without phase function");
+    tables.push_back(table_4d(single_mie));
+  }
+  return tables;
+}
+
+glsl::Texture& TableTexture(LutSet& luts, const std::string& name) {
+  if (name == "transmittance") return luts.transmittance;
+  if (name == "irradiance") return luts.irradiance;
+  if (name == "scattering") return luts.scattering;
+  if (name == "single_mie_scattering") return luts.single_mie_scattering;
+  throw InternalError("no table named '" + name + "'");
+}
+
+const glsl::Texture& TableTexture(const LutSet& luts, const std::string& name) {
+  return TableTexture(const_cast<LutSet&>(luts), name);
+}
+
+Metadata TableMetadata(const LutSet& luts, const TableDescription& table) {
+  const Spectrum& w = luts.atmosphere.wavelengths_nm;
+  char wavelengths[96];
+  std::snprintf(wavelengths, sizeof(wavelengths), "%.17g,%.17g,%.17g", w.x, w.y, w.z);
+  std::string channels;
+  for (const TableChannel& c : table.channels) channels += (channels.empty() ? "" : ",") + c.name;
+  return Metadata{
+      {kTableKey, table.name},
+      {kEncodingKey, table.encoding},
+      {kUnitsKey, table.units},
+      {kWavelengthsKey, wavelengths},
+      {kParametersKey, ParametersToJson(luts.parameters).dump()},
+      {kLayoutKey, table.layout},
+      {kChannelsKey, channels},
+      {kAtmosphereKey, ToToml(luts.atmosphere)},
+  };
+}
+
+TableImage MakeTableImage(const LutSet& luts, const TableDescription& table, FileFormat format, PixelType type) {
+  const glsl::Texture& texture = TableTexture(luts, table.name);
+  if (texture.width != table.width || texture.height != table.height || texture.depth != table.depth) {
+    throw InternalError("table " + table.name + " is " + std::to_string(texture.width) + "x" +
+                        std::to_string(texture.height) + "x" + std::to_string(texture.depth) +
+                        ", its parameters say " + std::to_string(table.width) + "x" + std::to_string(table.height) +
+                        "x" + std::to_string(table.depth));
+  }
+  TableImage image;
+  image.format = format;
+  image.pixel_type = type;
+  image.width = table.width;
+  image.height = table.height;
+  image.depth = table.depth;
+  image.is_3d = table.is_3d;
+  const std::size_t channels = table.channels.size();
+  for (const TableChannel& c : table.channels) image.channel_names.push_back(c.name);
+  image.values.resize(image.TexelCount() * channels);
+  for (std::size_t i = 0; i < image.TexelCount(); ++i) {
+    for (std::size_t c = 0; c < channels; ++c) image.values[i * channels + c] = texture.texels[4 * i + c];
+  }
+  image.metadata = TableMetadata(luts, table);
+  return image;
+}
+
+void CopyTableImage(const TableImage& image, const TableDescription& table, glsl::Texture* texture,
+                    const std::string& source) {
+  auto kind = image.metadata.find(kTableKey);
+  if (kind == image.metadata.end()) throw IoError(source + ": not a skybake table (no " + kTableKey + ")");
+  if (kind->second != table.name) {
+    throw IoError(source + ": holds the " + kind->second + " table, expected " + table.name);
+  }
+  if (image.width != table.width || image.height != table.height || image.depth != table.depth ||
+      image.is_3d != table.is_3d) {
+    auto size = [](int w, int h, int d, bool is_3d) {
+      return std::to_string(w) + "x" + std::to_string(h) + (is_3d ? "x" + std::to_string(d) : "");
+    };
+    throw IoError(source + ": is " + size(image.width, image.height, image.depth, image.is_3d) +
+                  ", the manifest's parameters say " + size(table.width, table.height, table.depth, table.is_3d));
+  }
+  std::vector<int> index;  // image channel of each table channel
+  for (const TableChannel& c : table.channels) {
+    auto found = std::find(image.channel_names.begin(), image.channel_names.end(), c.name);
+    if (found == image.channel_names.end()) throw IoError(source + ": missing channel " + c.name);
+    index.push_back(static_cast<int>(found - image.channel_names.begin()));
+  }
+  *texture = glsl::Texture(table.width, table.height, table.depth);
+  const std::size_t stride = image.channel_names.size();
+  for (std::size_t i = 0; i < image.TexelCount(); ++i) {
+    for (std::size_t c = 0; c < index.size(); ++c) texture->texels[4 * i + c] = image.values[i * stride + index[c]];
+  }
+}
+
+}  // namespace skybake

@@ -1,0 +1,248 @@
+#include "formats/manifest.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bake/config.h"
+#include "bake/errors.h"
+#include "bake/version.h"
+#include "formats/file_io.h"
+#include "formats/sha256.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+namespace skybake {
+
+namespace {
+
+ordered_json SettingsToJson(const BakeSettings& s) {
+  return ordered_json{{"orders", s.orders},
+                      {"transmittance_samples", s.transmittance_samples},
+                      {"ray_samples", s.ray_samples},
+                      {"sphere_samples", s.sphere_samples},
+                      {"pack_single_mie_in_alpha", s.pack_single_mie_in_alpha}};
+}
+
+ordered_json SizeToJson(int width, int height, int depth, bool is_3d) {
+  return is_3d ? ordered_json::array({width, height, depth}) : ordered_json::array({width, height});
+}
+
+// The constants the texture-coordinate mappings use, named as in functions.glsl.
+ordered_json ParameterizationToJson(const glsl::AtmosphereParameters& p) {
+  const double horizon = std::sqrt(p.top_radius * p.top_radius - p.bottom_radius * p.bottom_radius);
+  return ordered_json{
+      {"functions", "shaders_runtime/functions.glsl: GetTransmittanceTextureUvFromRMu, "
+                    "GetIrradianceTextureUvFromRMuS, GetScatteringTextureUvwzFromRMuMuSNu"},
+      {"bottom_radius", p.bottom_radius},
+      {"top_radius", p.top_radius},
+      {"H", horizon},
+      {"mu_s_min", p.mu_s_min},
+      {"texel_centres", "u = 0.5 / n + x * (1 - 1 / n) for x in [0, 1] on an axis of n texels"},
+  };
+}
+
+bool IsPlainFileName(const std::string& name) {
+  return !name.empty() && name != "." && name != ".." && name.find('/') == std::string::npos &&
+         name.find('\\') == std::string::npos && name.find('\0') == std::string::npos;
+}
+
+bool IsHexDigest(const std::string& s) {
+  return s.size() == 64 && std::all_of(s.begin(), s.end(), [](char c) {
+           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+         });
+}
+
+}  // namespace
+
+ManifestWriter::ManifestWriter(const LutSet& luts, std::string command_line)
+    : luts_(luts), command_line_(std::move(command_line)) {
+  for (const TableDescription& t : DescribeTables(luts)) {
+    ordered_json channels = ordered_json::array();
+    for (const TableChannel& c : t.channels) {
+      channels.push_back({{"name", c.name}, {"wavelength_nm", c.wavelength_nm}, {"meaning", c.meaning}});
+    }
+    ordered_json axes = ordered_json::array();
+    for (const TableAxis& a : t.axes) {
+      axes.push_back({{"axis", a.axis},
+                      {"coordinate", a.coordinate},
+                      {"size", a.size},
+                      {"range", {a.range_min, a.range_max}},
+                      {"units", a.units},
+                      {"mapping", a.mapping}});
+    }
+    tables_.push_back({{"name", t.name},
+                       {"encoding", t.encoding},
+                       {"units", t.units},
+                       {"size", SizeToJson(t.width, t.height, t.depth, t.is_3d)},
+                       {"layout", t.layout},
+                       {"channels", channels},
+                       {"axes", axes},
+                       {"files", ordered_json::array()}});
+  }
+}
+
+void ManifestWriter::AddTableFile(const TableDescription& table, const std::string& file, const TableImage& image,
+                                  const std::vector<std::uint8_t>& bytes) {
+  auto entry = std::find_if(tables_.begin(), tables_.end(), [&](const ordered_json& t) { return t["name"] == table.name; });
+  if (entry == tables_.end()) throw InternalError("manifest: no table " + table.name);
+  ordered_json f = {{"file", file},
+                    {"format", ToString(image.format)},
+                    {"pixel_type", ToString(image.pixel_type)},
+                    {"storage", image.StorageName()},
+                    {"size", SizeToJson(image.width, image.height, image.depth, image.is_3d)},
+                    {"stored_channels", StoredChannels(image)}};
+  if (image.format == FileFormat::kExr && image.is_3d) {
+    f["atlas"] = ordered_json::array({image.width, image.height * image.depth});
+  }
+  f["bytes"] = bytes.size();
+  f["sha256"] = Sha256Hex(bytes.data(), bytes.size());
+  (*entry)["files"].push_back(f);
+}
+
+void ManifestWriter::AddShaderFile(const std::string& file, std::string_view bytes, const std::string& description) {
+  if (!IsPlainFileName(file)) throw InternalError("manifest: shader file '" + file + "' is not a plain file name");
+  shaders_.push_back(
+      {{"file", file}, {"description", description}, {"bytes", bytes.size()}, {"sha256", Sha256Hex(bytes)}});
+}
+
+std::string ManifestWriter::Text() const {
+  const Spectrum& w = luts_.atmosphere.wavelengths_nm;
+  ordered_json manifest = {
+      {"schema", kManifestSchema},
+      {"schema_version", kManifestSchemaVersion},
+      {"generator", "skybake " SKYBAKE_VERSION},
+      {"command", command_line_},
+      {"wavelengths_nm", {w.x, w.y, w.z}},
+      {"parameters", ParametersToJson(luts_.parameters)},
+      {"parameterization", ParameterizationToJson(luts_.parameters)},
+      {"bake", SettingsToJson(luts_.settings)},
+      {"tables", tables_},
+      {"shaders", shaders_},
+      {"atmosphere", ordered_json::parse(ToJson(luts_.atmosphere))},
+      {"atmosphere_toml", ToToml(luts_.atmosphere)},
+  };
+  return manifest.dump(2) + "\n";
+}
+
+const ManifestFile* Manifest::Find(const std::string& table, FileFormat format) const {
+  for (const ManifestFile& f : table_files) {
+    if (f.table == table && f.format == format) return &f;
+  }
+  return nullptr;
+}
+
+Manifest ReadManifest(const fs::path& dir) {
+  Manifest m;
+  m.path = dir / kManifestFileName;
+  const std::string where = m.path.string();
+  if (!fs::exists(m.path)) {
+    throw IoError(where + ": no manifest (is " + dir.string() + " a directory written by skybake bake?)");
+  }
+  const std::string text = ReadFileText(m.path);
+  try {
+    m.document = json::parse(text);
+    if (!m.document.is_object() || m.document.value("schema", "") != kManifestSchema) {
+      throw IoError(where + ": not a skybake manifest");
+    }
+    const int version = m.document.at("schema_version").get<int>();
+    if (version != kManifestSchemaVersion) {
+      throw IoError(where + ": schema version " + std::to_string(version) + ", this skybake reads version " +
+                    std::to_string(kManifestSchemaVersion) + " (re-bake, or use a matching skybake)");
+    }
+    LutSet& luts = m.luts;
+    luts.parameters = ParametersFromJson(m.document.at("parameters"));
+    luts.atmosphere = ParseAtmosphere(m.document.at("atmosphere_toml").get<std::string>(), where);
+    const json& bake = m.document.at("bake");
+    BakeSettings& s = luts.settings;
+    s.orders = bake.at("orders").get<int>();
+    s.transmittance_samples = bake.at("transmittance_samples").get<int>();
+    s.ray_samples = bake.at("ray_samples").get<int>();
+    s.sphere_samples = bake.at("sphere_samples").get<int>();
+    s.pack_single_mie_in_alpha = bake.at("pack_single_mie_in_alpha").get<bool>();
+    const glsl::AtmosphereParameters& p = luts.parameters;
+    s.transmittance_width = p.transmittance_width;
+    s.transmittance_height = p.transmittance_height;
+    s.irradiance_width = p.irradiance_width;
+    s.irradiance_height = p.irradiance_height;
+    s.scattering_r_size = p.scattering_r_size;
+    s.scattering_mu_size = p.scattering_mu_size;
+    s.scattering_mu_s_size = p.scattering_mu_s_size;
+    s.scattering_nu_size = p.scattering_nu_size;
+    s.Validate();
+    if (p.single_mie_in_scattering_alpha != (s.pack_single_mie_in_alpha ? 1 : 0)) {
+      throw IoError(where + ": parameters and bake settings disagree on packing single Mie");
+    }
+
+    auto read_file = [&](const json& f, const std::string& table) {
+      ManifestFile entry;
+      entry.table = table;
+      entry.file = f.at("file").get<std::string>();
+      if (!IsPlainFileName(entry.file)) {
+        throw IoError(where + ": file '" + entry.file + "' must be a plain name in the manifest's directory");
+      }
+      entry.bytes = f.at("bytes").get<std::uint64_t>();
+      entry.sha256 = f.at("sha256").get<std::string>();
+      if (!IsHexDigest(entry.sha256)) throw IoError(where + ": file '" + entry.file + "': malformed sha256");
+      return entry;
+    };
+    for (const json& t : m.document.at("tables")) {
+      const std::string name = t.at("name").get<std::string>();
+      for (const json& f : t.at("files")) {
+        ManifestFile entry = read_file(f, name);
+        auto format = ParseFileFormat(f.at("format").get<std::string>());
+        if (!format) throw IoError(where + ": file '" + entry.file + "': unknown format " + f.at("format").dump());
+        entry.format = *format;
+        const std::string type = f.at("pixel_type").get<std::string>();
+        if (type != "float" && type != "half") throw IoError(where + ": file '" + entry.file + "': unknown pixel_type");
+        entry.pixel_type = type == "half" ? PixelType::kHalf : PixelType::kFloat;
+        m.table_files.push_back(entry);
+      }
+    }
+    for (const json& f : m.document.at("shaders")) m.shader_files.push_back(read_file(f, ""));
+  } catch (const json::exception& e) {
+    throw IoError(where + ": malformed manifest: " + e.what());
+  } catch (const InputError& e) {
+    // Atmosphere errors already name the manifest; settings errors do not.
+    const std::string message = e.what();
+    throw IoError(message.rfind(where, 0) == 0 ? message : where + ": " + message);
+  }
+  return m;
+}
+
+std::optional<ManifestFile> FindListing(const fs::path& file) {
+  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  if (!fs::exists(dir / kManifestFileName)) return std::nullopt;
+  const Manifest manifest = ReadManifest(dir);
+  const std::string name = file.filename().string();
+  for (const auto* list : {&manifest.table_files, &manifest.shader_files}) {
+    for (const ManifestFile& f : *list) {
+      if (f.file == name) return f;
+    }
+  }
+  return std::nullopt;
+}
+
+std::vector<std::uint8_t> ReadListedFile(const Manifest& manifest, const ManifestFile& entry) {
+  const fs::path path = manifest.Directory() / entry.file;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw IoError(path.string() + ": missing (listed in " + kManifestFileName + ")");
+  std::vector<std::uint8_t> bytes = ReadFileBytes(path);
+  VerifyListedFile(entry, bytes, path.string());
+  return bytes;
+}
+
+void VerifyListedFile(const ManifestFile& entry, const std::vector<std::uint8_t>& bytes, const std::string& source) {
+  if (bytes.size() != entry.bytes) {
+    throw IoError(source + ": " + (bytes.size() < entry.bytes ? "truncated" : "wrong size") + ": " +
+                  std::to_string(bytes.size()) + " bytes, the manifest says " + std::to_string(entry.bytes));
+  }
+  const std::string digest = Sha256Hex(bytes.data(), bytes.size());
+  if (digest != entry.sha256) {
+    throw IoError(source + ": checksum mismatch: sha256 " + digest.substr(0, 16) + "..., the manifest says " +
+                  entry.sha256.substr(0, 16) + "... (the file changed after the bake)");
+  }
+}
+
+}  // namespace skybake

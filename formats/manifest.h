@@ -1,0 +1,87 @@
+// The manifest `skybake.json`: the versioned description of a baked set that
+// engines and the loader read first (schema documented in docs/manifest.md).
+// It lists every file with its format, pixel type, size, channel meanings,
+// encoding, units, parameterization and SHA-256, plus the runtime constants,
+// the bake settings, the resolved atmosphere and the command that wrote it.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "formats/lut_tables.h"
+#include "formats/table_file.h"
+
+namespace skybake {
+
+inline constexpr const char kManifestFileName[] = "skybake.json";
+inline constexpr const char kManifestSchema[] = "skybake.manifest";
+inline constexpr int kManifestSchemaVersion = 2;
+
+class ManifestWriter {
+ public:
+  ManifestWriter(const LutSet& luts, std::string command_line);
+
+  // A table file as written (`bytes` are its whole content, hashed here).
+  void AddTableFile(const TableDescription& table, const std::string& file, const TableImage& image,
+                    const std::vector<std::uint8_t>& bytes);
+  // Any other file shipped beside the tables, such as the generated GLSL
+  // runtime: one call lists it under "shaders" with its size and SHA-256.
+  void AddShaderFile(const std::string& file, std::string_view bytes, const std::string& description);
+
+  // The manifest as JSON text (two-space indent, final newline).
+  std::string Text() const;
+
+ private:
+  const LutSet& luts_;
+  std::string command_line_;
+  nlohmann::ordered_json tables_ = nlohmann::ordered_json::array();
+  nlohmann::ordered_json shaders_ = nlohmann::ordered_json::array();
+};
+
+// One file listed in a manifest.
+struct ManifestFile {
+  std::string table;  // empty for shader files
+  std::string file;   // a plain name in the manifest's directory
+  FileFormat format = FileFormat::kExr;  // table files only
+  PixelType pixel_type = PixelType::kFloat;
+  std::uint64_t bytes = 0;
+  std::string sha256;
+};
+
+// A manifest read back: the set without texels, and its files.
+struct Manifest {
+  std::filesystem::path path;  // .../skybake.json
+  LutSet luts;                 // atmosphere, settings and parameters; textures empty
+  std::vector<ManifestFile> table_files;
+  std::vector<ManifestFile> shader_files;
+  nlohmann::json document;
+
+  std::filesystem::path Directory() const { return path.parent_path(); }
+  // The listed files of `table` in `format`; nullptr if there is none.
+  const ManifestFile* Find(const std::string& table, FileFormat format) const;
+};
+
+// Reads and validates DIR/skybake.json (schema, version, settings, that file
+// names are plain names). IoError naming the manifest for anything wrong.
+Manifest ReadManifest(const std::filesystem::path& dir);
+
+// The entry for `file` when the directory holding it has a manifest that
+// lists it (as a table or shader file); nullopt when there is no manifest or
+// it does not list the file. A manifest that cannot be read is an IoError.
+std::optional<ManifestFile> FindListing(const std::filesystem::path& file);
+
+// Reads a file the manifest lists and verifies it: IoError "<path>: missing
+// (listed in skybake.json)", "...: truncated", "...: checksum mismatch".
+std::vector<std::uint8_t> ReadListedFile(const Manifest& manifest, const ManifestFile& entry);
+
+// IoError "<source>: ..." unless `bytes` has the listed size and SHA-256.
+void VerifyListedFile(const ManifestFile& entry, const std::vector<std::uint8_t>& bytes, const std::string& source);
+
+}  // namespace skybake
