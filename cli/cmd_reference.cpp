@@ -1,7 +1,6 @@
 // `skybake reference`: answers the queries of `skybake eval` with the
 // independent Monte Carlo reference (reference/path_tracer.h), each Monte
 // Carlo figure with its standard error. Method: docs/reference.md.
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include "bake/config.h"
 #include "bake/errors.h"
 #include "cli/commands.h"
+#include "cli/progress.h"
 #include "formats/file_io.h"
 #include "reference/path_tracer.h"
 #include "reference/query_csv.h"
@@ -46,7 +46,7 @@ void RunReference(const ReferenceOptions& o) {
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
   reference::PathTracer tracer(atmosphere);
 
-  const bool progress = !o.quiet && isatty(fileno(stderr));
+  ProgressBar bar("reference", table.queries.size(), o.quiet);
   std::vector<reference::Result> results;
   double seconds = 0.0;
   int64_t truncated = 0;
@@ -55,12 +55,9 @@ void RunReference(const ReferenceOptions& o) {
     results.push_back(tracer.Evaluate(table.queries[row], settings, row));
     seconds += results.back().statistics.seconds;
     truncated += results.back().statistics.truncated;
-    if (progress) {
-      std::fprintf(stderr, "\rreference: %zu/%zu queries, %.1f s", row + 1, table.queries.size(), seconds);
-      std::fflush(stderr);
-    }
+    bar.Advance();
   }
-  if (progress) std::fprintf(stderr, "\n");
+  bar.Finish();
   if (truncated > 0 && !o.quiet) {
     std::fprintf(stderr,
                  "skybake: warning: %lld paths reached %d scattering events and were stopped (optically very "
