@@ -48,12 +48,10 @@ void RunReference(const ReferenceOptions& o) {
 
   ProgressBar bar("reference", table.queries.size(), o.quiet);
   std::vector<reference::Result> results;
-  double seconds = 0.0;
   int64_t truncated = 0;
   for (size_t row = 0; row < table.queries.size(); ++row) {
     // The row number separates the random streams of the rows.
     results.push_back(tracer.Evaluate(table.queries[row], settings, row));
-    seconds += results.back().statistics.seconds;
     truncated += results.back().statistics.truncated;
     bar.Advance();
   }
