@@ -255,7 +255,11 @@ Canvas Rasterize(const LinePlot& plot, const PlotFrame& f) {
   }
   for (size_t i = 0; i < plot.series.size(); ++i) {
     const PlotSeries& s = plot.series[i];
-    for (const auto& run : PixelRuns(f, s)) canvas.Polyline(run, s.width_px, s.style, Rgb(ColorIndex(plot, i)), area);
+    for (const auto& run : PixelRuns(f, s)) {
+      if (s.width_px > 0) canvas.Polyline(run, s.width_px, s.style, Rgb(ColorIndex(plot, i)), area);
+      if (s.marker_px > 0)
+        for (const auto& p : run) canvas.Segment(p[0], p[1], p[0], p[1], s.marker_px, Rgb(ColorIndex(plot, i)), area);
+    }
   }
   // Frame last, so curves along the edges do not hide it.
   canvas.Segment(f.left, f.top, f.right, f.top, 1.0, axis, everywhere);
@@ -274,8 +278,13 @@ Canvas Rasterize(const LinePlot& plot, const PlotFrame& f) {
     for (size_t k = 0; k < legend.entries.size(); ++k) {
       const PlotSeries& s = plot.series[legend.entries[k]];
       double y = legend.y + kLegendPad + kLegendRow * (k + 0.5) - 2;
-      canvas.Polyline({{legend.x + kLegendPad, y}, {legend.x + kLegendPad + kLegendSample, y}}, s.width_px, s.style,
-                      Rgb(ColorIndex(plot, legend.entries[k])), everywhere);
+      if (s.width_px > 0)
+        canvas.Polyline({{legend.x + kLegendPad, y}, {legend.x + kLegendPad + kLegendSample, y}}, s.width_px,
+                        s.style, Rgb(ColorIndex(plot, legend.entries[k])), everywhere);
+      if (s.marker_px > 0) {
+        double x = legend.x + kLegendPad + 0.5 * kLegendSample;
+        canvas.Segment(x, y, x, y, s.marker_px, Rgb(ColorIndex(plot, legend.entries[k])), everywhere);
+      }
     }
   }
   return canvas;
@@ -358,6 +367,12 @@ std::string RenderPlotSvg(const LinePlot& plot) {
     std::string dash;
     for (double d : DashPattern(s.style, s.width_px)) dash += (dash.empty() ? "" : ",") + Num(d);
     for (const auto& run : PixelRuns(f, s)) {
+      if (s.marker_px > 0) {
+        for (const auto& p : run)
+          o << "<circle data-series=\"" << i << "\" cx=\"" << Num(p[0]) << "\" cy=\"" << Num(p[1]) << "\" r=\""
+            << Num(0.5 * s.marker_px) << "\" fill=\"" << PlotColor(ColorIndex(plot, i)) << "\" stroke=\"none\"/>\n";
+      }
+      if (s.width_px <= 0) continue;
       o << "<polyline data-series=\"" << i << "\" stroke=\"" << PlotColor(ColorIndex(plot, i)) << "\" stroke-width=\""
         << Num(s.width_px) << "\"" << (dash.empty() ? "" : " stroke-dasharray=\"" + dash + "\"") << " points=\"";
       for (size_t k = 0; k < run.size(); ++k) o << (k ? " " : "") << Num(run[k][0]) << "," << Num(run[k][1]);
@@ -377,11 +392,16 @@ std::string RenderPlotSvg(const LinePlot& plot) {
       double y = legend.y + kLegendPad + kLegendRow * (k + 0.5) - 2;
       std::string dash;
       for (double d : DashPattern(s.style, s.width_px)) dash += (dash.empty() ? "" : ",") + Num(d);
-      o << "<line x1=\"" << Num(legend.x + kLegendPad) << "\" y1=\"" << Num(y) << "\" x2=\""
-        << Num(legend.x + kLegendPad + kLegendSample) << "\" y2=\"" << Num(y) << "\" stroke=\""
-        << PlotColor(ColorIndex(plot, legend.entries[k])) << "\" stroke-width=\"" << Num(s.width_px) << "\""
-        << (dash.empty() ? "" : " stroke-dasharray=\"" + dash + "\"") << "/>\n"
-        << "<text x=\"" << Num(legend.x + 2 * kLegendPad + kLegendSample) << "\" y=\"" << Num(y + 4) << "\">"
+      if (s.width_px > 0)
+        o << "<line x1=\"" << Num(legend.x + kLegendPad) << "\" y1=\"" << Num(y) << "\" x2=\""
+          << Num(legend.x + kLegendPad + kLegendSample) << "\" y2=\"" << Num(y) << "\" stroke=\""
+          << PlotColor(ColorIndex(plot, legend.entries[k])) << "\" stroke-width=\"" << Num(s.width_px) << "\""
+          << (dash.empty() ? "" : " stroke-dasharray=\"" + dash + "\"") << "/>\n";
+      if (s.marker_px > 0)
+        o << "<circle cx=\"" << Num(legend.x + kLegendPad + 0.5 * kLegendSample) << "\" cy=\"" << Num(y)
+          << "\" r=\"" << Num(0.5 * s.marker_px) << "\" fill=\"" << PlotColor(ColorIndex(plot, legend.entries[k]))
+          << "\"/>\n";
+      o << "<text x=\"" << Num(legend.x + 2 * kLegendPad + kLegendSample) << "\" y=\"" << Num(y + 4) << "\">"
         << XmlEscape(s.name) << "</text>\n";
     }
     o << "</g>\n";

@@ -17,7 +17,8 @@ struct PlotSeries {
   std::vector<double> x, y;  // equal lengths; a non-finite point, or one <= 0 on a log axis, breaks the line
   LineStyle style = LineStyle::kSolid;
   int color = -1;            // palette index; -1: the series' position in the plot
-  double width_px = 2.0;
+  double width_px = 2.0;     // line width; 0: no line (markers only)
+  double marker_px = 0.0;    // diameter of a dot drawn at every point; 0: none
 };
 
 struct PlotAxis {

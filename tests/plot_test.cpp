@@ -109,6 +109,34 @@ TEST(Plot, SvgPolylinesFollowTheDataAndBreakAtGaps) {
   EXPECT_NE(svg.find(PlotColor(1)), std::string::npos);
 }
 
+TEST(Plot, MarkersSitOnThePointsAndLinesCanBeLeftOut) {
+  LinePlot plot = SamplePlot();
+  PlotSeries dots{"dots", {10.0, 50.0}, {3.0, 30.0}, LineStyle::kSolid, 2, 0.0, 8.0};
+  plot.series.push_back(dots);
+  std::string svg = RenderPlotSvg(plot);
+  PlotFrame f = LayoutPlot(plot);
+  EXPECT_EQ(Polylines(svg).size(), 2u);  // the markers-only series draws no line
+  std::regex circle("<circle data-series=\"2\" cx=\"([^\"]*)\" cy=\"([^\"]*)\" r=\"([^\"]*)\"");
+  std::vector<std::array<double, 2>> centres;
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), circle); it != std::sregex_iterator(); ++it) {
+    centres.push_back({std::stod((*it)[1]), std::stod((*it)[2])});
+    EXPECT_DOUBLE_EQ(std::stod((*it)[3]), 4.0);  // radius: half the marker's diameter
+  }
+  ASSERT_EQ(centres.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR(centres[i][0], f.PixelX(dots.x[i]), 0.006);
+    EXPECT_NEAR(centres[i][1], f.PixelY(dots.y[i]), 0.006);
+  }
+  // The raster has the marker's colour at its centre.
+  std::vector<unsigned char> pixels = RasterizePlot(plot);
+  int x = static_cast<int>(centres[0][0]), y = static_cast<int>(centres[0][1]);
+  const unsigned char* p = &pixels[(static_cast<size_t>(y) * plot.width_px + x) * 3];
+  unsigned colour = std::stoul(PlotColor(2).substr(1), nullptr, 16);
+  EXPECT_NEAR(p[0], (colour >> 16) & 255, 2);
+  EXPECT_NEAR(p[1], (colour >> 8) & 255, 2);
+  EXPECT_NEAR(p[2], colour & 255, 2);
+}
+
 TEST(Plot, SvgEscapesText) {
   std::string svg = RenderPlotSvg(SamplePlot());
   EXPECT_NE(svg.find("m &amp; friends &lt;test&gt;"), std::string::npos);
