@@ -1,6 +1,7 @@
 // `skybake info FILE|DIR`: what a table file holds (format, size, per-channel
 // range and NaN/Inf counts, metadata), checked against the manifest when one
-// lists it; for a directory, every file its manifest lists.
+// lists it; for a directory, every file its manifest lists. `--plot OUT` also
+// draws the set's table slices through the CPU twin (render/lut_plots.h).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -12,12 +13,16 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/errors.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "formats/file_io.h"
+#include "formats/lut_files.h"
 #include "formats/manifest.h"
 #include "formats/sha256.h"
 #include "formats/table_file.h"
 #include "formats/table_stats.h"
+#include "render/lut_plots.h"
+#include "shaders_runtime/twin.h"
 
 namespace skybake::cli {
 
@@ -28,6 +33,7 @@ using nlohmann::json;
 
 struct InfoOptions {
   std::string path;
+  std::string plot_dir;  // empty: no plots
   bool json = false;
 };
 
@@ -94,10 +100,25 @@ void PrintTableFile(const json& d) {
   }
 }
 
+// Plots of the set's table slices into o.plot_dir; the file names, for the report.
+json WritePlots(const InfoOptions& o) {
+  const LutSet luts = LoadLutSet(o.path);
+  const Twin twin(MakeTwinTables(luts));
+  EnsureWritableDirectory(o.plot_dir);
+  const render::PlotFiles plots = render::WriteLutPlots(twin, luts.atmosphere.wavelengths_nm, o.plot_dir, CommandLine());
+  if (!plots.png_text) std::fputs("info: no TrueType font found; the PNG plots have no text\n", stderr);
+  json files = json::array();
+  for (const fs::path& f : plots.files) files.push_back(f.string());
+  return files;
+}
+
 void RunInfo(const InfoOptions& o) {
   const fs::path path = o.path;
   std::error_code ec;
   if (!fs::exists(path, ec)) throw IoError(o.path + ": no such file or directory");
+  if (!o.plot_dir.empty() && !fs::is_directory(path)) {
+    throw UsageError("info: --plot needs a baked directory, not a single file");
+  }
   if (!fs::is_directory(path)) {
     const std::optional<ManifestFile> listing = FindListing(path);
     const std::vector<std::uint8_t> bytes = ReadFileBytes(path);
@@ -123,6 +144,7 @@ void RunInfo(const InfoOptions& o) {
     shaders.push_back({{"file", (path / f.file).string()}, {"bytes", bytes.size()}, {"sha256", f.sha256}});
   }
   const json& doc = manifest.document;
+  const json plots = o.plot_dir.empty() ? json::array() : WritePlots(o);
   if (o.json) {
     json report = {{"manifest", manifest.path.string()},
                    {"schema_version", doc["schema_version"]},
@@ -132,6 +154,7 @@ void RunInfo(const InfoOptions& o) {
                    {"wavelengths_nm", doc["wavelengths_nm"]},
                    {"files", files},
                    {"shaders", shaders}};
+    if (!o.plot_dir.empty()) report["plots"] = plots;
     std::printf("%s\n", report.dump(2, ' ', false, json::error_handler_t::replace).c_str());
     return;
   }
@@ -149,6 +172,7 @@ void RunInfo(const InfoOptions& o) {
     std::printf("%s\n  %zu bytes, sha256 %s (matches)\n", s["file"].get<std::string>().c_str(),
                 s["bytes"].get<std::size_t>(), s["sha256"].get<std::string>().c_str());
   }
+  for (const json& f : plots) std::printf("plot %s\n", f.get<std::string>().c_str());
 }
 
 }  // namespace
@@ -160,6 +184,9 @@ void AddInfoCommand(CLI::App& app) {
               "NaN/Inf counts, metadata; files a manifest lists are checked against its SHA-256");
   cmd->add_option("path", o->path, "Table file (.exr, .ktx2) or directory written by skybake bake")->required();
   cmd->add_flag("--json", o->json, "Print the description as JSON on stdout");
+  cmd->add_option("--plot", o->plot_dir,
+                  "Also plot table slices of a baked directory (transmittance, sky radiance, irradiance; "
+                  "lut_*.svg and .png) into this directory");
   cmd->callback([o] { RunInfo(*o); });
 }
 

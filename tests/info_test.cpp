@@ -117,6 +117,32 @@ TEST_F(BakedSetTest, InfoOnOneFileChecksItAgainstTheManifest) {
   EXPECT_EQ(report["pixel_type"], "float");
 }
 
+// --plot draws the set's table slices (SVG and PNG) and lists them; it needs
+// a baked directory, not one file.
+TEST_F(BakedSetTest, InfoPlotsTableSlicesOfABakedSet) {
+  TempDir dir;
+  std::string out, err;
+  const fs::path plots = dir.path() / "plots";
+  ASSERT_EQ(RunCommand(Skybake() + " info --json " + ShellQuote(Lut()) + " --plot " + ShellQuote(plots), dir, &out,
+                       &err),
+            0)
+      << err;
+  json report = json::parse(out);
+  ASSERT_EQ(report["plots"].size(), 6u) << report["plots"];
+  for (const char* stem : {"lut_transmittance", "lut_sky_radiance", "lut_irradiance"}) {
+    for (const char* extension : {".svg", ".png"}) {
+      const fs::path file = plots / (std::string(stem) + extension);
+      ASSERT_TRUE(fs::exists(file)) << file;
+      EXPECT_GT(fs::file_size(file), 1000u) << file;
+    }
+    EXPECT_NE(ReadText(plots / (std::string(stem) + ".svg")).find("<polyline"), std::string::npos) << stem;
+  }
+  EXPECT_EQ(RunCommand(Skybake() + " info " + ShellQuote(Lut() / "irradiance.exr") + " --plot " + ShellQuote(plots),
+                       dir, &out, &err),
+            1);
+  EXPECT_EQ(Lines(err).size(), 1u) << err;
+}
+
 // NaN and Inf counts from a file that holds some.
 TEST_F(BakedSetTest, InfoCountsNanAndInf) {
   TempDir dir;
