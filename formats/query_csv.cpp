@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -15,7 +16,9 @@ namespace {
 
 const std::vector<std::string> kRequiredColumns = {"altitude_m", "view_zenith_deg", "sun_zenith_deg",
                                                    "view_sun_azimuth_deg"};
-const std::vector<std::string> kOptionalColumns = {"distance_m", "normal_zenith_deg"};
+// "group" is a free-text label (the case set of docs/report.md); the tools
+// echo it with the other input columns.
+const std::vector<std::string> kOptionalColumns = {"distance_m", "normal_zenith_deg", "group"};
 
 std::vector<std::string> SplitCsvLine(const std::string& line) {
   std::vector<std::string> fields;
@@ -43,8 +46,15 @@ std::string WavelengthName(double nm) {
   return buffer;
 }
 
-QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name) {
+size_t QueryTable::ResultColumn(const std::string& name) const {
+  auto it = std::find(result_columns.begin(), result_columns.end(), name);
+  if (it == result_columns.end()) throw InputError(source_name + ": missing column '" + name + "'");
+  return static_cast<size_t>(it - result_columns.begin());
+}
+
+QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name, ExtraColumns extra_columns) {
   QueryTable table;
+  table.source_name = source_name;
   std::istringstream in(text);
   std::string line;
   int line_number = 0;
@@ -57,17 +67,23 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
   for (size_t i = 0; i < table.header.size(); ++i) {
     const std::string& name = table.header[i];
     std::string where = source_name + ":" + std::to_string(line_number) + ": ";
-    if (!Contains(kRequiredColumns, name) && !Contains(kOptionalColumns, name)) {
+    if (column.count(name) || Contains(table.result_columns, name)) {
+      throw InputError(where + "duplicate column '" + name + "'");
+    }
+    if (Contains(kRequiredColumns, name) || Contains(kOptionalColumns, name)) {
+      column[name] = i;
+    } else if (extra_columns == ExtraColumns::kKeepAsResults) {
+      table.result_columns.push_back(name);
+    } else {
       throw InputError(where + "unknown column '" + name + "'");
     }
-    if (column.count(name)) throw InputError(where + "duplicate column '" + name + "'");
-    column[name] = i;
   }
   for (const std::string& name : kRequiredColumns) {
     if (!column.count(name)) throw InputError(source_name + ": missing column '" + name + "'");
   }
   table.has_distance = column.count("distance_m") > 0;
   table.has_normal = column.count("normal_zenith_deg") > 0;
+  table.has_group = column.count("group") > 0;
 
   while (std::getline(in, line)) {
     ++line_number;
@@ -110,6 +126,20 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
       q.has_normal = true;
       q.normal_zenith_deg = angle("normal_zenith_deg", true);
     }
+    if (table.has_group) table.groups.push_back(fields[column.at("group")]);
+    std::vector<double> results;
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (!Contains(table.result_columns, table.header[i])) continue;
+      if (fields[i].empty()) {  // not computed for this row (e.g. irradiance without a normal)
+        results.push_back(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
+      char* end = nullptr;
+      double value = std::strtod(fields[i].c_str(), &end);
+      if (*end != '\0') fail(table.header[i] + " = '" + fields[i] + "' is not a number");
+      results.push_back(value);
+    }
+    if (!table.result_columns.empty()) table.results.push_back(results);
     table.fields.push_back(fields);
     table.queries.push_back(q);
   }

@@ -1,7 +1,8 @@
 // Query files shared by every command that answers queries (`skybake eval`,
 // `skybake reference`): CSV with the header columns altitude_m,
 // view_zenith_deg, sun_zenith_deg, view_sun_azimuth_deg and optionally
-// distance_m and normal_zenith_deg, in any order (docs/eval.md).
+// distance_m, normal_zenith_deg and a free-text group label, in any order
+// (docs/eval.md, docs/report.md).
 #pragma once
 
 #include <string>
@@ -17,10 +18,25 @@ struct QueryTable {
   std::vector<Query> queries;                      // per row; altitude below 0 raised to 0
   bool has_distance = false;
   bool has_normal = false;
+  bool has_group = false;
+  std::vector<std::string> groups;                 // per row, when has_group
+  // With ExtraColumns::kKeepAsResults: every other column, parsed as a number; an
+  // empty field (a value not computed for that row) is NaN.
+  std::vector<std::string> result_columns;
+  std::vector<std::vector<double>> results;  // per row, per result column
+  // The index of a result column; InputError naming SOURCE when it is missing.
+  size_t ResultColumn(const std::string& name) const;
+  std::string source_name;
 };
 
+// What to do with columns that are not query columns: a query file rejects
+// them; a results file (eval or reference output read back, e.g. the report's
+// reference values) keeps them as numbers.
+enum class ExtraColumns { kReject, kKeepAsResults };
+
 // InputError "SOURCE:LINE: problem" on a malformed file.
-QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name);
+QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name,
+                         ExtraColumns extra_columns = ExtraColumns::kReject);
 
 // "680nm" for 680, "532.5nm" for 532.5: the suffix of per-wavelength columns.
 std::string WavelengthName(double nm);
