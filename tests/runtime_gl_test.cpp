@@ -15,6 +15,8 @@
 
 #include "bake/bake.h"
 #include "bake/config.h"
+#include "formats/lut_files.h"
+#include "formats/manifest.h"
 #include "shaders_runtime/query.h"
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/snippet.h"
@@ -178,6 +180,33 @@ std::vector<Item> MakeItems(double bottom_radius, double top_radius) {
 
 std::string FragmentSource(const LutSet& luts) {
   return RuntimeSnippetSource(luts.parameters, luts.atmosphere.wavelengths_nm, luts.atmosphere.name) + kMain;
+}
+
+// ---- the bake ships the snippet ----
+
+TEST(RuntimeSnippet, BakeWritesItWithConstantsFromTheManifestParameters) {
+  testing::TempDir dir;
+  const std::filesystem::path lut = dir.path() / "lut";
+  std::string err;
+  ASSERT_EQ(testing::RunCommand(testing::Skybake() + " bake earth -q --pack-mie -o " + testing::ShellQuote(lut) +
+                                    " --orders 1 --transmittance-size 32 8 --irradiance-size 8 4"
+                                    " --scattering-size 4 8 4 4 --ray-samples 8 --sphere-samples 4",
+                                dir, nullptr, &err),
+            0)
+      << err;
+  // The constants are a function of what the manifest records, so they agree
+  // with the tables by construction; a loader that rebuilds them gets the same text.
+  const LutSet loaded = LoadLutSet(lut);
+  EXPECT_EQ(testing::ReadText(lut / "atmosphere_constants.glsl"),
+            AtmosphereConstantsGlsl(loaded.parameters, loaded.atmosphere.wavelengths_nm, loaded.atmosphere.name));
+  EXPECT_NE(testing::ReadText(lut / "atmosphere_constants.glsl").find("SKYBAKE_HAS_SINGLE_MIE_SCATTERING_TEXTURE 0"),
+            std::string::npos);
+  const Manifest manifest = ReadManifest(lut);
+  std::vector<std::string> listed;
+  for (const ManifestFile& f : manifest.shader_files) listed.push_back(f.file);
+  EXPECT_EQ(listed, (std::vector<std::string>{"definitions.glsl", "atmosphere_constants.glsl", "functions.glsl"}));
+  EXPECT_EQ(testing::ReadText(lut / "functions.glsl"),
+            testing::ReadText(std::filesystem::path(SKYBAKE_SOURCE_DIR) / "shaders_runtime/functions.glsl"));
 }
 
 // ---- glslangValidator ----
