@@ -16,6 +16,7 @@
 #include "cli/command_line.h"
 #include "formats/file_io.h"
 #include "formats/lut_files.h"
+#include "shaders_runtime/snippet.h"
 
 namespace skybake::cli {
 
@@ -70,6 +71,10 @@ void RunBake(const BakeOptions& o) {
   };
   if (!o.quiet) std::fprintf(stderr, "baking %s\n", atmosphere.name.c_str());
   LutSet luts = Bake(atmosphere, settings, &report, print_phase);
+  // The GLSL runtime goes beside the tables, its constants from this bake's parameters.
+  for (SnippetFile& f : RuntimeSnippetFiles(luts.parameters, atmosphere.wavelengths_nm, atmosphere.name)) {
+    write_options.shaders.push_back(ShaderFile{f.file, std::move(f.text), f.description});
+  }
 
   auto write_start = std::chrono::steady_clock::now();
   WriteReport written = WriteLutSet(luts, o.output_dir, write_options);

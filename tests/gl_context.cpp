@@ -42,6 +42,7 @@ struct GlFunctions {
   X(void, BindTexture, (GLenum, GLuint))                                                                     \
   X(void, ActiveTexture, (GLenum))                                                                           \
   X(void, TexImage2D, (GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum, const void*))          \
+  X(void, TexImage3D, (GLenum, GLint, GLint, GLsizei, GLsizei, GLsizei, GLint, GLenum, GLenum, const void*))   \
   X(void, TexParameteri, (GLenum, GLenum, GLint))                                                            \
   X(void, GenFramebuffers, (GLsizei, GLuint*))                                                               \
   X(void, DeleteFramebuffers, (GLsizei, const GLuint*))                                                      \
@@ -89,6 +90,12 @@ struct GlContext::Impl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   GlFunctions gl;
+  struct BoundTexture {
+    std::string sampler;
+    GLenum target;
+    GLuint id;
+  };
+  std::vector<BoundTexture> textures;  // from SetTexture, units 1, 2, ...
 
   void Check(const char* where) {
     GLenum error = gl.GetError();
@@ -121,6 +128,7 @@ GlContext::GlContext(Api api) : api_(api), impl_(std::make_unique<Impl>()) {}
 
 GlContext::~GlContext() {
   if (impl_ && impl_->context != EGL_NO_CONTEXT) {
+    for (const Impl::BoundTexture& t : impl_->textures) impl_->gl.DeleteTextures(1, &t.id);
     eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(impl_->display, impl_->context);
     // No eglTerminate: the surfaceless display is shared by every context of
@@ -198,6 +206,31 @@ std::string GlContext::Description() const {
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
   };
   return text(GL_RENDERER) + ", " + text(GL_VERSION);
+}
+
+void GlContext::SetTexture(const std::string& sampler, int width, int height, int depth,
+                           const std::vector<float>& rgba) {
+  if (rgba.size() != size_t(4) * width * height * depth) throw std::runtime_error("SetTexture: size mismatch");
+  GlFunctions& gl = impl_->gl;
+  GLenum target = depth == 1 ? GL_TEXTURE_2D : GL_TEXTURE_3D;
+  GLuint id = 0;
+  gl.GenTextures(1, &id);
+  gl.ActiveTexture(GL_TEXTURE1);
+  gl.BindTexture(target, id);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  if (depth == 1) {
+    gl.TexImage2D(target, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, rgba.data());
+  } else {
+    gl.TexImage3D(target, 0, GL_RGBA32F, width, height, depth, 0, GL_RGBA, GL_FLOAT, rgba.data());
+    gl.TexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  }
+  gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl.TexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl.TexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl.ActiveTexture(GL_TEXTURE0);
+  impl_->Check("SetTexture");
+  impl_->textures.push_back({sampler, target, id});
 }
 
 std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source, const std::vector<Vec4>& inputs,
@@ -288,6 +321,12 @@ std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source,
     gl.Uniform1i(gl.GetUniformLocation(program, "skybake_inputs"), 0);
     gl.Uniform1i(gl.GetUniformLocation(program, "skybake_row_width"), width);
     gl.Uniform1i(gl.GetUniformLocation(program, "skybake_inputs_per_item"), inputs_per_item);
+    for (size_t t = 0; t < s.textures.size(); ++t) {
+      gl.ActiveTexture(GLenum(GL_TEXTURE1 + t));
+      gl.BindTexture(s.textures[t].target, s.textures[t].id);
+      gl.Uniform1i(gl.GetUniformLocation(program, s.textures[t].sampler.c_str()), GLint(1 + t));
+    }
+    gl.ActiveTexture(GL_TEXTURE0);
     gl.GenVertexArrays(1, &vao);  // core profiles draw nothing without a bound VAO
     gl.BindVertexArray(vao);
     gl.Viewport(0, 0, width, height);
@@ -327,6 +366,9 @@ std::unique_ptr<GlContext> GlContext::Create(Api, std::string* why_not) {
 }
 std::string GlContext::VersionLine() const { return api_ == Api::kGles30 ? "#version 300 es" : "#version 330 core"; }
 std::string GlContext::Description() const { return "none"; }
+void GlContext::SetTexture(const std::string&, int, int, int, const std::vector<float>&) {
+  throw std::runtime_error("no headless GL");
+}
 std::vector<Vec4> GlContext::RunFragmentPass(const std::string&, const std::vector<Vec4>&, int) {
   throw std::runtime_error("no headless GL");
 }

@@ -53,6 +53,12 @@ class GlContext {
   // so the caller's source holds its functions and a main() that writes
   // skybake_output. Throws std::runtime_error with the driver's log if the
   // shaders do not compile or link, or on any GL error.
+  // An RGBA32F texture (depth 1: 2D, else 3D), x fastest, sampled with
+  // GL_LINEAR and GL_CLAMP_TO_EDGE, bound for every later fragment pass to
+  // the sampler uniform `sampler`, which the caller's source declares.
+  // Float linear filtering needs OES_texture_float_linear on ES 3.0.
+  void SetTexture(const std::string& sampler, int width, int height, int depth, const std::vector<float>& rgba);
+
   std::vector<Vec4> RunFragmentPass(const std::string& fragment_source, const std::vector<Vec4>& inputs,
                                     int inputs_per_item = 1);
 
