@@ -18,5 +18,6 @@ void AddReferenceCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
 void AddInfoCommand(CLI::App& app);
 void AddConvertCommand(CLI::App& app);
+void AddBenchCommand(CLI::App& app);
 
 }  // namespace skybake::cli

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddRenderCommand(app);
   skybake::cli::AddInfoCommand(app);
   skybake::cli::AddConvertCommand(app);
+  skybake::cli::AddBenchCommand(app);
 
   try {
     app.parse(argc, argv);

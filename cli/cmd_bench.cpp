@@ -1,0 +1,236 @@
+// `skybake bench`: times each phase of a bake (files written included) over
+// several runs and reports medians and the peak resident memory, optionally
+// with the cost of scaling the work (each table axis doubled, orders 1-8,
+// 1 vs 2 threads). docs/benchmark.md holds its table (scripts/bench.sh).
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "bake/bake.h"
+#include "bake/config.h"
+#include "bake/errors.h"
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "formats/file_io.h"
+#include "formats/lut_files.h"
+
+namespace skybake::cli {
+
+namespace {
+
+struct BenchOptions {
+  std::string atmosphere = "earth";
+  std::string output_dir;  // empty: a temporary directory, removed afterwards
+  BakeSettings settings;
+  std::vector<int> transmittance_size, irradiance_size, scattering_size;
+  int runs = 5;
+  bool scaling = false;
+  bool json = false;
+};
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// Peak resident memory of this process so far (Linux reports KiB).
+double PeakResidentMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+// Per-phase seconds of `runs` bakes of one configuration, files written.
+struct Measurement {
+  std::vector<std::string> phases;                   // in the order they ran
+  std::map<std::string, std::vector<double>> seconds;  // phase (and "total") -> one value per run
+};
+
+Measurement Measure(const Atmosphere& atmosphere, const BakeSettings& settings, int runs,
+                    const std::filesystem::path& dir) {
+  WriteOptions write_options;
+  write_options.command_line = CommandLine();
+  Measurement m;
+  for (int run = 0; run < runs; ++run) {
+    auto start = std::chrono::steady_clock::now();
+    BakeReport report;
+    LutSet luts = Bake(atmosphere, settings, &report);
+    auto write_start = std::chrono::steady_clock::now();
+    WriteLutSet(luts, dir, write_options);
+    auto end = std::chrono::steady_clock::now();
+    report.timings.push_back({"write files", std::chrono::duration<double>(end - write_start).count()});
+    for (const BakeTiming& t : report.timings) {
+      if (run == 0) m.phases.push_back(t.phase);
+      m.seconds[t.phase].push_back(t.seconds);
+    }
+    m.seconds["total"].push_back(std::chrono::duration<double>(end - start).count());
+  }
+  return m;
+}
+
+std::string Describe(const BakeSettings& s) {
+  char text[160];
+  std::snprintf(text, sizeof text, "T %dx%d, E %dx%d, S %dx%dx%dx%d, %d orders, ", s.transmittance_width,
+                s.transmittance_height, s.irradiance_width, s.irradiance_height, s.scattering_r_size,
+                s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size, s.orders);
+  return text + (s.threads > 0 ? std::to_string(s.threads) + " threads" : std::string("all cores"));
+}
+
+// The scaling runs: the base configuration with one thing changed.
+struct Variant {
+  std::string name;
+  std::function<void(BakeSettings&)> change;
+};
+
+std::vector<Variant> ScalingVariants() {
+  std::vector<Variant> v = {
+      {"transmittance mu x2", [](BakeSettings& s) { s.transmittance_width *= 2; }},
+      {"transmittance r x2", [](BakeSettings& s) { s.transmittance_height *= 2; }},
+      {"irradiance mu_s x2", [](BakeSettings& s) { s.irradiance_width *= 2; }},
+      {"irradiance r x2", [](BakeSettings& s) { s.irradiance_height *= 2; }},
+      {"scattering r x2", [](BakeSettings& s) { s.scattering_r_size *= 2; }},
+      {"scattering mu x2", [](BakeSettings& s) { s.scattering_mu_size *= 2; }},
+      {"scattering mu_s x2", [](BakeSettings& s) { s.scattering_mu_s_size *= 2; }},
+      {"scattering nu x2", [](BakeSettings& s) { s.scattering_nu_size *= 2; }},
+  };
+  for (int orders = 1; orders <= 8; ++orders) {
+    v.push_back({"orders " + std::to_string(orders), [orders](BakeSettings& s) { s.orders = orders; }});
+  }
+  for (int threads = 1; threads <= 2; ++threads) {
+    v.push_back({"threads " + std::to_string(threads), [threads](BakeSettings& s) { s.threads = threads; }});
+  }
+  return v;
+}
+
+void RunBench(const BenchOptions& o) {
+  if (o.runs < 1 || o.runs > 1000) throw UsageError("--runs = " + std::to_string(o.runs) + " must be in [1, 1000]");
+  Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
+  BakeSettings settings = o.settings;
+  if (!o.transmittance_size.empty()) {
+    settings.transmittance_width = o.transmittance_size[0];
+    settings.transmittance_height = o.transmittance_size[1];
+  }
+  if (!o.irradiance_size.empty()) {
+    settings.irradiance_width = o.irradiance_size[0];
+    settings.irradiance_height = o.irradiance_size[1];
+  }
+  if (!o.scattering_size.empty()) {
+    settings.scattering_r_size = o.scattering_size[0];
+    settings.scattering_mu_size = o.scattering_size[1];
+    settings.scattering_mu_s_size = o.scattering_size[2];
+    settings.scattering_nu_size = o.scattering_size[3];
+  }
+  settings.Validate();
+
+  namespace fs = std::filesystem;
+  fs::path dir = o.output_dir;
+  bool temporary = dir.empty();
+  if (temporary) dir = fs::temp_directory_path() / ("skybake_bench_" + std::to_string(::getpid()));
+  EnsureWritableDirectory(dir);
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ignored;
+      if (!dir.empty()) fs::remove_all(dir, ignored);
+    }
+  } cleanup{temporary ? dir : fs::path()};
+
+  Measurement base = Measure(atmosphere, settings, o.runs, dir);
+  // Taken before the scaling runs, whose larger tables would raise it.
+  double peak_mib = PeakResidentMiB();
+  double base_total = Median(base.seconds["total"]);
+
+  std::vector<std::pair<std::string, BakeSettings>> variants;
+  std::vector<double> variant_totals;
+  if (o.scaling) {
+    for (const Variant& v : ScalingVariants()) {
+      BakeSettings changed = settings;
+      v.change(changed);
+      changed.Validate();
+      variants.emplace_back(v.name, changed);
+      variant_totals.push_back(Median(Measure(atmosphere, changed, o.runs, dir).seconds["total"]));
+    }
+  }
+
+  if (o.json) {
+    nlohmann::json phases = nlohmann::json::array();
+    for (const std::string& phase : base.phases) {
+      phases.push_back({{"phase", phase}, {"median_seconds", Median(base.seconds[phase])}});
+    }
+    nlohmann::json scaling = nlohmann::json::array();
+    for (size_t i = 0; i < variants.size(); ++i) {
+      scaling.push_back({{"variant", variants[i].first},
+                         {"settings", Describe(variants[i].second)},
+                         {"median_seconds", variant_totals[i]}});
+    }
+    nlohmann::json j = {{"atmosphere", atmosphere.name},
+                        {"settings", Describe(settings)},
+                        {"runs", o.runs},
+                        {"phases", phases},
+                        {"median_total_seconds", base_total},
+                        {"total_seconds", base.seconds["total"]},
+                        {"peak_resident_mib", peak_mib},
+                        {"scaling", scaling}};
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  std::printf("%s: %s, files written; median of %d runs\n\n", atmosphere.name.c_str(), Describe(settings).c_str(),
+              o.runs);
+  std::printf("| phase | median (s) |\n|---|---:|\n");
+  for (const std::string& phase : base.phases) {
+    std::printf("| %s | %.3f |\n", phase.c_str(), Median(base.seconds[phase]));
+  }
+  std::printf("| **total** | **%.3f** |\n\npeak resident memory: %.0f MiB\n", base_total, peak_mib);
+  if (o.scaling) {
+    std::printf("\n| variant | median total (s) | x base |\n|---|---:|---:|\n");
+    for (size_t i = 0; i < variants.size(); ++i) {
+      std::printf("| %s | %.3f | %.2f |\n", variants[i].first.c_str(), variant_totals[i],
+                  variant_totals[i] / base_total);
+    }
+  }
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App& app) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Time each bake phase (median of several runs, files written) and report peak memory");
+  cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->capture_default_str();
+  cmd->add_option("--runs", o->runs, "Bakes per configuration; medians are reported")->capture_default_str();
+  cmd->add_option("--orders", o->settings.orders, "Scattering orders (1 = single scattering)")
+      ->capture_default_str();
+  cmd->add_option("--transmittance-size", o->transmittance_size, "Transmittance table: MU R (default 256 64)")
+      ->expected(2);
+  cmd->add_option("--irradiance-size", o->irradiance_size, "Irradiance table: MU_S R (default 64 16)")->expected(2);
+  cmd->add_option("--scattering-size", o->scattering_size,
+                  "Scattering table: R MU MU_S NU (default 32 128 32 8; MU even)")
+      ->expected(4);
+  cmd->add_option("--ray-samples", o->settings.ray_samples, "Intervals per ray for inscattering integrals")
+      ->capture_default_str();
+  cmd->add_option("--sphere-samples", o->settings.sphere_samples,
+                  "Polar directions for integrals over the sphere (azimuths: twice as many)")
+      ->capture_default_str();
+  cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_flag("--scaling", o->scaling,
+                "Also time each table axis doubled, orders 1 to 8, and 1 and 2 threads (total time only)");
+  cmd->add_option("-o,--output", o->output_dir,
+                  "Directory the bakes write to (default: a temporary one, removed afterwards)");
+  cmd->add_flag("--json", o->json, "Print the figures as JSON instead of Markdown tables");
+  cmd->callback([o] { RunBench(*o); });
+}
+
+}  // namespace skybake::cli

@@ -1,0 +1,63 @@
+// `skybake bench`: the report's format and its errors (no timing assertions;
+// speed targets live in docs/benchmark.md, measured by scripts/bench.sh).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "test_util.h"
+
+namespace skybake {
+namespace {
+
+using testing::RunCommand;
+using testing::Skybake;
+using testing::TempDir;
+
+const char* kTinyBench =
+    " bench earth --transmittance-size 32 8 --irradiance-size 8 4 --scattering-size 4 8 4 2"
+    " --ray-samples 8 --sphere-samples 4 --orders 3";
+
+TEST(CliBench, MarkdownListsEveryPhaseTotalAndMemory) {
+  TempDir dir;
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + kTinyBench + " --runs 1", dir, &out, &err), 0) << err;
+  for (const char* row : {"| transmittance |", "| single scattering |", "| order 2: scattering density |",
+                          "| order 2: indirect irradiance |", "| order 2: multiple scattering |",
+                          "| order 3: multiple scattering |", "| write files |", "| **total** |",
+                          "peak resident memory:"}) {
+    EXPECT_NE(out.find(row), std::string::npos) << row << "\n" << out;
+  }
+  EXPECT_EQ(out.find("| order 4:"), std::string::npos) << out;
+}
+
+TEST(CliBench, JsonHasMediansPerPhaseAndPeakMemory) {
+  TempDir dir;
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + kTinyBench + " --runs 3 --json", dir, &out, &err), 0) << err;
+  nlohmann::json j = nlohmann::json::parse(out);
+  // transmittance, single scattering, 3 phases per order >= 2, write files.
+  ASSERT_EQ(j["phases"].size(), 2u + 3u * 2u + 1u);
+  double phase_sum = 0.0;
+  for (const auto& phase : j["phases"]) {
+    EXPECT_GE(phase["median_seconds"].get<double>(), 0.0) << phase;
+    phase_sum += phase["median_seconds"].get<double>();
+  }
+  ASSERT_EQ(j["total_seconds"].size(), 3u);
+  EXPECT_GT(j["median_total_seconds"].get<double>(), 0.0);
+  EXPECT_GT(phase_sum, 0.0);
+  EXPECT_GT(j["peak_resident_mib"].get<double>(), 1.0);
+  EXPECT_TRUE(j["scaling"].empty());
+}
+
+TEST(CliBench, Errors) {
+  TempDir dir;
+  std::string err;
+  EXPECT_EQ(RunCommand(Skybake() + " bench earth --runs 0", dir, nullptr, &err), 1);
+  EXPECT_NE(err.find("--runs"), std::string::npos) << err;
+  EXPECT_EQ(RunCommand(Skybake() + " bench no-such-planet --runs 1", dir, nullptr, &err), 2);
+  EXPECT_EQ(RunCommand(Skybake() + " bench earth --scattering-size 4 7 4 2 --runs 1", dir, nullptr, &err), 2);
+  EXPECT_NE(err.find("must be even"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace skybake
