@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include <nlohmann/json.hpp>
+
 #include "bake/bake.h"
 #include "test_atmospheres.h"
+#include "test_util.h"
 
 namespace skybake {
 namespace {
@@ -130,6 +133,28 @@ TEST(Orders, NoScatteringStopsAfterTheSecondOrder) {
   EXPECT_EQ(report.orders_used, 2);
   EXPECT_EQ(report.extrapolated_tail, 0.0);
   for (float v : luts.scattering.texels) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(Orders, CommandLineAcceptsAutoAndReportsConvergence) {
+  testing::TempDir dir;
+  const std::string bake = testing::Skybake() + " bake earth -o " + testing::ShellQuote(dir.path() / "out") +
+                           " --transmittance-size 64 16 --irradiance-size 16 8 --scattering-size 8 16 8 4"
+                           " --ray-samples 32 --sphere-samples 8 --format exr -q --json";
+  std::string out, err;
+  ASSERT_EQ(testing::RunCommand(bake + " --orders auto", dir, &out, &err), 0) << err;
+  nlohmann::json j = nlohmann::json::parse(out);
+  EXPECT_EQ(j["orders"], "auto");
+  EXPECT_GE(j["orders_used"].get<int>(), 3);
+  EXPECT_LT(j["remaining_error"].get<double>(), j["order_tolerance"].get<double>());
+  // One order: nothing to compare, so the remaining error is unknown.
+  ASSERT_EQ(testing::RunCommand(bake + " --orders 1", dir, &out, &err), 0) << err;
+  EXPECT_TRUE(nlohmann::json::parse(out)["remaining_error"].is_null());
+  for (const char* bad : {"0", "many", "4x"}) {
+    EXPECT_EQ(testing::RunCommand(bake + " --orders '" + bad + "'", dir, &out, &err), 1) << bad;
+    EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
+  }
+  EXPECT_EQ(testing::RunCommand(bake + " --orders auto --max-orders 1", dir, &out, &err), 2);
+  EXPECT_EQ(testing::RunCommand(bake + " --orders auto --order-tolerance 0", dir, &out, &err), 2);
 }
 
 }  // namespace
