@@ -27,6 +27,18 @@ fs::path TemporarySibling(const fs::path& path) {
   return temp;
 }
 
+// Writes `bytes` to `temp`; errors name `path`, the file the user asked for.
+void WriteWholeFile(const fs::path& temp, const fs::path& path, std::string_view bytes) {
+  std::FILE* file = std::fopen(temp.c_str(), "wb");
+  if (!file) throw IoError(path.string() + ": cannot write: " + std::strerror(errno));
+  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+  // fflush + fclose report a full disk that a buffered fwrite hid.
+  ok = (std::fflush(file) == 0) && ok;
+  int saved_errno = errno;
+  ok = (std::fclose(file) == 0) && ok;
+  if (!ok) throw IoError(path.string() + ": cannot write: " + std::strerror(saved_errno));
+}
+
 }  // namespace
 
 void WriteFileAtomically(const fs::path& path,
@@ -45,16 +57,31 @@ void WriteFileAtomically(const fs::path& path,
 }
 
 void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
-  WriteFileAtomically(path, [&](const fs::path& temp) {
-    std::FILE* file = std::fopen(temp.c_str(), "wb");
-    if (!file) throw IoError(path.string() + ": cannot write: " + std::strerror(errno));
-    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-    // fflush + fclose report a full disk that a buffered fwrite hid.
-    ok = (std::fflush(file) == 0) && ok;
-    int saved_errno = errno;
-    ok = (std::fclose(file) == 0) && ok;
-    if (!ok) throw IoError(path.string() + ": cannot write: " + std::strerror(saved_errno));
-  });
+  WriteFileAtomically(path, [&](const fs::path& temp) { WriteWholeFile(temp, path, bytes); });
+}
+
+StagedFiles::~StagedFiles() {
+  for (const Staged& file : staged_) {
+    std::error_code ignored;
+    fs::remove(file.temp, ignored);
+  }
+}
+
+void StagedFiles::Write(const fs::path& path, std::string_view bytes) {
+  staged_.push_back({TemporarySibling(path), path});
+  WriteWholeFile(staged_.back().temp, path, bytes);
+}
+
+void StagedFiles::Commit() {
+  for (const Staged& file : staged_) {
+    if (fs::is_directory(file.path)) throw IoError(file.path.string() + ": cannot write: is a directory");
+  }
+  for (const Staged& file : staged_) {
+    std::error_code ec;
+    fs::rename(file.temp, file.path, ec);
+    if (ec) throw IoError(file.path.string() + ": cannot write: " + ec.message());
+  }
+  staged_.clear();
 }
 
 std::vector<std::uint8_t> ReadFileBytes(const fs::path& path) {
