@@ -43,9 +43,8 @@ int ParseOrders(const std::string& text) {
   } catch (const std::exception&) {
     end = 0;
   }
-  if (end == 0 || end != text.size() || orders < 1) {
-    throw UsageError("--orders: '" + text + "' is neither a positive count nor auto");
-  }
+  if (end == 0 || end != text.size()) throw UsageError("--orders: '" + text + "' is neither a count nor auto");
+  if (orders < 1) throw InputError("orders = " + text + " must be in [1, 100] or auto");
   return orders;
 }
 
