@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -39,7 +40,26 @@ void WriteWholeFile(const fs::path& temp, const fs::path& path, std::string_view
   if (!ok) throw IoError(path.string() + ": cannot write: " + std::strerror(saved_errno));
 }
 
+constexpr int kDeferredSignals[] = {SIGINT, SIGTERM};
+volatile std::sig_atomic_t deferred_signal = 0;
+struct sigaction previous_actions[2];
+
+extern "C" void RememberSignal(int signal) { deferred_signal = signal; }
+
 }  // namespace
+
+DeferInterrupts::DeferInterrupts() {
+  deferred_signal = 0;
+  struct sigaction action {};
+  action.sa_handler = RememberSignal;
+  sigemptyset(&action.sa_mask);
+  for (int i = 0; i < 2; ++i) sigaction(kDeferredSignals[i], &action, &previous_actions[i]);
+}
+
+DeferInterrupts::~DeferInterrupts() {
+  for (int i = 0; i < 2; ++i) sigaction(kDeferredSignals[i], &previous_actions[i], nullptr);
+  if (deferred_signal != 0) std::raise(deferred_signal);
+}
 
 void WriteFileAtomically(const fs::path& path,
                          const std::function<void(const fs::path& temp_path)>& write) {

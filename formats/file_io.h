@@ -40,6 +40,18 @@ class StagedFiles {
   std::vector<Staged> staged_;
 };
 
+// While alive, SIGINT and SIGTERM are held back (process-wide) and delivered
+// when it is destroyed, so an interrupt during a StagedFiles write lands after
+// the set is committed or its temporaries removed, never in between. Declare
+// it before the StagedFiles it protects.
+class DeferInterrupts {
+ public:
+  DeferInterrupts();
+  ~DeferInterrupts();
+  DeferInterrupts(const DeferInterrupts&) = delete;
+  DeferInterrupts& operator=(const DeferInterrupts&) = delete;
+};
+
 // Whole-file read; IoError if the file is missing or unreadable.
 std::vector<std::uint8_t> ReadFileBytes(const std::filesystem::path& path);
 std::string ReadFileText(const std::filesystem::path& path);

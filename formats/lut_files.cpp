@@ -36,7 +36,9 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
   ManifestWriter manifest(luts, options.command_line);
   WriteReport report;
   // The whole set is staged and renamed at the end, so a failure part-way
-  // leaves the previous set (files and manifest) as it was.
+  // leaves the previous set (files and manifest) as it was; an interrupt
+  // waits until the set is committed or its temporaries removed.
+  DeferInterrupts defer_interrupts;
   StagedFiles staged;
   for (const TableDescription& table : DescribeTables(luts)) {
     for (FileFormat format : options.formats) {

@@ -2,6 +2,7 @@
 // no temporary files: the whole set is staged and renamed at the end.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 #include <map>
 
@@ -46,6 +47,21 @@ TEST(StagedFiles, CommitRenamesEveryFile) {
   EXPECT_EQ(Snapshot(dir.path()).count("b.txt"), 0u) << "nothing appears before Commit";
   staged.Commit();
   EXPECT_EQ(Snapshot(dir.path()), (std::map<std::string, std::string>{{"a.txt", "new a"}, {"b.txt", "new b"}}));
+}
+
+volatile std::sig_atomic_t received_signal = 0;
+extern "C" void RecordSignal(int signal) { received_signal = signal; }
+
+TEST(DeferInterrupts, DeliversSigintOnlyOnceDestroyed) {
+  auto previous = std::signal(SIGINT, RecordSignal);
+  received_signal = 0;
+  {
+    DeferInterrupts defer;
+    std::raise(SIGINT);
+    EXPECT_EQ(received_signal, 0);
+  }
+  EXPECT_EQ(received_signal, SIGINT);
+  std::signal(SIGINT, previous);
 }
 
 const std::string kTinyBake =
