@@ -21,7 +21,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -78,6 +80,85 @@ struct RaySamples {
   std::vector<std::vector<Spectrum>> scattering;  // [group][sample] scattering coefficient
 };
 
+// Sums over the scattering table, per channel, of the accumulated table and
+// of the newest order, both divided by the Rayleigh phase as the table is.
+struct OrderSums {
+  Spectrum table{0.0}, newest{0.0};
+};
+
+// Order-by-order convergence of the scattering orders. Past the first few
+// orders each order is close to the previous one times a constant ratio q
+// (the dominant eigenvalue of the scattering operator), so the orders not
+// computed sum to newest * q / (1 - q). Ratios and sizes are per channel and
+// global over the table: per texel ratios are noisy where orders are tiny.
+class OrderConvergence {
+ public:
+  void Add(const OrderSums& sums) {
+    previous_ratio_ = ratio_;
+    ratio_ = has_newest_ ? Divide(sums.newest, newest_) : Spectrum(-1.0);
+    has_previous_ratio_ = has_ratio_;
+    has_ratio_ = has_newest_;
+    newest_ = sums.newest;
+    has_newest_ = true;
+    relative_ = Divide(sums.newest, sums.table);
+  }
+  bool NewestIsZero() const { return Max(newest_) <= 0.0; }
+  // Largest ratio over the channels (0 before the third order).
+  double Ratio() const { return has_ratio_ ? std::max(0.0, Max(ratio_)) : 0.0; }
+  // Estimate of the orders not computed, relative to the table: the
+  // geometric tail if the ratio is known and below 1, otherwise the newest
+  // order alone (a lower bound).
+  double RemainingWithoutTail() const {
+    double remaining = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      bool geometric = has_ratio_ && ratio_[c] >= 0.0 && ratio_[c] < kMaxRatio;
+      remaining = std::max(remaining, geometric ? relative_[c] * ratio_[c] / (1.0 - ratio_[c]) : relative_[c]);
+    }
+    return remaining;
+  }
+  // q / (1 - q) per channel once the ratio is known twice and below
+  // kMaxRatio (a ratio near or above 1 means the series is not yet geometric).
+  std::optional<Spectrum> TailFactor() const {
+    if (!has_previous_ratio_) return std::nullopt;
+    Spectrum factor(0.0);
+    for (int c = 0; c < 3; ++c) {
+      if (relative_[c] <= 0.0) continue;
+      if (ratio_[c] < 0.0 || ratio_[c] >= kMaxRatio || previous_ratio_[c] < 0.0) return std::nullopt;
+      factor[c] = ratio_[c] / (1.0 - ratio_[c]);
+    }
+    return factor;
+  }
+  double RelativeTail() const {
+    std::optional<Spectrum> factor = TailFactor();
+    return factor ? Max(relative_ * *factor) : 0.0;
+  }
+  // Error of the extrapolated tail: its derivative newest / (1 - q)^2 with
+  // respect to q times the change of q over the last order.
+  double TailError() const {
+    if (!TailFactor()) return std::numeric_limits<double>::infinity();
+    double error = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      if (relative_[c] <= 0.0) continue;
+      double one_minus_q = 1.0 - ratio_[c];
+      error = std::max(error, relative_[c] * std::abs(ratio_[c] - previous_ratio_[c]) / (one_minus_q * one_minus_q));
+    }
+    return error;
+  }
+
+ private:
+  static constexpr double kMaxRatio = 0.999;
+  // a / b per channel; 0 where b is 0 (nothing to compare against).
+  static Spectrum Divide(const Spectrum& a, const Spectrum& b) {
+    Spectrum q(0.0);
+    for (int c = 0; c < 3; ++c) q[c] = b[c] > 0.0 ? a[c] / b[c] : 0.0;
+    return q;
+  }
+  static double Max(const Spectrum& v) { return std::max({v.x, v.y, v.z}); }
+
+  bool has_newest_ = false, has_ratio_ = false, has_previous_ratio_ = false;
+  Spectrum newest_{0.0}, relative_{0.0}, ratio_{0.0}, previous_ratio_{0.0};
+};
+
 class Baker {
  public:
   Baker(const Atmosphere& atmosphere, const BakeSettings& settings)
@@ -94,6 +175,10 @@ class Baker {
   void ComputeScatteringDensity(int order);
   void ComputeIndirectIrradiance(int order);
   void ComputeMultipleScattering();
+  // Convergence of the orders: the size of the newest order, and the
+  // extrapolated tail (factor times the newest order) added to the tables.
+  OrderSums MeasureNewestOrder();
+  void AddTail(const Spectrum& factor);
 
   void ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
                                bool& intersects_ground) const {
@@ -124,6 +209,7 @@ class Baker {
   Texture delta_multiple_;        // radiance of the latest order >= 2
   Texture scattering_density_;    // J of the current order
   Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
+  std::vector<double> inverse_rayleigh_phase_;  // per scattering texel, filled on first use
 };
 
 template <typename F>
@@ -149,16 +235,33 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
   Phase("transmittance", [&] { ComputeTransmittance(); });
   Phase("single scattering", [&] { ComputeSingleScattering(); });
   scattering_.texels = single_rayleigh_.texels;
-  if (s.orders >= 2) {
+  if (s.orders != 1) {  // 0 = auto
     scattering_density_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
     delta_multiple_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
     delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
   }
-  for (int order = 2; order <= s.orders; ++order) {
+  report_.orders_used = 1;
+  report_.remaining_error = -1.0;  // unknown until two orders can be compared
+  const bool auto_orders = s.orders == 0;
+  OrderConvergence convergence;
+  for (int order = 2; order <= (auto_orders ? s.max_orders : s.orders); ++order) {
     std::string prefix = "order " + std::to_string(order) + ": ";
     Phase(prefix + "scattering density", [&] { ComputeScatteringDensity(order); });
     Phase(prefix + "indirect irradiance", [&] { ComputeIndirectIrradiance(order - 1); });
     Phase(prefix + "multiple scattering", [&] { ComputeMultipleScattering(); });
+    report_.orders_used = order;
+    convergence.Add(MeasureNewestOrder());
+    report_.order_ratio = convergence.Ratio();
+    report_.remaining_error = convergence.RemainingWithoutTail();
+    if (!auto_orders) continue;
+    if (convergence.NewestIsZero()) break;
+    std::optional<Spectrum> tail = convergence.TailFactor();
+    if (tail && convergence.TailError() < s.order_tolerance) {
+      Phase("extrapolated orders", [&] { AddTail(*tail); });
+      report_.extrapolated_tail = convergence.RelativeTail();
+      report_.remaining_error = convergence.TailError();
+      break;
+    }
   }
 
   LutSet result;
@@ -466,6 +569,42 @@ void Baker::ComputeMultipleScattering() {
   });
 }
 
+OrderSums Baker::MeasureNewestOrder() {
+  const int width = scattering_.width, height = scattering_.height, depth = scattering_.depth;
+  if (inverse_rayleigh_phase_.empty()) {
+    inverse_rayleigh_phase_.resize(std::size_t(width) * height * depth);
+    tbb::parallel_for(0, depth, [&](int z) {
+      for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+          inverse_rayleigh_phase_[scattering_.Index(x, y, z) / 4] =
+              1.0 / glsl::RayleighPhaseFunction(GetScatteringTexel(params_, x, y, z).nu);
+        }
+      }
+    });
+  }
+  OrderSums sums;
+  for (std::size_t i = 0; i < inverse_rayleigh_phase_.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      sums.table[c] += scattering_.texels[4 * i + c];
+      sums.newest[c] += delta_multiple_.texels[4 * i + c] * inverse_rayleigh_phase_[i];
+    }
+  }
+  return sums;
+}
+
+void Baker::AddTail(const Spectrum& factor) {
+  for (std::size_t i = 0; i < inverse_rayleigh_phase_.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      scattering_.texels[4 * i + c] += float(delta_multiple_.texels[4 * i + c] * inverse_rayleigh_phase_[i] * factor[c]);
+    }
+  }
+  // The irradiance table holds one order fewer than the scattering table;
+  // its newest order decays with the same ratio.
+  for (std::size_t i = 0; i < irradiance_.texels.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) irradiance_.texels[i + c] += float(delta_irradiance_.texels[i + c] * factor[c]);
+  }
+}
+
 }  // namespace
 
 ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z) {
@@ -499,7 +638,11 @@ void BakeSettings::Validate() const {
   size(scattering_nu_size, 2, "scattering nu size");
   require(scattering_mu_size % 2 == 0,
           "scattering mu size = " + std::to_string(scattering_mu_size) + " must be even");
-  require(orders >= 1 && orders <= 100, "orders = " + std::to_string(orders) + " must be in [1, 100]");
+  require(orders >= 0 && orders <= 100, "orders = " + std::to_string(orders) + " must be in [1, 100] or 0 (auto)");
+  require(max_orders >= 2 && max_orders <= 1000,
+          "max orders = " + std::to_string(max_orders) + " must be in [2, 1000]");
+  require(order_tolerance > 0.0 && order_tolerance < 1.0,
+          "order tolerance = " + std::to_string(order_tolerance) + " must be in (0, 1)");
   require(transmittance_samples >= 8 && transmittance_samples <= 100000,
           "transmittance samples = " + std::to_string(transmittance_samples) + " must be in [8, 100000]");
   require(ray_samples >= 2 && ray_samples <= 100000,

@@ -23,8 +23,13 @@ struct BakeSettings {
   int scattering_mu_size = 128;
   int scattering_mu_s_size = 32;
   int scattering_nu_size = 8;
-  // Scattering orders: 1 = single scattering only.
+  // Scattering orders: 1 = single scattering only; 0 = auto: iterate until
+  // the estimated remaining sum of all higher orders is below
+  // `order_tolerance` relative to the table, at most `max_orders`, adding the
+  // extrapolated geometric tail of the orders not computed (docs/stability.md).
   int orders = 4;
+  double order_tolerance = 1e-4;
+  int max_orders = 100;
   // Integration: Gauss-Legendre nodes per optical-depth integral, intervals
   // per ray for the inscattering integrals, and polar directions for the
   // integrals over the sphere (twice as many azimuths).
@@ -61,6 +66,14 @@ struct BakeTiming {
 struct BakeReport {
   std::vector<BakeTiming> timings;  // in the order the phases ran
   double total_seconds = 0.0;
+  // Scattering orders computed, the ratio of the last two orders' sizes (0
+  // if fewer than three orders), the extrapolated tail added to the tables
+  // and the estimated remaining error, both relative to the scattering table
+  // (largest over the channels; see docs/stability.md).
+  int orders_used = 0;
+  double order_ratio = 0.0;
+  double extrapolated_tail = 0.0;
+  double remaining_error = 0.0;
 };
 
 // Called after each phase with its name and duration.

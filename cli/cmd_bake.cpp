@@ -26,6 +26,7 @@ struct BakeOptions {
   std::string atmosphere;
   std::string output_dir;
   BakeSettings settings;
+  std::string orders = "4";
   std::vector<int> transmittance_size, irradiance_size, scattering_size;
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
@@ -33,9 +34,25 @@ struct BakeOptions {
   bool quiet = false;
 };
 
+// --orders: a count, or "auto" (0 in BakeSettings).
+int ParseOrders(const std::string& text) {
+  if (text == "auto") return 0;
+  std::size_t end = 0;
+  int orders = -1;
+  try {
+    orders = std::stoi(text, &end);
+  } catch (const std::exception&) {
+    end = 0;
+  }
+  if (end == 0 || end != text.size()) throw UsageError("--orders: '" + text + "' is neither a count nor auto");
+  if (orders < 1) throw InputError("orders = " + text + " must be in [1, 100] or auto");
+  return orders;
+}
+
 void RunBake(const BakeOptions& o) {
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
   BakeSettings settings = o.settings;
+  settings.orders = ParseOrders(o.orders);
   if (!o.transmittance_size.empty()) {
     settings.transmittance_width = o.transmittance_size[0];
     settings.transmittance_height = o.transmittance_size[1];
@@ -84,6 +101,17 @@ void RunBake(const BakeOptions& o) {
   report.total_seconds += write.seconds;
   if (!o.quiet) {
     std::fprintf(stderr, "  %-36s %8.3f s\n", "total", report.total_seconds);
+    std::fprintf(stderr, "  orders used %d, ratio of the last two %.4g, extrapolated tail %.3g, ", report.orders_used,
+                 report.order_ratio, report.extrapolated_tail);
+    if (report.remaining_error >= 0.0) {
+      std::fprintf(stderr, "estimated remaining error %.3g\n", report.remaining_error);
+    } else {
+      std::fprintf(stderr, "remaining error unknown (fewer than two orders)\n");
+    }
+    if (settings.orders == 0 && !(report.remaining_error < settings.order_tolerance)) {
+      std::fprintf(stderr, "  warning: orders not converged to %g after %d orders\n", settings.order_tolerance,
+                   report.orders_used);
+    }
     for (const auto& [table, error] : written.half_errors) {
       std::fprintf(stderr,
                    "  half: %-22s max relative error %.3g over %zu values >= %g; %zu smaller (%zu became 0), "
@@ -107,7 +135,13 @@ void RunBake(const BakeOptions& o) {
     nlohmann::json j = {
         {"atmosphere", atmosphere.name},
         {"output_dir", o.output_dir},
-        {"orders", s.orders},
+        {"orders", s.orders == 0 ? nlohmann::json("auto") : nlohmann::json(s.orders)},
+        {"orders_used", report.orders_used},
+        {"order_tolerance", s.order_tolerance},
+        {"order_ratio", report.order_ratio},
+        {"extrapolated_tail", report.extrapolated_tail},
+        {"remaining_error", report.remaining_error >= 0.0 ? nlohmann::json(report.remaining_error)
+                                                          : nlohmann::json(nullptr)},
         {"pixel_type", o.half ? "half" : "float"},
         {"formats", o.formats},
         {"tables",
@@ -135,7 +169,14 @@ void AddBakeCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("bake", "Bake transmittance, irradiance and scattering tables");
   cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
   cmd->add_option("-o,--output", o->output_dir, "Output directory (created if missing)")->required();
-  cmd->add_option("--orders", o->settings.orders, "Scattering orders (1 = single scattering)")
+  cmd->add_option("--orders", o->orders,
+                  "Scattering orders (1 = single scattering), or auto: until the estimated remaining error is "
+                  "below --order-tolerance, with the geometric tail extrapolated")
+      ->capture_default_str();
+  cmd->add_option("--order-tolerance", o->settings.order_tolerance,
+                  "--orders auto: relative size of the orders not computed")
+      ->capture_default_str();
+  cmd->add_option("--max-orders", o->settings.max_orders, "--orders auto: most orders computed")
       ->capture_default_str();
   cmd->add_option("--transmittance-size", o->transmittance_size, "Transmittance table: MU R (default 256 64)")
       ->expected(2);

@@ -18,6 +18,40 @@ void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(const std::filesystem::path& temp_path)>& write);
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
+// A set of files that appears complete or not at all: Write() puts each under
+// a temporary name beside its final one, Commit() renames them all in the
+// order written, once every one is complete. Destroyed without Commit() (a
+// write failed), it removes its temporary files and every earlier file of the
+// same names is left intact. Commit() refuses up front a final name it could
+// not replace (a directory), so that no rename of the set has happened yet.
+class StagedFiles {
+ public:
+  StagedFiles() = default;
+  StagedFiles(const StagedFiles&) = delete;
+  StagedFiles& operator=(const StagedFiles&) = delete;
+  ~StagedFiles();
+  void Write(const std::filesystem::path& path, std::string_view bytes);
+  void Commit();
+
+ private:
+  struct Staged {
+    std::filesystem::path temp, path;
+  };
+  std::vector<Staged> staged_;
+};
+
+// While alive, SIGINT and SIGTERM are held back (process-wide) and delivered
+// when it is destroyed, so an interrupt during a StagedFiles write lands after
+// the set is committed or its temporaries removed, never in between. Declare
+// it before the StagedFiles it protects.
+class DeferInterrupts {
+ public:
+  DeferInterrupts();
+  ~DeferInterrupts();
+  DeferInterrupts(const DeferInterrupts&) = delete;
+  DeferInterrupts& operator=(const DeferInterrupts&) = delete;
+};
+
 // Whole-file read; IoError if the file is missing or unreadable.
 std::vector<std::uint8_t> ReadFileBytes(const std::filesystem::path& path);
 std::string ReadFileText(const std::filesystem::path& path);

@@ -11,10 +11,6 @@ namespace skybake {
 
 namespace {
 
-void WriteBytes(const fs::path& path, const std::vector<std::uint8_t>& bytes) {
-  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-}
-
 // The format LoadLutSet reads when none is asked for: KTX2 (no decompression)
 // if it is complete on disk, else OpenEXR.
 FileFormat ChooseFormat(const Manifest& manifest, const std::vector<TableDescription>& tables) {
@@ -39,12 +35,17 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
   const PixelType type = options.half ? PixelType::kHalf : PixelType::kFloat;
   ManifestWriter manifest(luts, options.command_line);
   WriteReport report;
+  // The whole set is staged and renamed at the end, so a failure part-way
+  // leaves the previous set (files and manifest) as it was; an interrupt
+  // waits until the set is committed or its temporaries removed.
+  DeferInterrupts defer_interrupts;
+  StagedFiles staged;
   for (const TableDescription& table : DescribeTables(luts)) {
     for (FileFormat format : options.formats) {
       const TableImage image = MakeTableImage(luts, table, format, type);
       const std::vector<std::uint8_t> bytes = EncodeTableImage(image);
       const std::string file = table.name + FileExtension(format);
-      WriteBytes(dir / file, bytes);
+      staged.Write(dir / file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
       manifest.AddTableFile(table, file, image, bytes);
       report.files.push_back({table.name, file, bytes.size()});
     }
@@ -54,13 +55,14 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
     }
   }
   for (const ShaderFile& shader : options.shaders) {
-    WriteFileAtomically(dir / shader.file, shader.text);
+    staged.Write(dir / shader.file, shader.text);
     manifest.AddShaderFile(shader.file, shader.text, shader.description);
     report.files.push_back({"", shader.file, shader.text.size()});
   }
   // Last, so a reader that finds the new manifest finds the files it lists.
   const std::string text = manifest.Text();
-  WriteFileAtomically(dir / kManifestFileName, text);
+  staged.Write(dir / kManifestFileName, text);
+  staged.Commit();
   report.files.push_back({"", kManifestFileName, text.size()});
   return report;
 }
