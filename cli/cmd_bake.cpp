@@ -12,6 +12,7 @@
 #include "bake/bake.h"
 #include "bake/config.h"
 #include "bake/errors.h"
+#include "cli/bake_settings_options.h"
 #include "cli/commands.h"
 #include "cli/command_line.h"
 #include "formats/file_io.h"
@@ -25,49 +26,16 @@ namespace {
 struct BakeOptions {
   std::string atmosphere;
   std::string output_dir;
-  BakeSettings settings;
-  std::string orders = "4";
-  std::vector<int> transmittance_size, irradiance_size, scattering_size;
+  BakeSettingsOptions bake;
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
   bool json = false;
   bool quiet = false;
 };
 
-// --orders: a count, or "auto" (0 in BakeSettings).
-int ParseOrders(const std::string& text) {
-  if (text == "auto") return 0;
-  std::size_t end = 0;
-  int orders = -1;
-  try {
-    orders = std::stoi(text, &end);
-  } catch (const std::exception&) {
-    end = 0;
-  }
-  if (end == 0 || end != text.size()) throw UsageError("--orders: '" + text + "' is neither a count nor auto");
-  if (orders < 1) throw InputError("orders = " + text + " must be in [1, 100] or auto");
-  return orders;
-}
-
 void RunBake(const BakeOptions& o) {
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
-  BakeSettings settings = o.settings;
-  settings.orders = ParseOrders(o.orders);
-  if (!o.transmittance_size.empty()) {
-    settings.transmittance_width = o.transmittance_size[0];
-    settings.transmittance_height = o.transmittance_size[1];
-  }
-  if (!o.irradiance_size.empty()) {
-    settings.irradiance_width = o.irradiance_size[0];
-    settings.irradiance_height = o.irradiance_size[1];
-  }
-  if (!o.scattering_size.empty()) {
-    settings.scattering_r_size = o.scattering_size[0];
-    settings.scattering_mu_size = o.scattering_size[1];
-    settings.scattering_mu_s_size = o.scattering_size[2];
-    settings.scattering_nu_size = o.scattering_size[3];
-  }
-  settings.Validate();
+  const BakeSettings settings = o.bake.Resolve();
   WriteOptions write_options;
   write_options.formats.clear();
   for (const std::string& name : o.formats) {
@@ -169,36 +137,11 @@ void AddBakeCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("bake", "Bake transmittance, irradiance and scattering tables");
   cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
   cmd->add_option("-o,--output", o->output_dir, "Output directory (created if missing)")->required();
-  cmd->add_option("--orders", o->orders,
-                  "Scattering orders (1 = single scattering), or auto: until the estimated remaining error is "
-                  "below --order-tolerance, with the geometric tail extrapolated")
-      ->capture_default_str();
-  cmd->add_option("--order-tolerance", o->settings.order_tolerance,
-                  "--orders auto: relative size of the orders not computed")
-      ->capture_default_str();
-  cmd->add_option("--max-orders", o->settings.max_orders, "--orders auto: most orders computed")
-      ->capture_default_str();
-  cmd->add_option("--transmittance-size", o->transmittance_size, "Transmittance table: MU R (default 256 64)")
-      ->expected(2);
-  cmd->add_option("--irradiance-size", o->irradiance_size, "Irradiance table: MU_S R (default 64 16)")->expected(2);
-  cmd->add_option("--scattering-size", o->scattering_size,
-                  "Scattering table: R MU MU_S NU (default 32 128 32 8; MU even)")
-      ->expected(4);
-  cmd->add_option("--transmittance-samples", o->settings.transmittance_samples,
-                  "Quadrature nodes per optical-depth integral")
-      ->capture_default_str();
-  cmd->add_option("--ray-samples", o->settings.ray_samples, "Intervals per ray for inscattering integrals")
-      ->capture_default_str();
-  cmd->add_option("--sphere-samples", o->settings.sphere_samples,
-                  "Polar directions for integrals over the sphere (azimuths: twice as many)")
-      ->capture_default_str();
-  cmd->add_flag("--pack-mie", o->settings.pack_single_mie_in_alpha,
-                "Store single Mie's red channel in the scattering table's alpha instead of a separate table");
+  o->bake.AddTo(cmd);
   cmd->add_option("--format", o->formats, "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
-  cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
   cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");
   cmd->callback([o] { RunBake(*o); });

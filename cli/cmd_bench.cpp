@@ -22,6 +22,7 @@
 #include "bake/config.h"
 #include "bake/errors.h"
 #include "cli/command_line.h"
+#include "cli/bake_settings_options.h"
 #include "cli/commands.h"
 #include "formats/file_io.h"
 #include "formats/lut_files.h"
@@ -33,8 +34,7 @@ namespace {
 struct BenchOptions {
   std::string atmosphere = "earth";
   std::string output_dir;  // empty: a temporary directory, removed afterwards
-  BakeSettings settings;
-  std::vector<int> transmittance_size, irradiance_size, scattering_size;
+  BakeSettingsOptions bake;
   int runs = 5;
   bool scaling = false;
   bool json = false;
@@ -118,22 +118,7 @@ std::vector<Variant> ScalingVariants() {
 void RunBench(const BenchOptions& o) {
   if (o.runs < 1 || o.runs > 1000) throw UsageError("--runs = " + std::to_string(o.runs) + " must be in [1, 1000]");
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
-  BakeSettings settings = o.settings;
-  if (!o.transmittance_size.empty()) {
-    settings.transmittance_width = o.transmittance_size[0];
-    settings.transmittance_height = o.transmittance_size[1];
-  }
-  if (!o.irradiance_size.empty()) {
-    settings.irradiance_width = o.irradiance_size[0];
-    settings.irradiance_height = o.irradiance_size[1];
-  }
-  if (!o.scattering_size.empty()) {
-    settings.scattering_r_size = o.scattering_size[0];
-    settings.scattering_mu_size = o.scattering_size[1];
-    settings.scattering_mu_s_size = o.scattering_size[2];
-    settings.scattering_nu_size = o.scattering_size[3];
-  }
-  settings.Validate();
+  const BakeSettings settings = o.bake.Resolve();
 
   namespace fs = std::filesystem;
   fs::path dir = o.output_dir;
@@ -211,20 +196,7 @@ void AddBenchCommand(CLI::App& app) {
       "bench", "Time each bake phase (median of several runs, files written) and report peak memory");
   cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->capture_default_str();
   cmd->add_option("--runs", o->runs, "Bakes per configuration; medians are reported")->capture_default_str();
-  cmd->add_option("--orders", o->settings.orders, "Scattering orders (1 = single scattering)")
-      ->capture_default_str();
-  cmd->add_option("--transmittance-size", o->transmittance_size, "Transmittance table: MU R (default 256 64)")
-      ->expected(2);
-  cmd->add_option("--irradiance-size", o->irradiance_size, "Irradiance table: MU_S R (default 64 16)")->expected(2);
-  cmd->add_option("--scattering-size", o->scattering_size,
-                  "Scattering table: R MU MU_S NU (default 32 128 32 8; MU even)")
-      ->expected(4);
-  cmd->add_option("--ray-samples", o->settings.ray_samples, "Intervals per ray for inscattering integrals")
-      ->capture_default_str();
-  cmd->add_option("--sphere-samples", o->settings.sphere_samples,
-                  "Polar directions for integrals over the sphere (azimuths: twice as many)")
-      ->capture_default_str();
-  cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  o->bake.AddTo(cmd);
   cmd->add_flag("--scaling", o->scaling,
                 "Also time each table axis doubled, orders 1 to 8, and 1 and 2 threads (total time only)");
   cmd->add_option("-o,--output", o->output_dir,
