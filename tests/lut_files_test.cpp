@@ -20,6 +20,7 @@
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
 #include "formats/sha256.h"
+#include "test_atmospheres.h"
 #include "test_util.h"
 
 namespace skybake {
@@ -30,13 +31,7 @@ using nlohmann::json;
 using testing::TempDir;
 
 BakeSettings SmallSettings(int threads, bool pack_mie = false) {
-  BakeSettings s;
-  s.transmittance_width = 64, s.transmittance_height = 16;
-  s.irradiance_width = 16, s.irradiance_height = 4;
-  s.scattering_r_size = 8, s.scattering_mu_size = 32, s.scattering_mu_s_size = 8, s.scattering_nu_size = 4;
-  s.ray_samples = 32;
-  s.sphere_samples = 8;
-  s.orders = 2;
+  BakeSettings s = testing::SmallBakeSettings();
   s.threads = threads;
   s.pack_single_mie_in_alpha = pack_mie;
   return s;

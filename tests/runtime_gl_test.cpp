@@ -21,6 +21,7 @@
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/snippet.h"
 #include "tests/gl_context.h"
+#include "tests/test_atmospheres.h"
 #include "tests/test_util.h"
 
 namespace skybake {
@@ -32,13 +33,7 @@ using testing::GlContext;
 BakeSettings SmallSettings(bool pack_mie) {
   // The comparison is between two evaluations of the same tables, so small
   // tables (fast to bake) test it as well as full ones.
-  BakeSettings s;
-  s.transmittance_width = 64, s.transmittance_height = 16;
-  s.irradiance_width = 16, s.irradiance_height = 4;
-  s.scattering_r_size = 8, s.scattering_mu_size = 32, s.scattering_mu_s_size = 8, s.scattering_nu_size = 4;
-  s.ray_samples = 32;
-  s.sphere_samples = 8;
-  s.orders = 2;
+  BakeSettings s = testing::SmallBakeSettings();
   s.pack_single_mie_in_alpha = pack_mie;
   return s;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "bake/atmosphere.h"
+#include "bake/bake.h"
 
 namespace skybake::testing {
 
@@ -42,6 +43,19 @@ inline Atmosphere Earth() {
                              PhaseFunction{PhaseKind::kCornetteShanks, 0.8}),
       ozone};
   return a;
+}
+
+// Small tables and sample counts (a bake in well under a second) for tests
+// that compare two evaluations of the same tables, where size does not matter.
+inline BakeSettings SmallBakeSettings() {
+  BakeSettings s;
+  s.transmittance_width = 64, s.transmittance_height = 16;
+  s.irradiance_width = 16, s.irradiance_height = 4;
+  s.scattering_r_size = 8, s.scattering_mu_size = 32, s.scattering_mu_s_size = 8, s.scattering_nu_size = 4;
+  s.ray_samples = 32;
+  s.sphere_samples = 8;
+  s.orders = 2;
+  return s;
 }
 
 }  // namespace skybake::testing
