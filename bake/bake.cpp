@@ -71,6 +71,28 @@ std::vector<double> RayDistances(double d, int n) {
   return t;
 }
 
+// The n-point Gauss-Legendre rule mapped to [a, b] (Newton's method on the
+// Legendre recurrence), appended to nodes and weights.
+void AppendGaussLegendre(int n, double a, double b, std::vector<double>& nodes, std::vector<double>& weights) {
+  for (int i = 0; i < n; ++i) {
+    double x = std::cos(kPi * (i + 0.75) / (n + 0.5));
+    double derivative = 1.0;
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      double p0 = 1.0, p1 = x;
+      for (int k = 2; k <= n; ++k) {
+        double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+        p0 = p1, p1 = p2;
+      }
+      derivative = n * (x * p1 - p0) / (x * x - 1.0);
+      double step = p1 / derivative;
+      x -= step;
+      if (std::abs(step) < 1e-15) break;
+    }
+    nodes.push_back(0.5 * (a + b) + 0.5 * (b - a) * x);
+    weights.push_back((b - a) / ((1.0 - x * x) * derivative * derivative));
+  }
+}
+
 // Samples along one ray of the scattering table, shared by its (mu_s, nu) texels.
 struct RaySamples {
   double r = 0.0, mu = 0.0;
@@ -187,6 +209,17 @@ class Baker {
     intersects_ground = texel.ray_intersects_ground;
   }
   RaySamples SampleRay(int mu_index, int r_index) const;
+  // The table holds single Rayleigh scattering phase free and the higher
+  // orders divided by the Rayleigh phase, which the runtime multiplies back
+  // with the query's nu. The division uses the nu of the texel's slice, not
+  // the texel's clamped nu: where (mu, mu_s) allow a narrow range of nu (near
+  // the zenith, where the mu axis is coarse at low altitude), every slice is
+  // clamped to nearly the same geometry, and dividing by the phase at that
+  // clamped nu and multiplying by the phase at the query's nu would scale the
+  // smooth higher orders by up to P(1)/P(0) = 2.
+  double MultipleScatteringPackingFactor(int x, int y, int z) const {
+    return 1.0 / glsl::RayleighPhaseFunction(GetScatteringTexel(params_, x, y, z).grid_nu);
+  }
 
   // Radiance of scattering order `order` arriving at radius r from direction
   // (mu, nu) with the sun at mu_s, excluding light reflected by the ground.
@@ -209,7 +242,7 @@ class Baker {
   Texture delta_multiple_;        // radiance of the latest order >= 2
   Texture scattering_density_;    // J of the current order
   Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
-  std::vector<double> inverse_rayleigh_phase_;  // per scattering texel, filled on first use
+  std::vector<double> packing_factor_;  // MultipleScatteringPackingFactor per texel, filled on first use
 };
 
 template <typename F>
@@ -428,7 +461,7 @@ void Baker::ComputeScatteringDensity(int order) {
   const int mu_s_size = params_.scattering_mu_s_size, r_size = params_.scattering_r_size;
   const int nu_size = params_.scattering_nu_size, mu_size = params_.scattering_mu_size;
   const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
-  const double d_angle = kPi / polar;
+  const double d_phi = 2.0 * kPi / azimuths;
   const int groups = static_cast<int>(medium_.groups().size());
   const vec3 albedo_over_pi = medium_.atmosphere().ground_albedo / kPi;
   const glsl::sampler2D transmittance{&transmittance_};
@@ -442,13 +475,20 @@ void Baker::ComputeScatteringDensity(int order) {
     const vec3 zenith(0.0, 0.0, 1.0);
     const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
 
+    // Polar nodes in cos(theta), a Gauss-Legendre rule on each side of the
+    // horizon: the incident radiance jumps there (long grazing sky paths
+    // above, the ground below), which a rule spanning it converges on slowly.
+    std::vector<double> cosines, cosine_weights;
+    const double horizon = -std::sqrt(std::max(0.0, 1.0 - (params_.bottom_radius / r) * (params_.bottom_radius / r)));
+    AppendGaussLegendre(polar / 2, -1.0, horizon, cosines, cosine_weights);
+    AppendGaussLegendre(polar - polar / 2, horizon, 1.0, cosines, cosine_weights);
+
     // Incoming radiance (of the previous order) from every direction.
     std::vector<vec3> directions, radiance;
     std::vector<double> solid_angles;
     directions.reserve(polar * azimuths);
     for (int l = 0; l < polar; ++l) {
-      double theta = (l + 0.5) * d_angle;
-      double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+      double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
       bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
       double ground_distance = 0.0;
       vec3 ground_transmittance(0.0);
@@ -457,7 +497,7 @@ void Baker::ComputeScatteringDensity(int order) {
         ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
       }
       for (int m = 0; m < azimuths; ++m) {
-        double phi = (m + 0.5) * d_angle;
+        double phi = (m + 0.5) * d_phi;
         vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
         double nu = glsl::ClampCosine(glm::dot(omega, sun));
         vec3 incident = IncidentRadiance(order - 1, r, cos_theta, mu_s, nu, intersects);
@@ -468,7 +508,7 @@ void Baker::ComputeScatteringDensity(int order) {
         }
         directions.push_back(omega);
         radiance.push_back(incident);
-        solid_angles.push_back(d_angle * d_angle * sin_theta);
+        solid_angles.push_back(cosine_weights[l] * d_phi);
       }
     }
 
@@ -563,7 +603,7 @@ void Baker::ComputeMultipleScattering() {
       Spectrum sum(0.0);
       for (int k = 0; k < n; ++k) sum += ExponentialTrapezoid(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
       delta_multiple_.Store(x, y, z, vec4(sum, 0.0));
-      vec4 total = scattering_.Fetch(x, y, z) + vec4(sum / glsl::RayleighPhaseFunction(nu), 0.0);
+      vec4 total = scattering_.Fetch(x, y, z) + vec4(sum * MultipleScatteringPackingFactor(x, y, z), 0.0);
       scattering_.Store(x, y, z, total);
     }
   });
@@ -571,31 +611,30 @@ void Baker::ComputeMultipleScattering() {
 
 OrderSums Baker::MeasureNewestOrder() {
   const int width = scattering_.width, height = scattering_.height, depth = scattering_.depth;
-  if (inverse_rayleigh_phase_.empty()) {
-    inverse_rayleigh_phase_.resize(std::size_t(width) * height * depth);
+  if (packing_factor_.empty()) {
+    packing_factor_.resize(std::size_t(width) * height * depth);
     tbb::parallel_for(0, depth, [&](int z) {
       for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
-          inverse_rayleigh_phase_[scattering_.Index(x, y, z) / 4] =
-              1.0 / glsl::RayleighPhaseFunction(GetScatteringTexel(params_, x, y, z).nu);
+          packing_factor_[scattering_.Index(x, y, z) / 4] = MultipleScatteringPackingFactor(x, y, z);
         }
       }
     });
   }
   OrderSums sums;
-  for (std::size_t i = 0; i < inverse_rayleigh_phase_.size(); ++i) {
+  for (std::size_t i = 0; i < packing_factor_.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
       sums.table[c] += scattering_.texels[4 * i + c];
-      sums.newest[c] += delta_multiple_.texels[4 * i + c] * inverse_rayleigh_phase_[i];
+      sums.newest[c] += delta_multiple_.texels[4 * i + c] * packing_factor_[i];
     }
   }
   return sums;
 }
 
 void Baker::AddTail(const Spectrum& factor) {
-  for (std::size_t i = 0; i < inverse_rayleigh_phase_.size(); ++i) {
+  for (std::size_t i = 0; i < packing_factor_.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
-      scattering_.texels[4 * i + c] += float(delta_multiple_.texels[4 * i + c] * inverse_rayleigh_phase_[i] * factor[c]);
+      scattering_.texels[4 * i + c] += float(delta_multiple_.texels[4 * i + c] * packing_factor_[i] * factor[c]);
     }
   }
   // The irradiance table holds one order fewer than the scattering table;
