@@ -342,8 +342,8 @@ vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture
 //   single Rayleigh, by the table method over a segment of
 //   DIRECT_SEGMENT_LENGTH (long enough not to cancel) minus its direct single
 //   Rayleigh, scaled to the short segment by the ratio of
-//   integral T sigma_s dt over the two: multiply scattered light is nearly
-//   uniform over such distances, so what it adds to a segment follows the
+//   integral T sigma_s dt over the two: multiply scattered light varies
+//   slowly over such distances, so what it adds to a segment follows the
 //   amount of scattering along it.
 // Between one and two DIRECT_SEGMENT_LENGTHs the table method is used with
 // the transmittance and single Mie blended from the direct integration to
@@ -351,9 +351,11 @@ vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture
 
 // Metres.
 const Number DIRECT_SEGMENT_LENGTH = 10000.0;
-// Trapezoidal intervals of the direct integration. 16 keep the quadrature
-// error of the optical depth below 1e-4 for segments up to
-// 2 DIRECT_SEGMENT_LENGTH through Earth's 1.2 km aerosol layer.
+// Trapezoidal intervals of the direct integration. On Earth the rule
+// overestimates the optical depth (440 nm) of a vertical segment from the
+// ground by 4.5e-5 at 5 km and 2.2e-4 at 10 km (the aerosols' 1.2 km scale
+// height), and of near-horizontal segments, whose altitude changes slowly,
+// by far less.
 const int SEGMENT_INTERVALS = 16;
 
 Number ProfileSampleAltitude(IN(AtmosphereParameters) atmosphere, int i) {
