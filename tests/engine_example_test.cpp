@@ -118,6 +118,26 @@ TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
   }
 }
 
+TEST(EngineExample, BadInputIsOneLineAndAnExitCodeWithNothingWritten) {
+  testing::TempDir dir;
+  const fs::path images = dir.path() / "images";
+  const std::string example = testing::ShellQuote(SKYBAKE_ENGINE_EXAMPLE_EXE);
+  struct Case {
+    std::string arguments;
+    int code;
+  };
+  for (const Case& c : {Case{testing::ShellQuote(dir.path() / "none") + " " + testing::ShellQuote(images), 3},
+                        Case{"lut " + testing::ShellQuote(images) + " --sun-zenith nan", 1},
+                        Case{"lut " + testing::ShellQuote(images) + " --size 2", 1},
+                        Case{"lut " + testing::ShellQuote(images) + " --format png", 1}, Case{"", 1}}) {
+    SCOPED_TRACE(c.arguments);
+    std::string err;
+    EXPECT_EQ(testing::RunCommand(example + " " + c.arguments, dir, nullptr, &err), c.code);
+    EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
+    EXPECT_FALSE(fs::exists(images / "fisheye.png"));
+  }
+}
+
 #else
 
 TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {

@@ -25,6 +25,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -239,6 +240,9 @@ std::string ShippedSnippet(const fs::path& lut_dir) {
 void Run(const Arguments& args) {
   if (args.size < 4 || args.size > 4096) throw skybake::UsageError("--size must be in 4..4096");
   if (!(args.altitude_m >= 0.0 && args.altitude_m <= 1e5)) throw skybake::UsageError("--altitude must be in 0..1e5 m");
+  if (!(args.sun_zenith_deg >= 0.0 && args.sun_zenith_deg <= 180.0))
+    throw skybake::UsageError("--sun-zenith must be in 0..180 degrees");
+  if (!std::isfinite(args.sun_azimuth_deg)) throw skybake::UsageError("--sun-azimuth must be a finite angle");
   skybake::LoadOptions load_options;
   if (!args.format.empty()) {
     load_options.format = skybake::ParseFileFormat(args.format);
@@ -309,6 +313,7 @@ void Run(const Arguments& args) {
   };
   const ViewSpec views[] = {{"fisheye", 0, args.size, kPi / args.size},
                             {"aerial", 1, std::max(1, args.size / 4), (kPi / 2) / args.size}};
+  std::vector<skybake::render::Image> rendered;
   for (const ViewSpec& v : views) {
     const int width = args.size, height = v.height;
     double sun_radius = luts.parameters.sun_angular_radius;
@@ -352,10 +357,14 @@ void Run(const Arguments& args) {
         }
       }
     }
-    const skybake::render::Attributes attributes = {{"skybake:view", v.name}};
-    skybake::render::WriteLinearExr(out_dir / (std::string(v.name) + ".exr"), image, attributes);
-    skybake::render::WritePng(out_dir / (std::string(v.name) + ".png"),
-                              skybake::render::ToneMapToSrgb(image, tone), attributes);
+    rendered.push_back(std::move(image));
+  }
+  // Written only once every view has rendered, each file atomically.
+  for (std::size_t i = 0; i < rendered.size(); ++i) {
+    const skybake::render::Attributes attributes = {{"skybake:view", views[i].name}};
+    skybake::render::WriteLinearExr(out_dir / (std::string(views[i].name) + ".exr"), rendered[i], attributes);
+    skybake::render::WritePng(out_dir / (std::string(views[i].name) + ".png"),
+                              skybake::render::ToneMapToSrgb(rendered[i], tone), attributes);
   }
   glDeleteVertexArrays(1, &vao);
   glDeleteProgram(program);
