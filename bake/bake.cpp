@@ -732,7 +732,26 @@ glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere
   p.scattering_nu_size = settings.scattering_nu_size;
   p.irradiance_width = settings.irradiance_width;
   p.irradiance_height = settings.irradiance_height;
+  SetAltitudeProfiles(atmosphere, &p);
   return p;
+}
+
+void SetAltitudeProfiles(const Atmosphere& atmosphere, glsl::AtmosphereParameters* parameters) {
+  const Medium medium(atmosphere);
+  std::vector<double> densities(medium.constituent_count());
+  const double height = atmosphere.top_radius_m - atmosphere.bottom_radius_m;
+  for (int i = 0; i < glsl::ALTITUDE_PROFILE_SIZE; ++i) {
+    // The sample altitudes of definitions.glsl.
+    double x = double(i) / double(glsl::ALTITUDE_PROFILE_SIZE - 1);
+    medium.Densities(height * x * x, densities.data());
+    Spectrum mie(0.0), others(0.0);
+    for (int g = 0; g < static_cast<int>(medium.groups().size()); ++g) {
+      (g == medium.mie_group() ? mie : others) += medium.GroupScattering(g, densities.data());
+    }
+    parameters->extinction_profile[i] = medium.Extinction(densities.data());
+    parameters->mie_scattering_profile[i] = mie;
+    parameters->rayleigh_scattering_profile[i] = others;
+  }
 }
 
 LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report,

@@ -96,6 +96,11 @@ ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters,
 // loaders that rebuild a LutSet from files).
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings);
 
+// Fills the coefficient profiles of `parameters` (definitions.glsl) from the
+// atmosphere; MakeAtmosphereParameters does it, and so must a loader that
+// reads the other parameters from a manifest.
+void SetAltitudeProfiles(const Atmosphere& atmosphere, glsl::AtmosphereParameters* parameters);
+
 }  // namespace skybake
 
 namespace skybake {

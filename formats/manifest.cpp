@@ -154,6 +154,8 @@ Manifest ReadManifest(const fs::path& dir) {
     LutSet& luts = m.luts;
     luts.parameters = ParametersFromJson(m.document.at("parameters"));
     luts.atmosphere = ParseAtmosphere(m.document.at("atmosphere_toml").get<std::string>(), where);
+    // The coefficient profiles are a function of the atmosphere, not stored twice.
+    SetAltitudeProfiles(luts.atmosphere, &luts.parameters);
     const json& bake = m.document.at("bake");
     BakeSettings& s = luts.settings;
     s.orders = bake.at("orders").get<int>();

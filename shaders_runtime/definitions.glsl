@@ -22,6 +22,12 @@ const int PHASE_NONE = 0;
 const int PHASE_HENYEY_GREENSTEIN = 1;
 const int PHASE_CORNETTE_SHANKS = 2;
 
+// Coefficient profiles for integrating along short segments (aerial
+// perspective near the horizon, functions.glsl): samples at the altitudes
+// (top_radius - bottom_radius) * (i / (ALTITUDE_PROFILE_SIZE - 1))^2, dense
+// near the ground where the aerosols' scale height is short.
+const int ALTITUDE_PROFILE_SIZE = 64;
+
 struct AtmosphereParameters {
   // Solar irradiance at the top of the atmosphere, W m^-2 nm^-1 per channel.
   vec3 solar_irradiance;
@@ -49,4 +55,10 @@ struct AtmosphereParameters {
   int scattering_nu_size;
   int irradiance_width;   // mu_s
   int irradiance_height;  // r
+  // Extinction and scattering coefficients, m^-1, at the profile altitudes:
+  // all constituents; the Mie group; every other group (applied with the
+  // Rayleigh phase function, as the scattering table is).
+  vec3 extinction_profile[ALTITUDE_PROFILE_SIZE];
+  vec3 mie_scattering_profile[ALTITUDE_PROFILE_SIZE];
+  vec3 rayleigh_scattering_profile[ALTITUDE_PROFILE_SIZE];
 };

@@ -27,6 +27,7 @@ using glm::clamp;
 using glm::dot;
 using glm::exp;
 using glm::length;
+using glm::log;
 using glm::max;
 using glm::min;
 using glm::mix;
@@ -34,12 +35,14 @@ using glm::normalize;
 using glm::smoothstep;
 using std::exp;
 using std::floor;
+using std::log;
 using std::sqrt;
 
 constexpr Number PI = 3.14159265358979323846;
 constexpr int PHASE_NONE = 0;
 constexpr int PHASE_HENYEY_GREENSTEIN = 1;
 constexpr int PHASE_CORNETTE_SHANKS = 2;
+constexpr int ALTITUDE_PROFILE_SIZE = 64;
 
 // Same fields, names and meaning as the struct in definitions.glsl.
 struct AtmosphereParameters {
@@ -60,6 +63,9 @@ struct AtmosphereParameters {
   int scattering_nu_size = 0;
   int irradiance_width = 0;
   int irradiance_height = 0;
+  vec3 extinction_profile[ALTITUDE_PROFILE_SIZE] = {};
+  vec3 mie_scattering_profile[ALTITUDE_PROFILE_SIZE] = {};
+  vec3 rayleigh_scattering_profile[ALTITUDE_PROFILE_SIZE] = {};
 };
 
 // An RGBA float texture, x fastest, then y, then z (depth 1 for 2D).

@@ -24,6 +24,13 @@ std::string Vec3Literal(const glsl::vec3& v) {
   return "vec3(" + FloatLiteral(v.x) + ", " + FloatLiteral(v.y) + ", " + FloatLiteral(v.z) + ")";
 }
 
+// vec3[ALTITUDE_PROFILE_SIZE](...), one sample per line.
+std::string ProfileLiteral(const glsl::vec3 (&profile)[glsl::ALTITUDE_PROFILE_SIZE]) {
+  std::string s = "vec3[ALTITUDE_PROFILE_SIZE](";
+  for (int i = 0; i < glsl::ALTITUDE_PROFILE_SIZE; ++i) s += (i ? ",\n        " : "\n        ") + Vec3Literal(profile[i]);
+  return s + ")";
+}
+
 std::string_view EmbeddedShader(const std::string& name) {
   for (const EmbeddedText& file : kRuntimeShaderFiles)
     if (file.name == name) return file.text;
@@ -63,7 +70,10 @@ std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& p, const g
        std::to_string(p.scattering_mu_s_size) + ", " + std::to_string(p.scattering_nu_size) +
        ",  // scattering r, mu, mu_s, nu sizes\n";
   s += "    " + std::to_string(p.irradiance_width) + ", " + std::to_string(p.irradiance_height) +
-       ");  // irradiance_width (mu_s), irradiance_height (r)\n";
+       ",  // irradiance_width (mu_s), irradiance_height (r)\n";
+  s += "    // extinction_profile, m^-1\n    " + ProfileLiteral(p.extinction_profile) + ",\n";
+  s += "    // mie_scattering_profile, m^-1\n    " + ProfileLiteral(p.mie_scattering_profile) + ",\n";
+  s += "    // rayleigh_scattering_profile, m^-1\n    " + ProfileLiteral(p.rayleigh_scattering_profile) + ");\n";
   return s;
 }
 
