@@ -286,7 +286,15 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
     convergence.Add(MeasureNewestOrder());
     report_.order_ratio = convergence.Ratio();
     report_.remaining_error = convergence.RemainingWithoutTail();
-    if (!auto_orders) continue;
+    if (!auto_orders) {
+      std::optional<Spectrum> tail = convergence.TailFactor();
+      if (order == s.orders && s.extrapolate_tail && tail && !convergence.NewestIsZero()) {
+        Phase("extrapolated orders", [&] { AddTail(*tail); });
+        report_.extrapolated_tail = convergence.RelativeTail();
+        report_.remaining_error = convergence.TailError();
+      }
+      continue;
+    }
     if (convergence.NewestIsZero()) break;
     std::optional<Spectrum> tail = convergence.TailFactor();
     if (tail && convergence.TailError() < s.order_tolerance) {

@@ -30,6 +30,11 @@ struct BakeSettings {
   int orders = 4;
   double order_tolerance = 1e-4;
   int max_orders = 100;
+  // With a fixed order count, add the extrapolated geometric tail of the
+  // orders not computed once the last orders decay geometrically (at 4
+  // orders Earth's blue sky still lacks about 1.5% without it); off, the
+  // tables hold exactly `orders` orders (to compare with a capped reference).
+  bool extrapolate_tail = true;
   // Integration: Gauss-Legendre nodes per optical-depth integral, intervals
   // per ray for the inscattering integrals, and polar directions for the
   // integrals over the sphere (twice as many azimuths).

@@ -29,13 +29,16 @@ int ParseOrders(const std::string& text) {
 
 void BakeSettingsOptions::AddTo(CLI::App* cmd) {
   cmd->add_option("--orders", orders,
-                  "Scattering orders (1 = single scattering), or auto: until the estimated remaining error is "
-                  "below --order-tolerance, with the geometric tail extrapolated")
+                  "Scattering orders computed (1 = single scattering), the rest extrapolated as a geometric tail "
+                  "(see --no-tail); or auto: until the estimated remaining error is below --order-tolerance")
       ->capture_default_str();
   cmd->add_option("--order-tolerance", settings.order_tolerance,
                   "--orders auto: relative size of the orders not computed")
       ->capture_default_str();
   cmd->add_option("--max-orders", settings.max_orders, "--orders auto: most orders computed")->capture_default_str();
+  cmd->add_flag("--no-tail", no_tail,
+                "With a count of orders: hold exactly that many, without the extrapolated tail of the orders not "
+                "computed");
   cmd->add_option("--transmittance-size", transmittance_size, "Transmittance table: MU R (default 256 64)")
       ->expected(2);
   cmd->add_option("--irradiance-size", irradiance_size, "Irradiance table: MU_S R (default 64 16)")->expected(2);
@@ -57,6 +60,7 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
 BakeSettings BakeSettingsOptions::Resolve() const {
   BakeSettings s = settings;
   s.orders = ParseOrders(orders);
+  s.extrapolate_tail = !no_tail;
   if (!transmittance_size.empty()) {
     s.transmittance_width = transmittance_size[0];
     s.transmittance_height = transmittance_size[1];

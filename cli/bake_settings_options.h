@@ -17,6 +17,7 @@ namespace skybake::cli {
 struct BakeSettingsOptions {
   BakeSettings settings;
   std::string orders = std::to_string(BakeSettings().orders);  // a count or "auto"
+  bool no_tail = false;
   std::vector<int> transmittance_size, irradiance_size, scattering_size;
 
   // Registers the options on `command`; the values land in this object.

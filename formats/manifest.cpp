@@ -19,6 +19,7 @@ namespace {
 
 ordered_json SettingsToJson(const BakeSettings& s) {
   return ordered_json{{"orders", s.orders},
+                      {"extrapolate_tail", s.extrapolate_tail},
                       {"transmittance_samples", s.transmittance_samples},
                       {"ray_samples", s.ray_samples},
                       {"sphere_samples", s.sphere_samples},
@@ -159,6 +160,7 @@ Manifest ReadManifest(const fs::path& dir) {
     const json& bake = m.document.at("bake");
     BakeSettings& s = luts.settings;
     s.orders = bake.at("orders").get<int>();
+    s.extrapolate_tail = bake.value("extrapolate_tail", false);  // absent: written before the tail existed
     s.transmittance_samples = bake.at("transmittance_samples").get<int>();
     s.ray_samples = bake.at("ray_samples").get<int>();
     s.sphere_samples = bake.at("sphere_samples").get<int>();

@@ -144,6 +144,7 @@ namespace {
 BakeSettings SmallSettings(int orders) {
   BakeSettings s;
   s.orders = orders;
+  s.extrapolate_tail = false;  // each order on its own
   s.transmittance_width = 128, s.transmittance_height = 32;
   s.scattering_r_size = 8, s.scattering_mu_size = 32, s.scattering_mu_s_size = 8, s.scattering_nu_size = 4;
   s.irradiance_width = 32, s.irradiance_height = 8;
