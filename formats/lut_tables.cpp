@@ -115,9 +115,9 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
   irradiance.channels = rgb("indirect irradiance");
   irradiance.width = p.irradiance_width;
   irradiance.height = p.irradiance_height;
-  irradiance.axes = {{"x", "mu_s", p.irradiance_width, -1.0, 1.0, "1", "x = (mu_s + 1) / 2" + std::string(kTexelCentres)},
-                     RAxis("y", p.irradiance_height, p,
-                           "x = (r - bottom_radius) / (top_radius - bottom_radius)" + std::string(kTexelCentres))};
+  irradiance.axes = {{"x", "mu_s", p.irradiance_width, p.mu_s_min, 1.0, "1",
+                      "x = (mu_s - mu_s_min) / (1 - mu_s_min)" + std::string(kTexelCentres)},
+                     RAxis("y", p.irradiance_height, p, std::string(kRhoOverH) + std::string(kTexelCentres))};
   irradiance.layout = "x = mu_s (" + std::to_string(p.irradiance_width) + "), y = r (" +
                       std::to_string(p.irradiance_height) + ")";
   tables.push_back(irradiance);

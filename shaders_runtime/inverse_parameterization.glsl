@@ -59,6 +59,8 @@ void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2
                                     OUT(Number) mu_s) {
   Number x_mu_s = GetUnitRangeFromTextureCoord(uv.x, atmosphere.irradiance_width);
   Number x_r = GetUnitRangeFromTextureCoord(uv.y, atmosphere.irradiance_height);
-  r = atmosphere.bottom_radius + x_r * (atmosphere.top_radius - atmosphere.bottom_radius);
-  mu_s = ClampCosine(2.0 * x_mu_s - 1.0);
+  Number H = sqrt(atmosphere.top_radius * atmosphere.top_radius - atmosphere.bottom_radius * atmosphere.bottom_radius);
+  Number rho = H * x_r;
+  r = sqrt(rho * rho + atmosphere.bottom_radius * atmosphere.bottom_radius);
+  mu_s = ClampCosine(atmosphere.mu_s_min + x_mu_s * (1.0 - atmosphere.mu_s_min));
 }
