@@ -161,7 +161,7 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
   return vec4(u_nu, u_mu_s, u_mu, u_r);
 }
 
-// Irradiance table: x = mu_s (linear over [-1, 1]), y = r (linear).
+// Irradiance table: x = mu_s (linear over [mu_s_min, 1]), y = r (as rho / H).
 // r as rho / H, like the other tables: texels crowd near the ground, where
 // the sky irradiance falls fastest with altitude (linear in r, 16 texels
 // read 4% high at 1 and 10 km). mu_s over the covered [mu_s_min, 1] only:
