@@ -267,6 +267,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
   LutSet result;
   result.atmosphere = medium_.atmosphere();
   result.settings = settings_;
+  result.orders_used = report_.orders_used;
   result.parameters = params_;
   result.transmittance = std::move(transmittance_);
   result.irradiance = std::move(irradiance_);
