@@ -174,7 +174,7 @@ constexpr Interval kMuSMin{-1.0, 1.0, true, false};
 // orbit gives ~15 W m^-2 nm^-1.
 constexpr Interval kRadiusRange{1.0, 1e11, true, true, "[1 m, 1e11 m]"};
 constexpr Interval kCoefficientRange{0.0, 1e3, true, true, "[0, 1000] m^-1"};
-constexpr Interval kIrradianceRange{0.0, 1e25, true, true};
+constexpr Interval kIrradianceRange{0.0, 1e25, true, true, "[0, 1e25]"};
 // Depolarization ratio of natural light by anisotropic molecules is at most
 // 1/2; beyond 6/7 the King factor changes sign.
 constexpr Interval kDepolarization{0.0, 0.5, true, true};
