@@ -31,6 +31,12 @@ std::vector<StressAtmosphere> StressSet();
 // irradiance) and --orders auto: each atmosphere bakes in about a second.
 BakeSettings StressBakeSettings();
 
+// `settings` with at least the resolution at which the energy balance of
+// an atmosphere that must balance converges to well within
+// kEnergyBalanceTolerance (docs/stability.md, "Energy balance"); other
+// atmospheres' settings unchanged.
+BakeSettings WithEnergyBalanceResolution(const StressAtmosphere& stress, BakeSettings settings);
+
 struct StressResult {
   BakeReport bake;
   InvariantReport tables;   // every texel
@@ -44,8 +50,8 @@ struct StressResult {
   std::int64_t Violations() const { return tables.violations + queries.violations + (energy_balanced ? 0 : 1); }
 };
 
-// Bakes one atmosphere and checks it: invariants on every texel and on
-// `queries` random twin queries, and the energy balance.
+// Bakes one atmosphere with `settings` as given and checks it: invariants on
+// every texel and on `queries` random twin queries, and the energy balance.
 StressResult RunStress(const StressAtmosphere& stress, const BakeSettings& settings, int queries,
                        std::uint64_t seed);
 

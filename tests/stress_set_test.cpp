@@ -30,7 +30,7 @@ class StressSetTest : public ::testing::TestWithParam<int> {};
 
 TEST_P(StressSetTest, NoInvariantViolations) {
   const StressAtmosphere stress = StressSet()[GetParam()];
-  StressResult r = RunStress(stress, StressBakeSettings(), kQueries, kSeed);
+  StressResult r = RunStress(stress, WithEnergyBalanceResolution(stress, StressBakeSettings()), kQueries, kSeed);
   EXPECT_EQ(r.tables.violations, 0) << Examples(r.tables);
   EXPECT_EQ(r.queries.violations, 0) << Examples(r.queries);
   EXPECT_GE(r.queries.values_checked, 3 * kQueries);
