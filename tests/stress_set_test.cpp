@@ -8,11 +8,14 @@
 #include <cmath>
 #include <limits>
 
+#include <nlohmann/json.hpp>
+
 #include "bake/config.h"
 #include "bake/energy_balance.h"
 #include "bake/invariants.h"
 #include "bake/stress_set.h"
 #include "test_atmospheres.h"
+#include "test_util.h"
 
 namespace skybake {
 namespace {
@@ -68,6 +71,26 @@ TEST(StressSet, EveryAtmosphereSurvivesItsOwnFileFormat) {
     EXPECT_EQ(ToToml(ParseAtmosphere(ToToml(s.atmosphere), s.atmosphere.name)), ToToml(s.atmosphere))
         << s.atmosphere.name;
   }
+}
+
+TEST(StressCommand, ReportsEachAtmosphereAndRejectsBadOptions) {
+  testing::TempDir dir;
+  std::string out, err;
+  const std::string stress = testing::Skybake() + " stress --queries 1000";
+  ASSERT_EQ(testing::RunCommand(stress + " --only no-constituents --only earth", dir, &out, &err), 0) << err;
+  std::vector<std::string> lines = testing::Lines(out);
+  ASSERT_EQ(lines.size(), 3u) << out;  // header and one line each
+  EXPECT_EQ(lines[1].rfind("no-constituents", 0), 0u);
+  EXPECT_EQ(lines[2].rfind("earth", 0), 0u);
+  ASSERT_EQ(testing::RunCommand(stress + " --only no-constituents --json", dir, &out, &err), 0) << err;
+  nlohmann::json j = nlohmann::json::parse(out);
+  ASSERT_EQ(j.size(), 1u);
+  EXPECT_EQ(j[0]["violations"], 0);
+  EXPECT_EQ(j[0]["orders_used"], 2);
+  EXPECT_EQ(testing::RunCommand(stress + " --only no-such-atmosphere", dir, &out, &err), 1);
+  EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
+  EXPECT_EQ(testing::RunCommand(testing::Skybake() + " stress --queries -1", dir, &out, &err), 2);
+  EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
 }
 
 // A vacuum over a ground of albedo a: the sun's flux on the planet's disc,
