@@ -58,14 +58,15 @@ double ExponentialTrapezoid(double a, double b, double h) {
 }
 
 // A sample of an inscattering integrand along a view ray,
-//   source * exp(-(view_optical_depth + sun_optical_depth)),
-// kept in factors, with the extinction coefficient there (the rate at which
-// view_optical_depth grows with distance).
+//   value = source * exp(-(view_optical_depth + sun_optical_depth)),
+// with its factors and the extinction coefficient there (the rate at which
+// view_optical_depth grows with distance) for optically thick intervals.
 struct RayIntegrand {
   Spectrum source{0.0};
   Spectrum view_optical_depth{0.0};
   Spectrum sun_optical_depth{0.0};
   Spectrum extinction{0.0};
+  Spectrum value{0.0};
 };
 
 // Integral between two samples of a RayIntegrand, `h` apart. Three failures
@@ -90,41 +91,39 @@ struct RayIntegrand {
 //   with the density.
 // * Beyond an optical depth of ~745, exp(-tau) underflows to 0 and an end
 //   looked like a zero of the integrand; rates from logarithms do not.
+// Over optically thin intervals (the common case) the exponential trapezoid
+// in distance is kept: it cannot overshoot there (an end that underflows
+// through the sun's optical depth gives at most half the interval's optical
+// depth times the other end), it is the more accurate assumption (the sun's
+// attenuation varies exponentially with distance, not with the view's
+// optical depth: measured against brute force in
+// SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent), and the
+// cheaper one.
 Spectrum IntegrateInterval(const RayIntegrand& a, const RayIntegrand& b, double h) {
   Spectrum result;
   for (int c = 0; c < 3; ++c) {
-    const double depth_a = a.view_optical_depth[c] + a.sun_optical_depth[c];
-    const double depth_b = b.view_optical_depth[c] + b.sun_optical_depth[c];
     const double view_depth = b.view_optical_depth[c] - a.view_optical_depth[c];
     const double extinction_a = a.extinction[c], extinction_b = b.extinction[c];
-    double width = h, value_a = a.source[c], value_b = b.source[c];
-    // Over optically thin intervals the exponential in distance is the more
-    // accurate assumption (the sun's attenuation varies exponentially with
-    // distance, not with the view's optical depth: measured against brute
-    // force, SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent)
-    // and cannot overshoot: past one optical depth it can.
-    if (view_depth > 1.0 && (extinction_a > 0.0 || extinction_b > 0.0)) {
-      width = view_depth;
-      value_a = extinction_a > 0.0 ? a.source[c] / extinction_a : b.source[c] / extinction_b;
-      value_b = extinction_b > 0.0 ? b.source[c] / extinction_b : value_a;
+    if (!(view_depth > 1.0 && (extinction_a > 0.0 || extinction_b > 0.0))) {
+      result[c] = ExponentialTrapezoid(a.value[c], b.value[c], h);
+      continue;
     }
+    // Per unit of the view's optical depth.
+    const double width = view_depth;
+    const double value_a = extinction_a > 0.0 ? a.source[c] / extinction_a : b.source[c] / extinction_b;
+    const double value_b = extinction_b > 0.0 ? b.source[c] / extinction_b : value_a;
     if (value_a <= 0.0 || value_b <= 0.0) {
       // An end is truly dark (in the planet's shadow, or nothing scatters):
-      // linear between the ends, exactly integrated against exp(-tau) when
-      // the width is an optical depth.
-      if (width == h) {
-        result[c] = 0.5 * h * (value_a * std::exp(-depth_a) + value_b * std::exp(-depth_b));
-        continue;
-      }
+      // linear between the ends, integrated exactly against exp(-tau).
       // With u the view's optical depth from a and g the values without the
       // view's attenuation: integral over [0, x] of (ga + (gb - ga) u / x) exp(-u).
       double ga = value_a * std::exp(-a.sun_optical_depth[c]), gb = value_b * std::exp(-b.sun_optical_depth[c]);
-      double x = width, decay = -std::expm1(-x);
-      double ramp = x < 1e-3 ? x * (0.5 - x / 3.0) : (decay - x * std::exp(-x)) / x;
+      double x = width, decay = -std::expm1(-x), ramp = (decay - x * std::exp(-x)) / x;
       result[c] = std::exp(-a.view_optical_depth[c]) * (ga * decay + (gb - ga) * ramp);
       continue;
     }
-    double log_a = std::log(value_a) - depth_a, log_b = std::log(value_b) - depth_b;
+    double log_a = std::log(value_a) - (a.view_optical_depth[c] + a.sun_optical_depth[c]);
+    double log_b = std::log(value_b) - (b.view_optical_depth[c] + b.sun_optical_depth[c]);
     double fa = std::exp(log_a), fb = std::exp(log_b), log_ratio = log_b - log_a;
     result[c] = std::abs(log_ratio) < 1e-4 ? 0.5 * width * (fa + fb) : width * (fb - fa) / log_ratio;
   }
@@ -430,8 +429,10 @@ void Baker::ComputeSingleScattering() {
         for (int g = 0; g < groups; ++g) {
           if (g != mie) other += scattering[g] * phase_ratio[g];
         }
-        rayleigh_out = RayIntegrand{other * visible, optical_depth, tau_sun, extinction};
-        mie_out = RayIntegrand{mie >= 0 ? scattering[mie] * visible : Spectrum(0.0), optical_depth, tau_sun, extinction};
+        Spectrum attenuation = glm::exp(-(optical_depth + tau_sun));
+        Spectrum rayleigh_source = other * visible, mie_source = mie >= 0 ? scattering[mie] * visible : Spectrum(0.0);
+        rayleigh_out = RayIntegrand{rayleigh_source, optical_depth, tau_sun, extinction, rayleigh_source * attenuation};
+        mie_out = RayIntegrand{mie_source, optical_depth, tau_sun, extinction, mie_source * attenuation};
       };
       std::vector<Spectrum> scattering_k(groups);
       for (int k = 0; k <= n; ++k) {
@@ -634,9 +635,15 @@ void Baker::ComputeMultipleScattering() {
     const int n = settings_.ray_samples;
     std::vector<double> mu_k(n + 1);
     std::vector<Spectrum> scattering_k(n + 1, Spectrum(0.0));
+    std::vector<Spectrum> attenuation(n + 1);
+    // The optical depths and extinctions are the ray's; the texels differ
+    // only in the source.
     std::vector<RayIntegrand> samples(n + 1);
     for (int k = 0; k <= n; ++k) {
       mu_k[k] = glsl::CosineAtDistance(ray.r, ray.mu, ray.t[k], ray.radius[k]);
+      attenuation[k] = glm::exp(-ray.optical_depth[k]);
+      samples[k].view_optical_depth = ray.optical_depth[k];
+      samples[k].extinction = ray.extinction[k];
       for (const std::vector<Spectrum>& group : ray.scattering) scattering_k[k] += group[k];
     }
     for (int x = 0; x < width; ++x) {
@@ -646,7 +653,8 @@ void Baker::ComputeMultipleScattering() {
       for (int k = 0; k <= n; ++k) {
         double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / ray.radius[k]);
         vec3 j(glsl::GetScattering(params_, density, ray.radius[k], mu_k[k], mu_s_k, nu, intersects));
-        samples[k] = RayIntegrand{j * scattering_k[k], ray.optical_depth[k], Spectrum(0.0), ray.extinction[k]};
+        samples[k].source = j * scattering_k[k];
+        samples[k].value = samples[k].source * attenuation[k];
       }
       Spectrum sum(0.0);
       for (int k = 0; k < n; ++k) sum += IntegrateInterval(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
