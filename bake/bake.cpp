@@ -57,9 +57,77 @@ double ExponentialTrapezoid(double a, double b, double h) {
   return h * (b - a) / std::log(ratio);
 }
 
-Spectrum ExponentialTrapezoid(const Spectrum& a, const Spectrum& b, double h) {
-  return Spectrum(ExponentialTrapezoid(a.x, b.x, h), ExponentialTrapezoid(a.y, b.y, h),
-                  ExponentialTrapezoid(a.z, b.z, h));
+// A sample of an inscattering integrand along a view ray,
+//   value = source * exp(-(view_optical_depth + sun_optical_depth)),
+// with its factors and the extinction coefficient there (the rate at which
+// view_optical_depth grows with distance) for optically thick intervals.
+struct RayIntegrand {
+  Spectrum source{0.0};
+  Spectrum view_optical_depth{0.0};
+  Spectrum sun_optical_depth{0.0};
+  Spectrum extinction{0.0};
+  Spectrum value{0.0};
+};
+
+// Integral between two samples of a RayIntegrand, `h` apart. Three failures
+// of ExponentialTrapezoid on the product in optically thick media are
+// avoided (docs/stability.md, "Integrals along rays"):
+// * Over an interval of optical depth dtau >> 1 where the density also
+//   changes, the product decays fastest where the medium is densest, not at
+//   one mean rate; the trapezoid then returned up to ~1.5 times the exact
+//   integral of beta_s exp(-tau), so orders could grow instead of shrink and
+//   a dense fog's orders diverged. Here the integral is taken over the
+//   view's optical depth, integrand * dt = (integrand / extinction) * dtau,
+//   wherever an interval is more than one optical depth thick,
+//   the integrand per unit optical depth varying exponentially (linearly if
+//   an end is 0) between the samples: a mean of the two ends times at most
+//   exp(-tau_a) - exp(-tau_b), which can never exceed the light that enters.
+// * An end where the density is 0 (a vacuum gap, or an exponential profile
+//   that underflowed far above its scale height) made the trapezoid take
+//   half the interval times the other end: with a kilometre-thin layer on
+//   a megametre-long interval, single scattering above the sun's
+//   irradiance. Such an end takes the other end's value per unit optical
+//   depth, as the light scattered per unit optical depth does not vanish
+//   with the density.
+// * Beyond an optical depth of ~745, exp(-tau) underflows to 0 and an end
+//   looked like a zero of the integrand; rates from logarithms do not.
+// Over optically thin intervals (the common case) the exponential trapezoid
+// in distance is kept: it cannot overshoot there (an end that underflows
+// through the sun's optical depth gives at most half the interval's optical
+// depth times the other end), it is the more accurate assumption (the sun's
+// attenuation varies exponentially with distance, not with the view's
+// optical depth: measured against brute force in
+// SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent), and the
+// cheaper one.
+Spectrum IntegrateInterval(const RayIntegrand& a, const RayIntegrand& b, double h) {
+  Spectrum result;
+  for (int c = 0; c < 3; ++c) {
+    const double view_depth = b.view_optical_depth[c] - a.view_optical_depth[c];
+    const double extinction_a = a.extinction[c], extinction_b = b.extinction[c];
+    if (!(view_depth > 1.0 && (extinction_a > 0.0 || extinction_b > 0.0))) {
+      result[c] = ExponentialTrapezoid(a.value[c], b.value[c], h);
+      continue;
+    }
+    // Per unit of the view's optical depth.
+    const double width = view_depth;
+    const double value_a = extinction_a > 0.0 ? a.source[c] / extinction_a : b.source[c] / extinction_b;
+    const double value_b = extinction_b > 0.0 ? b.source[c] / extinction_b : value_a;
+    if (value_a <= 0.0 || value_b <= 0.0) {
+      // An end is truly dark (in the planet's shadow, or nothing scatters):
+      // linear between the ends, integrated exactly against exp(-tau).
+      // With u the view's optical depth from a and g the values without the
+      // view's attenuation: integral over [0, x] of (ga + (gb - ga) u / x) exp(-u).
+      double ga = value_a * std::exp(-a.sun_optical_depth[c]), gb = value_b * std::exp(-b.sun_optical_depth[c]);
+      double x = width, decay = -std::expm1(-x), ramp = (decay - x * std::exp(-x)) / x;
+      result[c] = std::exp(-a.view_optical_depth[c]) * (ga * decay + (gb - ga) * ramp);
+      continue;
+    }
+    double log_a = std::log(value_a) - (a.view_optical_depth[c] + a.sun_optical_depth[c]);
+    double log_b = std::log(value_b) - (b.view_optical_depth[c] + b.sun_optical_depth[c]);
+    double fa = std::exp(log_a), fb = std::exp(log_b), log_ratio = log_b - log_a;
+    result[c] = std::abs(log_ratio) < 1e-4 ? 0.5 * width * (fa + fb) : width * (fb - fa) / log_ratio;
+  }
+  return result;
 }
 
 // Sample distances along a ray of length d: n equal intervals. (Grading them
@@ -99,6 +167,7 @@ struct RaySamples {
   bool intersects_ground = false;
   std::vector<double> t, radius;  // t[0] = 0 ... t[n] = end of the ray
   std::vector<Spectrum> optical_depth;           // from the camera to each sample
+  std::vector<Spectrum> extinction;              // extinction coefficient at each sample
   std::vector<std::vector<Spectrum>> scattering;  // [group][sample] scattering coefficient
 };
 
@@ -240,7 +309,7 @@ class Baker {
   Texture single_mie_;            // single scattering of the Mie group, phase free
   Texture single_rayleigh_;       // single scattering of the other groups / Rayleigh phase
   Texture delta_multiple_;        // radiance of the latest order >= 2
-  Texture scattering_density_;    // J of the current order
+  Texture scattering_density_;    // J of the current order per unit scattering coefficient
   Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
   std::vector<double> packing_factor_;  // MultipleScatteringPackingFactor per texel, filled on first use
 };
@@ -308,6 +377,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
   LutSet result;
   result.atmosphere = medium_.atmosphere();
   result.settings = settings_;
+  result.orders_used = report_.orders_used;
   result.parameters = params_;
   result.transmittance = std::move(transmittance_);
   result.irradiance = std::move(irradiance_);
@@ -346,6 +416,7 @@ RaySamples Baker::SampleRay(int mu_index, int r_index) const {
   ray.t = RayDistances(d, n);
   ray.radius.resize(n + 1);
   ray.optical_depth.assign(n + 1, Spectrum(0.0));
+  ray.extinction.resize(n + 1);
   ray.scattering.assign(groups, std::vector<Spectrum>(n + 1));
   std::vector<double> densities(constituents), previous(constituents);
   for (int k = 0; k <= n; ++k) {
@@ -353,6 +424,7 @@ RaySamples Baker::SampleRay(int mu_index, int r_index) const {
     ray.radius[k] = glsl::RadiusAtDistance(params_, ray.r, ray.mu, t);
     medium_.Densities(ray.radius[k] - params_.bottom_radius, densities.data());
     for (int g = 0; g < groups; ++g) ray.scattering[g][k] = medium_.GroupScattering(g, densities.data());
+    ray.extinction[k] = medium_.Extinction(densities.data());
     if (k > 0) {
       Spectrum tau = ray.optical_depth[k - 1];
       for (int c = 0; c < constituents; ++c) {
@@ -377,7 +449,7 @@ void Baker::ComputeSingleScattering() {
     RaySamples ray = SampleRay(y, z);
     const int n = settings_.ray_samples;
     std::vector<double> phase_ratio(groups);
-    std::vector<Spectrum> rayleigh(n + 1), mie_samples(n + 1);
+    std::vector<RayIntegrand> rayleigh(n + 1), mie_samples(n + 1);
     std::vector<double> visible(n + 1), densities(medium_.constituent_count());
     for (int x = 0; x < width; ++x) {
       double r, mu, mu_s, nu;
@@ -388,30 +460,32 @@ void Baker::ComputeSingleScattering() {
         phase_ratio[g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
       }
       // Scattered light at distance t along the ray, per group kind.
-      auto sample = [&](double t, double r_t, const Spectrum& optical_depth, const Spectrum* scattering,
-                        Spectrum& rayleigh_out, Spectrum& mie_out, double& visible) {
+      auto sample = [&](double t, double r_t, const Spectrum& optical_depth, const Spectrum& extinction,
+                        const Spectrum* scattering, RayIntegrand& rayleigh_out, RayIntegrand& mie_out,
+                        double& visible) {
         double mu_s_t = glsl::ClampCosine((r * mu_s + t * nu) / r_t);
         visible = glsl::SunVisibleFraction(params_, r_t, mu_s_t);
         Spectrum tau_sun = glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance, r_t, mu_s_t);
-        Spectrum attenuation = glm::exp(-(optical_depth + tau_sun)) * visible;
         Spectrum other(0.0);
         for (int g = 0; g < groups; ++g) {
           if (g != mie) other += scattering[g] * phase_ratio[g];
         }
-        rayleigh_out = other * attenuation;
-        mie_out = mie >= 0 ? scattering[mie] * attenuation : Spectrum(0.0);
+        Spectrum attenuation = glm::exp(-(optical_depth + tau_sun));
+        Spectrum rayleigh_source = other * visible, mie_source = mie >= 0 ? scattering[mie] * visible : Spectrum(0.0);
+        rayleigh_out = RayIntegrand{rayleigh_source, optical_depth, tau_sun, extinction, rayleigh_source * attenuation};
+        mie_out = RayIntegrand{mie_source, optical_depth, tau_sun, extinction, mie_source * attenuation};
       };
       std::vector<Spectrum> scattering_k(groups);
       for (int k = 0; k <= n; ++k) {
         for (int g = 0; g < groups; ++g) scattering_k[g] = ray.scattering[g][k];
-        sample(ray.t[k], ray.radius[k], ray.optical_depth[k], scattering_k.data(), rayleigh[k], mie_samples[k],
-               visible[k]);
+        sample(ray.t[k], ray.radius[k], ray.optical_depth[k], ray.extinction[k], scattering_k.data(), rayleigh[k],
+               mie_samples[k], visible[k]);
       }
       Spectrum rayleigh_sum(0.0), mie_sum(0.0);
       for (int k = 0; k < n; ++k) {
         if (visible[k] == visible[k + 1] && (visible[k] == 0.0 || visible[k] == 1.0)) {
-          rayleigh_sum += ExponentialTrapezoid(rayleigh[k], rayleigh[k + 1], ray.t[k + 1] - ray.t[k]);
-          mie_sum += ExponentialTrapezoid(mie_samples[k], mie_samples[k + 1], ray.t[k + 1] - ray.t[k]);
+          rayleigh_sum += IntegrateInterval(rayleigh[k], rayleigh[k + 1], ray.t[k + 1] - ray.t[k]);
+          mie_sum += IntegrateInterval(mie_samples[k], mie_samples[k + 1], ray.t[k + 1] - ray.t[k]);
           continue;
         }
         // The planet's shadow edge crosses this interval: the integrand
@@ -419,9 +493,9 @@ void Baker::ComputeSingleScattering() {
         const int pieces = kShadowEdgeSubdivisions;
         double width = ray.t[k + 1] - ray.t[k];
         double h = width / pieces;
-        Spectrum previous_rayleigh = rayleigh[k], previous_mie = mie_samples[k];
+        RayIntegrand previous_rayleigh = rayleigh[k], previous_mie = mie_samples[k];
         for (int i = 1; i <= pieces; ++i) {
-          Spectrum next_rayleigh = rayleigh[k + 1], next_mie = mie_samples[k + 1];
+          RayIntegrand next_rayleigh = rayleigh[k + 1], next_mie = mie_samples[k + 1];
           if (i < pieces) {
             double f = double(i) / pieces;
             double t = ray.t[k] + f * width;
@@ -430,10 +504,11 @@ void Baker::ComputeSingleScattering() {
             for (int g = 0; g < groups; ++g) scattering_k[g] = medium_.GroupScattering(g, densities.data());
             Spectrum optical_depth = glm::mix(ray.optical_depth[k], ray.optical_depth[k + 1], f);
             double unused;
-            sample(t, r_t, optical_depth, scattering_k.data(), next_rayleigh, next_mie, unused);
+            sample(t, r_t, optical_depth, medium_.Extinction(densities.data()), scattering_k.data(), next_rayleigh,
+                   next_mie, unused);
           }
-          rayleigh_sum += ExponentialTrapezoid(previous_rayleigh, next_rayleigh, h);
-          mie_sum += ExponentialTrapezoid(previous_mie, next_mie, h);
+          rayleigh_sum += IntegrateInterval(previous_rayleigh, next_rayleigh, h);
+          mie_sum += IntegrateInterval(previous_mie, next_mie, h);
           previous_rayleigh = next_rayleigh, previous_mie = next_mie;
         }
       }
@@ -523,7 +598,11 @@ void Baker::ComputeScatteringDensity(int order) {
     std::vector<double> densities(medium_.constituent_count());
     medium_.Densities(r - params_.bottom_radius, densities.data());
     std::vector<Spectrum> group_scattering(groups);
-    for (int g = 0; g < groups; ++g) group_scattering[g] = medium_.GroupScattering(g, densities.data());
+    Spectrum total_scattering(0.0);
+    for (int g = 0; g < groups; ++g) {
+      group_scattering[g] = medium_.GroupScattering(g, densities.data());
+      total_scattering += group_scattering[g];
+    }
 
     const size_t count = directions.size();
     for (int y = 0; y < mu_size; ++y) {
@@ -552,7 +631,16 @@ void Baker::ComputeScatteringDensity(int order) {
           }
           if (weight_sum > 0.0) density += group_scattering[g] * sum / weight_sum;
         }
-        scattering_density_.Store(x, y, z, vec4(density, 0.0));
+        // Stored per unit scattering coefficient, i.e. as the phase-weighted
+        // mean incoming radiance, which varies slowly with altitude; the
+        // multiple-scattering integral multiplies the coefficient back at
+        // each sample. Interpolating J itself between r texels overestimates
+        // a thin exponential haze (linear interpolation of a convex profile),
+        // so that an order could carry more light than the previous one and
+        // the orders of a dense fog diverged.
+        vec3 per_unit_scattering(0.0);
+        for (int c = 0; c < 3; ++c) per_unit_scattering[c] = total_scattering[c] > 0.0 ? density[c] / total_scattering[c] : 0.0;
+        scattering_density_.Store(x, y, z, vec4(per_unit_scattering, 0.0));
       }
     }
   });
@@ -594,10 +682,17 @@ void Baker::ComputeMultipleScattering() {
     RaySamples ray = SampleRay(y, z);
     const int n = settings_.ray_samples;
     std::vector<double> mu_k(n + 1);
-    std::vector<Spectrum> attenuation(n + 1), samples(n + 1);
+    std::vector<Spectrum> scattering_k(n + 1, Spectrum(0.0));
+    std::vector<Spectrum> attenuation(n + 1);
+    // The optical depths and extinctions are the ray's; the texels differ
+    // only in the source.
+    std::vector<RayIntegrand> samples(n + 1);
     for (int k = 0; k <= n; ++k) {
       mu_k[k] = glsl::CosineAtDistance(ray.r, ray.mu, ray.t[k], ray.radius[k]);
       attenuation[k] = glm::exp(-ray.optical_depth[k]);
+      samples[k].view_optical_depth = ray.optical_depth[k];
+      samples[k].extinction = ray.extinction[k];
+      for (const std::vector<Spectrum>& group : ray.scattering) scattering_k[k] += group[k];
     }
     for (int x = 0; x < width; ++x) {
       double r, mu, mu_s, nu;
@@ -606,10 +701,11 @@ void Baker::ComputeMultipleScattering() {
       for (int k = 0; k <= n; ++k) {
         double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / ray.radius[k]);
         vec3 j(glsl::GetScattering(params_, density, ray.radius[k], mu_k[k], mu_s_k, nu, intersects));
-        samples[k] = j * attenuation[k];
+        samples[k].source = j * scattering_k[k];
+        samples[k].value = samples[k].source * attenuation[k];
       }
       Spectrum sum(0.0);
-      for (int k = 0; k < n; ++k) sum += ExponentialTrapezoid(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
+      for (int k = 0; k < n; ++k) sum += IntegrateInterval(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
       delta_multiple_.Store(x, y, z, vec4(sum, 0.0));
       vec4 total = scattering_.Fetch(x, y, z) + vec4(sum * MultipleScatteringPackingFactor(x, y, z), 0.0);
       scattering_.Store(x, y, z, total);

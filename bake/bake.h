@@ -55,6 +55,9 @@ struct BakeSettings {
 struct LutSet {
   Atmosphere atmosphere;
   BakeSettings settings;
+  // Scattering orders the tables hold (settings.orders is 0 for auto);
+  // an extrapolated tail of further orders may be added on top.
+  int orders_used = 0;
   glsl::AtmosphereParameters parameters;
   glsl::Texture transmittance;  // 2D, rgb = optical depth to the top boundary
   glsl::Texture irradiance;     // 2D, rgb = indirect ground irradiance

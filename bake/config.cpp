@@ -164,6 +164,17 @@ constexpr Interval kSunRadiusRad{0.0, kPi / 2, false, false, "(0, pi/2)"};
 constexpr Interval kSunRadiusDeg{0.0, 90.0, false, false};
 constexpr Interval kLowestZenithDeg{0.0, 180.0, false, true};
 constexpr Interval kMuSMin{-1.0, 1.0, true, false};
+// Ranges outside which the tables' arithmetic overflows or loses every digit
+// (squared radii, optical depths along the longest chord, radiance times the
+// sharpest phase function, in float), found by fuzzing: a top radius of
+// 1e200 m, a scattering coefficient of 1e308 m^-1 or an irradiance of 1e308
+// baked to NaN and inf. Nothing physical comes near them: planets are
+// 1e3 m to 1e8 m in radius (Jupiter 7e7 m), the densest fog extinguishes
+// ~0.1 m^-1 (1000 m^-1 is a mean free path of 1 mm), the sun at Mercury's
+// orbit gives ~15 W m^-2 nm^-1.
+constexpr Interval kRadiusRange{1.0, 1e11, true, true, "[1 m, 1e11 m]"};
+constexpr Interval kCoefficientRange{0.0, 1e3, true, true, "[0, 1000] m^-1"};
+constexpr Interval kIrradianceRange{0.0, 1e25, true, true, "[0, 1e25]"};
 // Depolarization ratio of natural light by anisotropic molecules is at most
 // 1/2; beyond 6/7 the King factor changes sign.
 constexpr Interval kDepolarization{0.0, 0.5, true, true};
@@ -864,6 +875,9 @@ void Validate(const Atmosphere& a, const std::string& source_name) {
   CheckSpectrum(report, "planet.ground_albedo", a.ground_albedo, kUnit);
   CheckSpectrum(report, "spectrum.wavelengths_nm", a.wavelengths_nm, kPositive);
   CheckSpectrum(report, "sun.irradiance_w_m2_nm", a.solar_irradiance, kNonNegative);
+  CheckNumber(report, "planet.ground_radius_m", a.bottom_radius_m, kRadiusRange);
+  CheckNumber(report, "planet.top_radius_m", a.top_radius_m, kRadiusRange);
+  CheckSpectrum(report, "sun.irradiance_w_m2_nm", a.solar_irradiance, kIrradianceRange);
   CheckNumber(report, "sun.angular_radius_rad", a.sun_angular_radius_rad, kSunRadiusRad);
   CheckNumber(report, "sun.mu_s_min", a.mu_s_min, kMuSMin);
 
@@ -874,6 +888,8 @@ void Validate(const Atmosphere& a, const std::string& source_name) {
     if (!names.insert(c.name).second) report.Fail(path, "appears more than once");
     CheckSpectrum(report, path + ".scattering_per_m", c.scattering_per_m, kNonNegative);
     CheckSpectrum(report, path + ".absorption_per_m", c.absorption_per_m, kNonNegative);
+    CheckSpectrum(report, path + ".scattering_per_m", c.scattering_per_m, kCoefficientRange);
+    CheckSpectrum(report, path + ".absorption_per_m", c.absorption_per_m, kCoefficientRange);
     CheckPhase(report, path + ".phase", c.phase);
     CheckDensityProfile(report, path + ".density", c.density, a.top_radius_m - a.bottom_radius_m);
   }

@@ -160,8 +160,9 @@ void RunInfo(const InfoOptions& o) {
   }
   std::printf("%s: schema %s version %d, %s\n", manifest.path.string().c_str(), kManifestSchema,
               doc["schema_version"].get<int>(), doc.value("generator", "").c_str());
-  std::printf("  atmosphere %s, wavelengths %s nm, %d scattering orders\n", manifest.luts.atmosphere.name.c_str(),
-              doc["wavelengths_nm"].dump().c_str(), manifest.luts.settings.orders);
+  std::printf("  atmosphere %s, wavelengths %s nm, %d scattering orders%s\n", manifest.luts.atmosphere.name.c_str(),
+              doc["wavelengths_nm"].dump().c_str(), manifest.luts.orders_used,
+              manifest.luts.settings.orders == 0 ? " (auto)" : "");
   std::printf("  command: %s\n", doc.value("command", "").c_str());
   std::printf("  %zu table files, %zu shader files; every checksum matches\n\n", files.size(), shaders.size());
   for (const json& d : files) {

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddInfoCommand(app);
   skybake::cli::AddConvertCommand(app);
   skybake::cli::AddBenchCommand(app);
+  skybake::cli::AddStressCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -17,8 +17,11 @@ namespace skybake {
 
 namespace {
 
-ordered_json SettingsToJson(const BakeSettings& s) {
-  return ordered_json{{"orders", s.orders},
+// "orders" is what was asked for (a count or "auto"), "orders_used" what the
+// tables hold, "extrapolate_tail" whether they add the orders not computed.
+ordered_json SettingsToJson(const BakeSettings& s, int orders_used) {
+  return ordered_json{{"orders", s.orders == 0 ? ordered_json("auto") : ordered_json(s.orders)},
+                      {"orders_used", orders_used},
                       {"extrapolate_tail", s.extrapolate_tail},
                       {"transmittance_samples", s.transmittance_samples},
                       {"ray_samples", s.ray_samples},
@@ -118,7 +121,7 @@ std::string ManifestWriter::Text() const {
       {"wavelengths_nm", {w.x, w.y, w.z}},
       {"parameters", ParametersToJson(luts_.parameters)},
       {"parameterization", ParameterizationToJson(luts_.parameters)},
-      {"bake", SettingsToJson(luts_.settings)},
+      {"bake", SettingsToJson(luts_.settings, luts_.orders_used)},
       {"tables", tables_},
       {"shaders", shaders_},
       {"atmosphere", ordered_json::parse(ToJson(luts_.atmosphere))},
@@ -159,8 +162,10 @@ Manifest ReadManifest(const fs::path& dir) {
     SetAltitudeProfiles(luts.atmosphere, &luts.parameters);
     const json& bake = m.document.at("bake");
     BakeSettings& s = luts.settings;
-    s.orders = bake.at("orders").get<int>();
-    s.extrapolate_tail = bake.value("extrapolate_tail", false);  // absent: written before the tail existed
+    const json& orders = bake.at("orders");
+    s.orders = orders.is_string() && orders.get<std::string>() == "auto" ? 0 : orders.get<int>();
+    luts.orders_used = bake.at("orders_used").get<int>();
+    s.extrapolate_tail = bake.at("extrapolate_tail").get<bool>();
     s.transmittance_samples = bake.at("transmittance_samples").get<int>();
     s.ray_samples = bake.at("ray_samples").get<int>();
     s.sphere_samples = bake.at("sphere_samples").get<int>();

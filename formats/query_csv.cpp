@@ -14,6 +14,10 @@ namespace skybake {
 
 namespace {
 
+// Altitudes and distances beyond 1e12 m (6.7 au) are rejected: there the
+// runtime's ray-sphere arithmetic has lost its digits, and past ~1e154 m its
+// squares overflow and answer NaN.
+constexpr double kMaxLengthM = 1e12;
 const std::vector<std::string> kRequiredColumns = {"altitude_m", "view_zenith_deg", "sun_zenith_deg",
                                                    "view_sun_azimuth_deg"};
 // "group" is a free-text label (the case set of docs/report.md); the tools
@@ -112,14 +116,19 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
       if (value < 0.0 || value > 180.0) fail(name + " = " + fields[column.at(name)] + " is outside [0, 180]");
       return value;
     };
+    auto bounded_length = [&](const std::string& name, bool optional) {
+      double value = number(name, optional);
+      if (value > kMaxLengthM) fail(name + " = " + fields[column.at(name)] + " is beyond 1e12 m");
+      return value;
+    };
     Query q;
     // A camera below the ground is evaluated on the ground, as by `skybake eval`.
-    q.altitude_m = std::max(number("altitude_m", false), 0.0);
+    q.altitude_m = std::max(bounded_length("altitude_m", false), 0.0);
     q.view_zenith_deg = angle("view_zenith_deg", false);
     q.sun_zenith_deg = angle("sun_zenith_deg", false);
     q.view_sun_azimuth_deg = number("view_sun_azimuth_deg", false);
     if (table.has_distance) {
-      q.distance_m = number("distance_m", true);
+      q.distance_m = bounded_length("distance_m", true);
       if (q.distance_m < 0.0) fail("distance_m = " + fields[column.at("distance_m")] + " is negative");
     }
     if (table.has_normal && !fields[column.at("normal_zenith_deg")].empty()) {

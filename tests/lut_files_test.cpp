@@ -56,6 +56,7 @@ void ExpectSameSet(const LutSet& loaded, const LutSet& original, bool half) {
   EXPECT_EQ(ToToml(loaded.atmosphere), ToToml(original.atmosphere));
   EXPECT_EQ(ParametersToJson(loaded.parameters), ParametersToJson(original.parameters));
   EXPECT_EQ(loaded.settings.orders, original.settings.orders);
+  EXPECT_EQ(loaded.orders_used, original.orders_used);
   EXPECT_EQ(loaded.settings.ray_samples, original.settings.ray_samples);
   EXPECT_EQ(loaded.settings.pack_single_mie_in_alpha, original.settings.pack_single_mie_in_alpha);
   for (const TableDescription& table : DescribeTables(original)) {

@@ -166,6 +166,10 @@ TEST(Orders, CommandLineAcceptsAutoAndReportsConvergence) {
   EXPECT_EQ(j["orders"], "auto");
   EXPECT_GE(j["orders_used"].get<int>(), 3);
   EXPECT_LT(j["remaining_error"].get<double>(), j["order_tolerance"].get<double>());
+  // The manifest keeps the request and records the orders the tables hold.
+  nlohmann::json manifest = nlohmann::json::parse(testing::ReadText(dir.path() / "out" / "skybake.json"));
+  EXPECT_EQ(manifest["bake"]["orders"], "auto");
+  EXPECT_EQ(manifest["bake"]["orders_used"], j["orders_used"]);
   // One order: nothing to compare, so the remaining error is unknown.
   ASSERT_EQ(testing::RunCommand(bake + " --orders 1", dir, &out, &err), 0) << err;
   EXPECT_TRUE(nlohmann::json::parse(out)["remaining_error"].is_null());

@@ -93,5 +93,34 @@ TEST(BakeOutput, InterruptedBakeLeavesNoFiles) {
   EXPECT_TRUE(!fs::exists(out) || Snapshot(out).empty());
 }
 
+// A full disk: the output directory is a 256 KiB tmpfs (mounted in a user
+// and mount namespace, so no privileges are needed), holding a tiny set of
+// ~100 KB; the next bake's set (~500 KB) cannot fit, so a write fails with
+// ENOSPC part-way. Skipped where unprivileged namespaces are not allowed.
+TEST(BakeOutput, FullDiskExitsThreeAndKeepsThePreviousSet) {
+  TempDir dir;
+  const fs::path mount = dir.path() / "small_disk", out = mount / "out";
+  fs::create_directory(mount);
+  const std::string bake = Skybake() + " bake earth -o " + testing::ShellQuote(out);
+  const std::string script =
+      "mount -t tmpfs -o size=256k tmpfs " + testing::ShellQuote(mount) + " || exit 77\n" + bake + kTinyBake +
+      " --orders 1 || exit 78\n"
+      "cd " + testing::ShellQuote(out) + " && sha256sum * > ../../before\n" +
+      bake + " -q --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 8"
+             " --sphere-samples 4 --orders 1 2> ../../err\n"
+      "echo $? > ../../code\n"
+      "sha256sum * > ../../after; ls -a > ../../listing\n";
+  testing::WriteText(dir.path() / "full_disk.sh", script);
+  int code = RunCommand("unshare -r -m sh " + testing::ShellQuote(dir.path() / "full_disk.sh"), dir);
+  if (code == 77 || code == 1) GTEST_SKIP() << "cannot mount a small tmpfs in a user namespace here";
+  ASSERT_EQ(code, 0);
+  EXPECT_EQ(ReadText(dir.path() / "code"), "3\n");
+  const std::string err = ReadText(dir.path() / "err");
+  EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
+  EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
+  EXPECT_EQ(ReadText(dir.path() / "after"), ReadText(dir.path() / "before"));
+  EXPECT_EQ(ReadText(dir.path() / "listing").find(".tmp"), std::string::npos) << ReadText(dir.path() / "listing");
+}
+
 }  // namespace
 }  // namespace skybake
