@@ -19,5 +19,6 @@ void AddRenderCommand(CLI::App& app);
 void AddInfoCommand(CLI::App& app);
 void AddConvertCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
+void AddReportCommand(CLI::App& app);
 
 }  // namespace skybake::cli

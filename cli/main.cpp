@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddInfoCommand(app);
   skybake::cli::AddConvertCommand(app);
   skybake::cli::AddBenchCommand(app);
+  skybake::cli::AddReportCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "bake/errors.h"
 #include "fit/optical_path.h"
 #include "fit/sky_dome_fit.h"
 #include "shaders_runtime/hoffman_preetham.h"
@@ -168,6 +169,7 @@ ModelAnswer HoffmanPreethamModel::Evaluate(const ReferenceCase& c, long* fitted_
 // ---------------------------------------------------------------------------
 
 double MedianNanosecondsPerEvaluation(const ReferenceSet& reference, const Model& model, int passes) {
+  if (passes < 1 || reference.cases.empty()) throw InternalError("timing needs at least one pass and one case");
   // Summing a value from every answer keeps the evaluations from being
   // optimized away.
   volatile double sink = 0.0;
