@@ -111,7 +111,7 @@ std::string MarkdownTables(const std::string& atmosphere, const std::vector<Row>
   for (const std::string& g : groups) header += " " + g + " |", rule += "---|";
 
   out += "### Quality ladder (" + atmosphere + ")\n\n| configuration | bake (s) | written (MB) |" + header +
-         " Pareto |\n|---|---:|---:" + rule + ":---:|\n";
+         " Pareto |\n|---|---:|---:|" + rule + ":---:|\n";
   for (const Row& r : rows) {
     if (r.kind != "bake") continue;
     out += "| " + (r.is_base ? "**" + r.name + " (base)**" : r.name) + " | " + Fixed(r.bake_seconds, 1) + " | " +
@@ -135,7 +135,7 @@ std::string MarkdownTables(const std::string& atmosphere, const std::vector<Row>
   }
 
   out += "\n### Run-time models\n\n| model | ns / evaluation | texture fetches / eval. | loop iterations / eval. |" +
-         header + "\n|---|---:|---:|---:" + rule + "\n";
+         header + "\n|---|---:|---:|---:|" + rule + "\n";
   for (const Row& r : rows) {
     if (r.kind != "model") continue;
     std::string iterations = Fixed(r.density_samples, 1);
@@ -242,45 +242,43 @@ LinePlot ErrorAgainstTimePlot(const std::string& atmosphere, const std::vector<R
   plot.caption = CommandLine();
   plot.x = {"bake time, files written (s)", true, {}, {}};
   plot.y = {group + " RMS relative luminance error", true, {}, {}};
+  // One marker colour per knob, drawn last so that the larger markers of the
+  // Pareto front and of the base show around them as rings.
+  std::vector<PlotSeries> knobs;
   std::map<std::string, size_t> series_of_knob;
   std::vector<std::pair<double, double>> front;
+  PlotSeries base;
   for (const Row& r : rows) {
     if (r.kind != "bake") continue;
     double error = PlottedError(r, group);
     if (!series_of_knob.count(r.knob)) {
-      series_of_knob[r.knob] = plot.series.size();
+      series_of_knob[r.knob] = knobs.size();
       PlotSeries s;
       s.name = r.knob;
+      s.color = static_cast<int>(knobs.size());
       s.width_px = 0.0;
       s.marker_px = 8.0;
-      plot.series.push_back(s);
+      knobs.push_back(s);
     }
-    PlotSeries& s = plot.series[series_of_knob[r.knob]];
+    PlotSeries& s = knobs[series_of_knob[r.knob]];
     s.x.push_back(r.bake_seconds);
     s.y.push_back(error);
     if (r.pareto) front.emplace_back(r.bake_seconds, error);
+    if (r.is_base) base.name = "base (" + r.name + ")", base.x = {r.bake_seconds}, base.y = {error};
   }
   std::sort(front.begin(), front.end());
   PlotSeries pareto;
   pareto.name = "Pareto front";
   pareto.style = LineStyle::kDashed;
-  pareto.color = static_cast<int>(plot.series.size());
-  pareto.marker_px = 12.0;
+  pareto.color = static_cast<int>(knobs.size());
+  pareto.marker_px = 14.0;
   pareto.width_px = 1.5;
   for (const auto& [x, y] : front) pareto.x.push_back(x), pareto.y.push_back(y);
-  plot.series.push_back(pareto);
-  // The base bake, ringed.
-  for (const Row& r : rows) {
-    if (!r.is_base) continue;
-    PlotSeries base;
-    base.name = "base (" + r.name + ")";
-    base.x = {r.bake_seconds};
-    base.y = {PlottedError(r, group)};
-    base.width_px = 0.0;
-    base.marker_px = 16.0;
-    base.color = pareto.color + 1;
-    plot.series.push_back(base);
-  }
+  base.color = pareto.color + 1;
+  base.width_px = 0.0;
+  base.marker_px = 20.0;
+  plot.series = {base, pareto};
+  plot.series.insert(plot.series.end(), knobs.begin(), knobs.end());
   return plot;
 }
 

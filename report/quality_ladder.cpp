@@ -1,6 +1,7 @@
 #include "report/quality_ladder.h"
 
 #include <chrono>
+#include <cstdio>
 
 #include "bake/errors.h"
 #include "formats/half.h"
@@ -144,6 +145,9 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
     e.errors = MeasureTables(tables, reference);
     entries.push_back(e);
     if (e.is_base) base = tables;
+    char line[64];
+    std::snprintf(line, sizeof line, "order %d done after %.1f s", order, seconds);
+    say(line);
   });
   Written base_files = WriteTables(base, scratch_dir, false);
   for (LadderEntry& e : entries) {
