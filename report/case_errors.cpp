@@ -33,8 +33,11 @@ ReferenceSet ParseReference(const std::string& text, const std::string& source_n
   };
   auto radiance = columns("radiance_"), radiance_error = columns("radiance_stderr_");
   std::vector<size_t> sun, sky, sky_error;
-  if (table.has_normal) sun = columns("sun_irradiance_"), sky = columns("sky_irradiance_"),
-                        sky_error = columns("sky_irradiance_stderr_");
+  if (table.has_normal) {
+    sun = columns("sun_irradiance_");
+    sky = columns("sky_irradiance_");
+    sky_error = columns("sky_irradiance_stderr_");
+  }
   ReferenceSet set;
   set.source_name = source_name;
   for (size_t row = 0; row < table.queries.size(); ++row) {
