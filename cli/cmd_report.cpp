@@ -3,6 +3,7 @@
 // report"). Prints Markdown tables; writes report.csv, report.json and the
 // error-against-time plot (SVG and PNG) into the output directory.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>

@@ -1,5 +1,6 @@
 #include "report/error_stats.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
