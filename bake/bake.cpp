@@ -255,7 +255,7 @@ class Baker {
   Baker(const Atmosphere& atmosphere, const BakeSettings& settings)
       : medium_(atmosphere), settings_(settings), params_(MakeAtmosphereParameters(atmosphere, settings)) {}
 
-  LutSet Run(BakeReport* report, const BakeProgress& progress);
+  LutSet Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot);
 
  private:
   template <typename F>
@@ -270,6 +270,10 @@ class Baker {
   // extrapolated tail (factor times the newest order) added to the tables.
   OrderSums MeasureNewestOrder();
   void AddTail(const Spectrum& factor);
+  // The tables as they stand, copied (for BakeOrderSnapshot) or moved out
+  // (the result).
+  LutSet AssembleTables(Texture transmittance, Texture irradiance, Texture scattering, Texture single_mie) const;
+  double PhaseSecondsSoFar() const;
 
   void ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
                                bool& intersects_ground) const {
@@ -323,8 +327,40 @@ void Baker::Phase(const std::string& name, F&& work) {
   if (progress_) progress_(timing);
 }
 
-LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
+LutSet Baker::AssembleTables(Texture transmittance, Texture irradiance, Texture scattering,
+                             Texture single_mie) const {
+  LutSet result;
+  result.atmosphere = medium_.atmosphere();
+  result.settings = settings_;
+  result.orders_used = report_.orders_used;
+  result.parameters = params_;
+  result.transmittance = std::move(transmittance);
+  result.irradiance = std::move(irradiance);
+  if (params_.single_mie_in_scattering_alpha == 1) {
+    for (size_t i = 0; i < scattering.texels.size(); i += 4) scattering.texels[i + 3] = single_mie.texels[i];
+  } else {
+    result.single_mie_scattering = std::move(single_mie);
+  }
+  result.scattering = std::move(scattering);
+  return result;
+}
+
+double Baker::PhaseSecondsSoFar() const {
+  double seconds = 0.0;
+  for (const BakeTiming& t : report_.timings) seconds += t.seconds;
+  return seconds;
+}
+
+LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot) {
   progress_ = progress;
+  auto snapshot = [&](int order) {
+    if (order_snapshot) {
+      LutSet tables = AssembleTables(transmittance_, irradiance_, scattering_, single_mie_);
+      tables.settings.orders = order;  // exactly these orders, no tail
+      tables.settings.extrapolate_tail = false;
+      order_snapshot(order, tables, PhaseSecondsSoFar());
+    }
+  };
   auto start = std::chrono::steady_clock::now();
   const BakeSettings& s = settings_;
   int scattering_width = s.scattering_nu_size * s.scattering_mu_s_size;
@@ -343,6 +379,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
     delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
   }
   report_.orders_used = 1;
+  snapshot(1);
   report_.remaining_error = -1.0;  // unknown until two orders can be compared
   const bool auto_orders = s.orders == 0;
   OrderConvergence convergence;
@@ -355,6 +392,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
     convergence.Add(MeasureNewestOrder());
     report_.order_ratio = convergence.Ratio();
     report_.remaining_error = convergence.RemainingWithoutTail();
+    snapshot(order);
     if (!auto_orders) {
       std::optional<Spectrum> tail = convergence.TailFactor();
       if (order == s.orders && s.extrapolate_tail && tail && !convergence.NewestIsZero()) {
@@ -374,19 +412,8 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress) {
     }
   }
 
-  LutSet result;
-  result.atmosphere = medium_.atmosphere();
-  result.settings = settings_;
-  result.orders_used = report_.orders_used;
-  result.parameters = params_;
-  result.transmittance = std::move(transmittance_);
-  result.irradiance = std::move(irradiance_);
-  if (params_.single_mie_in_scattering_alpha == 1) {
-    for (size_t i = 0; i < scattering_.texels.size(); i += 4) scattering_.texels[i + 3] = single_mie_.texels[i];
-  } else {
-    result.single_mie_scattering = std::move(single_mie_);
-  }
-  result.scattering = std::move(scattering_);
+  LutSet result = AssembleTables(std::move(transmittance_), std::move(irradiance_), std::move(scattering_),
+                                 std::move(single_mie_));
   report_.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (report) *report = report_;
   return result;
@@ -859,7 +886,7 @@ void SetAltitudeProfiles(const Atmosphere& atmosphere, glsl::AtmosphereParameter
 }
 
 LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report,
-            const BakeProgress& progress) {
+            const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot) {
   settings.Validate();
   std::unique_ptr<tbb::global_control> thread_limit;
   if (settings.threads > 0) {
@@ -867,7 +894,7 @@ LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeRepo
                                                          static_cast<size_t>(settings.threads));
   }
   Baker baker(atmosphere, settings);
-  return baker.Run(report, progress);
+  return baker.Run(report, progress, order_snapshot);
 }
 
 }  // namespace skybake

@@ -87,8 +87,14 @@ struct BakeReport {
 // Called after each phase with its name and duration.
 using BakeProgress = std::function<void(const BakeTiming&)>;
 
+// Called once single scattering is done (order 1) and after each further
+// order with the tables a bake of exactly that many orders returns (before
+// any extrapolated tail) and the seconds the bake's phases took so far, so
+// that one bake yields every order up to `orders` (`skybake report`).
+using BakeOrderSnapshot = std::function<void(int order, const LutSet& tables, double bake_seconds)>;
+
 LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report = nullptr,
-            const BakeProgress& progress = nullptr);
+            const BakeProgress& progress = nullptr, const BakeOrderSnapshot& order_snapshot = nullptr);
 
 // The physical coordinates a scattering texel stands for. Texel
 // (x = nu_index * mu_s_size + mu_s_index, y = mu_index, z = r_index) sits at

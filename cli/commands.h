@@ -20,5 +20,6 @@ void AddInfoCommand(CLI::App& app);
 void AddConvertCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
 void AddStressCommand(CLI::App& app);
+void AddReportCommand(CLI::App& app);
 
 }  // namespace skybake::cli

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   skybake::cli::AddConvertCommand(app);
   skybake::cli::AddBenchCommand(app);
   skybake::cli::AddStressCommand(app);
+  skybake::cli::AddReportCommand(app);
 
   try {
     app.parse(argc, argv);

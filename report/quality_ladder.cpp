@@ -1,0 +1,185 @@
+#include "report/quality_ladder.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "bake/errors.h"
+#include "formats/half.h"
+#include "formats/lut_files.h"
+#include "report/run_time_models.h"
+
+namespace skybake::report {
+
+namespace {
+
+// Half of a size, kept at the setting's minimum (and even where it must be).
+int Halved(int size, int minimum, bool even = false) {
+  int half = std::max(size / 2, minimum);
+  return even && half % 2 ? half + 1 : half;
+}
+
+struct Knob {
+  std::string name;
+  std::function<void(BakeSettings&, bool doubled)> scale;
+};
+
+std::vector<Knob> Knobs(bool quick) {
+  std::vector<Knob> knobs = {
+      {"transmittance+irradiance size",
+       [](BakeSettings& s, bool doubled) {
+         for (int* size : {&s.transmittance_width, &s.transmittance_height, &s.irradiance_width,
+                           &s.irradiance_height}) {
+           *size = doubled ? *size * 2 : Halved(*size, 2);
+         }
+       }},
+  };
+  if (quick) return knobs;
+  knobs.push_back({"scattering r size", [](BakeSettings& s, bool doubled) {
+                     s.scattering_r_size = doubled ? s.scattering_r_size * 2 : Halved(s.scattering_r_size, 2);
+                   }});
+  knobs.push_back({"scattering mu size", [](BakeSettings& s, bool doubled) {
+                     s.scattering_mu_size = doubled ? s.scattering_mu_size * 2 : Halved(s.scattering_mu_size, 4, true);
+                   }});
+  knobs.push_back({"scattering mu_s+nu size", [](BakeSettings& s, bool doubled) {
+                     s.scattering_mu_s_size = doubled ? s.scattering_mu_s_size * 2 : Halved(s.scattering_mu_s_size, 2);
+                     s.scattering_nu_size = doubled ? s.scattering_nu_size * 2 : Halved(s.scattering_nu_size, 2);
+                   }});
+  knobs.push_back({"ray samples", [](BakeSettings& s, bool doubled) {
+                     s.ray_samples = doubled ? s.ray_samples * 2 : Halved(s.ray_samples, 2);
+                   }});
+  knobs.push_back({"sphere samples", [](BakeSettings& s, bool doubled) {
+                     s.sphere_samples = doubled ? s.sphere_samples * 2 : Halved(s.sphere_samples, 2);
+                   }});
+  return knobs;
+}
+
+struct Written {
+  double seconds = 0.0;
+  std::uint64_t bytes = 0;
+};
+
+Written WriteTables(const LutSet& tables, const std::filesystem::path& dir, bool half) {
+  WriteOptions options;
+  options.half = half;
+  auto start = std::chrono::steady_clock::now();
+  WriteReport report = WriteLutSet(tables, dir, options);
+  Written w;
+  w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const WrittenFile& f : report.files) w.bytes += f.bytes;
+  return w;
+}
+
+std::vector<GroupErrors> MeasureTables(const LutSet& tables, const ReferenceSet& reference) {
+  Twin twin(MakeTwinTables(tables));
+  return MeasureErrors(reference, [&](const ReferenceCase& c) { return EvaluateTwin(twin, c); });
+}
+
+std::string Describe(const BakeSettings& s) {
+  char text[200];
+  std::snprintf(text, sizeof text, "T %dx%d, E %dx%d, S %dx%dx%dx%d, %d ray / %d sphere samples",
+                s.transmittance_width, s.transmittance_height, s.irradiance_width, s.irradiance_height,
+                s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size,
+                s.ray_samples, s.sphere_samples);
+  return text;
+}
+
+}  // namespace
+
+LadderPlan MakeLadder(const BakeSettings& base, bool quick) {
+  LadderPlan plan;
+  plan.base = base;
+  plan.max_orders = quick ? 3 : 8;
+  if (base.orders < 1 || base.orders > plan.max_orders) {
+    throw InputError("report: the base bake's orders must be a count in [1, " + std::to_string(plan.max_orders) +
+                     "] (the ladder bakes orders 1 to " + std::to_string(plan.max_orders) + ")");
+  }
+  for (const Knob& knob : Knobs(quick)) {
+    for (bool doubled : {false, true}) {
+      LadderStep step;
+      step.knob = knob.name;
+      step.name = knob.name + (doubled ? " x2" : " x1/2");
+      step.settings = base;
+      knob.scale(step.settings, doubled);
+      step.settings.Validate();
+      plan.variants.push_back(step);
+    }
+  }
+  LadderStep half;
+  half.knob = "storage";
+  half.name = "half";
+  half.settings = base;
+  half.half = true;
+  plan.variants.push_back(half);
+  return plan;
+}
+
+LutSet RoundToHalf(LutSet tables) {
+  for (glsl::Texture* t : {&tables.transmittance, &tables.irradiance, &tables.scattering,
+                           &tables.single_mie_scattering}) {
+    for (float& v : t->texels) v = HalfToFloat(FloatToHalf(v));
+  }
+  return tables;
+}
+
+std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPlan& plan,
+                                   const ReferenceSet& reference, const std::filesystem::path& scratch_dir,
+                                   const std::function<void(const std::string&)>& progress, LutSet* base_tables) {
+  auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+  std::vector<LadderEntry> entries;
+
+  // Orders 1..max from one bake; the base is the snapshot at its own count.
+  BakeSettings orders_settings = plan.base;
+  orders_settings.orders = plan.max_orders;
+  say("bake " + Describe(plan.base) + ", orders 1-" + std::to_string(plan.max_orders));
+  LutSet base;
+  Bake(atmosphere, orders_settings, nullptr, nullptr, [&](int order, const LutSet& tables, double seconds) {
+    LadderEntry e;
+    e.step.knob = "orders";
+    e.step.name = "orders " + std::to_string(order);
+    e.step.settings = plan.base;
+    e.step.settings.orders = order;
+    e.is_base = order == plan.base.orders;
+    e.bake_seconds = seconds;
+    e.errors = MeasureTables(tables, reference);
+    entries.push_back(e);
+    if (e.is_base) base = tables;
+    char line[64];
+    std::snprintf(line, sizeof line, "order %d done after %.1f s", order, seconds);
+    say(line);
+  });
+  Written base_files = WriteTables(base, scratch_dir, false);
+  for (LadderEntry& e : entries) {
+    e.bake_seconds += base_files.seconds;
+    e.bytes = base_files.bytes;
+  }
+  const double base_bake_seconds = entries[plan.base.orders - 1].bake_seconds - base_files.seconds;
+
+  for (const LadderStep& step : plan.variants) {
+    LadderEntry e;
+    e.step = step;
+    if (step.half) {
+      say("half storage of the base tables");
+      Written w = WriteTables(base, scratch_dir, true);
+      e.bake_seconds = base_bake_seconds + w.seconds;
+      e.bytes = w.bytes;
+      e.errors = MeasureTables(RoundToHalf(base), reference);
+    } else {
+      say("bake " + step.name + ": " + Describe(step.settings));
+      BakeReport report;
+      LutSet tables = Bake(atmosphere, step.settings, &report);
+      Written w = WriteTables(tables, scratch_dir, false);
+      double seconds = 0.0;
+      for (const BakeTiming& t : report.timings) seconds += t.seconds;
+      e.bake_seconds = seconds + w.seconds;
+      e.bytes = w.bytes;
+      e.errors = MeasureTables(tables, reference);
+    }
+    entries.push_back(e);
+  }
+  if (base_tables) *base_tables = std::move(base);
+  return entries;
+}
+
+}  // namespace skybake::report
