@@ -30,7 +30,7 @@ struct LadderStep {
 
 struct LadderPlan {
   BakeSettings base;       // orders = the base's count
-  int max_orders = 8;      // orders 1..max_orders come from one bake
+  int max_orders = 8;      // orders 1..max_orders (no tail) come from one bake; the base is baked on its own
   std::vector<LadderStep> variants;  // each a bake of its own, except half storage
 };
 

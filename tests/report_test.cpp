@@ -282,15 +282,15 @@ TEST(ReportCommand, QuickLadderWritesTablesCsvJsonAndPlots) {
     // Every group of the case set, answered or not.
     EXPECT_EQ(row["errors"].size(), 7u) << row["name"];
   }
-  EXPECT_EQ(bakes, 3 + 2 + 1);  // orders 1-3, transmittance+irradiance x1/2 and x2, half
+  EXPECT_EQ(bakes, 1 + 3 + 2 + 1);  // base, orders 1-3, transmittance+irradiance x1/2 and x2, half
   EXPECT_EQ(models, 3);         // tables, Hoffman & Preetham, one ray march
   EXPECT_EQ(base, 1);
 
   std::vector<std::string> csv = testing::Lines(testing::ReadText(out / "report.csv"));
   ASSERT_GT(csv.size(), 1u);
   EXPECT_EQ(csv[0].rfind("kind,name,knob,", 0), 0u);
-  // 9 rows x 7 groups x (3 wavelengths + luminance), and the header.
-  EXPECT_EQ(csv.size(), 1u + 9 * 7 * 4);
+  // 10 rows x 7 groups x (3 wavelengths + luminance), and the header.
+  EXPECT_EQ(csv.size(), 1u + 10 * 7 * 4);
   for (const std::string& line : csv) {
     for (const char* bad : {",nan", ",-nan", ",inf", ",-inf"}) EXPECT_EQ(line.find(bad), std::string::npos) << line;
   }
