@@ -419,6 +419,12 @@ vec3 GetCoefficientsAtAltitude(IN(AtmosphereParameters) atmosphere, Number altit
 // free), with sunlight attenuated as in the bake (transmittance table toward
 // the sun, fraction of the disc above the horizon); and the scattering
 // weight, the integral of T(camera, t) * total scattering coefficient dt.
+// The mean of exp(-x) over [0, depth]: (1 - exp(-depth)) / depth, by its
+// series where that would cancel.
+Number MeanAttenuation(Number depth) {
+  return depth < 1e-4 ? 1.0 - 0.5 * depth : (1.0 - exp(-depth)) / depth;
+}
+
 vec3 IntegrateSegment(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture, Number r,
                       Number mu, Number mu_s, Number nu, Number d, OUT(vec3) single_rayleigh,
                       OUT(vec3) single_mie, OUT(vec3) scattering_weight) {
@@ -427,7 +433,7 @@ vec3 IntegrateSegment(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTextu
   vec3 previous_extinction = vec3(0.0);
   vec3 previous_rayleigh = vec3(0.0);
   vec3 previous_mie = vec3(0.0);
-  vec3 previous_weight = vec3(0.0);
+  vec3 previous_scattering = vec3(0.0);
   single_rayleigh = vec3(0.0);
   single_mie = vec3(0.0);
   scattering_weight = vec3(0.0);
@@ -441,23 +447,30 @@ vec3 IntegrateSegment(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTextu
     vec3 mie_scattering;
     vec3 rayleigh_scattering;
     vec3 extinction = GetCoefficientsAtAltitude(atmosphere, altitude, mie_scattering, rayleigh_scattering);
-    if (k > 0) optical_depth += (previous_extinction + extinction) * (0.5 * dt);
-    vec3 transmittance = exp(-optical_depth);
-    vec3 sunlight = transmittance *
-                    exp(-GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r_t, mu_s_t)) *
+    vec3 sunlight = exp(-GetOpticalDepthToTopAtmosphereBoundary(atmosphere, transmittance_texture, r_t, mu_s_t)) *
                     SunVisibleFraction(atmosphere, r_t, mu_s_t);
     vec3 rayleigh = rayleigh_scattering * sunlight;
     vec3 mie = mie_scattering * sunlight;
-    vec3 weight = (rayleigh_scattering + mie_scattering) * transmittance;
+    vec3 scattering = rayleigh_scattering + mie_scattering;
     if (k > 0) {
-      single_rayleigh += (previous_rayleigh + rayleigh) * (0.5 * dt);
-      single_mie += (previous_mie + mie) * (0.5 * dt);
-      scattering_weight += (previous_weight + weight) * (0.5 * dt);
+      // The sources are trapezoidal over the interval, the transmittance to
+      // the camera exponential within it: the interval's integral of T is
+      // T_start (1 - exp(-dtau)) / dtau, exact in a thick medium (where a
+      // trapezoid of T overshoots without bound) and T's trapezoid when thin.
+      vec3 interval_depth = (previous_extinction + extinction) * (0.5 * dt);
+      vec3 start_transmittance = exp(-optical_depth);
+      vec3 mean_transmittance = start_transmittance * vec3(MeanAttenuation(interval_depth.x),
+                                                           MeanAttenuation(interval_depth.y),
+                                                           MeanAttenuation(interval_depth.z));
+      single_rayleigh += (previous_rayleigh + rayleigh) * (0.5 * dt) * mean_transmittance;
+      single_mie += (previous_mie + mie) * (0.5 * dt) * mean_transmittance;
+      scattering_weight += (previous_scattering + scattering) * (0.5 * dt) * mean_transmittance;
+      optical_depth += interval_depth;
     }
     previous_extinction = extinction;
     previous_rayleigh = rayleigh;
     previous_mie = mie;
-    previous_weight = weight;
+    previous_scattering = scattering;
   }
   single_rayleigh *= atmosphere.solar_irradiance;
   single_mie *= atmosphere.solar_irradiance;
