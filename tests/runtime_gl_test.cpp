@@ -362,8 +362,10 @@ TEST_P(SnippetOnMesa, PrunedForASceneMatchesTheCppTwin) {
   std::unique_ptr<GlContext> gl = GlContext::Create(GetParam(), &why_not);
   if (!gl) GTEST_SKIP() << why_not;
   const Atmosphere earth = LoadAtmosphere("earth");
-  const Scene scene =
-      LoadScene((std::filesystem::path(SKYBAKE_SOURCE_DIR) / "examples/scenes/ground-daytime-game.toml").string());
+  const Scene scene = ParseScene(
+      "name = \"ground\"\n[effects]\nsky = true\naerial_perspective = { max_distance_km = 30 }\n"
+      "[camera]\naltitude_km = [0, 2]\n[objects]\naltitude_km = [0, 2]\n[sun]\nzenith_deg = [0, 90]\n",
+      "ground.toml");
   const ScenePlan plan = PlanScene(scene, earth);
   ASSERT_FALSE(plan.irradiance);
   ASSERT_TRUE(plan.pack_single_mie_in_alpha);
