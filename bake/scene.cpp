@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "bake/bake.h"
 #include "bake/errors.h"
 #include "bake/medium.h"
@@ -187,6 +189,33 @@ bool CanPackSingleMie(const Atmosphere& atmosphere) {
   return mie.x > 0.0 && other.x > 0.0 && other.y > 0.0 && other.z > 0.0;
 }
 
+Scene SceneFromJsonObject(const nlohmann::json& j) {
+  Scene scene;
+  scene.name = j.at("name").get<std::string>();
+  scene.description = j.at("description").get<std::string>();
+  const nlohmann::json& e = j.at("effects");
+  scene.effects.sky = e.at("sky").get<bool>();
+  scene.effects.aerial_perspective = e.at("aerial_perspective").get<bool>();
+  scene.effects.aerial_perspective_max_distance_m = e.at("aerial_perspective_max_distance_m").get<double>();
+  scene.effects.sun_transmittance = e.at("sun_transmittance").get<bool>();
+  scene.effects.ground_irradiance = e.at("ground_irradiance").get<bool>();
+  scene.effects.sharp_sun_halo = e.at("sharp_sun_halo").get<bool>();
+  scene.effects.space_views = e.at("space_views").get<bool>();
+  scene.camera_altitude_min_m = j.at("camera_altitude_m").at(0).get<double>();
+  scene.camera_altitude_max_m = j.at("camera_altitude_m").at(1).get<double>();
+  scene.object_altitude_min_m = j.at("object_altitude_m").at(0).get<double>();
+  scene.object_altitude_max_m = j.at("object_altitude_m").at(1).get<double>();
+  scene.sun_zenith_min_deg = j.at("sun_zenith_deg").at(0).get<double>();
+  scene.sun_zenith_max_deg = j.at("sun_zenith_deg").at(1).get<double>();
+  const nlohmann::json& p = j.at("precision");
+  scene.precision.transmittance_half = p.at("transmittance").get<std::string>() == "half";
+  scene.precision.irradiance_half = p.at("irradiance").get<std::string>() == "half";
+  scene.precision.scattering_half = p.at("scattering").get<std::string>() == "half";
+  scene.precision.single_mie_scattering_half = p.at("single_mie_scattering").get<std::string>() == "half";
+  scene.formats = j.at("formats").get<std::vector<std::string>>();
+  return scene;
+}
+
 }  // namespace
 
 Scene ParseScene(std::string_view toml_text, const std::string& source_name) {
@@ -315,10 +344,10 @@ std::string SceneQueryProblem(const Scene& scene, double bottom_radius_m, bool c
   return problem;
 }
 
-nlohmann::ordered_json SceneToJson(const Scene& scene) {
+std::string SceneToJson(const Scene& scene) {
   const SceneEffects& e = scene.effects;
   auto precision = [](bool half) { return half ? "half" : "float"; };
-  return {
+  const nlohmann::ordered_json j = {
       {"name", scene.name},
       {"description", scene.description},
       {"effects",
@@ -338,33 +367,15 @@ nlohmann::ordered_json SceneToJson(const Scene& scene) {
         {"scattering", precision(scene.precision.scattering_half)},
         {"single_mie_scattering", precision(scene.precision.single_mie_scattering_half)}}},
       {"formats", scene.formats}};
+  return j.dump();
 }
 
-Scene SceneFromJson(const nlohmann::json& j) {
-  Scene scene;
-  scene.name = j.at("name").get<std::string>();
-  scene.description = j.at("description").get<std::string>();
-  const nlohmann::json& e = j.at("effects");
-  scene.effects.sky = e.at("sky").get<bool>();
-  scene.effects.aerial_perspective = e.at("aerial_perspective").get<bool>();
-  scene.effects.aerial_perspective_max_distance_m = e.at("aerial_perspective_max_distance_m").get<double>();
-  scene.effects.sun_transmittance = e.at("sun_transmittance").get<bool>();
-  scene.effects.ground_irradiance = e.at("ground_irradiance").get<bool>();
-  scene.effects.sharp_sun_halo = e.at("sharp_sun_halo").get<bool>();
-  scene.effects.space_views = e.at("space_views").get<bool>();
-  scene.camera_altitude_min_m = j.at("camera_altitude_m").at(0).get<double>();
-  scene.camera_altitude_max_m = j.at("camera_altitude_m").at(1).get<double>();
-  scene.object_altitude_min_m = j.at("object_altitude_m").at(0).get<double>();
-  scene.object_altitude_max_m = j.at("object_altitude_m").at(1).get<double>();
-  scene.sun_zenith_min_deg = j.at("sun_zenith_deg").at(0).get<double>();
-  scene.sun_zenith_max_deg = j.at("sun_zenith_deg").at(1).get<double>();
-  const nlohmann::json& p = j.at("precision");
-  scene.precision.transmittance_half = p.at("transmittance").get<std::string>() == "half";
-  scene.precision.irradiance_half = p.at("irradiance").get<std::string>() == "half";
-  scene.precision.scattering_half = p.at("scattering").get<std::string>() == "half";
-  scene.precision.single_mie_scattering_half = p.at("single_mie_scattering").get<std::string>() == "half";
-  scene.formats = j.at("formats").get<std::vector<std::string>>();
-  return scene;
+Scene SceneFromJson(const std::string& json_text) {
+  try {
+    return SceneFromJsonObject(nlohmann::json::parse(json_text));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("malformed scene: ") + e.what());
+  }
 }
 
 }  // namespace skybake

@@ -12,8 +12,6 @@
 #include <string_view>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "bake/atmosphere.h"
 #include "shaders_runtime/query.h"
 
@@ -96,9 +94,10 @@ void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings*
 std::string SceneQueryProblem(const Scene& scene, double bottom_radius_m, bool clamp, Query* query,
                               std::vector<std::string>* clamped);
 
-// The scene as recorded in a manifest, and back (ParseSceneJson throws
-// nlohmann::json exceptions on a malformed object).
-nlohmann::ordered_json SceneToJson(const Scene& scene);
-Scene SceneFromJson(const nlohmann::json& json);
+// The scene as a JSON object in SI keys, as the manifest records it, and
+// back; text rather than a JSON type keeps the JSON header out of bake.h
+// (as ToJson in config.h). SceneFromJson throws InputError when malformed.
+std::string SceneToJson(const Scene& scene);
+Scene SceneFromJson(const std::string& json_text);
 
 }  // namespace skybake

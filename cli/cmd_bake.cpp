@@ -1,6 +1,7 @@
 // `skybake bake`: atmosphere → tables on disk.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -77,11 +78,12 @@ void PrintSceneSummary(const SceneSummary& s) {
   if (!s.plan.aerial_perspective_functions) {
     std::fprintf(stderr, "    left out %-22s no aerial_perspective\n", "GetSkyRadianceToPoint");
   }
+  constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
   std::fprintf(stderr, "    scattering mu_s from %.4f (full bake %.4f): lowest sun %.2f deg instead of %.2f deg\n",
-               s.plan.mu_s_min, s.full_mu_s_min, std::acos(s.plan.mu_s_min) * 180.0 / 3.14159265358979323846,
-               std::acos(s.full_mu_s_min) * 180.0 / 3.14159265358979323846);
+               s.plan.mu_s_min, s.full_mu_s_min, std::acos(s.plan.mu_s_min) * kDegreesPerRadian,
+               std::acos(s.full_mu_s_min) * kDegreesPerRadian);
   if (s.compared) {
-    std::fprintf(stderr, "    table bytes %llu vs %llu for the full bake (%.1f%%)\n",
+    std::fprintf(stderr, "    table bytes %llu vs %llu for the full bake in the same formats (%.1f%%)\n",
                  static_cast<unsigned long long>(s.scene_table_bytes),
                  static_cast<unsigned long long>(s.full_table_bytes),
                  100.0 * double(s.scene_table_bytes) / double(s.full_table_bytes));

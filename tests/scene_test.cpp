@@ -81,6 +81,7 @@ TEST(SceneFile, ReadsUnitsAndRanges) {
   EXPECT_EQ(s.formats, std::vector<std::string>{"ktx2"});
   // The manifest's JSON form reads back to the same scene.
   EXPECT_EQ(SceneToJson(SceneFromJson(SceneToJson(s))), SceneToJson(s));
+  EXPECT_THROW(SceneFromJson("{\"name\": 1}"), InputError);
 }
 
 TEST(SceneFile, RejectsBadInputWithOneLineNamingTheKey) {
