@@ -4,10 +4,12 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bake/atmosphere.h"
+#include "bake/scene.h"
 #include "shaders_runtime/glsl_shim.h"
 
 namespace skybake {
@@ -64,6 +66,9 @@ struct LutSet {
   glsl::Texture scattering;     // 3D, rgb = single Rayleigh + all higher orders / Rayleigh phase;
                                 // alpha = single Mie red if packed
   glsl::Texture single_mie_scattering;  // 3D, rgb; empty if packed
+  // The scene the set was baked for, if any: its tables are those
+  // PlanScene keeps (formats/lut_tables.h lists only those).
+  std::optional<Scene> scene;
 };
 
 struct BakeTiming {

@@ -30,6 +30,7 @@
 
 #include "bake/errors.h"
 #include "bake/physics.h"
+#include "bake/toml_input.h"
 #include "bake/version.h"
 #include "shaders_runtime/embedded_text.h"
 
@@ -37,30 +38,14 @@ namespace skybake {
 
 namespace {
 
+using namespace toml_input;
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr Spectrum kDefaultWavelengthsNm{680.0, 550.0, 440.0};
 
 // ---------------------------------------------------------------------------
-// Formatting shared by error messages and the TOML writer.
-
-// The shortest decimal that reads back as the same double (17 significant
-// digits at most), in fixed notation for everyday magnitudes and scientific
-// otherwise: messages quote "1.2" and "6360000", and ToToml round-trips.
-std::string FormatNumber(double value) {
-  if (std::isnan(value)) return "nan";
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char buffer[48];
-  int digits = 0;  // after the point in scientific notation; 16 always round-trips
-  for (;; ++digits) {
-    std::snprintf(buffer, sizeof buffer, "%.*e", digits, value);
-    if (digits == 16 || std::strtod(buffer, nullptr) == value) break;
-  }
-  int exponent = std::atoi(std::strchr(buffer, 'e') + 1);
-  if (exponent >= -4 && exponent < 16)
-    std::snprintf(buffer, sizeof buffer, "%.*f", std::max(0, digits - exponent), value);
-  return buffer;
-}
+// Formatting for the TOML writer (error messages format through toml_input).
 
 // A TOML float literal: FormatNumber plus ".0" where it would read as an integer.
 std::string TomlFloat(double value) {
@@ -68,92 +53,6 @@ std::string TomlFloat(double value) {
   if (text.find_first_of(".eni") == std::string::npos) text += ".0";
   return text;
 }
-
-std::string TomlString(std::string_view text) {
-  std::string out = "\"";
-  for (char c : text) {
-    unsigned char u = static_cast<unsigned char>(c);
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
-      default:
-        if (u < 0x20 || u == 0x7f) {
-          char escape[8];
-          std::snprintf(escape, sizeof escape, "\\u%04x", u);
-          out += escape;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
-// A key as TOML spells it: bare where allowed, quoted otherwise. Used both in
-// the writer and in key paths of error messages.
-std::string TomlKey(std::string_view key) {
-  bool bare = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '_' || c == '-';
-  });
-  return bare ? std::string(key) : TomlString(key);
-}
-
-std::string Join(const std::string& path, std::string_view key) {
-  return path.empty() ? TomlKey(key) : path + "." + TomlKey(key);
-}
-
-std::string Index(const std::string& path, size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-std::string OneLine(std::string text) {
-  std::replace_if(text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-  return text;
-}
-
-// ---------------------------------------------------------------------------
-// Error reporting: every message is "<source>: <key path>: <problem>" or
-// "<source>: <key path> = <value> <problem>", on one line.
-
-class Reporter {
- public:
-  explicit Reporter(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void Fail(const std::string& path, const std::string& problem) const {
-    throw InputError(OneLine(source_ + ": " + (path.empty() ? "" : path + ": ") + problem));
-  }
-  [[noreturn]] void FailValue(const std::string& path, double value,
-                              const std::string& problem) const {
-    throw InputError(OneLine(source_ + ": " + path + " = " + FormatNumber(value) + " " + problem));
-  }
-
- private:
-  std::string source_;
-};
-
-// An interval of acceptable values. Non-finite numbers are always rejected.
-struct Interval {
-  double lo;
-  double hi;
-  bool lo_closed;
-  bool hi_closed;
-  const char* text = nullptr;  // how to print it, where the bounds are not round numbers
-
-  bool Contains(double v) const {
-    return (lo_closed ? v >= lo : v > lo) && (hi_closed ? v <= hi : v < hi);
-  }
-  std::string Problem() const {
-    if (hi == kInf && lo == 0.0) return lo_closed ? "must be >= 0" : "must be > 0";
-    std::string range = text ? text
-                             : std::string(lo_closed ? "[" : "(") + FormatNumber(lo) + ", " +
-                                   FormatNumber(hi) + (hi_closed ? "]" : ")");
-    return "is outside " + range;
-  }
-};
 
 constexpr Interval kFinite{-kInf, kInf, false, false};
 constexpr Interval kPositive{0.0, kInf, false, false};
@@ -178,12 +77,6 @@ constexpr Interval kIrradianceRange{0.0, 1e25, true, true, "[0, 1e25]"};
 // Depolarization ratio of natural light by anisotropic molecules is at most
 // 1/2; beyond 6/7 the King factor changes sign.
 constexpr Interval kDepolarization{0.0, 0.5, true, true};
-
-void CheckNumber(const Reporter& report, const std::string& path, double value,
-                 const Interval& interval) {
-  if (!std::isfinite(value)) report.FailValue(path, value, "is not a finite number");
-  if (!interval.Contains(value)) report.FailValue(path, value, interval.Problem());
-}
 
 void CheckSpectrum(const Reporter& report, const std::string& path, const Spectrum& value,
                    const Interval& interval) {
@@ -277,29 +170,6 @@ void CheckPhase(const Reporter& report, const std::string& path, const PhaseFunc
 // ---------------------------------------------------------------------------
 // Reading the TOML tree.
 
-std::string TypeName(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array:
-      return "an array of " + std::to_string(node.as_array()->size());
-    case toml::node_type::string: return "string";
-    case toml::node_type::integer: return "integer";
-    case toml::node_type::floating_point: return "float";
-    case toml::node_type::boolean: return "boolean";
-    case toml::node_type::date: return "date";
-    case toml::node_type::time: return "time";
-    case toml::node_type::date_time: return "date-time";
-    case toml::node_type::none: break;
-  }
-  return "nothing";
-}
-
-std::string KeyList(std::initializer_list<std::string_view> keys) {
-  std::string text;
-  for (std::string_view key : keys) text += (text.empty() ? "" : ", ") + std::string(key);
-  return text;
-}
-
 struct PhaseName {
   std::string_view name;
   PhaseKind kind;
@@ -334,9 +204,9 @@ struct Length {
   double metres;
 };
 
-class FileReader {
+class FileReader : public TomlReader {
  public:
-  explicit FileReader(const std::string& source) : report_(source) {}
+  using TomlReader::TomlReader;
 
   Atmosphere Read(const toml::table& root) {
     CheckKeys(root, "", {"name", "description", "planet", "spectrum", "sun", "constituents"});
@@ -377,81 +247,6 @@ class FileReader {
   }
 
  private:
-  // --- generic access ---
-
-  void CheckKeys(const toml::table& table, const std::string& path,
-                 std::initializer_list<std::string_view> allowed) const {
-    for (auto&& [key, node] : table) {
-      if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end())
-        report_.Fail(Join(path, key.str()), "unknown key (expected " + KeyList(allowed) + ")");
-    }
-  }
-
-  const toml::table* OptionalTable(const toml::table& parent, const std::string& path,
-                                   std::string_view key) const {
-    const toml::node* node = parent.get(key);
-    if (!node) return nullptr;
-    if (!node->is_table()) report_.Fail(Join(path, key), "expected a table, got " + TypeName(*node));
-    return node->as_table();
-  }
-
-  const toml::table& RequireTable(const toml::table& parent, const std::string& path,
-                                  std::string_view key) const {
-    const toml::table* table = OptionalTable(parent, path, key);
-    if (!table) report_.Fail(Join(path, key), "missing required table");
-    return *table;
-  }
-
-  const toml::node& Require(const toml::table& table, const std::string& path,
-                            std::string_view key) const {
-    const toml::node* node = table.get(key);
-    if (!node) report_.Fail(Join(path, key), "missing required key");
-    return *node;
-  }
-
-  // Exactly one of `keys` must be present; returns its index and node.
-  std::pair<size_t, const toml::node*> ExactlyOne(
-      const toml::table& table, const std::string& path,
-      std::initializer_list<std::string_view> keys) const {
-    std::optional<size_t> found;
-    size_t i = 0;
-    for (std::string_view key : keys) {
-      if (table.get(key)) {
-        if (found)
-          report_.Fail(Join(path, key), "conflicts with " + Join(path, keys.begin()[*found]) +
-                                            " (give exactly one of " + KeyList(keys) + ")");
-        found = i;
-      }
-      ++i;
-    }
-    if (!found) report_.Fail(path, "missing one of " + KeyList(keys));
-    return {*found, table.get(keys.begin()[*found])};
-  }
-
-  std::string ReadString(const toml::node& node, const std::string& path) const {
-    if (!node.is_string()) report_.Fail(path, "expected a string, got " + TypeName(node));
-    return node.as_string()->get();
-  }
-
-  std::string RequireString(const toml::table& table, const std::string& path,
-                            std::string_view key) const {
-    return ReadString(Require(table, path, key), Join(path, key));
-  }
-
-  // A number; TOML integers are accepted and converted.
-  double ReadNumber(const toml::node& node, const std::string& path) const {
-    if (const auto* f = node.as_floating_point()) return f->get();
-    if (const auto* i = node.as_integer()) return static_cast<double>(i->get());
-    report_.Fail(path, "expected a number, got " + TypeName(node));
-  }
-
-  double ReadNumber(const toml::node& node, const std::string& path,
-                    const Interval& interval) const {
-    double value = ReadNumber(node, path);
-    CheckNumber(report_, path, value, interval);
-    return value;
-  }
-
   Spectrum ReadArray3(const toml::node& node, const std::string& path,
                       const Interval& interval) const {
     const toml::array* array = node.as_array();
@@ -693,7 +488,6 @@ class FileReader {
     return values;
   }
 
-  Reporter report_;
 };
 
 // ---------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 // `skybake bake`: atmosphere → tables on disk.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -12,11 +13,13 @@
 #include "bake/bake.h"
 #include "bake/config.h"
 #include "bake/errors.h"
+#include "bake/scene.h"
 #include "cli/bake_settings_options.h"
 #include "cli/commands.h"
 #include "cli/command_line.h"
 #include "formats/file_io.h"
 #include "formats/lut_files.h"
+#include "formats/lut_tables.h"
 #include "shaders_runtime/snippet.h"
 
 namespace skybake::cli {
@@ -31,14 +34,108 @@ struct BakeOptions {
   bool half = false;
   bool json = false;
   bool quiet = false;
+  std::string scene;
+  bool compare_full = false;
+  CLI::Option* format_option = nullptr;
 };
+
+// The bytes the table files of a set take in `formats`, encoded in memory.
+std::uint64_t TableFileBytes(const LutSet& luts, const WriteOptions& options) {
+  std::uint64_t bytes = 0;
+  for (const TableDescription& table : DescribeTables(luts)) {
+    const bool half = options.half || std::find(options.half_tables.begin(), options.half_tables.end(),
+                                                table.name) != options.half_tables.end();
+    for (FileFormat format : options.formats) {
+      bytes += EncodeTableImage(MakeTableImage(luts, table, format, half ? PixelType::kHalf : PixelType::kFloat))
+                   .size();
+    }
+  }
+  return bytes;
+}
+
+std::uint64_t TableFileBytes(const WriteReport& written) {
+  std::uint64_t bytes = 0;
+  for (const WrittenFile& f : written.files) bytes += f.table.empty() ? 0 : f.bytes;
+  return bytes;
+}
+
+// What a scene bake left out, and (with --compare-full) what it saved
+// against the full bake of the same atmosphere, table sizes and formats.
+struct SceneSummary {
+  Scene scene;
+  ScenePlan plan;
+  double full_mu_s_min = 0.0;
+  bool compared = false;
+  double full_bake_seconds = 0.0, scene_bake_seconds = 0.0;
+  std::uint64_t full_table_bytes = 0, scene_table_bytes = 0;
+};
+
+void PrintSceneSummary(const SceneSummary& s) {
+  std::fprintf(stderr, "  scene %s:\n", s.scene.name.c_str());
+  for (const OmittedTable& t : s.plan.omitted) {
+    std::fprintf(stderr, "    left out %-22s %s\n", t.table.c_str(), t.reason.c_str());
+  }
+  if (!s.plan.aerial_perspective_functions) {
+    std::fprintf(stderr, "    left out %-22s no aerial_perspective\n", "GetSkyRadianceToPoint");
+  }
+  constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
+  std::fprintf(stderr, "    scattering mu_s from %.4f (full bake %.4f): lowest sun %.2f deg instead of %.2f deg\n",
+               s.plan.mu_s_min, s.full_mu_s_min, std::acos(s.plan.mu_s_min) * kDegreesPerRadian,
+               std::acos(s.full_mu_s_min) * kDegreesPerRadian);
+  if (s.compared) {
+    std::fprintf(stderr, "    table bytes %llu vs %llu for the full bake in the same formats (%.1f%%)\n",
+                 static_cast<unsigned long long>(s.scene_table_bytes),
+                 static_cast<unsigned long long>(s.full_table_bytes),
+                 100.0 * double(s.scene_table_bytes) / double(s.full_table_bytes));
+    std::fprintf(stderr, "    bake time %.3f s vs %.3f s for the full bake (%.1f%%)\n", s.scene_bake_seconds,
+                 s.full_bake_seconds, 100.0 * s.scene_bake_seconds / s.full_bake_seconds);
+  }
+}
+
+nlohmann::json SceneSummaryJson(const SceneSummary& s) {
+  nlohmann::json omitted = nlohmann::json::array();
+  for (const OmittedTable& t : s.plan.omitted) omitted.push_back({{"table", t.table}, {"reason", t.reason}});
+  nlohmann::json j = {{"name", s.scene.name},
+                      {"omitted_tables", omitted},
+                      {"aerial_perspective_functions", s.plan.aerial_perspective_functions},
+                      {"scattering_mu_s_min", s.plan.mu_s_min},
+                      {"full_bake_mu_s_min", s.full_mu_s_min}};
+  if (s.compared) {
+    j["comparison"] = {{"scene_table_bytes", s.scene_table_bytes},
+                       {"full_table_bytes", s.full_table_bytes},
+                       {"scene_bake_seconds", s.scene_bake_seconds},
+                       {"full_bake_seconds", s.full_bake_seconds}};
+  }
+  return j;
+}
 
 void RunBake(const BakeOptions& o) {
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
-  const BakeSettings settings = o.bake.Resolve();
+  BakeSettings settings = o.bake.Resolve();
+  std::optional<SceneSummary> scene;
+  std::vector<std::string> formats = o.formats;
+  if (!o.scene.empty()) {
+    scene.emplace();
+    scene->scene = LoadScene(o.scene);
+    ValidateSceneForAtmosphere(scene->scene, atmosphere, std::filesystem::path(o.scene).filename().string());
+    if (o.format_option != nullptr && o.format_option->count() > 0) {
+      throw UsageError("--format: the scene names the formats (output.formats); give one or the other");
+    }
+    if (settings.pack_single_mie_in_alpha) {
+      throw UsageError("--pack-mie: the scene decides the packing (effects.sharp_sun_halo); give one or the other");
+    }
+    formats = scene->scene.formats;
+    scene->plan = PlanScene(scene->scene, atmosphere);
+    scene->full_mu_s_min = atmosphere.mu_s_min;
+  } else if (o.compare_full) {
+    throw UsageError("--compare-full: needs --scene");
+  }
+  const Atmosphere full_atmosphere = atmosphere;
+  const BakeSettings full_settings = settings;
+  if (scene) ApplyScenePlan(scene->plan, &atmosphere, &settings);
   WriteOptions write_options;
   write_options.formats.clear();
-  for (const std::string& name : o.formats) {
+  for (const std::string& name : formats) {
     std::optional<FileFormat> format = ParseFileFormat(name);
     if (!format) throw UsageError("--format: unknown format '" + name + "' (use exr, ktx2 or exr,ktx2)");
     if (std::find(write_options.formats.begin(), write_options.formats.end(), *format) == write_options.formats.end()) {
@@ -47,6 +144,16 @@ void RunBake(const BakeOptions& o) {
   }
   if (write_options.formats.empty()) throw UsageError("--format: name at least one format (exr, ktx2)");
   write_options.half = o.half;
+  if (scene) {
+    const ScenePrecision& p = scene->scene.precision;
+    const std::pair<bool, const char*> tables[] = {{p.transmittance_half, "transmittance"},
+                                                   {p.irradiance_half, "irradiance"},
+                                                   {p.scattering_half, "scattering"},
+                                                   {p.single_mie_scattering_half, "single_mie_scattering"}};
+    for (const auto& [half, table] : tables) {
+      if (half) write_options.half_tables.push_back(table);
+    }
+  }
   write_options.command_line = CommandLine();
   EnsureWritableDirectory(o.output_dir);
 
@@ -56,8 +163,28 @@ void RunBake(const BakeOptions& o) {
   };
   if (!o.quiet) std::fprintf(stderr, "baking %s\n", atmosphere.name.c_str());
   LutSet luts = Bake(atmosphere, settings, &report, print_phase);
+  SnippetParts parts;
+  if (scene) {
+    luts.scene = scene->scene;
+    parts.scattering = scene->plan.scattering;
+    parts.irradiance = scene->plan.irradiance;
+    parts.aerial_perspective = scene->plan.aerial_perspective_functions;
+  }
+  if (scene && o.compare_full) {
+    // The full bake of the same atmosphere, sizes and formats, timed the same
+    // way; its files are encoded in memory only, to count their bytes.
+    if (!o.quiet) std::fprintf(stderr, "baking %s without the scene, for comparison\n", atmosphere.name.c_str());
+    BakeReport full_report;
+    const LutSet full = Bake(full_atmosphere, full_settings, &full_report);
+    WriteOptions full_options = write_options;
+    full_options.half_tables.clear();
+    scene->compared = true;
+    scene->full_bake_seconds = full_report.total_seconds;
+    scene->scene_bake_seconds = report.total_seconds;
+    scene->full_table_bytes = TableFileBytes(full, full_options);
+  }
   // The GLSL runtime goes beside the tables, its constants from this bake's parameters.
-  for (SnippetFile& f : RuntimeSnippetFiles(luts.parameters, atmosphere.wavelengths_nm, atmosphere.name)) {
+  for (SnippetFile& f : RuntimeSnippetFiles(luts.parameters, atmosphere.wavelengths_nm, atmosphere.name, parts)) {
     write_options.shaders.push_back(ShaderFile{f.file, std::move(f.text), f.description});
   }
 
@@ -67,6 +194,7 @@ void RunBake(const BakeOptions& o) {
   print_phase(write);
   report.timings.push_back(write);
   report.total_seconds += write.seconds;
+  if (scene) scene->scene_table_bytes = TableFileBytes(written);
   if (!o.quiet) {
     std::fprintf(stderr, "  %-36s %8.3f s\n", "total", report.total_seconds);
     std::fprintf(stderr, "  orders used %d, ratio of the last two %.4g, extrapolated tail %.3g, ", report.orders_used,
@@ -87,6 +215,7 @@ void RunBake(const BakeOptions& o) {
                    table.c_str(), error.max_relative_error, error.measured, error.floor, error.below_floor,
                    error.flushed_to_zero, error.overflowed);
     }
+    if (scene) PrintSceneSummary(*scene);
   }
 
   if (o.json) {
@@ -111,7 +240,7 @@ void RunBake(const BakeOptions& o) {
         {"remaining_error", report.remaining_error >= 0.0 ? nlohmann::json(report.remaining_error)
                                                           : nlohmann::json(nullptr)},
         {"pixel_type", o.half ? "half" : "float"},
-        {"formats", o.formats},
+        {"formats", formats},
         {"tables",
          {{"transmittance", {s.transmittance_width, s.transmittance_height}},
           {"irradiance", {s.irradiance_width, s.irradiance_height}},
@@ -126,6 +255,7 @@ void RunBake(const BakeOptions& o) {
         {"half_error", half_errors},
         {"timings", timings},
         {"total_seconds", report.total_seconds}};
+    if (scene) j["scene"] = SceneSummaryJson(*scene);
     std::printf("%s\n", j.dump(2).c_str());
   }
 }
@@ -138,9 +268,14 @@ void AddBakeCommand(CLI::App& app) {
   cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
   cmd->add_option("-o,--output", o->output_dir, "Output directory (created if missing)")->required();
   o->bake.AddTo(cmd);
-  cmd->add_option("--format", o->formats, "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")
-      ->delimiter(',')
-      ->capture_default_str();
+  o->format_option = cmd->add_option("--format", o->formats,
+                                     "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")
+                          ->delimiter(',')
+                          ->capture_default_str();
+  cmd->add_option("--scene", o->scene,
+                  "Scene file (.toml, examples/scenes/README.md): bake and write only what the scene needs");
+  cmd->add_flag("--compare-full", o->compare_full,
+                "With --scene: also bake the full set (not written) and report the bytes and time saved");
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
   cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
   cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/errors.h"
+#include "bake/scene.h"
 #include "cli/commands.h"
 #include "formats/file_io.h"
 #include "formats/lut_files.h"
@@ -24,12 +25,28 @@ struct EvalOptions {
   std::string lut_dir;
   std::string input;
   std::string output;
+  bool clamp = false;
 };
 
 void RunEval(const EvalOptions& o) {
   // Queries are checked before the tables are loaded: a malformed file fails fast.
   QueryTable table = ParseQueryCsv(ReadFileText(o.input), std::filesystem::path(o.input).filename().string());
   LutSet luts = LoadLutSet(o.lut_dir);
+  if (luts.scene) {
+    // A scene's tables cover only its ranges (and may lack whole tables):
+    // a query outside them would read clamped or missing texels.
+    for (size_t row = 0; row < table.queries.size(); ++row) {
+      std::vector<std::string> clamped;
+      const std::string problem =
+          SceneQueryProblem(*luts.scene, luts.parameters.bottom_radius, o.clamp, &table.queries[row], &clamped);
+      const std::string where = table.source_name + ": row " + std::to_string(row + 1) + ": ";
+      if (!problem.empty()) {
+        throw InputError(where + problem + " (scene '" + luts.scene->name + "' of " + o.lut_dir +
+                         (o.clamp ? ")" : "; --clamp moves altitudes, sun angles and distances into range)"));
+      }
+      for (const std::string& c : clamped) std::fprintf(stderr, "warning: %s%s\n", where.c_str(), c.c_str());
+    }
+  }
   Twin twin(MakeTwinTables(luts));
 
   std::string out;
@@ -96,6 +113,9 @@ void AddEvalCommand(CLI::App& app) {
                                     "view_sun_azimuth_deg [, distance_m] [, normal_zenith_deg]")
       ->required();
   cmd->add_option("--out", o->output, "Result CSV (default: stdout)");
+  cmd->add_flag("--clamp", o->clamp,
+                "On a scene's bake: clamp altitudes, sun angles and distances outside the scene's ranges into them "
+                "(with a warning) instead of rejecting the query");
   cmd->callback([o] { RunEval(*o); });
 }
 

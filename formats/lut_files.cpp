@@ -1,5 +1,7 @@
 #include "formats/lut_files.h"
 
+#include <algorithm>
+
 #include "bake/errors.h"
 #include "formats/file_io.h"
 #include "formats/lut_tables.h"
@@ -32,7 +34,6 @@ FileFormat ChooseFormat(const Manifest& manifest, const std::vector<TableDescrip
 WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOptions& options) {
   if (options.formats.empty()) throw InternalError("WriteLutSet: no file format requested");
   EnsureWritableDirectory(dir);
-  const PixelType type = options.half ? PixelType::kHalf : PixelType::kFloat;
   ManifestWriter manifest(luts, options.command_line);
   WriteReport report;
   // The whole set is staged and renamed at the end, so a failure part-way
@@ -41,6 +42,9 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
   DeferInterrupts defer_interrupts;
   StagedFiles staged;
   for (const TableDescription& table : DescribeTables(luts)) {
+    const bool half = options.half || std::find(options.half_tables.begin(), options.half_tables.end(),
+                                                table.name) != options.half_tables.end();
+    const PixelType type = half ? PixelType::kHalf : PixelType::kFloat;
     for (FileFormat format : options.formats) {
       const TableImage image = MakeTableImage(luts, table, format, type);
       const std::vector<std::uint8_t> bytes = EncodeTableImage(image);
@@ -49,7 +53,7 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
       manifest.AddTableFile(table, file, image, bytes);
       report.files.push_back({table.name, file, bytes.size()});
     }
-    if (options.half) {
+    if (half) {
       const TableImage image = MakeTableImage(luts, table, options.formats.front(), PixelType::kFloat);
       report.half_errors.emplace_back(table.name, MeasureHalfError(image.values));
     }

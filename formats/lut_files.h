@@ -32,6 +32,7 @@ struct ShaderFile {
 struct WriteOptions {
   std::vector<FileFormat> formats = {FileFormat::kExr, FileFormat::kKtx2};
   bool half = false;          // store half floats instead of float32
+  std::vector<std::string> half_tables;  // tables stored as half even without `half` (a scene's precision)
   std::string command_line;   // recorded in the manifest
   std::vector<ShaderFile> shaders;  // written and listed under "shaders"
 };

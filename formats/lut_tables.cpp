@@ -1,5 +1,6 @@
 #include "formats/lut_tables.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -171,6 +172,17 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
     single_mie.encoding = "single Mie scattering radiance without phase function";
     single_mie.channels = rgb("single Mie scattering without phase function");
     tables.push_back(table_4d(single_mie));
+  }
+  if (luts.scene) {
+    // A scene's set holds only the tables its plan keeps.
+    const ScenePlan plan = PlanScene(*luts.scene, luts.atmosphere);
+    auto kept = [&](const TableDescription& t) {
+      if (t.name == "irradiance") return plan.irradiance;
+      if (t.name == "scattering" || t.name == "single_mie_scattering") return plan.scattering;
+      return plan.transmittance;
+    };
+    tables.erase(std::remove_if(tables.begin(), tables.end(), [&](const TableDescription& t) { return !kept(t); }),
+                 tables.end());
   }
   return tables;
 }

@@ -127,6 +127,16 @@ std::string ManifestWriter::Text() const {
       {"atmosphere", ordered_json::parse(ToJson(luts_.atmosphere))},
       {"atmosphere_toml", ToToml(luts_.atmosphere)},
   };
+  if (luts_.scene) {
+    // After the tables, so that sets baked without a scene stay byte-identical.
+    ordered_json scene = ordered_json::parse(SceneToJson(*luts_.scene));
+    ordered_json omitted = ordered_json::array();
+    for (const OmittedTable& t : PlanScene(*luts_.scene, luts_.atmosphere).omitted) {
+      omitted.push_back({{"table", t.table}, {"reason", t.reason}});
+    }
+    scene["omitted_tables"] = omitted;
+    manifest["scene"] = scene;
+  }
   return manifest.dump(2) + "\n";
 }
 
@@ -180,6 +190,7 @@ Manifest ReadManifest(const fs::path& dir) {
     s.scattering_mu_s_size = p.scattering_mu_s_size;
     s.scattering_nu_size = p.scattering_nu_size;
     s.Validate();
+    if (m.document.contains("scene")) luts.scene = SceneFromJson(m.document.at("scene").dump());
     if (p.single_mie_in_scattering_alpha != (s.pack_single_mie_in_alpha ? 1 : 0)) {
       throw IoError(where + ": parameters and bake settings disagree on packing single Mie");
     }

@@ -15,6 +15,19 @@
 // the ground, and the mu axis is split in two halves (rays that hit the ground
 // and rays that do not), so the table is discontinuous at the horizon on purpose.
 
+// Which parts a bake ships (the generated constants define these; a scene
+// can leave out tables and the functions that read them). Unset, as in the
+// C++ twin, everything is compiled.
+#ifndef SKYBAKE_HAS_SCATTERING_TEXTURE
+#define SKYBAKE_HAS_SCATTERING_TEXTURE 1
+#endif
+#ifndef SKYBAKE_HAS_IRRADIANCE_TEXTURE
+#define SKYBAKE_HAS_IRRADIANCE_TEXTURE 1
+#endif
+#ifndef SKYBAKE_HAS_AERIAL_PERSPECTIVE
+#define SKYBAKE_HAS_AERIAL_PERSPECTIVE 1
+#endif
+
 // ---------------------------------------------------------------------------
 // Defensive numerics
 
@@ -119,6 +132,7 @@ vec2 GetTransmittanceTextureUvFromRMu(IN(AtmosphereParameters) atmosphere, Numbe
               GetTextureCoordFromUnitRange(x_r, atmosphere.transmittance_height));
 }
 
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 // 4D scattering table, stored as a 3D texture: x packs nu (slowest) and mu_s,
 // y is mu, z is r. Returns (u_nu, u_mu_s, u_mu, u_r) in [0, 1].
 vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
@@ -160,7 +174,9 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
   Number u_nu = (nu + 1.0) / 2.0;
   return vec4(u_nu, u_mu_s, u_mu, u_r);
 }
+#endif
 
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 // Irradiance table: x = mu_s (linear over [mu_s_min, 1]), y = r (as rho / H).
 // r as rho / H, like the other tables: texels crowd near the ground, where
 // the sky irradiance falls fastest with altitude (linear in r, 16 texels
@@ -175,6 +191,7 @@ vec2 GetIrradianceTextureUvFromRMuS(IN(AtmosphereParameters) atmosphere, Number 
   return vec2(GetTextureCoordFromUnitRange(x_mu_s, atmosphere.irradiance_width),
               GetTextureCoordFromUnitRange(x_r, atmosphere.irradiance_height));
 }
+#endif
 
 // ---------------------------------------------------------------------------
 // Table lookups.
@@ -248,6 +265,7 @@ vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(Transmittance
          SunVisibleFraction(atmosphere, r, mu_s);
 }
 
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 // 4D lookup: trilinear in (mu_s, mu, r) by the texture unit, linear in nu
 // between the two neighbouring nu slices.
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
@@ -261,13 +279,17 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   vec3 uvw1 = vec3((tex_x + 1.0 + uvwz.y) / nu_size, uvwz.z, uvwz.w);
   return texture(scattering_texture, uvw0) * (1.0 - lerp) + texture(scattering_texture, uvw1) * lerp;
 }
+#endif
 
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) irradiance_texture,
                    Number r, Number mu_s) {
   vec2 uv = GetIrradianceTextureUvFromRMuS(atmosphere, r, mu_s);
   return vec3(texture(irradiance_texture, uv));
 }
+#endif
 
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 // ---------------------------------------------------------------------------
 // Phase functions, per steradian.
 
@@ -347,7 +369,9 @@ vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture
                                           mu_s, nu, ray_r_mu_intersects_ground, single_mie_scattering);
   return scattering * RayleighPhaseFunction(nu) + single_mie_scattering * MiePhaseFunction(atmosphere, nu);
 }
+#endif
 
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 // ---------------------------------------------------------------------------
 // Aerial perspective.
 //
@@ -600,7 +624,9 @@ vec3 GetSkyRadianceToPoint(IN(AtmosphereParameters) atmosphere, IN(Transmittance
                                          single_mie_scattering_texture, camera, point, 0.0, sun_direction,
                                          transmittance);
 }
+#endif
 
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 // Direct sun irradiance on a surface at `point` with unit `normal`, and (out)
 // the sky irradiance, from the table for a horizontal surface scaled by the
 // fraction of the sky the tilted surface sees.
@@ -614,6 +640,7 @@ vec3 GetSunAndSkyIrradiance(IN(AtmosphereParameters) atmosphere, IN(Transmittanc
   return atmosphere.solar_irradiance * GetTransmittanceToSun(atmosphere, transmittance_texture, r, mu_s) *
          max(dot(normal, sun_direction), 0.0);
 }
+#endif
 
 // Radiance of the sun's disc at the top of the atmosphere.
 vec3 GetSolarRadiance(IN(AtmosphereParameters) atmosphere) {

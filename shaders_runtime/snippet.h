@@ -18,17 +18,26 @@ struct SnippetFile {
   std::string description;
 };
 
+// The parts of functions.glsl a bake ships: a scene that leaves out a table
+// leaves out the functions that read it (SKYBAKE_HAS_* #defines).
+struct SnippetParts {
+  bool scattering = true;          // sky radiance (GetSkyRadiance and the 4D lookups)
+  bool irradiance = true;          // GetSunAndSkyIrradiance and the irradiance lookups
+  bool aerial_perspective = true;  // GetSkyRadianceToPoint[WithShadow]; needs scattering
+};
+
 // `atmosphere_constants.glsl`: `const AtmosphereParameters ATMOSPHERE`, the
-// wavelengths, and #defines saying which tables exist.
+// wavelengths, and #defines saying which tables and functions exist.
 std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& parameters, const glsl::vec3& wavelengths_nm,
-                                    const std::string& atmosphere_name);
+                                    const std::string& atmosphere_name, const SnippetParts& parts = {});
 
 // The shipped files, in the order a shader must include them.
 std::vector<SnippetFile> RuntimeSnippetFiles(const glsl::AtmosphereParameters& parameters,
-                                             const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name);
+                                             const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name,
+                                             const SnippetParts& parts = {});
 
 // The files of RuntimeSnippetFiles joined into one source (no #version line).
 std::string RuntimeSnippetSource(const glsl::AtmosphereParameters& parameters, const glsl::vec3& wavelengths_nm,
-                                 const std::string& atmosphere_name);
+                                 const std::string& atmosphere_name, const SnippetParts& parts = {});
 
 }  // namespace skybake
