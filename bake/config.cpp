@@ -522,13 +522,7 @@ std::string Array3(const Spectrum& value) {
 }  // namespace
 
 Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, source_name);
-  } catch (const toml::parse_error& error) {
-    throw InputError(OneLine(source_name + ":" + std::to_string(error.source().begin.line) +
-                             ": " + std::string(error.description())));
-  }
+  toml::table root = ParseDocument(toml_text, source_name);
   Atmosphere atmosphere = FileReader(source_name).Read(root);
   Validate(atmosphere, source_name);
   return atmosphere;

@@ -219,14 +219,7 @@ Scene SceneFromJsonObject(const nlohmann::json& j) {
 }  // namespace
 
 Scene ParseScene(std::string_view toml_text, const std::string& source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, source_name);
-  } catch (const toml::parse_error& error) {
-    throw InputError(OneLine(source_name + ":" + std::to_string(error.source().begin.line) + ": " +
-                             std::string(error.description())));
-  }
-  return SceneReader(source_name).Read(root);
+  return SceneReader(source_name).Read(ParseDocument(toml_text, source_name));
 }
 
 Scene LoadScene(const std::string& path) {

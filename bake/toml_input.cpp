@@ -73,6 +73,15 @@ std::string OneLine(std::string text) {
   return text;
 }
 
+toml::table ParseDocument(std::string_view toml_text, const std::string& source_name) {
+  try {
+    return toml::parse(toml_text, source_name);
+  } catch (const toml::parse_error& error) {
+    throw InputError(OneLine(source_name + ":" + std::to_string(error.source().begin.line) + ": " +
+                             std::string(error.description())));
+  }
+}
+
 // ---------------------------------------------------------------------------
 void CheckNumber(const Reporter& report, const std::string& path, double value,
                  const Interval& interval) {

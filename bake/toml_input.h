@@ -28,6 +28,8 @@ std::string TomlKey(std::string_view key);
 std::string Join(const std::string& path, std::string_view key);
 std::string Index(const std::string& path, size_t i);
 std::string OneLine(std::string text);
+// The TOML document, or InputError "<source>:<line>: <problem>".
+toml::table ParseDocument(std::string_view toml_text, const std::string& source_name);
 // "a table", "string", "an array of 3", ... for "expected X, got Y".
 std::string TypeName(const toml::node& node);
 std::string KeyList(std::initializer_list<std::string_view> keys);

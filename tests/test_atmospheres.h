@@ -6,6 +6,7 @@
 
 #include "bake/atmosphere.h"
 #include "bake/bake.h"
+#include "bake/stress_set.h"
 
 namespace skybake::testing {
 
@@ -47,13 +48,9 @@ inline Atmosphere Earth() {
 
 // Small tables and sample counts (a bake in well under a second) for tests
 // that compare two evaluations of the same tables, where size does not matter.
+// The stress set's small tables, at two orders.
 inline BakeSettings SmallBakeSettings() {
-  BakeSettings s;
-  s.transmittance_width = 64, s.transmittance_height = 16;
-  s.irradiance_width = 16, s.irradiance_height = 4;
-  s.scattering_r_size = 8, s.scattering_mu_size = 32, s.scattering_mu_s_size = 8, s.scattering_nu_size = 4;
-  s.ray_samples = 32;
-  s.sphere_samples = 8;
+  BakeSettings s = StressBakeSettings();
   s.orders = 2;
   return s;
 }
