@@ -503,18 +503,6 @@ std::string PresetName(std::string_view file_name) {
   return std::string(file_name.substr(0, file_name.rfind(".toml")));
 }
 
-std::string ReadFile(const std::filesystem::path& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error))
-    throw IoError(path.string() + ": is a directory, not an atmosphere file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")");
-  return text.str();
-}
-
 std::string Array3(const Spectrum& value) {
   return "[" + TomlFloat(value[0]) + ", " + TomlFloat(value[1]) + ", " + TomlFloat(value[2]) + "]";
 }
@@ -534,7 +522,7 @@ Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
   bool exists = std::filesystem::exists(path, error);
   if (error && error != std::errc::no_such_file_or_directory)
     throw IoError(file_or_preset + ": " + error.message());
-  if (exists) return ParseAtmosphere(ReadFile(path), path.filename().string());
+  if (exists) return ParseAtmosphere(ReadInputFile(path, "an atmosphere file"), path.filename().string());
   if (FindPreset(file_or_preset)) return LoadPreset(file_or_preset);
   throw InputError(file_or_preset + ": no such file or preset (see skybake presets)");
 }

@@ -164,17 +164,6 @@ class SceneReader : public TomlReader {
   }
 };
 
-std::string ReadSceneFile(const std::filesystem::path& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) throw IoError(path.string() + ": is a directory, not a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")");
-  return text.str();
-}
-
 // Single Mie can ride in the scattering table's alpha only when the Mie and
 // the other constituents both scatter red light (MakeAtmosphereParameters).
 bool CanPackSingleMie(const Atmosphere& atmosphere) {
@@ -226,7 +215,7 @@ Scene LoadScene(const std::string& path) {
   std::filesystem::path file(path);
   std::error_code error;
   if (!std::filesystem::exists(file, error)) throw InputError(path + ": no such scene file");
-  return ParseScene(ReadSceneFile(file), file.filename().string());
+  return ParseScene(ReadInputFile(file, "a scene file"), file.filename().string());
 }
 
 void ValidateSceneForAtmosphere(const Scene& scene, const Atmosphere& atmosphere, const std::string& source_name) {

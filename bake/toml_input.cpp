@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 namespace skybake::toml_input {
 
@@ -71,6 +73,17 @@ std::string Index(const std::string& path, size_t i) {
 std::string OneLine(std::string text) {
   std::replace_if(text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
   return text;
+}
+
+std::string ReadInputFile(const std::filesystem::path& path, const std::string& kind) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) throw IoError(path.string() + ": is a directory, not " + kind);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")");
+  return text.str();
 }
 
 toml::table ParseDocument(std::string_view toml_text, const std::string& source_name) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <filesystem>
 #include <initializer_list>
 #include <limits>
 #include <optional>
@@ -28,6 +29,9 @@ std::string TomlKey(std::string_view key);
 std::string Join(const std::string& path, std::string_view key);
 std::string Index(const std::string& path, size_t i);
 std::string OneLine(std::string text);
+// The whole file, or IoError naming it; `kind` ("an atmosphere file") words
+// the error for a directory given in its place.
+std::string ReadInputFile(const std::filesystem::path& path, const std::string& kind);
 // The TOML document, or InputError "<source>:<line>: <problem>".
 toml::table ParseDocument(std::string_view toml_text, const std::string& source_name);
 // "a table", "string", "an array of 3", ... for "expected X, got Y".
