@@ -268,6 +268,8 @@ class Baker {
   void ComputeMultipleScattering();
   // Convergence of the orders: the size of the newest order, and the
   // extrapolated tail (factor times the newest order) added to the tables.
+  // MultipleScatteringPackingFactor of every scattering texel, once per bake.
+  void ComputePackingFactors();
   OrderSums MeasureNewestOrder();
   void AddTail(const Spectrum& factor);
   // The tables as they stand, copied (for BakeOrderSnapshot) or moved out
@@ -315,7 +317,7 @@ class Baker {
   Texture delta_multiple_;        // radiance of the latest order >= 2
   Texture scattering_density_;    // J of the current order per unit scattering coefficient
   Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
-  std::vector<double> packing_factor_;  // MultipleScatteringPackingFactor per texel, filled on first use
+  std::vector<double> packing_factor_;  // per scattering texel (ComputePackingFactors)
 };
 
 template <typename F>
@@ -377,6 +379,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     scattering_density_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
     delta_multiple_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
     delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
+    ComputePackingFactors();
   }
   report_.orders_used = 1;
   snapshot(1);
@@ -393,18 +396,13 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     report_.order_ratio = convergence.Ratio();
     report_.remaining_error = convergence.RemainingWithoutTail();
     snapshot(order);
-    if (!auto_orders) {
-      std::optional<Spectrum> tail = convergence.TailFactor();
-      if (order == s.orders && s.extrapolate_tail && tail && !convergence.NewestIsZero()) {
-        Phase("extrapolated orders", [&] { AddTail(*tail); });
-        report_.extrapolated_tail = convergence.RelativeTail();
-        report_.remaining_error = convergence.TailError();
-      }
-      continue;
-    }
-    if (convergence.NewestIsZero()) break;
+    if (auto_orders && convergence.NewestIsZero()) break;
+    // Auto: stop once the tail is known well enough. A fixed count: add the
+    // tail after its last order, if the orders decay geometrically by then.
     std::optional<Spectrum> tail = convergence.TailFactor();
-    if (tail && convergence.TailError() < s.order_tolerance) {
+    const bool add_tail = auto_orders ? tail && convergence.TailError() < s.order_tolerance
+                                      : order == s.orders && s.extrapolate_tail && tail && !convergence.NewestIsZero();
+    if (add_tail) {
       Phase("extrapolated orders", [&] { AddTail(*tail); });
       report_.extrapolated_tail = convergence.RelativeTail();
       report_.remaining_error = convergence.TailError();
@@ -734,24 +732,25 @@ void Baker::ComputeMultipleScattering() {
       Spectrum sum(0.0);
       for (int k = 0; k < n; ++k) sum += IntegrateInterval(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
       delta_multiple_.Store(x, y, z, vec4(sum, 0.0));
-      vec4 total = scattering_.Fetch(x, y, z) + vec4(sum * MultipleScatteringPackingFactor(x, y, z), 0.0);
+      vec4 total = scattering_.Fetch(x, y, z) + vec4(sum * packing_factor_[scattering_.Index(x, y, z) / 4], 0.0);
       scattering_.Store(x, y, z, total);
     }
   });
 }
 
-OrderSums Baker::MeasureNewestOrder() {
+void Baker::ComputePackingFactors() {
   const int width = scattering_.width, height = scattering_.height, depth = scattering_.depth;
-  if (packing_factor_.empty()) {
-    packing_factor_.resize(std::size_t(width) * height * depth);
-    tbb::parallel_for(0, depth, [&](int z) {
-      for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) {
-          packing_factor_[scattering_.Index(x, y, z) / 4] = MultipleScatteringPackingFactor(x, y, z);
-        }
+  packing_factor_.resize(std::size_t(width) * height * depth);
+  tbb::parallel_for(0, depth, [&](int z) {
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        packing_factor_[scattering_.Index(x, y, z) / 4] = MultipleScatteringPackingFactor(x, y, z);
       }
-    });
-  }
+    }
+  });
+}
+
+OrderSums Baker::MeasureNewestOrder() {
   OrderSums sums;
   for (std::size_t i = 0; i < packing_factor_.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
