@@ -1,6 +1,6 @@
 // The CPU bake. The structure follows Bruneton's precomputation (transmittance,
 // single scattering, then per order: scattering density, indirect irradiance,
-// multiple scattering), with two CPU-specific choices:
+// multiple scattering), with three CPU-specific choices:
 //
 // * Rays are shared. Every texel of the 4D table with the same (r, mu) looks
 //   along the same ray, so the samples along it, the densities and the
@@ -11,6 +11,12 @@
 //   its altitude and the sun's zenith angle, not on the view direction, so
 //   the scattering density gathers the incoming radiance once per (r, mu_s)
 //   slice and reuses it for all (mu, nu) view texels of the slice.
+// * Orders are gathered once. Each order's radiance is needed only as the
+//   light the next order scatters, and an integral over the sphere smooths
+//   it, so it is gathered on a grid coarser in r and mu; the scattering
+//   densities of all orders, on the table's grid, are summed and integrated
+//   along the table's rays once at the end (the integral is linear in the
+//   density). docs/benchmark.md measures each choice's time and error.
 //
 // Integrals along rays use the exponential trapezoid rule (exact when the
 // integrand varies exponentially between samples, as densities and
@@ -55,6 +61,30 @@ double ExponentialTrapezoid(double a, double b, double h) {
   double ratio = b / a;
   if (std::abs(ratio - 1.0) < 1e-4) return 0.5 * h * (a + b);
   return h * (b - a) / std::log(ratio);
+}
+
+// Weights (w_a, w_b) of the integral over an interval of width h of
+// s(t) g(t), where the source s is linear between its end values s_a, s_b
+// and the factor g exponential between g_a and g_b, with lambda = ln(g_b /
+// g_a): the integral is w_a s_a + w_b s_b. lambda comes from the caller's
+// logarithms, so an end that underflowed to 0 (beyond an optical depth of
+// ~745) still decays at its true rate; where an end is truly 0 (lambda is
+// not finite), g is taken as linear instead. Written so that neither a
+// small nor a large lambda loses digits.
+std::pair<double, double> LinearTimesExponentialWeights(double g_a, double g_b, double lambda, double h) {
+  if (!std::isfinite(lambda)) return {h * (g_a / 3.0 + g_b / 6.0), h * (g_a / 6.0 + g_b / 3.0)};
+  if (std::abs(lambda) < 0.1) {
+    // w_a = h g_a sum lambda^n / (n+2)!, w_b = h g_a sum (n+1) lambda^n / (n+2)!
+    double w_a = 0.0, w_b = 0.0, term = 0.5;
+    for (int n = 0; n < 6; ++n) {
+      w_a += term;
+      w_b += (n + 1) * term;
+      term *= lambda / (n + 3);
+    }
+    return {h * g_a * w_a, h * g_a * w_b};
+  }
+  const double lambda2 = lambda * lambda;
+  return {h * (g_b - g_a * (1.0 + lambda)) / lambda2, h * (g_a - g_b * (1.0 - lambda)) / lambda2};
 }
 
 // A sample of an inscattering integrand along a view ray,
@@ -250,10 +280,110 @@ class OrderConvergence {
   Spectrum newest_{0.0}, relative_{0.0}, ratio_{0.0}, previous_ratio_{0.0};
 };
 
+// The grid of each higher order's radiance: the scattering table's r and mu
+// sizes divided by `divisor` (mu kept even). mu_s and nu are kept: halving
+// mu_s as well raised the sky irradiance error of the report's case set
+// from 12.6% to 15.4% RMS and tripled its twilight error, as the light of
+// low suns changes fastest with mu_s.
+AtmosphereParameters HigherOrderGrid(AtmosphereParameters grid, int divisor) {
+  grid.scattering_r_size = std::max(2, grid.scattering_r_size / divisor);
+  grid.scattering_mu_size = std::max(4, grid.scattering_mu_size / divisor / 2 * 2);
+  return grid;
+}
+
+Texture ScatteringGridTexture(const AtmosphereParameters& grid) {
+  return Texture(grid.scattering_nu_size * grid.scattering_mu_s_size, grid.scattering_mu_size, grid.scattering_r_size);
+}
+
+// The incoming radiance at a point, sampled in a set of directions with
+// their solid angles, and its mean over them weighted by a phase function
+// around a view direction. The discrete phase weights are normalised to sum
+// to one, so the quadrature neither creates nor loses energy for sharp lobes.
+class PhaseWeightedRadiance {
+ public:
+  PhaseWeightedRadiance(const std::vector<vec3>& directions, const std::vector<vec3>& radiance,
+                        const std::vector<double>& solid_angles) {
+    const std::size_t n = directions.size();
+    for (auto* v : {&x_, &y_, &z_, &r_, &g_, &b_, &w_}) v->resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const vec3& d = directions[i];
+      const vec3& l = radiance[i];
+      const double w = solid_angles[i];
+      x_[i] = float(d.x), y_[i] = float(d.y), z_[i] = float(d.z);
+      r_[i] = float(l.x), g_[i] = float(l.y), b_[i] = float(l.z), w_[i] = float(w);
+      // Moments for the Rayleigh and isotropic phases, whose weighted sums
+      // are quadratic forms of the view direction.
+      const double dd[6] = {d.x * d.x, d.y * d.y, d.z * d.z, d.x * d.y, d.x * d.z, d.y * d.z};
+      weight_ += w;
+      sum_ += l * w;
+      for (int j = 0; j < 6; ++j) {
+        weight_moments_[j] += w * dd[j];
+        moments_[j] += l * (w * dd[j]);
+      }
+    }
+  }
+
+  vec3 Mean(const PhaseFunction& phase, const vec3& view) const {
+    switch (phase.kind) {
+      case PhaseKind::kIsotropic:
+        return weight_ > 0.0 ? sum_ / weight_ : vec3(0.0);
+      case PhaseKind::kRayleigh: {
+        // Phase proportional to 1 + (v.d)^2.
+        const double vv[6] = {view.x * view.x,       view.y * view.y,       view.z * view.z,
+                              2.0 * view.x * view.y, 2.0 * view.x * view.z, 2.0 * view.y * view.z};
+        vec3 sum = sum_;
+        double weight = weight_;
+        for (int j = 0; j < 6; ++j) {
+          sum += moments_[j] * vv[j];
+          weight += weight_moments_[j] * vv[j];
+        }
+        return weight > 0.0 ? sum / weight : vec3(0.0);
+      }
+      case PhaseKind::kHenyeyGreenstein:
+        return LobeMean(phase.g, false, view);
+      case PhaseKind::kCornetteShanks:
+        return LobeMean(phase.g, true, view);
+    }
+    return vec3(0.0);
+  }
+
+ private:
+  // Henyey-Greenstein, times (1 + cos^2) for Cornette-Shanks, without their
+  // constant factors (they cancel in the normalised mean); a float loop the
+  // compiler vectorises.
+  vec3 LobeMean(double g, bool cornette_shanks, const vec3& view) const {
+    const float vx = float(view.x), vy = float(view.y), vz = float(view.z);
+    const float a = float(1.0 + g * g), b = float(2.0 * g);
+    float sr = 0.0f, sg = 0.0f, sb = 0.0f, sw = 0.0f;
+    const std::size_t n = x_.size();
+#pragma omp simd reduction(+ : sr, sg, sb, sw)
+    for (std::size_t i = 0; i < n; ++i) {
+      const float c = vx * x_[i] + vy * y_[i] + vz * z_[i];
+      const float denominator = a - b * c;
+      float w = w_[i] / (denominator * std::sqrt(denominator));
+      if (cornette_shanks) w *= 1.0f + c * c;
+      sr += w * r_[i];
+      sg += w * g_[i];
+      sb += w * b_[i];
+      sw += w;
+    }
+    return sw > 0.0f ? vec3(sr, sg, sb) / double(sw) : vec3(0.0);
+  }
+
+  std::vector<float> x_, y_, z_, r_, g_, b_, w_;
+  double weight_ = 0.0;
+  vec3 sum_{0.0};
+  double weight_moments_[6] = {};
+  vec3 moments_[6] = {vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0)};
+};
+
 class Baker {
  public:
   Baker(const Atmosphere& atmosphere, const BakeSettings& settings)
-      : medium_(atmosphere), settings_(settings), params_(MakeAtmosphereParameters(atmosphere, settings)) {}
+      : medium_(atmosphere),
+        settings_(settings),
+        params_(MakeAtmosphereParameters(atmosphere, settings)),
+        orders_grid_(HigherOrderGrid(params_, settings.higher_order_divisor)) {}
 
   LutSet Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot);
 
@@ -265,13 +395,23 @@ class Baker {
   void ComputeSingleScattering();
   void ComputeScatteringDensity(int order);
   void ComputeIndirectIrradiance(int order);
-  void ComputeMultipleScattering();
-  // Convergence of the orders: the size of the newest order, and the
-  // extrapolated tail (factor times the newest order) added to the tables.
-  // MultipleScatteringPackingFactor of every scattering texel, once per bake.
-  void ComputePackingFactors();
-  OrderSums MeasureNewestOrder();
-  void AddTail(const Spectrum& factor);
+  // The light of the orders whose scattering density (per unit scattering
+  // coefficient, on the grid of `density_grid`) is `density`, arriving at
+  // every texel of a table on the grid `grid`: the density integrated along
+  // each texel's ray.
+  Texture GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
+                          const AtmosphereParameters& density_grid) const;
+  // Whether the orders are gathered on a coarser grid than the table's, so
+  // that the table's higher orders come from one gather of their summed
+  // densities at the end.
+  bool GatherAtEnd() const { return settings_.higher_order_divisor > 1; }
+  // The scattering table: single Rayleigh plus the higher orders.
+  Texture ScatteringTable() const;
+  // MultipleScatteringPackingFactor per nu index of a grid.
+  static std::vector<double> PackingFactors(const AtmosphereParameters& grid);
+  // Mean over the texels of a table on a scattering grid, each times the
+  // factor of its nu index (1 where `per_nu` is empty).
+  static Spectrum TableMean(const Texture& table, const AtmosphereParameters& grid, const std::vector<double>& per_nu);
   // The tables as they stand, copied (for BakeOrderSnapshot) or moved out
   // (the result).
   LutSet AssembleTables(Texture transmittance, Texture irradiance, Texture scattering, Texture single_mie) const;
@@ -283,7 +423,8 @@ class Baker {
     r = texel.r, mu = texel.mu, mu_s = texel.mu_s, nu = texel.nu;
     intersects_ground = texel.ray_intersects_ground;
   }
-  RaySamples SampleRay(int mu_index, int r_index) const;
+  // The ray of a scattering texel row, sampled at n + 1 points.
+  RaySamples SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const;
   // The table holds single Rayleigh scattering phase free and the higher
   // orders divided by the Rayleigh phase, which the runtime multiplies back
   // with the query's nu. The division uses the nu of the texel's slice, not
@@ -292,8 +433,9 @@ class Baker {
   // clamped to nearly the same geometry, and dividing by the phase at that
   // clamped nu and multiplying by the phase at the query's nu would scale the
   // smooth higher orders by up to P(1)/P(0) = 2.
-  double MultipleScatteringPackingFactor(int x, int y, int z) const {
-    return 1.0 / glsl::RayleighPhaseFunction(GetScatteringTexel(params_, x, y, z).grid_nu);
+  static double MultipleScatteringPackingFactor(const AtmosphereParameters& grid, int nu_index) {
+    return 1.0 /
+           glsl::RayleighPhaseFunction(GetScatteringTexel(grid, nu_index * grid.scattering_mu_s_size, 0, 0).grid_nu);
   }
 
   // Radiance of scattering order `order` arriving at radius r from direction
@@ -306,18 +448,21 @@ class Baker {
   Medium medium_;
   BakeSettings settings_;
   AtmosphereParameters params_;
+  // The grid of each order's radiance (BakeSettings::higher_order_divisor).
+  AtmosphereParameters orders_grid_;
   BakeReport report_;
   BakeProgress progress_;
 
   Texture transmittance_;
   Texture irradiance_;
-  Texture scattering_;            // accumulated result (divided by the Rayleigh phase)
   Texture single_mie_;            // single scattering of the Mie group, phase free
   Texture single_rayleigh_;       // single scattering of the other groups / Rayleigh phase
-  Texture delta_multiple_;        // radiance of the latest order >= 2
+  Texture delta_multiple_;        // radiance of the latest order >= 2, on orders_grid_
   Texture scattering_density_;    // J of the current order per unit scattering coefficient
+  // Sum over the orders >= 2 so far, and their tail, of their radiance, or
+  // of their J where GatherAtEnd(); on the table's grid.
+  Texture higher_orders_;
   Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
-  std::vector<double> packing_factor_;  // per scattering texel (ComputePackingFactors)
 };
 
 template <typename F>
@@ -357,7 +502,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   progress_ = progress;
   auto snapshot = [&](int order) {
     if (order_snapshot) {
-      LutSet tables = AssembleTables(transmittance_, irradiance_, scattering_, single_mie_);
+      LutSet tables = AssembleTables(transmittance_, irradiance_, ScatteringTable(), single_mie_);
       tables.settings.orders = order;  // exactly these orders, no tail
       tables.settings.extrapolate_tail = false;
       order_snapshot(order, tables, PhaseSecondsSoFar());
@@ -365,34 +510,43 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   };
   auto start = std::chrono::steady_clock::now();
   const BakeSettings& s = settings_;
-  int scattering_width = s.scattering_nu_size * s.scattering_mu_s_size;
   transmittance_ = Texture(s.transmittance_width, s.transmittance_height);
   irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
-  scattering_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
-  single_mie_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
-  single_rayleigh_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+  single_mie_ = ScatteringGridTexture(params_);
+  single_rayleigh_ = ScatteringGridTexture(params_);
 
   Phase("transmittance", [&] { ComputeTransmittance(); });
   Phase("single scattering", [&] { ComputeSingleScattering(); });
-  scattering_.texels = single_rayleigh_.texels;
   if (s.orders != 1) {  // 0 = auto
-    scattering_density_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
-    delta_multiple_ = Texture(scattering_width, s.scattering_mu_size, s.scattering_r_size);
+    scattering_density_ = ScatteringGridTexture(params_);
+    higher_orders_ = ScatteringGridTexture(params_);
     delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
-    ComputePackingFactors();
   }
   report_.orders_used = 1;
   snapshot(1);
   report_.remaining_error = -1.0;  // unknown until two orders can be compared
   const bool auto_orders = s.orders == 0;
   OrderConvergence convergence;
+  // Convergence is measured on means over the tables (each order's on its own grid).
+  OrderSums sums;
+  sums.table = TableMean(single_rayleigh_, params_, {});
+  const std::vector<double> orders_packing = PackingFactors(orders_grid_);
+  const bool gather_at_end = GatherAtEnd();
   for (int order = 2; order <= (auto_orders ? s.max_orders : s.orders); ++order) {
     std::string prefix = "order " + std::to_string(order) + ": ";
     Phase(prefix + "scattering density", [&] { ComputeScatteringDensity(order); });
     Phase(prefix + "indirect irradiance", [&] { ComputeIndirectIrradiance(order - 1); });
-    Phase(prefix + "multiple scattering", [&] { ComputeMultipleScattering(); });
+    Phase(prefix + "multiple scattering", [&] {
+      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, params_);
+      // On the table's grid the orders themselves are summed; on a coarser
+      // one, their densities, for the final gather.
+      const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
+      for (std::size_t i = 0; i < newest.texels.size(); ++i) higher_orders_.texels[i] += newest.texels[i];
+    });
     report_.orders_used = order;
-    convergence.Add(MeasureNewestOrder());
+    sums.newest = TableMean(delta_multiple_, orders_grid_, orders_packing);
+    sums.table += sums.newest;
+    convergence.Add(sums);
     report_.order_ratio = convergence.Ratio();
     report_.remaining_error = convergence.RemainingWithoutTail();
     snapshot(order);
@@ -403,18 +557,65 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     const bool add_tail = auto_orders ? tail && convergence.TailError() < s.order_tolerance
                                       : order == s.orders && s.extrapolate_tail && tail && !convergence.NewestIsZero();
     if (add_tail) {
-      Phase("extrapolated orders", [&] { AddTail(*tail); });
+      // The orders not computed: the newest order's density and irradiance
+      // times q / (1 - q) per channel.
+      Phase("extrapolated orders", [&] {
+        const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
+        for (std::size_t i = 0; i < newest.texels.size(); i += 4) {
+          for (int c = 0; c < 3; ++c) higher_orders_.texels[i + c] += float(newest.texels[i + c] * (*tail)[c]);
+        }
+        for (std::size_t i = 0; i < irradiance_.texels.size(); i += 4) {
+          for (int c = 0; c < 3; ++c) irradiance_.texels[i + c] += float(delta_irradiance_.texels[i + c] * (*tail)[c]);
+        }
+      });
       report_.extrapolated_tail = convergence.RelativeTail();
       report_.remaining_error = convergence.TailError();
       break;
     }
   }
+  Texture scattering;
+  if (gather_at_end) {
+    Phase("gather higher orders", [&] { scattering = ScatteringTable(); });
+  } else {
+    scattering = ScatteringTable();
+  }
 
-  LutSet result = AssembleTables(std::move(transmittance_), std::move(irradiance_), std::move(scattering_),
+  LutSet result = AssembleTables(std::move(transmittance_), std::move(irradiance_), std::move(scattering),
                                  std::move(single_mie_));
   report_.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (report) *report = report_;
   return result;
+}
+
+Texture Baker::ScatteringTable() const {
+  Texture table = single_rayleigh_;
+  if (report_.orders_used < 2) return table;
+  const Texture higher = GatherAtEnd() ? GatherAlongRays(params_, higher_orders_, params_) : higher_orders_;
+  const int mu_s_size = params_.scattering_mu_s_size;
+  const std::vector<double> packing = PackingFactors(params_);
+  for (std::size_t i = 0; i < table.texels.size(); i += 4) {
+    const int x = int((i / 4) % table.width);
+    const double factor = packing[x / mu_s_size];
+    for (int c = 0; c < 3; ++c) table.texels[i + c] += float(higher.texels[i + c] * factor);
+  }
+  return table;
+}
+
+std::vector<double> Baker::PackingFactors(const AtmosphereParameters& grid) {
+  std::vector<double> factors(grid.scattering_nu_size);
+  for (int nu = 0; nu < grid.scattering_nu_size; ++nu) factors[nu] = MultipleScatteringPackingFactor(grid, nu);
+  return factors;
+}
+
+Spectrum Baker::TableMean(const Texture& table, const AtmosphereParameters& grid, const std::vector<double>& per_nu) {
+  const int mu_s_size = grid.scattering_mu_s_size;
+  Spectrum sum(0.0);
+  for (std::size_t i = 0; i < table.texels.size(); i += 4) {
+    const int x = int((i / 4) % table.width);
+    const double factor = per_nu.empty() ? 1.0 : per_nu[x / mu_s_size];
+    for (int c = 0; c < 3; ++c) sum[c] += table.texels[i + c] * factor;
+  }
+  return sum / double(table.texels.size() / 4);
 }
 
 void Baker::ComputeTransmittance() {
@@ -430,12 +631,11 @@ void Baker::ComputeTransmittance() {
   });
 }
 
-RaySamples Baker::SampleRay(int mu_index, int r_index) const {
+RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const {
   RaySamples ray;
-  double mu_s, nu;
-  ScatteringTexelGeometry(0, mu_index, r_index, ray.r, ray.mu, mu_s, nu, ray.intersects_ground);
+  const ScatteringTexel texel = GetScatteringTexel(grid, 0, mu_index, r_index);
+  ray.r = texel.r, ray.mu = texel.mu, ray.intersects_ground = texel.ray_intersects_ground;
   double d = glsl::DistanceToNearestAtmosphereBoundary(params_, ray.r, ray.mu, ray.intersects_ground);
-  const int n = settings_.ray_samples;
   const int constituents = medium_.constituent_count();
   const int groups = static_cast<int>(medium_.groups().size());
   ray.t = RayDistances(d, n);
@@ -463,82 +663,190 @@ RaySamples Baker::SampleRay(int mu_index, int r_index) const {
   return ray;
 }
 
+// The sun's optical depth to the top boundary at one radius, for any mu_s:
+// GetOpticalDepthToTopAtmosphereBoundary with the parts that depend on the
+// radius alone (the r texel row, the range of distances) computed once.
+class SunOpticalDepthAtRadius {
+ public:
+  SunOpticalDepthAtRadius(const AtmosphereParameters& params, const Texture& transmittance, double r)
+      : params_(&params), texture_(&transmittance), r_(r) {
+    const double H = glsl::HorizonDistanceAtTop(params), rho = glsl::HorizonDistance(params, r);
+    d_min_ = params.top_radius - r;
+    const double d_max = rho + H;
+    inverse_span_ = d_max > d_min_ ? 1.0 / (d_max - d_min_) : 0.0;
+    double fy;
+    glsl::detail::LinearTaps(glsl::GetTextureCoordFromUnitRange(rho / H, params.transmittance_height),
+                             transmittance.height, y0_, y1_, fy);
+    fy_ = fy;
+  }
+  Spectrum operator()(double mu_s) const {
+    const double d = glsl::DistanceToTopAtmosphereBoundary(*params_, r_, mu_s);
+    const double u = glsl::GetTextureCoordFromUnitRange((d - d_min_) * inverse_span_, params_->transmittance_width);
+    int x0, x1;
+    double fx;
+    glsl::detail::LinearTaps(u, texture_->width, x0, x1, fx);
+    const float* a0 = &texture_->texels[texture_->Index(x0, y0_)];
+    const float* a1 = &texture_->texels[texture_->Index(x1, y0_)];
+    const float* b0 = &texture_->texels[texture_->Index(x0, y1_)];
+    const float* b1 = &texture_->texels[texture_->Index(x1, y1_)];
+    Spectrum tau;
+    for (int c = 0; c < 3; ++c) {
+      tau[c] = (1.0 - fy_) * ((1.0 - fx) * a0[c] + fx * a1[c]) + fy_ * ((1.0 - fx) * b0[c] + fx * b1[c]);
+    }
+    return tau;
+  }
+
+ private:
+  const AtmosphereParameters* params_;
+  const Texture* texture_;
+  double r_, d_min_ = 0.0, inverse_span_ = 0.0, fy_ = 0.0;
+  int y0_ = 0, y1_ = 0;
+};
+
 void Baker::ComputeSingleScattering() {
   const int mu_size = params_.scattering_mu_size, r_size = params_.scattering_r_size;
-  const int width = scattering_.width;
+  const int mu_s_size = params_.scattering_mu_s_size, nu_size = params_.scattering_nu_size;
   const int groups = static_cast<int>(medium_.groups().size());
   const int mie = medium_.mie_group();
   const glsl::sampler2D transmittance{&transmittance_};
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     int z = ray_index / mu_size, y = ray_index % mu_size;
-    RaySamples ray = SampleRay(y, z);
     const int n = settings_.ray_samples;
-    std::vector<double> phase_ratio(groups);
-    std::vector<RayIntegrand> rayleigh(n + 1), mie_samples(n + 1);
-    std::vector<double> visible(n + 1), densities(medium_.constituent_count());
-    for (int x = 0; x < width; ++x) {
-      double r, mu, mu_s, nu;
-      bool intersects;
-      ScatteringTexelGeometry(x, y, z, r, mu, mu_s, nu, intersects);
-      // The table divides out the Rayleigh phase; other phases are applied here.
+    const RaySamples ray = SampleRay(params_, y, z, n);
+    // Per group and sample, the factors shared by all the ray's texels: the
+    // scattering coefficient times the view's transmittance, and the log of
+    // its ratio between neighbouring samples (so that the exponential
+    // trapezoid below needs no logarithm per texel).
+    std::vector<std::vector<Spectrum>> base(groups, std::vector<Spectrum>(n + 1));
+    std::vector<std::vector<Spectrum>> log_ratio(groups, std::vector<Spectrum>(n, Spectrum(0.0)));
+    std::vector<Spectrum> view_transmittance(n + 1);
+    std::vector<SunOpticalDepthAtRadius> sun_depth;
+    std::vector<bool> thin(n);  // interval less than one optical depth thick for the view
+    sun_depth.reserve(n + 1);
+    for (int k = 0; k <= n; ++k) {
+      view_transmittance[k] = glm::exp(-ray.optical_depth[k]);
+      for (int g = 0; g < groups; ++g) base[g][k] = ray.scattering[g][k] * view_transmittance[k];
+      sun_depth.emplace_back(params_, transmittance_, ray.radius[k]);
+    }
+    for (int k = 0; k < n; ++k) {
+      Spectrum view_depth = ray.optical_depth[k + 1] - ray.optical_depth[k];
+      thin[k] = std::max({view_depth.x, view_depth.y, view_depth.z}) <= 1.0;
       for (int g = 0; g < groups; ++g) {
-        phase_ratio[g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
-      }
-      // Scattered light at distance t along the ray, per group kind.
-      auto sample = [&](double t, double r_t, const Spectrum& optical_depth, const Spectrum& extinction,
-                        const Spectrum* scattering, RayIntegrand& rayleigh_out, RayIntegrand& mie_out,
-                        double& visible) {
-        double mu_s_t = glsl::ClampCosine((r * mu_s + t * nu) / r_t);
-        visible = glsl::SunVisibleFraction(params_, r_t, mu_s_t);
-        Spectrum tau_sun = glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance, r_t, mu_s_t);
-        Spectrum other(0.0);
-        for (int g = 0; g < groups; ++g) {
-          if (g != mie) other += scattering[g] * phase_ratio[g];
+        for (int c = 0; c < 3; ++c) {
+          double a = base[g][k][c], b = base[g][k + 1][c];
+          log_ratio[g][k][c] = a > 0.0 && b > 0.0 ? std::log(b / a) : 0.0;
         }
-        Spectrum attenuation = glm::exp(-(optical_depth + tau_sun));
-        Spectrum rayleigh_source = other * visible, mie_source = mie >= 0 ? scattering[mie] * visible : Spectrum(0.0);
-        rayleigh_out = RayIntegrand{rayleigh_source, optical_depth, tau_sun, extinction, rayleigh_source * attenuation};
-        mie_out = RayIntegrand{mie_source, optical_depth, tau_sun, extinction, mie_source * attenuation};
-      };
-      std::vector<Spectrum> scattering_k(groups);
-      for (int k = 0; k <= n; ++k) {
-        for (int g = 0; g < groups; ++g) scattering_k[g] = ray.scattering[g][k];
-        sample(ray.t[k], ray.radius[k], ray.optical_depth[k], ray.extinction[k], scattering_k.data(), rayleigh[k],
-               mie_samples[k], visible[k]);
       }
+    }
+
+    std::vector<double> phase_ratio(groups), densities(medium_.constituent_count());
+    std::vector<Spectrum> tau_sun(n + 1), sun_transmittance(n + 1), scattering_k(groups);
+    std::vector<double> visible(n + 1);
+    for (int mu_s_index = 0; mu_s_index < mu_s_size; ++mu_s_index) {
+      double previous_nu = std::numeric_limits<double>::quiet_NaN();
       Spectrum rayleigh_sum(0.0), mie_sum(0.0);
-      for (int k = 0; k < n; ++k) {
-        if (visible[k] == visible[k + 1] && (visible[k] == 0.0 || visible[k] == 1.0)) {
-          rayleigh_sum += IntegrateInterval(rayleigh[k], rayleigh[k + 1], ray.t[k + 1] - ray.t[k]);
-          mie_sum += IntegrateInterval(mie_samples[k], mie_samples[k + 1], ray.t[k + 1] - ray.t[k]);
-          continue;
-        }
-        // The planet's shadow edge crosses this interval: the integrand
-        // switches on or off within it, so subdivide it.
-        const int pieces = kShadowEdgeSubdivisions;
-        double width = ray.t[k + 1] - ray.t[k];
-        double h = width / pieces;
-        RayIntegrand previous_rayleigh = rayleigh[k], previous_mie = mie_samples[k];
-        for (int i = 1; i <= pieces; ++i) {
-          RayIntegrand next_rayleigh = rayleigh[k + 1], next_mie = mie_samples[k + 1];
-          if (i < pieces) {
-            double f = double(i) / pieces;
-            double t = ray.t[k] + f * width;
-            double r_t = glsl::RadiusAtDistance(params_, ray.r, ray.mu, t);
-            medium_.Densities(r_t - params_.bottom_radius, densities.data());
-            for (int g = 0; g < groups; ++g) scattering_k[g] = medium_.GroupScattering(g, densities.data());
-            Spectrum optical_depth = glm::mix(ray.optical_depth[k], ray.optical_depth[k + 1], f);
-            double unused;
-            sample(t, r_t, optical_depth, medium_.Extinction(densities.data()), scattering_k.data(), next_rayleigh,
-                   next_mie, unused);
+      for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+        const int x = nu_index * mu_s_size + mu_s_index;
+        const ScatteringTexel texel = GetScatteringTexel(params_, x, y, z);
+        const double r = texel.r, mu_s = texel.mu_s, nu = texel.nu;
+        // Slices clamped to the same nu have the same integral.
+        if (nu != previous_nu) {
+          previous_nu = nu;
+          // The table divides out the Rayleigh phase; other phases are applied here.
+          for (int g = 0; g < groups; ++g) {
+            phase_ratio[g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
           }
-          rayleigh_sum += IntegrateInterval(previous_rayleigh, next_rayleigh, h);
-          mie_sum += IntegrateInterval(previous_mie, next_mie, h);
-          previous_rayleigh = next_rayleigh, previous_mie = next_mie;
+          for (int k = 0; k <= n; ++k) {
+            double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / ray.radius[k]);
+            visible[k] = glsl::SunVisibleFraction(params_, ray.radius[k], mu_s_k);
+            tau_sun[k] = visible[k] > 0.0 ? sun_depth[k](mu_s_k) : Spectrum(0.0);
+            sun_transmittance[k] = visible[k] > 0.0 ? glm::exp(-tau_sun[k]) : Spectrum(0.0);
+          }
+          // Scattered light at distance t along the ray, per group kind (the
+          // general form, for the intervals the fast path below does not take).
+          auto sample = [&](double t, double r_t, const Spectrum& optical_depth, const Spectrum& extinction,
+                            const Spectrum* scattering, RayIntegrand& rayleigh_out, RayIntegrand& mie_out,
+                            double& visible_out) {
+            double mu_s_t = glsl::ClampCosine((r * mu_s + t * nu) / r_t);
+            visible_out = glsl::SunVisibleFraction(params_, r_t, mu_s_t);
+            Spectrum tau = glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance, r_t, mu_s_t);
+            Spectrum other(0.0);
+            for (int g = 0; g < groups; ++g) {
+              if (g != mie) other += scattering[g] * phase_ratio[g];
+            }
+            Spectrum attenuation = glm::exp(-(optical_depth + tau));
+            Spectrum rayleigh_source = other * visible_out,
+                     mie_source = mie >= 0 ? scattering[mie] * visible_out : Spectrum(0.0);
+            rayleigh_out = RayIntegrand{rayleigh_source, optical_depth, tau, extinction, rayleigh_source * attenuation};
+            mie_out = RayIntegrand{mie_source, optical_depth, tau, extinction, mie_source * attenuation};
+          };
+          auto sample_at = [&](int k, RayIntegrand& rayleigh_out, RayIntegrand& mie_out) {
+            for (int g = 0; g < groups; ++g) scattering_k[g] = ray.scattering[g][k];
+            double unused;
+            sample(ray.t[k], ray.radius[k], ray.optical_depth[k], ray.extinction[k], scattering_k.data(), rayleigh_out,
+                   mie_out, unused);
+          };
+          rayleigh_sum = Spectrum(0.0), mie_sum = Spectrum(0.0);
+          for (int k = 0; k < n; ++k) {
+            const double h = ray.t[k + 1] - ray.t[k];
+            if (visible[k] == 0.0 && visible[k + 1] == 0.0) continue;
+            if (thin[k] && visible[k] == 1.0 && visible[k + 1] == 1.0) {
+              // Fully lit, optically thin: the exponential trapezoid of each
+              // group's integrand, its log ratio from the shared part's and
+              // the sun's optical depths.
+              const Spectrum& sun_a = sun_transmittance[k];
+              const Spectrum& sun_b = sun_transmittance[k + 1];
+              for (int g = 0; g < groups; ++g) {
+                Spectrum integral;
+                for (int c = 0; c < 3; ++c) {
+                  const double fa = base[g][k][c] * sun_a[c], fb = base[g][k + 1][c] * sun_b[c];
+                  const double lambda = log_ratio[g][k][c] - (tau_sun[k + 1][c] - tau_sun[k][c]);
+                  integral[c] = fa > 0.0 && fb > 0.0 && std::abs(lambda) >= 1e-4 ? h * (fb - fa) / lambda
+                                                                                  : 0.5 * h * (fa + fb);
+                }
+                if (g == mie) {
+                  mie_sum += integral;
+                } else {
+                  rayleigh_sum += integral * phase_ratio[g];
+                }
+              }
+              continue;
+            }
+            RayIntegrand rayleigh_a, mie_a, rayleigh_b, mie_b;
+            sample_at(k, rayleigh_a, mie_a);
+            sample_at(k + 1, rayleigh_b, mie_b);
+            if (visible[k] == visible[k + 1]) {
+              rayleigh_sum += IntegrateInterval(rayleigh_a, rayleigh_b, h);
+              mie_sum += IntegrateInterval(mie_a, mie_b, h);
+              continue;
+            }
+            // The planet's shadow edge crosses this interval: the integrand
+            // switches on or off within it, so subdivide it.
+            const int pieces = kShadowEdgeSubdivisions;
+            const double piece = h / pieces;
+            RayIntegrand previous_rayleigh = rayleigh_a, previous_mie = mie_a;
+            for (int i = 1; i <= pieces; ++i) {
+              RayIntegrand next_rayleigh = rayleigh_b, next_mie = mie_b;
+              if (i < pieces) {
+                double f = double(i) / pieces;
+                double t = ray.t[k] + f * h;
+                double r_t = glsl::RadiusAtDistance(params_, ray.r, ray.mu, t);
+                medium_.Densities(r_t - params_.bottom_radius, densities.data());
+                for (int g = 0; g < groups; ++g) scattering_k[g] = medium_.GroupScattering(g, densities.data());
+                Spectrum optical_depth = glm::mix(ray.optical_depth[k], ray.optical_depth[k + 1], f);
+                double unused;
+                sample(t, r_t, optical_depth, medium_.Extinction(densities.data()), scattering_k.data(),
+                       next_rayleigh, next_mie, unused);
+              }
+              rayleigh_sum += IntegrateInterval(previous_rayleigh, next_rayleigh, piece);
+              mie_sum += IntegrateInterval(previous_mie, next_mie, piece);
+              previous_rayleigh = next_rayleigh, previous_mie = next_mie;
+            }
+          }
         }
+        single_rayleigh_.Store(x, y, z, vec4(rayleigh_sum * params_.solar_irradiance, 0.0));
+        single_mie_.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
       }
-      single_rayleigh_.Store(x, y, z, vec4(rayleigh_sum * params_.solar_irradiance, 0.0));
-      single_mie_.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
     }
   });
 }
@@ -562,12 +870,13 @@ vec3 Baker::IncidentRadiance(int order, double r, double mu, double mu_s, double
     vec3 mie(glsl::GetScattering(params_, glsl::sampler3D{&single_mie_}, r, mu, mu_s, nu, intersects_ground));
     return rayleigh * glsl::RayleighPhaseFunction(nu) + mie * glsl::MiePhaseFunction(params_, nu);
   }
-  return vec3(glsl::GetScattering(params_, glsl::sampler3D{&delta_multiple_}, r, mu, mu_s, nu, intersects_ground));
+  return vec3(glsl::GetScattering(orders_grid_, glsl::sampler3D{&delta_multiple_}, r, mu, mu_s, nu, intersects_ground));
 }
 
 void Baker::ComputeScatteringDensity(int order) {
-  const int mu_s_size = params_.scattering_mu_s_size, r_size = params_.scattering_r_size;
-  const int nu_size = params_.scattering_nu_size, mu_size = params_.scattering_mu_size;
+  const AtmosphereParameters& grid = params_;
+  const int mu_s_size = grid.scattering_mu_s_size, r_size = grid.scattering_r_size;
+  const int nu_size = grid.scattering_nu_size, mu_size = grid.scattering_mu_size;
   const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
   const double d_phi = 2.0 * kPi / azimuths;
   const int groups = static_cast<int>(medium_.groups().size());
@@ -576,9 +885,8 @@ void Baker::ComputeScatteringDensity(int order) {
 
   tbb::parallel_for(0, r_size * mu_s_size, [&](int slice) {
     int z = slice / mu_s_size, mu_s_index = slice % mu_s_size;
-    double r, mu_unused, mu_s, nu_unused;
-    bool intersects_unused;
-    ScatteringTexelGeometry(mu_s_index, 0, z, r, mu_unused, mu_s, nu_unused, intersects_unused);
+    const ScatteringTexel slice_texel = GetScatteringTexel(grid, mu_s_index, 0, z);
+    const double r = slice_texel.r, mu_s = slice_texel.mu_s;
     // Local frame: zenith along z, sun in the x-z plane.
     const vec3 zenith(0.0, 0.0, 1.0);
     const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
@@ -629,13 +937,12 @@ void Baker::ComputeScatteringDensity(int order) {
       total_scattering += group_scattering[g];
     }
 
-    const size_t count = directions.size();
+    const PhaseWeightedRadiance incoming(directions, radiance, solid_angles);
     for (int y = 0; y < mu_size; ++y) {
       for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
         int x = nu_index * mu_s_size + mu_s_index;
-        double r_texel, mu, mu_s_texel, nu;
-        bool intersects;
-        ScatteringTexelGeometry(x, y, z, r_texel, mu, mu_s_texel, nu, intersects);
+        const ScatteringTexel texel = GetScatteringTexel(grid, x, y, z);
+        const double mu = texel.mu, nu = texel.nu;
         // View direction with zenith cosine mu and sun cosine nu.
         double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
         double sin_mu_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
@@ -644,17 +951,7 @@ void Baker::ComputeScatteringDensity(int order) {
         vec3 density(0.0);
         for (int g = 0; g < groups; ++g) {
           if (group_scattering[g] == Spectrum(0.0)) continue;
-          const PhaseFunction& phase = medium_.groups()[g].phase;
-          // The discrete phase weights are normalised to sum to one, so the
-          // quadrature neither creates nor loses energy for sharp lobes.
-          vec3 sum(0.0);
-          double weight_sum = 0.0;
-          for (size_t i = 0; i < count; ++i) {
-            double w = phase.Evaluate(glm::dot(view, directions[i])) * solid_angles[i];
-            sum += radiance[i] * w;
-            weight_sum += w;
-          }
-          if (weight_sum > 0.0) density += group_scattering[g] * sum / weight_sum;
+          density += group_scattering[g] * incoming.Mean(medium_.groups()[g].phase, view);
         }
         // Stored per unit scattering coefficient, i.e. as the phase-weighted
         // mean incoming radiance, which varies slowly with altitude; the
@@ -698,80 +995,137 @@ void Baker::ComputeIndirectIrradiance(int order) {
   });
 }
 
-void Baker::ComputeMultipleScattering() {
-  const int mu_size = params_.scattering_mu_size, r_size = params_.scattering_r_size;
-  const int width = scattering_.width;
-  const glsl::sampler3D density{&scattering_density_};
+Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
+                               const AtmosphereParameters& density_grid) const {
+  Texture result = ScatteringGridTexture(grid);
+  const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
+  const int mu_s_size = grid.scattering_mu_s_size, nu_size = grid.scattering_nu_size;
+  const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
+  const int plane_width = density.width;  // density nu * mu_s
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
-    int z = ray_index / mu_size, y = ray_index % mu_size;
-    RaySamples ray = SampleRay(y, z);
-    const int n = settings_.ray_samples;
-    std::vector<double> mu_k(n + 1);
-    std::vector<Spectrum> scattering_k(n + 1, Spectrum(0.0));
-    std::vector<Spectrum> attenuation(n + 1);
-    // The optical depths and extinctions are the ray's; the texels differ
-    // only in the source.
-    std::vector<RayIntegrand> samples(n + 1);
+    const int z = ray_index / mu_size, y = ray_index % mu_size;
+    const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
+    const RaySamples ray = SampleRay(grid, y, z, n);
+    // The integrand is J times the scattering coefficient times the view's
+    // transmittance. Over optically thin intervals J varies slowly and is
+    // taken as linear between samples, the rest as exponential, which makes
+    // the integral a weighted sum of J at the samples with weights shared by
+    // all the ray's texels. Over thick ones (more than one optical depth) J
+    // can fall by orders of magnitude (into a fog) and the integrand is
+    // taken as exponential per unit of the view's optical depth, per texel,
+    // as IntegrateInterval does.
+    struct ThickInterval {
+      int k, c;
+      double albedo_a, albedo_b;
+    };
+    std::vector<ThickInterval> thick_intervals;
+    std::vector<Spectrum> weight(n + 1, Spectrum(0.0));
+    std::vector<Spectrum> scattering(n + 1, Spectrum(0.0));
+    std::vector<bool> needed(n + 1, false);  // J is looked up there
     for (int k = 0; k <= n; ++k) {
-      mu_k[k] = glsl::CosineAtDistance(ray.r, ray.mu, ray.t[k], ray.radius[k]);
-      attenuation[k] = glm::exp(-ray.optical_depth[k]);
-      samples[k].view_optical_depth = ray.optical_depth[k];
-      samples[k].extinction = ray.extinction[k];
-      for (const std::vector<Spectrum>& group : ray.scattering) scattering_k[k] += group[k];
+      for (const std::vector<Spectrum>& group : ray.scattering) scattering[k] += group[k];
     }
-    for (int x = 0; x < width; ++x) {
-      double r, mu, mu_s, nu;
-      bool intersects;
-      ScatteringTexelGeometry(x, y, z, r, mu, mu_s, nu, intersects);
-      for (int k = 0; k <= n; ++k) {
-        double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / ray.radius[k]);
-        vec3 j(glsl::GetScattering(params_, density, ray.radius[k], mu_k[k], mu_s_k, nu, intersects));
-        samples[k].source = j * scattering_k[k];
-        samples[k].value = samples[k].source * attenuation[k];
+    for (int k = 0; k < n; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        const double view_depth = ray.optical_depth[k + 1][c] - ray.optical_depth[k][c];
+        const double extinction_a = ray.extinction[k][c], extinction_b = ray.extinction[k + 1][c];
+        if (view_depth > 1.0 && (extinction_a > 0.0 || extinction_b > 0.0)) {
+          // Albedo per unit optical depth; a vacuum end takes the other's.
+          const double albedo_a =
+              extinction_a > 0.0 ? scattering[k][c] / extinction_a : scattering[k + 1][c] / extinction_b;
+          const double albedo_b = extinction_b > 0.0 ? scattering[k + 1][c] / extinction_b : albedo_a;
+          thick_intervals.push_back({k, c, albedo_a, albedo_b});
+          needed[k] = needed[k + 1] = true;
+          continue;
+        }
+        const double factor_a = scattering[k][c], factor_b = scattering[k + 1][c];
+        const double lambda = factor_a > 0.0 && factor_b > 0.0 ? std::log(factor_b / factor_a) - view_depth
+                                                                : std::numeric_limits<double>::quiet_NaN();
+        const std::pair<double, double> w = LinearTimesExponentialWeights(
+            factor_a * std::exp(-ray.optical_depth[k][c]), factor_b * std::exp(-ray.optical_depth[k + 1][c]), lambda,
+            ray.t[k + 1] - ray.t[k]);
+        weight[k][c] += w.first;
+        weight[k + 1][c] += w.second;
       }
+    }
+    // J at each sample's (r, mu) for every (nu, mu_s) texel of the density
+    // grid: the texture's r and mu interpolation, done once per sample.
+    std::vector<int> samples;  // those with a non-zero weight
+    std::vector<float> planes;
+    for (int k = 0; k <= n; ++k) {
+      needed[k] = needed[k] || weight[k] != Spectrum(0.0);
+      if (!needed[k]) continue;
+      const double mu_k = glsl::CosineAtDistance(ray.r, ray.mu, ray.t[k], ray.radius[k]);
+      const glsl::vec4 uvwz =
+          glsl::GetScatteringTextureUvwzFromRMuMuSNu(density_grid, ray.radius[k], mu_k, 1.0, 1.0, ray.intersects_ground);
+      int y0, y1, z0, z1;
+      double fy, fz;
+      glsl::detail::LinearTaps(uvwz.z, density.height, y0, y1, fy);
+      glsl::detail::LinearTaps(uvwz.w, density.depth, z0, z1, fz);
+      const float* t00 = &density.texels[density.Index(0, y0, z0)];
+      const float* t10 = &density.texels[density.Index(0, y1, z0)];
+      const float* t01 = &density.texels[density.Index(0, y0, z1)];
+      const float* t11 = &density.texels[density.Index(0, y1, z1)];
+      const float w00 = float((1 - fy) * (1 - fz)), w10 = float(fy * (1 - fz)), w01 = float((1 - fy) * fz),
+                  w11 = float(fy * fz);
+      const std::size_t offset = planes.size();
+      planes.resize(offset + std::size_t(4) * plane_width);
+      float* plane = &planes[offset];
+      for (int i = 0; i < 4 * plane_width; ++i) plane[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
+      samples.push_back(k);
+    }
+    std::vector<Spectrum> source(n + 1, Spectrum(0.0));  // J at the samples, per texel
+    for (int mu_s_index = 0; mu_s_index < mu_s_size; ++mu_s_index) {
+      double previous_nu = std::numeric_limits<double>::quiet_NaN();
       Spectrum sum(0.0);
-      for (int k = 0; k < n; ++k) sum += IntegrateInterval(samples[k], samples[k + 1], ray.t[k + 1] - ray.t[k]);
-      delta_multiple_.Store(x, y, z, vec4(sum, 0.0));
-      vec4 total = scattering_.Fetch(x, y, z) + vec4(sum * packing_factor_[scattering_.Index(x, y, z) / 4], 0.0);
-      scattering_.Store(x, y, z, total);
-    }
-  });
-}
-
-void Baker::ComputePackingFactors() {
-  const int width = scattering_.width, height = scattering_.height, depth = scattering_.depth;
-  packing_factor_.resize(std::size_t(width) * height * depth);
-  tbb::parallel_for(0, depth, [&](int z) {
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        packing_factor_[scattering_.Index(x, y, z) / 4] = MultipleScatteringPackingFactor(x, y, z);
+      for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+        const int x = nu_index * mu_s_size + mu_s_index;
+        const ScatteringTexel texel = GetScatteringTexel(grid, x, y, z);
+        // Slices clamped to the same nu (the edges of the range that mu and
+        // mu_s allow) have the same integral.
+        if (texel.nu != previous_nu) {
+          previous_nu = texel.nu;
+          const double nu_coord = 0.5 * (texel.nu + 1.0) * (density_nu_size - 1);
+          const int nu0 = std::min(int(std::floor(nu_coord)), density_nu_size - 1), nu1 = std::min(nu0 + 1, density_nu_size - 1);
+          const double f_nu = nu_coord - nu0;
+          sum = Spectrum(0.0);
+          for (std::size_t i = 0; i < samples.size(); ++i) {
+            Spectrum& j = source[samples[i]];
+            const int k = samples[i];
+            const double mu_s_k = glsl::ClampCosine((ray.r * texel.mu_s + ray.t[k] * texel.nu) / ray.radius[k]);
+            int m0, m1;
+            double f_mu_s;
+            glsl::detail::LinearTaps(glsl::GetScatteringTextureUMuS(density_grid, mu_s_k), density_mu_s_size, m0, m1, f_mu_s);
+            const float* plane = &planes[i * std::size_t(4) * plane_width];
+            const float* a0 = plane + 4 * (nu0 * density_mu_s_size + m0);
+            const float* a1 = plane + 4 * (nu0 * density_mu_s_size + m1);
+            const float* b0 = plane + 4 * (nu1 * density_mu_s_size + m0);
+            const float* b1 = plane + 4 * (nu1 * density_mu_s_size + m1);
+            const double w_a0 = (1 - f_nu) * (1 - f_mu_s), w_a1 = (1 - f_nu) * f_mu_s, w_b0 = f_nu * (1 - f_mu_s),
+                         w_b1 = f_nu * f_mu_s;
+            for (int c = 0; c < 3; ++c) j[c] = w_a0 * a0[c] + w_a1 * a1[c] + w_b0 * b0[c] + w_b1 * b1[c];
+            sum += weight[k] * j;
+          }
+          for (const ThickInterval& interval : thick_intervals) {
+            const int k = interval.k, c = interval.c;
+            const double tau_a = ray.optical_depth[k][c], width = ray.optical_depth[k + 1][c] - tau_a;
+            const double value_a = source[k][c] * interval.albedo_a, value_b = source[k + 1][c] * interval.albedo_b;
+            if (value_a <= 0.0 || value_b <= 0.0) {
+              // A dark end: linear between the ends, exactly against exp(-tau).
+              const double decay = -std::expm1(-width), ramp = (decay - width * std::exp(-width)) / width;
+              sum[c] += std::exp(-tau_a) * (value_a * decay + (value_b - value_a) * ramp);
+              continue;
+            }
+            const double log_a = std::log(value_a) - tau_a, log_b = std::log(value_b) - (tau_a + width);
+            const double fa = std::exp(log_a), fb = std::exp(log_b), log_ratio = log_b - log_a;
+            sum[c] += std::abs(log_ratio) < 1e-4 ? 0.5 * width * (fa + fb) : width * (fb - fa) / log_ratio;
+          }
+        }
+        result.Store(x, y, z, vec4(sum, 0.0));
       }
     }
   });
-}
-
-OrderSums Baker::MeasureNewestOrder() {
-  OrderSums sums;
-  for (std::size_t i = 0; i < packing_factor_.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      sums.table[c] += scattering_.texels[4 * i + c];
-      sums.newest[c] += delta_multiple_.texels[4 * i + c] * packing_factor_[i];
-    }
-  }
-  return sums;
-}
-
-void Baker::AddTail(const Spectrum& factor) {
-  for (std::size_t i = 0; i < packing_factor_.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      scattering_.texels[4 * i + c] += float(delta_multiple_.texels[4 * i + c] * packing_factor_[i] * factor[c]);
-    }
-  }
-  // The irradiance table holds one order fewer than the scattering table;
-  // its newest order decays with the same ratio.
-  for (std::size_t i = 0; i < irradiance_.texels.size(); i += 4) {
-    for (int c = 0; c < 3; ++c) irradiance_.texels[i + c] += float(delta_irradiance_.texels[i + c] * factor[c]);
-  }
+  return result;
 }
 
 }  // namespace
@@ -816,6 +1170,8 @@ void BakeSettings::Validate() const {
           "transmittance samples = " + std::to_string(transmittance_samples) + " must be in [8, 100000]");
   require(ray_samples >= 2 && ray_samples <= 100000,
           "ray samples = " + std::to_string(ray_samples) + " must be in [2, 100000]");
+  require(higher_order_divisor >= 1 && higher_order_divisor <= 64,
+          "higher-order divisor = " + std::to_string(higher_order_divisor) + " must be in [1, 64]");
   require(sphere_samples >= 2 && sphere_samples <= 1024,
           "sphere samples = " + std::to_string(sphere_samples) + " must be in [2, 1024]");
   require(threads >= 0, "threads = " + std::to_string(threads) + " must be >= 0");

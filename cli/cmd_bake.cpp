@@ -251,6 +251,7 @@ void RunBake(const BakeOptions& o) {
                                                         s.scattering_mu_s_size, s.scattering_nu_size})}}},
         {"samples",
          {{"transmittance", s.transmittance_samples}, {"ray", s.ray_samples}, {"sphere", s.sphere_samples}}},
+        {"higher_order_divisor", s.higher_order_divisor},
         {"files", files},
         {"half_error", half_errors},
         {"timings", timings},

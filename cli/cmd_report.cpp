@@ -170,7 +170,8 @@ json SettingsJson(const BakeSettings& s) {
           {"scattering_size", {s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size}},
           {"orders", s.orders},
           {"ray_samples", s.ray_samples},
-          {"sphere_samples", s.sphere_samples}};
+          {"sphere_samples", s.sphere_samples},
+          {"higher_order_divisor", s.higher_order_divisor}};
 }
 
 json ReportJson(const std::string& atmosphere, const std::string& reference, const std::vector<Row>& rows,

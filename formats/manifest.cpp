@@ -26,6 +26,7 @@ ordered_json SettingsToJson(const BakeSettings& s, int orders_used) {
                       {"transmittance_samples", s.transmittance_samples},
                       {"ray_samples", s.ray_samples},
                       {"sphere_samples", s.sphere_samples},
+                      {"higher_order_divisor", s.higher_order_divisor},
                       {"pack_single_mie_in_alpha", s.pack_single_mie_in_alpha}};
 }
 
@@ -179,6 +180,7 @@ Manifest ReadManifest(const fs::path& dir) {
     s.transmittance_samples = bake.at("transmittance_samples").get<int>();
     s.ray_samples = bake.at("ray_samples").get<int>();
     s.sphere_samples = bake.at("sphere_samples").get<int>();
+    s.higher_order_divisor = bake.at("higher_order_divisor").get<int>();
     s.pack_single_mie_in_alpha = bake.at("pack_single_mie_in_alpha").get<bool>();
     const glsl::AtmosphereParameters& p = luts.parameters;
     s.transmittance_width = p.transmittance_width;

@@ -76,10 +76,10 @@ std::vector<GroupErrors> MeasureTables(const LutSet& tables, const ReferenceSet&
 
 std::string Describe(const BakeSettings& s) {
   char text[200];
-  std::snprintf(text, sizeof text, "T %dx%d, E %dx%d, S %dx%dx%dx%d, %d ray / %d sphere samples",
+  std::snprintf(text, sizeof text, "T %dx%d, E %dx%d, S %dx%dx%dx%d, %d ray / %d sphere samples, orders >= 2 at 1/%d",
                 s.transmittance_width, s.transmittance_height, s.irradiance_width, s.irradiance_height,
                 s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size,
-                s.ray_samples, s.sphere_samples);
+                s.ray_samples, s.sphere_samples, s.higher_order_divisor);
   return text;
 }
 

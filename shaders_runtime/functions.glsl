@@ -133,6 +133,19 @@ vec2 GetTransmittanceTextureUvFromRMu(IN(AtmosphereParameters) atmosphere, Numbe
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+// mu_s through the distance to the top boundary from the ground, rescaled so
+// that mu_s_min maps to 0 and more texels go to low suns. (Independent of r:
+// the bake maps the sun's cosine along a ray with it alone.)
+Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
+  Number d = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, mu_s);
+  Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+  Number d_max = HorizonDistanceAtTop(atmosphere);
+  Number a = (d - d_min) / (d_max - d_min);
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.mu_s_min);
+  Number A = (D - d_min) / (d_max - d_min);
+  return GetTextureCoordFromUnitRange(max(1.0 - a / A, 0.0) / (1.0 + a), atmosphere.scattering_mu_s_size);
+}
+
 // 4D scattering table, stored as a 3D texture: x packs nu (slowest) and mu_s,
 // y is mu, z is r. Returns (u_nu, u_mu_s, u_mu, u_r) in [0, 1].
 vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
@@ -161,18 +174,8 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
     u_mu = 0.5 + 0.5 * (0.5 / half_mu_size + x * (1.0 - 1.0 / half_mu_size));
   }
 
-  // mu_s through the distance to the top boundary from the ground, rescaled so
-  // that mu_s_min maps to 0 and more texels go to low suns.
-  Number d = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, mu_s);
-  Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
-  Number d_max = H;
-  Number a = (d - d_min) / (d_max - d_min);
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.mu_s_min);
-  Number A = (D - d_min) / (d_max - d_min);
-  Number u_mu_s = GetTextureCoordFromUnitRange(max(1.0 - a / A, 0.0) / (1.0 + a),
-                                               atmosphere.scattering_mu_s_size);
   Number u_nu = (nu + 1.0) / 2.0;
-  return vec4(u_nu, u_mu_s, u_mu, u_r);
+  return vec4(u_nu, GetScatteringTextureUMuS(atmosphere, mu_s), u_mu, u_r);
 }
 #endif
 
