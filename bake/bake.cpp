@@ -11,12 +11,13 @@
 //   its altitude and the sun's zenith angle, not on the view direction, so
 //   the scattering density gathers the incoming radiance once per (r, mu_s)
 //   slice and reuses it for all (mu, nu) view texels of the slice.
-// * Orders are gathered once. Each order's radiance is needed only as the
-//   light the next order scatters, and an integral over the sphere smooths
-//   it, so it is gathered on a grid coarser in r and mu; the scattering
-//   densities of all orders, on the table's grid, are summed and integrated
-//   along the table's rays once at the end (the integral is linear in the
-//   density). docs/benchmark.md measures each choice's time and error.
+// * Gathering is a weighted sum. Along a ray the scattering density J is
+//   taken as linear between samples and the rest of the integrand as
+//   exponential, so the weights are computed once per ray and each of its
+//   texels sums weight times J. Being linear in J, it can also gather the
+//   summed densities of all orders once, when each order's own radiance is
+//   gathered on a coarser grid (BakeSettings::higher_order_divisor).
+//   docs/benchmark.md measures each choice's time and error.
 //
 // Integrals along rays use the exponential trapezoid rule (exact when the
 // integrand varies exponentially between samples, as densities and
@@ -291,6 +292,13 @@ AtmosphereParameters HigherOrderGrid(AtmosphereParameters grid, int divisor) {
   return grid;
 }
 
+// target += source * factor, per channel, over the rgb of every texel.
+void AddScaled(const Texture& source, const Spectrum& factor, Texture& target) {
+  for (std::size_t i = 0; i < target.texels.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) target.texels[i + c] += float(source.texels[i + c] * factor[c]);
+  }
+}
+
 Texture ScatteringGridTexture(const AtmosphereParameters& grid) {
   return Texture(grid.scattering_nu_size * grid.scattering_mu_s_size, grid.scattering_mu_size, grid.scattering_r_size);
 }
@@ -417,12 +425,6 @@ class Baker {
   LutSet AssembleTables(Texture transmittance, Texture irradiance, Texture scattering, Texture single_mie) const;
   double PhaseSecondsSoFar() const;
 
-  void ScatteringTexelGeometry(int x, int y, int z, double& r, double& mu, double& mu_s, double& nu,
-                               bool& intersects_ground) const {
-    ScatteringTexel texel = GetScatteringTexel(params_, x, y, z);
-    r = texel.r, mu = texel.mu, mu_s = texel.mu_s, nu = texel.nu;
-    intersects_ground = texel.ray_intersects_ground;
-  }
   // The ray of a scattering texel row, sampled at n + 1 points.
   RaySamples SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const;
   // The table holds single Rayleigh scattering phase free and the higher
@@ -536,12 +538,12 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     std::string prefix = "order " + std::to_string(order) + ": ";
     Phase(prefix + "scattering density", [&] { ComputeScatteringDensity(order); });
     Phase(prefix + "indirect irradiance", [&] { ComputeIndirectIrradiance(order - 1); });
+    // On the table's grid the orders themselves are summed; on a coarser
+    // one, their densities, for the final gather.
+    const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
     Phase(prefix + "multiple scattering", [&] {
       delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, params_);
-      // On the table's grid the orders themselves are summed; on a coarser
-      // one, their densities, for the final gather.
-      const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
-      for (std::size_t i = 0; i < newest.texels.size(); ++i) higher_orders_.texels[i] += newest.texels[i];
+      AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
     report_.orders_used = order;
     sums.newest = TableMean(delta_multiple_, orders_grid_, orders_packing);
@@ -560,13 +562,8 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
       // The orders not computed: the newest order's density and irradiance
       // times q / (1 - q) per channel.
       Phase("extrapolated orders", [&] {
-        const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
-        for (std::size_t i = 0; i < newest.texels.size(); i += 4) {
-          for (int c = 0; c < 3; ++c) higher_orders_.texels[i + c] += float(newest.texels[i + c] * (*tail)[c]);
-        }
-        for (std::size_t i = 0; i < irradiance_.texels.size(); i += 4) {
-          for (int c = 0; c < 3; ++c) irradiance_.texels[i + c] += float(delta_irradiance_.texels[i + c] * (*tail)[c]);
-        }
+        AddScaled(newest, *tail, higher_orders_);
+        AddScaled(delta_irradiance_, *tail, irradiance_);
       });
       report_.extrapolated_tail = convergence.RelativeTail();
       report_.remaining_error = convergence.TailError();
@@ -663,46 +660,6 @@ RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int 
   return ray;
 }
 
-// The sun's optical depth to the top boundary at one radius, for any mu_s:
-// GetOpticalDepthToTopAtmosphereBoundary with the parts that depend on the
-// radius alone (the r texel row, the range of distances) computed once.
-class SunOpticalDepthAtRadius {
- public:
-  SunOpticalDepthAtRadius(const AtmosphereParameters& params, const Texture& transmittance, double r)
-      : params_(&params), texture_(&transmittance), r_(r) {
-    const double H = glsl::HorizonDistanceAtTop(params), rho = glsl::HorizonDistance(params, r);
-    d_min_ = params.top_radius - r;
-    const double d_max = rho + H;
-    inverse_span_ = d_max > d_min_ ? 1.0 / (d_max - d_min_) : 0.0;
-    double fy;
-    glsl::detail::LinearTaps(glsl::GetTextureCoordFromUnitRange(rho / H, params.transmittance_height),
-                             transmittance.height, y0_, y1_, fy);
-    fy_ = fy;
-  }
-  Spectrum operator()(double mu_s) const {
-    const double d = glsl::DistanceToTopAtmosphereBoundary(*params_, r_, mu_s);
-    const double u = glsl::GetTextureCoordFromUnitRange((d - d_min_) * inverse_span_, params_->transmittance_width);
-    int x0, x1;
-    double fx;
-    glsl::detail::LinearTaps(u, texture_->width, x0, x1, fx);
-    const float* a0 = &texture_->texels[texture_->Index(x0, y0_)];
-    const float* a1 = &texture_->texels[texture_->Index(x1, y0_)];
-    const float* b0 = &texture_->texels[texture_->Index(x0, y1_)];
-    const float* b1 = &texture_->texels[texture_->Index(x1, y1_)];
-    Spectrum tau;
-    for (int c = 0; c < 3; ++c) {
-      tau[c] = (1.0 - fy_) * ((1.0 - fx) * a0[c] + fx * a1[c]) + fy_ * ((1.0 - fx) * b0[c] + fx * b1[c]);
-    }
-    return tau;
-  }
-
- private:
-  const AtmosphereParameters* params_;
-  const Texture* texture_;
-  double r_, d_min_ = 0.0, inverse_span_ = 0.0, fy_ = 0.0;
-  int y0_ = 0, y1_ = 0;
-};
-
 void Baker::ComputeSingleScattering() {
   const int mu_size = params_.scattering_mu_size, r_size = params_.scattering_r_size;
   const int mu_s_size = params_.scattering_mu_s_size, nu_size = params_.scattering_nu_size;
@@ -720,13 +677,10 @@ void Baker::ComputeSingleScattering() {
     std::vector<std::vector<Spectrum>> base(groups, std::vector<Spectrum>(n + 1));
     std::vector<std::vector<Spectrum>> log_ratio(groups, std::vector<Spectrum>(n, Spectrum(0.0)));
     std::vector<Spectrum> view_transmittance(n + 1);
-    std::vector<SunOpticalDepthAtRadius> sun_depth;
     std::vector<bool> thin(n);  // interval less than one optical depth thick for the view
-    sun_depth.reserve(n + 1);
     for (int k = 0; k <= n; ++k) {
       view_transmittance[k] = glm::exp(-ray.optical_depth[k]);
       for (int g = 0; g < groups; ++g) base[g][k] = ray.scattering[g][k] * view_transmittance[k];
-      sun_depth.emplace_back(params_, transmittance_, ray.radius[k]);
     }
     for (int k = 0; k < n; ++k) {
       Spectrum view_depth = ray.optical_depth[k + 1] - ray.optical_depth[k];
@@ -759,7 +713,9 @@ void Baker::ComputeSingleScattering() {
           for (int k = 0; k <= n; ++k) {
             double mu_s_k = glsl::ClampCosine((r * mu_s + ray.t[k] * nu) / ray.radius[k]);
             visible[k] = glsl::SunVisibleFraction(params_, ray.radius[k], mu_s_k);
-            tau_sun[k] = visible[k] > 0.0 ? sun_depth[k](mu_s_k) : Spectrum(0.0);
+            tau_sun[k] = visible[k] > 0.0 ? glsl::GetOpticalDepthToTopAtmosphereBoundary(params_, transmittance,
+                                                                                        ray.radius[k], mu_s_k)
+                                          : Spectrum(0.0);
             sun_transmittance[k] = visible[k] > 0.0 ? glm::exp(-tau_sun[k]) : Spectrum(0.0);
           }
           // Scattered light at distance t along the ray, per group kind (the
