@@ -2,10 +2,15 @@
 
 #include <algorithm>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
 #include "bake/errors.h"
 #include "formats/file_io.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
+#include "formats/sha256.h"
 
 namespace fs = std::filesystem;
 
@@ -41,19 +46,50 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
   // waits until the set is committed or its temporaries removed.
   DeferInterrupts defer_interrupts;
   StagedFiles staged;
-  for (const TableDescription& table : DescribeTables(luts)) {
-    const bool half = options.half || std::find(options.half_tables.begin(), options.half_tables.end(),
-                                                table.name) != options.half_tables.end();
-    const PixelType type = half ? PixelType::kHalf : PixelType::kFloat;
+  // Each table file is encoded and hashed on its own thread (zip
+  // compression of the EXR files is most of the writing), then written in
+  // a fixed order.
+  struct Encoded {
+    const TableDescription* table;
+    FileFormat format;
+    PixelType type;
+    TableImage image;
+    std::vector<std::uint8_t> bytes;
+    std::string sha256;
+  };
+  const std::vector<TableDescription> tables = DescribeTables(luts);
+  std::vector<Encoded> files;
+  auto is_half = [&](const TableDescription& table) {
+    return options.half ||
+           std::find(options.half_tables.begin(), options.half_tables.end(), table.name) != options.half_tables.end();
+  };
+  for (const TableDescription& table : tables) {
     for (FileFormat format : options.formats) {
-      const TableImage image = MakeTableImage(luts, table, format, type);
-      const std::vector<std::uint8_t> bytes = EncodeTableImage(image);
-      const std::string file = table.name + FileExtension(format);
-      staged.Write(dir / file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-      manifest.AddTableFile(table, file, image, bytes);
-      report.files.push_back({table.name, file, bytes.size()});
+      files.push_back({&table, format, is_half(table) ? PixelType::kHalf : PixelType::kFloat, {}, {}, {}});
     }
-    if (half) {
+  }
+  // One file per task (the default partitioner would hand both large EXR
+  // files, neighbours in the list, to the same thread).
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, files.size(), 1),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          Encoded& f = files[i];
+          f.image = MakeTableImage(luts, *f.table, f.format, f.type);
+          f.bytes = EncodeTableImage(f.image);
+          f.sha256 = Sha256Hex(f.bytes.data(), f.bytes.size());
+        }
+      },
+      tbb::simple_partitioner());
+  for (Encoded& f : files) {
+    const std::string file = f.table->name + FileExtension(f.format);
+    staged.Write(dir / file, std::string_view(reinterpret_cast<const char*>(f.bytes.data()), f.bytes.size()));
+    manifest.AddTableFile(*f.table, file, f.image, f.bytes.size(), f.sha256);
+    report.files.push_back({f.table->name, file, f.bytes.size()});
+    f.bytes = {}, f.image = {};
+  }
+  for (const TableDescription& table : tables) {
+    if (is_half(table)) {
       const TableImage image = MakeTableImage(luts, table, options.formats.front(), PixelType::kFloat);
       report.half_errors.emplace_back(table.name, MeasureHalfError(image.values));
     }

@@ -89,7 +89,7 @@ ManifestWriter::ManifestWriter(const LutSet& luts, std::string command_line)
 }
 
 void ManifestWriter::AddTableFile(const TableDescription& table, const std::string& file, const TableImage& image,
-                                  const std::vector<std::uint8_t>& bytes) {
+                                  std::size_t bytes, const std::string& sha256) {
   auto entry = std::find_if(tables_.begin(), tables_.end(), [&](const ordered_json& t) { return t["name"] == table.name; });
   if (entry == tables_.end()) throw InternalError("manifest: no table " + table.name);
   ordered_json f = {{"file", file},
@@ -101,8 +101,8 @@ void ManifestWriter::AddTableFile(const TableDescription& table, const std::stri
   if (image.format == FileFormat::kExr && image.is_3d) {
     f["atlas"] = ordered_json::array({image.width, image.height * image.depth});
   }
-  f["bytes"] = bytes.size();
-  f["sha256"] = Sha256Hex(bytes.data(), bytes.size());
+  f["bytes"] = bytes;
+  f["sha256"] = sha256;
   (*entry)["files"].push_back(f);
 }
 

@@ -28,9 +28,9 @@ class ManifestWriter {
  public:
   ManifestWriter(const LutSet& luts, std::string command_line);
 
-  // A table file as written (`bytes` are its whole content, hashed here).
+  // A table file as written: its size in bytes and their SHA-256 (hex).
   void AddTableFile(const TableDescription& table, const std::string& file, const TableImage& image,
-                    const std::vector<std::uint8_t>& bytes);
+                    std::size_t bytes, const std::string& sha256);
   // Any other file shipped beside the tables, such as the generated GLSL
   // runtime: one call lists it under "shaders" with its size and SHA-256.
   void AddShaderFile(const std::string& file, std::string_view bytes, const std::string& description);
