@@ -344,8 +344,7 @@ SunDirections RaySunDirections(const SunColumns& columns, double mu) {
     for (int nu_index = 0; nu_index < columns.nu_size; ++nu_index) {
       const int x = nu_index * columns.mu_s_size + mu_s_index;
       const double mu_s = columns.mu_s[x];
-      const double spread = std::sqrt(std::max(0.0, (1.0 - mu * mu) * (1.0 - mu_s * mu_s)));
-      const double nu = std::clamp(columns.grid_nu[x], mu * mu_s - spread, mu * mu_s + spread);
+      const double nu = ClampedNu(columns.grid_nu[x], mu, mu_s);
       if (nu_index == 0 || nu != directions.nu.back()) {
         directions.mu_s.push_back(mu_s);
         directions.nu.push_back(nu);
@@ -678,9 +677,22 @@ class Baker {
            glsl::RayleighPhaseFunction(GetScatteringTexel(grid, nu_index * grid.scattering_mu_s_size, 0, 0).grid_nu);
   }
 
-  // Radiance of scattering order `order` arriving at radius r from direction
-  // (mu, nu) with the sun at mu_s, excluding light reflected by the ground.
-  vec3 IncidentRadiance(int order, double r, double mu, double mu_s, double nu, bool intersects_ground) const;
+  // Radiance of scattering order `order` arriving at radius r from the
+  // directions with zenith cosine mu, with the sun at mu_s, excluding light
+  // reflected by the ground, as a function of nu (the cosine between the
+  // direction and the sun): the table lookups that do not depend on nu are
+  // done once, for all the azimuths of a ring of directions.
+  class IncidentAlongNu {
+   public:
+    IncidentAlongNu(const Baker& baker, int order, double r, double mu, double mu_s, bool intersects_ground);
+    vec3 At(double nu) const;
+
+   private:
+    const AtmosphereParameters& params_;
+    bool single_;  // order 1: Rayleigh and Mie tables, phases applied here
+    int nu_size_ = 0;
+    std::vector<vec3> first_, second_;  // per nu slice 0 ... nu_size
+  };
   // Irradiance of order `order` on the ground where the sun is at mu_s.
   vec3 GroundIrradiance(int order, double mu_s) const;
   vec3 DirectIrradiance(double r, double mu_s) const;
@@ -1217,13 +1229,37 @@ vec3 Baker::GroundIrradiance(int order, double mu_s) const {
   return glsl::GetIrradiance(params_, glsl::sampler2D{&delta_irradiance_}, params_.bottom_radius, mu_s);
 }
 
-vec3 Baker::IncidentRadiance(int order, double r, double mu, double mu_s, double nu, bool intersects_ground) const {
-  if (order == 1) {
-    vec3 rayleigh(glsl::GetScattering(params_, glsl::sampler3D{&single_rayleigh_}, r, mu, mu_s, nu, intersects_ground));
-    vec3 mie(glsl::GetScattering(params_, glsl::sampler3D{&single_mie_}, r, mu, mu_s, nu, intersects_ground));
-    return rayleigh * glsl::RayleighPhaseFunction(nu) + mie * glsl::MiePhaseFunction(params_, nu);
+Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r, double mu, double mu_s,
+                                        bool intersects_ground)
+    : params_(baker.params_), single_(order == 1) {
+  const AtmosphereParameters& grid = single_ ? baker.params_ : baker.orders_grid_;
+  nu_size_ = grid.scattering_nu_size;
+  // glsl::GetScattering's lookups of the nu slices 0 ... nu_size (the last
+  // clamped to the edge, as the texture unit does), which nu only blends.
+  const vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(grid, r, mu, mu_s, 0.0, intersects_ground);
+  auto slices = [&](const Texture& table, std::vector<vec3>& out) {
+    for (int slice = 0; slice <= nu_size_; ++slice) {
+      const glsl::vec3 uvw((slice + uvwz.y) / nu_size_, uvwz.z, uvwz.w);
+      out.push_back(vec3(glsl::texture(glsl::sampler3D{&table}, uvw)));
+    }
+  };
+  if (single_) {
+    slices(baker.single_rayleigh_, first_);
+    slices(baker.single_mie_, second_);
+  } else {
+    slices(baker.delta_multiple_, first_);
   }
-  return vec3(glsl::GetScattering(orders_grid_, glsl::sampler3D{&delta_multiple_}, r, mu, mu_s, nu, intersects_ground));
+}
+
+vec3 Baker::IncidentAlongNu::At(double nu) const {
+  // glsl::GetScattering's blend of the two slices around nu.
+  const double coordinate = (nu + 1.0) / 2.0 * (nu_size_ - 1);
+  const double slice = std::floor(coordinate), lerp = coordinate - slice;
+  const int i = std::clamp(static_cast<int>(slice), 0, nu_size_ - 1);
+  const vec3 first = first_[i] * (1.0 - lerp) + first_[i + 1] * lerp;
+  if (!single_) return first;
+  const vec3 mie = second_[i] * (1.0 - lerp) + second_[i + 1] * lerp;
+  return first * glsl::RayleighPhaseFunction(nu) + mie * glsl::MiePhaseFunction(params_, nu);
 }
 
 void Baker::ComputeScatteringDensity(int order) {
@@ -1236,6 +1272,7 @@ void Baker::ComputeScatteringDensity(int order) {
   const vec3 albedo_over_pi = medium_.atmosphere().ground_albedo / kPi;
   const glsl::sampler2D transmittance{&transmittance_};
 
+  const SunColumns columns(grid);
   tbb::parallel_for(0, r_size * mu_s_size, [&](int slice) {
     int z = slice / mu_s_size, mu_s_index = slice % mu_s_size;
     const ScatteringTexel slice_texel = GetScatteringTexel(grid, mu_s_index, 0, z);
@@ -1265,11 +1302,12 @@ void Baker::ComputeScatteringDensity(int order) {
         ground_distance = glsl::DistanceToBottomAtmosphereBoundary(params_, r, cos_theta);
         ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
       }
+      const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
       for (int m = 0; m < azimuths; ++m) {
         double phi = (m + 0.5) * d_phi;
         vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
         double nu = glsl::ClampCosine(glm::dot(omega, sun));
-        vec3 incident = IncidentRadiance(order - 1, r, cos_theta, mu_s, nu, intersects);
+        vec3 incident = incident_ring.At(nu);
         if (intersects) {
           vec3 ground_normal = glm::normalize(zenith * r + omega * ground_distance);
           double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
@@ -1292,10 +1330,10 @@ void Baker::ComputeScatteringDensity(int order) {
 
     const PhaseWeightedRadiance incoming(directions, radiance, solid_angles);
     for (int y = 0; y < mu_size; ++y) {
+      const double mu = GetScatteringTexel(grid, mu_s_index, y, z).mu;
       for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
         int x = nu_index * mu_s_size + mu_s_index;
-        const ScatteringTexel texel = GetScatteringTexel(grid, x, y, z);
-        const double mu = texel.mu, nu = texel.nu;
+        const double nu = ClampedNu(columns.grid_nu[x], mu, mu_s);
         // View direction with zenith cosine mu and sun cosine nu.
         double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
         double sin_mu_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
@@ -1334,11 +1372,12 @@ void Baker::ComputeIndirectIrradiance(int order) {
       for (int l = 0; l < polar; ++l) {
         double theta = (l + 0.5) * d_theta;
         double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+        const IncidentAlongNu incident_ring(*this, order, r, cos_theta, mu_s, false);
         for (int m = 0; m < azimuths; ++m) {
           double phi = (m + 0.5) * d_phi;
           vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
           double nu = glsl::ClampCosine(glm::dot(omega, sun));
-          result += IncidentRadiance(order, r, cos_theta, mu_s, nu, false) * (cos_theta * sin_theta * d_theta * d_phi);
+          result += incident_ring.At(nu) * (cos_theta * sin_theta * d_theta * d_phi);
         }
       }
       delta_irradiance_.Store(x, y, 0, vec4(result, 0.0));
@@ -1508,9 +1547,13 @@ ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters,
   ScatteringTexel t;
   glsl::GetRMuMuSNuFromScatteringTextureUvwz(parameters, uvwz, t.r, t.mu, t.mu_s, t.grid_nu,
                                              t.ray_intersects_ground);
-  double spread = std::sqrt(std::max(0.0, (1.0 - t.mu * t.mu) * (1.0 - t.mu_s * t.mu_s)));
-  t.nu = std::clamp(t.grid_nu, t.mu * t.mu_s - spread, t.mu * t.mu_s + spread);
+  t.nu = ClampedNu(t.grid_nu, t.mu, t.mu_s);
   return t;
+}
+
+double ClampedNu(double nu, double mu, double mu_s) {
+  const double spread = std::sqrt(std::max(0.0, (1.0 - mu * mu) * (1.0 - mu_s * mu_s)));
+  return std::clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
 }
 
 void BakeSettings::Validate() const {

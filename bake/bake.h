@@ -126,6 +126,8 @@ struct ScatteringTexel {
   bool ray_intersects_ground = false;
 };
 ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z);
+// nu clamped to the range that the view and sun cosines mu and mu_s allow.
+double ClampedNu(double nu, double mu, double mu_s);
 
 // The runtime constants for an atmosphere and table sizes (also used by
 // loaders that rebuild a LutSet from files).
