@@ -304,10 +304,22 @@ AtmosphereParameters HigherOrderGrid(AtmosphereParameters grid, int divisor) {
 }
 
 // target += source * factor, per channel, over the rgb of every texel.
+// f(row, first, end) over the rows of a texture (y and z) in parallel:
+// first and end are the row's texel offsets into texels.
+template <typename F>
+void ForEachRow(const Texture& texture, F&& f) {
+  const std::size_t row_size = std::size_t(4) * texture.width;
+  tbb::parallel_for(0, texture.height * texture.depth, [&](int row) {
+    f(row, row * row_size, (row + 1) * row_size);
+  });
+}
+
 void AddScaled(const Texture& source, const Spectrum& factor, Texture& target) {
-  for (std::size_t i = 0; i < target.texels.size(); i += 4) {
-    for (int c = 0; c < 3; ++c) target.texels[i + c] += float(source.texels[i + c] * factor[c]);
-  }
+  ForEachRow(target, [&](int, std::size_t first, std::size_t end) {
+    for (std::size_t i = first; i < end; i += 4) {
+      for (int c = 0; c < 3; ++c) target.texels[i + c] += float(source.texels[i + c] * factor[c]);
+    }
+  });
 }
 
 Texture ScatteringGridTexture(const AtmosphereParameters& grid) {
@@ -840,11 +852,12 @@ Texture Baker::ScatteringTable() const {
   const Texture higher = GatherAtEnd() ? GatherAlongRays(params_, higher_orders_, params_) : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;
   const std::vector<double> packing = PackingFactors(params_);
-  for (std::size_t i = 0; i < table.texels.size(); i += 4) {
-    const int x = int((i / 4) % table.width);
-    const double factor = packing[x / mu_s_size];
-    for (int c = 0; c < 3; ++c) table.texels[i + c] += float(higher.texels[i + c] * factor);
-  }
+  ForEachRow(table, [&](int, std::size_t first, std::size_t end) {
+    for (std::size_t i = first; i < end; i += 4) {
+      const double factor = packing[(i - first) / 4 / mu_s_size];
+      for (int c = 0; c < 3; ++c) table.texels[i + c] += float(higher.texels[i + c] * factor);
+    }
+  });
   return table;
 }
 
@@ -856,12 +869,18 @@ std::vector<double> Baker::PackingFactors(const AtmosphereParameters& grid) {
 
 Spectrum Baker::TableMean(const Texture& table, const AtmosphereParameters& grid, const std::vector<double>& per_nu) {
   const int mu_s_size = grid.scattering_mu_s_size;
+  // Per row, then the rows in order: the same sum whatever the threads do.
+  std::vector<Spectrum> row_sums(std::size_t(table.height) * table.depth, Spectrum(0.0));
+  ForEachRow(table, [&](int row, std::size_t first, std::size_t end) {
+    Spectrum sum(0.0);
+    for (std::size_t i = first; i < end; i += 4) {
+      const double factor = per_nu.empty() ? 1.0 : per_nu[(i - first) / 4 / mu_s_size];
+      for (int c = 0; c < 3; ++c) sum[c] += table.texels[i + c] * factor;
+    }
+    row_sums[row] = sum;
+  });
   Spectrum sum(0.0);
-  for (std::size_t i = 0; i < table.texels.size(); i += 4) {
-    const int x = int((i / 4) % table.width);
-    const double factor = per_nu.empty() ? 1.0 : per_nu[x / mu_s_size];
-    for (int c = 0; c < 3; ++c) sum[c] += table.texels[i + c] * factor;
-  }
+  for (const Spectrum& row_sum : row_sums) sum += row_sum;
   return sum / double(table.texels.size() / 4);
 }
 
