@@ -53,7 +53,7 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
                   "Polar directions for integrals over the sphere (azimuths: twice as many)")
       ->capture_default_str();
   cmd->add_option("--higher-order-divisor", settings.higher_order_divisor,
-                  "Orders >= 2 on a grid with the scattering r, mu and mu_s sizes divided by this (1 = full)")
+                  "Orders >= 2 on a grid with the scattering r and mu sizes divided by this (1 = full)")
       ->capture_default_str();
   cmd->add_flag("--pack-mie", settings.pack_single_mie_in_alpha,
                 "Store single Mie's red channel in the scattering table's alpha instead of a separate table");
