@@ -1,6 +1,6 @@
 // The CPU bake. The structure follows Bruneton's precomputation (transmittance,
 // single scattering, then per order: scattering density, indirect irradiance,
-// multiple scattering), with three CPU-specific choices:
+// multiple scattering), with four CPU-specific choices:
 //
 // * Rays are shared. Every texel of the 4D table with the same (r, mu) looks
 //   along the same ray, so the samples along it, the densities and the
@@ -17,6 +17,9 @@
 //   texels sums weight times J. Being linear in J, it can also gather the
 //   summed densities of all orders once, when each order's own radiance is
 //   gathered on a coarser grid (BakeSettings::higher_order_divisor).
+// * The innermost loops run over a ray's sun directions, in float, and
+//   vectorise (bake/float_math.h); the geometry that decides the planet's
+//   shadow stays in double.
 //   docs/benchmark.md measures each choice's time and error.
 //
 // Integrals along rays use the exponential trapezoid rule (exact when the
