@@ -516,17 +516,18 @@ class MuSCoordinate {
   explicit MuSCoordinate(const AtmosphereParameters& grid) {
     const double top = grid.top_radius, bottom = grid.bottom_radius;
     const double d_min = top - bottom, d_max = glsl::HorizonDistanceAtTop(grid);
-    const double big_d = glsl::DistanceToTopAtmosphereBoundary(grid, bottom, grid.mu_s_min);
+    const double big_d = glsl::DistanceToTopAtmosphereBoundary(grid, bottom, grid.scattering_mu_s_min);
     bottom_ = float(bottom), c_ = float((top - bottom) * (top + bottom)), d_min_ = float(d_min);
     inverse_span_ = float(1.0 / (d_max - d_min)), inverse_a_ = float((d_max - d_min) / (big_d - d_min));
     last_ = float(grid.scattering_mu_s_size - 1), last_left_ = grid.scattering_mu_s_size - 2;
+    scale_ = float((grid.scattering_mu_s_size - 1) / glsl::GetScatteringUnitMuS(grid, grid.scattering_mu_s_max));
   }
   // For `count` sun cosines: the position along the mu_s axis in texels
   // (in [0, size - 1]) split into a left tap (whose right neighbour exists)
   // and the weight of the right one.
   void Taps(const float* mu_s, int count, int* left, float* weight) const {
     const float bottom = bottom_, c = c_, d_min = d_min_, inverse_span = inverse_span_, inverse_a = inverse_a_;
-    const float last = last_;
+    const float last = last_, scale = scale_;
     const int last_left = last_left_;
 #pragma omp simd
     for (int j = 0; j < count; ++j) {
@@ -534,7 +535,7 @@ class MuSCoordinate {
       const float s = std::sqrt(std::max(r_mu * r_mu + c, 0.0f));
       const float d = std::max(r_mu > 0.0f ? c / (r_mu + s) : s - r_mu, 0.0f);
       const float a = (d - d_min) * inverse_span;
-      const float position = ClampFloat(std::max(1.0f - a * inverse_a, 0.0f) / (1.0f + a) * last, 0.0f, last);
+      const float position = ClampFloat(std::max(1.0f - a * inverse_a, 0.0f) / (1.0f + a) * scale, 0.0f, last);
       const int i = std::min(static_cast<int>(position), last_left);
       left[j] = i;
       weight[j] = position - float(i);
@@ -542,7 +543,7 @@ class MuSCoordinate {
   }
 
  private:
-  float bottom_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, inverse_span_ = 0.0f, inverse_a_ = 0.0f, last_ = 0.0f;
+  float bottom_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, inverse_span_ = 0.0f, inverse_a_ = 0.0f, last_ = 0.0f, scale_ = 0.0f;
   int last_left_ = 0;
 };
 
@@ -634,7 +635,8 @@ class Baker {
       : medium_(atmosphere),
         settings_(settings),
         params_(MakeAtmosphereParameters(atmosphere, settings)),
-        orders_grid_(HigherOrderGrid(params_, settings.higher_order_divisor)) {}
+        atmosphere_grid_(AtmosphereGrid(atmosphere, settings)),
+        orders_grid_(HigherOrderGrid(atmosphere_grid_, settings.higher_order_divisor)) {}
 
   LutSet Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot);
 
@@ -642,12 +644,19 @@ class Baker {
   template <typename F>
   void Phase(const std::string& name, F&& work);
 
+  // Single scattering on a grid, Rayleigh (the other groups) and Mie apart,
+  // both phase free.
+  struct SingleScattering {
+    Texture rayleigh, mie;
+  };
+
   void ComputeTransmittance();
-  void ComputeSingleScattering();
-  // Single scattering of the texels of one ray (mu index y, r index z).
-  // `columns`: the table's sun directions; `transmittance`: the
-  // transmittance table's channels.
-  void SingleScatteringAlongRay(int y, int z, const SunColumns& columns, const ChannelPlanes& transmittance);
+  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid) const;
+  // Single scattering of the texels of one ray of `grid` (mu index y, r
+  // index z) into `out`. `columns`: the grid's sun directions;
+  // `transmittance`: the transmittance table's channels.
+  void SingleScatteringAlongRay(const AtmosphereParameters& grid, int y, int z, const SunColumns& columns,
+                                const ChannelPlanes& transmittance, SingleScattering& out) const;
   // Single scattering over interval k of a ray for one sun direction, in
   // double, for the intervals SingleScatteringAlongRay does not vectorise:
   // optically thick, partly shadowed or crossed by the shadow edge.
@@ -662,10 +671,15 @@ class Baker {
   // each texel's ray.
   Texture GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
                           const AtmosphereParameters& density_grid) const;
-  // Whether the orders are gathered on a coarser grid than the table's, so
+  // Whether the table covers less than the whole atmosphere (a scene's bake):
+  // its grid is then not the one the orders are computed on.
+  bool TableRestricted() const { return settings_.scattering_range.has_value(); }
+  // Whether the orders are gathered on another grid than the table's, so
   // that the table's higher orders come from one gather of their summed
   // densities at the end.
-  bool GatherAtEnd() const { return settings_.higher_order_divisor > 1; }
+  bool GatherAtEnd() const { return settings_.higher_order_divisor > 1 || TableRestricted(); }
+  // Single scattering on the atmosphere's grid, the light of order 1.
+  const SingleScattering& GridSingle() const { return TableRestricted() ? grid_single_ : single_; }
   // The scattering table: single Rayleigh plus the higher orders.
   Texture ScatteringTable() const;
   // MultipleScatteringPackingFactor per nu index of a grid.
@@ -715,7 +729,11 @@ class Baker {
 
   Medium medium_;
   BakeSettings settings_;
-  AtmosphereParameters params_;
+  AtmosphereParameters params_;  // the tables'
+  // The grid over the whole atmosphere that each order's scattering density
+  // lives on: the table's, or for a table restricted to a scene's ranges
+  // one with BakeSettings::ScatteringRange's sizes.
+  AtmosphereParameters atmosphere_grid_;
   // The grid of each order's radiance (BakeSettings::higher_order_divisor).
   AtmosphereParameters orders_grid_;
   BakeReport report_;
@@ -723,12 +741,13 @@ class Baker {
 
   Texture transmittance_;
   Texture irradiance_;
-  Texture single_mie_;            // single scattering of the Mie group, phase free
-  Texture single_rayleigh_;       // single scattering of the other groups / Rayleigh phase
+  SingleScattering single_;       // on the table's grid
+  SingleScattering grid_single_;  // on atmosphere_grid_ where the table is restricted
   Texture delta_multiple_;        // radiance of the latest order >= 2, on orders_grid_
-  Texture scattering_density_;    // J of the current order per unit scattering coefficient
+  // J of the current order per unit scattering coefficient, on atmosphere_grid_.
+  Texture scattering_density_;
   // Sum over the orders >= 2 so far, and their tail, of their radiance, or
-  // of their J where GatherAtEnd(); on the table's grid.
+  // of their J where GatherAtEnd(); on atmosphere_grid_.
   Texture higher_orders_;
   Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
 };
@@ -770,7 +789,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   progress_ = progress;
   auto snapshot = [&](int order) {
     if (order_snapshot) {
-      LutSet tables = AssembleTables(transmittance_, irradiance_, ScatteringTable(), single_mie_);
+      LutSet tables = AssembleTables(transmittance_, irradiance_, ScatteringTable(), single_.mie);
       tables.settings.orders = order;  // exactly these orders, no tail
       tables.settings.extrapolate_tail = false;
       order_snapshot(order, tables, PhaseSecondsSoFar());
@@ -780,14 +799,15 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   const BakeSettings& s = settings_;
   transmittance_ = Texture(s.transmittance_width, s.transmittance_height);
   irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
-  single_mie_ = ScatteringGridTexture(params_);
-  single_rayleigh_ = ScatteringGridTexture(params_);
 
   Phase("transmittance", [&] { ComputeTransmittance(); });
-  Phase("single scattering", [&] { ComputeSingleScattering(); });
+  Phase("single scattering", [&] { single_ = ComputeSingleScattering(params_); });
+  if (s.orders != 1 && TableRestricted()) {
+    Phase("single scattering, whole atmosphere", [&] { grid_single_ = ComputeSingleScattering(atmosphere_grid_); });
+  }
   if (s.orders != 1) {  // 0 = auto
-    scattering_density_ = ScatteringGridTexture(params_);
-    higher_orders_ = ScatteringGridTexture(params_);
+    scattering_density_ = ScatteringGridTexture(atmosphere_grid_);
+    higher_orders_ = ScatteringGridTexture(atmosphere_grid_);
     delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
   }
   report_.orders_used = 1;
@@ -797,7 +817,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   OrderConvergence convergence;
   // Convergence is measured on means over the tables (each order's on its own grid).
   OrderSums sums;
-  sums.table = TableMean(single_rayleigh_, params_, {});
+  sums.table = TableMean(GridSingle().rayleigh, atmosphere_grid_, {});
   const std::vector<double> orders_packing = PackingFactors(orders_grid_);
   const bool gather_at_end = GatherAtEnd();
   for (int order = 2; order <= (auto_orders ? s.max_orders : s.orders); ++order) {
@@ -808,7 +828,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     // one, their densities, for the final gather.
     const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
     Phase(prefix + "multiple scattering", [&] {
-      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, params_);
+      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, atmosphere_grid_);
       AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
     report_.orders_used = order;
@@ -844,16 +864,16 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   }
 
   LutSet result = AssembleTables(std::move(transmittance_), std::move(irradiance_), std::move(scattering),
-                                 std::move(single_mie_));
+                                 std::move(single_.mie));
   report_.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (report) *report = report_;
   return result;
 }
 
 Texture Baker::ScatteringTable() const {
-  Texture table = single_rayleigh_;
+  Texture table = single_.rayleigh;
   if (report_.orders_used < 2) return table;
-  const Texture higher = GatherAtEnd() ? GatherAlongRays(params_, higher_orders_, params_) : higher_orders_;
+  const Texture higher = GatherAtEnd() ? GatherAlongRays(params_, higher_orders_, atmosphere_grid_) : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;
   const std::vector<double> packing = PackingFactors(params_);
   ForEachRow(table, [&](int, std::size_t first, std::size_t end) {
@@ -933,20 +953,25 @@ RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int 
   return ray;
 }
 
-void Baker::ComputeSingleScattering() {
-  const int mu_size = params_.scattering_mu_size, r_size = params_.scattering_r_size;
+Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameters& grid) const {
+  const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const ChannelPlanes transmittance(transmittance_);
-  const SunColumns columns(params_);
+  const SunColumns columns(grid);
+  SingleScattering result{ScatteringGridTexture(grid), ScatteringGridTexture(grid)};
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
-    SingleScatteringAlongRay(ray_index % mu_size, ray_index / mu_size, columns, transmittance);
+    SingleScatteringAlongRay(grid, ray_index % mu_size, ray_index / mu_size, columns, transmittance, result);
   });
+  return result;
 }
 
-void Baker::SingleScatteringAlongRay(int y, int z, const SunColumns& columns, const ChannelPlanes& transmittance) {
+void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int y, int z, const SunColumns& columns,
+                                     const ChannelPlanes& transmittance, SingleScattering& out) const {
   const int groups = static_cast<int>(medium_.groups().size());
   const int mie = medium_.mie_group();
-  const int n = settings_.ray_samples;
-  const RaySamples ray = SampleRay(params_, y, z, n);
+  // The grid under a restricted table feeds only the next order, through
+  // an integral over the sphere, and takes fewer intervals.
+  const int n = &grid == &params_ ? settings_.ray_samples : settings_.scattering_range->atmosphere_ray_samples;
+  const RaySamples ray = SampleRay(grid, y, z, n);
   const SunDirections directions = RaySunDirections(columns, ray.mu);
   const int count = static_cast<int>(directions.mu_s.size());
 
@@ -1176,8 +1201,8 @@ void Baker::SingleScatteringAlongRay(int y, int z, const SunColumns& columns, co
   for (int x = 0; x < int(directions.of_texel.size()); ++x) {
     const int j = directions.of_texel[x];
     const vec3 rayleigh(sums[0][0][j], sums[0][1][j], sums[0][2][j]), mie_sum(sums[1][0][j], sums[1][1][j], sums[1][2][j]);
-    single_rayleigh_.Store(x, y, z, vec4(rayleigh * params_.solar_irradiance, 0.0));
-    single_mie_.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
+    out.rayleigh.Store(x, y, z, vec4(rayleigh * params_.solar_irradiance, 0.0));
+    out.mie.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
   }
 }
 
@@ -1254,7 +1279,7 @@ vec3 Baker::GroundIrradiance(int order, double mu_s) const {
 Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r, double mu, double mu_s,
                                         bool intersects_ground)
     : params_(baker.params_), single_(order == 1) {
-  const AtmosphereParameters& grid = single_ ? baker.params_ : baker.orders_grid_;
+  const AtmosphereParameters& grid = single_ ? baker.atmosphere_grid_ : baker.orders_grid_;
   nu_size_ = grid.scattering_nu_size;
   // glsl::GetScattering's lookups of the nu slices 0 ... nu_size (the last
   // clamped to the edge, as the texture unit does), which nu only blends.
@@ -1266,8 +1291,8 @@ Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r,
     }
   };
   if (single_) {
-    slices(baker.single_rayleigh_, first_);
-    slices(baker.single_mie_, second_);
+    slices(baker.GridSingle().rayleigh, first_);
+    slices(baker.GridSingle().mie, second_);
   } else {
     slices(baker.delta_multiple_, first_);
   }
@@ -1285,7 +1310,7 @@ vec3 Baker::IncidentAlongNu::At(double nu) const {
 }
 
 void Baker::ComputeScatteringDensity(int order) {
-  const AtmosphereParameters& grid = params_;
+  const AtmosphereParameters& grid = atmosphere_grid_;
   const int mu_s_size = grid.scattering_mu_s_size, r_size = grid.scattering_r_size;
   const int nu_size = grid.scattering_nu_size, mu_size = grid.scattering_mu_size;
   const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
@@ -1610,6 +1635,22 @@ void BakeSettings::Validate() const {
   require(sphere_samples >= 2 && sphere_samples <= 1024,
           "sphere samples = " + std::to_string(sphere_samples) + " must be in [2, 1024]");
   require(threads >= 0, "threads = " + std::to_string(threads) + " must be >= 0");
+  if (const std::optional<ScatteringRange>& range = scattering_range) {
+    require(range->altitude_min_m >= 0.0 && range->altitude_min_m < range->altitude_max_m,
+            "scattering altitude range [" + std::to_string(range->altitude_min_m) + ", " +
+                std::to_string(range->altitude_max_m) + "] m must be non-empty and above the ground");
+    require(range->mu_s_min >= -1.0 && range->mu_s_min < range->mu_s_max && range->mu_s_max <= 1.0,
+            "scattering mu_s range [" + std::to_string(range->mu_s_min) + ", " + std::to_string(range->mu_s_max) +
+                "] must be non-empty and within [-1, 1]");
+    size(range->atmosphere_r_size, 2, "scattering r size over the atmosphere");
+    size(range->atmosphere_mu_size, 4, "scattering mu size over the atmosphere");
+    size(range->atmosphere_mu_s_size, 2, "scattering mu_s size over the atmosphere");
+    require(range->atmosphere_ray_samples >= 2 && range->atmosphere_ray_samples <= 100000,
+            "ray samples over the atmosphere = " + std::to_string(range->atmosphere_ray_samples) +
+                " must be in [2, 100000]");
+    require(range->atmosphere_mu_size % 2 == 0, "scattering mu size over the atmosphere = " +
+                                                    std::to_string(range->atmosphere_mu_size) + " must be even");
+  }
 }
 
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings) {
@@ -1653,8 +1694,28 @@ glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere
   p.scattering_nu_size = settings.scattering_nu_size;
   p.irradiance_width = settings.irradiance_width;
   p.irradiance_height = settings.irradiance_height;
+  p.scattering_r_min = atmosphere.bottom_radius_m;
+  p.scattering_r_max = atmosphere.top_radius_m;
+  p.scattering_mu_s_min = atmosphere.mu_s_min;
+  p.scattering_mu_s_max = 1.0;
+  if (const std::optional<ScatteringRange>& range = settings.scattering_range) {
+    p.scattering_r_min = atmosphere.bottom_radius_m + range->altitude_min_m;
+    p.scattering_r_max = atmosphere.bottom_radius_m + range->altitude_max_m;
+    p.scattering_mu_s_min = range->mu_s_min;
+    p.scattering_mu_s_max = range->mu_s_max;
+  }
   SetAltitudeProfiles(atmosphere, &p);
   return p;
+}
+
+glsl::AtmosphereParameters AtmosphereGrid(const Atmosphere& atmosphere, const BakeSettings& settings) {
+  if (!settings.scattering_range) return MakeAtmosphereParameters(atmosphere, settings);
+  BakeSettings whole = settings;
+  whole.scattering_range.reset();
+  whole.scattering_r_size = settings.scattering_range->atmosphere_r_size;
+  whole.scattering_mu_size = settings.scattering_range->atmosphere_mu_size;
+  whole.scattering_mu_s_size = settings.scattering_range->atmosphere_mu_s_size;
+  return MakeAtmosphereParameters(atmosphere, whole);
 }
 
 void SetAltitudeProfiles(const Atmosphere& atmosphere, glsl::AtmosphereParameters* parameters) {

@@ -14,6 +14,22 @@
 
 namespace skybake {
 
+// The part of the scattering tables' domain a scene's bake covers
+// (PlanScene in bake/scene.h): the altitudes and sun cosines the scene
+// shows. The light reaching those texels comes from the whole atmosphere,
+// so the orders are computed on a grid over all of it, of the table's nu
+// size and these other sizes, whose single scattering takes
+// `atmosphere_ray_samples` intervals per ray; the table's texels gather
+// their higher orders from it.
+struct ScatteringRange {
+  double altitude_min_m = 0.0, altitude_max_m = 0.0;  // above the ground
+  double mu_s_min = -1.0, mu_s_max = 1.0;
+  int atmosphere_r_size = 32;
+  int atmosphere_mu_size = 128;
+  int atmosphere_mu_s_size = 16;
+  int atmosphere_ray_samples = 32;
+};
+
 struct BakeSettings {
   // Table sizes. The scattering mu size must be even (two halves: rays that
   // hit the ground and rays that do not).
@@ -59,6 +75,9 @@ struct BakeSettings {
   // halves at 2), so the default keeps every order on the table's grid
   // (docs/benchmark.md).
   int higher_order_divisor = 1;
+  // Restricts the scattering tables to a scene's altitudes and suns; unset,
+  // they cover the atmosphere and every sun down to its mu_s_min.
+  std::optional<ScatteringRange> scattering_range;
   // Store single Mie's red channel in the scattering table's alpha instead of
   // a separate table (Bruneton 2017's approximation, halves the memory).
   bool pack_single_mie_in_alpha = false;
@@ -132,6 +151,10 @@ double ClampedNu(double nu, double mu, double mu_s);
 // The runtime constants for an atmosphere and table sizes (also used by
 // loaders that rebuild a LutSet from files).
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings);
+
+// The grid over the whole atmosphere a bake computes the scattering orders
+// on: the tables' own unless settings.scattering_range restricts them.
+glsl::AtmosphereParameters AtmosphereGrid(const Atmosphere& atmosphere, const BakeSettings& settings);
 
 // Fills the coefficient profiles of `parameters` (definitions.glsl) from the
 // atmosphere; MakeAtmosphereParameters does it, and so must a loader that

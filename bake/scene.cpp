@@ -16,6 +16,7 @@
 #include "bake/errors.h"
 #include "bake/medium.h"
 #include "bake/toml_input.h"
+#include "shaders_runtime/runtime.h"
 
 namespace skybake {
 
@@ -178,6 +179,60 @@ bool CanPackSingleMie(const Atmosphere& atmosphere) {
   return mie.x > 0.0 && other.x > 0.0 && other.y > 0.0 && other.z > 0.0;
 }
 
+// The scattering tables are looked up at the camera (the sky, from the top
+// of the atmosphere for a camera above it) and for aerial perspective at
+// the objects, at the end of the sunlit part of a partly shadowed segment
+// (which can dip below both ends) and, for segments shorter than
+// DIRECT_SEGMENT_LENGTH, that far along the ray as long as it stays inside
+// the table's radii (functions.glsl); with the sun as seen from there: the
+// scene's suns, moved by up to the central angle of the longest of these
+// distances. Restricts plan's tables to those altitudes and suns where that
+// is less than the whole atmosphere (a camera in space sees every sun).
+void PlanScatteringRange(const Scene& scene, const Atmosphere& atmosphere, ScenePlan* plan) {
+  const SceneEffects& e = scene.effects;
+  const double height = atmosphere.top_radius_m - atmosphere.bottom_radius_m;
+  double low = scene.camera_altitude_min_m, high = std::min(height, scene.camera_altitude_max_m);
+  double angle = 0.0;
+  if (e.aerial_perspective) {
+    const double rg = atmosphere.bottom_radius_m;
+    const double reach = std::max(e.aerial_perspective_max_distance_m, glsl::DIRECT_SEGMENT_LENGTH);
+    angle = 2.0 * std::asin(std::min(1.0, reach / (2.0 * rg)));
+    // The lowest point of a chord of that length between two points at or
+    // above the lowest camera or object.
+    const double r_low = rg + std::min(low, scene.object_altitude_min_m);
+    const double half_chord = 0.5 * e.aerial_perspective_max_distance_m;
+    low = std::max(0.0, std::sqrt(std::max(0.0, r_low * r_low - half_chord * half_chord)) - rg);
+    high = std::max(high, scene.object_altitude_max_m);
+  }
+  // A table needs two distinct ends: at least 100 m and half a degree.
+  constexpr double kMinAltitudeSpan = 100.0, kMinSunSpan = 0.5 * kDegree;
+  if (high - low < kMinAltitudeSpan) {
+    low = std::clamp(0.5 * (low + high - kMinAltitudeSpan), 0.0, height - kMinAltitudeSpan);
+    high = low + kMinAltitudeSpan;
+  }
+  double sun_low = std::max(0.0, scene.sun_zenith_min_deg * kDegree - angle);
+  double sun_high = std::min(kPi, scene.sun_zenith_max_deg * kDegree + angle);
+  if (sun_high - sun_low < kMinSunSpan) {
+    sun_low = std::clamp(0.5 * (sun_low + sun_high - kMinSunSpan), 0.0, kPi - kMinSunSpan);
+    sun_high = sun_low + kMinSunSpan;
+  }
+  double mu_s_min = std::max(plan->mu_s_min, std::cos(sun_high)), mu_s_max = std::cos(sun_low);
+  if (e.space_views) mu_s_min = plan->mu_s_min, mu_s_max = 1.0;
+  plan->restrict_scattering = low > 0.0 || high < height || mu_s_min > plan->mu_s_min || mu_s_max < 1.0;
+  if (!plan->restrict_scattering) return;
+  plan->altitude_min_m = low, plan->altitude_max_m = high;
+  plan->table_mu_s_min = mu_s_min, plan->table_mu_s_max = mu_s_max;
+}
+
+// Optical depth from the ground straight up to the top, per channel.
+Spectrum VerticalOpticalDepth(const Atmosphere& atmosphere) {
+  constexpr int kSamples = 256;
+  return Medium(atmosphere).OpticalDepth(atmosphere.bottom_radius_m, 1.0,
+                                         atmosphere.top_radius_m - atmosphere.bottom_radius_m, kSamples);
+}
+
+double Max(const Spectrum& v) { return std::max({v.x, v.y, v.z}); }
+
 Scene SceneFromJsonObject(const nlohmann::json& j) {
   Scene scene;
   scene.name = j.at("name").get<std::string>();
@@ -279,12 +334,37 @@ ScenePlan PlanScene(const Scene& scene, const Atmosphere& atmosphere) {
     const double lowest_zenith = std::min(kPi, scene.sun_zenith_max_deg * kDegree + reach);
     plan.mu_s_min = std::max(-1.0, std::cos(lowest_zenith));
   }
+  if (plan.scattering) PlanScatteringRange(scene, atmosphere, &plan);
   return plan;
 }
 
 void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings* settings) {
   atmosphere->mu_s_min = plan.mu_s_min;
   settings->pack_single_mie_in_alpha = plan.pack_single_mie_in_alpha;
+  if (!plan.restrict_scattering) return;
+  ScatteringRange range;
+  range.altitude_min_m = plan.altitude_min_m, range.altitude_max_m = plan.altitude_max_m;
+  range.mu_s_min = plan.table_mu_s_min, range.mu_s_max = plan.table_mu_s_max;
+  range.atmosphere_r_size = settings->scattering_r_size;
+  range.atmosphere_mu_size = settings->scattering_mu_size;
+  range.atmosphere_mu_s_size = std::max(2, settings->scattering_mu_s_size / 2);
+  range.atmosphere_ray_samples = std::min(settings->ray_samples, std::max(16, settings->ray_samples / 4));
+  // Each order's radiance on half the r and mu texels where the atmosphere
+  // is optically thin: optically thick ones lose light order after order on
+  // it (BakeSettings::higher_order_divisor).
+  if (Max(VerticalOpticalDepth(*atmosphere)) < 1.0) {
+    settings->higher_order_divisor = std::max(settings->higher_order_divisor, 2);
+  }
+  // Half again as many r texels as the whole table has over these
+  // altitudes (rho spans, as the r axis maps rho): part of the texels saved
+  // goes to precision (on earth's ground-level daytime scene, 7 texels gave
+  // the full bake's mean error and 10 a tenth less, docs/scenes.md).
+  const double rg = atmosphere->bottom_radius_m, rt = atmosphere->top_radius_m;
+  auto rho = [&](double altitude) { return std::sqrt(altitude * (2.0 * rg + altitude)); };
+  const double span = (rho(range.altitude_max_m) - rho(range.altitude_min_m)) / rho(rt - rg);
+  const int intervals = static_cast<int>(std::ceil(1.5 * span * (settings->scattering_r_size - 1)));
+  settings->scattering_r_size = std::clamp(intervals + 1, 2, settings->scattering_r_size);
+  settings->scattering_range = range;
 }
 
 std::string SceneQueryProblem(const Scene& scene, double bottom_radius_m, bool clamp, Query* q,

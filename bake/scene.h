@@ -72,16 +72,27 @@ struct ScenePlan {
   bool pack_single_mie_in_alpha = false;
   bool irradiance = true;
   bool aerial_perspective_functions = true;
-  // The lowest sun the scattering table covers (its mu_s_min).
+  // The lowest sun the bake covers (the atmosphere's mu_s_min): that of the
+  // points the scattering orders are computed for.
   double mu_s_min = -1.0;
+  // Where the scattering tables are restricted to what the scene shows:
+  // the altitudes of the cameras and objects and the sun cosines there
+  // (ScatteringRange in bake/bake.h).
+  bool restrict_scattering = false;
+  double altitude_min_m = 0.0, altitude_max_m = 0.0;
+  double table_mu_s_min = -1.0, table_mu_s_max = 1.0;
   std::vector<OmittedTable> omitted;
 };
 
 ScenePlan PlanScene(const Scene& scene, const Atmosphere& atmosphere);
 
-// Points the bake at the plan: the scattering table's lowest sun (the
-// atmosphere's mu_s_min, recorded as such in the manifest) and the packing
-// of single Mie.
+// Points the bake at the plan: the lowest sun (the atmosphere's mu_s_min,
+// recorded as such in the manifest), the packing of single Mie and the
+// scattering tables' ranges. A restricted table keeps the texel spacing
+// along r of `settings`' table over the whole atmosphere (fewer texels over
+// fewer altitudes) and all its mu_s texels (finer over fewer suns); the
+// orders are computed on a grid over the whole atmosphere with half its r
+// and mu sizes.
 struct BakeSettings;
 void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings* settings);
 

@@ -53,6 +53,10 @@ ordered_json ParametersToJson(const glsl::AtmosphereParameters& p) {
       {"scattering_mu_size", p.scattering_mu_size},
       {"scattering_mu_s_size", p.scattering_mu_s_size},
       {"scattering_nu_size", p.scattering_nu_size},
+      {"scattering_r_min", p.scattering_r_min},
+      {"scattering_r_max", p.scattering_r_max},
+      {"scattering_mu_s_min", p.scattering_mu_s_min},
+      {"scattering_mu_s_max", p.scattering_mu_s_max},
       {"irradiance_width", p.irradiance_width},
       {"irradiance_height", p.irradiance_height},
   };
@@ -75,6 +79,10 @@ glsl::AtmosphereParameters ParametersFromJson(const json& j) {
   p.scattering_mu_size = j.at("scattering_mu_size").get<int>();
   p.scattering_mu_s_size = j.at("scattering_mu_s_size").get<int>();
   p.scattering_nu_size = j.at("scattering_nu_size").get<int>();
+  p.scattering_r_min = j.at("scattering_r_min").get<double>();
+  p.scattering_r_max = j.at("scattering_r_max").get<double>();
+  p.scattering_mu_s_min = j.at("scattering_mu_s_min").get<double>();
+  p.scattering_mu_s_max = j.at("scattering_mu_s_max").get<double>();
   p.irradiance_width = j.at("irradiance_width").get<int>();
   p.irradiance_height = j.at("irradiance_height").get<int>();
   return p;
@@ -127,16 +135,20 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
   const std::vector<TableAxis> axes_4d = {
       {"x", "nu", p.scattering_nu_size, -1.0, 1.0, "1",
        "slice s = (nu + 1) / 2 * (nu_size - 1), linear between slices; texel x = floor(s) * mu_s_size + mu_s texel"},
-      {"x", "mu_s", p.scattering_mu_s_size, p.mu_s_min, 1.0, "1",
+      {"x", "mu_s", p.scattering_mu_s_size, p.scattering_mu_s_min, p.scattering_mu_s_max, "1",
        "a = (d - d_min) / (d_max - d_min) with d = distance from the ground to the top boundary along mu_s, "
-       "d_min = top_radius - bottom_radius, d_max = H; A = a at mu_s_min; x = max(1 - a / A, 0) / (1 + a)" +
+       "d_min = top_radius - bottom_radius, d_max = H; A = a at scattering_mu_s_min; f = max(1 - a / A, 0) / (1 + "
+       "a); x = f / f(scattering_mu_s_max)" +
            std::string(kTexelCentres)},
       {"y", "mu", p.scattering_mu_size, -1.0, 1.0, "1",
        "two halves of n / 2 texels, discontinuous at the horizon: rays that hit the ground in the lower half, "
        "u = 0.5 - 0.5 * (0.5 / (n / 2) + x * (1 - 1 / (n / 2))), x = (d - d_min) / (d_max - d_min), d = distance "
        "to the ground, d_min = r - bottom_radius, d_max = rho; other rays in the upper half, u = 0.5 + 0.5 * (...), "
        "d = distance to the top boundary, d_min = top_radius - r, d_max = rho + H"},
-      RAxis("z", p.scattering_r_size, p, kRhoOverH + std::string(kTexelCentres))};
+      {"z", "r", p.scattering_r_size, p.scattering_r_min, p.scattering_r_max, "m",
+       "x = (rho - rho(scattering_r_min)) / (rho(scattering_r_max) - rho(scattering_r_min)), rho(r) = sqrt(r^2 - "
+       "bottom_radius^2)" +
+           std::string(kTexelCentres)}};
   const std::string layout_4d =
       "x = nu * " + std::to_string(p.scattering_mu_s_size) + " + mu_s (nu " + std::to_string(p.scattering_nu_size) +
       ", mu_s " + std::to_string(p.scattering_mu_s_size) + "), y = mu (" + std::to_string(p.scattering_mu_size) +

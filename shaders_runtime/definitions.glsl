@@ -53,6 +53,13 @@ struct AtmosphereParameters {
   int scattering_mu_size;
   int scattering_mu_s_size;
   int scattering_nu_size;
+  // The radii and sun cosines the scattering tables cover: the whole
+  // atmosphere (bottom_radius to top_radius, mu_s_min to 1) unless a scene's
+  // bake restricted them to the altitudes and suns the scene shows.
+  Number scattering_r_min;
+  Number scattering_r_max;
+  Number scattering_mu_s_min;
+  Number scattering_mu_s_max;
   int irradiance_width;   // mu_s
   int irradiance_height;  // r
   // Extinction and scattering coefficients, m^-1, at the profile altitudes:

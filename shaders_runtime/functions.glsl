@@ -134,16 +134,31 @@ vec2 GetTransmittanceTextureUvFromRMu(IN(AtmosphereParameters) atmosphere, Numbe
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 // mu_s through the distance to the top boundary from the ground, rescaled so
-// that mu_s_min maps to 0 and more texels go to low suns. (Independent of r:
-// the bake maps the sun's cosine along a ray with it alone.)
-Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
+// that scattering_mu_s_min maps to 0 and more texels go to low suns, then
+// stretched so that scattering_mu_s_max maps to 1. (Independent of r: the
+// bake maps the sun's cosine along a ray with it alone.)
+Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
   Number d = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, mu_s);
   Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
   Number d_max = HorizonDistanceAtTop(atmosphere);
   Number a = (d - d_min) / (d_max - d_min);
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.mu_s_min);
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.scattering_mu_s_min);
   Number A = (D - d_min) / (d_max - d_min);
-  return GetTextureCoordFromUnitRange(max(1.0 - a / A, 0.0) / (1.0 + a), atmosphere.scattering_mu_s_size);
+  return max(1.0 - a / A, 0.0) / (1.0 + a);
+}
+
+Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
+  Number x = GetScatteringUnitMuS(atmosphere, mu_s) /
+             GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
+  return GetTextureCoordFromUnitRange(min(x, 1.0), atmosphere.scattering_mu_s_size);
+}
+
+// r through the distance to the horizon, over the table's radii.
+Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r) {
+  Number rho_min = HorizonDistance(atmosphere, atmosphere.scattering_r_min);
+  Number rho_max = HorizonDistance(atmosphere, atmosphere.scattering_r_max);
+  Number x = (HorizonDistance(atmosphere, r) - rho_min) / (rho_max - rho_min);
+  return GetTextureCoordFromUnitRange(clamp(x, 0.0, 1.0), atmosphere.scattering_r_size);
 }
 
 // 4D scattering table, stored as a 3D texture: x packs nu (slowest) and mu_s,
@@ -152,7 +167,7 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
                                           Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   Number H = HorizonDistanceAtTop(atmosphere);
   Number rho = HorizonDistance(atmosphere, r);
-  Number u_r = GetTextureCoordFromUnitRange(rho / H, atmosphere.scattering_r_size);
+  Number u_r = GetScatteringTextureUR(atmosphere, r);
 
   Number half_mu_size = Number(atmosphere.scattering_mu_size / 2);
   Number u_mu;
@@ -400,6 +415,18 @@ vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture
 
 // Metres.
 const Number DIRECT_SEGMENT_LENGTH = 10000.0;
+
+// Distance along the ray (r, mu), from r inside the radii the scattering
+// tables cover, to where it leaves them (a scene's bake restricts them; over
+// the whole atmosphere this is the nearest boundary or beyond).
+Number DistanceInsideScatteringRadii(IN(AtmosphereParameters) atmosphere, Number r, Number mu) {
+  Number r_max = atmosphere.scattering_r_max;
+  Number r_min = atmosphere.scattering_r_min;
+  Number across = r * r * (mu * mu - 1.0);
+  Number up = -r * mu + SafeSqrt(across + r_max * r_max);
+  Number down_discriminant = across + r_min * r_min;
+  return mu < 0.0 && down_discriminant >= 0.0 ? min(up, -r * mu - sqrt(down_discriminant)) : up;
+}
 // Trapezoidal intervals of the direct integration. On Earth the rule
 // overestimates the optical depth (440 nm) of a vertical segment from the
 // ground by 4.5e-5 at 5 km and 2.2e-4 at 10 km (the aerosols' 1.2 km scale
@@ -583,9 +610,10 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
   if (lit < DIRECT_SEGMENT_LENGTH) {
     // Multiple scattering by the table method over a segment long enough not
     // to cancel (or up to the ground or the top, where the table alone
-    // holds the whole ray), less its single Rayleigh.
+    // holds the whole ray), less its single Rayleigh; the far end stays
+    // where the tables are.
     Number boundary = DistanceToNearestAtmosphereBoundary(atmosphere, r, mu, ray_r_mu_intersects_ground);
-    Number far = max(min(DIRECT_SEGMENT_LENGTH, boundary), lit);
+    Number far = max(min(min(DIRECT_SEGMENT_LENGTH, boundary), DistanceInsideScatteringRadii(atmosphere, r, mu)), lit);
     vec3 far_rayleigh;
     vec3 far_mie;
     vec3 far_weight;

@@ -61,6 +61,10 @@ struct AtmosphereParameters {
   int scattering_mu_size = 0;
   int scattering_mu_s_size = 0;
   int scattering_nu_size = 0;
+  Number scattering_r_min = 0.0;
+  Number scattering_r_max = 0.0;
+  Number scattering_mu_s_min = -1.0;
+  Number scattering_mu_s_max = 1.0;
   int irradiance_width = 0;
   int irradiance_height = 0;
   vec3 extinction_profile[ALTITUDE_PROFILE_SIZE] = {};

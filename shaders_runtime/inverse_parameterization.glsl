@@ -24,7 +24,9 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
                                           OUT(Number) mu, OUT(Number) mu_s, OUT(Number) nu,
                                           OUT(bool) ray_r_mu_intersects_ground) {
   Number H = HorizonDistanceAtTop(atmosphere);
-  Number rho = H * GetUnitRangeFromTextureCoord(uvwz.w, atmosphere.scattering_r_size);
+  Number rho_min = HorizonDistance(atmosphere, atmosphere.scattering_r_min);
+  Number rho_max = HorizonDistance(atmosphere, atmosphere.scattering_r_max);
+  Number rho = rho_min + (rho_max - rho_min) * GetUnitRangeFromTextureCoord(uvwz.w, atmosphere.scattering_r_size);
   Number bottom = atmosphere.bottom_radius;
   r = sqrt(rho * rho + bottom * bottom);
 
@@ -44,10 +46,11 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
     ray_r_mu_intersects_ground = false;
   }
 
-  Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size);
+  Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size) *
+                  GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
   Number d_min = atmosphere.top_radius - bottom;
   Number d_max = H;
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.mu_s_min);
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.scattering_mu_s_min);
   Number A = (D - d_min) / (d_max - d_min);
   Number a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
   Number d = d_min + min(a, A) * (d_max - d_min);

@@ -74,6 +74,10 @@ std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& p, const g
   s += "    " + std::to_string(p.scattering_r_size) + ", " + std::to_string(p.scattering_mu_size) + ", " +
        std::to_string(p.scattering_mu_s_size) + ", " + std::to_string(p.scattering_nu_size) +
        ",  // scattering r, mu, mu_s, nu sizes\n";
+  s += "    " + FloatLiteral(p.scattering_r_min) + ", " + FloatLiteral(p.scattering_r_max) +
+       ",  // scattering_r_min, scattering_r_max, m\n";
+  s += "    " + FloatLiteral(p.scattering_mu_s_min) + ", " + FloatLiteral(p.scattering_mu_s_max) +
+       ",  // scattering_mu_s_min, scattering_mu_s_max\n";
   s += "    " + std::to_string(p.irradiance_width) + ", " + std::to_string(p.irradiance_height) +
        ",  // irradiance_width (mu_s), irradiance_height (r)\n";
   s += "    // extinction_profile, m^-1\n    " + ProfileLiteral(p.extinction_profile) + ",\n";

@@ -29,8 +29,16 @@ TEST(Parameterization, TransmittanceRoundTrip) {
   }
 }
 
-TEST(Parameterization, ScatteringRoundTripBothHalves) {
-  glsl::AtmosphereParameters p = Parameters();
+// A scene's table: altitudes 500 m to 3 km, suns from 20 to 95 degrees.
+glsl::AtmosphereParameters RestrictedParameters() {
+  BakeSettings settings;
+  settings.scattering_r_size = 12;
+  settings.scattering_range = ScatteringRange{500.0, 3000.0, std::cos(95.0 * glsl::PI / 180.0),
+                                              std::cos(20.0 * glsl::PI / 180.0)};
+  return MakeAtmosphereParameters(testing::Earth(), settings);
+}
+
+void ExpectScatteringRoundTrip(const glsl::AtmosphereParameters& p) {
   int ground = 0;
   for (int z = 0; z < p.scattering_r_size; z += 3) {
     for (int y = 0; y < p.scattering_mu_size; ++y) {
@@ -64,6 +72,34 @@ TEST(Parameterization, ScatteringRoundTripBothHalves) {
     }
   }
   EXPECT_GT(ground, 0);
+}
+
+TEST(Parameterization, ScatteringRoundTripBothHalves) { ExpectScatteringRoundTrip(Parameters()); }
+
+TEST(Parameterization, RestrictedScatteringRoundTripBothHalves) { ExpectScatteringRoundTrip(RestrictedParameters()); }
+
+TEST(Parameterization, RestrictedAxesSpanTheirRanges) {
+  // The first and last texel centres of the r and mu_s axes are the ends of
+  // the scene's ranges; the mu axis is the full one at each radius.
+  const glsl::AtmosphereParameters p = RestrictedParameters();
+  double r, mu, mu_s, nu;
+  bool ground;
+  const double n_r = p.scattering_r_size, n_mu_s = p.scattering_mu_s_size;
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 0.5 / n_mu_s, 0.75, 0.5 / n_r), r, mu, mu_s, nu,
+                                             ground);
+  EXPECT_NEAR(r, p.bottom_radius + 500.0, 1e-6);
+  EXPECT_NEAR(mu_s, std::cos(95.0 * glsl::PI / 180.0), 1e-9);
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 1.0 - 0.5 / n_mu_s, 0.75, 1.0 - 0.5 / n_r), r, mu,
+                                             mu_s, nu, ground);
+  EXPECT_NEAR(r, p.bottom_radius + 3000.0, 1e-6);
+  EXPECT_NEAR(mu_s, std::cos(20.0 * glsl::PI / 180.0), 1e-9);
+  // Straight up and straight down are the first texels of the mu axis's
+  // halves there too.
+  const double n_mu = p.scattering_mu_size;
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 0.5, 0.5 + 0.5 / n_mu, 0.5), r, mu, mu_s, nu, ground);
+  EXPECT_NEAR(mu, 1.0, 1e-9);
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 0.5, 0.5 - 0.5 / n_mu, 0.5), r, mu, mu_s, nu, ground);
+  EXPECT_NEAR(mu, -1.0, 1e-9);
 }
 
 TEST(Parameterization, MuSAxisSpansLowestSunToZenith) {

@@ -192,6 +192,59 @@ TEST(ScenePlan, SunRangeSetsTheLowestSunOfTheScatteringTable) {
   EXPECT_EQ(PlanScene(space, earth).mu_s_min, earth.mu_s_min);
 }
 
+TEST(ScenePlan, RestrictsTheScatteringTablesToWhatTheSceneShows) {
+  const Atmosphere earth = LoadAtmosphere("earth");
+  const double rg = 6360e3, rt = 6420e3;
+  // Ground-level daytime, sky only: the cameras' altitudes and the suns
+  // themselves, from the zenith to the horizon.
+  ScenePlan sky = PlanScene(ParseScene(SceneText("sky = true"), "s.toml"), earth);
+  ASSERT_TRUE(sky.restrict_scattering);
+  EXPECT_EQ(sky.altitude_min_m, 0.0);
+  EXPECT_EQ(sky.altitude_max_m, 2000.0);
+  EXPECT_NEAR(sky.table_mu_s_min, 0.0, 1e-12);
+  EXPECT_EQ(sky.table_mu_s_max, 1.0);
+  // With aerial perspective to 30 km the sun is looked up at the objects,
+  // up to the central angle of a 30 km chord away.
+  ScenePlan aerial = PlanScene(ParseScene(SceneText("aerial_perspective = { max_distance_km = 30 }"), "s.toml"), earth);
+  ASSERT_TRUE(aerial.restrict_scattering);
+  EXPECT_NEAR(aerial.table_mu_s_min, std::cos(kPi / 2 + 2.0 * std::asin(15e3 / rg)), 1e-12);
+  // Cameras and objects above the ground: a 150 km chord between two points
+  // 1 km up dips to sqrt((rg + 1 km)^2 - (75 km)^2) - rg.
+  const Scene high = ParseScene(
+      "name = \"h\"\n[effects]\naerial_perspective = { max_distance_km = 150 }\n[camera]\naltitude_km = [1, 3]\n"
+      "[objects]\naltitude_km = [1, 2]\n[sun]\nzenith_deg = [30, 60]\n",
+      "h.toml");
+  ScenePlan high_plan = PlanScene(high, earth);
+  ASSERT_TRUE(high_plan.restrict_scattering);
+  EXPECT_NEAR(high_plan.altitude_min_m, std::sqrt((rg + 1e3) * (rg + 1e3) - 75e3 * 75e3) - rg, 1e-6);
+  EXPECT_EQ(high_plan.altitude_max_m, 3000.0);
+  const double angle = 2.0 * std::asin(75e3 / rg);
+  EXPECT_NEAR(high_plan.table_mu_s_min, std::cos(kPi / 3 + angle), 1e-12);
+  EXPECT_NEAR(high_plan.table_mu_s_max, std::cos(kPi / 6 - angle), 1e-12);
+  // From space every sun is seen; all altitudes: nothing to restrict.
+  const Scene space = ParseScene(
+      "name = \"s\"\n[effects]\nsky = true\nspace_views = true\n[camera]\naltitude_km = [0, 1000]\n"
+      "[sun]\nzenith_deg = [0, 90]\n",
+      "s.toml");
+  EXPECT_FALSE(PlanScene(space, earth).restrict_scattering);
+
+  // The table keeps 1.5 times the full table's r texel density over rho:
+  // rho spans sqrt(2 km (2 rg + 2 km)) of sqrt(60 km (2 rg + 60 km)).
+  Atmosphere planned = earth;
+  BakeSettings settings;
+  ApplyScenePlan(sky, &planned, &settings);
+  const double span = std::sqrt(2e3 * (2.0 * rg + 2e3)) / std::sqrt((rt - rg) * (rt + rg));
+  EXPECT_EQ(settings.scattering_r_size, static_cast<int>(std::ceil(1.5 * span * 31)) + 1);
+  ASSERT_TRUE(settings.scattering_range.has_value());
+  EXPECT_EQ(settings.scattering_range->atmosphere_r_size, 32);
+  EXPECT_EQ(settings.higher_order_divisor, 2);  // earth is optically thin
+  // A thick atmosphere keeps each order's radiance on the full grid.
+  Atmosphere fog = LoadAtmosphere("heavy-fog");
+  BakeSettings fog_settings;
+  ApplyScenePlan(PlanScene(ParseScene(SceneText("sky = true"), "s.toml"), fog), &fog, &fog_settings);
+  EXPECT_EQ(fog_settings.higher_order_divisor, 1);
+}
+
 // ---- the pruned GLSL ----
 
 std::string CallsFor(const SnippetParts& parts) {
@@ -259,6 +312,14 @@ glsl::vec3 Sky(const Twin& twin, double altitude_m, double vz, double sz) {
   const QueryGeometry g = MakeQueryGeometry(q, twin.parameters().bottom_radius);
   glsl::vec3 transmittance;
   return twin.SkyRadiance(g.camera, g.view, g.sun, &transmittance);
+}
+
+// The twin's sky radiance (no distance) or aerial perspective for a query.
+glsl::vec3 Radiance(const Twin& twin, const Query& q) {
+  const QueryGeometry g = MakeQueryGeometry(q, twin.parameters().bottom_radius);
+  glsl::vec3 transmittance;
+  if (q.distance_m <= 0.0) return twin.SkyRadiance(g.camera, g.view, g.sun, &transmittance);
+  return twin.SkyRadianceToPoint(g.camera, g.camera + g.view * q.distance_m, g.sun, &transmittance);
 }
 
 TEST(SceneBake, AllEffectsFromSpaceBakeTheFullSet) {
@@ -330,15 +391,19 @@ TEST(SceneBake, WritesAndLoadsOnlyTheKeptTables) {
                      "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,normal_zenith_deg\n0,60,30,0,0\n");
   EXPECT_EQ(testing::RunCommand(eval + testing::ShellQuote(normal) + " --clamp", dir, nullptr, &err), 2);
   EXPECT_NE(err.find("irradiance (normal_zenith_deg) is not in the scene"), std::string::npos) << err;
+
 }
 
 TEST(SceneBake, ReproducesTheFullBakeInsideTheScenesRanges) {
-  // Ground-level daytime scene with a separate single Mie table, so the only
-  // difference from the full bake is where the mu_s texels lie. Both are
-  // compared with a finer full bake (twice the mu_s and r texels, more orders
-  // of accuracy in the interpolation) at sky queries inside the scene.
+  // Ground-level daytime scene with a separate single Mie table: its tables
+  // cover the scene's altitudes and suns, their higher orders gathered from
+  // a grid over the whole atmosphere. Both it and the full bake at the same
+  // sizes are compared with a finer full bake (twice the mu_s and r
+  // texels) at sky and aerial-perspective queries inside the scene.
   const Atmosphere earth = LoadAtmosphere("earth");
-  const Scene scene = ParseScene(SceneText("sky = true\nsharp_sun_halo = true"), "s.toml");
+  const Scene scene =
+      ParseScene(SceneText("sky = true\nsharp_sun_halo = true\naerial_perspective = { max_distance_km = 30 }"),
+                 "s.toml");
   BakeSettings settings = testing::SmallBakeSettings();
   settings.scattering_mu_s_size = 16;
   Atmosphere planned = earth;
@@ -355,28 +420,36 @@ TEST(SceneBake, ReproducesTheFullBakeInsideTheScenesRanges) {
   for (double altitude : {0.0, 1000.0, 2000.0}) {
     for (double vz : {0.0, 45.0, 80.0, 89.0, 95.0}) {
       for (double sz = 0.0; sz <= 90.0; sz += 7.5) {
-        const glsl::vec3 ref = Sky(reference, altitude, vz, sz);
-        const glsl::vec3 a = Sky(full, altitude, vz, sz), b = Sky(pruned, altitude, vz, sz);
-        for (int c = 0; c < 3; ++c) {
-          ASSERT_TRUE(std::isfinite(b[c]));
-          if (ref[c] <= 0.0) continue;  // looking down from the ground: no air to scatter
-          const double full_relative = std::abs(a[c] - ref[c]) / ref[c];
-          const double scene_relative = std::abs(b[c] - ref[c]) / ref[c];
-          full_error += full_relative, scene_error += scene_relative;
-          full_largest = std::max(full_largest, full_relative);
-          scene_largest = std::max(scene_largest, scene_relative);
-          ++n;
+        for (double distance : {0.0, 1000.0, 10000.0, 25000.0}) {
+          Query q;
+          q.altitude_m = altitude, q.view_zenith_deg = vz, q.sun_zenith_deg = sz, q.view_sun_azimuth_deg = 60.0;
+          q.distance_m = distance;
+          std::vector<std::string> unused;
+          if (!SceneQueryProblem(scene, earth.bottom_radius_m, false, &q, &unused).empty()) continue;
+          const glsl::vec3 ref = Radiance(reference, q);
+          const glsl::vec3 a = Radiance(full, q), b = Radiance(pruned, q);
+          for (int c = 0; c < 3; ++c) {
+            ASSERT_TRUE(std::isfinite(b[c]));
+            if (ref[c] <= 0.0) continue;  // looking down from the ground: no air to scatter
+            const double full_relative = std::abs(a[c] - ref[c]) / ref[c];
+            const double scene_relative = std::abs(b[c] - ref[c]) / ref[c];
+            full_error += full_relative, scene_error += scene_relative;
+            full_largest = std::max(full_largest, full_relative);
+            scene_largest = std::max(scene_largest, scene_relative);
+            ++n;
+          }
         }
       }
     }
   }
-  ASSERT_GT(n, 500);
+  ASSERT_GT(n, 700);
   full_error /= n, scene_error /= n;
   std::cout << "relative difference to the finer bake, mean / largest: full " << full_error << " / " << full_largest
             << ", scene " << scene_error << " / " << scene_largest << "\n";
-  // The scene spends the mu_s texels on its suns: no worse than the full
-  // bake at equal sizes, on average (5% slack: the two grids favour
-  // different queries) and at the worst query (25% slack: one query).
+  // The scene spends the r and mu_s texels on its altitudes and suns: no
+  // worse than the full bake at equal sizes, on average (5% slack: the two
+  // grids favour different queries) and at the worst query (25% slack: one
+  // query).
   EXPECT_LE(scene_error, full_error * 1.05);
   EXPECT_LE(scene_largest, full_largest * 1.25);
 }
