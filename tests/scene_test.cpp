@@ -392,6 +392,14 @@ TEST(SceneBake, WritesAndLoadsOnlyTheKeptTables) {
   EXPECT_EQ(testing::RunCommand(eval + testing::ShellQuote(normal) + " --clamp", dir, nullptr, &err), 2);
   EXPECT_NE(err.find("irradiance (normal_zenith_deg) is not in the scene"), std::string::npos) << err;
 
+  // render: the panorama shows the ground, which this scene does not light.
+  const std::string render = testing::Skybake() + " render " + testing::ShellQuote(lut) + " -q -o " +
+                             testing::ShellQuote(dir.path() / "render") + " --size 8 --sun-zenith 30";
+  EXPECT_EQ(testing::RunCommand(render + " --views panorama", dir, nullptr, &err), 2);
+  EXPECT_NE(err.find("view 'panorama' (the ground"), std::string::npos) << err;
+  EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "render"));
+  EXPECT_EQ(testing::RunCommand(render + " --views fisheye", dir, nullptr, &err), 0) << err;
 }
 
 TEST(SceneBake, ReproducesTheFullBakeInsideTheScenesRanges) {
