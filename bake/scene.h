@@ -81,6 +81,7 @@ struct ScenePlan {
   bool restrict_scattering = false;
   double altitude_min_m = 0.0, altitude_max_m = 0.0;
   double table_mu_s_min = -1.0, table_mu_s_max = 1.0;
+  bool sun_above_horizon = false;  // the scene's suns never set
   std::vector<OmittedTable> omitted;
 };
 
@@ -91,8 +92,7 @@ ScenePlan PlanScene(const Scene& scene, const Atmosphere& atmosphere);
 // scattering tables' ranges. A restricted table keeps the texel spacing
 // along r of `settings`' table over the whole atmosphere (fewer texels over
 // fewer altitudes) and all its mu_s texels (finer over fewer suns); the
-// orders are computed on a grid over the whole atmosphere with half its r
-// and mu sizes.
+// orders are computed on a grid over the whole atmosphere (ScatteringRange).
 struct BakeSettings;
 void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings* settings);
 

@@ -227,6 +227,10 @@ TEST(ScenePlan, RestrictsTheScatteringTablesToWhatTheSceneShows) {
       "[sun]\nzenith_deg = [0, 90]\n",
       "s.toml");
   EXPECT_FALSE(PlanScene(space, earth).restrict_scattering);
+  // Cameras up to 20 km span 58% of the r axis's rho: not worth a second grid.
+  std::string flight = SceneText("sky = true");
+  flight.replace(flight.find("altitude_km = [0, 2]"), 20, "altitude_km = [0, 20]");
+  EXPECT_FALSE(PlanScene(ParseScene(flight, "f.toml"), earth).restrict_scattering);
 
   // The table keeps 1.5 times the full table's r texel density over rho:
   // rho spans sqrt(2 km (2 rg + 2 km)) of sqrt(60 km (2 rg + 60 km)).
@@ -238,6 +242,17 @@ TEST(ScenePlan, RestrictsTheScatteringTablesToWhatTheSceneShows) {
   ASSERT_TRUE(settings.scattering_range.has_value());
   EXPECT_EQ(settings.scattering_range->atmosphere_r_size, 32);
   EXPECT_EQ(settings.higher_order_divisor, 2);  // earth is optically thin
+  EXPECT_EQ(settings.scattering_range->atmosphere_mu_s_size, 16);  // the sun never sets
+  // A sun that sets keeps every mu_s texel on the orders' grid.
+  BakeSettings sunset_settings;
+  Atmosphere sunset_planned = earth;
+  ApplyScenePlan(PlanScene(ParseScene(SceneText("sky = true").replace(SceneText("sky = true").find("[0, 90]"), 7,
+                                                                      "[80, 96]"),
+                                      "s.toml"),
+                           earth),
+                 &sunset_planned, &sunset_settings);
+  ASSERT_TRUE(sunset_settings.scattering_range.has_value());
+  EXPECT_EQ(sunset_settings.scattering_range->atmosphere_mu_s_size, 32);
   // A thick atmosphere keeps each order's radiance on the full grid.
   Atmosphere fog = LoadAtmosphere("heavy-fog");
   BakeSettings fog_settings;
