@@ -361,8 +361,9 @@ TEST_P(SnippetOnMesa, MatchesTheCppTwin) {
 }
 
 // A scene's pruned snippet (ground-level daytime: no irradiance functions,
-// single Mie packed into alpha, the scattering table's sun axis restricted)
-// gives the twin's numbers for the functions it keeps, at the scene's queries.
+// single Mie packed into alpha, the scattering tables restricted to the
+// scene's altitudes and suns) gives the twin's numbers for the functions it
+// keeps, at the scene's queries.
 TEST_P(SnippetOnMesa, PrunedForASceneMatchesTheCppTwin) {
   std::string why_not;
   std::unique_ptr<GlContext> gl = GlContext::Create(GetParam(), &why_not);
@@ -386,18 +387,28 @@ TEST_P(SnippetOnMesa, PrunedForASceneMatchesTheCppTwin) {
                    luts.scattering.texels);
   }
   std::vector<Item> items;
+  int aerial_items = 0;
   for (const Item& item : MakeItems(luts.parameters.bottom_radius, luts.parameters.top_radius)) {
     const bool irradiance = item.what == kSunIrradiance || item.what == kSkyIrradiance;
     const double altitude = glm::length(item.camera) - luts.parameters.bottom_radius;
     const double sun_zenith_deg = std::acos(glm::dot(glm::normalize(item.camera), item.sun)) * 180.0 / M_PI;
     if (irradiance || altitude > scene.camera_altitude_max_m || sun_zenith_deg > scene.sun_zenith_max_deg) continue;
-    // Short segments in the air are MatchesTheCppTwin's to judge: since the
-    // higher orders' packing changed (bake.cpp) they exceed its 3e-3 there
-    // on the full snippet too (1.1e-2 measured), which pruning cannot cause.
-    if (std::string(item.group) == "aerial perspective") continue;
+    // Aerial perspective to objects inside the scene: its short segments
+    // read the restricted table only as far as its radii reach.
+    const bool aerial = item.what == kAerialRadiance || item.what == kAerialTransmittance ||
+                        item.what == kAerialRadianceInShadow;
+    if (aerial) {
+      const double object_altitude = glm::length(item.extra) - luts.parameters.bottom_radius;
+      const double distance = glm::length(item.extra - item.camera);
+      if (object_altitude > scene.object_altitude_max_m || distance > scene.effects.aerial_perspective_max_distance_m) {
+        continue;
+      }
+      ++aerial_items;
+    }
     items.push_back(item);
   }
   ASSERT_GE(items.size(), 100u);
+  ASSERT_GE(aerial_items, 30);
   SnippetParts parts;
   parts.irradiance = false;
   ExpectGlMatchesTwin(gl.get(), luts, FragmentSource(luts, parts), items);
