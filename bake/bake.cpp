@@ -296,8 +296,8 @@ class OrderConvergence {
   Spectrum newest_{0.0}, relative_{0.0}, ratio_{0.0}, previous_ratio_{0.0};
 };
 
-// The grid of each higher order's radiance: the scattering table's r and mu
-// sizes divided by `divisor` (mu kept even). mu_s and nu are kept: halving
+// The grid of each higher order's radiance: the r and mu sizes of the grid
+// of the scattering densities divided by `divisor` (mu kept even). mu_s and nu are kept: halving
 // mu_s as well raised the sky irradiance error of the report's case set
 // from 12.6% to 15.4% RMS and tripled its twilight error, as the light of
 // low suns changes fastest with mu_s.
@@ -651,11 +651,12 @@ class Baker {
   };
 
   void ComputeTransmittance();
-  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid) const;
+  // Single scattering on `grid`, with `ray_samples` intervals per ray.
+  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples) const;
   // Single scattering of the texels of one ray of `grid` (mu index y, r
-  // index z) into `out`. `columns`: the grid's sun directions;
-  // `transmittance`: the transmittance table's channels.
-  void SingleScatteringAlongRay(const AtmosphereParameters& grid, int y, int z, const SunColumns& columns,
+  // index z), n intervals, into `out`. `columns`: the grid's sun
+  // directions; `transmittance`: the transmittance table's channels.
+  void SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
                                 const ChannelPlanes& transmittance, SingleScattering& out) const;
   // Single scattering over interval k of a ray for one sun direction, in
   // double, for the intervals SingleScatteringAlongRay does not vectorise:
@@ -801,9 +802,12 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
 
   Phase("transmittance", [&] { ComputeTransmittance(); });
-  Phase("single scattering", [&] { single_ = ComputeSingleScattering(params_); });
+  Phase("single scattering", [&] { single_ = ComputeSingleScattering(params_, s.ray_samples); });
   if (s.orders != 1 && TableRestricted()) {
-    Phase("single scattering, whole atmosphere", [&] { grid_single_ = ComputeSingleScattering(atmosphere_grid_); });
+    // It feeds only the next order, through an integral over the sphere.
+    Phase("single scattering, whole atmosphere", [&] {
+      grid_single_ = ComputeSingleScattering(atmosphere_grid_, s.scattering_range->atmosphere_ray_samples);
+    });
   }
   if (s.orders != 1) {  // 0 = auto
     scattering_density_ = ScatteringGridTexture(atmosphere_grid_);
@@ -953,24 +957,22 @@ RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int 
   return ray;
 }
 
-Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameters& grid) const {
+Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples) const {
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const ChannelPlanes transmittance(transmittance_);
   const SunColumns columns(grid);
   SingleScattering result{ScatteringGridTexture(grid), ScatteringGridTexture(grid)};
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
-    SingleScatteringAlongRay(grid, ray_index % mu_size, ray_index / mu_size, columns, transmittance, result);
+    SingleScatteringAlongRay(grid, ray_samples, ray_index % mu_size, ray_index / mu_size, columns, transmittance,
+                             result);
   });
   return result;
 }
 
-void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int y, int z, const SunColumns& columns,
+void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
                                      const ChannelPlanes& transmittance, SingleScattering& out) const {
   const int groups = static_cast<int>(medium_.groups().size());
   const int mie = medium_.mie_group();
-  // The grid under a restricted table feeds only the next order, through
-  // an integral over the sphere, and takes fewer intervals.
-  const int n = &grid == &params_ ? settings_.ray_samples : settings_.scattering_range->atmosphere_ray_samples;
   const RaySamples ray = SampleRay(grid, y, z, n);
   const SunDirections directions = RaySunDirections(columns, ray.mu);
   const int count = static_cast<int>(directions.mu_s.size());

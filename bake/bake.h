@@ -66,14 +66,14 @@ struct BakeSettings {
   int ray_samples = 128;
   int sphere_samples = 16;
   // Above 1, each order >= 2 is gathered from its scattering density on a
-  // grid with the scattering table's r and mu sizes divided by this, as the
-  // radiance the next order scatters (which an integral over the sphere
-  // smooths), and the densities of all orders, on the table's grid, are
-  // summed and gathered once along the table's own rays. Faster (earth: 5.4
-  // instead of 7 s) at a small error for thin atmospheres, but optically
-  // thick ones lose light order after order (heavy-fog's reflected energy
-  // halves at 2), so the default keeps every order on the table's grid
-  // (docs/benchmark.md).
+  // grid with the r and mu sizes of the densities' grid (the table's, or
+  // ScatteringRange's) divided by this, as the radiance the next order
+  // scatters (which an integral over the sphere smooths), and the densities
+  // of all orders, on their grid, are summed and gathered once along the
+  // table's own rays. Faster (earth: 5.4 instead of 7 s) at a small error
+  // for thin atmospheres, but optically thick ones lose light order after
+  // order (heavy-fog's reflected energy halves at 2), so the default keeps
+  // every order on the table's grid (docs/benchmark.md).
   int higher_order_divisor = 1;
   // Restricts the scattering tables to a scene's altitudes and suns; unset,
   // they cover the atmosphere and every sun down to its mu_s_min.

@@ -65,7 +65,8 @@ struct SceneSummary {
   Scene scene;
   ScenePlan plan;
   double full_mu_s_min = 0.0;
-  int full_r_size = 0, table_r_size = 0, atmosphere_r_size = 0, atmosphere_mu_size = 0;
+  int full_r_size = 0, table_r_size = 0;
+  int atmosphere_r_size = 0, atmosphere_mu_size = 0, atmosphere_mu_s_size = 0;
   bool compared = false;
   double full_bake_seconds = 0.0, scene_bake_seconds = 0.0;
   std::uint64_t full_table_bytes = 0, scene_table_bytes = 0;
@@ -86,11 +87,11 @@ void PrintSceneSummary(const SceneSummary& s) {
   if (s.plan.restrict_scattering) {
     std::fprintf(stderr,
                  "    scattering tables restricted to altitudes %.4g-%.4g km and suns %.2f-%.2f deg (%d r texels "
-                 "instead of %d); orders on a %d x %d (r x mu) grid over the whole atmosphere\n",
+                 "instead of %d); orders on a %d x %d x %d (r, mu, mu_s) grid over the whole atmosphere\n",
                  s.plan.altitude_min_m / 1000.0, s.plan.altitude_max_m / 1000.0,
                  std::acos(s.plan.table_mu_s_max) * kDegreesPerRadian,
                  std::acos(s.plan.table_mu_s_min) * kDegreesPerRadian, s.table_r_size, s.full_r_size,
-                 s.atmosphere_r_size, s.atmosphere_mu_size);
+                 s.atmosphere_r_size, s.atmosphere_mu_size, s.atmosphere_mu_s_size);
   }
   if (s.compared) {
     std::fprintf(stderr, "    table bytes %llu vs %llu for the full bake in the same formats (%.1f%%)\n",
@@ -115,7 +116,8 @@ nlohmann::json SceneSummaryJson(const SceneSummary& s) {
                              {"mu_s", {s.plan.table_mu_s_min, s.plan.table_mu_s_max}},
                              {"r_size", s.table_r_size},
                              {"full_r_size", s.full_r_size},
-                             {"atmosphere_grid_r_mu_size", {s.atmosphere_r_size, s.atmosphere_mu_size}}};
+                             {"atmosphere_grid_r_mu_mu_s_size",
+                              {s.atmosphere_r_size, s.atmosphere_mu_size, s.atmosphere_mu_s_size}}};
   }
   if (s.compared) {
     j["comparison"] = {{"scene_table_bytes", s.scene_table_bytes},
@@ -156,6 +158,7 @@ void RunBake(const BakeOptions& o) {
     if (settings.scattering_range) {
       scene->atmosphere_r_size = settings.scattering_range->atmosphere_r_size;
       scene->atmosphere_mu_size = settings.scattering_range->atmosphere_mu_size;
+      scene->atmosphere_mu_s_size = settings.scattering_range->atmosphere_mu_s_size;
     }
   }
   WriteOptions write_options;
