@@ -20,6 +20,7 @@
 #include "formats/file_io.h"
 #include "formats/lut_files.h"
 #include "formats/lut_tables.h"
+#include "report/scene_accuracy.h"
 #include "shaders_runtime/snippet.h"
 
 namespace skybake::cli {
@@ -36,6 +37,7 @@ struct BakeOptions {
   bool quiet = false;
   std::string scene;
   bool compare_full = false;
+  std::string reference;
   CLI::Option* format_option = nullptr;
 };
 
@@ -60,7 +62,8 @@ std::uint64_t TableFileBytes(const WriteReport& written) {
 }
 
 // What a scene bake left out, and (with --compare-full) what it saved
-// against the full bake of the same atmosphere, table sizes and formats.
+// against the full bake of the same atmosphere, table sizes and formats and
+// the error of both on the reference cases inside the scene.
 struct SceneSummary {
   Scene scene;
   ScenePlan plan;
@@ -70,7 +73,23 @@ struct SceneSummary {
   bool compared = false;
   double full_bake_seconds = 0.0, scene_bake_seconds = 0.0;
   std::uint64_t full_table_bytes = 0, scene_table_bytes = 0;
+  std::optional<report::SceneAccuracy> accuracy;  // with a reference for the atmosphere
 };
+
+std::string ErrorText(const report::ErrorStats& e) {
+  char text[96];
+  std::snprintf(text, sizeof text, "mean %.3f%% rms %.3f%% max %.3f%%", 100.0 * e.mean_relative,
+                100.0 * e.rms_relative, 100.0 * e.max_relative);
+  return text;
+}
+
+nlohmann::json ErrorJson(const report::ErrorStats& e) {
+  return {{"mean_relative", e.mean_relative},
+          {"rms_relative", e.rms_relative},
+          {"max_relative", e.max_relative},
+          {"values", e.count},
+          {"rms_reference_noise", e.rms_noise}};
+}
 
 void PrintSceneSummary(const SceneSummary& s) {
   std::fprintf(stderr, "  scene %s:\n", s.scene.name.c_str());
@@ -100,6 +119,17 @@ void PrintSceneSummary(const SceneSummary& s) {
                  100.0 * double(s.scene_table_bytes) / double(s.full_table_bytes));
     std::fprintf(stderr, "    bake time %.3f s vs %.3f s for the full bake (%.1f%%)\n", s.scene_bake_seconds,
                  s.full_bake_seconds, 100.0 * s.scene_bake_seconds / s.full_bake_seconds);
+    if (!s.accuracy) {
+      std::fprintf(stderr, "    accuracy: no reference cases for %s (pass --reference FILE)\n",
+                   s.scene.name.c_str());
+    } else {
+      std::fprintf(stderr, "    error on the %d reference cases of %s inside the scene (relative, every channel):\n",
+                   s.accuracy->cases, s.accuracy->reference.c_str());
+      for (const report::SceneQuantityErrors& q : s.accuracy->quantities) {
+        std::fprintf(stderr, "      %-15s scene %s; full bake %s\n", q.quantity.c_str(), ErrorText(q.scene).c_str(),
+                     ErrorText(q.full).c_str());
+      }
+    }
   }
 }
 
@@ -124,6 +154,16 @@ nlohmann::json SceneSummaryJson(const SceneSummary& s) {
                        {"full_table_bytes", s.full_table_bytes},
                        {"scene_bake_seconds", s.scene_bake_seconds},
                        {"full_bake_seconds", s.full_bake_seconds}};
+    if (s.accuracy) {
+      nlohmann::json quantities = nlohmann::json::object();
+      for (const report::SceneQuantityErrors& q : s.accuracy->quantities) {
+        quantities[q.quantity] = {{"scene", ErrorJson(q.scene)}, {"full", ErrorJson(q.full)}};
+      }
+      j["comparison"]["accuracy"] = {{"reference", s.accuracy->reference},
+                                     {"cases", s.accuracy->cases},
+                                     {"groups", s.accuracy->groups},
+                                     {"errors", quantities}};
+    }
   }
   return j;
 }
@@ -149,6 +189,10 @@ void RunBake(const BakeOptions& o) {
   } else if (o.compare_full) {
     throw UsageError("--compare-full: needs --scene");
   }
+  if (!o.reference.empty() && !o.compare_full) throw UsageError("--reference: needs --compare-full");
+  // Read before baking, so that a bad file fails at once.
+  std::optional<report::ReferenceSet> reference;
+  if (o.compare_full) reference = report::LoadReference(o.reference, atmosphere);
   const Atmosphere full_atmosphere = atmosphere;
   const BakeSettings full_settings = settings;
   if (scene) {
@@ -210,6 +254,7 @@ void RunBake(const BakeOptions& o) {
     scene->full_bake_seconds = full_report.total_seconds;
     scene->scene_bake_seconds = report.total_seconds;
     scene->full_table_bytes = TableFileBytes(full, full_options);
+    if (reference) scene->accuracy = report::MeasureSceneAccuracy(*reference, scene->scene, luts, full);
   }
   // The GLSL runtime goes beside the tables, its constants from this bake's parameters.
   for (SnippetFile& f : RuntimeSnippetFiles(luts.parameters, atmosphere.wavelengths_nm, atmosphere.name, parts)) {
@@ -304,7 +349,11 @@ void AddBakeCommand(CLI::App& app) {
   cmd->add_option("--scene", o->scene,
                   "Scene file (.toml, examples/scenes/README.md): bake and write only what the scene needs");
   cmd->add_flag("--compare-full", o->compare_full,
-                "With --scene: also bake the full set (not written) and report the bytes and time saved");
+                "With --scene: also bake the full set (not written) and report the bytes and time saved and the "
+                "error of both on the reference cases inside the scene");
+  cmd->add_option("--reference", o->reference,
+                  "With --compare-full: reference values (skybake reference over a case set with a group column); "
+                  "default: the committed one for earth");
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
   cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
   cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,6 @@
 #include "formats/query_csv.h"
 #include "report/case_errors.h"
 #include "report/quality_ladder.h"
-#include "report/reference_files.h"
 #include "report/run_time_models.h"
 
 namespace skybake::cli {
@@ -60,19 +60,6 @@ struct Row {
   std::string note;
   std::vector<GroupErrors> errors;
 };
-
-report::ReferenceSet LoadReference(const ReportOptions& o, const Atmosphere& atmosphere) {
-  if (!o.reference.empty()) {
-    return report::ParseReference(ReadFileText(o.reference), std::filesystem::path(o.reference).filename().string(),
-                                  atmosphere);
-  }
-  const EmbeddedText* committed = report::CommittedReference(atmosphere.name);
-  if (!committed) {
-    throw InputError("report: no committed reference for '" + atmosphere.name +
-                     "' (only earth has one); compute one with skybake reference and pass --reference FILE");
-  }
-  return report::ParseReference(std::string(committed->text), std::string(committed->name), atmosphere);
-}
 
 std::string Cell(const report::ErrorStats& s) {
   if (s.count == 0) return "n/a";
@@ -287,7 +274,12 @@ LinePlot ErrorAgainstTimePlot(const std::string& atmosphere, const std::vector<R
 void RunReport(const ReportOptions& o) {
   namespace fs = std::filesystem;
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
-  report::ReferenceSet reference = LoadReference(o, atmosphere);
+  std::optional<report::ReferenceSet> loaded = report::LoadReference(o.reference, atmosphere);
+  if (!loaded) {
+    throw InputError("report: no committed reference for '" + atmosphere.name +
+                     "' (only earth has one); compute one with skybake reference and pass --reference FILE");
+  }
+  const report::ReferenceSet& reference = *loaded;
   const report::LadderPlan plan = report::MakeLadder(o.bake.Resolve(), o.quick);
   std::vector<int> march_steps = o.march_steps;
   if (march_steps.empty()) march_steps = o.quick ? std::vector<int>{4, 8} : std::vector<int>{4, 8, 16, 32};

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 
+#include <filesystem>
+
 #include "bake/errors.h"
+#include "formats/file_io.h"
 #include "formats/query_csv.h"
+#include "report/reference_files.h"
 
 namespace skybake::report {
 
@@ -58,6 +62,15 @@ ReferenceSet ParseReference(const std::string& text, const std::string& source_n
   }
   if (set.cases.empty()) throw InputError(source_name + ": no reference values");
   return set;
+}
+
+std::optional<ReferenceSet> LoadReference(const std::string& file, const Atmosphere& atmosphere) {
+  if (!file.empty()) {
+    return ParseReference(ReadFileText(file), std::filesystem::path(file).filename().string(), atmosphere);
+  }
+  const EmbeddedText* committed = CommittedReference(atmosphere.name);
+  if (!committed) return std::nullopt;
+  return ParseReference(std::string(committed->text), std::string(committed->name), atmosphere);
 }
 
 std::vector<std::string> MeasuredGroups(const ReferenceSet& reference) {

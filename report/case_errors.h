@@ -10,6 +10,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,10 @@ struct ReferenceSet {
 // without the per-wavelength columns of `atmosphere`'s wavelengths (a
 // reference computed for another atmosphere).
 ReferenceSet ParseReference(const std::string& text, const std::string& source_name, const Atmosphere& atmosphere);
+
+// The reference in `file`, or where `file` is empty the one committed for
+// `atmosphere` (reference_files.h); nullopt if there is none.
+std::optional<ReferenceSet> LoadReference(const std::string& file, const Atmosphere& atmosphere);
 
 // What a model answers for one case; a model that cannot answer a quantity
 // (a ray march has no sky irradiance, Hoffman & Preetham no view from space)

@@ -20,7 +20,7 @@ double LuminanceStandardError(const glm::dvec3& e) {
 
 ErrorStats ComputeErrorStats(const std::vector<ErrorSample>& samples) {
   ErrorStats s;
-  double sum_squares = 0.0, noise_squares = 0.0;
+  double sum = 0.0, sum_squares = 0.0, noise_squares = 0.0;
   for (const ErrorSample& sample : samples) {
     if (!(std::isfinite(sample.reference) && sample.reference > 0.0)) {
       ++s.skipped;
@@ -31,11 +31,13 @@ ErrorStats ComputeErrorStats(const std::vector<ErrorSample>& samples) {
     double relative = std::isfinite(sample.value) ? difference / sample.reference : INFINITY;
     double noise = kNoiseStandardErrors * sample.standard_error;
     if (difference < noise) ++s.below_noise;
+    sum += relative;
     sum_squares += relative * relative;
     noise_squares += (noise / sample.reference) * (noise / sample.reference);
     s.max_relative = std::max(s.max_relative, relative);
   }
   if (s.count > 0) {
+    s.mean_relative = sum / s.count;
     s.rms_relative = std::sqrt(sum_squares / s.count);
     s.rms_noise = std::sqrt(noise_squares / s.count);
   }

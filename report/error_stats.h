@@ -39,6 +39,7 @@ struct ErrorStats {
   int count = 0;        // samples measured: reference > 0 and finite
   int skipped = 0;      // samples left out: reference <= 0 (e.g. no sunlight) or not finite
   int below_noise = 0;  // measured samples with |value - reference| < kNoiseStandardErrors * standard error
+  double mean_relative = 0.0;  // mean(|value - reference| / reference); inf if a value is not finite
   double rms_relative = 0.0;  // sqrt(mean(((value - reference) / reference)^2)); inf if a value is not finite
   double max_relative = 0.0;
   double rms_noise = 0.0;     // sqrt(mean((kNoiseStandardErrors * standard_error / reference)^2))

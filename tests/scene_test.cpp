@@ -3,6 +3,7 @@
 // set round-trips through its files, and that a scene bake reproduces the
 // full bake inside the scene's ranges.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -415,6 +416,44 @@ TEST(SceneBake, WritesAndLoadsOnlyTheKeptTables) {
   EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "render"));
   EXPECT_EQ(testing::RunCommand(render + " --views fisheye", dir, nullptr, &err), 0) << err;
+}
+
+TEST(SceneBake, CompareFullReportsBytesTimeAndAccuracyInsideTheScene) {
+  testing::TempDir dir;
+  const std::filesystem::path scene_file = dir.path() / "ground.toml";
+  testing::WriteText(scene_file, SceneText("sky = true\nground_irradiance = true"));
+  const std::string small =
+      " --orders 2 --transmittance-size 32 8 --irradiance-size 8 4 --scattering-size 8 16 8 4 --ray-samples 16"
+      " --sphere-samples 4";
+  auto bake = [&](const std::string& atmosphere, const std::string& extra, std::string* out, std::string* err) {
+    return testing::RunCommand(testing::Skybake() + " bake " + atmosphere + " -q --json -o " +
+                                   testing::ShellQuote(dir.path() / atmosphere) + " --scene " +
+                                   testing::ShellQuote(scene_file) + small + extra,
+                               dir, out, err);
+  };
+  std::string out, err;
+  ASSERT_EQ(bake("earth", " --compare-full", &out, &err), 0) << err;
+  const nlohmann::json comparison = nlohmann::json::parse(out)["scene"]["comparison"];
+  EXPECT_LT(comparison["scene_table_bytes"].get<double>(), comparison["full_table_bytes"].get<double>());
+  // Earth's committed reference: the sky and irradiance cases with cameras
+  // below 2 km and the sun above the horizon.
+  const nlohmann::json& accuracy = comparison["accuracy"];
+  EXPECT_EQ(accuracy["reference"], "earth_reference.csv");
+  EXPECT_GT(accuracy["cases"].get<int>(), 50);
+  for (const char* quantity : {"radiance", "sun_irradiance", "sky_irradiance"}) {
+    for (const char* bake_name : {"scene", "full"}) {
+      const nlohmann::json& e = accuracy["errors"][quantity][bake_name];
+      EXPECT_GT(e["values"].get<int>(), 0) << quantity;
+      EXPECT_GE(e["max_relative"].get<double>(), e["rms_relative"].get<double>()) << quantity;
+      EXPECT_GE(e["rms_relative"].get<double>(), e["mean_relative"].get<double>()) << quantity;
+    }
+  }
+  // No reference for mars: said so, no accuracy.
+  ASSERT_EQ(bake("mars", " --compare-full", &out, &err), 0) << err;
+  EXPECT_FALSE(nlohmann::json::parse(out)["scene"]["comparison"].contains("accuracy"));
+  // --reference needs --compare-full.
+  EXPECT_EQ(bake("earth", " --reference x.csv", &out, &err), 1);
+  EXPECT_NE(err.find("--reference: needs --compare-full"), std::string::npos) << err;
 }
 
 TEST(SceneBake, ReproducesTheFullBakeInsideTheScenesRanges) {
