@@ -427,6 +427,7 @@ Number DistanceInsideScatteringRadii(IN(AtmosphereParameters) atmosphere, Number
   Number down_discriminant = across + r_min * r_min;
   return mu < 0.0 && down_discriminant >= 0.0 ? min(up, -r * mu - sqrt(down_discriminant)) : up;
 }
+
 // Trapezoidal intervals of the direct integration. On Earth the rule
 // overestimates the optical depth (440 nm) of a vertical segment from the
 // ground by 4.5e-5 at 5 km and 2.2e-4 at 10 km (the aerosols' 1.2 km scale
