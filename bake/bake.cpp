@@ -108,6 +108,27 @@ struct RayIntegrand {
   Spectrum value{0.0};
 };
 
+// Integral over an interval of a ray from the view's optical depth tau_a to
+// tau_b of the light scattered there per unit optical depth, value_a and
+// value_b at the ends, attenuated by the view's optical depth and by the
+// sun's, sun_a and sun_b at the ends (IntegrateInterval's rule for
+// optically thick intervals, for one channel): exponential per unit optical
+// depth between the ends, linear where an end is dark.
+double IntegrateOverOpticalDepth(double value_a, double value_b, double sun_a, double sun_b, double tau_a,
+                                 double tau_b) {
+  const double width = tau_b - tau_a;
+  if (value_a <= 0.0 || value_b <= 0.0) {
+    // With u the view's optical depth from a and g the values without the
+    // view's attenuation: integral over [0, width] of (ga + (gb - ga) u / width) exp(-u).
+    const double ga = value_a * std::exp(-sun_a), gb = value_b * std::exp(-sun_b);
+    const double decay = -std::expm1(-width), ramp = (decay - width * std::exp(-width)) / width;
+    return std::exp(-tau_a) * (ga * decay + (gb - ga) * ramp);
+  }
+  const double log_a = std::log(value_a) - (tau_a + sun_a), log_b = std::log(value_b) - (tau_b + sun_b);
+  const double fa = std::exp(log_a), fb = std::exp(log_b), log_ratio = log_b - log_a;
+  return std::abs(log_ratio) < 1e-4 ? 0.5 * width * (fa + fb) : width * (fb - fa) / log_ratio;
+}
+
 // Integral between two samples of a RayIntegrand, `h` apart. Three failures
 // of ExponentialTrapezoid on the product in optically thick media are
 // avoided (docs/stability.md, "Integrals along rays"):
@@ -147,24 +168,12 @@ Spectrum IntegrateInterval(const RayIntegrand& a, const RayIntegrand& b, double 
       result[c] = ExponentialTrapezoid(a.value[c], b.value[c], h);
       continue;
     }
-    // Per unit of the view's optical depth.
-    const double width = view_depth;
+    // Per unit of the view's optical depth; an end that is truly dark (in
+    // the planet's shadow, or nothing scatters) makes the rule linear.
     const double value_a = extinction_a > 0.0 ? a.source[c] / extinction_a : b.source[c] / extinction_b;
     const double value_b = extinction_b > 0.0 ? b.source[c] / extinction_b : value_a;
-    if (value_a <= 0.0 || value_b <= 0.0) {
-      // An end is truly dark (in the planet's shadow, or nothing scatters):
-      // linear between the ends, integrated exactly against exp(-tau).
-      // With u the view's optical depth from a and g the values without the
-      // view's attenuation: integral over [0, x] of (ga + (gb - ga) u / x) exp(-u).
-      double ga = value_a * std::exp(-a.sun_optical_depth[c]), gb = value_b * std::exp(-b.sun_optical_depth[c]);
-      double x = width, decay = -std::expm1(-x), ramp = (decay - x * std::exp(-x)) / x;
-      result[c] = std::exp(-a.view_optical_depth[c]) * (ga * decay + (gb - ga) * ramp);
-      continue;
-    }
-    double log_a = std::log(value_a) - (a.view_optical_depth[c] + a.sun_optical_depth[c]);
-    double log_b = std::log(value_b) - (b.view_optical_depth[c] + b.sun_optical_depth[c]);
-    double fa = std::exp(log_a), fb = std::exp(log_b), log_ratio = log_b - log_a;
-    result[c] = std::abs(log_ratio) < 1e-4 ? 0.5 * width * (fa + fb) : width * (fb - fa) / log_ratio;
+    result[c] = IntegrateOverOpticalDepth(value_a, value_b, a.sun_optical_depth[c], b.sun_optical_depth[c],
+                                          a.view_optical_depth[c], b.view_optical_depth[c]);
   }
   return result;
 }
@@ -1453,8 +1462,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // the integral a weighted sum of J at the samples with weights shared by
     // all the ray's texels. Over thick ones (more than one optical depth) J
     // can fall by orders of magnitude (into a fog) and the integrand is
-    // taken as exponential per unit of the view's optical depth, per texel,
-    // as IntegrateInterval does.
+    // taken as exponential per unit of the view's optical depth, per texel
+    // (IntegrateOverOpticalDepth).
     struct ThickInterval {
       int k, c;
       double albedo_a, albedo_b;
@@ -1564,18 +1573,10 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       Spectrum sum(sums[0][j], sums[1][j], sums[2][j]);
       for (const ThickInterval& interval : thick_intervals) {
         const int k = interval.k, c = interval.c;
-        const double tau_a = ray.optical_depth[k][c], width = ray.optical_depth[k + 1][c] - tau_a;
         const double value_a = source[(std::size_t(k) * 3 + c) * count + j] * interval.albedo_a;
         const double value_b = source[(std::size_t(k + 1) * 3 + c) * count + j] * interval.albedo_b;
-        if (value_a <= 0.0 || value_b <= 0.0) {
-          // A dark end: linear between the ends, exactly against exp(-tau).
-          const double decay = -std::expm1(-width), ramp = (decay - width * std::exp(-width)) / width;
-          sum[c] += std::exp(-tau_a) * (value_a * decay + (value_b - value_a) * ramp);
-          continue;
-        }
-        const double log_a = std::log(value_a) - tau_a, log_b = std::log(value_b) - (tau_a + width);
-        const double fa = std::exp(log_a), fb = std::exp(log_b), log_ratio = log_b - log_a;
-        sum[c] += std::abs(log_ratio) < 1e-4 ? 0.5 * width * (fa + fb) : width * (fb - fa) / log_ratio;
+        sum[c] += IntegrateOverOpticalDepth(value_a, value_b, 0.0, 0.0, ray.optical_depth[k][c],
+                                            ray.optical_depth[k + 1][c]);
       }
       directions_sum[j] = sum;
     }
