@@ -179,6 +179,14 @@ bool CanPackSingleMie(const Atmosphere& atmosphere) {
   return mie.x > 0.0 && other.x > 0.0 && other.y > 0.0 && other.z > 0.0;
 }
 
+// The part of the scattering table's r axis, which maps the distance to the
+// horizon rho = sqrt(r^2 - bottom^2), that the altitudes [low, high] span.
+double RhoSpan(const Atmosphere& atmosphere, double low, double high) {
+  const double rg = atmosphere.bottom_radius_m;
+  auto rho = [&](double altitude) { return std::sqrt(altitude * (2.0 * rg + altitude)); };
+  return (rho(high) - rho(low)) / rho(atmosphere.top_radius_m - rg);
+}
+
 // The scattering tables are looked up at the camera (the sky, from the top
 // of the atmosphere for a camera above it) and for aerial perspective at
 // the objects, at the end of the sunlit part of a partly shadowed segment
@@ -223,9 +231,7 @@ void PlanScatteringRange(const Scene& scene, const Atmosphere& atmosphere, Scene
   // scene (0-20 km, 58% of the span) the restricted bake took as long as the
   // full one and was less accurate (mean 0.51% against 0.39% from a finer
   // bake, single Mie packed in both).
-  auto rho = [&](double altitude) { return std::sqrt(altitude * (2.0 * rg + altitude)); };
-  const double span = (rho(high) - rho(low)) / rho(height);
-  plan->restrict_scattering = span <= 1.0 / 3.0;
+  plan->restrict_scattering = RhoSpan(atmosphere, low, high) <= 1.0 / 3.0;
   if (!plan->restrict_scattering) return;
   plan->altitude_min_m = low, plan->altitude_max_m = high;
   plan->sun_above_horizon = scene.sun_zenith_max_deg <= 90.0;
@@ -371,9 +377,7 @@ void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings*
   // altitudes (rho spans, as the r axis maps rho): part of the texels saved
   // goes to precision (on earth's ground-level daytime scene, 7 texels gave
   // the full bake's mean error and 10 a tenth less, examples/scenes/README.md).
-  const double rg = atmosphere->bottom_radius_m, rt = atmosphere->top_radius_m;
-  auto rho = [&](double altitude) { return std::sqrt(altitude * (2.0 * rg + altitude)); };
-  const double span = (rho(range.altitude_max_m) - rho(range.altitude_min_m)) / rho(rt - rg);
+  const double span = RhoSpan(*atmosphere, range.altitude_min_m, range.altitude_max_m);
   const int intervals = static_cast<int>(std::ceil(1.5 * span * (settings->scattering_r_size - 1)));
   settings->scattering_r_size = std::clamp(intervals + 1, 2, settings->scattering_r_size);
   settings->scattering_range = range;

@@ -153,11 +153,11 @@ Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s
   return GetTextureCoordFromUnitRange(min(x, 1.0), atmosphere.scattering_mu_s_size);
 }
 
-// r through the distance to the horizon, over the table's radii.
-Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r) {
+// r through its distance to the horizon rho, over the table's radii.
+Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number rho) {
   Number rho_min = HorizonDistance(atmosphere, atmosphere.scattering_r_min);
   Number rho_max = HorizonDistance(atmosphere, atmosphere.scattering_r_max);
-  Number x = (HorizonDistance(atmosphere, r) - rho_min) / (rho_max - rho_min);
+  Number x = (rho - rho_min) / (rho_max - rho_min);
   return GetTextureCoordFromUnitRange(clamp(x, 0.0, 1.0), atmosphere.scattering_r_size);
 }
 
@@ -167,7 +167,7 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
                                           Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   Number H = HorizonDistanceAtTop(atmosphere);
   Number rho = HorizonDistance(atmosphere, r);
-  Number u_r = GetScatteringTextureUR(atmosphere, r);
+  Number u_r = GetScatteringTextureUR(atmosphere, rho);
 
   Number half_mu_size = Number(atmosphere.scattering_mu_size / 2);
   Number u_mu;
