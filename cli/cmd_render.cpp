@@ -15,7 +15,6 @@
 #include "bake/bake.h"
 #include "bake/errors.h"
 #include "bake/scene.h"
-#include "bake/toml_input.h"
 #include "bake/version.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -54,18 +53,23 @@ std::string ZenithTag(double zenith_deg) {
 
 
 // A scene's bake holds only what its scene shows (bake/scene.h): refuses the
-// views, suns and altitudes it cannot render, as eval refuses queries.
-using toml_input::FormatNumber;
-
-void CheckSceneCanRender(const Scene& scene, const RenderArguments& args, const std::vector<render::View>& views) {
+// views it cannot render, and the suns and camera altitudes eval would
+// refuse for its sky.
+void CheckSceneCanRender(const Scene& scene, double bottom_radius_m, const RenderArguments& args,
+                         const std::vector<render::View>& views) {
   const SceneEffects& e = scene.effects;
-  auto refuse = [&](const std::string& what) {
-    throw InputError("render: " + what + " is not in the scene '" + scene.name + "' of " + args.lut_dir);
-  };
+  const std::string of_scene = "the scene '" + scene.name + "' of " + args.lut_dir;
+  auto refuse = [&](const std::string& what) { throw InputError("render: " + what + " is not in " + of_scene); };
   if (args.plots) refuse("--plots (they span every altitude and sun)");
+  for (double z : args.sun_zenith_deg) {
+    Query sky;
+    sky.altitude_m = args.altitude_m, sky.sun_zenith_deg = z;
+    std::vector<std::string> unused;
+    const std::string problem = SceneQueryProblem(scene, bottom_radius_m, false, &sky, &unused);
+    if (!problem.empty()) throw InputError("render: " + problem + " (" + of_scene + ")");
+  }
   for (render::View view : views) {
     const std::string name = std::string("view '") + render::ToString(view) + "'";
-    if (!e.sky) refuse(name + " (the sky)");
     if (view == render::View::kSpace && !e.space_views) refuse(name + " (effects.space_views)");
     // Every view but the fisheye shows the ground, lit by the sun and the
     // sky and seen through the air.
@@ -73,17 +77,8 @@ void CheckSceneCanRender(const Scene& scene, const RenderArguments& args, const 
       refuse(name + " (the ground, which needs ground_irradiance and aerial_perspective)");
     }
   }
-  for (double z : args.sun_zenith_deg) {
-    if (z < scene.sun_zenith_min_deg || z > scene.sun_zenith_max_deg) {
-      refuse("--sun-zenith " + FormatNumber(z) + " (suns " + FormatNumber(scene.sun_zenith_min_deg) + " to " +
-             FormatNumber(scene.sun_zenith_max_deg) + " degrees)");
-    }
-  }
-  if (args.altitude_m < scene.camera_altitude_min_m || args.altitude_m > scene.camera_altitude_max_m) {
-    refuse("--altitude-m " + FormatNumber(args.altitude_m) + " (cameras " + FormatNumber(scene.camera_altitude_min_m) +
-           " to " + FormatNumber(scene.camera_altitude_max_m) + " m)");
-  }
 }
+
 void RunRender(const RenderArguments& args) {
   std::vector<render::View> views;
   for (const std::string& name : args.views) {
@@ -106,7 +101,7 @@ void RunRender(const RenderArguments& args) {
   }
   if (!(args.altitude_m >= 0.0 && args.altitude_m < luts.atmosphere.top_radius_m - luts.atmosphere.bottom_radius_m))
     throw InputError("render: --altitude-m must lie inside the atmosphere");
-  if (luts.scene) CheckSceneCanRender(*luts.scene, args, views);
+  if (luts.scene) CheckSceneCanRender(*luts.scene, luts.atmosphere.bottom_radius_m, args, views);
   EnsureWritableDirectory(args.output_dir);
   const std::filesystem::path out_dir(args.output_dir);
 
