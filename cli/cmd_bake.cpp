@@ -69,7 +69,7 @@ struct SceneSummary {
   ScenePlan plan;
   double full_mu_s_min = 0.0;
   int full_r_size = 0, table_r_size = 0;
-  int atmosphere_r_size = 0, atmosphere_mu_size = 0, atmosphere_mu_s_size = 0;
+  std::optional<ScatteringRange> range;  // the bake's, where the plan restricts the tables
   bool compared = false;
   double full_bake_seconds = 0.0, scene_bake_seconds = 0.0;
   std::uint64_t full_table_bytes = 0, scene_table_bytes = 0;
@@ -103,14 +103,14 @@ void PrintSceneSummary(const SceneSummary& s) {
   std::fprintf(stderr, "    orders computed down to mu_s %.4f (full bake %.4f): lowest sun %.2f deg instead of %.2f deg\n",
                s.plan.mu_s_min, s.full_mu_s_min, std::acos(s.plan.mu_s_min) * kDegreesPerRadian,
                std::acos(s.full_mu_s_min) * kDegreesPerRadian);
-  if (s.plan.restrict_scattering) {
+  if (const std::optional<ScatteringRange>& range = s.range) {
     std::fprintf(stderr,
                  "    scattering tables restricted to altitudes %.4g-%.4g km and suns %.2f-%.2f deg (%d r texels "
                  "instead of %d); orders on a %d x %d x %d (r, mu, mu_s) grid over the whole atmosphere\n",
-                 s.plan.altitude_min_m / 1000.0, s.plan.altitude_max_m / 1000.0,
-                 std::acos(s.plan.table_mu_s_max) * kDegreesPerRadian,
-                 std::acos(s.plan.table_mu_s_min) * kDegreesPerRadian, s.table_r_size, s.full_r_size,
-                 s.atmosphere_r_size, s.atmosphere_mu_size, s.atmosphere_mu_s_size);
+                 range->altitude_min_m / 1000.0, range->altitude_max_m / 1000.0,
+                 std::acos(range->mu_s_max) * kDegreesPerRadian, std::acos(range->mu_s_min) * kDegreesPerRadian,
+                 s.table_r_size, s.full_r_size, range->atmosphere_r_size, range->atmosphere_mu_size,
+                 range->atmosphere_mu_s_size);
   }
   if (s.compared) {
     std::fprintf(stderr, "    table bytes %llu vs %llu for the full bake in the same formats (%.1f%%)\n",
@@ -141,13 +141,13 @@ nlohmann::json SceneSummaryJson(const SceneSummary& s) {
                       {"aerial_perspective_functions", s.plan.aerial_perspective_functions},
                       {"orders_mu_s_min", s.plan.mu_s_min},
                       {"full_bake_mu_s_min", s.full_mu_s_min}};
-  if (s.plan.restrict_scattering) {
-    j["scattering_range"] = {{"altitude_m", {s.plan.altitude_min_m, s.plan.altitude_max_m}},
-                             {"mu_s", {s.plan.table_mu_s_min, s.plan.table_mu_s_max}},
+  if (const std::optional<ScatteringRange>& range = s.range) {
+    j["scattering_range"] = {{"altitude_m", {range->altitude_min_m, range->altitude_max_m}},
+                             {"mu_s", {range->mu_s_min, range->mu_s_max}},
                              {"r_size", s.table_r_size},
                              {"full_r_size", s.full_r_size},
                              {"atmosphere_grid_r_mu_mu_s_size",
-                              {s.atmosphere_r_size, s.atmosphere_mu_size, s.atmosphere_mu_s_size}}};
+                              {range->atmosphere_r_size, range->atmosphere_mu_size, range->atmosphere_mu_s_size}}};
   }
   if (s.compared) {
     j["comparison"] = {{"scene_table_bytes", s.scene_table_bytes},
@@ -199,11 +199,7 @@ void RunBake(const BakeOptions& o) {
     ApplyScenePlan(scene->plan, &atmosphere, &settings);
     scene->full_r_size = full_settings.scattering_r_size;
     scene->table_r_size = settings.scattering_r_size;
-    if (settings.scattering_range) {
-      scene->atmosphere_r_size = settings.scattering_range->atmosphere_r_size;
-      scene->atmosphere_mu_size = settings.scattering_range->atmosphere_mu_size;
-      scene->atmosphere_mu_s_size = settings.scattering_range->atmosphere_mu_s_size;
-    }
+    scene->range = settings.scattering_range;
   }
   WriteOptions write_options;
   write_options.formats.clear();
