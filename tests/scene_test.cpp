@@ -19,6 +19,7 @@
 #include "formats/lut_files.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
+#include "report/run_time_models.h"
 #include "shaders_runtime/query.h"
 #include "shaders_runtime/snippet.h"
 #include "shaders_runtime/twin.h"
@@ -320,22 +321,11 @@ TEST(SceneSnippet, PrunedGlslCompilesAndLacksTheFunctionsLeftOut) {
 
 // ---- the bake ----
 
-// The twin's sky radiance for a ground-level camera, view zenith vz and sun
-// zenith sz (degrees), sun 60 degrees in azimuth from the view.
-glsl::vec3 Sky(const Twin& twin, double altitude_m, double vz, double sz) {
-  Query q;
-  q.altitude_m = altitude_m, q.view_zenith_deg = vz, q.sun_zenith_deg = sz, q.view_sun_azimuth_deg = 60.0;
-  const QueryGeometry g = MakeQueryGeometry(q, twin.parameters().bottom_radius);
-  glsl::vec3 transmittance;
-  return twin.SkyRadiance(g.camera, g.view, g.sun, &transmittance);
-}
-
 // The twin's sky radiance (no distance) or aerial perspective for a query.
 glsl::vec3 Radiance(const Twin& twin, const Query& q) {
-  const QueryGeometry g = MakeQueryGeometry(q, twin.parameters().bottom_radius);
-  glsl::vec3 transmittance;
-  if (q.distance_m <= 0.0) return twin.SkyRadiance(g.camera, g.view, g.sun, &transmittance);
-  return twin.SkyRadianceToPoint(g.camera, g.camera + g.view * q.distance_m, g.sun, &transmittance);
+  report::ReferenceCase c;
+  c.query = q;
+  return report::EvaluateTwin(twin, c).radiance;
 }
 
 TEST(SceneBake, AllEffectsFromSpaceBakeTheFullSet) {
