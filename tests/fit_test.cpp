@@ -950,7 +950,7 @@ TEST(Query, AnswersAreExactFittedAndIqbal) {
 
 // ---- the command line ----
 
-std::string Exe() { return ShellQuote(SKYBAKE_EXE); }
+std::string Exe() { return testing::Skybake(); }
 
 TEST(FitCli, MalformedQueryCsvExitsTwoNamingTheLine) {
   TempDir dir;

@@ -63,8 +63,13 @@ inline int RunCommand(const std::string& command, const TempDir& dir, std::strin
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-// The skybake executable under test, quoted for a shell.
-inline std::string Skybake() { return ShellQuote(SKYBAKE_EXE); }
+// The skybake executable under test, quoted for a shell. SKYBAKE_TEST_EXE
+// points the command-line tests at another build (for example an older one,
+// to see a regression test fail there).
+inline std::string Skybake() {
+  const char* other = std::getenv("SKYBAKE_TEST_EXE");
+  return ShellQuote(other != nullptr && *other != '\0' ? other : SKYBAKE_EXE);
+}
 
 inline std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;
