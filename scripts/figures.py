@@ -1,0 +1,185 @@
+#!/usr/bin/python3
+"""Regenerates the figures in README.md and docs/*.md that come from commands.
+
+Each figure is a Markdown block between two marker comments,
+
+    <!-- figures:NAME begin: scripts/figures.sh PART -->
+    ...
+    <!-- figures:NAME end -->
+
+and running a part replaces the block in place (the markers stay). Normally
+run through scripts/figures.sh, which builds skybake first:
+
+    /usr/bin/python3 scripts/figures.py SKYBAKE PART...
+
+Parts (figure blocks, the page, the commands run):
+
+  sizes    file-sizes (docs/files.md): `skybake bake earth` and
+           `skybake bake earth --half` (--json), `skybake convert --half --json`
+           on each float EXR table; a few seconds
+  orders   orders-tail (docs/accuracy.md): `skybake bake earth --orders N
+           --json` for N = 1..6 and auto, and `--orders 4 --no-tail`; under a minute
+  cli      presets, bake-defaults (docs/cli.md): `skybake presets --json`,
+           `skybake bake --help`; instant
+  bench    bench (docs/benchmark.md): scripts/bench.sh (RUNS=5: about 7 minutes)
+  report   report (docs/accuracy.md), docs/images/report/: `/usr/bin/time -v
+           skybake report earth -o build/figures/report` (about 10 minutes)
+
+bench and report time the machine: run them with nothing else running.
+"""
+import json
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+WORK = pathlib.Path("build") / "figures"  # relative to ROOT, the working directory
+TABLES = ["transmittance", "irradiance", "scattering", "single_mie_scattering"]
+
+
+def run(args, **kwargs):
+    return subprocess.run(args, check=True, capture_output=True, text=True, cwd=ROOT, **kwargs).stdout
+
+
+def replace_block(page, name, part, text):
+    """Replaces the text between figures:NAME's markers in page (relative to the root)."""
+    path = ROOT / page
+    source = path.read_text()
+    pattern = re.compile(r"(<!-- figures:%s begin[^>]*-->\n).*?(<!-- figures:%s end -->)" % (re.escape(name),
+                                                                                              re.escape(name)),
+                         re.S)
+    if not pattern.search(source):
+        sys.exit(f"figures: no figures:{name} markers in {page}")
+    begin = f"<!-- figures:{name} begin: scripts/figures.sh {part} -->\n"
+    updated = pattern.sub(lambda m: begin + text.rstrip("\n") + "\n" + m.group(2), source, count=1)
+    path.write_text(updated)
+    print(f"figures: {page}: figures:{name}", file=sys.stderr)
+
+
+def thousands(n):
+    return f"{n:,}".replace(",", " ")
+
+
+def bake_json(skybake, directory, *options):
+    shutil.rmtree(directory, ignore_errors=True)
+    return json.loads(run([skybake, "bake", "earth", "-o", str(directory), "-q", "--json", *options]))
+
+
+def sizes(skybake):
+    full = bake_json(skybake, WORK / "sizes" / "float")
+    half = bake_json(skybake, WORK / "sizes" / "half", "--half")
+    size = lambda report, name: next(f["bytes"] for f in report["files"] if f["file"] == name)
+    rows = []
+    for table in TABLES:
+        dims = full["tables"][table]
+        texture = "×".join(str(d) for d in dims)
+        conversion = json.loads(run([skybake, "convert", str(WORK / "sizes" / "float" / f"{table}.exr"),
+                                     str(WORK / "sizes" / f"{table}.half.exr"), "--half", "--json"]))
+        error = conversion["half_error"]
+        values = len(conversion["channels"])
+        for d in dims:
+            values *= d
+        rows.append(f"| {table} | {texture} | {thousands(size(full, table + '.exr'))} | "
+                    f"{thousands(size(half, table + '.exr'))} | {thousands(size(full, table + '.ktx2'))} | "
+                    f"{thousands(size(half, table + '.ktx2'))} | {error['max_relative_error']:.2e} | "
+                    f"{thousands(error['below_floor'])} ({thousands(error['flushed_to_zero'])}) of {thousands(values)} |")
+    total = lambda report: sum(f["bytes"] for f in report["files"] if f["table"])
+    text = ("| table | size | EXR float | EXR half | KTX2 float | KTX2 half | half: max relative error (|v| ≥ 2⁻¹⁴) "
+            "| half: non-zero values < 2⁻¹⁴ (flushed to 0) of all values |\n"
+            "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n" + "\n".join(rows) + "\n\n"
+            f"All table files: {thousands(total(full))} bytes in float, {thousands(total(half))} bytes in half.")
+    replace_block("docs/files.md", "file-sizes", "sizes", text)
+
+
+def orders(skybake):
+    runs = [(str(n), ["--orders", str(n)]) for n in range(1, 7)]
+    runs.insert(4, ("4, `--no-tail`", ["--orders", "4", "--no-tail"]))
+    runs.append(("auto", ["--orders", "auto"]))
+    rows = []
+    for label, options in runs:
+        r = bake_json(skybake, WORK / "orders", *options)
+        remaining = "—" if r["remaining_error"] is None else f"{r['remaining_error']:.2e}"
+        tail = f"{100 * r['extrapolated_tail']:.2f}%" if r["extrapolated_tail"] > 0 else "none"
+        ratio = f"{r['order_ratio']:.4f}" if r["orders_used"] >= 3 else "—"  # 0 until order 3
+        rows.append(f"| {label} | {r['orders_used']} | {ratio} | {tail} | {remaining} |")
+    shutil.rmtree(WORK / "orders", ignore_errors=True)
+    text = ("| `--orders` | orders computed | ratio q of the last two | extrapolated tail (of the table) "
+            "| estimated remaining error |\n| --- | ---: | ---: | ---: | ---: |\n" + "\n".join(rows))
+    replace_block("docs/accuracy.md", "orders-tail", "orders", text)
+
+
+def bake_defaults(help_text):
+    """(option, default) for every option of `skybake bake --help` that states one."""
+    # CLI11 moves a description to the next line when the option column is full.
+    lines = []
+    for line in help_text.splitlines():
+        if lines and re.match(r"\s{20,}\S", line) and not line.lstrip().startswith("-"):
+            lines[-1] += " " + line.strip()
+        else:
+            lines.append(line)
+    defaults = []
+    for line in lines:
+        m = re.match(r"\s+(?:-\w,)?(--[\w-]+)(?: (\w+))?(?:=(\S+))?(?: x (\d))?(?:\s+(.*))?$", line)
+        if not m:
+            continue
+        option, value, description = m.group(1), m.group(3), m.group(5) or ""
+        if value is None:
+            d = re.search(r"\(default ([^;)]*)", description)
+            value = d.group(1) if d else None
+        if value is not None and option != "--help":
+            defaults.append((option, value.replace("[", "").replace("]", "")))
+    return defaults
+
+
+def cli(skybake):
+    presets = json.loads(run([skybake, "presets", "--json"]))
+    text = "| preset | description |\n| --- | --- |\n" + "\n".join(
+        f"| `{p['name']}` | {p['description']} |" for p in presets)
+    replace_block("docs/cli.md", "presets", "cli", text)
+    defaults = bake_defaults(run([skybake, "bake", "--help"]))
+    text = "| option | default |\n| --- | --- |\n" + "\n".join(f"| `{o}` | `{v}` |" for o, v in defaults)
+    replace_block("docs/cli.md", "bake-defaults", "cli", text)
+
+
+def bench(skybake):
+    env = dict(os.environ, RUNS=os.environ.get("RUNS", "5"))
+    text = run([str(ROOT / "scripts" / "bench.sh")], env=env)
+    replace_block("docs/benchmark.md", "bench", "bench", f"`RUNS={env['RUNS']} scripts/bench.sh`:\n\n" + text)
+
+
+def report(skybake):
+    out = WORK / "report"
+    shutil.rmtree(out, ignore_errors=True)
+    with tempfile.NamedTemporaryFile("r", suffix=".time") as timing:
+        tables = run(["/usr/bin/time", "-v", "-o", timing.name, skybake, "report", "earth", "-o", str(out)])
+        usage = timing.read()
+    field = lambda name: re.search(re.escape(name) + r": (.*)", usage).group(1).strip()
+    wall = field("Elapsed (wall clock) time (h:mm:ss or m:ss)")
+    cpu = float(field("User time (seconds)")) + float(field("System time (seconds)"))
+    peak = int(field("Maximum resident set size (kbytes)")) / 1024
+    for name in ["error_vs_bake_time.png", "error_vs_bake_time.svg"]:
+        shutil.copy(out / name, ROOT / "docs" / "images" / "report" / name)
+    text = (f"`skybake report earth -o build/figures/report`: {wall} wall time, {cpu:.0f} s CPU, peak resident "
+            f"memory {peak:.0f} MiB (`/usr/bin/time -v`), {os.cpu_count()} cores.\n\n" + tables)
+    replace_block("docs/accuracy.md", "report", "report", text)
+
+
+PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "bench": bench, "report": report}
+
+
+def main():
+    if len(sys.argv) < 3 or any(p not in PARTS for p in sys.argv[2:]):
+        sys.exit(__doc__)
+    skybake = sys.argv[1]
+    os.chdir(ROOT)
+    WORK.mkdir(parents=True, exist_ok=True)
+    for part in sys.argv[2:]:
+        PARTS[part](skybake)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Regenerates the figures in README.md and docs/*.md that come from commands,
+# in place between their marker comments (<!-- figures:NAME begin ... -->
+# ... <!-- figures:NAME end -->); scripts/figures.py lists which command
+# makes which block.
+#
+#   scripts/figures.sh            # = fast: sizes orders cli (about a minute)
+#   scripts/figures.sh sizes      # file sizes and half error (docs/files.md)
+#   scripts/figures.sh orders     # --orders N and the extrapolated tail (docs/accuracy.md)
+#   scripts/figures.sh cli        # presets and bake defaults (docs/cli.md)
+#   scripts/figures.sh bench      # docs/benchmark.md (scripts/bench.sh, about 7 minutes)
+#   scripts/figures.sh report     # docs/accuracy.md and docs/images/report/ (skybake report, about 10 minutes)
+#   scripts/figures.sh images     # the gallery and the engine example's images (scripts/gallery.sh,
+#                                 # scripts/engine_example_images.sh)
+#   scripts/figures.sh all        # everything above (about 20 minutes)
+#
+# bench and report time the machine: run them with nothing else running.
+# SKYBAKE=path/to/skybake uses that executable and skips the build.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+parts=()
+images=0
+for arg in "${@:-fast}"; do
+  case "$arg" in
+    fast) parts+=(sizes orders cli) ;;
+    all) parts+=(sizes orders cli bench report); images=1 ;;
+    images) images=1 ;;
+    sizes | orders | cli | bench | report) parts+=("$arg") ;;
+    *) sed -n '2,18p' "${BASH_SOURCE[0]}" >&2; exit 1 ;;
+  esac
+done
+
+if [ -z "${SKYBAKE:-}" ]; then
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build build -j"${JOBS:-2}" --target skybake >&2
+  SKYBAKE=build/cli/skybake
+fi
+if ((${#parts[@]})); then
+  /usr/bin/python3 scripts/figures.py "$SKYBAKE" "${parts[@]}"
+fi
+if ((images)); then
+  scripts/gallery.sh
+  scripts/engine_example_images.sh
+fi
