@@ -22,7 +22,6 @@
 #include "formats/table_file.h"
 #include "formats/table_stats.h"
 #include "render/lut_plots.h"
-#include "shaders_runtime/twin.h"
 
 namespace skybake::cli {
 
@@ -100,16 +99,19 @@ void PrintTableFile(const json& d) {
   }
 }
 
-// Plots of the set's table slices into o.plot_dir; the file names, for the report.
-json WritePlots(const InfoOptions& o) {
+// Plots of the set's table slices into o.plot_dir: those the set's tables
+// can draw, each one left out named on stderr. Adds "plots" and
+// "plots_left_out" to `report`.
+void WritePlots(const InfoOptions& o, json* report) {
   const LutSet luts = LoadLutSet(o.path);
-  const Twin twin(MakeTwinTables(luts));
   EnsureWritableDirectory(o.plot_dir);
-  const render::PlotFiles plots = render::WriteLutPlots(twin, luts.atmosphere.wavelengths_nm, o.plot_dir, CommandLine());
+  const render::PlotFiles plots = render::WriteLutPlots(luts, o.plot_dir, CommandLine());
   if (!plots.png_text) std::fputs("info: no TrueType font found; the PNG plots have no text\n", stderr);
   json files = json::array();
   for (const fs::path& f : plots.files) files.push_back(f.string());
-  return files;
+  for (const std::string& line : plots.left_out) std::fprintf(stderr, "info: plot left out: %s\n", line.c_str());
+  (*report)["plots"] = files;
+  (*report)["plots_left_out"] = plots.left_out;
 }
 
 void RunInfo(const InfoOptions& o) {
@@ -144,7 +146,8 @@ void RunInfo(const InfoOptions& o) {
     shaders.push_back({{"file", (path / f.file).string()}, {"bytes", bytes.size()}, {"sha256", f.sha256}});
   }
   const json& doc = manifest.document;
-  const json plots = o.plot_dir.empty() ? json::array() : WritePlots(o);
+  json plot_report = json::object();
+  if (!o.plot_dir.empty()) WritePlots(o, &plot_report);
   if (o.json) {
     json report = {{"manifest", manifest.path.string()},
                    {"schema_version", doc["schema_version"]},
@@ -154,7 +157,7 @@ void RunInfo(const InfoOptions& o) {
                    {"wavelengths_nm", doc["wavelengths_nm"]},
                    {"files", files},
                    {"shaders", shaders}};
-    if (!o.plot_dir.empty()) report["plots"] = plots;
+    report.update(plot_report);
     std::printf("%s\n", report.dump(2, ' ', false, json::error_handler_t::replace).c_str());
     return;
   }
@@ -173,7 +176,7 @@ void RunInfo(const InfoOptions& o) {
     std::printf("%s\n  %zu bytes, sha256 %s (matches)\n", s["file"].get<std::string>().c_str(),
                 s["bytes"].get<std::size_t>(), s["sha256"].get<std::string>().c_str());
   }
-  for (const json& f : plots) std::printf("plot %s\n", f.get<std::string>().c_str());
+  for (const json& f : plot_report.value("plots", json::array())) std::printf("plot %s\n", f.get<std::string>().c_str());
 }
 
 }  // namespace
@@ -187,7 +190,8 @@ void AddInfoCommand(CLI::App& app) {
   cmd->add_flag("--json", o->json, "Print the description as JSON on stdout");
   cmd->add_option("--plot", o->plot_dir,
                   "Also plot table slices of a baked directory (transmittance, sky radiance, irradiance; "
-                  "lut_*.svg and .png) into this directory");
+                  "lut_*.svg and .png) into this directory; a plot whose table the set leaves out (a scene's "
+                  "bake) is not drawn and is named on stderr");
   cmd->callback([o] { RunInfo(*o); });
 }
 

@@ -60,7 +60,6 @@ void CheckSceneCanRender(const Scene& scene, double bottom_radius_m, const Rende
   const SceneEffects& e = scene.effects;
   const std::string of_scene = "the scene '" + scene.name + "' of " + args.lut_dir;
   auto refuse = [&](const std::string& what) { throw InputError("render: " + what + " is not in " + of_scene); };
-  if (args.plots) refuse("--plots (they span every altitude and sun)");
   for (double z : args.sun_zenith_deg) {
     Query sky;
     sky.altitude_m = args.altitude_m, sky.sun_zenith_deg = z;
@@ -176,10 +175,12 @@ void RunRender(const RenderArguments& args) {
     report["contact_sheet"] = sheet.string();
   }
   if (args.plots) {
-    render::PlotFiles plots = render::WriteLutPlots(twin, luts.atmosphere.wavelengths_nm, out_dir, CommandLine());
+    render::PlotFiles plots = render::WriteLutPlots(luts, out_dir, CommandLine());
     nlohmann::json files = nlohmann::json::array();
     for (const auto& f : plots.files) files.push_back(f.string());
     report["plots"] = files;
+    report["plots_left_out"] = plots.left_out;
+    for (const std::string& line : plots.left_out) std::fprintf(stderr, "render: plot left out: %s\n", line.c_str());
     if (!plots.png_text && !args.quiet) std::fputs("render: no TrueType font found; the PNG plots have no text\n", stderr);
   }
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -219,7 +220,9 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--ground-albedo", args->ground_albedo,
                   "Grey Lambertian ground albedo (default: the atmosphere's ground albedo)")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->add_flag("--plots", args->plots, "Also plot table slices (lut_*.svg and .png)");
+  cmd->add_flag("--plots", args->plots,
+                "Also plot table slices (lut_*.svg and .png); a plot whose table the set leaves out (a scene's "
+                "bake) is not drawn and is named on stderr");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary on stderr");
   cmd->add_flag("--json", args->json, "Print a JSON report of the files written on stdout");
   cmd->callback([args] { RunRender(*args); });

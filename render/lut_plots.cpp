@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bake/bake.h"
+#include "bake/scene.h"
 #include "formats/plot.h"
 #include "shaders_runtime/twin.h"
 
@@ -30,10 +32,20 @@ void Write(const LinePlot& plot, const std::filesystem::path& dir, const std::st
   out->files.push_back(png);
 }
 
+// Why `table` is not in `luts`: the scene's reason when a scene left it out.
+std::string MissingTable(const LutSet& luts, const std::string& table) {
+  std::string why = "the set has no " + table + " table";
+  if (!luts.scene) return why;
+  for (const OmittedTable& t : PlanScene(*luts.scene, luts.atmosphere).omitted)
+    if (t.table == table) return why + " (scene '" + luts.scene->name + "': " + t.reason + ")";
+  return why + " (scene '" + luts.scene->name + "')";
+}
+
 }  // namespace
 
-PlotFiles WriteLutPlots(const Twin& twin, const vec3& wavelengths_nm, const std::filesystem::path& dir,
-                        const std::string& caption) {
+PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, const std::string& caption) {
+  const Twin twin(MakeTwinTables(luts));
+  const vec3& wavelengths_nm = luts.atmosphere.wavelengths_nm;
   const glsl::AtmosphereParameters& p = twin.parameters();
   PlotFiles files;
 
@@ -65,14 +77,36 @@ PlotFiles WriteLutPlots(const Twin& twin, const vec3& wavelengths_nm, const std:
     Write(plot, dir, "lut_transmittance", &files);
   }
 
-  {
+  // The sky seen from 1 m above the ground, for the sun zeniths a scene's
+  // restricted scattering tables cover there.
+  const double sky_camera_altitude_m = 1.0;
+  std::vector<double> sky_sun_zeniths;
+  for (double sun_zenith : {0.0, 45.0, 80.0, 90.0}) {
+    std::string problem;
+    if (luts.scene) {
+      Query sky;
+      sky.altitude_m = sky_camera_altitude_m, sky.sun_zenith_deg = sun_zenith;
+      std::vector<std::string> unused;
+      problem = SceneQueryProblem(*luts.scene, p.bottom_radius, false, &sky, &unused);
+    }
+    if (problem.empty()) {
+      sky_sun_zeniths.push_back(sun_zenith);
+    } else if (twin.has_scattering()) {
+      char line[64];
+      std::snprintf(line, sizeof(line), "lut_sky_radiance: sun zenith %g deg: ", sun_zenith);
+      files.left_out.push_back(line + problem);
+    }
+  }
+  if (!twin.has_scattering()) {
+    files.left_out.push_back("lut_sky_radiance: " + MissingTable(luts, "scattering"));
+  } else if (!sky_sun_zeniths.empty()) {
     LinePlot plot;
     plot.title = "Sky radiance from the ground in the sun's vertical plane (" + ChannelName(wavelengths_nm, 1) + ")";
     plot.caption = caption;
     plot.x = {"view zenith angle (degrees; negative: away from the sun)", false, -90.0, 90.0};
     plot.y = {"radiance (W m^-2 sr^-1 nm^-1)", true, {}, {}};
-    const vec3 camera(0.0, 0.0, p.bottom_radius + 1.0);
-    for (double sun_zenith : {0.0, 45.0, 80.0, 90.0}) {
+    const vec3 camera(0.0, 0.0, p.bottom_radius + sky_camera_altitude_m);
+    for (double sun_zenith : sky_sun_zeniths) {
       PlotSeries s;
       char name[48];
       std::snprintf(name, sizeof(name), "sun zenith %g deg", sun_zenith);
@@ -91,7 +125,9 @@ PlotFiles WriteLutPlots(const Twin& twin, const vec3& wavelengths_nm, const std:
     Write(plot, dir, "lut_sky_radiance", &files);
   }
 
-  {
+  if (!twin.has_irradiance()) {
+    files.left_out.push_back("lut_irradiance: " + MissingTable(luts, "irradiance"));
+  } else {
     LinePlot plot;
     plot.title = "Irradiance on horizontal ground";
     plot.caption = caption;

@@ -8,6 +8,10 @@
 //                                from the sun), for sun zeniths 0, 45, 80, 90;
 //   lut_irradiance.{svg,png}     direct sun and sky irradiance on horizontal
 //                                ground vs sun zenith.
+// A scene's bake (bake/scene.h) holds only some tables and covers only some
+// cameras and suns: a plot whose table the set leaves out is not drawn, the
+// sky radiance plot keeps only the sun zeniths the scene covers at the
+// ground, and each omission is described in PlotFiles::left_out.
 #pragma once
 
 #include <filesystem>
@@ -17,7 +21,7 @@
 #include "shaders_runtime/glsl_shim.h"
 
 namespace skybake {
-class Twin;
+struct LutSet;
 }
 
 namespace skybake::render {
@@ -25,11 +29,13 @@ namespace skybake::render {
 struct PlotFiles {
   std::vector<std::filesystem::path> files;  // in the order written
   bool png_text = true;                       // false: no TrueType font, PNGs have no text
+  // One line per plot or curve left out, e.g.
+  // "lut_irradiance: the set has no irradiance table (...)".
+  std::vector<std::string> left_out;
 };
 
-// Writes the plots into `dir` (which must exist), each file atomically.
-// `caption` goes under each plot (e.g. the command line).
-PlotFiles WriteLutPlots(const Twin& twin, const glsl::vec3& wavelengths_nm, const std::filesystem::path& dir,
-                        const std::string& caption);
+// Writes the plots of `luts` into `dir` (which must exist), each file
+// atomically. `caption` goes under each plot (e.g. the command line).
+PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, const std::string& caption);
 
 }  // namespace skybake::render

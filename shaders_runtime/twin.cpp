@@ -1,5 +1,8 @@
 #include "shaders_runtime/twin.h"
 
+#include <string>
+
+#include "bake/errors.h"
 #include "shaders_runtime/runtime.h"
 
 namespace skybake {
@@ -7,18 +10,34 @@ namespace skybake {
 using glsl::vec3;
 using glsl::vec4;
 
+namespace {
+
+// A table the set does not hold is null: sampling an empty texture would
+// read outside its (empty) texel array.
+const glsl::Texture* Present(const glsl::Texture* table) { return table && !table->empty() ? table : nullptr; }
+
+template <typename Sampler>
+void Require(const Sampler& sampler, const char* table, const char* function) {
+  if (!sampler.texture)
+    throw InternalError(std::string("the CPU twin has no ") + table + " table for " + function +
+                        " (the set leaves it out)");
+}
+
+}  // namespace
+
 Twin::Twin(const TwinTables& tables)
     : tables_(tables),
       transmittance_{tables.transmittance},
-      scattering_{tables.scattering},
+      scattering_{Present(tables.scattering)},
       // When single Mie is packed into alpha the runtime never samples it.
-      single_mie_{tables.single_mie_scattering && !tables.single_mie_scattering->empty()
-                      ? tables.single_mie_scattering
-                      : tables.scattering},
-      irradiance_{tables.irradiance} {}
+      single_mie_{Present(tables.single_mie_scattering) ? tables.single_mie_scattering : Present(tables.scattering)},
+      irradiance_{Present(tables.irradiance)} {
+  if (!Present(tables.transmittance)) throw InternalError("the CPU twin needs the transmittance table");
+}
 
 vec3 Twin::SkyRadiance(const vec3& camera, const vec3& view_ray, const vec3& sun_direction,
                        vec3* transmittance) const {
+  Require(scattering_, "scattering", "GetSkyRadiance");
   vec3 t;
   vec3 radiance = glsl::GetSkyRadiance(tables_.parameters, transmittance_, scattering_, single_mie_, camera,
                                        view_ray, sun_direction, t);
@@ -28,6 +47,7 @@ vec3 Twin::SkyRadiance(const vec3& camera, const vec3& view_ray, const vec3& sun
 
 vec3 Twin::SkyRadianceToPoint(const vec3& camera, const vec3& point, const vec3& sun_direction,
                               vec3* transmittance) const {
+  Require(scattering_, "scattering", "GetSkyRadianceToPoint");
   vec3 t;
   vec3 radiance = glsl::GetSkyRadianceToPoint(tables_.parameters, transmittance_, scattering_, single_mie_, camera,
                                               point, sun_direction, t);
@@ -37,6 +57,7 @@ vec3 Twin::SkyRadianceToPoint(const vec3& camera, const vec3& point, const vec3&
 
 vec3 Twin::SunAndSkyIrradiance(const vec3& point, const vec3& normal, const vec3& sun_direction,
                                vec3* sky_irradiance) const {
+  Require(irradiance_, "irradiance", "GetSunAndSkyIrradiance");
   vec3 sky;
   vec3 sun = glsl::GetSunAndSkyIrradiance(tables_.parameters, transmittance_, irradiance_, point, normal,
                                           sun_direction, sky);
@@ -47,6 +68,7 @@ vec3 Twin::SunAndSkyIrradiance(const vec3& point, const vec3& normal, const vec3
 vec3 Twin::SolarRadiance() const { return glsl::GetSolarRadiance(tables_.parameters); }
 
 vec4 Twin::Scattering(double r, double mu, double mu_s, double nu, bool ray_intersects_ground) const {
+  Require(scattering_, "scattering", "GetScattering");
   return glsl::GetScattering(tables_.parameters, scattering_, r, mu, mu_s, nu, ray_intersects_ground);
 }
 
@@ -55,6 +77,7 @@ vec3 Twin::OpticalDepthToTop(double r, double mu) const {
 }
 
 vec3 Twin::Irradiance(double r, double mu_s) const {
+  Require(irradiance_, "irradiance", "GetIrradiance");
   return glsl::GetIrradiance(tables_.parameters, irradiance_, r, mu_s);
 }
 

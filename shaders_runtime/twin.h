@@ -8,6 +8,10 @@
 
 namespace skybake {
 
+// A scene's bake leaves tables out (bake/scene.h): a null or empty
+// scattering or irradiance table is absent, and the twin refuses, with an
+// InternalError, the functions that would sample it (as the GLSL snippet
+// compiles them out), so a caller checks has_scattering() / has_irradiance().
 struct TwinTables {
   glsl::AtmosphereParameters parameters;
   const glsl::Texture* transmittance = nullptr;
@@ -21,6 +25,10 @@ class Twin {
   explicit Twin(const TwinTables& tables);
 
   const glsl::AtmosphereParameters& parameters() const { return tables_.parameters; }
+  // SkyRadiance, SkyRadianceToPoint and Scattering need the scattering table;
+  // SunAndSkyIrradiance and Irradiance the irradiance table.
+  bool has_scattering() const { return scattering_.texture != nullptr; }
+  bool has_irradiance() const { return irradiance_.texture != nullptr; }
 
   // Positions relative to the planet centre in metres; directions unit length.
   glsl::vec3 SkyRadiance(const glsl::vec3& camera, const glsl::vec3& view_ray, const glsl::vec3& sun_direction,
