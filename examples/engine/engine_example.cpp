@@ -51,6 +51,20 @@ constexpr double kAerialPitchDeg = 7.0;  // as render/views.cpp
 // sky (with the sun's disc) where it misses the ground, lit ground seen
 // through the atmosphere where it hits it. The pixel-to-ray mappings and the
 // shading are those of render/views.cpp.
+//
+// A scene's bake (examples/scenes/README.md) ships a pruned snippet:
+// atmosphere_constants.glsl sets SKYBAKE_HAS_SCATTERING_TEXTURE,
+// SKYBAKE_HAS_IRRADIANCE_TEXTURE and SKYBAKE_HAS_AERIAL_PERSPECTIVE, and
+// functions.glsl compiles only the functions whose tables exist, so the
+// shader calls a function only under its macro and draws what the set holds:
+//   no scattering table:  a black sky (the sun's disc still dims through the
+//                         air by the transmittance table);
+//   no aerial perspective: the ground unveiled (no in-scattering, no
+//                         extinction between it and the camera);
+//   no irradiance table:  the ground lit by the direct sun only (as
+//                         GetSunAndSkyIrradiance computes it, without the sky
+//                         term), as an engine that lights it by its own
+//                         probes would have them add the rest.
 const char* const kFragmentMain = R"(
 uniform sampler2D transmittance_texture;
 uniform sampler3D scattering_texture;
@@ -67,6 +81,42 @@ uniform vec3 ground_albedo;
 uniform float cos_disc;     // the drawn sun disc: at least one pixel wide,
 uniform float disc_scale;   // its radiance scaled to keep the sun's irradiance
 out vec4 radiance_out;
+
+vec3 Sky(vec3 camera, vec3 dir, out vec3 transmittance) {
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+  return GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
+                        camera, dir, sun_direction, transmittance);
+#else
+  float r = ClampRadius(ATMOSPHERE, length(camera));
+  transmittance = GetTransmittanceToTopAtmosphereBoundary(ATMOSPHERE, transmittance_texture, r,
+                                                          ClampCosine(dot(camera, dir) / length(camera)));
+  return vec3(0.0);
+#endif
+}
+
+vec3 GroundLight(vec3 point, vec3 normal) {
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+  vec3 sky_irradiance;
+  vec3 sun_irradiance = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, point, normal,
+                                               sun_direction, sky_irradiance);
+  return sun_irradiance + sky_irradiance;
+#else
+  float r = ClampRadius(ATMOSPHERE, length(point));
+  float mu_s = ClampCosine(dot(point, sun_direction) / length(point));
+  return ATMOSPHERE.solar_irradiance * GetTransmittanceToSun(ATMOSPHERE, transmittance_texture, r, mu_s) *
+         max(dot(normal, sun_direction), 0.0);
+#endif
+}
+
+vec3 AerialPerspective(vec3 camera, vec3 point, out vec3 transmittance) {
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+  return GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
+                               camera, point, sun_direction, transmittance);
+#else
+  transmittance = vec3(1.0);
+  return vec3(0.0);
+#endif
+}
 
 void main() {
   // Pixel centre, measured from the image's top-left corner.
@@ -99,18 +149,12 @@ void main() {
     float t = c / (sqrt(disc) - b);
     vec3 normal = normalize(camera + dir * t);
     vec3 point = normal * bottom;
-    vec3 sky_irradiance;
-    vec3 sun_irradiance = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture,
-                                                 point, normal, sun_direction, sky_irradiance);
     vec3 transmittance;
-    vec3 inscatter = GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture,
-                                           single_mie_scattering_texture, camera, point, sun_direction,
-                                           transmittance);
-    radiance = ground_albedo / PI * (sun_irradiance + sky_irradiance) * transmittance + inscatter;
+    vec3 inscatter = AerialPerspective(camera, point, transmittance);
+    radiance = ground_albedo / PI * GroundLight(point, normal) * transmittance + inscatter;
   } else {
     vec3 transmittance;
-    radiance = GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture,
-                              single_mie_scattering_texture, camera, dir, sun_direction, transmittance);
+    radiance = Sky(camera, dir, transmittance);
     if (dot(dir, sun_direction) > cos_disc) radiance += GetSolarRadiance(ATMOSPHERE) * transmittance * disc_scale;
   }
   radiance_out = vec4(radiance, 1.0);
@@ -252,19 +296,31 @@ void Run(const Arguments& args) {
   const skybake::LutSet luts = skybake::LoadLutSet(lut_dir, load_options);
   const std::string snippet = ShippedSnippet(lut_dir);
 
+  // What a scene's bake leaves out, and so what the shader draws without
+  // (kFragmentMain); the snippet's macros say the same.
+  const bool aerial_perspective = !luts.scene || luts.scene->effects.aerial_perspective;
+  if (luts.scattering.empty()) std::fputs("skybake_engine_example: no scattering table: the sky is black\n", stderr);
+  if (!aerial_perspective)
+    std::fputs("skybake_engine_example: no aerial-perspective functions: the ground is drawn unveiled\n", stderr);
+  if (luts.irradiance.empty())
+    std::fputs("skybake_engine_example: no irradiance table: the ground is lit by the direct sun only\n", stderr);
+
   HeadlessContext context;
   const skybake::glsl::Texture& single_mie =
       luts.single_mie_scattering.empty() ? luts.scattering : luts.single_mie_scattering;
   struct Binding {
     const char* sampler;
     const skybake::glsl::Texture* table;
+    GLenum target;
   };
-  const Binding bindings[] = {{"transmittance_texture", &luts.transmittance},
-                              {"scattering_texture", &luts.scattering},
-                              {"single_mie_scattering_texture", &single_mie},
-                              {"irradiance_texture", &luts.irradiance}};
+  const Binding bindings[] = {{"transmittance_texture", &luts.transmittance, GL_TEXTURE_2D},
+                              {"scattering_texture", &luts.scattering, GL_TEXTURE_3D},
+                              {"single_mie_scattering_texture", &single_mie, GL_TEXTURE_3D},
+                              {"irradiance_texture", &luts.irradiance, GL_TEXTURE_2D}};
+  // A table the set leaves out is not uploaded: the snippet has no function
+  // that samples it.
   std::vector<GLuint> textures;
-  for (const Binding& b : bindings) textures.push_back(UploadTable(*b.table));
+  for (const Binding& b : bindings) textures.push_back(b.table->empty() ? 0 : UploadTable(*b.table));
 
   GLuint vertex = CompileShader(GL_VERTEX_SHADER, kVertexShader);
   GLuint fragment = CompileShader(GL_FRAGMENT_SHADER, "#version 300 es\n" + snippet + kFragmentMain);
@@ -276,9 +332,11 @@ void Run(const Arguments& args) {
   glGetProgramiv(program, GL_LINK_STATUS, &linked);
   if (!linked) throw skybake::InternalError("the shaders do not link");
   glUseProgram(program);
+  // Each sampler on its own unit, whether or not its table exists: samplers
+  // of different types must not share a unit.
   for (int unit = 0; unit < 4; ++unit) {
     glActiveTexture(GL_TEXTURE0 + unit);
-    glBindTexture(bindings[unit].table->depth == 1 ? GL_TEXTURE_2D : GL_TEXTURE_3D, textures[unit]);
+    if (textures[unit] != 0) glBindTexture(bindings[unit].target, textures[unit]);
     glUniform1i(glGetUniformLocation(program, bindings[unit].sampler), unit);
   }
   GLuint vao = 0;
@@ -370,7 +428,8 @@ void Run(const Arguments& args) {
   glDeleteProgram(program);
   glDeleteShader(vertex);
   glDeleteShader(fragment);
-  glDeleteTextures(GLsizei(textures.size()), textures.data());
+  for (GLuint texture : textures)
+    if (texture != 0) glDeleteTextures(1, &texture);
 }
 
 }  // namespace
