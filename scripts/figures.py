@@ -154,6 +154,7 @@ def bench(skybake):
 def report(skybake):
     out = WORK / "report"
     shutil.rmtree(out, ignore_errors=True)
+    load = os.getloadavg()[0]  # other work on the machine slows the timed bakes
     with tempfile.NamedTemporaryFile("r", suffix=".time") as timing:
         tables = run(["/usr/bin/time", "-v", "-o", timing.name, skybake, "report", "earth", "-o", str(out)])
         usage = timing.read()
@@ -164,7 +165,8 @@ def report(skybake):
     for name in ["error_vs_bake_time.png", "error_vs_bake_time.svg"]:
         shutil.copy(out / name, ROOT / "docs" / "images" / "report" / name)
     text = (f"`skybake report earth -o build/figures/report`: {wall} wall time, {cpu:.0f} s CPU, peak resident "
-            f"memory {peak:.0f} MiB (`/usr/bin/time -v`), {os.cpu_count()} cores.\n\n" + tables)
+            f"memory {peak:.0f} MiB (`/usr/bin/time -v`), {os.cpu_count()} cores, load average {load:.1f} at the "
+            f"start (0 on an idle machine; more slows the bake times).\n\n" + tables)
     replace_block("docs/accuracy.md", "report", "report", text)
 
 
