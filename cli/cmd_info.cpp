@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -114,6 +115,23 @@ void WritePlots(const InfoOptions& o, json* report) {
   (*report)["plots_left_out"] = plots.left_out;
 }
 
+// The entries of the set's folder its manifest does not list (tables left
+// from an earlier bake, for instance), sorted; a folder's name ends in '/'.
+std::vector<std::string> UnlistedEntries(const Manifest& manifest) {
+  std::vector<std::string> listed = {kManifestFileName};
+  for (const ManifestFile& f : manifest.table_files) listed.push_back(f.file);
+  for (const ManifestFile& f : manifest.shader_files) listed.push_back(f.file);
+  std::vector<std::string> unlisted;
+  for (const fs::directory_entry& entry : fs::directory_iterator(manifest.Directory())) {
+    const std::string name = entry.path().filename().string();
+    if (std::find(listed.begin(), listed.end(), name) != listed.end()) continue;
+    std::error_code ec;
+    unlisted.push_back(entry.is_directory(ec) ? name + "/" : name);
+  }
+  std::sort(unlisted.begin(), unlisted.end());
+  return unlisted;
+}
+
 void RunInfo(const InfoOptions& o) {
   const fs::path path = o.path;
   std::error_code ec;
@@ -145,6 +163,7 @@ void RunInfo(const InfoOptions& o) {
     const std::vector<std::uint8_t> bytes = ReadListedFile(manifest, f);
     shaders.push_back({{"file", (path / f.file).string()}, {"bytes", bytes.size()}, {"sha256", f.sha256}});
   }
+  const std::vector<std::string> unlisted = UnlistedEntries(manifest);
   const json& doc = manifest.document;
   json plot_report = json::object();
   if (!o.plot_dir.empty()) WritePlots(o, &plot_report);
@@ -156,7 +175,8 @@ void RunInfo(const InfoOptions& o) {
                    {"atmosphere", manifest.luts.atmosphere.name},
                    {"wavelengths_nm", doc["wavelengths_nm"]},
                    {"files", files},
-                   {"shaders", shaders}};
+                   {"shaders", shaders},
+                   {"unlisted_files", unlisted}};
     report.update(plot_report);
     std::printf("%s\n", report.dump(2, ' ', false, json::error_handler_t::replace).c_str());
     return;
@@ -167,7 +187,14 @@ void RunInfo(const InfoOptions& o) {
               doc["wavelengths_nm"].dump().c_str(), manifest.luts.orders_used,
               manifest.luts.settings.orders == 0 ? " (auto)" : "");
   std::printf("  command: %s\n", doc.value("command", "").c_str());
-  std::printf("  %zu table files, %zu shader files; every checksum matches\n\n", files.size(), shaders.size());
+  std::printf("  %zu table files, %zu shader files; every checksum matches\n", files.size(), shaders.size());
+  if (!unlisted.empty()) {
+    std::string names;
+    for (const std::string& name : unlisted) names += (names.empty() ? "" : ", ") + name;
+    std::printf("  warning: %zu files here are not listed in the manifest (not part of this set): %s\n", unlisted.size(),
+                names.c_str());
+  }
+  std::printf("\n");
   for (const json& d : files) {
     PrintTableFile(d);
     std::printf("\n");
@@ -185,7 +212,9 @@ void AddInfoCommand(CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand(
       "info", "Describe a table file (EXR or KTX2) or a baked directory: size, format, per-channel min/max and "
-              "NaN/Inf counts, metadata; files a manifest lists are checked against its SHA-256");
+              "NaN/Inf counts, metadata; files a manifest lists are checked against its SHA-256. Files in a "
+              "directory that its manifest does not list (e.g. tables of an earlier bake) are named in one "
+              "warning line (--json: \"unlisted_files\"); they are a warning, not an error: exit 0");
   cmd->add_option("path", o->path, "Table file (.exr, .ktx2) or directory written by skybake bake")->required();
   cmd->add_flag("--json", o->json, "Print the description as JSON on stdout");
   cmd->add_option("--plot", o->plot_dir,

@@ -78,5 +78,45 @@ TEST(NewcomerDefects, D01_InfoPlotOnSceneBakeWithoutIrradiance) {
   EXPECT_NE(err.find("lut_irradiance"), std::string::npos) << err;
 }
 
+// Stale earth KTX2 files beside a mars set baked as EXR only: `info DIR`
+// names them in one warning line and in --json ("unlisted_files"), and
+// exits 0 (a warning, as --help states).
+TEST(NewcomerDefects, D04_InfoNamesUnlistedFiles) {
+  TempDir dir;
+  const fs::path earth = dir.path() / "earth", mars = dir.path() / "mars";
+  SmallBake(dir, "earth", earth);
+  SmallBake(dir, "mars", mars, " --format exr");
+  std::vector<std::string> stale;
+  for (const fs::directory_entry& entry : fs::directory_iterator(earth)) {
+    if (entry.path().extension() != ".ktx2") continue;
+    ASSERT_FALSE(fs::exists(mars / entry.path().filename()));
+    fs::copy_file(entry.path(), mars / entry.path().filename());
+    stale.push_back(entry.path().filename().string());
+  }
+  std::sort(stale.begin(), stale.end());
+  ASSERT_EQ(stale.size(), 4u);
+
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + " info " + ShellQuote(mars), dir, &out, &err), 0) << err;
+  std::vector<std::string> naming;
+  for (const std::string& line : Lines(out))
+    if (std::all_of(stale.begin(), stale.end(), [&](const std::string& f) { return line.find(f) != std::string::npos; }))
+      naming.push_back(line);
+  ASSERT_EQ(naming.size(), 1u) << out;
+  EXPECT_NE(naming[0].find("not listed in the manifest"), std::string::npos) << naming[0];
+
+  ASSERT_EQ(RunCommand(Skybake() + " info --json " + ShellQuote(mars), dir, &out, &err), 0) << err;
+  const nlohmann::json report = nlohmann::json::parse(out);
+  ASSERT_TRUE(report.contains("unlisted_files")) << out.substr(0, 400);
+  EXPECT_EQ(report["unlisted_files"].get<std::vector<std::string>>(), stale);
+
+  // A set alone in its folder has none, and --help states the exit code.
+  ASSERT_EQ(RunCommand(Skybake() + " info --json " + ShellQuote(earth), dir, &out, &err), 0) << err;
+  EXPECT_TRUE(nlohmann::json::parse(out)["unlisted_files"].empty());
+  ASSERT_EQ(RunCommand(Skybake() + " info --help", dir, &out, &err), 0);
+  EXPECT_NE(out.find("not list"), std::string::npos) << out;
+  EXPECT_NE(out.find("exit 0"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace skybake
