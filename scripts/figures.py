@@ -23,7 +23,7 @@ Parts (figure blocks, the page, the commands run):
            `skybake bake --help`; instant
   bench    bench (docs/benchmark.md): scripts/bench.sh (RUNS=5: about 7 minutes)
   report   report (docs/accuracy.md), docs/images/report/: `/usr/bin/time -v
-           skybake report earth -o build/figures/report` (about 10 minutes)
+           skybake report earth -o build/figures/report` (a few minutes)
 
 bench and report time the machine: run them with nothing else running.
 """

@@ -9,10 +9,10 @@
 #   scripts/figures.sh orders     # --orders N and the extrapolated tail (docs/accuracy.md)
 #   scripts/figures.sh cli        # presets and bake defaults (docs/cli.md)
 #   scripts/figures.sh bench      # docs/benchmark.md (scripts/bench.sh, about 7 minutes)
-#   scripts/figures.sh report     # docs/accuracy.md and docs/images/report/ (skybake report, about 10 minutes)
+#   scripts/figures.sh report     # docs/accuracy.md and docs/images/report/ (skybake report, a few minutes)
 #   scripts/figures.sh images     # the gallery and the engine example's images (scripts/gallery.sh,
 #                                 # scripts/engine_example_images.sh)
-#   scripts/figures.sh all        # everything above (about 20 minutes)
+#   scripts/figures.sh all        # everything above (about 12 minutes)
 #
 # bench and report time the machine: run them with nothing else running.
 # SKYBAKE=path/to/skybake uses that executable and skips the build.
