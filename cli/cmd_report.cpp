@@ -18,6 +18,7 @@
 
 #include "bake/config.h"
 #include "bake/errors.h"
+#include "bake/interrupt.h"
 #include "cli/bake_settings_options.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -387,11 +388,12 @@ void RunReport(const ReportOptions& o) {
     std::fputs("report: no TrueType font found; the PNG plot has no text\n", stderr);
   }
   {
-    DeferInterrupts defer;
+    InterruptScope interrupts;
     StagedFiles files;
     files.Write(dir / "report.csv", ReportCsv(rows, wavelengths));
     files.Write(dir / "report.json", j.dump(2) + "\n");
     files.Write(dir / "error_vs_bake_time.svg", RenderPlotSvg(plot));
+    ThrowIfInterrupted("the report in " + dir.string() + " was not written");
     files.Commit();
   }
   if (o.json) {

@@ -1,20 +1,78 @@
 // skybake: bakes atmospheric-scattering tables for real-time renderers.
 //
-// Exit codes: 0 ok, 1 usage, 2 invalid input, 3 I/O error, 4 internal error.
+// Exit codes: 0 ok, 1 usage, 2 invalid input, 3 I/O error, 4 internal error,
+// 130 interrupted.
 #include <cstdio>
+#include <cstring>
 #include <exception>
+#include <string>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "bake/errors.h"
+#include "bake/interrupt.h"
 #include "bake/version.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
 
+namespace {
+
+// Whether the command line asks for machine-readable output (`--json`
+// before any `--`): errors then go to stdout as JSON too.
+bool WantsJson(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--") == 0) return false;
+    if (std::strcmp(argv[i], "--json") == 0) return true;
+  }
+  return false;
+}
+
+// The first word, when it is neither a subcommand nor a global option, named
+// as CLI11's "a subcommand is required" would not.
+void CheckFirstWord(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return;
+  const std::string word = argv[1];
+  if (word == "--" || word.empty()) return;
+  if (word[0] == '-') {
+    for (const char* known : {"-h", "--help", "--help-all", "--version"}) {
+      if (word == known) return;
+    }
+    throw skybake::UsageError("unknown option '" + word + "' (options follow the command: skybake COMMAND --help)");
+  }
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (sub->get_name() == word) return;
+  }
+  std::string commands;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    commands += (commands.empty() ? "" : ", ") + sub->get_name();
+  }
+  throw skybake::UsageError("unknown command '" + word + "' (commands: " + commands + ")");
+}
+
+int Fail(bool json, skybake::ExitCode code, const std::string& message, const skybake::ErrorLocation& where = {}) {
+  std::fprintf(stderr, "skybake: %s\n", message.c_str());
+  if (json) {
+    auto or_null = [](const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); };
+    nlohmann::json error = {{"exit_code", static_cast<int>(code)},
+                            {"message", message},
+                            {"file", or_null(where.file)},
+                            {"key", or_null(where.key)},
+                            {"line", where.line > 0 ? nlohmann::json(where.line) : nlohmann::json(nullptr)}};
+    std::fflush(stdout);
+    std::printf("%s\n", nlohmann::json{{"error", error}}.dump(2).c_str());
+  }
+  return static_cast<int>(code);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{
       "skybake bakes physically based atmospheric-scattering data for real-time renderers.\n"
-      "Exit codes: 0 ok, 1 usage, 2 invalid input, 3 I/O error, 4 internal error."};
+      "Exit codes: 0 ok, 1 usage, 2 invalid input, 3 I/O error, 4 internal error, 130 interrupted (SIGINT or "
+      "SIGTERM before the outputs were complete; nothing half-written is left). With --json, an error is also "
+      "a JSON object on stdout: {\"error\": {\"exit_code\", \"message\", \"file\", \"key\", \"line\"}}."};
   app.name("skybake");
   skybake::cli::SetCommandLine(argc, argv);
   app.set_version_flag("--version", "skybake " SKYBAKE_VERSION);
@@ -32,7 +90,10 @@ int main(int argc, char** argv) {
   skybake::cli::AddStressCommand(app);
   skybake::cli::AddReportCommand(app);
 
+  const bool json = WantsJson(argc, argv);
+  using skybake::ExitCode;
   try {
+    CheckFirstWord(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
@@ -41,17 +102,19 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "skybake: %s (see skybake --help)\n", e.what());
-    return static_cast<int>(skybake::ExitCode::kUsage);
+    return Fail(json, ExitCode::kUsage, std::string(e.what()) + " (see skybake --help)");
+  } catch (const skybake::ReportedError& e) {
+    return Fail(false, e.code(), e.what());
   } catch (const skybake::Error& e) {
-    std::fprintf(stderr, "skybake: %s\n", e.what());
-    return static_cast<int>(e.code());
+    return Fail(json, e.code(), e.what(), e.location());
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "skybake: out of memory\n");
-    return static_cast<int>(skybake::ExitCode::kInternal);
+    return Fail(json, ExitCode::kInternal, "out of memory");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "skybake: internal error: %s\n", e.what());
-    return static_cast<int>(skybake::ExitCode::kInternal);
+    return Fail(json, ExitCode::kInternal, std::string("internal error: ") + e.what());
   }
-  return static_cast<int>(skybake::ExitCode::kOk);
+  // A signal recorded but never acted on arrived after the outputs were complete.
+  if (skybake::TakeInterrupt() != 0) {
+    std::fputs("skybake: interrupted after the outputs were complete; nothing was lost\n", stderr);
+  }
+  return static_cast<int>(ExitCode::kOk);
 }

@@ -2,14 +2,16 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <random>
 #include <sstream>
 
+#include "bake/config.h"
 #include "bake/errors.h"
 
 namespace fs = std::filesystem;
@@ -18,10 +20,12 @@ namespace skybake {
 
 namespace {
 
+constexpr char kTemporaryMarker[] = ".tmp-";
+
 fs::path TemporarySibling(const fs::path& path) {
   std::random_device device;
   char suffix[32];
-  std::snprintf(suffix, sizeof(suffix), ".tmp-%d-%08x", static_cast<int>(::getpid()),
+  std::snprintf(suffix, sizeof(suffix), "%s%d-%08x", kTemporaryMarker, static_cast<int>(::getpid()),
                 static_cast<unsigned>(device()));
   fs::path temp = path;
   temp += suffix;
@@ -40,26 +44,7 @@ void WriteWholeFile(const fs::path& temp, const fs::path& path, std::string_view
   if (!ok) throw IoError(path.string() + ": cannot write: " + std::strerror(saved_errno));
 }
 
-constexpr int kDeferredSignals[] = {SIGINT, SIGTERM};
-volatile std::sig_atomic_t deferred_signal = 0;
-struct sigaction previous_actions[2];
-
-extern "C" void RememberSignal(int signal) { deferred_signal = signal; }
-
 }  // namespace
-
-DeferInterrupts::DeferInterrupts() {
-  deferred_signal = 0;
-  struct sigaction action {};
-  action.sa_handler = RememberSignal;
-  sigemptyset(&action.sa_mask);
-  for (int i = 0; i < 2; ++i) sigaction(kDeferredSignals[i], &action, &previous_actions[i]);
-}
-
-DeferInterrupts::~DeferInterrupts() {
-  for (int i = 0; i < 2; ++i) sigaction(kDeferredSignals[i], &previous_actions[i], nullptr);
-  if (deferred_signal != 0) std::raise(deferred_signal);
-}
 
 void WriteFileAtomically(const fs::path& path,
                          const std::function<void(const fs::path& temp_path)>& write) {
@@ -105,6 +90,11 @@ void StagedFiles::Commit() {
 }
 
 std::vector<std::uint8_t> ReadFileBytes(const fs::path& path) {
+  if (path == kStandardStream) {
+    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(std::cin)), std::istreambuf_iterator<char>());
+    if (std::cin.bad()) throw IoError("standard input: read error");
+    return bytes;
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path.string() + ": cannot read: " + std::strerror(errno));
   std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -115,6 +105,39 @@ std::vector<std::uint8_t> ReadFileBytes(const fs::path& path) {
 std::string ReadFileText(const fs::path& path) {
   std::vector<std::uint8_t> bytes = ReadFileBytes(path);
   return std::string(bytes.begin(), bytes.end());
+}
+
+bool IsTemporaryFileName(const std::string& file_name) {
+  // NAME.tmp-PID-XXXXXXXX
+  const std::size_t marker = file_name.rfind(kTemporaryMarker);
+  if (marker == std::string::npos || marker == 0) return false;
+  const std::string tail = file_name.substr(marker + sizeof(kTemporaryMarker) - 1);
+  const std::size_t dash = tail.find('-');
+  if (dash == std::string::npos || dash == 0 || tail.size() - dash - 1 != 8) return false;
+  auto all_of = [&](std::size_t begin, std::size_t end, int (*accept)(int)) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!accept(static_cast<unsigned char>(tail[i]))) return false;
+    }
+    return true;
+  };
+  return all_of(0, dash, std::isdigit) && all_of(dash + 1, tail.size(), std::isxdigit);
+}
+
+void CheckOutputDirectory(const fs::path& dir) {
+  std::error_code ec;
+  fs::path existing = dir.empty() ? fs::path(".") : dir;
+  while (!fs::exists(existing, ec)) {
+    if (!existing.has_relative_path() || existing.parent_path() == existing) break;
+    existing = existing.parent_path().empty() ? fs::path(".") : existing.parent_path();
+  }
+  if (!fs::is_directory(existing, ec)) {
+    throw IoError(dir.string() + ": cannot create output directory: " + existing.string() + " is not a directory");
+  }
+  if (::access(existing.c_str(), W_OK) != 0) {
+    throw IoError(dir.string() + (existing == dir ? ": output directory is not writable"
+                                                  : ": cannot create output directory: " + existing.string() +
+                                                        " is not writable"));
+  }
 }
 
 void EnsureWritableDirectory(const fs::path& dir) {

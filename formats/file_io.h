@@ -40,21 +40,18 @@ class StagedFiles {
   std::vector<Staged> staged_;
 };
 
-// While alive, SIGINT and SIGTERM are held back (process-wide) and delivered
-// when it is destroyed, so an interrupt during a StagedFiles write lands after
-// the set is committed or its temporaries removed, never in between. Declare
-// it before the StagedFiles it protects.
-class DeferInterrupts {
- public:
-  DeferInterrupts();
-  ~DeferInterrupts();
-  DeferInterrupts(const DeferInterrupts&) = delete;
-  DeferInterrupts& operator=(const DeferInterrupts&) = delete;
-};
-
-// Whole-file read; IoError if the file is missing or unreadable.
+// Whole-file read (standard input for "-"); IoError if the file is missing or
+// unreadable.
 std::vector<std::uint8_t> ReadFileBytes(const std::filesystem::path& path);
 std::string ReadFileText(const std::filesystem::path& path);
+
+// Whether `file_name` is one of the temporary names WriteFileAtomically and
+// StagedFiles use (left behind only by a process that was killed).
+bool IsTemporaryFileName(const std::string& file_name);
+
+// IoError unless `dir` is a writable directory or could be created as one
+// (its nearest existing ancestor is a writable directory); creates nothing.
+void CheckOutputDirectory(const std::filesystem::path& dir);
 
 // Creates `dir` (and parents) if needed; IoError if it cannot be created or is
 // not a writable directory.

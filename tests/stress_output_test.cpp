@@ -7,6 +7,7 @@
 #include <map>
 
 #include "bake/errors.h"
+#include "bake/interrupt.h"
 #include "formats/file_io.h"
 #include "test_util.h"
 
@@ -49,17 +50,22 @@ TEST(StagedFiles, CommitRenamesEveryFile) {
   EXPECT_EQ(Snapshot(dir.path()), (std::map<std::string, std::string>{{"a.txt", "new a"}, {"b.txt", "new b"}}));
 }
 
-volatile std::sig_atomic_t received_signal = 0;
-extern "C" void RecordSignal(int signal) { received_signal = signal; }
-
-TEST(DeferInterrupts, DeliversSigintOnlyOnceDestroyed) {
-  auto previous = std::signal(SIGINT, RecordSignal);
+TEST(InterruptScope, RecordsSigintUntilTakenAndRestoresTheHandler) {
+  static volatile std::sig_atomic_t received_signal = 0;
+  auto previous = std::signal(SIGINT, [](int signal) { received_signal = signal; });
   received_signal = 0;
   {
-    DeferInterrupts defer;
+    InterruptScope outer;
+    {
+      InterruptScope inner;  // nested scopes share the outermost's handler
+    }
     std::raise(SIGINT);
     EXPECT_EQ(received_signal, 0);
+    EXPECT_EQ(PendingInterrupt(), SIGINT);
+    EXPECT_THROW(ThrowIfInterrupted("test"), InterruptedError);
+    EXPECT_EQ(PendingInterrupt(), 0);
   }
+  std::raise(SIGINT);  // the previous handler is back
   EXPECT_EQ(received_signal, SIGINT);
   std::signal(SIGINT, previous);
 }
