@@ -507,6 +507,24 @@ std::string Array3(const Spectrum& value) {
   return "[" + TomlFloat(value[0]) + ", " + TomlFloat(value[1]) + ", " + TomlFloat(value[2]) + "]";
 }
 
+constexpr std::string_view kPresetPrefix = "preset:";
+
+// Whether `file_or_preset` is spelled as a path: standard input, a '/' or a
+// ".toml" suffix. Other words are preset names first.
+bool SpelledAsPath(const std::string& file_or_preset) {
+  return file_or_preset == kStandardStream || file_or_preset.find('/') != std::string::npos ||
+         std::filesystem::path(file_or_preset).extension() == ".toml";
+}
+
+// The preset `file_or_preset` names under LoadAtmosphere's rule, or nullopt
+// where it names a file.
+std::optional<std::string> NamedPreset(const std::string& file_or_preset) {
+  const std::string_view text(file_or_preset);
+  if (text.substr(0, kPresetPrefix.size()) == kPresetPrefix) return std::string(text.substr(kPresetPrefix.size()));
+  if (!SpelledAsPath(file_or_preset) && FindPreset(file_or_preset)) return file_or_preset;
+  return std::nullopt;
+}
+
 }  // namespace
 
 Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name) {
@@ -517,14 +535,23 @@ Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source
 }
 
 Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
-  std::filesystem::path path(file_or_preset);
+  if (std::optional<std::string> preset = NamedPreset(file_or_preset)) return LoadPreset(*preset);
+  const std::filesystem::path path(file_or_preset);
   std::error_code error;
-  bool exists = std::filesystem::exists(path, error);
-  if (error && error != std::errc::no_such_file_or_directory)
-    throw IoError(file_or_preset + ": " + error.message());
-  if (exists) return ParseAtmosphere(ReadInputFile(path, "an atmosphere file"), path.filename().string());
-  if (FindPreset(file_or_preset)) return LoadPreset(file_or_preset);
-  throw InputError(file_or_preset + ": no such file or preset (see skybake presets)");
+  if (!SpelledAsPath(file_or_preset) && !std::filesystem::exists(path, error)) {
+    throw IoError(file_or_preset + ": no such file or preset (see skybake presets)", ErrorLocation(file_or_preset));
+  }
+  return ParseAtmosphere(ReadInputFile(path, "an atmosphere file"), InputName(file_or_preset));
+}
+
+std::string InputName(const std::string& path) {
+  return path == kStandardStream ? "standard input" : std::filesystem::path(path).filename().string();
+}
+
+std::string AtmosphereSourceName(const std::string& file_or_preset) {
+  if (std::optional<std::string> preset = NamedPreset(file_or_preset)) return *preset;
+  if (file_or_preset == kStandardStream) return "stdin";
+  return std::filesystem::path(file_or_preset).stem().string();
 }
 
 std::vector<PresetInfo> ListPresets() {

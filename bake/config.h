@@ -18,10 +18,24 @@ namespace skybake {
 // error messages (usually the file's base name).
 Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name);
 
-// Reads FILE if it exists, otherwise looks up a built-in preset of that name.
-// A missing file that is not a preset name is an InputError; an unreadable
-// file is an IoError.
+// The path that names standard input (or output) on the command line.
+inline constexpr const char kStandardStream[] = "-";
+// How messages name an input: "standard input" for "-", else the file name.
+std::string InputName(const std::string& path);
+
+// An atmosphere named on the command line, by one rule:
+// - "preset:NAME" is always the built-in preset NAME (InputError if none);
+// - "-" is standard input;
+// - a path with a '/' or ending in ".toml" is always a file;
+// - any other word is the preset of that name where one exists (a file or
+//   folder of the same name does not hide it: write ./NAME for the file),
+//   otherwise a file.
+// A missing or unreadable file is an IoError.
 Atmosphere LoadAtmosphere(const std::string& file_or_preset);
+
+// The name a batch bake gives the output of `file_or_preset`: the preset's
+// name, or the file name without ".toml".
+std::string AtmosphereSourceName(const std::string& file_or_preset);
 
 struct PresetInfo {
   std::string name;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
+#include "bake/config.h"
 #include "bake/errors.h"
 #include "bake/medium.h"
 #include "bake/toml_input.h"
@@ -282,9 +283,7 @@ Scene ParseScene(std::string_view toml_text, const std::string& source_name) {
 
 Scene LoadScene(const std::string& path) {
   std::filesystem::path file(path);
-  std::error_code error;
-  if (!std::filesystem::exists(file, error)) throw InputError(path + ": no such scene file");
-  return ParseScene(ReadInputFile(file, "a scene file"), file.filename().string());
+  return ParseScene(ReadInputFile(file, "a scene file"), InputName(path));
 }
 
 void ValidateSceneForAtmosphere(const Scene& scene, const Atmosphere& atmosphere, const std::string& source_name) {
@@ -411,12 +410,27 @@ std::string SceneQueryProblem(const Scene& scene, double bottom_radius_m, bool c
   }
   if (problem.empty() && q->distance_m > 0.0) {
     const QueryGeometry g = MakeQueryGeometry(*q, bottom_radius_m);
+    const double r = glm::length(g.camera), mu = glm::dot(g.camera, g.view) / r;
     const double object_altitude = glm::length(g.camera + g.view * q->distance_m) - bottom_radius_m;
+    const double lo = scene.object_altitude_min_m, hi = scene.object_altitude_max_m;
     // A metre of slack: the altitude is recomputed from the geometry in double.
-    if (object_altitude < scene.object_altitude_min_m - 1.0 || object_altitude > scene.object_altitude_max_m + 1.0) {
+    if (object_altitude < lo - 1.0 || object_altitude > hi + 1.0) {
       problem = "the object's altitude " + FormatNumber(std::round(object_altitude)) +
-                " m is outside the scene's objects [" + FormatNumber(scene.object_altitude_min_m) + ", " +
-                FormatNumber(scene.object_altitude_max_m) + "]";
+                " m is outside the scene's objects [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
+      const double camera_altitude = r - bottom_radius_m;
+      if (clamp && camera_altitude >= lo - 1.0 && camera_altitude <= hi + 1.0) {
+        // The object moves back along the view to where the ray first leaves
+        // the objects' shell: the root of |camera + d view| = bottom + bound,
+        // d^2 + 2 r mu d + r^2 - (bottom + bound)^2 = 0, nearest the camera.
+        const double bound = bottom_radius_m + (object_altitude > hi ? hi : lo);
+        const double discriminant = std::max(0.0, r * r * (mu * mu - 1.0) + bound * bound);
+        const double moved = object_altitude > hi ? -r * mu + std::sqrt(discriminant)
+                                                  : -r * mu - std::sqrt(discriminant);
+        clamped->push_back(problem + ", distance_m " + FormatNumber(q->distance_m) + " clamped to " +
+                           FormatNumber(std::max(0.0, moved)));
+        q->distance_m = std::max(0.0, moved);
+        problem.clear();
+      }
     }
   }
   return problem;

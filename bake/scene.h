@@ -100,8 +100,10 @@ void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings*
 // an effect the scene left out, or a camera altitude, sun zenith, distance
 // or object altitude outside its ranges. With `clamp`, the camera altitude,
 // sun zenith and distance are moved into the ranges instead and each move is
-// described in `clamped`; a left-out effect or an object outside the
-// objects' range is still a problem.
+// described in `clamped`: an object outside the objects' altitudes moves back
+// along the view to where the ray leaves them. A left-out effect, or an
+// object the view cannot bring into range (a camera outside the objects'
+// altitudes), is still a problem.
 std::string SceneQueryProblem(const Scene& scene, double bottom_radius_m, bool clamp, Query* query,
                               std::vector<std::string>* clamped);
 

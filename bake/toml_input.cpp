@@ -7,7 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <sstream>
+
+#include "bake/config.h"
 
 namespace skybake::toml_input {
 
@@ -76,13 +79,21 @@ std::string OneLine(std::string text) {
 }
 
 std::string ReadInputFile(const std::filesystem::path& path, const std::string& kind) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) throw IoError(path.string() + ": is a directory, not " + kind);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
   std::ostringstream text;
+  if (path == kStandardStream) {
+    text << std::cin.rdbuf();
+    if (std::cin.bad()) throw IoError("standard input: read failed (" + std::string(std::strerror(errno)) + ")");
+    return text.str();
+  }
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw IoError(path.string() + ": is a directory, not " + kind, {path.string()});
+  }
+  if (!std::filesystem::exists(path, error)) throw IoError(path.string() + ": no such file", {path.string()});
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")", {path.string()});
   text << in.rdbuf();
-  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")");
+  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")", {path.string()});
   return text.str();
 }
 
@@ -90,8 +101,9 @@ toml::table ParseDocument(std::string_view toml_text, const std::string& source_
   try {
     return toml::parse(toml_text, source_name);
   } catch (const toml::parse_error& error) {
-    throw InputError(OneLine(source_name + ":" + std::to_string(error.source().begin.line) + ": " +
-                             std::string(error.description())));
+    const int line = static_cast<int>(error.source().begin.line);
+    throw InputError(OneLine(LocationPrefix(source_name, line) + std::string(error.description())),
+                     {source_name, line});
   }
 }
 

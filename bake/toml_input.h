@@ -29,8 +29,8 @@ std::string TomlKey(std::string_view key);
 std::string Join(const std::string& path, std::string_view key);
 std::string Index(const std::string& path, size_t i);
 std::string OneLine(std::string text);
-// The whole file, or IoError naming it; `kind` ("an atmosphere file") words
-// the error for a directory given in its place.
+// The whole file (standard input for "-"), or IoError naming it; `kind`
+// ("an atmosphere file") words the error for a directory given in its place.
 std::string ReadInputFile(const std::filesystem::path& path, const std::string& kind);
 // The TOML document, or InputError "<source>:<line>: <problem>".
 toml::table ParseDocument(std::string_view toml_text, const std::string& source_name);
@@ -46,11 +46,12 @@ class Reporter {
   explicit Reporter(std::string source) : source_(std::move(source)) {}
 
   [[noreturn]] void Fail(const std::string& path, const std::string& problem) const {
-    throw InputError(OneLine(source_ + ": " + (path.empty() ? "" : path + ": ") + problem));
+    throw InputError(OneLine(LocationPrefix(source_) + (path.empty() ? "" : path + ": ") + problem), {source_, 0, path});
   }
   [[noreturn]] void FailValue(const std::string& path, double value,
                               const std::string& problem) const {
-    throw InputError(OneLine(source_ + ": " + path + " = " + FormatNumber(value) + " " + problem));
+    throw InputError(OneLine(LocationPrefix(source_) + path + " = " + FormatNumber(value) + " " + problem),
+                     {source_, 0, path});
   }
 
  private:

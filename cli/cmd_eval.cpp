@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bake/config.h"
 #include "bake/errors.h"
 #include "bake/scene.h"
 #include "cli/commands.h"
@@ -30,7 +31,7 @@ struct EvalOptions {
 
 void RunEval(const EvalOptions& o) {
   // Queries are checked before the tables are loaded: a malformed file fails fast.
-  QueryTable table = ParseQueryCsv(ReadFileText(o.input), std::filesystem::path(o.input).filename().string());
+  QueryTable table = ParseQueryCsv(ReadFileText(o.input), InputName(o.input));
   LutSet luts = LoadLutSet(o.lut_dir);
   if (luts.scene) {
     // A scene's tables cover only its ranges (and may lack whole tables):
@@ -39,10 +40,12 @@ void RunEval(const EvalOptions& o) {
       std::vector<std::string> clamped;
       const std::string problem =
           SceneQueryProblem(*luts.scene, luts.parameters.bottom_radius, o.clamp, &table.queries[row], &clamped);
-      const std::string where = table.source_name + ": row " + std::to_string(row + 1) + ": ";
+      const int line = table.line_numbers[row];
+      const std::string where = LocationPrefix(table.source_name, line);
       if (!problem.empty()) {
         throw InputError(where + problem + " (scene '" + luts.scene->name + "' of " + o.lut_dir +
-                         (o.clamp ? ")" : "; --clamp moves altitudes, sun angles and distances into range)"));
+                             (o.clamp ? ")" : "; --clamp moves altitudes, sun angles and distances into range)"),
+                         {table.source_name, line});
       }
       for (const std::string& c : clamped) std::fprintf(stderr, "warning: %s%s\n", where.c_str(), c.c_str());
     }

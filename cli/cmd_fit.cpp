@@ -59,7 +59,7 @@ void RunFit(const FitArguments& args) {
 
   // Read the queries first, so a typo fails before any slow part.
   std::vector<fit::Query> queries;
-  std::string query_name = std::filesystem::path(args.query_file).filename().string();
+  std::string query_name = InputName(args.query_file);
   if (!args.query_file.empty()) queries = fit::ParseQueryCsv(ReadFileText(args.query_file), query_name);
   Atmosphere atmosphere = LoadAtmosphere(args.atmosphere);
   fit::CheckQueries(queries, atmosphere, query_name);

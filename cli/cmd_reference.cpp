@@ -40,9 +40,7 @@ void RunReference(const ReferenceOptions& o) {
                      "'");
   }
   settings.Validate();
-  std::string text = ReadFileText(o.input);
-  QueryTable table =
-      ParseQueryCsv(text, std::filesystem::path(o.input).filename().string());
+  QueryTable table = ParseQueryCsv(ReadFileText(o.input), InputName(o.input));
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
   reference::PathTracer tracer(atmosphere);
 

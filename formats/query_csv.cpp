@@ -70,20 +70,22 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
   std::map<std::string, size_t> column;
   for (size_t i = 0; i < table.header.size(); ++i) {
     const std::string& name = table.header[i];
-    std::string where = source_name + ":" + std::to_string(line_number) + ": ";
+    const std::string where = LocationPrefix(source_name, line_number);
     if (column.count(name) || Contains(table.result_columns, name)) {
-      throw InputError(where + "duplicate column '" + name + "'");
+      throw InputError(where + "duplicate column '" + name + "'", {source_name, line_number, name});
     }
     if (Contains(kRequiredColumns, name) || Contains(kOptionalColumns, name)) {
       column[name] = i;
     } else if (extra_columns == ExtraColumns::kKeepAsResults) {
       table.result_columns.push_back(name);
     } else {
-      throw InputError(where + "unknown column '" + name + "'");
+      throw InputError(where + "unknown column '" + name + "'", {source_name, line_number, name});
     }
   }
   for (const std::string& name : kRequiredColumns) {
-    if (!column.count(name)) throw InputError(source_name + ": missing column '" + name + "'");
+    if (!column.count(name)) {
+      throw InputError(LocationPrefix(source_name) + "missing column '" + name + "'", {source_name, 0, name});
+    }
   }
   table.has_distance = column.count("distance_m") > 0;
   table.has_normal = column.count("normal_zenith_deg") > 0;
@@ -94,7 +96,7 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
     if (Blank(line)) continue;
     std::vector<std::string> fields = SplitCsvLine(line);
     auto fail = [&](const std::string& problem) {
-      throw InputError(source_name + ":" + std::to_string(line_number) + ": " + problem);
+      throw InputError(LocationPrefix(source_name, line_number) + problem, {source_name, line_number});
     };
     if (fields.size() != table.header.size()) {
       fail("expected " + std::to_string(table.header.size()) + " fields, got " + std::to_string(fields.size()));
@@ -151,6 +153,7 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
     if (!table.result_columns.empty()) table.results.push_back(results);
     table.fields.push_back(fields);
     table.queries.push_back(q);
+    table.line_numbers.push_back(line_number);
   }
   return table;
 }

@@ -16,6 +16,7 @@ struct QueryTable {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> fields;  // per row, as written
   std::vector<Query> queries;                      // per row; altitude below 0 raised to 0
+  std::vector<int> line_numbers;                   // per row: its 1-based line in the file
   bool has_distance = false;
   bool has_normal = false;
   bool has_group = false;
