@@ -1606,6 +1606,13 @@ double ClampedNu(double nu, double mu, double mu_s) {
   return std::clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
 }
 
+double EstimatedBakeBytes(const BakeSettings& s) {
+  constexpr double kFixedBytes = 160.0 * 1024.0 * 1024.0, kBytesPerTexel = 160.0;
+  const double texels =
+      double(s.scattering_r_size) * s.scattering_mu_size * s.scattering_mu_s_size * s.scattering_nu_size;
+  return kFixedBytes + kBytesPerTexel * texels;
+}
+
 void BakeSettings::Validate() const {
   auto require = [](bool ok, const std::string& message) {
     if (!ok) throw InputError(message);

@@ -88,6 +88,11 @@ struct BakeSettings {
   void Validate() const;
 };
 
+// The peak memory a bake with these settings takes, in bytes, from a fit of
+// measured peaks (docs/benchmark.md): a fixed part plus a part proportional to
+// the 4D tables' texels, rounded up.
+double EstimatedBakeBytes(const BakeSettings& settings);
+
 // The baked tables and the constants the runtime needs to sample them.
 struct LutSet {
   Atmosphere atmosphere;

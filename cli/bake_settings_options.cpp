@@ -1,6 +1,11 @@
 #include "cli/bake_settings_options.h"
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <exception>
+#include <initializer_list>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -9,6 +14,13 @@
 namespace skybake::cli {
 
 namespace {
+
+constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
+
+double PhysicalMemoryBytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page_size = ::sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page_size > 0 ? double(pages) * double(page_size) : 0.0;
+}
 
 // --orders: a count, or "auto" (0 in BakeSettings).
 int ParseOrders(const std::string& text) {
@@ -21,7 +33,7 @@ int ParseOrders(const std::string& text) {
     end = 0;
   }
   if (end == 0 || end != text.size()) throw UsageError("--orders: '" + text + "' is neither a count nor auto");
-  if (orders < 1) throw InputError("orders = " + text + " must be in [1, 100] or auto");
+  if (orders < 1) throw UsageError("--orders: " + text + " must be in [1, 100] or auto");
   return orders;
 }
 
@@ -39,10 +51,23 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
   cmd->add_flag("--no-tail", no_tail,
                 "With a count of orders: hold exactly that many, without the extrapolated tail of the orders not "
                 "computed");
-  cmd->add_option("--transmittance-size", transmittance_size, "Transmittance table: MU R (default 256 64)")
+  // The defaults are this command's (stress bakes smaller tables than bake).
+  auto sizes = [](std::initializer_list<int> values) {
+    std::string text;
+    for (int v : values) text += (text.empty() ? "" : " ") + std::to_string(v);
+    return text;
+  };
+  const BakeSettings& d = settings;
+  cmd->add_option("--transmittance-size", transmittance_size,
+                  "Transmittance table: MU R (default " + sizes({d.transmittance_width, d.transmittance_height}) + ")")
       ->expected(2);
-  cmd->add_option("--irradiance-size", irradiance_size, "Irradiance table: MU_S R (default 64 16)")->expected(2);
-  cmd->add_option("--scattering-size", scattering_size, "Scattering table: R MU MU_S NU (default 32 128 32 8; MU even)")
+  cmd->add_option("--irradiance-size", irradiance_size,
+                  "Irradiance table: MU_S R (default " + sizes({d.irradiance_width, d.irradiance_height}) + ")")
+      ->expected(2);
+  cmd->add_option("--scattering-size", scattering_size,
+                  "Scattering table: R MU MU_S NU (default " +
+                      sizes({d.scattering_r_size, d.scattering_mu_size, d.scattering_mu_s_size, d.scattering_nu_size}) +
+                      "; MU even)")
       ->expected(4);
   cmd->add_option("--transmittance-samples", settings.transmittance_samples,
                   "Quadrature nodes per optical-depth integral")
@@ -78,7 +103,22 @@ BakeSettings BakeSettingsOptions::Resolve() const {
     s.scattering_mu_s_size = scattering_size[2];
     s.scattering_nu_size = scattering_size[3];
   }
-  s.Validate();
+  // Out-of-range values are option values, so usage errors, as CLI11's own.
+  try {
+    s.Validate();
+  } catch (const InputError& e) {
+    throw UsageError(std::string("bake settings: ") + e.what());
+  }
+  // Refused before anything is allocated: a bake that cannot fit in memory.
+  const double needed = EstimatedBakeBytes(s), available = PhysicalMemoryBytes();
+  if (available > 0.0 && needed > available) {
+    char text[160];
+    std::snprintf(text, sizeof text, "the bake would need about %.1f GiB, more than this machine's %.1f GiB",
+                  needed / kGiB, available / kGiB);
+    throw UsageError("--scattering-size " + std::to_string(s.scattering_r_size) + " " +
+                     std::to_string(s.scattering_mu_size) + " " + std::to_string(s.scattering_mu_s_size) + " " +
+                     std::to_string(s.scattering_nu_size) + ": " + text);
+  }
   return s;
 }
 

@@ -13,6 +13,7 @@
 #include "bake/bake.h"
 #include "bake/config.h"
 #include "bake/errors.h"
+#include "bake/interrupt.h"
 #include "bake/scene.h"
 #include "cli/bake_settings_options.h"
 #include "cli/commands.h"
@@ -28,8 +29,9 @@ namespace skybake::cli {
 namespace {
 
 struct BakeOptions {
-  std::string atmosphere;
-  std::string output_dir;
+  std::vector<std::string> atmospheres;
+  std::string output_dir;  // with several atmospheres: a folder for one each, or a pattern with {name}
+  bool clean = false;
   BakeSettingsOptions bake;
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
@@ -168,8 +170,9 @@ nlohmann::json SceneSummaryJson(const SceneSummary& s) {
   return j;
 }
 
-void RunBake(const BakeOptions& o) {
-  Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
+// Bakes one atmosphere into `output_dir`; the --json report of it.
+nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, const std::string& output_dir) {
+  Atmosphere atmosphere = LoadAtmosphere(atmosphere_arg);
   BakeSettings settings = o.bake.Resolve();
   std::optional<SceneSummary> scene;
   std::vector<std::string> formats = o.formats;
@@ -223,11 +226,15 @@ void RunBake(const BakeOptions& o) {
     }
   }
   write_options.command_line = CommandLine();
-  EnsureWritableDirectory(o.output_dir);
+  write_options.clean = o.clean;
+  // Checked before baking, created only when the set is written, so a bake
+  // that fails or is interrupted leaves no empty folder behind.
+  CheckOutputDirectory(output_dir);
 
   BakeReport report;
   auto print_phase = [&](const BakeTiming& t) {
     if (!o.quiet) std::fprintf(stderr, "  %-36s %8.3f s\n", t.phase.c_str(), t.seconds);
+    ThrowIfInterrupted("nothing was written to " + output_dir);
   };
   if (!o.quiet) std::fprintf(stderr, "baking %s\n", atmosphere.name.c_str());
   LutSet luts = Bake(atmosphere, settings, &report, print_phase);
@@ -243,7 +250,8 @@ void RunBake(const BakeOptions& o) {
     // way; its files are encoded in memory only, to count their bytes.
     if (!o.quiet) std::fprintf(stderr, "baking %s without the scene, for comparison\n", atmosphere.name.c_str());
     BakeReport full_report;
-    const LutSet full = Bake(full_atmosphere, full_settings, &full_report);
+    const LutSet full = Bake(full_atmosphere, full_settings, &full_report,
+                             [&](const BakeTiming&) { ThrowIfInterrupted("nothing was written to " + output_dir); });
     WriteOptions full_options = write_options;
     full_options.half_tables.clear();
     scene->compared = true;
@@ -258,7 +266,7 @@ void RunBake(const BakeOptions& o) {
   }
 
   auto write_start = std::chrono::steady_clock::now();
-  WriteReport written = WriteLutSet(luts, o.output_dir, write_options);
+  WriteReport written = WriteLutSet(luts, output_dir, write_options);
   BakeTiming write{"write files", std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count()};
   print_phase(write);
   report.timings.push_back(write);
@@ -287,7 +295,7 @@ void RunBake(const BakeOptions& o) {
     if (scene) PrintSceneSummary(*scene);
   }
 
-  if (o.json) {
+  {
     nlohmann::json timings = nlohmann::json::array();
     for (const BakeTiming& t : report.timings) timings.push_back({{"phase", t.phase}, {"seconds", t.seconds}});
     nlohmann::json files = nlohmann::json::array();
@@ -300,7 +308,7 @@ void RunBake(const BakeOptions& o) {
     const BakeSettings& s = luts.settings;
     nlohmann::json j = {
         {"atmosphere", atmosphere.name},
-        {"output_dir", o.output_dir},
+        {"output_dir", output_dir},
         {"orders", s.orders == 0 ? nlohmann::json("auto") : nlohmann::json(s.orders)},
         {"orders_used", report.orders_used},
         {"order_tolerance", s.order_tolerance},
@@ -326,7 +334,79 @@ void RunBake(const BakeOptions& o) {
         {"timings", timings},
         {"total_seconds", report.total_seconds}};
     if (scene) j["scene"] = SceneSummaryJson(*scene);
-    std::printf("%s\n", j.dump(2).c_str());
+    return j;
+  }
+}
+
+// Where each atmosphere's set goes: `output` with {name} replaced by the
+// atmosphere's name, or, for several atmospheres and no {name}, output/name.
+std::vector<std::string> OutputDirs(const BakeOptions& o) {
+  constexpr std::string_view kName = "{name}";
+  const bool pattern = o.output_dir.find(kName) != std::string::npos;
+  std::vector<std::string> dirs;
+  for (const std::string& atmosphere : o.atmospheres) {
+    const std::string name = AtmosphereSourceName(atmosphere);
+    std::string dir = o.output_dir;
+    if (pattern) {
+      for (std::size_t at; (at = dir.find(kName)) != std::string::npos;) dir.replace(at, kName.size(), name);
+    } else if (o.atmospheres.size() > 1) {
+      dir = (std::filesystem::path(o.output_dir) / name).string();
+    }
+    if (std::find(dirs.begin(), dirs.end(), dir) != dirs.end()) {
+      throw UsageError("-o: two atmospheres would be baked into " + dir + " (name them apart, or use {name})");
+    }
+    dirs.push_back(dir);
+  }
+  return dirs;
+}
+
+void RunBake(const BakeOptions& o) {
+  if (o.atmospheres.size() > 1 && std::count(o.atmospheres.begin(), o.atmospheres.end(), std::string(kStandardStream)) > 0) {
+    throw UsageError("-: standard input can only be baked alone");
+  }
+  const std::vector<std::string> dirs = OutputDirs(o);
+  InterruptScope interrupts;
+  if (o.atmospheres.size() == 1) {
+    nlohmann::json report = BakeOne(o, o.atmospheres[0], dirs[0]);
+    if (o.json) std::printf("%s\n", report.dump(2).c_str());
+    return;
+  }
+  // A batch: every atmosphere is baked (an interrupt stops the rest); one
+  // summary, and the exit code of the first failure.
+  nlohmann::json bakes = nlohmann::json::array();
+  std::optional<Error> first_failure;
+  int failures = 0;
+  for (std::size_t i = 0; i < o.atmospheres.size(); ++i) {
+    const std::string& atmosphere = o.atmospheres[i];
+    try {
+      ThrowIfInterrupted("not baked: " + std::to_string(o.atmospheres.size() - i) + " of " +
+                         std::to_string(o.atmospheres.size()) + " atmospheres");
+      nlohmann::json report = BakeOne(o, atmosphere, dirs[i]);
+      std::fprintf(stderr, "bake %s -> %s: ok (%.3f s)\n", atmosphere.c_str(), dirs[i].c_str(),
+                   report["total_seconds"].get<double>());
+      report["input"] = atmosphere;
+      bakes.push_back(report);
+    } catch (const InterruptedError&) {
+      throw;
+    } catch (const Error& e) {
+      std::fprintf(stderr, "bake %s -> %s: failed (exit %d): %s\n", atmosphere.c_str(), dirs[i].c_str(),
+                   static_cast<int>(e.code()), e.what());
+      bakes.push_back({{"input", atmosphere},
+                       {"output_dir", dirs[i]},
+                       {"error", {{"exit_code", static_cast<int>(e.code())}, {"message", e.what()}}}});
+      ++failures;
+      if (!first_failure) first_failure = e;
+    }
+  }
+  std::fprintf(stderr, "baked %zu of %zu atmospheres\n", o.atmospheres.size() - failures, o.atmospheres.size());
+  if (o.json) std::printf("%s\n", nlohmann::json({{"bakes", bakes}, {"failed", failures}}).dump(2).c_str());
+  if (first_failure) {
+    const Error summary(first_failure->code(),
+                        std::to_string(failures) + " of " + std::to_string(o.atmospheres.size()) +
+                            " bakes failed; the first: " + first_failure->what(),
+                        first_failure->location());
+    if (o.json) throw ReportedError(summary);  // each error is in the batch's JSON already
+    throw summary;
   }
 }
 
@@ -335,8 +415,17 @@ void RunBake(const BakeOptions& o) {
 void AddBakeCommand(CLI::App& app) {
   auto o = std::make_shared<BakeOptions>();
   CLI::App* cmd = app.add_subcommand("bake", "Bake transmittance, irradiance and scattering tables");
-  cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
-  cmd->add_option("-o,--output", o->output_dir, "Output directory (created if missing)")->required();
+  cmd->add_option("atmosphere", o->atmospheres,
+                  "Atmosphere files (.toml; - for standard input) or preset names (preset:NAME always names the "
+                  "preset; a bare NAME is the preset where one exists, else a file); several are baked in turn")
+      ->required();
+  cmd->add_option("-o,--output", o->output_dir,
+                  "Output directory (created if missing); {name} is replaced by the atmosphere's name; with "
+                  "several atmospheres and no {name}, each goes to DIR/NAME")
+      ->required();
+  cmd->add_flag("--clean", o->clean,
+                "Remove the files of an earlier set in the output directory that the new set does not list "
+                "(without it, such files make the bake refuse; files no skybake set listed are never removed)");
   o->bake.AddTo(cmd);
   o->format_option = cmd->add_option("--format", o->formats,
                                      "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")

@@ -7,6 +7,7 @@
 #include <tbb/partitioner.h>
 
 #include "bake/errors.h"
+#include "bake/interrupt.h"
 #include "formats/file_io.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
@@ -34,17 +35,14 @@ FileFormat ChooseFormat(const Manifest& manifest, const std::vector<TableDescrip
   return manifest.table_files.empty() ? FileFormat::kExr : manifest.table_files.front().format;
 }
 
-}  // namespace
-
-WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOptions& options) {
-  if (options.formats.empty()) throw InternalError("WriteLutSet: no file format requested");
-  EnsureWritableDirectory(dir);
+// The staged writing of WriteLutSet.
+WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescription>& tables, const fs::path& dir,
+                           const WriteOptions& options) {
   ManifestWriter manifest(luts, options.command_line);
   WriteReport report;
-  // The whole set is staged and renamed at the end, so a failure part-way
-  // leaves the previous set (files and manifest) as it was; an interrupt
-  // waits until the set is committed or its temporaries removed.
-  DeferInterrupts defer_interrupts;
+  // The whole set is staged and renamed at the end, so a failure or an
+  // interrupt part-way leaves the previous set (files and manifest) as it was.
+  InterruptScope interrupts;
   StagedFiles staged;
   // Each table file is encoded and hashed on its own thread (zip
   // compression of the EXR files is most of the writing), then written in
@@ -57,7 +55,6 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
     std::vector<std::uint8_t> bytes;
     std::string sha256;
   };
-  const std::vector<TableDescription> tables = DescribeTables(luts);
   std::vector<Encoded> files;
   auto is_half = [&](const TableDescription& table) {
     return options.half ||
@@ -102,9 +99,77 @@ WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOpti
   // Last, so a reader that finds the new manifest finds the files it lists.
   const std::string text = manifest.Text();
   staged.Write(dir / kManifestFileName, text);
+  ThrowIfInterrupted(dir.string() + " was left as it was");
   staged.Commit();
   report.files.push_back({"", kManifestFileName, text.size()});
   return report;
+}
+
+std::string NameList(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+// The entries of `dir` that are not in `new_files`, after checking that each
+// may be removed: IoError naming them without `clean`, or naming those no
+// earlier skybake set listed.
+std::vector<std::string> StaleFiles(const fs::path& dir, const std::vector<std::string>& new_files, bool clean) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return {};
+  std::vector<std::string> stale;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (std::find(new_files.begin(), new_files.end(), name) == new_files.end()) stale.push_back(name);
+  }
+  if (ec) throw IoError(dir.string() + ": cannot list the output directory: " + ec.message());
+  std::sort(stale.begin(), stale.end());
+  if (stale.empty()) return stale;
+  if (!clean) {
+    throw IoError(dir.string() + ": holds files the new set would not list: " + NameList(stale) +
+                  " (--clean removes those an earlier skybake set listed; move anything else away)",
+                  ErrorLocation(dir.string()));
+  }
+  const std::vector<std::string> known = ListedFileNames(dir);
+  std::vector<std::string> foreign;
+  for (const std::string& name : stale) {
+    const bool ours = std::find(known.begin(), known.end(), name) != known.end() || IsTemporaryFileName(name);
+    if (!ours || fs::is_directory(dir / name, ec)) foreign.push_back(name);
+  }
+  if (!foreign.empty()) {
+    throw IoError(dir.string() + ": holds files no earlier skybake set there listed, which --clean leaves alone: " +
+                  NameList(foreign) + " (move them away)",
+                  ErrorLocation(dir.string()));
+  }
+  return stale;
+}
+
+}  // namespace
+
+WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOptions& options) {
+  if (options.formats.empty()) throw InternalError("WriteLutSet: no file format requested");
+  const std::vector<TableDescription> tables = DescribeTables(luts);
+  std::vector<std::string> new_files = {kManifestFileName};
+  for (const TableDescription& table : tables) {
+    for (FileFormat format : options.formats) new_files.push_back(table.name + FileExtension(format));
+  }
+  for (const ShaderFile& shader : options.shaders) new_files.push_back(shader.file);
+  const std::vector<std::string> stale = StaleFiles(dir, new_files, options.clean);
+
+  std::error_code ec;
+  const bool created = !fs::exists(dir, ec);
+  EnsureWritableDirectory(dir);
+  try {
+    WriteReport report = WriteStagedSet(luts, tables, dir, options);
+    for (const std::string& name : stale) {
+      fs::remove(dir / name, ec);
+      if (ec) throw IoError((dir / name).string() + ": cannot remove (--clean): " + ec.message());
+    }
+    return report;
+  } catch (...) {
+    if (created && fs::is_empty(dir, ec)) fs::remove(dir, ec);
+    throw;
+  }
 }
 
 LutSet LoadLutSet(const fs::path& dir, const LoadOptions& options) {

@@ -35,6 +35,10 @@ struct WriteOptions {
   std::vector<std::string> half_tables;  // tables stored as half even without `half` (a scene's precision)
   std::string command_line;   // recorded in the manifest
   std::vector<ShaderFile> shaders;  // written and listed under "shaders"
+  // Remove the files of an earlier set in the directory that the new set does
+  // not list (those its manifest listed, and temporary files of a killed
+  // write); without it such files make WriteLutSet refuse.
+  bool clean = false;
 };
 
 struct WrittenFile {
@@ -50,7 +54,12 @@ struct WriteReport {
 };
 
 // Writes every table in every requested format, the shader files, and then
-// the manifest, each atomically. IoError on failure.
+// the manifest, as one staged set: it appears complete or not at all, and an
+// interrupt (bake/interrupt.h) before the commit leaves the directory as it
+// was. A directory it creates is removed again on failure. IoError on
+// failure, and, before anything is written, when the directory holds a file
+// the new set does not list (see WriteOptions::clean; anything that no
+// earlier skybake set listed is never removed).
 WriteReport WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
 
 struct LoadOptions {

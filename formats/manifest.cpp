@@ -148,6 +148,27 @@ const ManifestFile* Manifest::Find(const std::string& table, FileFormat format) 
   return nullptr;
 }
 
+std::vector<std::string> ListedFileNames(const fs::path& dir) {
+  const fs::path path = dir / kManifestFileName;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return {};
+  const json document = json::parse(ReadFileText(path), nullptr, /*allow_exceptions=*/false);
+  if (!document.is_object() || document.value("schema", "") != kManifestSchema) return {};
+  std::vector<std::string> names = {kManifestFileName};
+  auto add = [&](const json& entry) {
+    if (!entry.is_object() || !entry.contains("file") || !entry["file"].is_string()) return;
+    const std::string file = entry["file"].get<std::string>();
+    if (IsPlainFileName(file)) names.push_back(file);
+  };
+  for (const json& table : document.value("tables", json::array())) {
+    if (table.is_object()) {
+      for (const json& file : table.value("files", json::array())) add(file);
+    }
+  }
+  for (const json& shader : document.value("shaders", json::array())) add(shader);
+  return names;
+}
+
 Manifest ReadManifest(const fs::path& dir) {
   Manifest m;
   m.path = dir / kManifestFileName;

@@ -72,6 +72,11 @@ struct Manifest {
 // names are plain names). IoError naming the manifest for anything wrong.
 Manifest ReadManifest(const std::filesystem::path& dir);
 
+// The plain file names DIR/skybake.json lists (tables and shaders) and the
+// manifest itself, read from any schema version; empty where there is no
+// manifest or it is not a skybake manifest. What `bake --clean` may remove.
+std::vector<std::string> ListedFileNames(const std::filesystem::path& dir);
+
 // The entry for `file` when the directory holding it has a manifest that
 // lists it (as a table or shader file); nullopt when there is no manifest or
 // it does not list the file. A manifest that cannot be read is an IoError.
