@@ -172,8 +172,8 @@ void RunBench(const BenchOptions& o) {
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
-  std::printf("%s: %s, files written; median of %d runs\n\n", atmosphere.name.c_str(), Describe(settings).c_str(),
-              o.runs);
+  const std::string runs = o.runs == 1 ? "one run" : "median of " + std::to_string(o.runs) + " runs";
+  std::printf("%s: %s, files written; %s\n\n", atmosphere.name.c_str(), Describe(settings).c_str(), runs.c_str());
   std::printf("| phase | median (s) |\n|---|---:|\n");
   for (const std::string& phase : base.phases) {
     std::printf("| %s | %.3f |\n", phase.c_str(), Median(base.seconds[phase]));

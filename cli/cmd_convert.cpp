@@ -85,18 +85,20 @@ void RunConvert(const ConvertOptions& o) {
     std::printf("%s\n", report.dump(2, ' ', false, json::error_handler_t::replace).c_str());
     return;
   }
-  std::printf("%s (%s %s) -> %s (%s %s), %llu bytes\n", o.input.c_str(), ToString(in.format), ToString(in.pixel_type),
-              o.output.c_str(), ToString(out.format), ToString(out.pixel_type),
-              static_cast<unsigned long long>(written));
+  // The summary goes to stderr, as every command's; stdout carries only --json.
+  std::fprintf(stderr, "%s (%s %s) -> %s (%s %s), %llu bytes\n", o.input.c_str(), ToString(in.format),
+               ToString(in.pixel_type), o.output.c_str(), ToString(out.format), ToString(out.pixel_type),
+               static_cast<unsigned long long>(written));
   if (!rounds) {
-    std::printf("lossless: every value is stored exactly\n");
+    std::fprintf(stderr, "lossless: every value is stored exactly\n");
     return;
   }
-  std::printf("half: max relative error %.4g (at %.6g) over %zu values with |v| >= %g\n", error.max_relative_error,
-              error.worst_value, error.measured, error.floor);
-  std::printf("half: %zu non-zero values below the floor, max absolute error there %.3g; %zu flushed to zero; "
-              "%zu overflowed to infinity\n",
-              error.below_floor, error.max_absolute_error_below_floor, error.flushed_to_zero, error.overflowed);
+  std::fprintf(stderr, "half: max relative error %.4g (at %.6g) over %zu values with |v| >= %g\n",
+               error.max_relative_error, error.worst_value, error.measured, error.floor);
+  std::fprintf(stderr,
+               "half: %zu non-zero values below the floor, max absolute error there %.3g; %zu flushed to zero; "
+               "%zu overflowed to infinity\n",
+               error.below_floor, error.max_absolute_error_below_floor, error.flushed_to_zero, error.overflowed);
 }
 
 }  // namespace

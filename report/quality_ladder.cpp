@@ -89,10 +89,9 @@ LadderPlan MakeLadder(const BakeSettings& base, bool quick) {
   LadderPlan plan;
   plan.base = base;
   plan.max_orders = quick ? 3 : 8;
-  if (base.orders < 1 || base.orders > plan.max_orders) {
-    throw InputError("report: the base bake's orders must be a count in [1, " + std::to_string(plan.max_orders) +
-                     "] (the ladder bakes orders 1 to " + std::to_string(plan.max_orders) + ")");
-  }
+  // The base is baked on its own, so any count of orders serves; the ladder's
+  // orders 1..max_orders come from a separate bake.
+  if (base.orders < 1) throw UsageError("--orders: the report's base bake needs a count of orders, not auto");
   for (const Knob& knob : Knobs(quick)) {
     for (bool doubled : {false, true}) {
       LadderStep step;

@@ -36,8 +36,7 @@ struct LadderPlan {
 
 // The full ladder (orders 1-8, every knob at x1/2 and x2, half), or the
 // quick one for tests (orders 1-3, transmittance and irradiance sizes at
-// x1/2 and x2, half). InputError if the base's orders are auto or above the
-// ladder's.
+// x1/2 and x2, half). UsageError if the base's orders are auto.
 LadderPlan MakeLadder(const BakeSettings& base, bool quick);
 
 struct LadderEntry {

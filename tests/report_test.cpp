@@ -185,7 +185,7 @@ TEST(ReportLadder, ChangesOneKnobAtATime) {
   EXPECT_EQ(quick.variants.size(), 3u);
   BakeSettings auto_orders = base;
   auto_orders.orders = 0;
-  EXPECT_THROW(report::MakeLadder(auto_orders, false), InputError);
+  EXPECT_THROW(report::MakeLadder(auto_orders, false), UsageError);
 }
 
 // A camera on the ground looking at the zenith with the sun overhead, in one
