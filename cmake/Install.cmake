@@ -1,0 +1,41 @@
+# `cmake --install BUILD --prefix PREFIX` puts the command-line tool, the
+# loader library (skybake::formats: LoadLutSet and the manifest, with the
+# LutSet of skybake::bake and the CPU twin of skybake::runtime), their headers
+# and the runtime GLSL into PREFIX, with a CMake package:
+#
+#   find_package(skybake REQUIRED)
+#   target_link_libraries(my_tool PRIVATE skybake::formats)
+#
+# Headers keep the source tree's layout under include/skybake/ (so
+# `#include "formats/lut_files.h"`, as inside skybake).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(SKYBAKE_INSTALL_INCLUDEDIR ${CMAKE_INSTALL_INCLUDEDIR}/skybake)
+set(SKYBAKE_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/skybake)
+
+set_target_properties(skybake_runtime PROPERTIES EXPORT_NAME runtime)
+set_target_properties(skybake_bake PROPERTIES EXPORT_NAME bake)
+set_target_properties(skybake_formats PROPERTIES EXPORT_NAME formats)
+foreach(target skybake_runtime skybake_bake skybake_formats)
+  target_include_directories(${target} INTERFACE $<INSTALL_INTERFACE:${SKYBAKE_INSTALL_INCLUDEDIR}>)
+endforeach()
+
+install(TARGETS skybake RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS skybake_runtime skybake_bake skybake_formats EXPORT skybakeTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+foreach(dir bake formats shaders_runtime)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${SKYBAKE_INSTALL_INCLUDEDIR}/${dir}
+          FILES_MATCHING PATTERN "*.h")
+endforeach()
+install(FILES ${PROJECT_BINARY_DIR}/generated/bake/version.h DESTINATION ${SKYBAKE_INSTALL_INCLUDEDIR}/bake)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders_runtime/ DESTINATION ${CMAKE_INSTALL_DATADIR}/skybake/shaders_runtime
+        FILES_MATCHING PATTERN "*.glsl" PATTERN "README.md")
+
+install(EXPORT skybakeTargets NAMESPACE skybake:: DESTINATION ${SKYBAKE_INSTALL_CMAKEDIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/skybakeConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/skybakeConfig.cmake INSTALL_DESTINATION ${SKYBAKE_INSTALL_CMAKEDIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/skybakeConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/skybakeConfig.cmake ${PROJECT_BINARY_DIR}/skybakeConfigVersion.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/OpenImageIO.cmake
+        DESTINATION ${SKYBAKE_INSTALL_CMAKEDIR})
