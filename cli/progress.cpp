@@ -39,9 +39,13 @@ void ProgressBar::Advance(std::size_t units) {
 void ProgressBar::Draw(std::size_t done) {
   int permille = static_cast<int>(1000 * done / total_);
   if (permille == drawn_permille_) return;  // redraw only when the figure changes
+  const auto now = std::chrono::steady_clock::now();
+  const auto interval = std::chrono::milliseconds(1000 / kMaxRedrawsPerSecond);
+  if (drawn_permille_ >= 0 && now - drawn_at_ < interval) return;  // the first draw is immediate
   drawn_permille_ = permille;
+  drawn_at_ = now;
   int filled = permille * kBarWidth / 1000;
-  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  double seconds = std::chrono::duration<double>(now - start_).count();
   std::fprintf(stream_, "\r%s [%s%s] %5.1f%% %6.1f s", label_.c_str(), std::string(filled, '#').c_str(),
                std::string(kBarWidth - filled, '.').c_str(), permille / 10.0, seconds);
   std::fflush(stream_);

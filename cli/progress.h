@@ -1,9 +1,12 @@
 // A progress bar on stderr for work that takes more than a second.
 //
 // Shown only when the stream is a terminal (isatty) and the command was not
-// given --quiet; otherwise every call is a no-op, so logs and pipes stay
-// clean. It never writes to stdout, which carries reports and --json.
-// Advance() may be called from worker threads.
+// given --quiet; otherwise every call is a no-op, so logs and pipes keep only
+// the command's own final summary line. It never writes to stdout, which
+// carries reports and --json. Advance() may be called from worker threads.
+// The bar is redrawn only when its figure (0.1%) changes and at most
+// kMaxRedrawsPerSecond times a second, so fast work does not flood the
+// terminal.
 //
 //   ProgressBar bar("bake: scattering", total_units, quiet);
 //   ... bar.Advance(n) from any thread ...
@@ -20,6 +23,8 @@ namespace skybake::cli {
 
 class ProgressBar {
  public:
+  static constexpr int kMaxRedrawsPerSecond = 10;
+
   ProgressBar(std::string label, std::size_t total, bool quiet, std::FILE* stream = stderr);
   ~ProgressBar();
   ProgressBar(const ProgressBar&) = delete;
@@ -45,6 +50,7 @@ class ProgressBar {
   int drawn_permille_ = -1;
   bool finished_ = false;
   std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point drawn_at_;  // the last redraw
 };
 
 }  // namespace skybake::cli
