@@ -432,15 +432,27 @@ std::vector<unsigned char> RasterizePlot(const LinePlot& plot) {
   return pixels;
 }
 
+void WriteSrgbPng(const std::filesystem::path& path, int width, int height, const unsigned char* rgb,
+                  const std::vector<std::pair<std::string, std::string>>& text) {
+  using namespace OIIO;
+  ImageSpec spec(width, height, 3, TypeDesc::UINT8);
+  for (const auto& [key, value] : text) spec.attribute(key, value);
+  // OpenImageIO's PNG writer turns this colour space into the sRGB chunk.
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  ImageBuf image(spec);
+  image.set_pixels(ROI::All(), TypeDesc::UINT8, rgb);
+  WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
+    // The temporary name has no .png extension, so name the format explicitly.
+    if (!image.write(temp.string(), TypeDesc::UINT8, "png"))
+      throw IoError(path.string() + ": cannot write PNG: " + image.geterror());
+  });
+}
+
 bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
   using namespace OIIO;
   PlotFrame f = LayoutPlot(plot);
   std::vector<unsigned char> pixels = RasterizePlot(plot);
-  ImageSpec spec(plot.width_px, plot.height_px, 3, TypeDesc::UINT8);
-  // The caption (who made the plot) also goes into the PNG's text chunks.
-  if (!plot.caption.empty()) spec.attribute("ImageDescription", plot.caption);
-  if (!plot.title.empty()) spec.attribute("DocumentName", plot.title);
-  ImageBuf image(spec);
+  ImageBuf image(ImageSpec(plot.width_px, plot.height_px, 3, TypeDesc::UINT8));
   image.set_pixels(ROI::All(), TypeDesc::UINT8, pixels.data());
 
   std::string font;
@@ -488,11 +500,12 @@ bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
     }
   }
 
-  WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
-    // The temporary name has no .png extension, so name the format explicitly.
-    if (!image.write(temp.string(), TypeDesc::UINT8, "png"))
-      throw IoError(path.string() + ": cannot write PNG: " + image.geterror());
-  });
+  image.get_pixels(ROI::All(), TypeDesc::UINT8, pixels.data());
+  // The caption (who made the plot) also goes into the PNG's text chunks.
+  std::vector<std::pair<std::string, std::string>> text;
+  if (!plot.caption.empty()) text.push_back({"ImageDescription", plot.caption});
+  if (!plot.title.empty()) text.push_back({"DocumentName", plot.title});
+  WriteSrgbPng(path, plot.width_px, plot.height_px, pixels.data(), text);
   return !font.empty();
 }
 

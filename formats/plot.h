@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace skybake {
@@ -55,6 +56,15 @@ std::string PlotColor(int index);
 
 std::string RenderPlotSvg(const LinePlot& plot);
 void WritePlotSvg(const std::filesystem::path& path, const LinePlot& plot);
+
+// Every PNG skybake writes (plots, render previews) goes through here: 8-bit
+// RGB pixels, row-major from the top, already encoded with the sRGB transfer
+// function, written atomically with an sRGB chunk (and the gAMA and cHRM
+// chunks the PNG specification pairs with it), so viewers need not guess
+// the colour space, and `text` as text chunks. The pixels are stored as
+// given. IoError on failure.
+void WriteSrgbPng(const std::filesystem::path& path, int width, int height, const unsigned char* rgb,
+                  const std::vector<std::pair<std::string, std::string>>& text);
 
 // RGB pixels, row-major from the top, 8 bits per channel, without text.
 std::vector<unsigned char> RasterizePlot(const LinePlot& plot);

@@ -8,6 +8,7 @@
 
 #include "bake/errors.h"
 #include "formats/file_io.h"
+#include "formats/plot.h"
 
 namespace skybake::render {
 
@@ -72,12 +73,7 @@ void WriteLinearExr(const std::filesystem::path& path, const Image& image, const
 }
 
 void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes) {
-  using namespace OIIO;
-  ImageSpec spec(image.width, image.height, 3, TypeDesc::UINT8);
-  Annotate(&spec, attributes);
-  ImageBuf buffer(spec);
-  buffer.set_pixels(ROI::All(), TypeDesc::UINT8, image.rgb.data());
-  WriteAtomically(path, buffer, TypeDesc::UINT8, "png");
+  WriteSrgbPng(path, image.width, image.height, image.rgb.data(), attributes);
 }
 
 Rgb8 ReadPng(const std::filesystem::path& path) {

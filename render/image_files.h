@@ -42,7 +42,8 @@ Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone);
 // Text attributes stored in the files (e.g. the command line).
 using Attributes = std::vector<std::pair<std::string, std::string>>;
 
-// Both written atomically; IoError on failure.
+// Both written atomically; IoError on failure. The PNG carries an sRGB
+// chunk (formats/plot.h WriteSrgbPng).
 void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes);
 void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes);
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -27,6 +28,22 @@ using testing::TempDir;
 const char* const kSmallBake =
     " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
     " --sphere-samples 8 --orders 2";
+
+// The chunk types of a PNG file, in file order (empty if it is not a PNG).
+std::vector<std::string> PngChunks(const fs::path& path) {
+  const std::string bytes = testing::ReadText(path);
+  const std::string signature = "\x89PNG\r\n\x1a\n";
+  std::vector<std::string> chunks;
+  if (bytes.compare(0, signature.size(), signature) != 0) return chunks;
+  // Each chunk: 4-byte big-endian data length, 4-byte type, data, 4-byte CRC.
+  for (std::size_t at = signature.size(); at + 8 <= bytes.size();) {
+    std::size_t length = 0;
+    for (int i = 0; i < 4; ++i) length = length << 8 | static_cast<unsigned char>(bytes[at + i]);
+    chunks.push_back(bytes.substr(at + 4, 4));
+    at += 12 + length;
+  }
+  return chunks;
+}
 
 const std::string kGroundScene = std::string(SKYBAKE_SOURCE_DIR) + "/examples/scenes/ground-daytime-game.toml";
 
@@ -116,6 +133,58 @@ TEST(NewcomerDefects, D04_InfoNamesUnlistedFiles) {
   ASSERT_EQ(RunCommand(Skybake() + " info --help", dir, &out, &err), 0);
   EXPECT_NE(out.find("not list"), std::string::npos) << out;
   EXPECT_NE(out.find("exit 0"), std::string::npos) << out;
+}
+
+// Every PNG skybake writes (render previews and contact sheet, LUT plots of
+// render and info) carries an sRGB chunk ahead of the image data.
+TEST(NewcomerDefects, D11_PngsCarrySrgbChunk) {
+  TempDir dir;
+  const fs::path lut = dir.path() / "lut", images = dir.path() / "images", plots = dir.path() / "plots";
+  SmallBake(dir, "earth", lut);
+  std::string err;
+  ASSERT_EQ(RunCommand(Skybake() + " render -q " + ShellQuote(lut) + " -o " + ShellQuote(images) +
+                           " --size 16 --sun-zenith 30 --plots",
+                       dir, nullptr, &err),
+            0)
+      << err;
+  ASSERT_EQ(RunCommand(Skybake() + " info " + ShellQuote(lut) + " --plot " + ShellQuote(plots), dir, nullptr, &err), 0)
+      << err;
+  int pngs = 0;
+  for (const fs::path& folder : {images, plots}) {
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+      if (entry.path().extension() != ".png") continue;
+      ++pngs;
+      const std::vector<std::string> chunks = PngChunks(entry.path());
+      const auto srgb = std::find(chunks.begin(), chunks.end(), "sRGB");
+      const auto data = std::find(chunks.begin(), chunks.end(), "IDAT");
+      ASSERT_NE(data, chunks.end()) << entry.path();
+      EXPECT_TRUE(srgb < data) << entry.path() << ": no sRGB chunk before the image data";
+    }
+  }
+  // 4 views, the contact sheet and 3 plots from render; 3 plots from info.
+  EXPECT_EQ(pngs, 4 + 1 + 3 + 3);
+}
+
+// On a terminal the render progress bar is redrawn at most
+// ProgressBar::kMaxRedrawsPerSecond (10) times a second, not once per row.
+TEST(NewcomerDefects, D11_ProgressRedrawThrottled) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "util-linux `script` not installed";
+  TempDir dir;
+  const fs::path lut = dir.path() / "lut";
+  SmallBake(dir, "earth", lut);
+  // 2 suns x (128 + 64 + 128 + 32) rows: a redraw per row would be 704.
+  const std::string command = Skybake() + " render " + ShellQuote(lut) + " -o " + ShellQuote(dir.path() / "images") +
+                              " --size 128 --sun-zenith 30,85";
+  std::string out, err;
+  // `script` runs the command on a pseudo-terminal and copies what it wrote.
+  ASSERT_EQ(RunCommand("script -qec " + ShellQuote(command) + " /dev/null", dir, &out, &err), 0) << err;
+  std::size_t redraws = 0;
+  for (std::size_t at = out.find("render ["); at != std::string::npos; at = out.find("render [", at + 1)) ++redraws;
+  const std::size_t summary = out.find(" images in ");
+  ASSERT_NE(summary, std::string::npos) << out;
+  const double seconds = std::stod(out.substr(summary + 11));  // printed to 0.1 s
+  EXPECT_GE(redraws, 1u) << out;
+  EXPECT_LE(redraws, 10.0 * (seconds + 0.1) + 1.0) << seconds << " s; " << out.substr(0, 2000);
 }
 
 }  // namespace
