@@ -21,6 +21,7 @@ Parts (figure blocks, the page, the commands run):
            --json` for N = 1..6 and auto, and `--orders 4 --no-tail`; under a minute
   cli      presets, bake-defaults (docs/cli.md): `skybake presets --json`,
            `skybake bake --help`; instant
+  stress   stress (docs/stability.md): `skybake stress --json`; about half a minute
   bench    bench (docs/benchmark.md): scripts/bench.sh (RUNS=5: about 7 minutes)
   report   report (docs/accuracy.md), docs/images/report/: `/usr/bin/time -v
            skybake report earth -o build/figures/report` (a few minutes)
@@ -31,10 +32,12 @@ import json
 import os
 import pathlib
 import re
+import resource
 import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 WORK = pathlib.Path("build") / "figures"  # relative to ROOT, the working directory
@@ -170,7 +173,55 @@ def report(skybake):
     replace_block("docs/accuracy.md", "report", "report", text)
 
 
-PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "bench": bench, "report": report}
+# What each atmosphere of bake/stress_set.cpp pushes to an extreme.
+STRESSES = {
+    "optical-depth-10": "τ = 10 (blue), albedo 0.99, HG g = 0.7, 10 km slab",
+    "optical-depth-100": "τ = 100, albedo 0.9, Rayleigh phase, H = 2 km",
+    "optical-depth-1000": "τ = 1000, albedo 0.8, isotropic, 10 km slab",
+    "albedo-0.999999": "albedo 0.999999, τ = 1, ground 0.3",
+    "forward-g-0.999": "Earth air + HG haze g = +0.999",
+    "backward-g-0.999": "Earth air + HG haze g = −0.999",
+    "tiny-planet-1km": "R = 1 km, 500 m of air",
+    "giant-planet-100000km": "R = 100,000 km, 200 km of air",
+    "thin-shell-1m": "1 m atmosphere on Earth's radius, τ = 0.1",
+    "thick-shell-10R": "atmosphere 10 planet radii thick",
+    "vacuum-gap": "haze at 0–2 km and 20–60 km, vacuum between",
+    "no-constituents": "vacuum",
+    "absorption-only": "uniform absorber, τ = 1.2",
+    "black-ground": "Earth air, ground albedo 0",
+    "white-ground": "non-absorbing Earth air, ground albedo 1, μs_min = −1",
+    "heavy-fog": "preset, haze 0.01 m⁻¹",
+}
+
+
+def stress(skybake):
+    start, before = time.monotonic(), resource.getrusage(resource.RUSAGE_CHILDREN)
+    results = json.loads(run([skybake, "stress", "--json"]))
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    wall, cpu = time.monotonic() - start, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    presets = {p["name"] for p in json.loads(run([skybake, "presets", "--json"]))}
+    delta = lambda v: "0" if v == 0 else f"{v:.2g}"
+    rows = []
+    for r in results:
+        name = r["atmosphere"]
+        what = STRESSES.get(name, "preset" if name in presets else "")
+        energy = " ".join(f"{e:.4f}" if name == "white-ground" else f"{e:.3f}" for e in r["energy_out"])
+        if name == "white-ground":
+            energy = f"**{energy}**"
+        rows.append(f"| `{name}` | {what} | {r['orders_used']} | {delta(r['remaining_error'])} | {energy} | "
+                    f"{delta(r['largest_transmittance_increase'])}, {delta(r['largest_direction_difference'])} |")
+    violations = sum(r["violations"] for r in results)
+    unbalanced = [r["atmosphere"] for r in results if not r.get("energy_balanced", True)]
+    text = (f"`skybake stress --json`: {len(results)} atmospheres, {violations} invariant violations, "
+            f"energy balanced in {'all' if not unbalanced else 'all but ' + ', '.join(unbalanced)}; "
+            f"{wall:.1f} s wall, {cpu:.1f} s CPU on {os.cpu_count()} cores (load average "
+            f"{os.getloadavg()[0]:.1f} at the end).\n\n"
+            "| atmosphere | stresses | orders | remaining | energy out | ΔT along, ΔT reversed |\n"
+            "| --- | --- | ---: | ---: | --- | --- |\n" + "\n".join(rows))
+    replace_block("docs/stability.md", "stress", "stress", text)
+
+
+PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report}
 
 
 def main():

@@ -8,6 +8,7 @@
 #   scripts/figures.sh sizes      # file sizes and half error (docs/files.md)
 #   scripts/figures.sh orders     # --orders N and the extrapolated tail (docs/accuracy.md)
 #   scripts/figures.sh cli        # presets and bake defaults (docs/cli.md)
+#   scripts/figures.sh stress     # the stress set's table (docs/stability.md, about half a minute)
 #   scripts/figures.sh bench      # docs/benchmark.md (scripts/bench.sh, about 7 minutes)
 #   scripts/figures.sh report     # docs/accuracy.md and docs/images/report/ (skybake report, a few minutes)
 #   scripts/figures.sh images     # the gallery and the engine example's images (scripts/gallery.sh,
@@ -24,10 +25,10 @@ images=0
 for arg in "${@:-fast}"; do
   case "$arg" in
     fast) parts+=(sizes orders cli) ;;
-    all) parts+=(sizes orders cli bench report); images=1 ;;
+    all) parts+=(sizes orders cli stress bench report); images=1 ;;
     images) images=1 ;;
-    sizes | orders | cli | bench | report) parts+=("$arg") ;;
-    *) sed -n '2,18p' "${BASH_SOURCE[0]}" >&2; exit 1 ;;
+    sizes | orders | cli | stress | bench | report) parts+=("$arg") ;;
+    *) sed -n '2,19p' "${BASH_SOURCE[0]}" >&2; exit 1 ;;
   esac
 done
 
