@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,7 @@ struct RenderArguments {
   double sun_azimuth_deg = 0.0;
   int size = 512;
   std::vector<std::string> views = {"fisheye", "panorama", "space", "aerial"};
-  double exposure_ev = 3.3;
+  std::string exposure = "auto";  // "auto" or EV (render::AutoExposureEv)
   double altitude_m = 100.0;
   double ground_albedo = -1.0;  // < 0: the atmosphere's
   bool plots = false;
@@ -78,7 +79,23 @@ void CheckSceneCanRender(const Scene& scene, double bottom_radius_m, const Rende
   }
 }
 
+// The fixed exposure `--exposure` gives; nullopt for "auto".
+std::optional<double> ParseExposure(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  std::size_t used = 0;
+  double ev = 0.0;
+  try {
+    ev = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(ev))
+    throw UsageError("render: --exposure must be 'auto' or a number of EV, not '" + text + "'");
+  return ev;
+}
+
 void RunRender(const RenderArguments& args) {
+  const std::optional<double> fixed_exposure = ParseExposure(args.exposure);
   std::vector<render::View> views;
   for (const std::string& name : args.views) {
     render::View view;
@@ -106,7 +123,7 @@ void RunRender(const RenderArguments& args) {
 
   TwinTables tables = MakeTwinTables(luts);
   Twin twin(tables);
-  render::ToneMap tone{args.exposure_ev, render::WhiteBalance(luts.parameters.solar_irradiance)};
+  const glsl::vec3 white = render::WhiteBalance(luts.parameters.solar_irradiance);
   const glsl::vec3 albedo = args.ground_albedo >= 0.0 ? glsl::vec3(args.ground_albedo) : luts.atmosphere.ground_albedo;
 
   std::size_t total_rows = 0;
@@ -118,7 +135,7 @@ void RunRender(const RenderArguments& args) {
                                      {"skybake.command_line", CommandLine()}};
   nlohmann::json images = nlohmann::json::array();
   std::vector<std::vector<render::Rgb8>> columns(args.sun_zenith_deg.size());
-  std::vector<std::string> labels;
+  std::vector<std::string> labels, exposure_lines;
   for (std::size_t z = 0; z < args.sun_zenith_deg.size(); ++z) {
     double zenith = args.sun_zenith_deg[z];
     char label[48];
@@ -139,17 +156,23 @@ void RunRender(const RenderArguments& args) {
       exr_attributes.push_back({"skybake.sun_zenith_deg", std::to_string(zenith)});
       exr_attributes.push_back({"skybake.units", "W m^-2 sr^-1 nm^-1 (linear radiance, R G B = the tables' wavelengths)"});
       render::WriteLinearExr(out_dir / (stem + ".exr"), image, exr_attributes);
-      render::Rgb8 png = render::ToneMapToSrgb(image, tone);
+      const double exposure_ev = fixed_exposure ? *fixed_exposure : render::AutoExposureEv(image);
+      render::Rgb8 png = render::ToneMapToSrgb(image, render::ToneMap{exposure_ev, white});
       render::Attributes png_attributes = common;
-      char description[160];
+      char description[192];
       std::snprintf(description, sizeof(description),
-                    "%s view, sun zenith %g deg, exposure %g EV, tone curve 1 - exp(-x), sRGB", render::ToString(view),
-                    zenith, args.exposure_ev);
+                    "%s view, sun zenith %g deg, exposure %.4g EV (%s), tone curve 1 - exp(-x), sRGB",
+                    render::ToString(view), zenith, exposure_ev, fixed_exposure ? "fixed" : "auto");
+      char exposure_line[128];
+      std::snprintf(exposure_line, sizeof(exposure_line), "render: %s sun zenith %g deg: exposure %.4g EV (%s)",
+                    render::ToString(view), zenith, exposure_ev, fixed_exposure ? "fixed" : "auto");
+      exposure_lines.push_back(exposure_line);
       png_attributes.push_back({"ImageDescription", description});
       render::WritePng(out_dir / (stem + ".png"), png, png_attributes);
       columns[z].push_back(std::move(png));
       images.push_back({{"view", render::ToString(view)},
                         {"sun_zenith_deg", zenith},
+                        {"exposure_ev", exposure_ev},
                         {"width", image.width},
                         {"height", image.height},
                         {"exr", (out_dir / (stem + ".exr")).string()},
@@ -157,11 +180,13 @@ void RunRender(const RenderArguments& args) {
     }
   }
   bar.Finish();
+  if (!args.quiet)
+    for (const std::string& line : exposure_lines) std::fprintf(stderr, "%s\n", line.c_str());
 
   nlohmann::json report = {{"lut_dir", args.lut_dir},
                            {"output_dir", args.output_dir},
                            {"size", args.size},
-                           {"exposure_ev", args.exposure_ev},
+                           {"exposure", fixed_exposure ? nlohmann::json(*fixed_exposure) : nlohmann::json("auto")},
                            {"sun_azimuth_deg", args.sun_azimuth_deg},
                            {"images", images}};
   if (!views.empty()) {
@@ -212,8 +237,14 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--views", args->views, "Views to render, comma separated: fisheye, panorama, space, aerial")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--exposure", args->exposure_ev,
-                  "Exposure in EV for the PNGs: radiance x 2^EV, then 1 - exp(-x), then sRGB")
+  cmd->add_option("--exposure", args->exposure,
+                  "Exposure of the PNGs: radiance x 2^EV (after white balance), then 1 - exp(-x), then sRGB. "
+                  "A number of EV, or auto: per image, EV = log2(-ln(1 - 0.18) / Y_med), Y_med the median "
+                  "luminance (Y = 0.2126 R + 0.7152 G + 0.0722 B of the linear radiance) over the pixels with Y > 0 "
+                  "that show sky (rays that miss the ground; from space, the whole planet; all pixels with Y > 0 "
+                  "if none), so it leaves the tone "
+                  "curve at mid-grey 0.18 before the sRGB transfer. The EV used is printed on stderr and recorded "
+                  "in each PNG's ImageDescription and in --json")
       ->capture_default_str();
   cmd->add_option("--altitude-m", args->altitude_m, "Camera altitude of the ground views, metres")
       ->capture_default_str();

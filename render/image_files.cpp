@@ -9,6 +9,7 @@
 #include "bake/errors.h"
 #include "formats/file_io.h"
 #include "formats/plot.h"
+#include "report/error_stats.h"
 
 namespace skybake::render {
 
@@ -39,6 +40,23 @@ glsl::vec3 WhiteBalance(const glsl::vec3& solar_irradiance) {
   double mean = (solar_irradiance.x + solar_irradiance.y + solar_irradiance.z) / 3.0;
   if (!(mean > 0.0)) return glsl::vec3(1.0);
   return solar_irradiance / mean;
+}
+
+double AutoExposureEv(const Image& image) {
+  const std::size_t pixels = std::size_t(image.width) * image.height;
+  std::vector<double> sky, lit;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    double y = 0.0;
+    for (int c = 0; c < 3; ++c) y += report::kLuminanceWeights[c] * image.rgb[3 * i + c];
+    if (!(y > 0.0)) continue;
+    lit.push_back(y);
+    if (i < image.sky.size() && image.sky[i]) sky.push_back(y);
+  }
+  std::vector<double>& chosen = sky.empty() ? lit : sky;
+  if (chosen.empty()) return 0.0;
+  auto median = chosen.begin() + chosen.size() / 2;
+  std::nth_element(chosen.begin(), median, chosen.end());
+  return std::log2(-std::log(1.0 - kAutoExposureMidGrey) / *median);
 }
 
 Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone) {

@@ -28,6 +28,19 @@ struct ToneMap {
   glsl::vec3 white{1.0};  // per-channel white balance divisor (see WhiteBalance)
 };
 
+// Auto exposure (`render --exposure auto`): with Y = 0.2126 R + 0.7152 G +
+// 0.0722 B the luminance of a pixel's linear radiance, and Y_med the median
+// (the floor(n/2)-th smallest, from 0) of Y over the n pixels with Y > 0
+// that show sky (Image::sky: rays that miss the ground; from space, the
+// whole planet), the exposure is
+//   EV = log2(-ln(1 - 0.18) / Y_med),
+// so that a grey pixel of luminance Y_med leaves the tone curve at
+// 1 - exp(-Y_med 2^EV) = 0.18, mid-grey, before the sRGB transfer function.
+// Where no such pixel exists (or the image has no sky mask) Y_med is taken
+// over all pixels with Y > 0; an image without any gets EV 0.
+inline constexpr double kAutoExposureMidGrey = 0.18;
+double AutoExposureEv(const Image& image);
+
 // The white-balance divisor for a solar irradiance spectrum: irradiance / mean.
 glsl::vec3 WhiteBalance(const glsl::vec3& solar_irradiance);
 

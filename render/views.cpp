@@ -47,9 +47,11 @@ struct Shader {
     disc_scale = (1.0 - std::cos(sun_radius)) / (1.0 - cos_disc);
   }
 
-  vec3 Radiance(const vec3& camera, const vec3& dir) const {
+  // `hits_ground`: whether the ray ends on the ground.
+  vec3 Radiance(const vec3& camera, const vec3& dir, bool* hits_ground) const {
     double bottom = twin.parameters().bottom_radius;
     double t = DistanceToGround(camera, dir, bottom);
+    *hits_ground = t > 0.0;
     if (t > 0.0) {
       vec3 normal = glsl::normalize(camera + dir * t);
       vec3 point = normal * bottom;
@@ -103,6 +105,7 @@ Image RenderView(const Twin& twin, View view, const ViewSettings& settings, cons
   image.width = settings.width;
   image.height = ViewHeight(view, settings.width);
   image.rgb.assign(std::size_t(3) * image.width * image.height, 0.0f);
+  image.sky.assign(std::size_t(image.width) * image.height, 0);
   const double w = image.width, h = image.height;
   const double bottom = twin.parameters().bottom_radius, top = twin.parameters().top_radius;
   const vec3 ground_camera(0.0, 0.0, bottom + settings.camera_altitude_m);
@@ -168,8 +171,11 @@ Image RenderView(const Twin& twin, View view, const ViewSettings& settings, cons
       for (int x = 0; x < image.width; ++x) {
         vec3 dir;
         if (!ray(x + 0.5, y + 0.5, &dir)) continue;
-        vec3 radiance = shader.Radiance(camera, dir);
-        float* p = &image.rgb[3 * (static_cast<std::size_t>(y) * image.width + x)];
+        bool hits_ground = false;
+        vec3 radiance = shader.Radiance(camera, dir, &hits_ground);
+        const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
+        image.sky[pixel] = view == View::kSpace || !hits_ground ? 1 : 0;
+        float* p = &image.rgb[3 * pixel];
         p[0] = static_cast<float>(radiance.x);
         p[1] = static_cast<float>(radiance.y);
         p[2] = static_cast<float>(radiance.z);

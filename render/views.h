@@ -26,6 +26,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -59,6 +60,11 @@ struct ViewSettings {
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgb;  // 3 * width * height
+  // Per pixel, 1 where it shows sky: in the ground views (fisheye,
+  // panorama, aerial) where its ray misses the ground (the sun's disc
+  // included); from space every pixel, as the planet is seen through its
+  // atmosphere. RenderView fills it; other images may leave it empty.
+  std::vector<std::uint8_t> sky;
   glsl::vec3 At(int x, int y) const {
     const float* p = &rgb[3 * (static_cast<std::size_t>(y) * width + x)];
     return glsl::vec3(p[0], p[1], p[2]);

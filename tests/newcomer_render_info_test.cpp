@@ -5,13 +5,19 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
+#include "bake/bake.h"
+#include "formats/lut_files.h"
+#include "render/image_files.h"
 #include "tests/test_util.h"
 
 namespace skybake {
@@ -185,6 +191,113 @@ TEST(NewcomerDefects, D11_ProgressRedrawThrottled) {
   const double seconds = std::stod(out.substr(summary + 11));  // printed to 0.1 s
   EXPECT_GE(redraws, 1u) << out;
   EXPECT_LE(redraws, 10.0 * (seconds + 0.1) + 1.0) << seconds << " s; " << out.substr(0, 2000);
+}
+
+// The luminance Y = 0.2126 R + 0.7152 G + 0.0722 B of each pixel of a
+// linear EXR written by render.
+std::vector<double> ExrLuminance(const fs::path& path, int* width, int* height) {
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) return {};
+  const OIIO::ImageSpec& spec = input->spec();
+  *width = spec.width;
+  *height = spec.height;
+  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+  input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+  std::vector<double> y(std::size_t(spec.width) * spec.height);
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    const float* p = &pixels[i * spec.nchannels];
+    y[i] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+  }
+  return y;
+}
+
+// `render` exposes each image automatically by default: the fisheye shows
+// only sky, so its exposure is log2(-ln(1 - 0.18) / median Y) over the
+// pixels inside its circle (Y > 0), computed here from the EXR; the PNG is
+// that exposure's tone mapping, and the EV is reported in --json, on stderr
+// and in the PNG. A number still fixes the exposure.
+TEST(NewcomerDefects, RenderAutoExposureMapsTheMedianSkyToMidGrey) {
+  TempDir dir;
+  const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
+  SmallBake(dir, "earth", lut);
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + " render " + ShellQuote(lut) + " -o " + ShellQuote(images) +
+                           " --views fisheye --size 48 --sun-zenith 30 --json",
+                       dir, &out, &err),
+            0)
+      << err;
+  int width = 0, height = 0;
+  std::vector<double> y = ExrLuminance(images / "fisheye_sz30.exr", &width, &height);
+  ASSERT_EQ(width, 48);
+  y.erase(std::remove_if(y.begin(), y.end(), [](double v) { return !(v > 0.0); }), y.end());
+  std::sort(y.begin(), y.end());
+  // Inside the circle: pi/4 of the square, give or take its rim.
+  ASSERT_NEAR(double(y.size()) / (width * height), 3.14159265 / 4, 0.03);
+  const double expected_ev = std::log2(-std::log(1.0 - 0.18) / y[y.size() / 2]);
+
+  const nlohmann::json report = nlohmann::json::parse(out);
+  ASSERT_EQ(report["images"].size(), 1u);
+  ASSERT_TRUE(report["images"][0].contains("exposure_ev")) << out;
+  const double ev = report["images"][0]["exposure_ev"].get<double>();
+  EXPECT_NEAR(ev, expected_ev, 1e-9);
+  EXPECT_EQ(report["exposure"], "auto");
+  char printed[32];
+  std::snprintf(printed, sizeof(printed), "%.4g EV", expected_ev);
+  EXPECT_NE(err.find(printed), std::string::npos) << err;
+
+  // The PNG is the EXR tone-mapped at that exposure, and records it.
+  const LutSet luts = LoadLutSet(lut);
+  const render::ToneMap tone{expected_ev, render::WhiteBalance(luts.parameters.solar_irradiance)};
+  render::Image exr;
+  exr.width = width, exr.height = height;
+  {
+    auto input = OIIO::ImageInput::open((images / "fisheye_sz30.exr").string());
+    ASSERT_TRUE(input);
+    exr.rgb.resize(std::size_t(3) * width * height);
+    input->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, exr.rgb.data());
+  }
+  const render::Rgb8 png = render::ReadPng(images / "fisheye_sz30.png");
+  EXPECT_TRUE(png.rgb == render::ToneMapToSrgb(exr, tone).rgb);
+  EXPECT_NE(testing::ReadText(images / "fisheye_sz30.png").find(printed), std::string::npos);
+
+  // A fixed exposure is kept as given.
+  ASSERT_EQ(RunCommand(Skybake() + " render -q " + ShellQuote(lut) + " -o " + ShellQuote(images) +
+                           " --views fisheye --size 48 --sun-zenith 30 --exposure 1.5 --json",
+                       dir, &out, &err),
+            0)
+      << err;
+  EXPECT_EQ(nlohmann::json::parse(out)["images"][0]["exposure_ev"].get<double>(), 1.5);
+  EXPECT_TRUE(render::ReadPng(images / "fisheye_sz30.png").rgb ==
+              render::ToneMapToSrgb(exr, render::ToneMap{1.5, tone.white}).rgb);
+  EXPECT_EQ(RunCommand(Skybake() + " render " + ShellQuote(lut) + " -o " + ShellQuote(images) + " --exposure bright",
+                       dir, &out, &err),
+            1);
+  EXPECT_EQ(Lines(err).size(), 1u) << err;
+}
+
+// A dim atmosphere's default render is not black: heavy fog with a low sun,
+// where the former fixed exposure left the sky near black.
+TEST(NewcomerDefects, RenderDefaultOfADimPresetIsNotBlack) {
+  TempDir dir;
+  const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
+  SmallBake(dir, "heavy-fog", lut);
+  std::string err;
+  ASSERT_EQ(RunCommand(Skybake() + " render -q " + ShellQuote(lut) + " -o " + ShellQuote(images) +
+                           " --views fisheye --size 32 --sun-zenith 85",
+                       dir, nullptr, &err),
+            0)
+      << err;
+  const render::Rgb8 png = render::ReadPng(images / "fisheye_sz85.png");
+  // The median green value of the pixels inside the fisheye's circle: mid-grey
+  // 0.18 is 118 in sRGB.
+  std::vector<int> green;
+  for (int y = 0; y < png.height; ++y)
+    for (int x = 0; x < png.width; ++x) {
+      double dx = (x + 0.5) / png.width * 2 - 1, dy = (y + 0.5) / png.height * 2 - 1;
+      if (dx * dx + dy * dy < 0.9) green.push_back(png.rgb[3 * (std::size_t(y) * png.width + x) + 1]);
+    }
+  std::sort(green.begin(), green.end());
+  EXPECT_GE(green[green.size() / 2], 80) << "median green of the sky";
 }
 
 }  // namespace
