@@ -76,12 +76,12 @@ TEST(CliBake, BakeErrors) {
   EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "file" / "sub") + kSmallBake, dir,
                        nullptr, &err), 3);
   EXPECT_EQ(Lines(err).size(), 1u) << err;
-  // Invalid settings and atmospheres: invalid input.
+  // Out-of-range option values: usage errors; a missing atmosphere: an I/O error.
   EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + " --scattering-size 8 31 8 4",
-                       dir, nullptr, &err), 2);
+                       dir, nullptr, &err), 1);
   EXPECT_EQ(Lines(err).size(), 1u) << err;
-  EXPECT_EQ(RunCommand(Skybake() + " bake no-such-atmosphere -o " + ShellQuote(dir.path() / "x"), dir), 2);
-  EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + " --orders 0", dir), 2);
+  EXPECT_EQ(RunCommand(Skybake() + " bake no-such-atmosphere -o " + ShellQuote(dir.path() / "x"), dir), 3);
+  EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + " --orders 0", dir), 1);
 }
 
 class EvalTest : public ::testing::Test {

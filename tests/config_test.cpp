@@ -582,8 +582,14 @@ TEST(Validate, RejectsBrokenHandBuiltAtmospheres) {
 
 TEST(LoadAtmosphere, FileThenPresetThenError) {
   ExpectIdentical(LoadAtmosphere("mars"), LoadPreset("mars"));
-  EXPECT_EQ(InputErrorOf([] { LoadAtmosphere("no_such_atmosphere.toml"); }),
-            "no_such_atmosphere.toml: no such file or preset (see skybake presets)");
+  // A missing file is an I/O error; a bare word names it as a file or preset.
+  EXPECT_THROW(LoadAtmosphere("no_such_atmosphere.toml"), IoError);
+  try {
+    LoadAtmosphere("no_such_atmosphere");
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_STREQ(e.what(), "no_such_atmosphere: no such file or preset (see skybake presets)");
+  }
   EXPECT_NE(InputErrorOf([] { LoadPreset("venus"); }).find("venus: no such preset"),
             std::string::npos);
   EXPECT_THROW(LoadAtmosphere((kSourceDir / "tests" / "data").string()), IoError);
@@ -624,11 +630,11 @@ TEST(Cli, ValidateBadFileExitsTwoWithOneLine) {
   EXPECT_EQ(result.out, "");
 }
 
-TEST(Cli, ValidateMissingPathExitsTwo) {
+TEST(Cli, ValidateMissingPathExitsThree) {
   CommandResult result = RunSkybake("validate does/not/exist.toml");
-  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(result.exit_code, 3);  // a missing file is an I/O error
   EXPECT_EQ(CountLines(result.err), 1) << result.err;
-  EXPECT_NE(result.err.find("does/not/exist.toml: no such file or preset"), std::string::npos)
+  EXPECT_NE(result.err.find("does/not/exist.toml: no such file"), std::string::npos)
       << result.err;
 }
 

@@ -970,7 +970,7 @@ TEST(FitCli, UsageErrorsExitOne) {
   WriteText(dir.path() / "q.csv", "zenith_deg,altitude_m\n0,0\n");
   EXPECT_EQ(RunCommand(Exe() + " fit earth --query " + ShellQuote(dir.path() / "q.csv"), dir), 1);  // no --constituent
   EXPECT_EQ(RunCommand(Exe() + " fit earth -o " + ShellQuote(dir.path()) + " --form nonsense", dir), 1);
-  EXPECT_EQ(RunCommand(Exe() + " fit no-such-preset-or-file -o " + ShellQuote(dir.path()), dir), 2);
+  EXPECT_EQ(RunCommand(Exe() + " fit no-such-preset-or-file -o " + ShellQuote(dir.path()), dir), 3);
   EXPECT_EQ(RunCommand(Exe() + " fit earth --constituent rayleigh --query " + ShellQuote(dir.path() / "missing.csv"), dir), 3);
 }
 

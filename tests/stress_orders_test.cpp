@@ -177,9 +177,10 @@ TEST(Orders, CommandLineAcceptsAutoAndReportsConvergence) {
     EXPECT_EQ(testing::RunCommand(bake + " --orders '" + bad + "'", dir, &out, &err), 1) << bad;
     EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
   }
-  EXPECT_EQ(testing::RunCommand(bake + " --orders 0", dir, &out, &err), 2);  // a count out of range
-  EXPECT_EQ(testing::RunCommand(bake + " --orders auto --max-orders 1", dir, &out, &err), 2);
-  EXPECT_EQ(testing::RunCommand(bake + " --orders auto --order-tolerance 0", dir, &out, &err), 2);
+  // Out of range: usage errors too, as every bad option value.
+  EXPECT_EQ(testing::RunCommand(bake + " --orders 0", dir, &out, &err), 1);
+  EXPECT_EQ(testing::RunCommand(bake + " --orders auto --max-orders 1", dir, &out, &err), 1);
+  EXPECT_EQ(testing::RunCommand(bake + " --orders auto --order-tolerance 0", dir, &out, &err), 1);
 }
 
 }  // namespace
