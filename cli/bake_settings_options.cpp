@@ -41,8 +41,9 @@ int ParseOrders(const std::string& text) {
 
 void BakeSettingsOptions::AddTo(CLI::App* cmd) {
   cmd->add_option("--orders", orders,
-                  "Scattering orders computed (1 = single scattering), the rest extrapolated as a geometric tail "
-                  "(see --no-tail); or auto: until the estimated remaining error is below --order-tolerance")
+                  "Scattering orders computed (1 = single scattering); from 4 orders on, the rest extrapolated as a "
+                  "geometric tail (see --no-tail); or auto: until the estimated remaining error is below "
+                  "--order-tolerance")
       ->capture_default_str();
   cmd->add_option("--order-tolerance", settings.order_tolerance,
                   "--orders auto: relative size of the orders not computed")
