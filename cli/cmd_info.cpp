@@ -117,21 +117,6 @@ void WritePlots(const InfoOptions& o, json* report) {
 
 // The entries of the set's folder its manifest does not list (tables left
 // from an earlier bake, for instance), sorted; a folder's name ends in '/'.
-std::vector<std::string> UnlistedEntries(const Manifest& manifest) {
-  std::vector<std::string> listed = {kManifestFileName};
-  for (const ManifestFile& f : manifest.table_files) listed.push_back(f.file);
-  for (const ManifestFile& f : manifest.shader_files) listed.push_back(f.file);
-  std::vector<std::string> unlisted;
-  for (const fs::directory_entry& entry : fs::directory_iterator(manifest.Directory())) {
-    const std::string name = entry.path().filename().string();
-    if (std::find(listed.begin(), listed.end(), name) != listed.end()) continue;
-    std::error_code ec;
-    unlisted.push_back(entry.is_directory(ec) ? name + "/" : name);
-  }
-  std::sort(unlisted.begin(), unlisted.end());
-  return unlisted;
-}
-
 void RunInfo(const InfoOptions& o) {
   const fs::path path = o.path;
   std::error_code ec;
@@ -163,7 +148,7 @@ void RunInfo(const InfoOptions& o) {
     const std::vector<std::uint8_t> bytes = ReadListedFile(manifest, f);
     shaders.push_back({{"file", (path / f.file).string()}, {"bytes", bytes.size()}, {"sha256", f.sha256}});
   }
-  const std::vector<std::string> unlisted = UnlistedEntries(manifest);
+  const std::vector<std::string> unlisted = EntriesNotIn(manifest.Directory(), ListedFileNames(manifest.Directory()));
   const json& doc = manifest.document;
   json plot_report = json::object();
   if (!o.plot_dir.empty()) WritePlots(o, &plot_report);

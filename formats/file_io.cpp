@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -105,6 +106,20 @@ std::vector<std::uint8_t> ReadFileBytes(const fs::path& path) {
 std::string ReadFileText(const fs::path& path) {
   std::vector<std::uint8_t> bytes = ReadFileBytes(path);
   return std::string(bytes.begin(), bytes.end());
+}
+
+std::vector<std::string> EntriesNotIn(const fs::path& dir, const std::vector<std::string>& names) {
+  std::vector<std::string> entries;
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+    std::error_code type_error;
+    entries.push_back(entry.is_directory(type_error) ? name + "/" : name);
+  }
+  if (ec) throw IoError(dir.string() + ": cannot list: " + ec.message());
+  std::sort(entries.begin(), entries.end());
+  return entries;
 }
 
 bool IsTemporaryFileName(const std::string& file_name) {

@@ -45,6 +45,10 @@ class StagedFiles {
 std::vector<std::uint8_t> ReadFileBytes(const std::filesystem::path& path);
 std::string ReadFileText(const std::filesystem::path& path);
 
+// The entries of `dir` whose names are not in `names`, sorted; a folder's
+// name ends in '/'. IoError if `dir` cannot be listed.
+std::vector<std::string> EntriesNotIn(const std::filesystem::path& dir, const std::vector<std::string>& names);
+
 // Whether `file_name` is one of the temporary names WriteFileAtomically and
 // StagedFiles use (left behind only by a process that was killed).
 bool IsTemporaryFileName(const std::string& file_name);

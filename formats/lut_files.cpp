@@ -117,13 +117,7 @@ std::string NameList(const std::vector<std::string>& names) {
 std::vector<std::string> StaleFiles(const fs::path& dir, const std::vector<std::string>& new_files, bool clean) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return {};
-  std::vector<std::string> stale;
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (std::find(new_files.begin(), new_files.end(), name) == new_files.end()) stale.push_back(name);
-  }
-  if (ec) throw IoError(dir.string() + ": cannot list the output directory: " + ec.message());
-  std::sort(stale.begin(), stale.end());
+  const std::vector<std::string> stale = EntriesNotIn(dir, new_files);
   if (stale.empty()) return stale;
   if (!clean) {
     throw IoError(dir.string() + ": holds files the new set would not list: " + NameList(stale) +
@@ -133,8 +127,9 @@ std::vector<std::string> StaleFiles(const fs::path& dir, const std::vector<std::
   const std::vector<std::string> known = ListedFileNames(dir);
   std::vector<std::string> foreign;
   for (const std::string& name : stale) {
+    // A folder's name ends in '/', so it is never one of the listed files.
     const bool ours = std::find(known.begin(), known.end(), name) != known.end() || IsTemporaryFileName(name);
-    if (!ours || fs::is_directory(dir / name, ec)) foreign.push_back(name);
+    if (!ours) foreign.push_back(name);
   }
   if (!foreign.empty()) {
     throw IoError(dir.string() + ": holds files no earlier skybake set there listed, which --clean leaves alone: " +

@@ -74,7 +74,8 @@ Manifest ReadManifest(const std::filesystem::path& dir);
 
 // The plain file names DIR/skybake.json lists (tables and shaders) and the
 // manifest itself, read from any schema version; empty where there is no
-// manifest or it is not a skybake manifest. What `bake --clean` may remove.
+// manifest or it is not a skybake manifest. What `bake --clean` may remove,
+// and what `info` does not warn about.
 std::vector<std::string> ListedFileNames(const std::filesystem::path& dir);
 
 // The entry for `file` when the directory holding it has a manifest that
