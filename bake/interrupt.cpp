@@ -47,7 +47,9 @@ int TakeInterrupt() {
 }
 
 void ThrowIfInterrupted(const std::string& what) {
-  if (const int signal = TakeInterrupt()) throw InterruptedError(std::string("interrupted by ") + SignalName(signal) + ": " + what);
+  if (const int signal = TakeInterrupt()) {
+    throw InterruptedError(std::string("interrupted by ") + SignalName(signal) + ": " + what);
+  }
 }
 
 }  // namespace skybake

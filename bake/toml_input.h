@@ -46,7 +46,8 @@ class Reporter {
   explicit Reporter(std::string source) : source_(std::move(source)) {}
 
   [[noreturn]] void Fail(const std::string& path, const std::string& problem) const {
-    throw InputError(OneLine(LocationPrefix(source_) + (path.empty() ? "" : path + ": ") + problem), {source_, 0, path});
+    throw InputError(OneLine(LocationPrefix(source_) + (path.empty() ? "" : path + ": ") + problem),
+                     {source_, 0, path});
   }
   [[noreturn]] void FailValue(const std::string& path, double value,
                               const std::string& problem) const {

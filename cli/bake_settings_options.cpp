@@ -17,6 +17,17 @@ namespace {
 
 constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
 
+// "32 128 32 8": table sizes as the options spell them.
+std::string SizeList(std::initializer_list<int> values) {
+  std::string text;
+  for (int v : values) text += (text.empty() ? "" : " ") + std::to_string(v);
+  return text;
+}
+
+std::string ScatteringSize(const BakeSettings& s) {
+  return SizeList({s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size});
+}
+
 double PhysicalMemoryBytes() {
   const long pages = ::sysconf(_SC_PHYS_PAGES), page_size = ::sysconf(_SC_PAGE_SIZE);
   return pages > 0 && page_size > 0 ? double(pages) * double(page_size) : 0.0;
@@ -53,22 +64,16 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
                 "With a count of orders: hold exactly that many, without the extrapolated tail of the orders not "
                 "computed");
   // The defaults are this command's (stress bakes smaller tables than bake).
-  auto sizes = [](std::initializer_list<int> values) {
-    std::string text;
-    for (int v : values) text += (text.empty() ? "" : " ") + std::to_string(v);
-    return text;
-  };
   const BakeSettings& d = settings;
   cmd->add_option("--transmittance-size", transmittance_size,
-                  "Transmittance table: MU R (default " + sizes({d.transmittance_width, d.transmittance_height}) + ")")
+                  "Transmittance table: MU R (default " + SizeList({d.transmittance_width, d.transmittance_height}) +
+                      ")")
       ->expected(2);
   cmd->add_option("--irradiance-size", irradiance_size,
-                  "Irradiance table: MU_S R (default " + sizes({d.irradiance_width, d.irradiance_height}) + ")")
+                  "Irradiance table: MU_S R (default " + SizeList({d.irradiance_width, d.irradiance_height}) + ")")
       ->expected(2);
   cmd->add_option("--scattering-size", scattering_size,
-                  "Scattering table: R MU MU_S NU (default " +
-                      sizes({d.scattering_r_size, d.scattering_mu_size, d.scattering_mu_s_size, d.scattering_nu_size}) +
-                      "; MU even)")
+                  "Scattering table: R MU MU_S NU (default " + ScatteringSize(d) + "; MU even)")
       ->expected(4);
   cmd->add_option("--transmittance-samples", settings.transmittance_samples,
                   "Quadrature nodes per optical-depth integral")
@@ -116,9 +121,7 @@ BakeSettings BakeSettingsOptions::Resolve() const {
     char text[160];
     std::snprintf(text, sizeof text, "the bake would need about %.1f GiB, more than this machine's %.1f GiB",
                   needed / kGiB, available / kGiB);
-    throw UsageError("--scattering-size " + std::to_string(s.scattering_r_size) + " " +
-                     std::to_string(s.scattering_mu_size) + " " + std::to_string(s.scattering_mu_s_size) + " " +
-                     std::to_string(s.scattering_nu_size) + ": " + text);
+    throw UsageError("--scattering-size " + ScatteringSize(s) + ": " + text);
   }
   return s;
 }

@@ -232,9 +232,11 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   CheckOutputDirectory(output_dir);
 
   BakeReport report;
+  // Each phase's end is a point where an interrupt leaves nothing behind.
+  auto check_interrupt = [&](const BakeTiming&) { ThrowIfInterrupted("nothing was written to " + output_dir); };
   auto print_phase = [&](const BakeTiming& t) {
     if (!o.quiet) std::fprintf(stderr, "  %-36s %8.3f s\n", t.phase.c_str(), t.seconds);
-    ThrowIfInterrupted("nothing was written to " + output_dir);
+    check_interrupt(t);
   };
   if (!o.quiet) std::fprintf(stderr, "baking %s\n", atmosphere.name.c_str());
   LutSet luts = Bake(atmosphere, settings, &report, print_phase);
@@ -250,8 +252,7 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
     // way; its files are encoded in memory only, to count their bytes.
     if (!o.quiet) std::fprintf(stderr, "baking %s without the scene, for comparison\n", atmosphere.name.c_str());
     BakeReport full_report;
-    const LutSet full = Bake(full_atmosphere, full_settings, &full_report,
-                             [&](const BakeTiming&) { ThrowIfInterrupted("nothing was written to " + output_dir); });
+    const LutSet full = Bake(full_atmosphere, full_settings, &full_report, check_interrupt);
     WriteOptions full_options = write_options;
     full_options.half_tables.clear();
     scene->compared = true;
@@ -295,47 +296,45 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
     if (scene) PrintSceneSummary(*scene);
   }
 
-  {
-    nlohmann::json timings = nlohmann::json::array();
-    for (const BakeTiming& t : report.timings) timings.push_back({{"phase", t.phase}, {"seconds", t.seconds}});
-    nlohmann::json files = nlohmann::json::array();
-    for (const WrittenFile& f : written.files) {
-      files.push_back({{"file", f.file}, {"table", f.table.empty() ? nlohmann::json(nullptr) : nlohmann::json(f.table)},
-                       {"bytes", f.bytes}});
-    }
-    nlohmann::json half_errors = nlohmann::json::object();
-    for (const auto& [table, error] : written.half_errors) half_errors[table] = ToJson(error);
-    const BakeSettings& s = luts.settings;
-    nlohmann::json j = {
-        {"atmosphere", atmosphere.name},
-        {"output_dir", output_dir},
-        {"orders", s.orders == 0 ? nlohmann::json("auto") : nlohmann::json(s.orders)},
-        {"orders_used", report.orders_used},
-        {"order_tolerance", s.order_tolerance},
-        {"order_ratio", report.order_ratio},
-        {"extrapolated_tail", report.extrapolated_tail},
-        {"remaining_error", report.remaining_error >= 0.0 ? nlohmann::json(report.remaining_error)
-                                                          : nlohmann::json(nullptr)},
-        {"pixel_type", o.half ? "half" : "float"},
-        {"formats", formats},
-        {"tables",
-         {{"transmittance", {s.transmittance_width, s.transmittance_height}},
-          {"irradiance", {s.irradiance_width, s.irradiance_height}},
-          {"scattering", {s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size}},
-          {"single_mie_scattering",
-           s.pack_single_mie_in_alpha ? nlohmann::json(nullptr)
-                                      : nlohmann::json({s.scattering_r_size, s.scattering_mu_size,
-                                                        s.scattering_mu_s_size, s.scattering_nu_size})}}},
-        {"samples",
-         {{"transmittance", s.transmittance_samples}, {"ray", s.ray_samples}, {"sphere", s.sphere_samples}}},
-        {"higher_order_divisor", s.higher_order_divisor},
-        {"files", files},
-        {"half_error", half_errors},
-        {"timings", timings},
-        {"total_seconds", report.total_seconds}};
-    if (scene) j["scene"] = SceneSummaryJson(*scene);
-    return j;
+  nlohmann::json timings = nlohmann::json::array();
+  for (const BakeTiming& t : report.timings) timings.push_back({{"phase", t.phase}, {"seconds", t.seconds}});
+  nlohmann::json files = nlohmann::json::array();
+  for (const WrittenFile& f : written.files) {
+    files.push_back({{"file", f.file}, {"table", f.table.empty() ? nlohmann::json(nullptr) : nlohmann::json(f.table)},
+                     {"bytes", f.bytes}});
   }
+  nlohmann::json half_errors = nlohmann::json::object();
+  for (const auto& [table, error] : written.half_errors) half_errors[table] = ToJson(error);
+  const BakeSettings& s = luts.settings;
+  nlohmann::json j = {
+      {"atmosphere", atmosphere.name},
+      {"output_dir", output_dir},
+      {"orders", s.orders == 0 ? nlohmann::json("auto") : nlohmann::json(s.orders)},
+      {"orders_used", report.orders_used},
+      {"order_tolerance", s.order_tolerance},
+      {"order_ratio", report.order_ratio},
+      {"extrapolated_tail", report.extrapolated_tail},
+      {"remaining_error", report.remaining_error >= 0.0 ? nlohmann::json(report.remaining_error)
+                                                        : nlohmann::json(nullptr)},
+      {"pixel_type", o.half ? "half" : "float"},
+      {"formats", formats},
+      {"tables",
+       {{"transmittance", {s.transmittance_width, s.transmittance_height}},
+        {"irradiance", {s.irradiance_width, s.irradiance_height}},
+        {"scattering", {s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size}},
+        {"single_mie_scattering",
+         s.pack_single_mie_in_alpha ? nlohmann::json(nullptr)
+                                    : nlohmann::json({s.scattering_r_size, s.scattering_mu_size,
+                                                      s.scattering_mu_s_size, s.scattering_nu_size})}}},
+      {"samples",
+       {{"transmittance", s.transmittance_samples}, {"ray", s.ray_samples}, {"sphere", s.sphere_samples}}},
+      {"higher_order_divisor", s.higher_order_divisor},
+      {"files", files},
+      {"half_error", half_errors},
+      {"timings", timings},
+      {"total_seconds", report.total_seconds}};
+  if (scene) j["scene"] = SceneSummaryJson(*scene);
+  return j;
 }
 
 // Where each atmosphere's set goes: `output` with {name} replaced by the
@@ -361,7 +360,9 @@ std::vector<std::string> OutputDirs(const BakeOptions& o) {
 }
 
 void RunBake(const BakeOptions& o) {
-  if (o.atmospheres.size() > 1 && std::count(o.atmospheres.begin(), o.atmospheres.end(), std::string(kStandardStream)) > 0) {
+  const std::string standard_input = kStandardStream;
+  if (o.atmospheres.size() > 1 &&
+      std::find(o.atmospheres.begin(), o.atmospheres.end(), standard_input) != o.atmospheres.end()) {
     throw UsageError("-: standard input can only be baked alone");
   }
   const std::vector<std::string> dirs = OutputDirs(o);

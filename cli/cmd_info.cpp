@@ -115,8 +115,6 @@ void WritePlots(const InfoOptions& o, json* report) {
   (*report)["plots_left_out"] = plots.left_out;
 }
 
-// The entries of the set's folder its manifest does not list (tables left
-// from an earlier bake, for instance), sorted; a folder's name ends in '/'.
 void RunInfo(const InfoOptions& o) {
   const fs::path path = o.path;
   std::error_code ec;
@@ -176,8 +174,8 @@ void RunInfo(const InfoOptions& o) {
   if (!unlisted.empty()) {
     std::string names;
     for (const std::string& name : unlisted) names += (names.empty() ? "" : ", ") + name;
-    std::printf("  warning: %zu files here are not listed in the manifest (not part of this set): %s\n", unlisted.size(),
-                names.c_str());
+    std::printf("  warning: %zu files here are not listed in the manifest (not part of this set): %s\n",
+                unlisted.size(), names.c_str());
   }
   std::printf("\n");
   for (const json& d : files) {
@@ -188,7 +186,9 @@ void RunInfo(const InfoOptions& o) {
     std::printf("%s\n  %zu bytes, sha256 %s (matches)\n", s["file"].get<std::string>().c_str(),
                 s["bytes"].get<std::size_t>(), s["sha256"].get<std::string>().c_str());
   }
-  for (const json& f : plot_report.value("plots", json::array())) std::printf("plot %s\n", f.get<std::string>().c_str());
+  for (const json& f : plot_report.value("plots", json::array())) {
+    std::printf("plot %s\n", f.get<std::string>().c_str());
+  }
 }
 
 }  // namespace

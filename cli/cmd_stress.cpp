@@ -70,7 +70,9 @@ void RunStressCommand(const StressOptions& o) {
   }
   // A user's own atmospheres get every check but the energy balance, which
   // only closes for the white-ground case the stress set builds for it.
-  for (const std::string& atmosphere : o.atmospheres) set.push_back(StressAtmosphere{LoadAtmosphere(atmosphere), false});
+  for (const std::string& atmosphere : o.atmospheres) {
+    set.push_back(StressAtmosphere{LoadAtmosphere(atmosphere), false});
+  }
   if (!o.only.empty()) {
     std::vector<StressAtmosphere> chosen;
     for (const std::string& name : o.only) {

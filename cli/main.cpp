@@ -40,11 +40,9 @@ void CheckFirstWord(const CLI::App& app, int argc, char** argv) {
     }
     throw skybake::UsageError("unknown option '" + word + "' (options follow the command: skybake COMMAND --help)");
   }
-  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
-    if (sub->get_name() == word) return;
-  }
   std::string commands;
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (sub->get_name() == word) return;
     commands += (commands.empty() ? "" : ", ") + sub->get_name();
   }
   throw skybake::UsageError("unknown command '" + word + "' (commands: " + commands + ")");

@@ -129,13 +129,10 @@ bool IsTemporaryFileName(const std::string& file_name) {
   const std::string tail = file_name.substr(marker + sizeof(kTemporaryMarker) - 1);
   const std::size_t dash = tail.find('-');
   if (dash == std::string::npos || dash == 0 || tail.size() - dash - 1 != 8) return false;
-  auto all_of = [&](std::size_t begin, std::size_t end, int (*accept)(int)) {
-    for (std::size_t i = begin; i < end; ++i) {
-      if (!accept(static_cast<unsigned char>(tail[i]))) return false;
-    }
-    return true;
-  };
-  return all_of(0, dash, std::isdigit) && all_of(dash + 1, tail.size(), std::isxdigit);
+  auto digit = [](unsigned char c) { return std::isdigit(c) != 0; };
+  auto hex_digit = [](unsigned char c) { return std::isxdigit(c) != 0; };
+  return std::all_of(tail.begin(), tail.begin() + dash, digit) &&
+         std::all_of(tail.begin() + dash + 1, tail.end(), hex_digit);
 }
 
 void CheckOutputDirectory(const fs::path& dir) {
