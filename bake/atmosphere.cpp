@@ -1,4 +1,5 @@
 #include "bake/atmosphere.h"
+#include "core/constants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +8,6 @@
 namespace skybake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 }
 
 double DensityProfile::At(double altitude_m) const {

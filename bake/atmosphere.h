@@ -7,14 +7,9 @@
 #include <string>
 #include <vector>
 
-#include <glm/vec3.hpp>
+#include "core/spectrum.h"
 
 namespace skybake {
-
-// One value per wavelength. Tables carry one wavelength per RGB channel, so an
-// atmosphere has exactly three wavelengths.
-using Spectrum = glm::dvec3;
-constexpr int kWavelengthCount = 3;
 
 // density(h) = clamp(exp_term * exp(exp_scale * h) + linear_term * h + constant_term, 0, 1)
 // for altitudes h inside the layer (h measured from the ground, not from the

@@ -40,9 +40,10 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
-#include "bake/errors.h"
 #include "bake/float_math.h"
 #include "bake/medium.h"
+#include "core/constants.h"
+#include "core/errors.h"
 #include "shaders_runtime/runtime.h"
 
 namespace skybake {
@@ -53,7 +54,6 @@ using glsl::AtmosphereParameters;
 using glsl::Texture;
 using glsl::vec3;
 using glsl::vec4;
-constexpr double kPi = 3.14159265358979323846;
 // Intervals of a ray that are partly shadowed (the planet's shadow edge
 // crosses them, or the sun's disc is partly hidden) are integrated on this
 // many sub-intervals. Against 16 (evaluated in double), the Earth's single

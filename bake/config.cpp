@@ -28,10 +28,12 @@
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
-#include "bake/errors.h"
 #include "bake/physics.h"
 #include "bake/toml_input.h"
-#include "bake/version.h"
+#include "core/constants.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "shaders_runtime/embedded_text.h"
 
 namespace skybake {
@@ -40,7 +42,6 @@ namespace {
 
 using namespace toml_input;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr Spectrum kDefaultWavelengthsNm{680.0, 550.0, 440.0};
 
@@ -541,7 +542,7 @@ Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
   if (!SpelledAsPath(file_or_preset) && !std::filesystem::exists(path, error)) {
     throw IoError(file_or_preset + ": no such file or preset (see skybake presets)", ErrorLocation(file_or_preset));
   }
-  return ParseAtmosphere(ReadInputFile(path, "an atmosphere file"), InputName(file_or_preset));
+  return ParseAtmosphere(ReadFileText(path, "an atmosphere file"), InputName(file_or_preset));
 }
 
 std::string InputName(const std::string& path) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bake/atmosphere.h"
+#include "core/file_io.h"
 
 namespace skybake {
 
@@ -18,8 +19,6 @@ namespace skybake {
 // error messages (usually the file's base name).
 Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name);
 
-// The path that names standard input (or output) on the command line.
-inline constexpr const char kStandardStream[] = "-";
 // How messages name an input: "standard input" for "-", else the file name.
 std::string InputName(const std::string& path);
 

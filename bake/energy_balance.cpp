@@ -5,6 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "core/constants.h"
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/twin.h"
 
@@ -13,7 +14,6 @@ namespace skybake {
 namespace {
 
 using glsl::vec3;
-constexpr double kPi = 3.14159265358979323846;
 
 // Midpoints of n equal intervals of [a, b] and their common width.
 std::vector<double> Midpoints(double a, double b, int n, double* width) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <random>
 
+#include "core/constants.h"
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/twin.h"
 
@@ -13,7 +14,6 @@ namespace skybake {
 namespace {
 
 using glsl::vec3;
-constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMaxExamples = 5;
 // Slack on the energy bounds for float storage and the quadratures of the
 // bake (midpoint sums over the sphere, trapezoids along rays), which can

@@ -1,11 +1,11 @@
 #include "bake/physics.h"
+#include "core/constants.h"
 
 #include <cmath>
 
 namespace skybake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 }
 
 double KingFactor(double depolarization) {

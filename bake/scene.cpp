@@ -14,9 +14,11 @@
 
 #include "bake/bake.h"
 #include "bake/config.h"
-#include "bake/errors.h"
 #include "bake/medium.h"
 #include "bake/toml_input.h"
+#include "core/constants.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "shaders_runtime/runtime.h"
 
 namespace skybake {
@@ -25,7 +27,6 @@ namespace {
 
 using namespace toml_input;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegree = kPi / 180.0;
 constexpr Interval kNonNegativeMetres{0.0, std::numeric_limits<double>::infinity(), true, false};
 constexpr Interval kPositiveMetres{0.0, std::numeric_limits<double>::infinity(), false, false};
@@ -283,7 +284,7 @@ Scene ParseScene(std::string_view toml_text, const std::string& source_name) {
 
 Scene LoadScene(const std::string& path) {
   std::filesystem::path file(path);
-  return ParseScene(ReadInputFile(file, "a scene file"), InputName(path));
+  return ParseScene(ReadFileText(file, "a scene file"), InputName(path));
 }
 
 void ValidateSceneForAtmosphere(const Scene& scene, const Atmosphere& atmosphere, const std::string& source_name) {

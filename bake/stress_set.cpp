@@ -5,12 +5,12 @@
 #include <cmath>
 
 #include "bake/config.h"
+#include "core/constants.h"
 
 namespace skybake {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kEarthRadius = 6360e3;
 
 // Earth's sun, wavelengths and lowest sun (DESIGN.md "earth") around a planet

@@ -78,25 +78,6 @@ std::string OneLine(std::string text) {
   return text;
 }
 
-std::string ReadInputFile(const std::filesystem::path& path, const std::string& kind) {
-  std::ostringstream text;
-  if (path == kStandardStream) {
-    text << std::cin.rdbuf();
-    if (std::cin.bad()) throw IoError("standard input: read failed (" + std::string(std::strerror(errno)) + ")");
-    return text.str();
-  }
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
-    throw IoError(path.string() + ": is a directory, not " + kind, {path.string()});
-  }
-  if (!std::filesystem::exists(path, error)) throw IoError(path.string() + ": no such file", {path.string()});
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")", {path.string()});
-  text << in.rdbuf();
-  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")", {path.string()});
-  return text.str();
-}
-
 toml::table ParseDocument(std::string_view toml_text, const std::string& source_name) {
   try {
     return toml::parse(toml_text, source_name);

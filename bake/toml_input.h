@@ -16,7 +16,7 @@
 
 #include <toml++/toml.h>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake::toml_input {
 
@@ -29,9 +29,6 @@ std::string TomlKey(std::string_view key);
 std::string Join(const std::string& path, std::string_view key);
 std::string Index(const std::string& path, size_t i);
 std::string OneLine(std::string text);
-// The whole file (standard input for "-"), or IoError naming it; `kind`
-// ("an atmosphere file") words the error for a directory given in its place.
-std::string ReadInputFile(const std::filesystem::path& path, const std::string& kind);
 // The TOML document, or InputError "<source>:<line>: <problem>".
 toml::table ParseDocument(std::string_view toml_text, const std::string& source_name);
 // "a table", "string", "an array of 3", ... for "expected X, got Y".

@@ -9,7 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake::cli {
 

@@ -12,13 +12,14 @@
 
 #include "bake/bake.h"
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "bake/interrupt.h"
 #include "bake/scene.h"
 #include "cli/bake_settings_options.h"
-#include "cli/commands.h"
 #include "cli/command_line.h"
-#include "formats/file_io.h"
+#include "cli/commands.h"
+#include "core/constants.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/interrupt.h"
 #include "formats/lut_files.h"
 #include "formats/lut_tables.h"
 #include "report/scene_accuracy.h"
@@ -101,7 +102,7 @@ void PrintSceneSummary(const SceneSummary& s) {
   if (!s.plan.aerial_perspective_functions) {
     std::fprintf(stderr, "    left out %-22s no aerial_perspective\n", "GetSkyRadianceToPoint");
   }
-  constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
+  constexpr double kDegreesPerRadian = 180.0 / kPi;
   std::fprintf(stderr, "    orders computed down to mu_s %.4f (full bake %.4f): lowest sun %.2f deg instead of %.2f deg\n",
                s.plan.mu_s_min, s.full_mu_s_min, std::acos(s.plan.mu_s_min) * kDegreesPerRadian,
                std::acos(s.full_mu_s_min) * kDegreesPerRadian);

@@ -20,11 +20,11 @@
 
 #include "bake/bake.h"
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "cli/command_line.h"
 #include "cli/bake_settings_options.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/lut_files.h"
 
 namespace skybake::cli {

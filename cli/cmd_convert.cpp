@@ -11,9 +11,9 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "bake/errors.h"
 #include "cli/commands.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/manifest.h"
 #include "formats/table_file.h"
 #include "formats/table_stats.h"

@@ -9,10 +9,10 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/config.h"
-#include "bake/errors.h"
 #include "bake/scene.h"
 #include "cli/commands.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/lut_files.h"
 #include "formats/query_csv.h"
 #include "shaders_runtime/query.h"

@@ -10,14 +10,14 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "bake/version.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "fit/outputs.h"
 #include "fit/query.h"
 #include "fit/sky_dome_fit.h"
-#include "formats/file_io.h"
 
 namespace skybake::cli {
 

@@ -13,10 +13,10 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "bake/errors.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/lut_files.h"
 #include "formats/manifest.h"
 #include "formats/sha256.h"

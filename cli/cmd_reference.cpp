@@ -11,10 +11,10 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/config.h"
-#include "bake/errors.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "reference/path_tracer.h"
 #include "reference/query_csv.h"
 

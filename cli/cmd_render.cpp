@@ -14,13 +14,13 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
-#include "bake/errors.h"
 #include "bake/scene.h"
-#include "bake/version.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "formats/lut_files.h"
 #include "render/image_files.h"
 #include "render/lut_plots.h"

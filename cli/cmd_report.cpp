@@ -17,13 +17,13 @@
 #include <unistd.h>
 
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "bake/interrupt.h"
 #include "cli/bake_settings_options.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
-#include "formats/file_io.h"
-#include "formats/plot.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/interrupt.h"
+#include "plot/plot.h"
 #include "formats/query_csv.h"
 #include "report/case_errors.h"
 #include "report/quality_ladder.h"

@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/config.h"
-#include "bake/errors.h"
 #include "bake/stress_set.h"
 #include "cli/bake_settings_options.h"
 #include "cli/commands.h"
+#include "core/errors.h"
 
 namespace skybake::cli {
 

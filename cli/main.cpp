@@ -10,11 +10,11 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "bake/errors.h"
-#include "bake/interrupt.h"
-#include "bake/version.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "core/errors.h"
+#include "core/interrupt.h"
+#include "core/version.h"
 
 namespace {
 

@@ -1,6 +1,7 @@
 # `cmake --install BUILD --prefix PREFIX` puts the command-line tool, the
 # loader library (skybake::formats: LoadLutSet and the manifest, with the
-# LutSet of skybake::bake and the CPU twin of skybake::runtime), their headers
+# LutSet of skybake::bake, the CPU twin of skybake::runtime and the errors
+# of skybake::core), their headers
 # and the runtime GLSL into PREFIX, with a CMake package:
 #
 #   find_package(skybake REQUIRED)
@@ -14,21 +15,22 @@ include(CMakePackageConfigHelpers)
 set(SKYBAKE_INSTALL_INCLUDEDIR ${CMAKE_INSTALL_INCLUDEDIR}/skybake)
 set(SKYBAKE_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/skybake)
 
+set_target_properties(skybake_core PROPERTIES EXPORT_NAME core)
 set_target_properties(skybake_runtime PROPERTIES EXPORT_NAME runtime)
 set_target_properties(skybake_bake PROPERTIES EXPORT_NAME bake)
 set_target_properties(skybake_formats PROPERTIES EXPORT_NAME formats)
-foreach(target skybake_runtime skybake_bake skybake_formats)
+foreach(target skybake_core skybake_runtime skybake_bake skybake_formats)
   target_include_directories(${target} INTERFACE $<INSTALL_INTERFACE:${SKYBAKE_INSTALL_INCLUDEDIR}>)
 endforeach()
 
 install(TARGETS skybake RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(TARGETS skybake_runtime skybake_bake skybake_formats EXPORT skybakeTargets
+install(TARGETS skybake_core skybake_runtime skybake_bake skybake_formats EXPORT skybakeTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-foreach(dir bake formats shaders_runtime)
+foreach(dir core bake formats shaders_runtime)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${SKYBAKE_INSTALL_INCLUDEDIR}/${dir}
           FILES_MATCHING PATTERN "*.h")
 endforeach()
-install(FILES ${PROJECT_BINARY_DIR}/generated/bake/version.h DESTINATION ${SKYBAKE_INSTALL_INCLUDEDIR}/bake)
+install(FILES ${PROJECT_BINARY_DIR}/generated/core/version.h DESTINATION ${SKYBAKE_INSTALL_INCLUDEDIR}/core)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders_runtime/ DESTINATION ${CMAKE_INSTALL_DATADIR}/skybake/shaders_runtime
         FILES_MATCHING PATTERN "*.glsl" PATTERN "README.md")
 

@@ -8,15 +8,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bake/errors.h"
-#include "bake/version.h"
+#include "core/constants.h"
+#include "core/errors.h"
+#include "core/version.h"
 #include "fit/optical_path.h"
 
 namespace skybake::fit {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 const Constituent* FindConstituent(const Atmosphere& atmosphere, const std::string& name) {
   for (const Constituent& c : atmosphere.constituents)

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake::fit {
 

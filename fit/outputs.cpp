@@ -3,9 +3,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/errors.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "fit/codegen.h"
-#include "formats/file_io.h"
 
 namespace skybake::fit {
 

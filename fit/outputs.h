@@ -16,7 +16,7 @@
 #include "fit/dome_mesh.h"
 #include "fit/report.h"
 #include "fit/sky_dome_fit.h"
-#include "formats/plot.h"
+#include "plot/plot.h"
 
 namespace skybake::fit {
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "fit/forms.h"
 #include "fit/optical_path.h"
 

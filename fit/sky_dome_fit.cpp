@@ -7,7 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "fit/optical_path.h"
 #include "fit/solver.h"
 

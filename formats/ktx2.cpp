@@ -7,9 +7,9 @@
 #include <sstream>
 #include <string_view>
 
-#include "bake/errors.h"
-#include "bake/version.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "formats/half.h"
 
 namespace skybake::ktx2 {

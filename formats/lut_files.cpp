@@ -6,9 +6,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 
-#include "bake/errors.h"
-#include "bake/interrupt.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/interrupt.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
 #include "formats/sha256.h"

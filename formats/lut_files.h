@@ -55,7 +55,7 @@ struct WriteReport {
 
 // Writes every table in every requested format, the shader files, and then
 // the manifest, as one staged set: it appears complete or not at all, and an
-// interrupt (bake/interrupt.h) before the commit leaves the directory as it
+// interrupt (core/interrupt.h) before the commit leaves the directory as it
 // was. A directory it creates is removed again on failure. IoError on
 // failure, and, before anything is written, when the directory holds a file
 // the new set does not list (see WriteOptions::clean; anything that no

@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "bake/config.h"
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake {
 

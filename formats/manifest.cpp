@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "bake/version.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "formats/sha256.h"
 
 namespace fs = std::filesystem;

@@ -8,7 +8,7 @@
 #include <map>
 #include <sstream>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake {
 

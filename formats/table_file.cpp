@@ -14,9 +14,9 @@
 #include <cstring>
 #include <set>
 
-#include "bake/errors.h"
-#include "bake/version.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "formats/half.h"
 #include "formats/ktx2.h"
 

@@ -20,7 +20,8 @@
 #include <tbb/task_arena.h>
 
 #include "bake/config.h"
-#include "bake/errors.h"
+#include "core/constants.h"
+#include "core/errors.h"
 #include "reference/phase_sampling.h"
 #include "reference/random.h"
 #include "reference/ray_segment.h"
@@ -31,7 +32,6 @@ namespace skybake::reference {
 namespace {
 
 using glm::dvec3;
-constexpr double kPi = 3.14159265358979323846;
 
 // Ray segments at the start of each path that use a forced collision (more
 // were measured to cost as much time as they save variance).

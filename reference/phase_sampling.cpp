@@ -1,3 +1,4 @@
+#include "core/constants.h"
 #include "reference/phase_sampling.h"
 
 #include <algorithm>
@@ -8,7 +9,6 @@
 namespace skybake::reference {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 }
 
 double SampleHenyeyGreensteinCosine(double g, double u) {

@@ -6,9 +6,9 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
-#include "bake/errors.h"
-#include "formats/file_io.h"
-#include "formats/plot.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "plot/plot.h"
 #include "report/error_stats.h"
 
 namespace skybake::render {

@@ -56,7 +56,7 @@ Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone);
 using Attributes = std::vector<std::pair<std::string, std::string>>;
 
 // Both written atomically; IoError on failure. The PNG carries an sRGB
-// chunk (formats/plot.h WriteSrgbPng).
+// chunk (plot/plot.h WriteSrgbPng).
 void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes);
 void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes);
 

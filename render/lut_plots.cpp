@@ -6,7 +6,7 @@
 
 #include "bake/bake.h"
 #include "bake/scene.h"
-#include "formats/plot.h"
+#include "plot/plot.h"
 #include "shaders_runtime/twin.h"
 
 namespace skybake::render {
@@ -15,7 +15,7 @@ namespace {
 
 using glsl::vec3;
 constexpr double kDegree = glsl::PI / 180.0;
-// Palette indices (formats/plot.h) that read as red, green and blue.
+// Palette indices (plot/plot.h) that read as red, green and blue.
 constexpr int kChannelColor[3] = {2, 4, 0};
 
 std::string ChannelName(const vec3& wavelengths_nm, int c) {

@@ -1,4 +1,4 @@
-// Plots of table slices through the CPU twin (SVG and PNG via formats/plot.h),
+// Plots of table slices through the CPU twin (SVG and PNG via plot/plot.h),
 // for people who would rather look than read:
 //   lut_transmittance.{svg,png}  transmittance to the top of the atmosphere vs
 //                                view zenith, at altitudes 0, 5 and 20 km;

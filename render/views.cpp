@@ -6,7 +6,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "bake/errors.h"
+#include "core/constants.h"
+#include "core/errors.h"
 #include "shaders_runtime/twin.h"
 
 namespace skybake::render {
@@ -14,7 +15,6 @@ namespace skybake::render {
 namespace {
 
 using glsl::vec3;
-constexpr double kPi = glsl::PI;
 constexpr double kDegree = kPi / 180.0;
 constexpr double kSpaceDistanceInRadii = 4.0;
 constexpr double kAerialPitchDeg = 7.0;

@@ -4,8 +4,8 @@
 
 #include <filesystem>
 
-#include "bake/errors.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/query_csv.h"
 #include "report/reference_files.h"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake::report {
 

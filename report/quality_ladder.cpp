@@ -3,7 +3,7 @@
 #include <chrono>
 #include <cstdio>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "formats/half.h"
 #include "formats/lut_files.h"
 #include "report/run_time_models.h"

@@ -4,7 +4,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake::report {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <map>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "fit/optical_path.h"
 #include "fit/sky_dome_fit.h"
 #include "shaders_runtime/hoffman_preetham.h"

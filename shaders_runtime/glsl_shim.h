@@ -16,6 +16,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "core/constants.h"
+
 namespace skybake::glsl {
 
 using Number = double;
@@ -38,7 +40,7 @@ using std::floor;
 using std::log;
 using std::sqrt;
 
-constexpr Number PI = 3.14159265358979323846;
+constexpr Number PI = kPi;
 constexpr int PHASE_NONE = 0;
 constexpr int PHASE_HENYEY_GREENSTEIN = 1;
 constexpr int PHASE_CORNETTE_SHANKS = 2;

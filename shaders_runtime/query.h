@@ -29,7 +29,7 @@ struct QueryGeometry {
 };
 
 inline QueryGeometry MakeQueryGeometry(const Query& q, double bottom_radius_m) {
-  constexpr double kDegree = 3.14159265358979323846 / 180.0;
+  constexpr double kDegree = kPi / 180.0;
   double vz = q.view_zenith_deg * kDegree, sz = q.sun_zenith_deg * kDegree;
   double az = q.view_sun_azimuth_deg * kDegree, nz = q.normal_zenith_deg * kDegree;
   QueryGeometry g;

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "bake/version.h"
+#include "core/version.h"
 #include "shaders_runtime/embedded_text.h"
 
 namespace skybake {

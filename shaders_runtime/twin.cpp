@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "shaders_runtime/runtime.h"
 
 namespace skybake {

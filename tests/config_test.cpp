@@ -16,7 +16,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "bake/errors.h"
+#include "core/constants.h"
+#include "core/errors.h"
 #include "test_util.h"
 
 namespace skybake {
@@ -24,7 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kPi = 3.14159265358979323846;
 const fs::path kSourceDir = SKYBAKE_SOURCE_DIR;
 const fs::path kPresetDir = kSourceDir / "examples" / "atmospheres";
 const std::set<std::string> kPresetNames = {"earth",      "earth-clear-2008", "light-haze",

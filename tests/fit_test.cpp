@@ -27,8 +27,9 @@
 
 #include "bake/atmosphere.h"
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "test_util.h"
+#include "core/constants.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "fit/codegen.h"
 #include "fit/dome_mesh.h"
 #include "fit/forms.h"
@@ -38,14 +39,13 @@
 #include "fit/query.h"
 #include "fit/sky_dome_fit.h"
 #include "fit/solver.h"
-#include "formats/file_io.h"
+#include "test_util.h"
 #include "tests/gl_context.h"
 
 namespace skybake::fit {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kEarthRadius = 6360e3;
 constexpr double kEarthTop = 6420e3;
 

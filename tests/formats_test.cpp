@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "formats/half.h"
 #include "formats/ktx2.h"
 #include "formats/table_file.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "formats/file_io.h"
+#include "core/file_io.h"
 #include "formats/half.h"
 #include "formats/manifest.h"
 #include "formats/table_file.h"

@@ -9,7 +9,7 @@ build=$1 source=$2 work=$3
 rm -rf "$work"
 mkdir -p "$work"
 cmake --install "$build" --prefix "$work/prefix" >"$work/install.log"
-for f in bin/skybake include/skybake/formats/lut_files.h include/skybake/bake/version.h \
+for f in bin/skybake include/skybake/formats/lut_files.h include/skybake/core/version.h \
          lib/cmake/skybake/skybakeConfig.cmake share/skybake/shaders_runtime/functions.glsl; do
   [ -e "$work/prefix/$f" ] || { echo "install_check: $f was not installed"; exit 1; }
 done

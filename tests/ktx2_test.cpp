@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "bake/errors.h"
-#include "bake/version.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/version.h"
 #include "formats/half.h"
 #include "formats/ktx2.h"
 

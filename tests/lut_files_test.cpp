@@ -13,8 +13,8 @@
 
 #include "bake/bake.h"
 #include "bake/config.h"
-#include "bake/errors.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/half.h"
 #include "formats/lut_files.h"
 #include "formats/lut_tables.h"

@@ -12,8 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bake/errors.h"
-#include "bake/interrupt.h"
+#include "core/errors.h"
+#include "core/interrupt.h"
 #include "formats/lut_files.h"
 #include "test_atmospheres.h"
 #include "test_util.h"

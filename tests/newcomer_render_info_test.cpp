@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
+#include "core/constants.h"
 #include "formats/lut_files.h"
 #include "render/image_files.h"
 #include "tests/test_util.h"
@@ -232,7 +233,7 @@ TEST(NewcomerDefects, RenderAutoExposureMapsTheMedianSkyToMidGrey) {
   y.erase(std::remove_if(y.begin(), y.end(), [](double v) { return !(v > 0.0); }), y.end());
   std::sort(y.begin(), y.end());
   // Inside the circle: pi/4 of the square, give or take its rim.
-  ASSERT_NEAR(double(y.size()) / (width * height), 3.14159265 / 4, 0.03);
+  ASSERT_NEAR(double(y.size()) / (width * height), kPi / 4, 0.03);
   const double expected_ev = std::log2(-std::log(1.0 - 0.18) / y[y.size() / 2]);
 
   const nlohmann::json report = nlohmann::json::parse(out);

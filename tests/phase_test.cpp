@@ -21,11 +21,11 @@
 #include <gtest/gtest.h>
 
 #include "bake/atmosphere.h"
+#include "core/constants.h"
 
 namespace skybake {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 struct GaussLegendre {
   std::vector<double> nodes, weights;  // on [-1, 1]

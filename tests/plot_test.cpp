@@ -15,8 +15,8 @@
 #include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
 
-#include "bake/errors.h"
-#include "formats/plot.h"
+#include "core/errors.h"
+#include "plot/plot.h"
 
 namespace skybake {
 namespace {

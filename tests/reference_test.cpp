@@ -24,7 +24,8 @@
 #include <glm/geometric.hpp>
 
 #include "bake/atmosphere.h"
-#include "bake/errors.h"
+#include "core/constants.h"
+#include "core/errors.h"
 #include "reference/layered_medium.h"
 #include "reference/path_tracer.h"
 #include "reference/phase_sampling.h"
@@ -37,7 +38,6 @@ namespace skybake::reference {
 namespace {
 
 using glm::dvec3;
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegree = kPi / 180.0;
 
 int64_t Scaled(int64_t paths) {

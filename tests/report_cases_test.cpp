@@ -10,7 +10,7 @@
 #include <string>
 
 #include "bake/config.h"
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "formats/query_csv.h"
 #include "test_util.h"
 

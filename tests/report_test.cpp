@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
-#include "bake/errors.h"
+#include "core/errors.h"
 #include "report/case_errors.h"
 #include "report/error_stats.h"
 #include "report/quality_ladder.h"

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "bake/bake.h"
+#include "core/constants.h"
 #include "quadrature.h"
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/twin.h"
@@ -92,7 +93,7 @@ TEST(SingleScattering, MatchesBruteForceQuadratureWithinHalfPercent) {
     for (int y : {0, 1, p.scattering_mu_size - 2, p.scattering_mu_size - 1}) {
       ScatteringTexel t = GetScatteringTexel(p, 0, y, z);
       double horizon = -std::sqrt(1.0 - (p.bottom_radius / t.r) * (p.bottom_radius / t.r));
-      if (std::abs(std::acos(t.mu) - std::acos(horizon)) < 0.1 * 3.14159265358979 / 180.0) {
+      if (std::abs(std::acos(t.mu) - std::acos(horizon)) < 0.1 * kPi / 180.0) {
         texels.push_back({x_dist(rng), y, z});
         ++near_horizon;
       }

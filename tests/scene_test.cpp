@@ -14,8 +14,9 @@
 
 #include "bake/bake.h"
 #include "bake/config.h"
-#include "bake/errors.h"
 #include "bake/scene.h"
+#include "core/constants.h"
+#include "core/errors.h"
 #include "formats/lut_files.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
@@ -29,7 +30,6 @@
 namespace skybake {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A scene with the given [effects] lines, a ground camera, objects and all suns.
 std::string SceneText(const std::string& effects, const std::string& extra = "") {

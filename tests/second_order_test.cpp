@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "core/constants.h"
 #include "shaders_runtime/twin.h"
 #include "test_atmospheres.h"
 
@@ -17,7 +18,6 @@ namespace skybake {
 namespace {
 
 using glm::dvec3;
-constexpr double kPi = 3.14159265358979323846;
 
 double RayleighPhase(double cos_theta) { return 3.0 / (16.0 * kPi) * (1.0 + cos_theta * cos_theta); }
 

@@ -22,9 +22,9 @@
 #include <vector>
 
 #include "bake/config.h"
-#include "bake/errors.h"
 #include "bake/invariants.h"
 #include "bake/stress_set.h"
+#include "core/errors.h"
 #include "formats/query_csv.h"
 #include "shaders_runtime/query.h"
 #include "shaders_runtime/twin.h"

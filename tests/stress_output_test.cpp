@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <map>
 
-#include "bake/errors.h"
-#include "bake/interrupt.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
+#include "core/interrupt.h"
 #include "test_util.h"
 
 namespace skybake {

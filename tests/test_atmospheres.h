@@ -7,6 +7,7 @@
 #include "bake/atmosphere.h"
 #include "bake/bake.h"
 #include "bake/stress_set.h"
+#include "core/constants.h"
 
 namespace skybake::testing {
 
@@ -31,7 +32,7 @@ inline Atmosphere Earth() {
   a.wavelengths_nm = Spectrum(680.0, 550.0, 440.0);
   a.solar_irradiance = Spectrum(1.474, 1.8504, 1.91198);
   a.sun_angular_radius_rad = 0.004675;
-  a.mu_s_min = std::cos(102.0 * 3.14159265358979323846 / 180.0);
+  a.mu_s_min = std::cos(102.0 * kPi / 180.0);
   Constituent ozone;
   ozone.name = "ozone";
   ozone.absorption_per_m = Spectrum(0.650e-6, 1.881e-6, 0.085e-6);

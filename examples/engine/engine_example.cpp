@@ -31,19 +31,20 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/bake.h"
-#include "bake/errors.h"
-#include "formats/file_io.h"
+#include "core/constants.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/lut_files.h"
 #include "formats/table_file.h"
 #include "render/image_files.h"
 #include "render/views.h"
 
 namespace fs = std::filesystem;
+using skybake::kPi;
 using skybake::glsl::vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegree = kPi / 180.0;
 constexpr double kAerialPitchDeg = 7.0;  // as render/views.cpp
 

@@ -1,8 +1,8 @@
-#include "bake/interrupt.h"
+#include "core/interrupt.h"
 
 #include <csignal>
 
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace skybake {
 

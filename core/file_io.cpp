@@ -1,4 +1,4 @@
-#include "formats/file_io.h"
+#include "core/file_io.h"
 
 #include <unistd.h>
 
@@ -12,8 +12,7 @@
 #include <random>
 #include <sstream>
 
-#include "bake/config.h"
-#include "bake/errors.h"
+#include "core/errors.h"
 
 namespace fs = std::filesystem;
 
@@ -90,22 +89,27 @@ void StagedFiles::Commit() {
   staged_.clear();
 }
 
-std::vector<std::uint8_t> ReadFileBytes(const fs::path& path) {
-  if (path == kStandardStream) {
-    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(std::cin)), std::istreambuf_iterator<char>());
-    if (std::cin.bad()) throw IoError("standard input: read error");
-    return bytes;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string() + ": cannot read: " + std::strerror(errno));
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw IoError(path.string() + ": read error");
-  return bytes;
+std::vector<std::uint8_t> ReadFileBytes(const fs::path& path, const std::string& kind) {
+  const std::string text = ReadFileText(path, kind);
+  return std::vector<std::uint8_t>(text.begin(), text.end());
 }
 
-std::string ReadFileText(const fs::path& path) {
-  std::vector<std::uint8_t> bytes = ReadFileBytes(path);
-  return std::string(bytes.begin(), bytes.end());
+std::string ReadFileText(const fs::path& path, const std::string& kind) {
+  std::ostringstream text;
+  if (path == kStandardStream) {
+    text << std::cin.rdbuf();
+    if (std::cin.bad()) throw IoError("standard input: read failed (" + std::string(std::strerror(errno)) + ")");
+    return text.str();
+  }
+  const ErrorLocation location{path.string()};
+  std::error_code error;
+  if (fs::is_directory(path, error)) throw IoError(path.string() + ": is a directory, not " + kind, location);
+  if (!fs::exists(path, error)) throw IoError(path.string() + ": no such file", location);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")", location);
+  text << in.rdbuf();
+  if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")", location);
+  return text.str();
 }
 
 std::vector<std::string> EntriesNotIn(const fs::path& dir, const std::vector<std::string>& names) {

@@ -1,4 +1,4 @@
-#include "formats/plot.h"
+#include "plot/plot.h"
 
 #include <algorithm>
 #include <array>
@@ -10,8 +10,8 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
-#include "bake/errors.h"
-#include "formats/file_io.h"
+#include "core/errors.h"
+#include "core/file_io.h"
 
 namespace skybake {
 

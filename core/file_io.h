@@ -40,10 +40,14 @@ class StagedFiles {
   std::vector<Staged> staged_;
 };
 
-// Whole-file read (standard input for "-"); IoError if the file is missing or
-// unreadable.
-std::vector<std::uint8_t> ReadFileBytes(const std::filesystem::path& path);
-std::string ReadFileText(const std::filesystem::path& path);
+// The path that names standard input for every file a command reads.
+inline constexpr const char kStandardStream[] = "-";
+
+// Whole-file read (standard input for kStandardStream). IoError naming the
+// file (as an ErrorLocation) if it is missing, a directory (`kind` says what
+// was expected there, e.g. "an atmosphere file") or unreadable.
+std::vector<std::uint8_t> ReadFileBytes(const std::filesystem::path& path, const std::string& kind = "a file");
+std::string ReadFileText(const std::filesystem::path& path, const std::string& kind = "a file");
 
 // The entries of `dir` whose names are not in `names`, sorted; a folder's
 // name ends in '/'. IoError if `dir` cannot be listed.
