@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "core/version.h"
+#include "formats/settings_record.h"
 #include "formats/sha256.h"
 
 namespace fs = std::filesystem;
@@ -16,19 +17,6 @@ using nlohmann::ordered_json;
 namespace skybake {
 
 namespace {
-
-// "orders" is what was asked for (a count or "auto"), "orders_used" what the
-// tables hold, "extrapolate_tail" whether they add the orders not computed.
-ordered_json SettingsToJson(const BakeSettings& s, int orders_used) {
-  return ordered_json{{"orders", s.orders == 0 ? ordered_json("auto") : ordered_json(s.orders)},
-                      {"orders_used", orders_used},
-                      {"extrapolate_tail", s.extrapolate_tail},
-                      {"transmittance_samples", s.transmittance_samples},
-                      {"ray_samples", s.ray_samples},
-                      {"sphere_samples", s.sphere_samples},
-                      {"higher_order_divisor", s.higher_order_divisor},
-                      {"pack_single_mie_in_alpha", s.pack_single_mie_in_alpha}};
-}
 
 ordered_json SizeToJson(int width, int height, int depth, bool is_3d) {
   return is_3d ? ordered_json::array({width, height, depth}) : ordered_json::array({width, height});
@@ -122,7 +110,7 @@ std::string ManifestWriter::Text() const {
       {"wavelengths_nm", {w.x, w.y, w.z}},
       {"parameters", ParametersToJson(luts_.parameters)},
       {"parameterization", ParameterizationToJson(luts_.parameters)},
-      {"bake", SettingsToJson(luts_.settings, luts_.orders_used)},
+      {"bake", SettingsJson(luts_.settings, SettingsFields::kManifest, luts_.orders_used)},
       {"tables", tables_},
       {"shaders", shaders_},
       {"atmosphere", ordered_json::parse(ToJson(luts_.atmosphere))},

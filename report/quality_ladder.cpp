@@ -6,6 +6,7 @@
 #include "core/errors.h"
 #include "formats/half.h"
 #include "formats/lut_files.h"
+#include "formats/settings_record.h"
 #include "report/run_time_models.h"
 
 namespace skybake::report {
@@ -74,15 +75,6 @@ std::vector<GroupErrors> MeasureTables(const LutSet& tables, const ReferenceSet&
   return MeasureErrors(reference, [&](const ReferenceCase& c) { return EvaluateTwin(twin, c); });
 }
 
-std::string Describe(const BakeSettings& s) {
-  char text[200];
-  std::snprintf(text, sizeof text, "T %dx%d, E %dx%d, S %dx%dx%dx%d, %d ray / %d sphere samples, orders >= 2 at 1/%d",
-                s.transmittance_width, s.transmittance_height, s.irradiance_width, s.irradiance_height,
-                s.scattering_r_size, s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size,
-                s.ray_samples, s.sphere_samples, s.higher_order_divisor);
-  return text;
-}
-
 }  // namespace
 
 LadderPlan MakeLadder(const BakeSettings& base, bool quick) {
@@ -130,7 +122,7 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
 
   // The base: exactly what `skybake bake` makes with these settings (with the
   // extrapolated tail of the orders it does not compute, by default).
-  say("bake the base: " + Describe(plan.base));
+  say("bake the base: " + DescribeSettings(plan.base, SettingsDetail::kSamples));
   BakeReport base_report;
   LutSet base = Bake(atmosphere, plan.base, &base_report);
   const Written base_files = WriteTables(base, scratch_dir, false);
@@ -152,7 +144,7 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
   BakeSettings orders_settings = plan.base;
   orders_settings.orders = plan.max_orders;
   orders_settings.extrapolate_tail = false;
-  say("bake " + Describe(plan.base) + ", orders 1-" + std::to_string(plan.max_orders) + " without the tail");
+  say("bake " + DescribeSettings(plan.base, SettingsDetail::kSamples) + ", orders 1-" + std::to_string(plan.max_orders) + " without the tail");
   Bake(atmosphere, orders_settings, nullptr, nullptr, [&](int order, const LutSet& tables, double seconds) {
     LadderEntry e;
     e.step.knob = "orders";
@@ -177,7 +169,7 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
       e.bytes = w.bytes;
       e.errors = MeasureTables(RoundToHalf(base), reference);
     } else {
-      say("bake " + step.name + ": " + Describe(step.settings));
+      say("bake " + step.name + ": " + DescribeSettings(step.settings, SettingsDetail::kSamples));
       BakeReport report;
       LutSet tables = Bake(atmosphere, step.settings, &report);
       Written w = WriteTables(tables, scratch_dir, false);
