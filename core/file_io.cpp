@@ -167,4 +167,14 @@ void EnsureWritableDirectory(const fs::path& dir) {
   }
 }
 
+ScratchDirectory::ScratchDirectory(const std::string& prefix)
+    : path_(fs::temp_directory_path() / (prefix + std::to_string(::getpid()))) {
+  EnsureWritableDirectory(path_);
+}
+
+ScratchDirectory::~ScratchDirectory() {
+  std::error_code ignored;
+  fs::remove_all(path_, ignored);
+}
+
 }  // namespace skybake

@@ -65,4 +65,20 @@ void CheckOutputDirectory(const std::filesystem::path& dir);
 // not a writable directory.
 void EnsureWritableDirectory(const std::filesystem::path& dir);
 
+// A scratch folder, PREFIX followed by this process's id under the system's
+// temporary directory: created (EnsureWritableDirectory) on construction and
+// removed with everything in it on destruction, on success and on error alike
+// (a failure to remove it is ignored: nothing of it is an output).
+class ScratchDirectory {
+ public:
+  explicit ScratchDirectory(const std::string& prefix);
+  ~ScratchDirectory();
+  ScratchDirectory(const ScratchDirectory&) = delete;
+  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 }  // namespace skybake
