@@ -3,17 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/quadrature.h"
+
 namespace skybake {
 
 namespace {
-
-// 8-point Gauss-Legendre rule on [-1, 1].
-constexpr double kGaussNodes[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
-                                   -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
-                                   0.7966664774136267,  0.9602898564975363};
-constexpr double kGaussWeights[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
-                                     0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
-                                     0.2223810344533745, 0.1012285362903763};
 
 bool IsMiePhase(const PhaseFunction& phase) {
   return phase.kind == PhaseKind::kHenyeyGreenstein || phase.kind == PhaseKind::kCornetteShanks;
@@ -91,10 +85,10 @@ Spectrum Medium::OpticalDepth(double r, double mu, double d, int nodes) const {
     for (int k = 0; k < intervals; ++k) {
       double mid = a + (k + 0.5) * h;
       for (int n = 0; n < 8; ++n) {
-        double t = mid + 0.5 * h * kGaussNodes[n];
+        double t = mid + 0.5 * h * GaussLegendre8Rule::kNodes[n];
         double radius = std::sqrt(t * t + 2.0 * r * mu * t + r * r);
         Densities(radius - atmosphere_.bottom_radius_m, densities.data());
-        sum += Extinction(densities.data()) * (0.5 * h * kGaussWeights[n]);
+        sum += Extinction(densities.data()) * (0.5 * h * GaussLegendre8Rule::kWeights[n]);
       }
     }
   }

@@ -4,25 +4,11 @@
 #include <cmath>
 #include <queue>
 
+#include "core/quadrature.h"
+
 namespace skybake::fit {
 
 namespace {
-
-// QUADPACK qk15 abscissae (positive half, last = centre) and weights.
-constexpr double kNodes[8] = {
-    0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-    0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-    0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
-    0.207784955007898467600689403773245, 0.000000000000000000000000000000000};
-constexpr double kKronrodWeights[8] = {
-    0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-    0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-    0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
-    0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
-// Gauss weights for the odd-indexed nodes 1, 3, 5 and the centre 7.
-constexpr double kGaussWeights[4] = {
-    0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-    0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
 
 struct Panel {
   double a, b, value, error;
@@ -33,13 +19,13 @@ Panel Rule(const std::function<double(double)>& f, double a, double b) {
   double centre = 0.5 * (a + b);
   double half = 0.5 * (b - a);
   double fc = f(centre);
-  double kronrod = fc * kKronrodWeights[7];
-  double gauss = fc * kGaussWeights[3];
+  double kronrod = fc * GaussKronrod15Rule::kKronrodWeights[7];
+  double gauss = fc * GaussKronrod15Rule::kGaussWeights[3];
   for (int i = 0; i < 7; ++i) {
-    double dx = half * kNodes[i];
+    double dx = half * GaussKronrod15Rule::kNodes[i];
     double pair = f(centre - dx) + f(centre + dx);
-    kronrod += kKronrodWeights[i] * pair;
-    if (i % 2 == 1) gauss += kGaussWeights[i / 2] * pair;
+    kronrod += GaussKronrod15Rule::kKronrodWeights[i] * pair;
+    if (i % 2 == 1) gauss += GaussKronrod15Rule::kGaussWeights[i / 2] * pair;
   }
   return {a, b, kronrod * half, std::abs((kronrod - gauss) * half)};
 }

@@ -22,36 +22,18 @@
 
 #include "bake/atmosphere.h"
 #include "core/constants.h"
+#include "core/quadrature.h"
 
 namespace skybake {
 namespace {
-
 
 struct GaussLegendre {
   std::vector<double> nodes, weights;  // on [-1, 1]
 };
 
-// Nodes are roots of P_n found by Newton's method from the Chebyshev guess.
 GaussLegendre MakeGaussLegendre(int n) {
   GaussLegendre rule;
-  for (int i = 0; i < n; ++i) {
-    double x = std::cos(kPi * (i + 0.75) / (n + 0.5));
-    double derivative = 0.0;
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double p0 = 1.0, p1 = x;  // P_0, P_1; recurrence up to P_n
-      for (int k = 2; k <= n; ++k) {
-        double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      derivative = n * (x * p1 - p0) / (x * x - 1.0);
-      double step = p1 / derivative;
-      x -= step;
-      if (std::abs(step) < 1e-16) break;
-    }
-    rule.nodes.push_back(x);
-    rule.weights.push_back(2.0 / ((1.0 - x * x) * derivative * derivative));
-  }
+  AppendGaussLegendre(n, -1.0, 1.0, rule.nodes, rule.weights);
   return rule;
 }
 
