@@ -1,14 +1,12 @@
 #include "bake/atmosphere.h"
-#include "core/constants.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace skybake {
+#include "core/phase.h"
 
-namespace {
-}
+namespace skybake {
 
 double DensityProfile::At(double altitude_m) const {
   if (kind == Kind::kTabulated) {
@@ -62,19 +60,10 @@ std::vector<double> DensityProfile::Breakpoints() const {
 
 double PhaseFunction::Evaluate(double cos_theta) const {
   switch (kind) {
-    case PhaseKind::kIsotropic:
-      return 1.0 / (4.0 * kPi);
-    case PhaseKind::kRayleigh:
-      return 3.0 / (16.0 * kPi) * (1.0 + cos_theta * cos_theta);
-    case PhaseKind::kHenyeyGreenstein: {
-      double denom = 1.0 + g * g - 2.0 * g * cos_theta;
-      return (1.0 - g * g) / (4.0 * kPi * denom * std::sqrt(denom));
-    }
-    case PhaseKind::kCornetteShanks: {
-      double denom = 1.0 + g * g - 2.0 * g * cos_theta;
-      double k = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
-      return k * (1.0 + cos_theta * cos_theta) / (denom * std::sqrt(denom));
-    }
+    case PhaseKind::kIsotropic: return IsotropicPhase();
+    case PhaseKind::kRayleigh: return RayleighPhase(cos_theta);
+    case PhaseKind::kHenyeyGreenstein: return HenyeyGreensteinPhase(g, cos_theta);
+    case PhaseKind::kCornetteShanks: return CornetteShanksPhase(g, cos_theta);
   }
   return 0.0;
 }

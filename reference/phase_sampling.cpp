@@ -1,4 +1,3 @@
-#include "core/constants.h"
 #include "reference/phase_sampling.h"
 
 #include <algorithm>
@@ -6,10 +5,9 @@
 
 #include <glm/geometric.hpp>
 
-namespace skybake::reference {
+#include "core/constants.h"
 
-namespace {
-}
+namespace skybake::reference {
 
 double SampleHenyeyGreensteinCosine(double g, double u) {
   // Below |g| = 1e-4 the closed form loses digits to cancellation, and the

@@ -11,6 +11,7 @@
 
 #include "bake/bake.h"
 #include "core/constants.h"
+#include "core/phase.h"
 #include "shaders_runtime/twin.h"
 #include "test_atmospheres.h"
 
@@ -18,8 +19,6 @@ namespace skybake {
 namespace {
 
 using glm::dvec3;
-
-double RayleighPhase(double cos_theta) { return 3.0 / (16.0 * kPi) * (1.0 + cos_theta * cos_theta); }
 
 class DoubleScattering {
  public:
