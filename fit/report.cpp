@@ -11,7 +11,7 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-json Json(const ErrorStats& e) {
+json Json(const OpticalPathErrors& e) {
   return {{"points", e.points},
           {"max_relative", e.max_relative},
           {"rms_relative", e.rms_relative},

@@ -29,8 +29,8 @@ std::vector<double> Linspace(double lo, double hi, int count) {
   return v;
 }
 
-ErrorStats MeasureErrors(const SampleGrid& grid, const std::function<double(double, double)>& model) {
-  ErrorStats stats;
+OpticalPathErrors MeasureErrors(const SampleGrid& grid, const std::function<double(double, double)>& model) {
+  OpticalPathErrors stats;
   double sum_sq = 0.0;
   for (size_t a = 0; a < grid.altitude_m.size(); ++a) {
     for (size_t z = 0; z < grid.zenith_deg.size(); ++z) {

@@ -48,7 +48,9 @@ struct Surface {
   double NormalizedAltitude(double altitude_m) const;
 };
 
-struct ErrorStats {
+// Errors of a fitted relative optical path against the exact samples of a
+// grid (not report::ErrorStats, which compares radiances with the reference).
+struct OpticalPathErrors {
   int points = 0;
   double max_relative = 0.0;
   double rms_relative = 0.0;
@@ -59,7 +61,7 @@ struct ErrorStats {
 
 struct CandidateFit {
   Surface surface;
-  ErrorStats fit_grid, validation_grid;
+  OpticalPathErrors fit_grid, validation_grid;
   double final_cost = 0.0;
   int iterations = 0;
   std::string termination;
@@ -95,8 +97,8 @@ struct ConstituentFit {
   bool fitted = false;
   std::string skip_reason;
   Surface surface;         // the kept candidate
-  ErrorStats fit_errors, validation_errors;
-  ErrorStats iqbal_fit_errors, iqbal_validation_errors;
+  OpticalPathErrors fit_errors, validation_errors;
+  OpticalPathErrors iqbal_fit_errors, iqbal_validation_errors;
   std::vector<CandidateFit> candidates;
   std::vector<ZenithOpticalLength> zenith_optical_length;  // at the fit altitudes
   std::vector<OpticalPathSample> samples;  // a few exact values at the lowest, middle and highest altitude

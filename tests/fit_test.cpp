@@ -386,7 +386,7 @@ TEST(Fit, ChapmanChordFormIsExactForAConstantDensitySlab) {
   EXPECT_LE(fit.surface.altitude_hi_m, 1250.0);
 }
 
-void ExpectFinite(const ErrorStats& e, const std::string& what) {
+void ExpectFinite(const OpticalPathErrors& e, const std::string& what) {
   EXPECT_TRUE(std::isfinite(e.max_relative) && std::isfinite(e.rms_relative) &&
               std::isfinite(e.max_relative_zenith_le_85))
       << what;
