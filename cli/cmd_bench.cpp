@@ -11,12 +11,12 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
 #include "bake/bake.h"
 #include "bake/config.h"
@@ -25,7 +25,8 @@
 #include "cli/commands.h"
 #include "core/errors.h"
 #include "core/file_io.h"
-#include "formats/lut_files.h"
+#include "formats/settings_record.h"
+#include "report/bake_pipeline.h"
 
 namespace skybake::cli {
 
@@ -61,32 +62,24 @@ struct Measurement {
 
 Measurement Measure(const Atmosphere& atmosphere, const BakeSettings& settings, int runs,
                     const std::filesystem::path& dir) {
-  WriteOptions write_options;
-  write_options.command_line = CommandLine();
+  // The bake pipeline of `skybake bake` without the GLSL runtime: the tables
+  // and the manifest, in EXR and KTX2.
+  report::BakeJob job;
+  job.settings = settings;
+  job.runtime = false;
+  job.command_line = CommandLine();
   Measurement m;
   for (int run = 0; run < runs; ++run) {
     auto start = std::chrono::steady_clock::now();
-    BakeReport report;
-    LutSet luts = Bake(atmosphere, settings, &report);
-    auto write_start = std::chrono::steady_clock::now();
-    WriteLutSet(luts, dir, write_options);
+    const report::BakeOutcome outcome = report::BakeAndWrite(atmosphere, job, dir);
     auto end = std::chrono::steady_clock::now();
-    report.timings.push_back({"write files", std::chrono::duration<double>(end - write_start).count()});
-    for (const BakeTiming& t : report.timings) {
+    for (const BakeTiming& t : outcome.report.timings) {
       if (run == 0) m.phases.push_back(t.phase);
       m.seconds[t.phase].push_back(t.seconds);
     }
     m.seconds["total"].push_back(std::chrono::duration<double>(end - start).count());
   }
   return m;
-}
-
-std::string Describe(const BakeSettings& s) {
-  char text[160];
-  std::snprintf(text, sizeof text, "T %dx%d, E %dx%d, S %dx%dx%dx%d, %d orders, ", s.transmittance_width,
-                s.transmittance_height, s.irradiance_width, s.irradiance_height, s.scattering_r_size,
-                s.scattering_mu_size, s.scattering_mu_s_size, s.scattering_nu_size, s.orders);
-  return text + (s.threads > 0 ? std::to_string(s.threads) + " threads" : std::string("all cores"));
 }
 
 // The scaling runs: the base configuration with one thing changed.
@@ -120,18 +113,10 @@ void RunBench(const BenchOptions& o) {
   Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
   const BakeSettings settings = o.bake.Resolve();
 
-  namespace fs = std::filesystem;
-  fs::path dir = o.output_dir;
-  bool temporary = dir.empty();
-  if (temporary) dir = fs::temp_directory_path() / ("skybake_bench_" + std::to_string(::getpid()));
+  std::optional<ScratchDirectory> scratch;
+  if (o.output_dir.empty()) scratch.emplace("skybake_bench_");
+  const std::filesystem::path dir = scratch ? scratch->path() : std::filesystem::path(o.output_dir);
   EnsureWritableDirectory(dir);
-  struct Cleanup {
-    fs::path dir;
-    ~Cleanup() {
-      std::error_code ignored;
-      if (!dir.empty()) fs::remove_all(dir, ignored);
-    }
-  } cleanup{temporary ? dir : fs::path()};
 
   Measurement base = Measure(atmosphere, settings, o.runs, dir);
   // Taken before the scaling runs, whose larger tables would raise it.
@@ -158,11 +143,11 @@ void RunBench(const BenchOptions& o) {
     nlohmann::json scaling = nlohmann::json::array();
     for (size_t i = 0; i < variants.size(); ++i) {
       scaling.push_back({{"variant", variants[i].first},
-                         {"settings", Describe(variants[i].second)},
+                         {"settings", DescribeSettings(variants[i].second, SettingsDetail::kOrdersAndThreads)},
                          {"median_seconds", variant_totals[i]}});
     }
     nlohmann::json j = {{"atmosphere", atmosphere.name},
-                        {"settings", Describe(settings)},
+                        {"settings", DescribeSettings(settings, SettingsDetail::kOrdersAndThreads)},
                         {"runs", o.runs},
                         {"phases", phases},
                         {"median_total_seconds", base_total},
@@ -173,7 +158,8 @@ void RunBench(const BenchOptions& o) {
     return;
   }
   const std::string runs = o.runs == 1 ? "one run" : "median of " + std::to_string(o.runs) + " runs";
-  std::printf("%s: %s, files written; %s\n\n", atmosphere.name.c_str(), Describe(settings).c_str(), runs.c_str());
+  std::printf("%s: %s, files written; %s\n\n", atmosphere.name.c_str(),
+              DescribeSettings(settings, SettingsDetail::kOrdersAndThreads).c_str(), runs.c_str());
   std::printf("| phase | median (s) |\n|---|---:|\n");
   for (const std::string& phase : base.phases) {
     std::printf("| %s | %.3f |\n", phase.c_str(), Median(base.seconds[phase]));

@@ -3,10 +3,12 @@
 #include <chrono>
 #include <cstdio>
 
+#include <Imath/half.h>
+
 #include "core/errors.h"
-#include "formats/half.h"
 #include "formats/lut_files.h"
 #include "formats/settings_record.h"
+#include "report/bake_pipeline.h"
 #include "report/run_time_models.h"
 
 namespace skybake::report {
@@ -70,6 +72,32 @@ Written WriteTables(const LutSet& tables, const std::filesystem::path& dir, bool
   return w;
 }
 
+// A bake through the pipeline of `skybake bake` (bake_pipeline.h), without
+// the GLSL runtime and the command line, so that every configuration writes
+// the files a plain bake of it would: the tables and the manifest, float,
+// EXR and KTX2.
+struct LadderBake {
+  LutSet tables;
+  BakeReport report;
+  double bake_seconds = 0.0;  // the phases before the write
+  Written files;
+};
+
+LadderBake BakeAndWriteTables(const Atmosphere& atmosphere, const BakeSettings& settings,
+                              const std::filesystem::path& dir) {
+  BakeJob job;
+  job.settings = settings;
+  job.runtime = false;
+  BakeOutcome outcome = BakeAndWrite(atmosphere, job, dir);
+  LadderBake b;
+  b.report = outcome.report;
+  b.files.seconds = b.report.timings.back().seconds;  // the write is the last phase
+  for (size_t i = 0; i + 1 < b.report.timings.size(); ++i) b.bake_seconds += b.report.timings[i].seconds;
+  for (const WrittenFile& f : outcome.written.files) b.files.bytes += f.bytes;
+  b.tables = std::move(outcome.luts);
+  return b;
+}
+
 std::vector<GroupErrors> MeasureTables(const LutSet& tables, const ReferenceSet& reference) {
   Twin twin(MakeTwinTables(tables));
   return MeasureErrors(reference, [&](const ReferenceCase& c) { return EvaluateTwin(twin, c); });
@@ -107,7 +135,7 @@ LadderPlan MakeLadder(const BakeSettings& base, bool quick) {
 LutSet RoundToHalf(LutSet tables) {
   for (glsl::Texture* t : {&tables.transmittance, &tables.irradiance, &tables.scattering,
                            &tables.single_mie_scattering}) {
-    for (float& v : t->texels) v = HalfToFloat(FloatToHalf(v));
+    for (float& v : t->texels) v = static_cast<float>(Imath::half(v));
   }
   return tables;
 }
@@ -123,11 +151,11 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
   // The base: exactly what `skybake bake` makes with these settings (with the
   // extrapolated tail of the orders it does not compute, by default).
   say("bake the base: " + DescribeSettings(plan.base, SettingsDetail::kSamples));
-  BakeReport base_report;
-  LutSet base = Bake(atmosphere, plan.base, &base_report);
-  const Written base_files = WriteTables(base, scratch_dir, false);
-  double base_bake_seconds = 0.0;
-  for (const BakeTiming& t : base_report.timings) base_bake_seconds += t.seconds;
+  LadderBake base_bake = BakeAndWriteTables(atmosphere, plan.base, scratch_dir);
+  LutSet& base = base_bake.tables;
+  const BakeReport& base_report = base_bake.report;
+  const Written& base_files = base_bake.files;
+  const double base_bake_seconds = base_bake.bake_seconds;
   {
     LadderEntry e;
     e.step.knob = "base";
@@ -170,14 +198,10 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
       e.errors = MeasureTables(RoundToHalf(base), reference);
     } else {
       say("bake " + step.name + ": " + DescribeSettings(step.settings, SettingsDetail::kSamples));
-      BakeReport report;
-      LutSet tables = Bake(atmosphere, step.settings, &report);
-      Written w = WriteTables(tables, scratch_dir, false);
-      double seconds = 0.0;
-      for (const BakeTiming& t : report.timings) seconds += t.seconds;
-      e.bake_seconds = seconds + w.seconds;
-      e.bytes = w.bytes;
-      e.errors = MeasureTables(tables, reference);
+      const LadderBake b = BakeAndWriteTables(atmosphere, step.settings, scratch_dir);
+      e.bake_seconds = b.bake_seconds + b.files.seconds;
+      e.bytes = b.files.bytes;
+      e.errors = MeasureTables(b.tables, reference);
     }
     entries.push_back(e);
   }
