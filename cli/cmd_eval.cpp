@@ -15,6 +15,7 @@
 #include "core/file_io.h"
 #include "formats/lut_files.h"
 #include "formats/query_csv.h"
+#include "report/twin_query.h"
 #include "shaders_runtime/query.h"
 #include "shaders_runtime/twin.h"
 
@@ -71,9 +72,7 @@ void RunEval(const EvalOptions& o) {
     const Query& q = table.queries[row];
     QueryGeometry g = MakeQueryGeometry(q, luts.parameters.bottom_radius);
     glsl::vec3 transmittance;
-    glsl::vec3 radiance = q.distance_m > 0.0
-        ? twin.SkyRadianceToPoint(g.camera, g.camera + g.view * q.distance_m, g.sun, &transmittance)
-        : twin.SkyRadiance(g.camera, g.view, g.sun, &transmittance);
+    glsl::vec3 radiance = report::QuerySkyRadiance(twin, q, g, &transmittance);
     const std::vector<std::string>& fields = table.fields[row];
     std::string line;
     for (size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + fields[i];

@@ -8,6 +8,7 @@
 #include "core/errors.h"
 #include "fit/optical_path.h"
 #include "fit/sky_dome_fit.h"
+#include "report/twin_query.h"
 #include "shaders_runtime/hoffman_preetham.h"
 
 namespace skybake::report {
@@ -21,9 +22,7 @@ ModelAnswer EvaluateTwin(const Twin& twin, const ReferenceCase& c) {
     return a;
   }
   a.has_radiance = true;
-  a.radiance = c.query.distance_m > 0.0
-                   ? twin.SkyRadianceToPoint(g.camera, g.camera + g.view * c.query.distance_m, g.sun, nullptr)
-                   : twin.SkyRadiance(g.camera, g.view, g.sun, nullptr);
+  a.radiance = QuerySkyRadiance(twin, c.query, g, nullptr);
   return a;
 }
 
