@@ -7,14 +7,27 @@
 #include <sstream>
 #include <string_view>
 
+#include <Imath/half.h>
+
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "core/version.h"
-#include "formats/half.h"
 
 namespace skybake::ktx2 {
 
 namespace {
+
+std::uint32_t FloatBits(float value) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &value, sizeof(bits));
+  return bits;
+}
+
+float FloatFromBits(std::uint32_t bits) {
+  float value;
+  std::memcpy(&value, &bits, sizeof(value));
+  return value;
+}
 
 // §3.1: «KTX 20»\r\n\x1A\n
 constexpr std::uint8_t kIdentifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32,
@@ -550,7 +563,7 @@ std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& 
   const std::size_t channel_bytes = BytesPerChannel(format);
   std::vector<std::uint8_t> out(values.size() * channel_bytes);
   for (std::size_t i = 0; i < values.size(); ++i) {
-    const std::uint32_t bits = channel_bytes == 2 ? FloatToHalf(values[i]) : FloatBits(values[i]);
+    const std::uint32_t bits = channel_bytes == 2 ? Imath::half(values[i]).bits() : FloatBits(values[i]);
     for (std::size_t b = 0; b < channel_bytes; ++b) out[i * channel_bytes + b] = static_cast<std::uint8_t>(bits >> (8 * b));
   }
   return out;
@@ -566,7 +579,8 @@ std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>
   for (std::size_t i = 0; i < out.size(); ++i) {
     std::uint32_t bits = 0;
     for (std::size_t b = 0; b < channel_bytes; ++b) bits |= static_cast<std::uint32_t>(data[i * channel_bytes + b]) << (8 * b);
-    out[i] = channel_bytes == 2 ? HalfToFloat(static_cast<std::uint16_t>(bits)) : FloatFromBits(bits);
+    out[i] = channel_bytes == 2 ? static_cast<float>(Imath::half(Imath::half::FromBits, static_cast<std::uint16_t>(bits)))
+                                : FloatFromBits(bits);
   }
   return out;
 }

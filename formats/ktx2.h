@@ -80,7 +80,7 @@ void WriteFile(const std::filesystem::path& path, const Texture& texture);
 Texture ReadFile(const std::filesystem::path& path);
 
 // Float texels <-> level bytes for `format`: float32 stored as is, half
-// formats converted with round-to-nearest-even (formats/half.h). `values`
+// formats converted with round-to-nearest-even (Imath::half). `values`
 // holds ChannelCount(format) floats per texel.
 std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& values);
 std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data);

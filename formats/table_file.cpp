@@ -14,10 +14,11 @@
 #include <cstring>
 #include <set>
 
+#include <Imath/half.h>
+
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "core/version.h"
-#include "formats/half.h"
 #include "formats/ktx2.h"
 
 namespace fs = std::filesystem;
@@ -128,7 +129,7 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   header.insert(kSizeKey, Imf::StringAttribute(SizeString(image.width, image.height, image.depth, image.is_3d)));
   header.insert(kExrGeneratorKey, Imf::StringAttribute("skybake " SKYBAKE_VERSION));
 
-  // Planar copies in the stored pixel type; halves rounded by half.h so both
+  // Planar copies in the stored pixel type; halves rounded by Imath::half so both
   // formats agree bit for bit.
   const std::size_t texels = image.TexelCount();
   std::vector<float> floats;
@@ -136,7 +137,7 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   if (half) {
     halves.resize(texels * channels);
     for (std::size_t i = 0; i < texels; ++i) {
-      for (int c = 0; c < channels; ++c) halves[c * texels + i] = FloatToHalf(image.values[i * channels + c]);
+      for (int c = 0; c < channels; ++c) halves[c * texels + i] = Imath::half(image.values[i * channels + c]).bits();
     }
   } else {
     floats.resize(texels * channels);

@@ -13,7 +13,7 @@
 // channel of zeros there, since Vulkan guarantees no three-channel float
 // format for sampled images; "skybake.channels" names the meaningful ones.
 //
-// Halves are rounded by formats/half.h in both formats, so an EXR half table
+// Halves are rounded by Imath::half in both formats, so an EXR half table
 // and a KTX2 half table hold identical values.
 #pragma once
 

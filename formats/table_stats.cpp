@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "formats/half.h"
+#include <Imath/half.h>
 
 namespace skybake {
 
@@ -36,7 +36,7 @@ HalfError MeasureHalfError(const std::vector<float>& values, double floor) {
   e.floor = floor;
   for (float v : values) {
     if (!std::isfinite(v)) continue;
-    const float h = HalfToFloat(FloatToHalf(v));
+    const float h = static_cast<float>(Imath::half(v));
     if (std::isinf(h)) {
       ++e.overflowed;
       continue;

@@ -27,7 +27,7 @@ std::vector<ChannelStats> ComputeChannelStats(const TableImage& image);
 // error reported instead.
 inline constexpr double kDefaultHalfErrorFloor = 6.103515625e-05;
 
-// Rounding float values to half (formats/half.h, round to nearest even):
+// Rounding float values to half (Imath::half, round to nearest even):
 //   max_relative_error = max |half(v) - v| / |v| over finite v with |v| >= floor
 // (at most 2^-11 = 4.88e-4 for values that stay below the half maximum, 65504).
 struct HalfError {

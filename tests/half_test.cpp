@@ -1,18 +1,34 @@
-// formats/half.h against the IEEE 754 binary16 definition: every one of the
-// 65536 patterns, every rounding boundary between adjacent halves, and
+// Imath::half, with which every half table is written, against the IEEE 754
+// binary16 definition: every one of the 65536 patterns, every rounding
+// boundary between adjacent halves (round to nearest, ties to even), and
 // hand-checked values.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include <Imath/half.h>
 
-#include "formats/half.h"
-
 namespace skybake {
 namespace {
+
+// The conversions under test, on bit patterns.
+std::uint16_t FloatToHalf(float value) { return Imath::half(value).bits(); }
+float HalfToFloat(std::uint16_t bits) { return Imath::half(Imath::half::FromBits, bits); }
+
+std::uint32_t FloatBits(float value) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &value, sizeof(bits));
+  return bits;
+}
+
+float FloatFromBits(std::uint32_t bits) {
+  float value;
+  std::memcpy(&value, &bits, sizeof(value));
+  return value;
+}
 
 bool IsHalfNan(std::uint16_t h) { return (h & 0x7C00u) == 0x7C00u && (h & 0x3FFu) != 0; }
 
@@ -126,23 +142,6 @@ TEST(Half, EveryRoundingBoundaryBetweenAdjacentHalves) {
       ASSERT_EQ(FloatToHalf(s * std::nextafter(mid, 0.0f)), lo_half | sign_bit) << "below tie at 0x" << std::hex << h;
       ASSERT_EQ(FloatToHalf(s * std::nextafter(mid, 1e9f)), hi_half | sign_bit) << "above tie at 0x" << std::hex << h;
       ASSERT_EQ(FloatToHalf(s * static_cast<float>(lo)), lo_half | sign_bit);
-    }
-  }
-}
-
-// Imath::half (OpenEXR's) rounds like FloatToHalf: every half value, every
-// midpoint between adjacent halves and the floats on either side of it, of
-// either sign, and back again.
-TEST(Half, ImathHalfAgreesWithFloatToHalf) {
-  for (std::uint32_t h = 0; h <= 0xFFFFu; ++h) {
-    const auto half = static_cast<std::uint16_t>(h);
-    if (IsHalfNan(half)) continue;
-    const float f = HalfToFloat(half);
-    ASSERT_EQ(FloatBits(static_cast<float>(Imath::half(Imath::half::FromBits, half))), FloatBits(f)) << std::hex << h;
-    const float next = HalfToFloat(static_cast<std::uint16_t>(h + 1));
-    const float mid = (h & 0x7FFFu) < 0x7C00u ? static_cast<float>((static_cast<double>(f) + next) / 2) : f;
-    for (float v : {f, mid, std::nextafter(mid, 0.0f), std::nextafter(mid, 2.0f * mid)}) {
-      ASSERT_EQ(Imath::half(v).bits(), FloatToHalf(v)) << "float 0x" << std::hex << FloatBits(v);
     }
   }
 }

@@ -5,6 +5,7 @@
 // IoErrors; writing is byte-reproducible across runs and thread counts.
 #include <gtest/gtest.h>
 
+#include <Imath/half.h>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -15,7 +16,6 @@
 #include "bake/config.h"
 #include "core/errors.h"
 #include "core/file_io.h"
-#include "formats/half.h"
 #include "formats/lut_files.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
@@ -67,7 +67,7 @@ void ExpectSameSet(const LutSet& loaded, const LutSet& original, bool half) {
     ASSERT_EQ(a.depth, b.depth) << table.name;
     std::vector<float> expected = b.texels;
     if (half) {
-      for (float& v : expected) v = HalfToFloat(FloatToHalf(v));
+      for (float& v : expected) v = static_cast<float>(Imath::half(v));
     }
     EXPECT_TRUE(SameBits(a.texels, expected)) << table.name;
   }
