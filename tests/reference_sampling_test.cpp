@@ -1,0 +1,230 @@
+// Validation of the reference solver's building blocks (reference/): its
+// sampling routines and its deterministic integrals (quadrature, optical
+// depths, free flights). Tolerances: see reference_test_util.h.
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include "bake/atmosphere.h"
+#include "core/constants.h"
+#include "reference/layered_medium.h"
+#include "reference/phase_sampling.h"
+#include "reference/quadrature.h"
+#include "reference/random.h"
+#include "shaders_runtime/runtime.h"
+#include "reference_test_util.h"
+
+namespace skybake::reference {
+namespace {
+
+using glm::dvec3;
+
+// ---------------------------------------------------------------------------
+// Sampling routines.
+
+// Probability that the cosine of a sample from `phase` falls in [a, b]:
+// 2 pi times the integral of the phase, by composite Simpson.
+double PhaseProbability(const PhaseFunction& phase, double a, double b, int n = 200) {
+  double h = (b - a) / n, sum = phase.Evaluate(a) + phase.Evaluate(b);
+  for (int i = 1; i < n; ++i) sum += phase.Evaluate(a + i * h) * (i % 2 ? 4.0 : 2.0);
+  return 2.0 * kPi * sum * h / 3.0;
+}
+
+struct PhaseCase {
+  const char* name;
+  PhaseFunction phase;
+};
+
+TEST(ReferenceSampling, PhaseSamplesFollowThePhaseFunction) {
+  // Chi-square over 40 equal bins in cos(theta) of 400k samples. The least
+  // likely bin (backward, HG g = 0.8) expects ~600 samples, so the statistic
+  // follows chi-square with 39 degrees of freedom: its 0.999 quantile is
+  // 72.1. A sampler using HG's misprinted (1 - g)^2 numerator, or sampling CS
+  // as plain HG, scores in the thousands.
+  const PhaseCase cases[] = {{"Rayleigh", {PhaseKind::kRayleigh, 0.0}},
+                             {"HG 0.8", {PhaseKind::kHenyeyGreenstein, 0.8}},
+                             {"CS 0.8", {PhaseKind::kCornetteShanks, 0.8}},
+                             {"HG -0.5", {PhaseKind::kHenyeyGreenstein, -0.5}},
+                             {"isotropic", {PhaseKind::kIsotropic, 0.0}}};
+  const int bins = 40, samples = 400000;
+  for (const PhaseCase& c : cases) {
+    Pcg32 rng(12345, 678);
+    std::vector<int> counts(bins, 0);
+    for (int i = 0; i < samples; ++i) {
+      double mu = SamplePhaseCosine(c.phase, rng);
+      ASSERT_GE(mu, -1.0);
+      ASSERT_LE(mu, 1.0);
+      counts[std::min(bins - 1, static_cast<int>((mu + 1.0) / 2.0 * bins))]++;
+    }
+    double chi2 = 0.0, total_probability = 0.0;
+    for (int b = 0; b < bins; ++b) {
+      double p = PhaseProbability(c.phase, -1.0 + 2.0 * b / bins, -1.0 + 2.0 * (b + 1) / bins);
+      total_probability += p;
+      double expected = p * samples;
+      chi2 += (counts[b] - expected) * (counts[b] - expected) / expected;
+    }
+    EXPECT_NEAR(total_probability, 1.0, 1e-9) << c.name;
+    Note("phase %s: chi2 %.1f (39 dof)\n", c.name, chi2);
+    EXPECT_LT(chi2, 72.1) << c.name;
+  }
+}
+
+TEST(ReferenceSampling, InverseCdfsRoundTrip) {
+  // CDF(sample(u)) = u, with the CDF integrated from the phase function
+  // (fine Simpson steps: the g = 0.8 lobe is ~0.02 wide in cos(theta)).
+  PhaseFunction hg{PhaseKind::kHenyeyGreenstein, 0.8}, rayleigh{PhaseKind::kRayleigh, 0.0};
+  for (double u = 0.01; u < 1.0; u += 0.07) {
+    EXPECT_NEAR(PhaseProbability(hg, -1.0, SampleHenyeyGreensteinCosine(0.8, u), 20000), u, 1e-9) << u;
+    EXPECT_NEAR(PhaseProbability(rayleigh, -1.0, SampleRayleighCosine(u)), u, 1e-9) << u;
+  }
+}
+
+TEST(ReferenceSampling, CosineHemisphere) {
+  // Mean of cos(theta) under the density cos / pi is 2/3; of cos^2, 1/2.
+  dvec3 normal = glm::normalize(dvec3(0.3, -0.5, 0.8));
+  Pcg32 rng(1, 1);
+  double sum = 0.0, sum2 = 0.0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    double u1 = rng.Uniform(), u2 = rng.Uniform();
+    double c = glm::dot(SampleCosineHemisphere(normal, u1, u2), normal);
+    ASSERT_GE(c, 0.0);
+    sum += c;
+    sum2 += c * c;
+  }
+  // Standard deviations of cos: sqrt(1/2 - 4/9) = 0.236 -> 5e-4 on the mean.
+  EXPECT_NEAR(sum / n, 2.0 / 3.0, 4 * 0.236 / std::sqrt(double(n)));
+  EXPECT_NEAR(sum2 / n, 0.5, 4 * 0.25 / std::sqrt(double(n)));
+}
+
+// ---------------------------------------------------------------------------
+// Deterministic integrals.
+
+TEST(ReferenceQuadrature, GaussKronrodIsExactForPolynomials) {
+  // Kronrod-15 integrates degree 22 exactly, Gauss-7 degree 13.
+  auto poly = [](int degree) {
+    return [degree](double t) { return Spectrum(std::pow(t, degree)); };
+  };
+  for (int degree : {0, 5, 13, 22}) {
+    GaussKronrodResult r = GaussKronrod15(poly(degree), -0.5, 2.0);
+    double exact = (std::pow(2.0, degree + 1) - std::pow(-0.5, degree + 1)) / (degree + 1);
+    EXPECT_NEAR(r.kronrod.x, exact, 1e-12 * std::abs(exact)) << degree;
+    if (degree <= 13) {
+      EXPECT_NEAR(r.gauss.x, exact, 1e-12 * std::abs(exact)) << degree;
+    }
+  }
+  GaussKronrodResult e = GaussKronrod15([](double t) { return Spectrum(std::exp(t)); }, 0.0, 1.0);
+  EXPECT_NEAR(e.kronrod.x, std::exp(1.0) - 1.0, 1e-15);
+}
+
+TEST(ReferenceQuadrature, OpticalDepthMatchesClosedForms) {
+  Atmosphere a = Earth();
+  a.constituents.resize(1);  // Rayleigh only: exp(-h / H)
+  LayeredMedium medium(a);
+  const double H = 8000.0, sigma = 33.1e-6;
+  // Straight up from altitude h0 to the top: sigma H (e^-h0/H - e^-60km/H).
+  for (double h0 : {0.0, 1500.0, 30000.0}) {
+    double r = a.bottom_radius_m + h0;
+    OpticalDepthEstimate tau = medium.OpticalDepth(r, 1.0, 0.0, a.top_radius_m - r, 1e-12);
+    double exact = sigma * H * (std::exp(-h0 / H) - std::exp(-60000.0 / H));
+    EXPECT_NEAR(tau.value.z, exact, 1e-12 * exact) << h0;
+    EXPECT_LT(tau.error.z, 1e-9 * exact);
+  }
+  // A constant layer crossed on a grazing chord: sigma x length.
+  Atmosphere slab = Earth();
+  slab.constituents.resize(1);
+  slab.constituents[0].density.layers = {DensityLayer{20000.0, 0.0, 0.0, 0.0, 1.0},
+                                         DensityLayer{0.0, 0.0, 0.0, 0.0, 0.0}};
+  LayeredMedium slab_medium(slab);
+  double r = slab.bottom_radius_m + 5000.0, mu = -0.02;
+  double length = glsl::DistanceToTopAtmosphereBoundary(slab_medium.geometry(), r, mu);
+  // The chord inside the 20 km layer, from the ray's own sphere crossings.
+  double b = r * mu, c = r * r - std::pow(slab.bottom_radius_m + 20000.0, 2);
+  double inside = -b + std::sqrt(b * b - c);
+  OpticalDepthEstimate tau = slab_medium.OpticalDepth(r, mu, 0.0, length, 1e-12);
+  EXPECT_NEAR(tau.value.z, sigma * inside, 1e-9 * sigma * inside);
+}
+
+TEST(ReferenceMedium, MajorantsBoundTheExtinction) {
+  // Earth, plus a layer whose formula peaks inside a shell (exp + linear)
+  // and a tabulated profile.
+  Atmosphere a = Earth();
+  Constituent bump;
+  bump.name = "bump";
+  bump.density.layers = {DensityLayer{0.0, -1.0, -1.0 / 3000.0, 1.0 / 20000.0, 0.5}};
+  bump.scattering_per_m = Spectrum(2e-6);
+  a.constituents.push_back(bump);
+  Constituent table;
+  table.name = "table";
+  table.density.kind = DensityProfile::Kind::kTabulated;
+  table.density.altitudes_m = {0.0, 3000.0, 3500.0, 12000.0};
+  table.density.densities = {0.2, 1.0, 0.1, 0.0};
+  table.scattering_per_m = Spectrum(5e-6);
+  a.constituents.push_back(table);
+  LayeredMedium medium(a);
+  Pcg32 rng(3, 4);
+  for (int i = 0; i < 200000; ++i) {
+    double r = a.bottom_radius_m + (a.top_radius_m - a.bottom_radius_m) * rng.Uniform();
+    Spectrum extinction = medium.Extinction(r);
+    int s = medium.ShellIndex(r);
+    for (int w = 0; w < kWavelengthCount; ++w) ASSERT_LE(extinction[w], medium.Majorant(s, w)) << r;
+  }
+}
+
+TEST(ReferenceMedium, FreeFlightsEscapeWithTheTransmittance) {
+  // Delta tracking: the fraction of free flights that cross a ray without a
+  // collision is T = exp(-tau); binomial sigma = sqrt(T (1 - T) / n).
+  LayeredMedium medium(Earth());
+  const glsl::AtmosphereParameters& g = medium.geometry();
+  const int n = 100000;
+  struct Ray {
+    double altitude, mu;
+    int w;
+  };
+  for (Ray ray : {Ray{0.0, 1.0, 2}, Ray{0.0, 0.02, 2}, Ray{0.0, 0.02, 0}, Ray{8000.0, -0.1, 1}}) {
+    double r = g.bottom_radius + ray.altitude;
+    bool ground = glsl::RayIntersectsGround(g, r, ray.mu);
+    double length = ground ? glsl::DistanceToBottomAtmosphereBoundary(g, r, ray.mu)
+                           : glsl::DistanceToTopAtmosphereBoundary(g, r, ray.mu);
+    double transmittance = std::exp(-medium.OpticalDepth(r, ray.mu, 0.0, length, 1e-10).value[ray.w]);
+    Pcg32 rng(99, 7);
+    int crossed = 0;
+    for (int i = 0; i < n; ++i) {
+      RayEvent e = medium.SampleFreeFlight(r, ray.mu, std::numeric_limits<double>::infinity(), ray.w, rng);
+      if (e.end != RayEnd::kCollision) {
+        ++crossed;
+        EXPECT_EQ(e.end, ground ? RayEnd::kGround : RayEnd::kSpace);
+        EXPECT_NEAR(e.distance, length, 1e-6 * length);
+      }
+    }
+    double sigma = std::sqrt(transmittance * (1.0 - transmittance) / n);
+    EXPECT_NEAR(double(crossed) / n, transmittance, 4.0 * sigma) << ray.altitude << " " << ray.mu;
+  }
+}
+
+TEST(ReferenceMedium, RatioTrackingIsUnbiased) {
+  LayeredMedium medium(Earth());
+  const glsl::AtmosphereParameters& g = medium.geometry();
+  double r = g.bottom_radius + 500.0, mu = 0.05;
+  double length = glsl::DistanceToTopAtmosphereBoundary(g, r, mu);
+  Pcg32 rng(5, 6);
+  for (int w = 0; w < kWavelengthCount; ++w) {
+    double exact = std::exp(-medium.OpticalDepth(r, mu, 0.0, length, 1e-10).value[w]);
+    const int n = 50000;
+    double sum = 0.0, sum2 = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double t = medium.RatioTrackingTransmittance(r, mu, length, w, rng);
+      sum += t;
+      sum2 += t * t;
+    }
+    double mean = sum / n, sigma = std::sqrt((sum2 / n - mean * mean) / n);
+    EXPECT_NEAR(mean, exact, 4.0 * sigma + 1e-12) << w;
+  }
+}
+
+}  // namespace
+}  // namespace skybake::reference
