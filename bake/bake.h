@@ -48,20 +48,23 @@ struct BakeSettings {
   int orders = 4;
   double order_tolerance = 1e-4;
   int max_orders = 100;
-  // With a fixed order count, add the extrapolated geometric tail of the
-  // orders not computed once the last orders decay geometrically (at 4
-  // orders Earth's blue sky still lacks about 1.5% without it); off, the
-  // tables hold exactly `orders` orders (to compare with a capped reference).
+  // With a fixed order count N, add the extrapolated geometric tail of the
+  // orders not computed once the last orders decay geometrically: with q the
+  // ratio of successive orders, L_(N+1) + L_(N+2) + ... = L_N q / (1 - q)
+  // (its size for Earth: docs/accuracy.md); off, the tables hold exactly
+  // `orders` orders (to compare with a capped reference).
   bool extrapolate_tail = true;
   // Integration: Gauss-Legendre nodes per optical-depth integral, intervals
   // per ray for the inscattering integrals, and polar directions for the
   // integrals over the sphere (twice as many azimuths).
   // Single scattering takes `ray_samples` intervals per ray; the higher
   // orders, whose source along the ray is smooth, half as many but not
-  // fewer than 32 (with 4, a fuzzed 100-optical-depth haze overshot the
-  // energy bound) or all where there are fewer (at 64 for
-  // single scattering too, texels near the horizon were 1.1% off a brute-force
-  // integral, SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent).
+  // fewer than 32 (too few intervals let an optically thick haze overshoot
+  // the energy bound, stress_fuzz_test) or all where there are fewer. Single
+  // scattering keeps them all: its source has the edge of the planet's
+  // shadow, and near the horizon half as many miss the brute-force integral
+  // by more than SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent
+  // allows (docs/benchmark.md).
   int transmittance_samples = 64;
   int ray_samples = 128;
   int sphere_samples = 16;
@@ -70,10 +73,9 @@ struct BakeSettings {
   // ScatteringRange's) divided by this, as the radiance the next order
   // scatters (which an integral over the sphere smooths), and the densities
   // of all orders, on their grid, are summed and gathered once along the
-  // table's own rays. Faster (earth: 5.4 instead of 7 s) at a small error
-  // for thin atmospheres, but optically thick ones lose light order after
-  // order (heavy-fog's reflected energy halves at 2), so the default keeps
-  // every order on the table's grid (docs/benchmark.md).
+  // table's own rays. Faster, at a small error for thin atmospheres, but
+  // optically thick ones lose light order after order, so the default keeps
+  // every order on the table's grid (docs/benchmark.md has both).
   int higher_order_divisor = 1;
   // Restricts the scattering tables to a scene's altitudes and suns; unset,
   // they cover the atmosphere and every sun down to its mu_s_min.

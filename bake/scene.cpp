@@ -229,10 +229,8 @@ void PlanScatteringRange(const Scene& scene, const Atmosphere& atmosphere, Scene
   if (e.space_views) mu_s_min = plan->mu_s_min, mu_s_max = 1.0;
   // Worth it where the altitudes are a small part of the r axis (a third of
   // its rho span, so that ApplyScenePlan's table has at most half the
-  // texels): the orders then cost a second grid. On the flight simulator
-  // scene (0-20 km, 58% of the span) the restricted bake took as long as the
-  // full one and was less accurate (mean 0.51% against 0.39% from a finer
-  // bake, single Mie packed in both).
+  // texels): the orders then cost a second grid, which a wider span repays
+  // neither in time nor in accuracy (docs/accuracy.md, "Scenes").
   plan->restrict_scattering = RhoSpan(atmosphere, low, high) <= 1.0 / 3.0;
   if (!plan->restrict_scattering) return;
   plan->altitude_min_m = low, plan->altitude_max_m = high;
@@ -361,9 +359,9 @@ void ApplyScenePlan(const ScenePlan& plan, Atmosphere* atmosphere, BakeSettings*
   range.mu_s_min = plan.table_mu_s_min, range.mu_s_max = plan.table_mu_s_max;
   range.atmosphere_r_size = settings->scattering_r_size;
   range.atmosphere_mu_size = settings->scattering_mu_size;
-  // Half the mu_s texels while the sun stays above the horizon: in twilight
-  // the light changes fastest with mu_s (on the sunset scene, halving them
-  // raised the mean error from 1.2% to 4.9%).
+  // Half the mu_s texels while the sun stays above the horizon; in twilight
+  // the light changes fastest with mu_s, so a scene that reaches it keeps
+  // them all (docs/accuracy.md, "Scenes").
   range.atmosphere_mu_s_size =
       plan.sun_above_horizon ? std::max(2, settings->scattering_mu_s_size / 2) : settings->scattering_mu_s_size;
   range.atmosphere_ray_samples = std::min(settings->ray_samples, std::max(16, settings->ray_samples / 4));

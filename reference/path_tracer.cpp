@@ -33,8 +33,9 @@ namespace {
 
 using glm::dvec3;
 
-// Ray segments at the start of each path that use a forced collision (more
-// were measured to cost as much time as they save variance).
+// Ray segments at the start of each path that use a forced collision: the
+// first only, as forcing later ones costs as much time as it saves variance
+// (docs/reference.md).
 constexpr int kForcedSegments = 1;
 
 enum Estimator : uint64_t { kRadianceEstimator = 1, kIrradianceEstimator = 2 };
