@@ -100,7 +100,7 @@ void ExpectViewMatchesTwin(const Twin& twin, render::View view, const render::Vi
         // The GL test's bounds for float32 against the double twin: 1e-3
         // for the sky, 3e-3 for aerial perspective; the ground points of
         // the aerial view add their own float rounding (a radius near
-        // 6.4e6 m), measured at 3.6e-3.
+        // 6.4e6 m: a few 1e-3).
         EXPECT_LE(relative, view == render::View::kFisheye ? 1e-3 : 5e-3)
             << "pixel " << x << "," << y << " channel " << c;
       }

@@ -76,7 +76,7 @@ class ExponentialFit : public ::testing::TestWithParam<double> {};
 
 TEST_P(ExponentialFit, IsAccurateAndBeatsIqbal) {
   // The bars (0.5% to 85°, 2% to 90°, 5x better than Iqbal) are what a sky
-  // dome needs; the fit's measured errors are ~10x below them.
+  // dome needs; the fit stays about 10x below them (the test prints its errors).
   Atmosphere atmosphere = SingleExponential(GetParam());
   FitSet set = FitAtmosphere(atmosphere, {}, FitOptions{});
   ASSERT_EQ(set.constituents.size(), 1u);
@@ -187,7 +187,7 @@ TEST(Fit, EveryPresetFitsWithFiniteSmallErrors) {
     for (const ConstituentFit& c : set.constituents) {
       ASSERT_TRUE(c.fitted) << atmosphere.name << "/" << c.name << ": " << c.skip_reason;
       EXPECT_EQ(c.unconverged_samples, 0) << atmosphere.name << "/" << c.name;
-      // 1% is the dome's error budget; measured: at most 0.3% (the ozone tent).
+      // 1% is the dome's error budget; the largest error, on the ozone tent, is about 0.3%.
       EXPECT_LT(c.validation_errors.max_relative, 0.01) << atmosphere.name << "/" << c.name;
       EXPECT_LT(c.validation_errors.max_relative, c.iqbal_validation_errors.max_relative)
           << atmosphere.name << "/" << c.name;

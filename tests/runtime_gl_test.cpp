@@ -295,22 +295,22 @@ void ExpectGlMatchesTwin(GlContext* gl, const LutSet& luts, const std::string& s
     for (int c = 0; c < 3; ++c) max_value[item.what] = std::max(max_value[item.what], twin.back()[c]);
   }
   // Relative difference where the value exceeds 1e-6 of its output's
-  // maximum: 1e-3, the bound float32 evaluation should meet; llvmpipe
-  // measures <= 2e-5 for every output but aerial perspective. Aerial
-  // perspective used to need 3e-3 (transmittance) and 0.1 (radiance): the
-  // table method subtracts two optical-depth lookups and computes
+  // maximum: 1e-3, the bound float32 evaluation should meet; llvmpipe stays
+  // near 2e-5 for every output but aerial perspective. There the table
+  // method subtracts two optical-depth lookups and computes
   // S(camera) - T S(point), both of which amplify the 0.5 m float rounding
   // of the point's radius near 6.4e6 m, most on short near-horizontal
-  // segments. Segments under 10 km are now integrated along the segment,
-  // with altitudes taken as the camera's plus the rise along the ray; longer
-  // ones (long shadows' sunlit parts, grazing rays to the ground) still use
-  // the table method, whose transmittance differs by up to 2.1e-3.
+  // segments. Segments under 10 km are therefore integrated along the
+  // segment, with altitudes taken as the camera's plus the rise along the
+  // ray; longer ones (long shadows' sunlit parts, grazing rays to the
+  // ground) use the table method, whose transmittance differs by up to
+  // about 2e-3, hence 3e-3 for it.
   // The radiance of short segments keeps one cancelling term: its multiple
   // scattering is the table method's S(x) - T S(p) over a 10 km stretch
   // minus that stretch's single scattering, a small difference in float of
-  // table values interpolated by the driver. Measured 1.6e-3 to 1.1e-2 with
-  // the same snippet, depending only on how the driver compiled the test's
-  // main() around it; hence 2e-2 for those radiances.
+  // table values interpolated by the driver. It ranges from about 2e-3 to
+  // 1e-2 for the same snippet, depending only on how the driver compiles the
+  // test's main() around it; hence 2e-2 for those radiances.
   auto tolerance = [](int what) {
     if (what == kAerialRadiance || what == kAerialRadianceInShadow) return 2e-2;
     return what == kAerialTransmittance ? 3e-3 : 1e-3;
