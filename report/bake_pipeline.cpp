@@ -101,7 +101,9 @@ json ErrorJson(const ErrorStats& e) {
 std::string SceneSummaryText(const SceneSummary& s) {
   std::string out;
   Append(&out, "  scene %s:\n", s.scene.name.c_str());
-  for (const OmittedTable& t : s.plan.omitted) Append(&out, "    left out %-22s %s\n", t.table.c_str(), t.reason.c_str());
+  for (const OmittedTable& t : s.plan.omitted) {
+    Append(&out, "    left out %-22s %s\n", t.table.c_str(), t.reason.c_str());
+  }
   if (!s.plan.aerial_perspective_functions) {
     Append(&out, "    left out %-22s no aerial_perspective\n", "GetSkyRadianceToPoint");
   }

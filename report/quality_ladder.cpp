@@ -172,7 +172,8 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
   BakeSettings orders_settings = plan.base;
   orders_settings.orders = plan.max_orders;
   orders_settings.extrapolate_tail = false;
-  say("bake " + DescribeSettings(plan.base, SettingsDetail::kSamples) + ", orders 1-" + std::to_string(plan.max_orders) + " without the tail");
+  say("bake " + DescribeSettings(plan.base, SettingsDetail::kSamples) + ", orders 1-" +
+      std::to_string(plan.max_orders) + " without the tail");
   Bake(atmosphere, orders_settings, nullptr, nullptr, [&](int order, const LutSet& tables, double seconds) {
     LadderEntry e;
     e.step.knob = "orders";
