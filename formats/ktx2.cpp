@@ -579,8 +579,11 @@ std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>
   for (std::size_t i = 0; i < out.size(); ++i) {
     std::uint32_t bits = 0;
     for (std::size_t b = 0; b < channel_bytes; ++b) bits |= static_cast<std::uint32_t>(data[i * channel_bytes + b]) << (8 * b);
-    out[i] = channel_bytes == 2 ? static_cast<float>(Imath::half(Imath::half::FromBits, static_cast<std::uint16_t>(bits)))
-                                : FloatFromBits(bits);
+    if (channel_bytes == 2) {
+      out[i] = static_cast<float>(Imath::half(Imath::half::FromBits, static_cast<std::uint16_t>(bits)));
+    } else {
+      out[i] = FloatFromBits(bits);
+    }
   }
   return out;
 }
