@@ -1,0 +1,171 @@
+// The CPU bake. The structure follows Bruneton's precomputation (transmittance,
+// single scattering, then per order: scattering density, indirect irradiance,
+// multiple scattering), with four CPU-specific choices:
+//
+// * Rays are shared. Every texel of the 4D table with the same (r, mu) looks
+//   along the same ray, so the samples along it, the densities and the
+//   optical depth from the camera are computed once per ray and reused by all
+//   (mu_s, nu) texels; only the sun's transmittance and the looked-up source
+//   differ.
+// * Incoming radiance is shared. The radiance arriving at a point depends on
+//   its altitude and the sun's zenith angle, not on the view direction, so
+//   the scattering density gathers the incoming radiance once per (r, mu_s)
+//   slice and reuses it for all (mu, nu) view texels of the slice.
+// * Gathering is a weighted sum. Along a ray the scattering density J is
+//   taken as linear between samples and the rest of the integrand as
+//   exponential, so the weights are computed once per ray and each of its
+//   texels sums weight times J. Being linear in J, it can also gather the
+//   summed densities of all orders once, when each order's own radiance is
+//   gathered on a coarser grid (BakeSettings::higher_order_divisor).
+// * The innermost loops run over a ray's sun directions, in float, and
+//   vectorise (bake/float_math.h); the geometry that decides the planet's
+//   shadow stays in double.
+//   docs/benchmark.md measures each choice's time and error.
+//
+// Integrals along rays use the exponential trapezoid rule (exact when the
+// integrand varies exponentially between samples, as densities and
+// transmittances do), so a thin haze layer seen on a steep ray needs no more
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bake/bake.h"
+#include "bake/grids.h"
+#include "bake/medium.h"
+#include "bake/ray_integrals.h"
+#include "bake/sun_lookups.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake::detail {
+
+using glsl::AtmosphereParameters;
+using glsl::Texture;
+using glsl::vec3;
+using glsl::vec4;
+
+class Baker {
+ public:
+  Baker(const Atmosphere& atmosphere, const BakeSettings& settings)
+      : medium_(atmosphere),
+        settings_(settings),
+        params_(MakeAtmosphereParameters(atmosphere, settings)),
+        atmosphere_grid_(AtmosphereGrid(atmosphere, settings)),
+        orders_grid_(HigherOrderGrid(atmosphere_grid_, settings.higher_order_divisor)) {}
+
+  LutSet Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot);
+
+ private:
+  template <typename F>
+  void Phase(const std::string& name, F&& work);
+
+  // Single scattering on a grid, Rayleigh (the other groups) and Mie apart,
+  // both phase free.
+  struct SingleScattering {
+    Texture rayleigh, mie;
+  };
+
+  void ComputeTransmittance();
+  // Single scattering on `grid`, with `ray_samples` intervals per ray.
+  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples) const;
+  // Single scattering of the texels of one ray of `grid` (mu index y, r
+  // index z), n intervals, into `out`. `columns`: the grid's sun
+  // directions; `transmittance`: the transmittance table's channels.
+  void SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
+                                const ChannelPlanes& transmittance, SingleScattering& out) const;
+  // Single scattering over interval k of a ray for one sun direction, in
+  // double, for the intervals SingleScatteringAlongRay does not vectorise:
+  // optically thick, partly shadowed or crossed by the shadow edge.
+  // phase_ratio: per group, its phase over the Rayleigh phase at nu.
+  void SingleScatteringInterval(const RaySamples& ray, int k, double mu_s, double nu, const double* phase_ratio,
+                                Spectrum& rayleigh_sum, Spectrum& mie_sum) const;
+  void ComputeScatteringDensity(int order);
+  void ComputeIndirectIrradiance(int order);
+  // The light of the orders whose scattering density (per unit scattering
+  // coefficient, on the grid of `density_grid`) is `density`, arriving at
+  // every texel of a table on the grid `grid`: the density integrated along
+  // each texel's ray.
+  Texture GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
+                          const AtmosphereParameters& density_grid) const;
+  // Whether the table covers less than the whole atmosphere (a scene's bake):
+  // its grid is then not the one the orders are computed on.
+  bool TableRestricted() const { return settings_.scattering_range.has_value(); }
+  // Whether the orders are gathered on another grid than the table's, so
+  // that the table's higher orders come from one gather of their summed
+  // densities at the end.
+  bool GatherAtEnd() const { return settings_.higher_order_divisor > 1 || TableRestricted(); }
+  // Single scattering on the atmosphere's grid, the light of order 1.
+  const SingleScattering& GridSingle() const { return TableRestricted() ? grid_single_ : single_; }
+  // The scattering table: single Rayleigh plus the higher orders.
+  Texture ScatteringTable() const;
+  // MultipleScatteringPackingFactor per nu index of a grid.
+  static std::vector<double> PackingFactors(const AtmosphereParameters& grid);
+  // Mean over the texels of a table on a scattering grid, each times the
+  // factor of its nu index (1 where `per_nu` is empty).
+  static Spectrum TableMean(const Texture& table, const AtmosphereParameters& grid, const std::vector<double>& per_nu);
+  // The tables as they stand, copied (for BakeOrderSnapshot) or moved out
+  // (the result).
+  LutSet AssembleTables(Texture transmittance, Texture irradiance, Texture scattering, Texture single_mie) const;
+  double PhaseSecondsSoFar() const;
+
+  // The ray of a scattering texel row, sampled at n + 1 points.
+  RaySamples SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const;
+  // The table holds single Rayleigh scattering phase free and the higher
+  // orders divided by the Rayleigh phase, which the runtime multiplies back
+  // with the query's nu. The division uses the nu of the texel's slice, not
+  // the texel's clamped nu: where (mu, mu_s) allow a narrow range of nu (near
+  // the zenith, where the mu axis is coarse at low altitude), every slice is
+  // clamped to nearly the same geometry, and dividing by the phase at that
+  // clamped nu and multiplying by the phase at the query's nu would scale the
+  // smooth higher orders by up to P(1)/P(0) = 2.
+  static double MultipleScatteringPackingFactor(const AtmosphereParameters& grid, int nu_index) {
+    return 1.0 /
+           glsl::RayleighPhaseFunction(GetScatteringTexel(grid, nu_index * grid.scattering_mu_s_size, 0, 0).grid_nu);
+  }
+
+  // Radiance of scattering order `order` arriving at radius r from the
+  // directions with zenith cosine mu, with the sun at mu_s, excluding light
+  // reflected by the ground, as a function of nu (the cosine between the
+  // direction and the sun): the table lookups that do not depend on nu are
+  // done once, for all the azimuths of a ring of directions.
+  class IncidentAlongNu {
+   public:
+    IncidentAlongNu(const Baker& baker, int order, double r, double mu, double mu_s, bool intersects_ground);
+    vec3 At(double nu) const;
+
+   private:
+    const AtmosphereParameters& params_;
+    bool single_;  // order 1: Rayleigh and Mie tables, phases applied here
+    int nu_size_ = 0;
+    std::vector<vec3> first_, second_;  // per nu slice 0 ... nu_size
+  };
+  // Irradiance of order `order` on the ground where the sun is at mu_s.
+  vec3 GroundIrradiance(int order, double mu_s) const;
+  vec3 DirectIrradiance(double r, double mu_s) const;
+
+  Medium medium_;
+  BakeSettings settings_;
+  AtmosphereParameters params_;  // the tables'
+  // The grid over the whole atmosphere that each order's scattering density
+  // lives on: the table's, or for a table restricted to a scene's ranges
+  // one with BakeSettings::ScatteringRange's sizes.
+  AtmosphereParameters atmosphere_grid_;
+  // The grid of each order's radiance (BakeSettings::higher_order_divisor).
+  AtmosphereParameters orders_grid_;
+  BakeReport report_;
+  BakeProgress progress_;
+
+  Texture transmittance_;
+  Texture irradiance_;
+  SingleScattering single_;       // on the table's grid
+  SingleScattering grid_single_;  // on atmosphere_grid_ where the table is restricted
+  Texture delta_multiple_;        // radiance of the latest order >= 2, on orders_grid_
+  // J of the current order per unit scattering coefficient, on atmosphere_grid_.
+  Texture scattering_density_;
+  // Sum over the orders >= 2 so far, and their tail, of their radiance, or
+  // of their J where GatherAtEnd(); on atmosphere_grid_.
+  Texture higher_orders_;
+  Texture delta_irradiance_;      // ground irradiance of the latest order >= 2
+};
+
+}  // namespace skybake::detail

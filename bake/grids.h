@@ -1,0 +1,55 @@
+// The bake's grids and whole-table operations on them: the coarser grid of
+// the higher orders, a texture per scattering grid, and parallel loops over
+// a table's rows.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+
+#include <tbb/parallel_for.h>
+
+#include "core/spectrum.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake::detail {
+
+using glsl::AtmosphereParameters;
+using glsl::Texture;
+using glsl::vec3;
+using glsl::vec4;
+
+
+// The grid of each higher order's radiance: the r and mu sizes of the grid
+// of the scattering densities divided by `divisor` (mu kept even). mu_s and nu are kept: halving
+// mu_s as well raised the sky irradiance error of the report's case set
+// from 12.6% to 15.4% RMS and tripled its twilight error, as the light of
+// low suns changes fastest with mu_s.
+inline AtmosphereParameters HigherOrderGrid(AtmosphereParameters grid, int divisor) {
+  grid.scattering_r_size = std::max(2, grid.scattering_r_size / divisor);
+  grid.scattering_mu_size = std::max(4, grid.scattering_mu_size / divisor / 2 * 2);
+  return grid;
+}
+
+// target += source * factor, per channel, over the rgb of every texel.
+// f(row, first, end) over the rows of a texture (y and z) in parallel:
+// first and end are the row's texel offsets into texels.
+template <typename F>
+inline void ForEachRow(const Texture& texture, F&& f) {
+  const std::size_t row_size = std::size_t(4) * texture.width;
+  tbb::parallel_for(0, texture.height * texture.depth, [&](int row) {
+    f(row, row * row_size, (row + 1) * row_size);
+  });
+}
+
+inline void AddScaled(const Texture& source, const Spectrum& factor, Texture& target) {
+  ForEachRow(target, [&](int, std::size_t first, std::size_t end) {
+    for (std::size_t i = first; i < end; i += 4) {
+      for (int c = 0; c < 3; ++c) target.texels[i + c] += float(source.texels[i + c] * factor[c]);
+    }
+  });
+}
+
+inline Texture ScatteringGridTexture(const AtmosphereParameters& grid) {
+  return Texture(grid.scattering_nu_size * grid.scattering_mu_s_size, grid.scattering_mu_size, grid.scattering_r_size);
+}
+}  // namespace skybake::detail

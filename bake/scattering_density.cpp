@@ -1,0 +1,195 @@
+// The scattering density of an order (light of the previous order scattered
+// at a point) and the ground's indirect irradiance.
+#include "bake/baker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "bake/grids.h"
+#include "bake/phase_weighted_radiance.h"
+#include "core/constants.h"
+#include "core/quadrature.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake::detail {
+
+using glsl::AtmosphereParameters;
+using glsl::Texture;
+using glsl::vec3;
+using glsl::vec4;
+
+vec3 Baker::DirectIrradiance(double r, double mu_s) const {
+  // Cosine factor averaged over the sun's disc when it straddles the horizon.
+  double alpha = params_.sun_angular_radius;
+  double cosine = mu_s < -alpha ? 0.0 : (mu_s > alpha ? mu_s : (mu_s + alpha) * (mu_s + alpha) / (4.0 * alpha));
+  return params_.solar_irradiance *
+         glsl::GetTransmittanceToTopAtmosphereBoundary(params_, glsl::sampler2D{&transmittance_}, r, mu_s) * cosine;
+}
+
+vec3 Baker::GroundIrradiance(int order, double mu_s) const {
+  if (order == 1) return DirectIrradiance(params_.bottom_radius, mu_s);
+  return glsl::GetIrradiance(params_, glsl::sampler2D{&delta_irradiance_}, params_.bottom_radius, mu_s);
+}
+
+Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r, double mu, double mu_s,
+                                        bool intersects_ground)
+    : params_(baker.params_), single_(order == 1) {
+  const AtmosphereParameters& grid = single_ ? baker.atmosphere_grid_ : baker.orders_grid_;
+  nu_size_ = grid.scattering_nu_size;
+  // glsl::GetScattering's lookups of the nu slices 0 ... nu_size (the last
+  // clamped to the edge, as the texture unit does), which nu only blends.
+  const vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(grid, r, mu, mu_s, 0.0, intersects_ground);
+  auto slices = [&](const Texture& table, std::vector<vec3>& out) {
+    for (int slice = 0; slice <= nu_size_; ++slice) {
+      const glsl::vec3 uvw((slice + uvwz.y) / nu_size_, uvwz.z, uvwz.w);
+      out.push_back(vec3(glsl::texture(glsl::sampler3D{&table}, uvw)));
+    }
+  };
+  if (single_) {
+    slices(baker.GridSingle().rayleigh, first_);
+    slices(baker.GridSingle().mie, second_);
+  } else {
+    slices(baker.delta_multiple_, first_);
+  }
+}
+
+vec3 Baker::IncidentAlongNu::At(double nu) const {
+  // glsl::GetScattering's blend of the two slices around nu.
+  const double coordinate = (nu + 1.0) / 2.0 * (nu_size_ - 1);
+  const double slice = std::floor(coordinate), lerp = coordinate - slice;
+  const int i = std::clamp(static_cast<int>(slice), 0, nu_size_ - 1);
+  const vec3 first = first_[i] * (1.0 - lerp) + first_[i + 1] * lerp;
+  if (!single_) return first;
+  const vec3 mie = second_[i] * (1.0 - lerp) + second_[i + 1] * lerp;
+  return first * glsl::RayleighPhaseFunction(nu) + mie * glsl::MiePhaseFunction(params_, nu);
+}
+
+void Baker::ComputeScatteringDensity(int order) {
+  const AtmosphereParameters& grid = atmosphere_grid_;
+  const int mu_s_size = grid.scattering_mu_s_size, r_size = grid.scattering_r_size;
+  const int nu_size = grid.scattering_nu_size, mu_size = grid.scattering_mu_size;
+  const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
+  const double d_phi = 2.0 * kPi / azimuths;
+  const int groups = static_cast<int>(medium_.groups().size());
+  const vec3 albedo_over_pi = medium_.atmosphere().ground_albedo / kPi;
+  const glsl::sampler2D transmittance{&transmittance_};
+
+  const SunColumns columns(grid);
+  tbb::parallel_for(0, r_size * mu_s_size, [&](int slice) {
+    int z = slice / mu_s_size, mu_s_index = slice % mu_s_size;
+    const ScatteringTexel slice_texel = GetScatteringTexel(grid, mu_s_index, 0, z);
+    const double r = slice_texel.r, mu_s = slice_texel.mu_s;
+    // Local frame: zenith along z, sun in the x-z plane.
+    const vec3 zenith(0.0, 0.0, 1.0);
+    const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+
+    // Polar nodes in cos(theta), a Gauss-Legendre rule on each side of the
+    // horizon: the incident radiance jumps there (long grazing sky paths
+    // above, the ground below), which a rule spanning it converges on slowly.
+    std::vector<double> cosines, cosine_weights;
+    const double horizon = -std::sqrt(std::max(0.0, 1.0 - (params_.bottom_radius / r) * (params_.bottom_radius / r)));
+    AppendGaussLegendre(polar / 2, -1.0, horizon, cosines, cosine_weights);
+    AppendGaussLegendre(polar - polar / 2, horizon, 1.0, cosines, cosine_weights);
+
+    // Incoming radiance (of the previous order) from every direction.
+    std::vector<vec3> directions, radiance;
+    std::vector<double> solid_angles;
+    directions.reserve(polar * azimuths);
+    for (int l = 0; l < polar; ++l) {
+      double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+      bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
+      double ground_distance = 0.0;
+      vec3 ground_transmittance(0.0);
+      if (intersects) {
+        ground_distance = glsl::DistanceToBottomAtmosphereBoundary(params_, r, cos_theta);
+        ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
+      }
+      const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
+      for (int m = 0; m < azimuths; ++m) {
+        double phi = (m + 0.5) * d_phi;
+        vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+        double nu = glsl::ClampCosine(glm::dot(omega, sun));
+        vec3 incident = incident_ring.At(nu);
+        if (intersects) {
+          vec3 ground_normal = glm::normalize(zenith * r + omega * ground_distance);
+          double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
+          incident += ground_transmittance * albedo_over_pi * GroundIrradiance(order - 1, ground_mu_s);
+        }
+        directions.push_back(omega);
+        radiance.push_back(incident);
+        solid_angles.push_back(cosine_weights[l] * d_phi);
+      }
+    }
+
+    std::vector<double> densities(medium_.constituent_count());
+    medium_.Densities(r - params_.bottom_radius, densities.data());
+    std::vector<Spectrum> group_scattering(groups);
+    Spectrum total_scattering(0.0);
+    for (int g = 0; g < groups; ++g) {
+      group_scattering[g] = medium_.GroupScattering(g, densities.data());
+      total_scattering += group_scattering[g];
+    }
+
+    const PhaseWeightedRadiance incoming(directions, radiance, solid_angles);
+    for (int y = 0; y < mu_size; ++y) {
+      const double mu = GetScatteringTexel(grid, mu_s_index, y, z).mu;
+      for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+        int x = nu_index * mu_s_size + mu_s_index;
+        const double nu = ClampedNu(columns.grid_nu[x], mu, mu_s);
+        // View direction with zenith cosine mu and sun cosine nu.
+        double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+        double sin_mu_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+        double cos_phi = sin_mu * sin_mu_s > 0.0 ? std::clamp((nu - mu * mu_s) / (sin_mu * sin_mu_s), -1.0, 1.0) : 1.0;
+        vec3 view(sin_mu * cos_phi, sin_mu * std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi)), mu);
+        vec3 density(0.0);
+        for (int g = 0; g < groups; ++g) {
+          if (group_scattering[g] == Spectrum(0.0)) continue;
+          density += group_scattering[g] * incoming.Mean(medium_.groups()[g].phase, view);
+        }
+        // Stored per unit scattering coefficient, i.e. as the phase-weighted
+        // mean incoming radiance, which varies slowly with altitude; the
+        // multiple-scattering integral multiplies the coefficient back at
+        // each sample. Interpolating J itself between r texels overestimates
+        // a thin exponential haze (linear interpolation of a convex profile),
+        // so that an order could carry more light than the previous one and
+        // the orders of a dense fog diverged.
+        vec3 per_unit_scattering(0.0);
+        for (int c = 0; c < 3; ++c) per_unit_scattering[c] = total_scattering[c] > 0.0 ? density[c] / total_scattering[c] : 0.0;
+        scattering_density_.Store(x, y, z, vec4(per_unit_scattering, 0.0));
+      }
+    }
+  });
+}
+
+void Baker::ComputeIndirectIrradiance(int order) {
+  const int width = irradiance_.width, height = irradiance_.height;
+  const int polar = settings_.sphere_samples, azimuths = 4 * settings_.sphere_samples;
+  const double d_theta = 0.5 * kPi / polar, d_phi = 2.0 * kPi / azimuths;
+  tbb::parallel_for(0, height, [&](int y) {
+    for (int x = 0; x < width; ++x) {
+      double r, mu_s;
+      glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu_s);
+      const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+      vec3 result(0.0);
+      for (int l = 0; l < polar; ++l) {
+        double theta = (l + 0.5) * d_theta;
+        double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+        const IncidentAlongNu incident_ring(*this, order, r, cos_theta, mu_s, false);
+        for (int m = 0; m < azimuths; ++m) {
+          double phi = (m + 0.5) * d_phi;
+          vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+          double nu = glsl::ClampCosine(glm::dot(omega, sun));
+          result += incident_ring.At(nu) * (cos_theta * sin_theta * d_theta * d_phi);
+        }
+      }
+      delta_irradiance_.Store(x, y, 0, vec4(result, 0.0));
+      vec4 total = irradiance_.Fetch(x, y) + vec4(result, 0.0);
+      irradiance_.Store(x, y, 0, total);
+    }
+  });
+}
+}  // namespace skybake::detail

@@ -1,0 +1,240 @@
+// The sun seen from the samples of a ray, for all of the ray's sun
+// directions at once: the directions of a scattering grid's texels, and the
+// transmittance table's optical depth and the visible fraction of the sun's
+// disc, in float and vectorised.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "bake/bake.h"
+#include "bake/float_math.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake::detail {
+
+using glsl::AtmosphereParameters;
+using glsl::Texture;
+using glsl::vec3;
+using glsl::vec4;
+
+
+// Per texel column x of a scattering grid, the sun's cosine mu_s and the
+// nu of the column's slice: they depend on x alone.
+struct SunColumns {
+  std::vector<double> mu_s, grid_nu;
+  int mu_s_size = 0, nu_size = 0;
+  explicit SunColumns(const AtmosphereParameters& grid)
+      : mu_s_size(grid.scattering_mu_s_size), nu_size(grid.scattering_nu_size) {
+    for (int x = 0; x < mu_s_size * nu_size; ++x) {
+      const ScatteringTexel texel = GetScatteringTexel(grid, x, 0, 0);
+      mu_s.push_back(texel.mu_s), grid_nu.push_back(texel.grid_nu);
+    }
+  }
+};
+
+// The distinct sun directions of one ray (view cosine mu) of a scattering
+// grid: its (mu_s, nu) texels, nu clamped as GetScatteringTexel clamps it to
+// the range that mu and mu_s allow, with the slices that clamping gave the
+// same nu merged, as their integrals are the same.
+struct SunDirections {
+  std::vector<double> mu_s, nu;  // per direction
+  std::vector<int> of_texel;     // texel x -> direction
+};
+
+inline SunDirections RaySunDirections(const SunColumns& columns, double mu) {
+  SunDirections directions;
+  directions.of_texel.resize(columns.mu_s.size());
+  for (int mu_s_index = 0; mu_s_index < columns.mu_s_size; ++mu_s_index) {
+    for (int nu_index = 0; nu_index < columns.nu_size; ++nu_index) {
+      const int x = nu_index * columns.mu_s_size + mu_s_index;
+      const double mu_s = columns.mu_s[x];
+      const double nu = ClampedNu(columns.grid_nu[x], mu, mu_s);
+      if (nu_index == 0 || nu != directions.nu.back()) {
+        directions.mu_s.push_back(mu_s);
+        directions.nu.push_back(nu);
+      }
+      directions.of_texel[x] = static_cast<int>(directions.nu.size()) - 1;
+    }
+  }
+  return directions;
+}
+
+// The rgb of a 2D texture as one plane per channel (gathers of one channel).
+struct ChannelPlanes {
+  int width = 0, height = 0;
+  std::vector<float> channel[3];
+  explicit ChannelPlanes(const Texture& texture) : width(texture.width), height(texture.height) {
+    for (int c = 0; c < 3; ++c) {
+      channel[c].resize(std::size_t(width) * height);
+      for (std::size_t i = 0; i < channel[c].size(); ++i) channel[c][i] = texture.texels[4 * i + c];
+    }
+  }
+};
+
+// The transmittance table's x in texels for a ray from radius r (with
+// c = top^2 - r^2, d_min = top - r and scale = (width - 1) / (d_max - d_min))
+// in direction mu: glsl::DistanceToTopAtmosphereBoundary, then
+// GetTransmittanceTextureUvFromRMu's x, in float.
+inline float TransmittanceTableX(float r, float c, float d_min, float scale, float mu, float last) {
+  const float r_mu = r * mu;
+  const float s = std::sqrt(std::max(r_mu * r_mu + c, 0.0f));
+  const float d = std::max(r_mu > 0.0f ? c / (r_mu + s) : s - r_mu, 0.0f);
+  return ClampFloat((d - d_min) * scale, 0.0f, last);
+}
+
+class SunAtRadius {
+ public:
+  SunAtRadius(const AtmosphereParameters& params, const ChannelPlanes& transmittance)
+      : params_(params), transmittance_(transmittance) {
+    for (auto& row : row_) row.resize(transmittance.width);
+  }
+
+  void SetRadius(double r) {
+    const AtmosphereParameters& p = params_;
+    r = std::clamp(r, p.bottom_radius, p.top_radius);
+    const double horizon_at_top = glsl::HorizonDistanceAtTop(p), rho = glsl::HorizonDistance(p, r);
+    const double d_min = p.top_radius - r, d_max = rho + horizon_at_top;
+    r_ = float(r);
+    c_ = float((p.top_radius - r) * (p.top_radius + r));
+    d_min_ = float(d_min);
+    scale_ = d_max > d_min ? float((transmittance_.width - 1) / (d_max - d_min)) : 0.0f;
+    int y0, y1;
+    double fy;
+    glsl::detail::LinearTaps(glsl::GetTextureCoordFromUnitRange(rho / horizon_at_top, transmittance_.height),
+                             transmittance_.height, y0, y1, fy);
+    // The two rows around the radius, blended once for all directions.
+    const int width = transmittance_.width;
+    const float weight = float(fy);
+    for (int channel = 0; channel < 3; ++channel) {
+      const float* a = transmittance_.channel[channel].data() + std::size_t(y0) * width;
+      const float* b = transmittance_.channel[channel].data() + std::size_t(y1) * width;
+      float* row = row_[channel].data();
+#pragma omp simd
+      for (int x = 0; x < width; ++x) row[x] = a[x] + weight * (b[x] - a[x]);
+    }
+    const double sin_horizon = p.bottom_radius / r;
+    horizon_cosine_ = float(-std::sqrt(std::max(0.0, 1.0 - sin_horizon * sin_horizon)));
+    half_disc_ = float(sin_horizon * p.sun_angular_radius);
+  }
+
+  // For `count` sun cosines: the optical depth per channel into tau[c][j]
+  // and the visible fraction into visible[j].
+  void Evaluate(const float* mu_s, int count, std::vector<float> (&tau)[3], float* visible) {
+    const float r = r_, c = c_, d_min = d_min_, scale = scale_;
+    const float horizon = horizon_cosine_, half_disc = half_disc_;
+    const float last = float(transmittance_.width - 1);
+    const int last_left = transmittance_.width - 2;
+    if (int(left_.size()) < count) left_.resize(count), weight_.resize(count);
+    int* left = left_.data();
+    float* weight = weight_.data();
+#pragma omp simd
+    for (int j = 0; j < count; ++j) {
+      const float x = TransmittanceTableX(r, c, d_min, scale, mu_s[j], last);
+      left[j] = std::min(static_cast<int>(x), last_left);
+      weight[j] = x - float(left[j]);
+      visible[j] = SmoothstepFloat(-half_disc, half_disc, mu_s[j] - horizon);
+    }
+    for (int channel = 0; channel < 3; ++channel) {
+      const float* row = row_[channel].data();
+      float* out = tau[channel].data();
+#pragma omp simd
+      for (int j = 0; j < count; ++j) out[j] = row[left[j]] + weight[j] * (row[left[j] + 1] - row[left[j]]);
+    }
+  }
+
+ private:
+  const AtmosphereParameters& params_;
+  const ChannelPlanes& transmittance_;  // optical depth
+  std::vector<int> left_;               // per direction: the left tap along x
+  std::vector<float> weight_;           // and the right one's weight
+  std::vector<float> row_[3];           // per channel, the table interpolated to the radius
+  float r_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, scale_ = 0.0f, horizon_cosine_ = 0.0f, half_disc_ = 0.0f;
+};
+
+// The same for points at different radii (each its own bilinear lookup):
+// for the sub-intervals of the partly shadowed intervals of a ray, batched.
+class SunAtPoints {
+ public:
+  SunAtPoints(const AtmosphereParameters& params, const ChannelPlanes& transmittance)
+      : params_(params), transmittance_(transmittance) {}
+
+  // For `count` points at radii r[l] with sun cosines mu_s[l]: the optical
+  // depth per channel into tau[c][l] and the visible fraction into visible[l].
+  void Evaluate(const float* r_in, const float* mu_s, int count, std::vector<float> (&tau)[3], float* visible) const {
+    const AtmosphereParameters& p = params_;
+    const float bottom = float(p.bottom_radius), top = float(p.top_radius);
+    const float horizon_at_top = float(glsl::HorizonDistanceAtTop(p)), angular_radius = float(p.sun_angular_radius);
+    const int width = transmittance_.width, height = transmittance_.height;
+    const float last_x = float(width - 1), last_y = float(height - 1);
+    const int last_left = width - 2, last_low = std::max(height - 2, 0);
+    const float *plane0 = transmittance_.channel[0].data(), *plane1 = transmittance_.channel[1].data(),
+                *plane2 = transmittance_.channel[2].data();
+    float *tau0 = tau[0].data(), *tau1 = tau[1].data(), *tau2 = tau[2].data();
+#pragma omp simd
+    for (int l = 0; l < count; ++l) {
+      const float r = ClampFloat(r_in[l], bottom, top);
+      const float rho = std::sqrt(std::max((r - bottom) * (r + bottom), 0.0f));
+      const float d_min = top - r, d_max = rho + horizon_at_top;
+      const float scale = d_max > d_min ? last_x / (d_max - d_min) : 0.0f;
+      const float x = TransmittanceTableX(r, (top - r) * (top + r), d_min, scale, mu_s[l], last_x);
+      const float y = ClampFloat(rho / horizon_at_top * last_y, 0.0f, last_y);
+      const int i = std::min(static_cast<int>(x), last_left), k = std::min(static_cast<int>(y), last_low);
+      const float fx = x - float(i), fy = y - float(k);
+      const int t00 = k * width + i, t10 = t00 + 1, t01 = std::min(k + 1, height - 1) * width + i, t11 = t01 + 1;
+      const float a0 = plane0[t00] + fx * (plane0[t10] - plane0[t00]), b0 = plane0[t01] + fx * (plane0[t11] - plane0[t01]);
+      const float a1 = plane1[t00] + fx * (plane1[t10] - plane1[t00]), b1 = plane1[t01] + fx * (plane1[t11] - plane1[t01]);
+      const float a2 = plane2[t00] + fx * (plane2[t10] - plane2[t00]), b2 = plane2[t01] + fx * (plane2[t11] - plane2[t01]);
+      tau0[l] = a0 + fy * (b0 - a0), tau1[l] = a1 + fy * (b1 - a1), tau2[l] = a2 + fy * (b2 - a2);
+      const float sin_horizon = bottom / r;
+      const float horizon = -std::sqrt(std::max(1.0f - sin_horizon * sin_horizon, 0.0f));
+      const float half_disc = sin_horizon * angular_radius;
+      visible[l] = SmoothstepFloat(-half_disc, half_disc, mu_s[l] - horizon);
+    }
+  }
+
+ private:
+  const AtmosphereParameters& params_;
+  const ChannelPlanes& transmittance_;  // optical depth
+};
+
+// glsl::GetScatteringTextureUMuS in float, as the left tap and weight of the
+// linear interpolation along mu_s (vectorisable).
+class MuSCoordinate {
+ public:
+  explicit MuSCoordinate(const AtmosphereParameters& grid) {
+    const double top = grid.top_radius, bottom = grid.bottom_radius;
+    const double d_min = top - bottom, d_max = glsl::HorizonDistanceAtTop(grid);
+    const double big_d = glsl::DistanceToTopAtmosphereBoundary(grid, bottom, grid.scattering_mu_s_min);
+    bottom_ = float(bottom), c_ = float((top - bottom) * (top + bottom)), d_min_ = float(d_min);
+    inverse_span_ = float(1.0 / (d_max - d_min)), inverse_a_ = float((d_max - d_min) / (big_d - d_min));
+    last_ = float(grid.scattering_mu_s_size - 1), last_left_ = grid.scattering_mu_s_size - 2;
+    scale_ = float((grid.scattering_mu_s_size - 1) / glsl::GetScatteringUnitMuS(grid, grid.scattering_mu_s_max));
+  }
+  // For `count` sun cosines: the position along the mu_s axis in texels
+  // (in [0, size - 1]) split into a left tap (whose right neighbour exists)
+  // and the weight of the right one.
+  void Taps(const float* mu_s, int count, int* left, float* weight) const {
+    const float bottom = bottom_, c = c_, d_min = d_min_, inverse_span = inverse_span_, inverse_a = inverse_a_;
+    const float last = last_, scale = scale_;
+    const int last_left = last_left_;
+#pragma omp simd
+    for (int j = 0; j < count; ++j) {
+      const float r_mu = bottom * mu_s[j];
+      const float s = std::sqrt(std::max(r_mu * r_mu + c, 0.0f));
+      const float d = std::max(r_mu > 0.0f ? c / (r_mu + s) : s - r_mu, 0.0f);
+      const float a = (d - d_min) * inverse_span;
+      const float position = ClampFloat(std::max(1.0f - a * inverse_a, 0.0f) / (1.0f + a) * scale, 0.0f, last);
+      const int i = std::min(static_cast<int>(position), last_left);
+      left[j] = i;
+      weight[j] = position - float(i);
+    }
+  }
+
+ private:
+  float bottom_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, inverse_span_ = 0.0f, inverse_a_ = 0.0f, last_ = 0.0f, scale_ = 0.0f;
+  int last_left_ = 0;
+};
+}  // namespace skybake::detail
