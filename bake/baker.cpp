@@ -20,12 +20,6 @@
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 template <typename F>
 void Baker::Phase(const std::string& name, F&& work) {
   auto start = std::chrono::steady_clock::now();

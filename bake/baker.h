@@ -31,19 +31,13 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "bake/detail.h"
 #include "bake/grids.h"
 #include "bake/medium.h"
 #include "bake/ray_integrals.h"
 #include "bake/sun_lookups.h"
-#include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 class Baker {
  public:
   Baker(const Atmosphere& atmosphere, const BakeSettings& settings)

@@ -14,12 +14,6 @@
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
                                const AtmosphereParameters& density_grid) const {
   Texture result = ScatteringGridTexture(grid);

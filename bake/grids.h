@@ -8,22 +8,15 @@
 
 #include <tbb/parallel_for.h>
 
+#include "bake/detail.h"
 #include "core/spectrum.h"
-#include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
 
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
-
 // The grid of each higher order's radiance: the r and mu sizes of the grid
-// of the scattering densities divided by `divisor` (mu kept even). mu_s and nu are kept: halving
-// mu_s as well raised the sky irradiance error of the report's case set
-// from 12.6% to 15.4% RMS and tripled its twilight error, as the light of
-// low suns changes fastest with mu_s.
+// of the scattering densities divided by `divisor` (mu kept even). mu_s and
+// nu keep their sizes, as the light of low suns changes fastest with mu_s
+// (docs/benchmark.md measures the divisor's error).
 inline AtmosphereParameters HigherOrderGrid(AtmosphereParameters grid, int divisor) {
   grid.scattering_r_size = std::max(2, grid.scattering_r_size / divisor);
   grid.scattering_mu_size = std::max(4, grid.scattering_mu_size / divisor / 2 * 2);

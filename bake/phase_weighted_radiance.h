@@ -7,15 +7,9 @@
 #include <vector>
 
 #include "bake/atmosphere.h"
-#include "shaders_runtime/runtime.h"
+#include "bake/detail.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 
 // The incoming radiance at a point, sampled in a set of directions with
 // their solid angles, and its mean over them weighted by a phase function

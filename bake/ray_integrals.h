@@ -9,17 +9,11 @@
 #include <utility>
 #include <vector>
 
+#include "bake/detail.h"
 #include "core/constants.h"
 #include "core/spectrum.h"
-#include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 
 // Integral over an interval of width h of a positive function that takes the
 // values a and b at its ends, assuming it is exponential in between; the

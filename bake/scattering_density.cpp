@@ -16,12 +16,6 @@
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 vec3 Baker::DirectIrradiance(double r, double mu_s) const {
   // Cosine factor averaged over the sun's disc when it straddles the horizon.
   double alpha = params_.sun_angular_radius;

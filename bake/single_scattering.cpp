@@ -14,12 +14,6 @@
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 // Intervals of a ray that are partly shadowed (the planet's shadow edge
 // crosses them, or the sun's disc is partly hidden) are integrated on this
 // many sub-intervals: the shadow edge moves the integrand from lit to dark

@@ -10,16 +10,10 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "bake/detail.h"
 #include "bake/float_math.h"
-#include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
-
-using glsl::AtmosphereParameters;
-using glsl::Texture;
-using glsl::vec3;
-using glsl::vec4;
-
 
 // Per texel column x of a scattering grid, the sun's cosine mu_s and the
 // nu of the column's slice: they depend on x alone.
