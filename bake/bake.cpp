@@ -17,24 +17,15 @@
 
 namespace skybake {
 
-using glsl::vec4;
-
 ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z) {
-  const int mu_s_size = parameters.scattering_mu_s_size;
-  int nu_index = x / mu_s_size, mu_s_index = x % mu_s_size;
-  vec4 uvwz(double(nu_index) / (parameters.scattering_nu_size - 1), (mu_s_index + 0.5) / mu_s_size,
-            (y + 0.5) / parameters.scattering_mu_size, (z + 0.5) / parameters.scattering_r_size);
   ScatteringTexel t;
-  glsl::GetRMuMuSNuFromScatteringTextureUvwz(parameters, uvwz, t.r, t.mu, t.mu_s, t.grid_nu,
-                                             t.ray_intersects_ground);
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(parameters, glsl::GetScatteringTextureUvwzFromTexel(parameters, x, y, z),
+                                             t.r, t.mu, t.mu_s, t.grid_nu, t.ray_intersects_ground);
   t.nu = ClampedNu(t.grid_nu, t.mu, t.mu_s);
   return t;
 }
 
-double ClampedNu(double nu, double mu, double mu_s) {
-  const double spread = std::sqrt(std::max(0.0, (1.0 - mu * mu) * (1.0 - mu_s * mu_s)));
-  return std::clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
-}
+double ClampedNu(double nu, double mu, double mu_s) { return glsl::ClampNuToDirections(nu, mu, mu_s); }
 
 double EstimatedBakeBytes(const BakeSettings& s) {
   constexpr double kFixedBytes = 160.0 * 1024.0 * 1024.0, kBytesPerTexel = 160.0;

@@ -67,3 +67,24 @@ void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2
   r = sqrt(rho * rho + atmosphere.bottom_radius * atmosphere.bottom_radius);
   mu_s = ClampCosine(atmosphere.mu_s_min + x_mu_s * (1.0 - atmosphere.mu_s_min));
 }
+
+// The texture coordinates uvwz of texel (x, y, z) of a scattering table as
+// GetScattering reads it: x = nu index * mu_s size + mu_s index; texel centres
+// on the mu_s, mu and r axes, and on the nu axis the slice's own coordinate
+// index / (nu size - 1), at which GetScattering reads that slice alone.
+vec4 GetScatteringTextureUvwzFromTexel(IN(AtmosphereParameters) atmosphere, int x, int y, int z) {
+  int mu_s_size = atmosphere.scattering_mu_s_size;
+  int nu_index = x / mu_s_size;
+  int mu_s_index = x - nu_index * mu_s_size;
+  return vec4(Number(nu_index) / Number(atmosphere.scattering_nu_size - 1),
+              (Number(mu_s_index) + 0.5) / Number(mu_s_size),
+              (Number(y) + 0.5) / Number(atmosphere.scattering_mu_size),
+              (Number(z) + 0.5) / Number(atmosphere.scattering_r_size));
+}
+
+// nu clamped to the range that the view and sun zenith cosines allow:
+// nu = mu mu_s + sqrt((1 - mu^2)(1 - mu_s^2)) cos(azimuth), azimuth in [0, pi].
+Number ClampNuToDirections(Number nu, Number mu, Number mu_s) {
+  Number spread = SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
+  return clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
+}

@@ -2,7 +2,11 @@
 // agree (map, inverse map, round trip), including at the horizon split.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
+
+#include <glm/geometric.hpp>
 
 #include "bake/bake.h"
 #include "shaders_runtime/runtime.h"
@@ -113,6 +117,26 @@ TEST(Parameterization, MuSAxisSpansLowestSunToZenith) {
   EXPECT_NEAR(mu_s, p.mu_s_min, 1e-9);
   glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 1.0 - 0.5 / n, 0.75, 0.5), r, mu, mu_s, nu, ground);
   EXPECT_NEAR(mu_s, 1.0, 1e-9);
+}
+
+// nu of two unit vectors built from their zenith cosines and an azimuth
+// difference stays as it is; a nu beyond what the cosines allow goes to the
+// nearest of the two directions at azimuth 0 and pi.
+TEST(Parameterization, NuIsClampedToTheDirectionsTheCosinesAllow) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> cosine(-1.0, 1.0), azimuth(0.0, 3.141592653589793);
+  for (int i = 0; i < 1000; ++i) {
+    const double mu = cosine(random), mu_s = cosine(random), phi = azimuth(random);
+    const glsl::vec3 view(std::sqrt(1.0 - mu * mu), 0.0, mu);
+    const glsl::vec3 sun(std::sqrt(1.0 - mu_s * mu_s) * std::cos(phi), std::sqrt(1.0 - mu_s * mu_s) * std::sin(phi),
+                         mu_s);
+    const double nu = glm::dot(view, sun);
+    EXPECT_NEAR(ClampedNu(nu, mu, mu_s), nu, 1e-12);
+    const glsl::vec3 toward(sun.x >= 0.0 ? std::sqrt(1.0 - mu_s * mu_s) : -std::sqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+    const glsl::vec3 away(-toward.x, 0.0, mu_s);
+    EXPECT_NEAR(ClampedNu(2.0, mu, mu_s), std::max(glm::dot(view, toward), glm::dot(view, away)), 1e-12);
+    EXPECT_NEAR(ClampedNu(-2.0, mu, mu_s), std::min(glm::dot(view, toward), glm::dot(view, away)), 1e-12);
+  }
 }
 
 TEST(Parameterization, IrradianceRoundTrip) {
