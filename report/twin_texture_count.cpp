@@ -35,6 +35,7 @@ vec4 texture(const CountingSampler3D& s, const vec3& uvw) {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
 #include "shaders_runtime/functions.glsl"
+#include "shaders_runtime/aerial_perspective.glsl"
 #pragma GCC diagnostic pop
 #undef IN
 #undef OUT

@@ -1,6 +1,6 @@
 // The GLSL runtime compiled as C++ (double precision): every function of
-// functions.glsl and inverse_parameterization.glsl, in namespace
-// skybake::glsl. The bake uses the parameterization and lookups; the CPU twin
+// functions.glsl, aerial_perspective.glsl and inverse_parameterization.glsl,
+// in namespace skybake::glsl. The bake uses the parameterization and lookups; the CPU twin
 // (twin.h) uses the run-time functions. Each translation unit gets its own
 // internal copy, as GLSL functions cannot be declared inline.
 #pragma once
@@ -18,6 +18,7 @@ namespace {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
 #include "shaders_runtime/functions.glsl"
+#include "shaders_runtime/aerial_perspective.glsl"
 #include "shaders_runtime/inverse_parameterization.glsl"
 #pragma GCC diagnostic pop
 }  // namespace

@@ -86,6 +86,11 @@ std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& p, const g
   return s;
 }
 
+std::string RuntimeFunctionsGlsl() {
+  // The engine's functions.glsl: the sources in their order of definition.
+  return std::string(EmbeddedShader("functions.glsl")) + std::string(EmbeddedShader("aerial_perspective.glsl"));
+}
+
 std::vector<SnippetFile> RuntimeSnippetFiles(const glsl::AtmosphereParameters& parameters,
                                              const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name,
                                              const SnippetParts& parts) {
@@ -94,7 +99,7 @@ std::vector<SnippetFile> RuntimeSnippetFiles(const glsl::AtmosphereParameters& p
        "GLSL runtime, part 1 of 3: types and precision"},
       {"atmosphere_constants.glsl", AtmosphereConstantsGlsl(parameters, wavelengths_nm, atmosphere_name, parts),
        "GLSL runtime, part 2 of 3: this bake's constants (ATMOSPHERE)"},
-      {"functions.glsl", std::string(EmbeddedShader("functions.glsl")),
+      {"functions.glsl", RuntimeFunctionsGlsl(),
        "GLSL runtime, part 3 of 3: sky radiance, aerial perspective, irradiance"},
   };
 }

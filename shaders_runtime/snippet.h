@@ -31,6 +31,11 @@ struct SnippetParts {
 std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& parameters, const glsl::vec3& wavelengths_nm,
                                     const std::string& atmosphere_name, const SnippetParts& parts = {});
 
+// The shipped functions.glsl: shaders_runtime/functions.glsl (geometry,
+// parameterization, lookups, sky radiance) followed by
+// shaders_runtime/aerial_perspective.glsl (aerial perspective, irradiance).
+std::string RuntimeFunctionsGlsl();
+
 // The shipped files, in the order a shader must include them.
 std::vector<SnippetFile> RuntimeSnippetFiles(const glsl::AtmosphereParameters& parameters,
                                              const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name,

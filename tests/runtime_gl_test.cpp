@@ -231,8 +231,9 @@ TEST(RuntimeSnippet, BakeWritesItWithConstantsFromTheManifestParameters) {
   std::vector<std::string> listed;
   for (const ManifestFile& f : manifest.shader_files) listed.push_back(f.file);
   EXPECT_EQ(listed, (std::vector<std::string>{"definitions.glsl", "atmosphere_constants.glsl", "functions.glsl"}));
+  const std::filesystem::path sources = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "shaders_runtime";
   EXPECT_EQ(testing::ReadText(lut / "functions.glsl"),
-            testing::ReadText(std::filesystem::path(SKYBAKE_SOURCE_DIR) / "shaders_runtime/functions.glsl"));
+            testing::ReadText(sources / "functions.glsl") + testing::ReadText(sources / "aerial_perspective.glsl"));
 }
 
 // ---- glslangValidator ----
