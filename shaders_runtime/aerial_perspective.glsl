@@ -161,20 +161,14 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
     return vec3(0.0);
   }
   vec3 view_ray = normalize(camera_to_point);
-  Number r = length(camera);
-  Number r_mu = dot(camera, view_ray);
-  if (r > atmosphere.top_radius) {
-    Number c = (r - atmosphere.top_radius) * (r + atmosphere.top_radius);
-    Number disc = r_mu * r_mu - c;
-    if (r_mu >= 0.0 || disc < 0.0) {
-      transmittance = vec3(1.0);
-      return vec3(0.0);
-    }
-    Number distance_to_top = c / (SafeSqrt(disc) - r_mu);
-    camera = camera + view_ray * distance_to_top;
-    r = atmosphere.top_radius;
-    r_mu += distance_to_top;
+  vec3 entry;
+  Number r;
+  Number r_mu;
+  if (!EnterAtmosphere(atmosphere, camera, view_ray, entry, r, r_mu)) {
+    transmittance = vec3(1.0);
+    return vec3(0.0);
   }
+  camera = entry;
   Number mu = ClampCosine(r_mu / r);
   Number mu_s = ClampCosine(dot(camera, sun_direction) / r);
   Number nu = ClampCosine(dot(view_ray, sun_direction));

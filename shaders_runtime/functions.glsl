@@ -94,6 +94,29 @@ Number CosineAtDistance(Number r, Number mu, Number d, Number r_d) {
   return ClampCosine((r * mu + d) / r_d);
 }
 
+// Where a ray from `camera` along `view_ray` starts inside the atmosphere:
+// the camera itself if it is inside, else the entry point at the near root d
+// of the ray / top-sphere quadratic d^2 + 2 r_mu d + r^2 - top^2 = 0, written
+// as c / (sqrt(disc) - r_mu) to avoid cancellation. r and r_mu =
+// dot(entry, view_ray) are those of the entry. False if the ray misses the
+// atmosphere.
+bool EnterAtmosphere(IN(AtmosphereParameters) atmosphere, IN(vec3) camera, IN(vec3) view_ray, OUT(vec3) entry,
+                     OUT(Number) r, OUT(Number) r_mu) {
+  entry = camera;
+  r = length(camera);
+  r_mu = dot(camera, view_ray);
+  if (r > atmosphere.top_radius) {
+    Number c = (r - atmosphere.top_radius) * (r + atmosphere.top_radius);
+    Number disc = r_mu * r_mu - c;
+    if (r_mu >= 0.0 || disc < 0.0) return false;
+    Number distance_to_top = c / (SafeSqrt(disc) - r_mu);
+    entry = camera + view_ray * distance_to_top;
+    r = atmosphere.top_radius;
+    r_mu += distance_to_top;
+  }
+  return true;
+}
+
 // ---------------------------------------------------------------------------
 // Texture coordinates. A table of n texels samples the unit range at texel
 // centres, so [0, 1] maps to [0.5 / n, 1 - 0.5 / n].
@@ -360,21 +383,14 @@ vec3 GetCombinedScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTex
 vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
                     IN(ScatteringTexture) scattering_texture, IN(ScatteringTexture) single_mie_scattering_texture,
                     vec3 camera, IN(vec3) view_ray, IN(vec3) sun_direction, OUT(vec3) transmittance) {
-  Number r = length(camera);
-  Number r_mu = dot(camera, view_ray);
-  if (r > atmosphere.top_radius) {
-    // Distance to the entry point: the near root of the ray / top-sphere quadratic.
-    Number c = (r - atmosphere.top_radius) * (r + atmosphere.top_radius);
-    Number disc = r_mu * r_mu - c;
-    if (r_mu >= 0.0 || disc < 0.0) {
-      transmittance = vec3(1.0);
-      return vec3(0.0);
-    }
-    Number distance_to_top = c / (SafeSqrt(disc) - r_mu);
-    camera = camera + view_ray * distance_to_top;
-    r = atmosphere.top_radius;
-    r_mu += distance_to_top;
+  vec3 entry;
+  Number r;
+  Number r_mu;
+  if (!EnterAtmosphere(atmosphere, camera, view_ray, entry, r, r_mu)) {
+    transmittance = vec3(1.0);
+    return vec3(0.0);
   }
+  camera = entry;
   Number mu = ClampCosine(r_mu / r);
   Number mu_s = ClampCosine(dot(camera, sun_direction) / r);
   Number nu = ClampCosine(dot(view_ray, sun_direction));
