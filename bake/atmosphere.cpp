@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/phase.h"
+#include "shaders_runtime/primitives.h"
 
 namespace skybake {
 
@@ -60,10 +60,10 @@ std::vector<double> DensityProfile::Breakpoints() const {
 
 double PhaseFunction::Evaluate(double cos_theta) const {
   switch (kind) {
-    case PhaseKind::kIsotropic: return IsotropicPhase();
-    case PhaseKind::kRayleigh: return RayleighPhase(cos_theta);
-    case PhaseKind::kHenyeyGreenstein: return HenyeyGreensteinPhase(g, cos_theta);
-    case PhaseKind::kCornetteShanks: return CornetteShanksPhase(g, cos_theta);
+    case PhaseKind::kIsotropic: return glsl::IsotropicPhaseFunction();
+    case PhaseKind::kRayleigh: return glsl::RayleighPhaseFunction(cos_theta);
+    case PhaseKind::kHenyeyGreenstein: return glsl::HenyeyGreensteinPhaseFunction(g, cos_theta);
+    case PhaseKind::kCornetteShanks: return glsl::CornetteShanksPhaseFunction(g, cos_theta);
   }
   return 0.0;
 }

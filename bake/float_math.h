@@ -55,12 +55,4 @@ inline float ExponentialTrapezoidFloat(float a, float b, float lambda, float h) 
   return integral > 0.0f ? integral : 0.0f;
 }
 
-// GLSL's smoothstep with a width that may be 0 (then a step at edge0).
-inline float SmoothstepFloat(float edge0, float edge1, float x) {
-  const float width = edge1 - edge0;
-  float t = width > 0.0f ? (x - edge0) / width : (x >= edge0 ? 1.0f : 0.0f);
-  t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-  return t * t * (3.0f - 2.0f * t);
-}
-
 }  // namespace skybake

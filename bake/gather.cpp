@@ -104,7 +104,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     std::vector<int> nu_row0(count), nu_row1(count);  // offsets of the nu rows in a plane
     std::vector<float> nu_weight(count);
     for (int j = 0; j < count; ++j) {
-      const double nu_coord = 0.5 * (directions.nu[j] + 1.0) * (density_nu_size - 1);
+      const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (density_nu_size - 1);
       const int nu0 = std::min(int(std::floor(nu_coord)), density_nu_size - 1), nu1 = std::min(nu0 + 1, density_nu_size - 1);
       nu_row0[j] = 4 * nu0 * density_mu_s_size, nu_row1[j] = 4 * nu1 * density_mu_s_size;
       nu_weight[j] = float(nu_coord - nu0);

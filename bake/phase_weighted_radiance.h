@@ -8,6 +8,7 @@
 
 #include "bake/atmosphere.h"
 #include "bake/detail.h"
+#include "shaders_runtime/primitives.h"
 
 namespace skybake::detail {
 
@@ -64,20 +65,24 @@ class PhaseWeightedRadiance {
   }
 
  private:
-  // Henyey-Greenstein, times (1 + cos^2) for Cornette-Shanks, without their
-  // constant factors (they cancel in the normalised mean); a float loop the
-  // compiler vectorises.
+  // The mean weighted by a Henyey-Greenstein or Cornette-Shanks lobe: the
+  // runtime's phase functions, in float.
   vec3 LobeMean(double g, bool cornette_shanks, const vec3& view) const {
+    const float gf = float(g);
+    if (cornette_shanks) return WeightedMean([gf](float c) { return glsl_float::CornetteShanksPhaseFunction(gf, c); }, view);
+    return WeightedMean([gf](float c) { return glsl_float::HenyeyGreensteinPhaseFunction(gf, c); }, view);
+  }
+
+  // The mean weighted by phase(cosine to the view); a float loop the
+  // compiler vectorises.
+  template <class Phase>
+  vec3 WeightedMean(Phase phase, const vec3& view) const {
     const float vx = float(view.x), vy = float(view.y), vz = float(view.z);
-    const float a = float(1.0 + g * g), b = float(2.0 * g);
     float sr = 0.0f, sg = 0.0f, sb = 0.0f, sw = 0.0f;
     const std::size_t n = x_.size();
 #pragma omp simd reduction(+ : sr, sg, sb, sw)
     for (std::size_t i = 0; i < n; ++i) {
-      const float c = vx * x_[i] + vy * y_[i] + vz * z_[i];
-      const float denominator = a - b * c;
-      float w = w_[i] / (denominator * std::sqrt(denominator));
-      if (cornette_shanks) w *= 1.0f + c * c;
+      const float w = w_[i] * phase(vx * x_[i] + vy * y_[i] + vz * z_[i]);
       sr += w * r_[i];
       sg += w * g_[i];
       sb += w * b_[i];

@@ -53,7 +53,7 @@ Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r,
 
 vec3 Baker::IncidentAlongNu::At(double nu) const {
   // glsl::GetScattering's blend of the two slices around nu.
-  const double coordinate = (nu + 1.0) / 2.0 * (nu_size_ - 1);
+  const double coordinate = glsl::ScatteringUnitNu(nu) * (nu_size_ - 1);
   const double slice = std::floor(coordinate), lerp = coordinate - slice;
   const int i = std::clamp(static_cast<int>(slice), 0, nu_size_ - 1);
   const vec3 first = first_[i] * (1.0 - lerp) + first_[i + 1] * lerp;
@@ -85,7 +85,7 @@ void Baker::ComputeScatteringDensity(int order) {
     // horizon: the incident radiance jumps there (long grazing sky paths
     // above, the ground below), which a rule spanning it converges on slowly.
     std::vector<double> cosines, cosine_weights;
-    const double horizon = -std::sqrt(std::max(0.0, 1.0 - (params_.bottom_radius / r) * (params_.bottom_radius / r)));
+    const double horizon = glsl::HorizonZenithCosine(params_.bottom_radius, r);
     AppendGaussLegendre(polar / 2, -1.0, horizon, cosines, cosine_weights);
     AppendGaussLegendre(polar - polar / 2, horizon, 1.0, cosines, cosine_weights);
 

@@ -12,6 +12,7 @@
 #include "bake/bake.h"
 #include "bake/detail.h"
 #include "bake/float_math.h"
+#include "shaders_runtime/primitives.h"
 
 namespace skybake::detail {
 
@@ -70,13 +71,10 @@ struct ChannelPlanes {
 
 // The transmittance table's x in texels for a ray from radius r (with
 // c = top^2 - r^2, d_min = top - r and scale = (width - 1) / (d_max - d_min))
-// in direction mu: glsl::DistanceToTopAtmosphereBoundary, then
-// GetTransmittanceTextureUvFromRMu's x, in float.
+// in direction mu: GetTransmittanceTextureUvFromRMu's x, with its linear map
+// from distance to texels hoisted into d_min and scale.
 inline float TransmittanceTableX(float r, float c, float d_min, float scale, float mu, float last) {
-  const float r_mu = r * mu;
-  const float s = std::sqrt(std::max(r_mu * r_mu + c, 0.0f));
-  const float d = std::max(r_mu > 0.0f ? c / (r_mu + s) : s - r_mu, 0.0f);
-  return ClampFloat((d - d_min) * scale, 0.0f, last);
+  return ClampFloat((glsl_float::DistanceToSphereFromInside(r * mu, c) - d_min) * scale, 0.0f, last);
 }
 
 class SunAtRadius {
@@ -110,7 +108,7 @@ class SunAtRadius {
       for (int x = 0; x < width; ++x) row[x] = a[x] + weight * (b[x] - a[x]);
     }
     const double sin_horizon = p.bottom_radius / r;
-    horizon_cosine_ = float(-std::sqrt(std::max(0.0, 1.0 - sin_horizon * sin_horizon)));
+    horizon_cosine_ = float(glsl::HorizonZenithCosine(p.bottom_radius, r));
     half_disc_ = float(sin_horizon * p.sun_angular_radius);
   }
 
@@ -129,7 +127,7 @@ class SunAtRadius {
       const float x = TransmittanceTableX(r, c, d_min, scale, mu_s[j], last);
       left[j] = std::min(static_cast<int>(x), last_left);
       weight[j] = x - float(left[j]);
-      visible[j] = SmoothstepFloat(-half_disc, half_disc, mu_s[j] - horizon);
+      visible[j] = glsl_float::SunVisibleFractionAboveHorizon(mu_s[j], horizon, half_disc);
     }
     for (int channel = 0; channel < 3; ++channel) {
       const float* row = row_[channel].data();
@@ -170,7 +168,7 @@ class SunAtPoints {
 #pragma omp simd
     for (int l = 0; l < count; ++l) {
       const float r = ClampFloat(r_in[l], bottom, top);
-      const float rho = std::sqrt(std::max((r - bottom) * (r + bottom), 0.0f));
+      const float rho = glsl_float::DistanceToHorizon(bottom, r);
       const float d_min = top - r, d_max = rho + horizon_at_top;
       const float scale = d_max > d_min ? last_x / (d_max - d_min) : 0.0f;
       const float x = TransmittanceTableX(r, (top - r) * (top + r), d_min, scale, mu_s[l], last_x);
@@ -182,10 +180,8 @@ class SunAtPoints {
       const float a1 = plane1[t00] + fx * (plane1[t10] - plane1[t00]), b1 = plane1[t01] + fx * (plane1[t11] - plane1[t01]);
       const float a2 = plane2[t00] + fx * (plane2[t10] - plane2[t00]), b2 = plane2[t01] + fx * (plane2[t11] - plane2[t01]);
       tau0[l] = a0 + fy * (b0 - a0), tau1[l] = a1 + fy * (b1 - a1), tau2[l] = a2 + fy * (b2 - a2);
-      const float sin_horizon = bottom / r;
-      const float horizon = -std::sqrt(std::max(1.0f - sin_horizon * sin_horizon, 0.0f));
-      const float half_disc = sin_horizon * angular_radius;
-      visible[l] = SmoothstepFloat(-half_disc, half_disc, mu_s[l] - horizon);
+      const float horizon = -rho / r, half_disc = bottom / r * angular_radius;
+      visible[l] = glsl_float::SunVisibleFractionAboveHorizon(mu_s[l], horizon, half_disc);
     }
   }
 
@@ -195,7 +191,9 @@ class SunAtPoints {
 };
 
 // glsl::GetScatteringTextureUMuS in float, as the left tap and weight of the
-// linear interpolation along mu_s (vectorisable).
+// linear interpolation along mu_s (vectorisable): the same primitives, with
+// the linear maps of the distance to its unit range and of the unit range to
+// texels hoisted into constants.
 class MuSCoordinate {
  public:
   explicit MuSCoordinate(const AtmosphereParameters& grid) {
@@ -216,11 +214,9 @@ class MuSCoordinate {
     const int last_left = last_left_;
 #pragma omp simd
     for (int j = 0; j < count; ++j) {
-      const float r_mu = bottom * mu_s[j];
-      const float s = std::sqrt(std::max(r_mu * r_mu + c, 0.0f));
-      const float d = std::max(r_mu > 0.0f ? c / (r_mu + s) : s - r_mu, 0.0f);
+      const float d = glsl_float::DistanceToSphereFromInside(bottom * mu_s[j], c);
       const float a = (d - d_min) * inverse_span;
-      const float position = ClampFloat(std::max(1.0f - a * inverse_a, 0.0f) / (1.0f + a) * scale, 0.0f, last);
+      const float position = ClampFloat(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale, 0.0f, last);
       const int i = std::min(static_cast<int>(position), last_left);
       left[j] = i;
       weight[j] = position - float(i);

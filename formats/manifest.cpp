@@ -1,7 +1,6 @@
 #include "formats/manifest.h"
 
 #include <algorithm>
-#include <cmath>
 
 #include "bake/config.h"
 #include "core/errors.h"
@@ -9,6 +8,7 @@
 #include "core/version.h"
 #include "formats/settings_record.h"
 #include "formats/sha256.h"
+#include "shaders_runtime/runtime.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -24,13 +24,12 @@ ordered_json SizeToJson(int width, int height, int depth, bool is_3d) {
 
 // The constants the texture-coordinate mappings use, named as in functions.glsl.
 ordered_json ParameterizationToJson(const glsl::AtmosphereParameters& p) {
-  const double horizon = std::sqrt(p.top_radius * p.top_radius - p.bottom_radius * p.bottom_radius);
   return ordered_json{
       {"functions", "shaders_runtime/functions.glsl: GetTransmittanceTextureUvFromRMu, "
                     "GetIrradianceTextureUvFromRMuS, GetScatteringTextureUvwzFromRMuMuSNu"},
       {"bottom_radius", p.bottom_radius},
       {"top_radius", p.top_radius},
-      {"H", horizon},
+      {"H", glsl::HorizonDistanceAtTop(p)},
       {"mu_s_min", p.mu_s_min},
       {"texel_centres", "u = 0.5 / n + x * (1 - 1 / n) for x in [0, 1] on an axis of n texels"},
   };

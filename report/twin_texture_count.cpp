@@ -5,6 +5,7 @@
 
 #include "report/run_time_models.h"
 #include "shaders_runtime/glsl_shim.h"
+#include "shaders_runtime/primitives.h"
 
 namespace skybake::glsl {
 namespace {

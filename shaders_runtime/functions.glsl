@@ -1,9 +1,10 @@
 // skybake GLSL runtime: geometry, table parameterization and lookups, and the
 // functions an engine calls (sky radiance, aerial perspective, irradiance).
 //
-// This file is compiled twice: as GLSL by the engine, after definitions.glsl
-// and the generated constants, and as C++ in double precision by the bake and
-// the CPU twin (see glsl_shim.h). Keep it to the common subset: Number for
+// This file is compiled twice: as GLSL by the engine, after definitions.glsl,
+// the generated constants, primitives.glsl and phase_functions.glsl (shipped
+// joined with this file), and as C++ in double precision by the bake and the
+// CPU twin (see runtime.h). Keep it to the common subset: Number for
 // scalars, literals written as 1.0 (never 1 for a Number), explicit Number()
 // around ints, IN()/OUT() for parameters.
 //
@@ -29,22 +30,11 @@
 #endif
 
 // ---------------------------------------------------------------------------
-// Defensive numerics
-
-Number ClampCosine(Number mu) {
-  return clamp(mu, -1.0, 1.0);
-}
-
-Number ClampDistance(Number d) {
-  return max(d, 0.0);
-}
+// Defensive numerics (ClampCosine, ClampDistance and SafeSqrt are in
+// primitives.glsl)
 
 Number ClampRadius(IN(AtmosphereParameters) atmosphere, Number r) {
   return clamp(r, atmosphere.bottom_radius, atmosphere.top_radius);
-}
-
-Number SafeSqrt(Number a) {
-  return sqrt(max(a, 0.0));
 }
 
 // ---------------------------------------------------------------------------
@@ -58,9 +48,7 @@ Number SafeSqrt(Number a) {
 // (r <= top_radius).
 Number DistanceToTopAtmosphereBoundary(IN(AtmosphereParameters) atmosphere, Number r, Number mu) {
   Number c = (atmosphere.top_radius - r) * (atmosphere.top_radius + r);  // >= 0
-  Number r_mu = r * mu;
-  Number s = SafeSqrt(r_mu * r_mu + c);
-  return ClampDistance(r_mu > 0.0 ? c / (r_mu + s) : s - r_mu);
+  return DistanceToSphereFromInside(r * mu, c);
 }
 
 // Distance from radius r along mu to the ground, for a ray that hits it
@@ -138,7 +126,7 @@ Number HorizonDistanceAtTop(IN(AtmosphereParameters) atmosphere) {
 
 // Distance from radius r to the horizon (0 on the ground).
 Number HorizonDistance(IN(AtmosphereParameters) atmosphere, Number r) {
-  return SafeSqrt((r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius));
+  return DistanceToHorizon(atmosphere.bottom_radius, r);
 }
 
 // Transmittance table: x = mu through the distance to the top boundary
@@ -167,7 +155,7 @@ Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
   Number a = (d - d_min) / (d_max - d_min);
   Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.scattering_mu_s_min);
   Number A = (D - d_min) / (d_max - d_min);
-  return max(1.0 - a / A, 0.0) / (1.0 + a);
+  return ScatteringUnitMuSFromDistance(a, 1.0 / A);
 }
 
 Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
@@ -212,7 +200,7 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
     u_mu = 0.5 + 0.5 * (0.5 / half_mu_size + x * (1.0 - 1.0 / half_mu_size));
   }
 
-  Number u_nu = (nu + 1.0) / 2.0;
+  Number u_nu = ScatteringUnitNu(nu);
   return vec4(u_nu, GetScatteringTextureUMuS(atmosphere, mu_s), u_mu, u_r);
 }
 #endif
@@ -225,9 +213,7 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
 // below the horizon the irradiance falls by an order of magnitude within a
 // few degrees, and texels below mu_s_min would be wasted.
 vec2 GetIrradianceTextureUvFromRMuS(IN(AtmosphereParameters) atmosphere, Number r, Number mu_s) {
-  Number H = sqrt(atmosphere.top_radius * atmosphere.top_radius - atmosphere.bottom_radius * atmosphere.bottom_radius);
-  Number rho = SafeSqrt(r * r - atmosphere.bottom_radius * atmosphere.bottom_radius);
-  Number x_r = rho / H;
+  Number x_r = HorizonDistance(atmosphere, r) / HorizonDistanceAtTop(atmosphere);
   Number x_mu_s = clamp((mu_s - atmosphere.mu_s_min) / (1.0 - atmosphere.mu_s_min), 0.0, 1.0);
   return vec2(GetTextureCoordFromUnitRange(x_mu_s, atmosphere.irradiance_width),
               GetTextureCoordFromUnitRange(x_r, atmosphere.irradiance_height));
@@ -295,9 +281,8 @@ vec3 GetTransmittance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTextu
 // smooth step over the disc's angular size (Bruneton 2017).
 Number SunVisibleFraction(IN(AtmosphereParameters) atmosphere, Number r, Number mu_s) {
   Number sin_theta_h = atmosphere.bottom_radius / r;
-  Number cos_theta_h = -SafeSqrt(1.0 - sin_theta_h * sin_theta_h);
-  return smoothstep(-sin_theta_h * atmosphere.sun_angular_radius,
-                    sin_theta_h * atmosphere.sun_angular_radius, mu_s - cos_theta_h);
+  return SunVisibleFractionAboveHorizon(mu_s, HorizonZenithCosine(atmosphere.bottom_radius, r),
+                                        sin_theta_h * atmosphere.sun_angular_radius);
 }
 
 vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
@@ -332,23 +317,11 @@ vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) ir
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 // ---------------------------------------------------------------------------
-// Phase functions, per steradian.
-
-Number RayleighPhaseFunction(Number nu) {
-  Number k = 3.0 / (16.0 * PI);
-  return k * (1.0 + nu * nu);
-}
+// Phase functions (phase_functions.glsl), per steradian.
 
 Number MiePhaseFunction(IN(AtmosphereParameters) atmosphere, Number nu) {
-  Number g = atmosphere.mie_g;
-  Number denom = 1.0 + g * g - 2.0 * g * nu;
-  if (atmosphere.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom));
-  }
-  if (atmosphere.mie_phase == PHASE_CORNETTE_SHANKS) {
-    Number k = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
-    return k * (1.0 + nu * nu) / (denom * sqrt(denom));
-  }
+  if (atmosphere.mie_phase == PHASE_HENYEY_GREENSTEIN) return HenyeyGreensteinPhaseFunction(atmosphere.mie_g, nu);
+  if (atmosphere.mie_phase == PHASE_CORNETTE_SHANKS) return CornetteShanksPhaseFunction(atmosphere.mie_g, nu);
   return 0.0;
 }
 

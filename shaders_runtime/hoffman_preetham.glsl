@@ -4,8 +4,9 @@
 // exp() per pixel.
 //
 // Compiled twice, like functions.glsl: as GLSL after definitions.glsl (it
-// uses Number, IN(), PI), and as C++ in double precision through
-// shaders_runtime/hoffman_preetham.h. It does not depend on functions.glsl.
+// uses Number, IN(), PI) and phase_functions.glsl, and as C++ in double
+// precision through shaders_runtime/hoffman_preetham.h. It does not depend on
+// functions.glsl.
 //
 // The model. Two constituents of constant density: air (Rayleigh phase) and
 // haze (Henyey-Greenstein phase), with the scattering and extinction
@@ -66,15 +67,6 @@ struct HoffmanPreethamParameters {
   Number horizon_cos;
 };
 
-Number HoffmanPreethamRayleighPhase(Number cos_theta) {
-  return 3.0 / (16.0 * PI) * (1.0 + cos_theta * cos_theta);
-}
-
-Number HoffmanPreethamHenyeyGreensteinPhase(Number g, Number cos_theta) {
-  Number denom = 1.0 + g * g - 2.0 * g * cos_theta;
-  return (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom));
-}
-
 // A(k, s) = (1 - exp(-k s)) / k, the length of a segment weighted by its
 // transmittance back to the start; s when k s -> 0. In float the quotient
 // loses digits as x = k s falls (relative error ~ 6e-8 / x), so below
@@ -100,8 +92,8 @@ vec3 HoffmanPreethamExtinction(IN(HoffmanPreethamParameters) p, Number s) {
 // `cos_theta` = dot(view direction, sun direction).
 vec3 HoffmanPreethamInScattering(IN(HoffmanPreethamParameters) p, Number s, Number cos_theta,
                                  IN(vec3) sun_irradiance) {
-  vec3 angular = p.air_scattering * HoffmanPreethamRayleighPhase(cos_theta) +
-                 p.haze_scattering * HoffmanPreethamHenyeyGreensteinPhase(p.haze_g, cos_theta);
+  vec3 angular = p.air_scattering * RayleighPhaseFunction(cos_theta) +
+                 p.haze_scattering * HenyeyGreensteinPhaseFunction(p.haze_g, cos_theta);
   return angular * HoffmanPreethamAttenuatedLength(p.air_extinction + p.haze_extinction, s) * sun_irradiance;
 }
 
@@ -124,8 +116,8 @@ vec3 HoffmanPreethamSunIrradiance(IN(HoffmanPreethamParameters) p, Number mu_s, 
 // cut at d for a point at distance d).
 vec3 HoffmanPreethamSkyRadiance(IN(HoffmanPreethamParameters) p, Number air_length, Number haze_length,
                                 Number cos_theta, IN(vec3) sun_irradiance) {
-  vec3 air_angular = p.air_scattering * HoffmanPreethamRayleighPhase(cos_theta);
-  vec3 haze_angular = p.haze_scattering * HoffmanPreethamHenyeyGreensteinPhase(p.haze_g, cos_theta);
+  vec3 air_angular = p.air_scattering * RayleighPhaseFunction(cos_theta);
+  vec3 haze_angular = p.haze_scattering * HenyeyGreensteinPhaseFunction(p.haze_g, cos_theta);
   vec3 both = p.air_extinction + p.haze_extinction;
   Number near = min(air_length, haze_length);
   vec3 radiance = (air_angular + haze_angular) * HoffmanPreethamAttenuatedLength(both, near);

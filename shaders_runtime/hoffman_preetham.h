@@ -1,12 +1,14 @@
 // Hoffman & Preetham's analytic model (hoffman_preetham.glsl) compiled as C++
 // in double precision, in namespace skybake::glsl. A separate header from
-// runtime.h: the model shares no function with functions.glsl, and a
-// translation unit may include both. As with runtime.h, each translation unit
+// runtime.h: the model shares only the phase functions with functions.glsl
+// (phase_functions.glsl, through primitives.h), and a translation unit may
+// include both. As with runtime.h, each translation unit
 // gets its own internal copy (GLSL functions cannot be declared inline), so
 // keep HoffmanPreethamParameters out of headers that other units include.
 #pragma once
 
 #include "shaders_runtime/glsl_shim.h"
+#include "shaders_runtime/primitives.h"
 
 #define IN(type) const type&
 #define OUT(type) type&

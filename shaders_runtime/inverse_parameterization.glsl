@@ -62,8 +62,7 @@ void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2
                                     OUT(Number) mu_s) {
   Number x_mu_s = GetUnitRangeFromTextureCoord(uv.x, atmosphere.irradiance_width);
   Number x_r = GetUnitRangeFromTextureCoord(uv.y, atmosphere.irradiance_height);
-  Number H = sqrt(atmosphere.top_radius * atmosphere.top_radius - atmosphere.bottom_radius * atmosphere.bottom_radius);
-  Number rho = H * x_r;
+  Number rho = HorizonDistanceAtTop(atmosphere) * x_r;
   r = sqrt(rho * rho + atmosphere.bottom_radius * atmosphere.bottom_radius);
   mu_s = ClampCosine(atmosphere.mu_s_min + x_mu_s * (1.0 - atmosphere.mu_s_min));
 }

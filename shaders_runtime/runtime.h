@@ -1,11 +1,13 @@
 // The GLSL runtime compiled as C++ (double precision): every function of
-// functions.glsl, aerial_perspective.glsl and inverse_parameterization.glsl,
+// primitives.glsl and phase_functions.glsl (primitives.h), functions.glsl,
+// aerial_perspective.glsl and inverse_parameterization.glsl,
 // in namespace skybake::glsl. The bake uses the parameterization and lookups; the CPU twin
 // (twin.h) uses the run-time functions. Each translation unit gets its own
 // internal copy, as GLSL functions cannot be declared inline.
 #pragma once
 
 #include "shaders_runtime/glsl_shim.h"
+#include "shaders_runtime/primitives.h"
 
 #define IN(type) const type&
 #define OUT(type) type&

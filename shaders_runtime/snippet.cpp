@@ -88,7 +88,9 @@ std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& p, const g
 
 std::string RuntimeFunctionsGlsl() {
   // The engine's functions.glsl: the sources in their order of definition.
-  return std::string(EmbeddedShader("functions.glsl")) + std::string(EmbeddedShader("aerial_perspective.glsl"));
+  std::string text;
+  for (const char* name : kRuntimeFunctionSources) text += EmbeddedShader(name);
+  return text;
 }
 
 std::vector<SnippetFile> RuntimeSnippetFiles(const glsl::AtmosphereParameters& parameters,

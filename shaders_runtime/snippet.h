@@ -31,9 +31,13 @@ struct SnippetParts {
 std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& parameters, const glsl::vec3& wavelengths_nm,
                                     const std::string& atmosphere_name, const SnippetParts& parts = {});
 
-// The shipped functions.glsl: shaders_runtime/functions.glsl (geometry,
-// parameterization, lookups, sky radiance) followed by
-// shaders_runtime/aerial_perspective.glsl (aerial perspective, irradiance).
+// The sources of the shipped functions.glsl, in their order of definition:
+// scalar primitives, phase functions, geometry, parameterization, lookups and
+// sky radiance, then aerial perspective and irradiance.
+inline constexpr const char* kRuntimeFunctionSources[] = {"primitives.glsl", "phase_functions.glsl",
+                                                           "functions.glsl", "aerial_perspective.glsl"};
+
+// The shipped functions.glsl: the kRuntimeFunctionSources joined.
 std::string RuntimeFunctionsGlsl();
 
 // The shipped files, in the order a shader must include them.

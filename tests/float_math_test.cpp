@@ -39,13 +39,7 @@ TEST(FloatMath, ExponentialTrapezoidMatchesTheExactIntegral) {
   EXPECT_GE(ExponentialTrapezoidFloat(1e-40f, 0.0f, 0.5f, 1.0f), 0.0f);
 }
 
-TEST(FloatMath, SmoothstepAndClamp) {
-  EXPECT_EQ(SmoothstepFloat(-1.0f, 1.0f, -2.0f), 0.0f);
-  EXPECT_EQ(SmoothstepFloat(-1.0f, 1.0f, 2.0f), 1.0f);
-  EXPECT_FLOAT_EQ(SmoothstepFloat(-1.0f, 1.0f, 0.0f), 0.5f);
-  // A zero width is a step at the edge.
-  EXPECT_EQ(SmoothstepFloat(0.0f, 0.0f, -1e-6f), 0.0f);
-  EXPECT_EQ(SmoothstepFloat(0.0f, 0.0f, 0.0f), 1.0f);
+TEST(FloatMath, Clamp) {
   EXPECT_EQ(ClampFloat(2.0f, -1.0f, 1.0f), 1.0f);
   EXPECT_EQ(ClampFloat(-2.0f, -1.0f, 1.0f), -1.0f);
   EXPECT_EQ(ClampFloat(0.25f, -1.0f, 1.0f), 0.25f);

@@ -47,9 +47,9 @@ TEST(HoffmanPreetham, PhaseFunctionsIntegrateToOne) {
   auto over_sphere = [](auto phase) {
     return testing::Integrate<double>([&](double mu) { return 2.0 * M_PI * phase(mu); }, -1.0, 1.0, 1e-12, 256);
   };
-  EXPECT_NEAR(over_sphere([](double mu) { return glsl::HoffmanPreethamRayleighPhase(mu); }), 1.0, 1e-9);
+  EXPECT_NEAR(over_sphere([](double mu) { return glsl::RayleighPhaseFunction(mu); }), 1.0, 1e-9);
   for (double g : {-0.5, 0.0, 0.76, 0.9}) {
-    EXPECT_NEAR(over_sphere([g](double mu) { return glsl::HoffmanPreethamHenyeyGreensteinPhase(g, mu); }), 1.0, 1e-9)
+    EXPECT_NEAR(over_sphere([g](double mu) { return glsl::HenyeyGreensteinPhaseFunction(g, mu); }), 1.0, 1e-9)
         << g;
   }
 }
@@ -58,8 +58,8 @@ TEST(HoffmanPreetham, InScatteringAndExtinctionMatchQuadratureOfAConstantDensity
   HoffmanPreethamParameters p = HazyAir();
   vec3 beta = p.air_extinction + p.haze_extinction;
   for (double cos_theta : {-1.0, 0.0, 0.7, 0.999}) {
-    vec3 angular = p.air_scattering * glsl::HoffmanPreethamRayleighPhase(cos_theta) +
-                   p.haze_scattering * glsl::HoffmanPreethamHenyeyGreensteinPhase(p.haze_g, cos_theta);
+    vec3 angular = p.air_scattering * glsl::RayleighPhaseFunction(cos_theta) +
+                   p.haze_scattering * glsl::HenyeyGreensteinPhaseFunction(p.haze_g, cos_theta);
     // 10 m (x ~ 1e-3, the series) to 100 km (x ~ 14, the quotient).
     for (double s : {10.0, 300.0, 1000.0, 5000.0, 100000.0}) {
       SCOPED_TRACE("cos_theta " + std::to_string(cos_theta) + ", s " + std::to_string(s));
@@ -79,8 +79,8 @@ TEST(HoffmanPreetham, InScatteringAndExtinctionMatchQuadratureOfAConstantDensity
 TEST(HoffmanPreetham, TwoShellSkyMatchesQuadratureOfTwoNestedShells) {
   HoffmanPreethamParameters p = HazyAir();
   const double cos_theta = 0.5;
-  vec3 air = p.air_scattering * glsl::HoffmanPreethamRayleighPhase(cos_theta);
-  vec3 haze = p.haze_scattering * glsl::HoffmanPreethamHenyeyGreensteinPhase(p.haze_g, cos_theta);
+  vec3 air = p.air_scattering * glsl::RayleighPhaseFunction(cos_theta);
+  vec3 haze = p.haze_scattering * glsl::HenyeyGreensteinPhaseFunction(p.haze_g, cos_theta);
   for (auto [air_length, haze_length] : {std::pair{8400.0, 1250.0}, {1250.0, 8400.0}, {30000.0, 30000.0},
                                         {50.0, 20.0}}) {
     SCOPED_TRACE(std::to_string(air_length) + " m of air, " + std::to_string(haze_length) + " m of haze");

@@ -13,11 +13,11 @@
 
 #include "bake/bake.h"
 #include "core/errors.h"
-#include "core/phase.h"
 #include "report/case_errors.h"
 #include "report/error_stats.h"
 #include "report/quality_ladder.h"
 #include "report/ray_march.h"
+#include "shaders_runtime/primitives.h"
 #include "test_atmospheres.h"
 #include "test_util.h"
 
@@ -209,7 +209,7 @@ TEST(ReportRayMarch, ConvergesToTheExactIntegralOfAVerticalColumn) {
   const double thickness = a.top_radius_m - a.bottom_radius_m;
   const double column = scale_height * (1.0 - std::exp(-thickness / scale_height));
   const Spectrum tau = a.constituents[0].Extinction() * column;
-  const double phase = RayleighPhase(1.0);
+  const double phase = glsl::RayleighPhaseFunction(1.0);
   const Spectrum exact = a.solar_irradiance * a.constituents[0].scattering_per_m * phase * column * glm::exp(-tau);
 
   const glm::dvec3 camera(0.0, 0.0, a.bottom_radius_m), up(0.0, 0.0, 1.0);

@@ -233,7 +233,8 @@ TEST(RuntimeSnippet, BakeWritesItWithConstantsFromTheManifestParameters) {
   EXPECT_EQ(listed, (std::vector<std::string>{"definitions.glsl", "atmosphere_constants.glsl", "functions.glsl"}));
   const std::filesystem::path sources = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "shaders_runtime";
   EXPECT_EQ(testing::ReadText(lut / "functions.glsl"),
-            testing::ReadText(sources / "functions.glsl") + testing::ReadText(sources / "aerial_perspective.glsl"));
+            testing::ReadText(sources / "primitives.glsl") + testing::ReadText(sources / "phase_functions.glsl") +
+                testing::ReadText(sources / "functions.glsl") + testing::ReadText(sources / "aerial_perspective.glsl"));
 }
 
 // ---- glslangValidator ----

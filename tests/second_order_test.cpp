@@ -11,7 +11,7 @@
 
 #include "bake/bake.h"
 #include "core/constants.h"
-#include "core/phase.h"
+#include "shaders_runtime/primitives.h"
 #include "shaders_runtime/twin.h"
 #include "test_atmospheres.h"
 
@@ -85,7 +85,7 @@ class DoubleScattering {
   Spectrum Single(const dvec3& p, const dvec3& d, const dvec3& sun) const {
     const int n = 48;
     double length = RayLength(p, d);
-    double phase = RayleighPhase(glm::dot(d, sun));
+    double phase = glsl::RayleighPhaseFunction(glm::dot(d, sun));
     Spectrum tau(0.0), sum(0.0), previous_value(0.0), previous_e = Extinction(p);
     double previous_t = 0.0;
     for (int k = 0; k <= n; ++k) {
@@ -120,7 +120,7 @@ class DoubleScattering {
           double phi = 2.0 * kPi * (j + 0.5) / azimuths;
           dvec3 d = mu * zenith + s * (std::cos(phi) * east + std::sin(phi) * north);
           double weight = (hi - lo) / polar * 2.0 * kPi / azimuths;
-          sum += weight * RayleighPhase(glm::dot(view, d)) * Single(p, d, sun);
+          sum += weight * glsl::RayleighPhaseFunction(glm::dot(view, d)) * Single(p, d, sun);
         }
       }
     }
