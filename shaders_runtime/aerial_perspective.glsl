@@ -161,17 +161,16 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
     return vec3(0.0);
   }
   vec3 view_ray = normalize(camera_to_point);
-  vec3 entry;
+  vec3 start;
   Number r;
-  Number r_mu;
-  if (!EnterAtmosphere(atmosphere, camera, view_ray, entry, r, r_mu)) {
+  Number mu;
+  Number mu_s;
+  Number nu;
+  if (!GetViewRayStart(atmosphere, camera, view_ray, sun_direction, start, r, mu, mu_s, nu)) {
     transmittance = vec3(1.0);
     return vec3(0.0);
   }
-  camera = entry;
-  Number mu = ClampCosine(r_mu / r);
-  Number mu_s = ClampCosine(dot(camera, sun_direction) / r);
-  Number nu = ClampCosine(dot(view_ray, sun_direction));
+  camera = start;
   Number d = max(length(point - camera), 0.0);
   Number lit = max(d - max(shadow_length, 0.0), 0.0);
   bool ray_r_mu_intersects_ground = RayIntersectsGround(atmosphere, r, mu);

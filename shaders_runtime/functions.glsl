@@ -105,6 +105,21 @@ bool EnterAtmosphere(IN(AtmosphereParameters) atmosphere, IN(vec3) camera, IN(ve
   return true;
 }
 
+// The ray from `camera` along `view_ray` from where it starts inside the
+// atmosphere (EnterAtmosphere): that start, its radius r, the cosines mu of
+// the ray and mu_s of the sun along `sun_direction` there, and nu between the
+// two. False if the ray misses the atmosphere.
+bool GetViewRayStart(IN(AtmosphereParameters) atmosphere, IN(vec3) camera, IN(vec3) view_ray,
+                     IN(vec3) sun_direction, OUT(vec3) start, OUT(Number) r, OUT(Number) mu, OUT(Number) mu_s,
+                     OUT(Number) nu) {
+  Number r_mu;
+  if (!EnterAtmosphere(atmosphere, camera, view_ray, start, r, r_mu)) return false;
+  mu = ClampCosine(r_mu / r);
+  mu_s = ClampCosine(dot(start, sun_direction) / r);
+  nu = ClampCosine(dot(view_ray, sun_direction));
+  return true;
+}
+
 // ---------------------------------------------------------------------------
 // Texture coordinates. A table of n texels samples the unit range at texel
 // centres, so [0, 1] maps to [0.5 / n, 1 - 0.5 / n].
@@ -355,18 +370,16 @@ vec3 GetCombinedScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTex
 // moved to where the ray enters the atmosphere.
 vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
                     IN(ScatteringTexture) scattering_texture, IN(ScatteringTexture) single_mie_scattering_texture,
-                    vec3 camera, IN(vec3) view_ray, IN(vec3) sun_direction, OUT(vec3) transmittance) {
-  vec3 entry;
+                    IN(vec3) camera, IN(vec3) view_ray, IN(vec3) sun_direction, OUT(vec3) transmittance) {
+  vec3 start;
   Number r;
-  Number r_mu;
-  if (!EnterAtmosphere(atmosphere, camera, view_ray, entry, r, r_mu)) {
+  Number mu;
+  Number mu_s;
+  Number nu;
+  if (!GetViewRayStart(atmosphere, camera, view_ray, sun_direction, start, r, mu, mu_s, nu)) {
     transmittance = vec3(1.0);
     return vec3(0.0);
   }
-  camera = entry;
-  Number mu = ClampCosine(r_mu / r);
-  Number mu_s = ClampCosine(dot(camera, sun_direction) / r);
-  Number nu = ClampCosine(dot(view_ray, sun_direction));
   bool ray_r_mu_intersects_ground = RayIntersectsGround(atmosphere, r, mu);
   transmittance = ray_r_mu_intersects_ground
       ? vec3(0.0)
