@@ -11,23 +11,12 @@
 
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "core/float_bits.h"
 #include "core/version.h"
 
 namespace skybake::ktx2 {
 
 namespace {
-
-std::uint32_t FloatBits(float value) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &value, sizeof(bits));
-  return bits;
-}
-
-float FloatFromBits(std::uint32_t bits) {
-  float value;
-  std::memcpy(&value, &bits, sizeof(value));
-  return value;
-}
 
 // §3.1: «KTX 20»\r\n\x1A\n
 constexpr std::uint8_t kIdentifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32,

@@ -6,10 +6,11 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 
 #include <Imath/half.h>
+
+#include "core/float_bits.h"
 
 namespace skybake {
 namespace {
@@ -17,18 +18,6 @@ namespace {
 // The conversions under test, on bit patterns.
 std::uint16_t FloatToHalf(float value) { return Imath::half(value).bits(); }
 float HalfToFloat(std::uint16_t bits) { return Imath::half(Imath::half::FromBits, bits); }
-
-std::uint32_t FloatBits(float value) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &value, sizeof(bits));
-  return bits;
-}
-
-float FloatFromBits(std::uint32_t bits) {
-  float value;
-  std::memcpy(&value, &bits, sizeof(value));
-  return value;
-}
 
 bool IsHalfNan(std::uint16_t h) { return (h & 0x7C00u) == 0x7C00u && (h & 0x3FFu) != 0; }
 
