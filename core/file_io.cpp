@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <random>
-#include <sstream>
 
 #include "core/errors.h"
 
@@ -89,17 +89,24 @@ void StagedFiles::Commit() {
   staged_.clear();
 }
 
-std::vector<std::uint8_t> ReadFileBytes(const fs::path& path, const std::string& kind) {
-  const std::string text = ReadFileText(path, kind);
-  return std::vector<std::uint8_t>(text.begin(), text.end());
+namespace {
+
+// The rest of `in` appended to `out` (a std::string or a byte vector).
+template <class Buffer>
+void AppendStream(std::istream& in, Buffer& out) {
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) out.insert(out.end(), chunk, chunk + in.gcount());
 }
 
-std::string ReadFileText(const fs::path& path, const std::string& kind) {
-  std::ostringstream text;
+// The whole file at `path` (or standard input for kStandardStream) as a
+// Buffer; `kind` names what was expected in the error for a folder.
+template <class Buffer>
+Buffer ReadWhole(const fs::path& path, const std::string& kind) {
+  Buffer contents;
   if (path == kStandardStream) {
-    text << std::cin.rdbuf();
+    AppendStream(std::cin, contents);
     if (std::cin.bad()) throw IoError("standard input: read failed (" + std::string(std::strerror(errno)) + ")");
-    return text.str();
+    return contents;
   }
   const ErrorLocation location{path.string()};
   std::error_code error;
@@ -107,10 +114,20 @@ std::string ReadFileText(const fs::path& path, const std::string& kind) {
   if (!fs::exists(path, error)) throw IoError(path.string() + ": no such file", location);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path.string() + ": cannot open (" + std::strerror(errno) + ")", location);
-  text << in.rdbuf();
+  const std::uintmax_t size = fs::file_size(path, error);
+  if (!error) contents.reserve(size);
+  AppendStream(in, contents);
   if (in.bad()) throw IoError(path.string() + ": read failed (" + std::strerror(errno) + ")", location);
-  return text.str();
+  return contents;
 }
+
+}  // namespace
+
+std::vector<std::uint8_t> ReadFileBytes(const fs::path& path, const std::string& kind) {
+  return ReadWhole<std::vector<std::uint8_t>>(path, kind);
+}
+
+std::string ReadFileText(const fs::path& path, const std::string& kind) { return ReadWhole<std::string>(path, kind); }
 
 std::vector<std::string> EntriesNotIn(const fs::path& dir, const std::vector<std::string>& names) {
   std::vector<std::string> entries;
