@@ -22,6 +22,7 @@
 #include "core/constants.h"
 #include "reference/path_tracer.h"
 #include "reference/query_csv.h"
+#include "test_atmospheres.h"
 
 namespace skybake::reference {
 
@@ -40,35 +41,7 @@ inline void Note(const char* format, ...) {
   va_end(args);
 }
 
-// Earth, with the parameter values of DESIGN.md (Bruneton's 2017 set).
-inline Atmosphere Earth() {
-  Atmosphere a;
-  a.name = "earth";
-  a.bottom_radius_m = 6360e3;
-  a.top_radius_m = 6420e3;
-  a.ground_albedo = Spectrum(0.1);
-  a.solar_irradiance = Spectrum(1.474, 1.8504, 1.91198);
-  a.sun_angular_radius_rad = 0.004675;
-  a.mu_s_min = std::cos(102.0 * kDegree);
-  Constituent rayleigh;
-  rayleigh.name = "rayleigh";
-  rayleigh.density.layers = {DensityLayer{0.0, 1.0, -1.0 / 8000.0, 0.0, 0.0}};
-  rayleigh.scattering_per_m = Spectrum(5.802e-6, 13.558e-6, 33.1e-6);
-  rayleigh.phase = {PhaseKind::kRayleigh, 0.0};
-  Constituent mie;
-  mie.name = "mie";
-  mie.density.layers = {DensityLayer{0.0, 1.0, -1.0 / 1200.0, 0.0, 0.0}};
-  mie.scattering_per_m = Spectrum(3.996e-6);
-  mie.absorption_per_m = Spectrum(0.444e-6);
-  mie.phase = {PhaseKind::kCornetteShanks, 0.8};
-  Constituent ozone;
-  ozone.name = "ozone";
-  ozone.density.layers = {DensityLayer{25000.0, 0.0, 0.0, 1.0 / 15000.0, -2.0 / 3.0},
-                          DensityLayer{0.0, 0.0, 0.0, -1.0 / 15000.0, 8.0 / 3.0}};
-  ozone.absorption_per_m = Spectrum(0.650e-6, 1.881e-6, 0.085e-6);
-  a.constituents = {rayleigh, mie, ozone};
-  return a;
-}
+using testing::Earth;
 
 // The query at `altitude` looking at `view_zenith` with the sun at
 // `sun_zenith` and `azimuth` between them (degrees), as a ray.
