@@ -20,6 +20,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
 #include "bake/atmosphere.h"
@@ -271,14 +273,9 @@ TEST(DomeMesh, VerticesLieAtTheFittedOpticalLengthOfAir) {
     const float* p = mesh->positions.data();
     std::uint32_t a = mesh->indices[t], b = mesh->indices[t + 1], c = mesh->indices[t + 2];
     ASSERT_LT(std::max({a, b, c}), mesh->vertex_count());
-    double e1[3], e2[3], centroid[3];
-    for (int k = 0; k < 3; ++k) {
-      e1[k] = p[3 * b + k] - p[3 * a + k];
-      e2[k] = p[3 * c + k] - p[3 * a + k];
-      centroid[k] = p[3 * a + k] + p[3 * b + k] + p[3 * c + k];
-    }
-    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-    EXPECT_LT(n[0] * centroid[0] + n[1] * centroid[1] + n[2] * centroid[2], 0.0) << "triangle " << t / 3;
+    auto vertex = [p](std::uint32_t i) { return glm::dvec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]); };
+    const glm::dvec3 normal = glm::cross(vertex(b) - vertex(a), vertex(c) - vertex(a));
+    EXPECT_LT(glm::dot(normal, vertex(a) + vertex(b) + vertex(c)), 0.0) << "triangle " << t / 3;
   }
 }
 
