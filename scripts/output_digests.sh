@@ -6,11 +6,19 @@
 #
 #   scripts/output_digests.sh BUILD/cli/skybake > after.txt
 #   diff before.txt after.txt   # nothing: the outputs are byte-identical
+#
+# With a second argument the sets are kept in that (new) folder, for
+# scripts/table_differences.sh OLD/earth NEW/earth where the bytes differ.
 set -eu
 exe=$(realpath "$1")
 root=$(cd "$(dirname "$0")/.." && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+if [ $# -ge 2 ]; then
+  mkdir "$2"
+  work=$(realpath "$2")
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
 cd "$work"
 "$exe" bake earth -o earth -q
 "$exe" bake earth --scene "$root/examples/scenes/sunset-cinematic.toml" -o scene -q
