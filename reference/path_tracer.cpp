@@ -38,6 +38,12 @@ using glm::dvec3;
 // (docs/reference.md).
 constexpr int kForcedSegments = 1;
 
+// On the view ray and the forced segments, distances are drawn from a
+// mixture: with this share from extinction x transmittance, otherwise from
+// that density weighted by the sunlight at each piece (SunlightTable), so
+// that after sunset, when only a thin high shell is lit, paths still find it.
+constexpr double kUnguidedShare = 0.5;
+
 enum Estimator : uint64_t { kRadianceEstimator = 1, kIrradianceEstimator = 2 };
 
 struct Tally {
@@ -48,8 +54,10 @@ struct Tally {
 // The path logic at one wavelength.
 class Tracer {
  public:
-  Tracer(const LayeredMedium& medium, const Settings& settings, const dvec3& sun, int wavelength)
+  Tracer(const LayeredMedium& medium, const SunlightTable& sunlight, const Settings& settings, const dvec3& sun,
+         int wavelength)
       : medium_(medium),
+        sunlight_(sunlight),
         settings_(settings),
         sun_(sun),
         w_(wavelength),
@@ -59,9 +67,10 @@ class Tracer {
 
   // Sky radiance along the view segment, one path; u stratifies the distance
   // of its first vertex.
-  double Radiance(const RaySegment& view, const dvec3& direction, double u, Pcg32& rng, Tally& tally) {
+  double Radiance(const RaySegment& view, const dvec3& direction, const RaySegment::Mixture& view_density, double u,
+                  Pcg32& rng, Tally& tally) {
     double t, weight;
-    if (!view.Sample(medium_, w_, u, &t, &weight)) return 0.0;
+    if (!view.SampleMixture(medium_, view_density, u, &t, &weight)) return 0.0;
     dvec3 x = view.origin() + t * direction;
     double r = RadiusAlongRay(view.r(), view.mu(), t);
     double sigma_s = medium_.Scattering(r, w_, sigma_.data());
@@ -79,6 +88,18 @@ class Tracer {
     return Trace(camera + t_in * direction, 0.0, direction, weight, 0.0, 0, false, rng, tally);
   }
 
+  // Per piece of `segment` (along `direction`), the tabulated sunlight at
+  // its middle: the guide of MakeMixture.
+  std::vector<double> SunlitPieces(const RaySegment& segment, const dvec3& direction) const {
+    std::vector<double> weights;
+    for (double t : segment.PieceMiddles()) {
+      const dvec3 x = segment.origin() + t * direction;
+      const double r = glm::length(x);
+      weights.push_back(sunlight_.At(r, glm::dot(x, sun_) / r)[w_]);
+    }
+    return weights;
+  }
+
   // E_sun x visible fraction of the disc x transmittance to the top, seen
   // from radius r where the sun's zenith cosine is mu_s.
   double Sunlight(double r, double mu_s, Pcg32& rng) const {
@@ -86,9 +107,7 @@ class Tracer {
     r = std::clamp(r, g.bottom_radius, g.top_radius);
     double visible = glsl::SunVisibleFraction(g, r, mu_s);
     if (!(visible > 0.0) || solar_ == 0.0) return 0.0;
-    // A disc centre below the horizon: its visible part is seen along the
-    // horizon, the ray that grazes the ground.
-    double mu = glsl::RayIntersectsGround(g, r, mu_s) ? HorizonCosine(g.bottom_radius, r) : mu_s;
+    double mu = SunRayCosine(g, r, mu_s);
     double length = glsl::DistanceToTopAtmosphereBoundary(g, r, mu);
     double transmittance =
         settings_.sun_transmittance == SunTransmittanceMethod::kQuadrature
@@ -168,7 +187,8 @@ class Tracer {
         RaySegment segment(medium_, x, direction, 0.0, RaySegment::Table::kSampling);
         if (!segment.hits_ground()) {
           double t, transmittance_over_pdf;
-          if (!segment.Sample(medium_, w_, rng.Uniform(), &t, &transmittance_over_pdf)) return sum;
+          const RaySegment::Mixture density = segment.MakeMixture(w_, SunlitPieces(segment, direction), kUnguidedShare);
+          if (!segment.SampleMixture(medium_, density, rng.Uniform(), &t, &transmittance_over_pdf)) return sum;
           ++events;
           ++tally.vertices;
           x = segment.origin() + t * direction;
@@ -208,6 +228,7 @@ class Tracer {
   }
 
   const LayeredMedium& medium_;
+  const SunlightTable& sunlight_;
   const Settings& settings_;
   dvec3 sun_;
   int w_;
@@ -339,7 +360,7 @@ Atmosphere Checked(const Atmosphere& atmosphere) {
 }
 }  // namespace
 
-PathTracer::PathTracer(const Atmosphere& atmosphere) : medium_(Checked(atmosphere)) {}
+PathTracer::PathTracer(const Atmosphere& atmosphere) : medium_(Checked(atmosphere)), sunlight_(medium_) {}
 
 Spectrum PathTracer::SunTransmittance(const dvec3& point, const dvec3& sun, Spectrum* error) const {
   const glsl::AtmosphereParameters& g = medium_.geometry();
@@ -348,7 +369,7 @@ Spectrum PathTracer::SunTransmittance(const dvec3& point, const dvec3& sun, Spec
   double mu_s = std::clamp(glm::dot(point, sun) / r, -1.0, 1.0);
   double visible = glsl::SunVisibleFraction(g, r, mu_s);
   if (!(visible > 0.0)) return Spectrum(0.0);
-  double mu = glsl::RayIntersectsGround(g, r, mu_s) ? HorizonCosine(g.bottom_radius, r) : mu_s;
+  double mu = SunRayCosine(g, r, mu_s);
   double t_in, t_out;
   if (!InsideTopSphere(g, r, mu, &t_in, &t_out)) return Spectrum(visible);
   OpticalDepthEstimate tau = medium_.OpticalDepth(r, mu, t_in, t_out, kReportedTolerance);
@@ -384,15 +405,22 @@ Result PathTracer::Evaluate(const RayQuery& query, const Settings& settings, uin
   std::vector<Spectrum> radiance_sums(blocks, Spectrum(0.0)), irradiance_sums(blocks, Spectrum(0.0));
   std::vector<Tally> tallies(blocks);
   IrradianceSampler hemisphere(medium_, normal, sun);
+  // Per wavelength, the density of the paths' first vertices along the view
+  // ray, guided by the sunlight on its pieces.
+  std::vector<RaySegment::Mixture> view_densities;
+  for (int w = 0; w < kWavelengthCount; ++w) {
+    view_densities.push_back(
+        segment.MakeMixture(w, Tracer(medium_, sunlight_, settings, sun, w).SunlitPieces(segment, view), kUnguidedShare));
+  }
   auto run_block = [&](int64_t b) {
     Tally& tally = tallies[b];
     for (int w = 0; w < kWavelengthCount; ++w) {
-      Tracer tracer(medium_, settings, sun, w);
+      Tracer tracer(medium_, sunlight_, settings, sun, w);
       for (int j = 0; j < kPathsPerBlock; ++j) {
         const uint64_t path = static_cast<uint64_t>(b) * kPathsPerBlock + j;
         Pcg32 rng = PathGenerator(settings.seed, stream, kRadianceEstimator, w, path);
         double u = (j + rng.Uniform()) / kPathsPerBlock;  // stratified along the view ray
-        radiance_sums[b][w] += tracer.Radiance(segment, view, u, rng, tally);
+        radiance_sums[b][w] += tracer.Radiance(segment, view, view_densities[w], u, rng, tally);
         if (!query.has_normal) continue;
         Pcg32 irradiance_rng = PathGenerator(settings.seed, stream, kIrradianceEstimator, w, path);
         constexpr int kSide = 8;  // kPathsPerBlock = kSide^2 strata of the hemisphere

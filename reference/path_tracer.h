@@ -22,6 +22,7 @@
 
 #include "bake/atmosphere.h"
 #include "reference/layered_medium.h"
+#include "reference/sunlight_table.h"
 #include "shaders_runtime/query.h"
 
 namespace skybake::reference {
@@ -122,6 +123,7 @@ class PathTracer {
 
  private:
   LayeredMedium medium_;
+  SunlightTable sunlight_;  // where to look for sunlit scattering
 };
 
 }  // namespace skybake::reference

@@ -37,9 +37,8 @@ bool InsideTopSphere(const glsl::AtmosphereParameters& g, double r, double mu, d
   return true;
 }
 
-double HorizonCosine(double bottom_radius, double r) {
-  double ratio = bottom_radius / r;
-  return -std::sqrt(std::max(0.0, 1.0 - ratio * ratio));
+double SunRayCosine(const glsl::AtmosphereParameters& g, double r, double mu_s) {
+  return glsl::RayIntersectsGround(g, r, mu_s) ? glsl::HorizonZenithCosine(g.bottom_radius, r) : mu_s;
 }
 
 RaySegment::RaySegment(const LayeredMedium& medium, const glm::dvec3& start, const glm::dvec3& direction,
@@ -113,22 +112,10 @@ Spectrum RaySegment::Transmittance(Spectrum* error) const {
   return transmittance;
 }
 
-bool RaySegment::Sample(const LayeredMedium& medium, int w, double u, double* t,
-                        double* transmittance_over_pdf) const {
-  // With tau~ the table's piecewise-linear optical depth, t has the density
-  // slope exp(-tau~(t)) / (1 - exp(-tau~(length))): the truncated
-  // exponential in tau~, inverted in closed form.
-  if (t_.size() < 2) return false;
+void RaySegment::SampleInPiece(const LayeredMedium& medium, int w, std::size_t k, double target, double* t,
+                               double* transmittance_over_pdf) const {
   const std::vector<double>& tau = tau_[w];
-  double tau_max = tau.back();
-  if (!(tau_max > 0.0)) return false;
-  double norm = -std::expm1(-tau_max);
-  double target = std::min(-std::log1p(-u * norm), tau_max);
-  size_t k = static_cast<size_t>(std::upper_bound(tau.begin(), tau.end(), target) - tau.begin());
-  k = std::clamp<size_t>(k, 1, tau.size() - 1) - 1;
-  // Only target == tau_max can land on a piece without extinction (at the
-  // end of the table): step back to the last piece with some.
-  while (k > 0 && !(tau[k + 1] > tau[k])) --k;
+  double norm = -std::expm1(-tau.back());
   double slope = (tau[k + 1] - tau[k]) / (t_[k + 1] - t_[k]);
   *t = std::clamp(t_[k] + (target - tau[k]) / slope, t_[k], t_[k + 1]);
   double approximate = tau[k] + (*t - t_[k]) * slope;
@@ -136,6 +123,58 @@ bool RaySegment::Sample(const LayeredMedium& medium, int w, double u, double* t,
                      ? tau[k] + medium.OpticalDepth(r_, mu_, t_[k], *t, kVertexTolerance).value[w]
                      : medium.OpticalDepth(r_, mu_, 0.0, *t, kVertexTolerance).value[w];
   *transmittance_over_pdf = std::exp(-(exact - approximate)) * norm / slope;
+}
+
+std::vector<double> RaySegment::PieceMiddles() const {
+  std::vector<double> middles;
+  for (std::size_t k = 0; k + 1 < t_.size(); ++k) middles.push_back(0.5 * (t_[k] + t_[k + 1]));
+  return middles;
+}
+
+RaySegment::Mixture RaySegment::MakeMixture(int w, const std::vector<double>& piece_weights, double keep) const {
+  // Piece k holds mass P_k = exp(-tau_k) - exp(-tau_k+1) of the first
+  // density (times its norm); the guided density gives it P_k g_k / G with
+  // G = sum P_k g_k, so on piece k the mixture is the first density times
+  // c_k = keep + (1 - keep) g_k norm / G.
+  Mixture mixture;
+  mixture.wavelength = w;
+  if (t_.size() < 2) return mixture;
+  const std::vector<double>& tau = tau_[w];
+  const double norm = -std::expm1(-tau.back());
+  if (!(norm > 0.0)) return mixture;
+  const std::size_t pieces = t_.size() - 1;
+  std::vector<double> mass(pieces);
+  double guided = 0.0;
+  for (std::size_t k = 0; k < pieces; ++k) {
+    mass[k] = std::exp(-tau[k]) * -std::expm1(-(tau[k + 1] - tau[k]));
+    guided += mass[k] * piece_weights[k];
+  }
+  double sum = 0.0;
+  for (std::size_t k = 0; k < pieces; ++k) {
+    const double factor = guided > 0.0 ? keep + (1.0 - keep) * piece_weights[k] * norm / guided : 1.0;
+    sum += mass[k] * factor / norm;
+    mixture.factor.push_back(factor);
+    mixture.cumulative.push_back(sum);
+  }
+  for (double& c : mixture.cumulative) c /= sum;  // 1 up to rounding
+  return mixture;
+}
+
+bool RaySegment::SampleMixture(const LayeredMedium& medium, const Mixture& mixture, double u, double* t,
+                               double* transmittance_over_pdf) const {
+  if (mixture.cumulative.empty()) return false;
+  const std::vector<double>& c = mixture.cumulative;
+  std::size_t k = static_cast<std::size_t>(std::upper_bound(c.begin(), c.end(), u) - c.begin());
+  k = std::min(k, c.size() - 1);
+  // A u on the last edge can land on a piece without mass: step back.
+  while (k > 0 && !(c[k] > c[k - 1])) --k;
+  const double begin = k > 0 ? c[k - 1] : 0.0;
+  const double v = c[k] > begin ? std::clamp((u - begin) / (c[k] - begin), 0.0, 1.0) : 0.5;
+  // Within the piece, the first density: the truncated exponential in tau~.
+  const std::vector<double>& tau = tau_[mixture.wavelength];
+  SampleInPiece(medium, mixture.wavelength, k, tau[k] - std::log1p(v * std::expm1(-(tau[k + 1] - tau[k]))), t,
+                transmittance_over_pdf);
+  *transmittance_over_pdf /= mixture.factor[k];
   return true;
 }
 

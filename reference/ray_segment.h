@@ -24,16 +24,20 @@ constexpr double kVertexTolerance = 1e-7;
 bool InsideTopSphere(const glsl::AtmosphereParameters& geometry, double r, double mu, double* t_in,
                      double* t_out);
 
-// Cosine of the zenith angle of the horizon seen from radius r.
-double HorizonCosine(double bottom_radius, double r);
+// The zenith cosine of the ray along which the sun's visible part is seen
+// from radius r, for the sun's zenith cosine mu_s: mu_s itself, or the
+// horizon's when the disc's centre is below it (its visible part is then
+// seen along the ray that grazes the ground).
+double SunRayCosine(const glsl::AtmosphereParameters& geometry, double r, double mu_s);
 
 // A ray clipped to the atmosphere (a camera in space starts where the ray
 // enters it) and ending at the ground, the top, or the given distance, with
 // its optical depth at nodes: the shell crossings, refined so that
 // neighbours differ by a bounded optical depth. Distances are sampled with
 // density extinction x transmittance under the table's piecewise-linear
-// optical depth; the table defines only that density, and every weight uses
-// the exact transmittance, so a coarse table costs variance, never bias.
+// optical depth, optionally guided (MakeMixture); the table defines only
+// that density, and every weight uses the exact transmittance, so a coarse
+// table costs variance, never bias.
 class RaySegment {
  public:
   enum class Table {
@@ -55,11 +59,34 @@ class RaySegment {
   // for a whole ray that ends on the ground.
   Spectrum Transmittance(Spectrum* error) const;
 
-  // A distance t for wavelength w from u in [0, 1), and T(t) / pdf(t); false
-  // if the segment has no extinction at that wavelength.
-  bool Sample(const LayeredMedium& medium, int w, double u, double* t, double* transmittance_over_pdf) const;
+  // The middle distance of each piece between two nodes of the table.
+  std::vector<double> PieceMiddles() const;
+
+  // A density over distances for wavelength w: a mixture with share `keep`
+  // of extinction x transmittance (under the table's piecewise-linear
+  // optical depth tau~: slope exp(-tau~(t)) / (1 - exp(-tau~(length))), the
+  // truncated exponential in tau~), and otherwise that density times
+  // piece_weights[k] on piece k (normalised), for the pieces a path should
+  // find more often (the sunlit ones after sunset). Without weight on any
+  // piece where the first density is not 0 it is the first density.
+  struct Mixture {
+    int wavelength = 0;
+    std::vector<double> cumulative;  // of the pieces' masses, ending at 1
+    std::vector<double> factor;      // on each piece, the mixture / the first density
+  };
+  Mixture MakeMixture(int w, const std::vector<double>& piece_weights, double keep) const;
+
+  // A distance t from u in [0, 1) and T(t) / pdf(t) under the mixture;
+  // false if the segment has no extinction at its wavelength.
+  bool SampleMixture(const LayeredMedium& medium, const Mixture& mixture, double u, double* t,
+                     double* transmittance_over_pdf) const;
 
  private:
+  // The distance within piece k at the table's optical depth `target`, and
+  // T(t) / pdf(t) under extinction x transmittance.
+  void SampleInPiece(const LayeredMedium& medium, int w, std::size_t k, double target, double* t,
+                     double* transmittance_over_pdf) const;
+
   Table table_;
   glm::dvec3 origin_{0.0};
   double r_ = 0.0, mu_ = 0.0, length_ = 0.0;
