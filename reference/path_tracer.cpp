@@ -22,6 +22,7 @@
 #include "bake/config.h"
 #include "core/constants.h"
 #include "core/errors.h"
+#include "reference/direction_guide.h"
 #include "reference/phase_sampling.h"
 #include "reference/random.h"
 #include "reference/ray_segment.h"
@@ -44,6 +45,16 @@ constexpr int kForcedSegments = 1;
 // that after sunset, when only a thin high shell is lit, paths still find it.
 constexpr double kUnguidedShare = 0.5;
 
+// Directions after a scattering event are drawn from a mixture with the same
+// aim: with this share from the phase function, otherwise from the
+// DirectionGuide nearest to the vertex. The guides are built at
+// kDirectionGuides points along the view ray when the sun is this close to
+// or below the horizon where the view ray starts (in daylight the phase
+// function alone does well).
+constexpr double kPhaseShare = 0.5;
+constexpr int kDirectionGuides = 8;
+constexpr double kGuideSunCosine = 0.1;
+
 enum Estimator : uint64_t { kRadianceEstimator = 1, kIrradianceEstimator = 2 };
 
 struct Tally {
@@ -54,10 +65,11 @@ struct Tally {
 // The path logic at one wavelength.
 class Tracer {
  public:
-  Tracer(const LayeredMedium& medium, const SunlightTable& sunlight, const Settings& settings, const dvec3& sun,
-         int wavelength)
+  Tracer(const LayeredMedium& medium, const SunlightTable& sunlight, const std::vector<DirectionGuide>& directions,
+         const Settings& settings, const dvec3& sun, int wavelength)
       : medium_(medium),
         sunlight_(sunlight),
+        directions_(directions),
         settings_(settings),
         sun_(sun),
         w_(wavelength),
@@ -86,6 +98,35 @@ class Tracer {
     double t_in, t_out;
     if (!InsideTopSphere(g, r, mu, &t_in, &t_out)) return 0.0;
     return Trace(camera + t_in * direction, 0.0, direction, weight, 0.0, 0, false, rng, tally);
+  }
+
+  // The usable guide built nearest to x, or null.
+  const DirectionGuide* NearestGuide(const dvec3& x) const {
+    const DirectionGuide* nearest = nullptr;
+    double best = 0.0;
+    for (const DirectionGuide& guide : directions_) {
+      const double distance = glm::length(guide.point() - x);
+      if (guide.usable() && (!nearest || distance < best)) nearest = &guide, best = distance;
+    }
+    return nearest;
+  }
+
+  // Per piece of the view segment (along `direction`), an estimate at its
+  // middle of the light a vertex there scatters into the ray: the sunlight
+  // (SunlightTable) times the phase function, plus the single-scattered
+  // light of the nearest direction guide spread evenly over the sphere.
+  std::vector<double> SourcePieces(const RaySegment& segment, const dvec3& direction) {
+    std::vector<double> weights;
+    for (double t : segment.PieceMiddles()) {
+      const dvec3 x = segment.origin() + t * direction;
+      const double r = glm::length(x);
+      const double sigma_s = medium_.Scattering(r, w_, sigma_.data());
+      const double direct = sigma_s > 0.0 ? PhaseMixture(glm::dot(sun_, direction), sigma_s) : 0.0;
+      const DirectionGuide* guide = NearestGuide(x);
+      weights.push_back(direct * sunlight_.At(r, glm::dot(x, sun_) / r)[w_] +
+                        (guide ? guide->Incoming() / (4.0 * kPi) : 0.0));
+    }
+    return weights;
   }
 
   // Per piece of `segment` (along `direction`), the tabulated sunlight at
@@ -172,8 +213,20 @@ class Tracer {
           if (pick < sigma_[i]) break;
           pick -= sigma_[i];
         }
-        double cos_theta = SamplePhaseCosine(medium_.phase(c), rng);
-        direction = DirectionAround(direction, cos_theta, rng.Uniform());
+        const DirectionGuide* guide = NearestGuide(x);
+        dvec3 next;
+        if (guide && rng.Uniform() >= kPhaseShare) {
+          const double u_cell = rng.Uniform(), u1 = rng.Uniform();
+          next = guide->Sample(u_cell, u1, rng.Uniform());
+        } else {
+          next = DirectionAround(direction, SamplePhaseCosine(medium_.phase(c), rng), rng.Uniform());
+        }
+        if (guide) {
+          // The mixture's density against the phase function it stands for.
+          const double phase = PhaseMixture(glm::dot(direction, next), sigma_s);
+          weight *= phase / (kPhaseShare * phase + (1.0 - kPhaseShare) * guide->Pdf(next));
+        }
+        direction = next;
         at_vertex = false;
       }
 
@@ -229,6 +282,7 @@ class Tracer {
 
   const LayeredMedium& medium_;
   const SunlightTable& sunlight_;
+  const std::vector<DirectionGuide>& directions_;  // empty: phase sampling alone
   const Settings& settings_;
   dvec3 sun_;
   int w_;
@@ -408,14 +462,25 @@ Result PathTracer::Evaluate(const RayQuery& query, const Settings& settings, uin
   // Per wavelength, the density of the paths' first vertices along the view
   // ray, guided by the sunlight on its pieces.
   std::vector<RaySegment::Mixture> view_densities;
+  std::vector<DirectionGuide> direction_guides[kWavelengthCount];
+  const dvec3 view_start = segment.length() > 0.0 ? segment.origin() : query.camera;
+  // (Single scattering alone continues no path: no use for them.)
+  const bool twilight = glm::dot(glm::normalize(view_start), sun) < kGuideSunCosine && settings.max_order != 1;
   for (int w = 0; w < kWavelengthCount; ++w) {
-    view_densities.push_back(
-        segment.MakeMixture(w, Tracer(medium_, sunlight_, settings, sun, w).SunlitPieces(segment, view), kUnguidedShare));
+    if (twilight && segment.length() > 0.0) {
+      for (int k = 0; k < kDirectionGuides; ++k) {
+        const dvec3 point = segment.origin() + segment.length() * (k + 0.5) / kDirectionGuides * view;
+        direction_guides[w].emplace_back(medium_, sunlight_, point, sun, w);
+      }
+    }
+    view_densities.push_back(segment.MakeMixture(
+        w, Tracer(medium_, sunlight_, direction_guides[w], settings, sun, w).SourcePieces(segment, view),
+        kUnguidedShare));
   }
   auto run_block = [&](int64_t b) {
     Tally& tally = tallies[b];
     for (int w = 0; w < kWavelengthCount; ++w) {
-      Tracer tracer(medium_, sunlight_, settings, sun, w);
+      Tracer tracer(medium_, sunlight_, direction_guides[w], settings, sun, w);
       for (int j = 0; j < kPathsPerBlock; ++j) {
         const uint64_t path = static_cast<uint64_t>(b) * kPathsPerBlock + j;
         Pcg32 rng = PathGenerator(settings.seed, stream, kRadianceEstimator, w, path);
