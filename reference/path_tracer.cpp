@@ -36,7 +36,9 @@ using glm::dvec3;
 
 // Ray segments at the start of each path that use a forced collision: the
 // first only, as forcing later ones costs as much time as it saves variance
-// (docs/reference.md).
+// in daylight (docs/reference.md). In twilight, when direction guides are
+// built, every segment that escapes to space is forced: an analog flight
+// would rarely stop in the thin lit shell.
 constexpr int kForcedSegments = 1;
 
 // On the view ray and the forced segments, distances are drawn from a
@@ -194,7 +196,7 @@ class Tracer {
                Pcg32& rng, Tally& tally) {
     const glsl::AtmosphereParameters& g = medium_.geometry();
     const double reference = weight;
-    int forced = kForcedSegments;
+    int forced = directions_.empty() ? kForcedSegments : kMaxEventsPerPath;
     double sum = 0.0;
     for (;;) {
       if (at_vertex) {
