@@ -19,36 +19,60 @@
 
 namespace skybake::reference {
 
+// A point's local frame: its zenith, and the horizontal direction toward the
+// sun's azimuth and the one across it. The light field is symmetric about
+// the axis through the planet's centre toward the sun, so a guide built at
+// one point serves every point at the same radius and sun cosine, in that
+// point's own frame.
+struct GuideFrame {
+  glm::dvec3 zenith{0.0, 0.0, 1.0}, toward_sun{1.0, 0.0, 0.0}, across{0.0, 1.0, 0.0};
+  GuideFrame() = default;
+  GuideFrame(const glm::dvec3& point, const glm::dvec3& sun);
+};
+
 class DirectionGuide {
  public:
-  // The radiance estimate at `point` for the sun along `sun`, wavelength w.
-  DirectionGuide(const LayeredMedium& medium, const SunlightTable& sunlight, const glm::dvec3& point,
-                 const glm::dvec3& sun, int w);
+  // The radiance estimate at radius r where the sun's zenith cosine is mu_s,
+  // wavelength w.
+  DirectionGuide(const LayeredMedium& medium, const SunlightTable& sunlight, double r, double mu_s, int w);
 
   // False where no direction sees lit air: then it must not be sampled.
   bool usable() const { return total_ > 0.0; }
 
-  // A direction from three uniform numbers in [0, 1).
-  glm::dvec3 Sample(double u_cell, double u1, double u2) const;
+  // A direction in `frame` from three uniform numbers in [0, 1).
+  glm::dvec3 Sample(const GuideFrame& frame, double u_cell, double u1, double u2) const;
 
   // Its density per steradian.
-  double Pdf(const glm::dvec3& direction) const;
+  double Pdf(const GuideFrame& frame, const glm::dvec3& direction) const;
 
   // The estimate's integral over the sphere: the single-scattered light
   // arriving at the point from all directions (per unit solar irradiance).
   double Incoming() const { return total_ * kCellSolidAngle; }
 
-  const glm::dvec3& point() const { return point_; }
-
  private:
   static constexpr int kZenithCells = 32, kAzimuthCells = 32, kSteps = 32;
   // Each cell spans 2 / kZenithCells in cosine and 2 pi / kAzimuthCells.
   static constexpr double kCellSolidAngle = (2.0 / kZenithCells) * (2.0 * kPi / kAzimuthCells);
-  glm::dvec3 point_{0.0};
-  glm::dvec3 zenith_{0.0, 0.0, 1.0}, x_axis_{1.0, 0.0, 0.0}, y_axis_{0.0, 1.0, 0.0};
   std::vector<double> cumulative_;  // per cell, azimuth fastest
   std::vector<double> value_;
   double total_ = 0.0;
+};
+
+// Guides at altitudes x sun cosines, built once per atmosphere and
+// wavelength for the twilight sky; a point uses the nearest.
+class DirectionGuideField {
+ public:
+  DirectionGuideField(const LayeredMedium& medium, const SunlightTable& sunlight, int w);
+  // The guide for radius r and sun cosine mu_s, or null where it is not usable.
+  const DirectionGuide* At(double r, double mu_s) const;
+
+ private:
+  // Altitudes top_height (i / (kAltitudes - 1))^2, sun cosines in
+  // [kMinCosine, kMaxCosine] (sun zenith 105 to 78 degrees).
+  static constexpr int kAltitudes = 8, kCosines = 14;
+  static constexpr double kMinCosine = -0.26, kMaxCosine = 0.2;
+  double bottom_ = 0.0, height_ = 0.0;
+  std::vector<DirectionGuide> guides_;  // kCosines per altitude
 };
 
 }  // namespace skybake::reference

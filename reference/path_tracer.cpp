@@ -22,7 +22,6 @@
 #include "bake/config.h"
 #include "core/constants.h"
 #include "core/errors.h"
-#include "reference/direction_guide.h"
 #include "reference/phase_sampling.h"
 #include "reference/random.h"
 #include "reference/ray_segment.h"
@@ -49,12 +48,10 @@ constexpr double kUnguidedShare = 0.5;
 
 // Directions after a scattering event are drawn from a mixture with the same
 // aim: with this share from the phase function, otherwise from the
-// DirectionGuide nearest to the vertex. The guides are built at
-// kDirectionGuides points along the view ray when the sun is this close to
-// or below the horizon where the view ray starts (in daylight the phase
-// function alone does well).
+// DirectionGuide for the vertex's altitude and sun cosine, when the sun's
+// zenith cosine where the view ray starts is below kGuideSunCosine (in
+// daylight the phase function alone does well).
 constexpr double kPhaseShare = 0.5;
-constexpr int kDirectionGuides = 8;
 constexpr double kGuideSunCosine = 0.1;
 
 enum Estimator : uint64_t { kRadianceEstimator = 1, kIrradianceEstimator = 2 };
@@ -67,7 +64,7 @@ struct Tally {
 // The path logic at one wavelength.
 class Tracer {
  public:
-  Tracer(const LayeredMedium& medium, const SunlightTable& sunlight, const std::vector<DirectionGuide>& directions,
+  Tracer(const LayeredMedium& medium, const SunlightTable& sunlight, const DirectionGuideField* directions,
          const Settings& settings, const dvec3& sun, int wavelength)
       : medium_(medium),
         sunlight_(sunlight),
@@ -102,15 +99,11 @@ class Tracer {
     return Trace(camera + t_in * direction, 0.0, direction, weight, 0.0, 0, false, rng, tally);
   }
 
-  // The usable guide built nearest to x, or null.
-  const DirectionGuide* NearestGuide(const dvec3& x) const {
-    const DirectionGuide* nearest = nullptr;
-    double best = 0.0;
-    for (const DirectionGuide& guide : directions_) {
-      const double distance = glm::length(guide.point() - x);
-      if (guide.usable() && (!nearest || distance < best)) nearest = &guide, best = distance;
-    }
-    return nearest;
+  // The usable direction guide for the point x, or null.
+  const DirectionGuide* GuideAt(const dvec3& x) const {
+    if (!directions_) return nullptr;
+    const double r = glm::length(x);
+    return directions_->At(r, glm::dot(x, sun_) / r);
   }
 
   // Per piece of the view segment (along `direction`), an estimate at its
@@ -124,7 +117,7 @@ class Tracer {
       const double r = glm::length(x);
       const double sigma_s = medium_.Scattering(r, w_, sigma_.data());
       const double direct = sigma_s > 0.0 ? PhaseMixture(glm::dot(sun_, direction), sigma_s) : 0.0;
-      const DirectionGuide* guide = NearestGuide(x);
+      const DirectionGuide* guide = GuideAt(x);
       weights.push_back(direct * sunlight_.At(r, glm::dot(x, sun_) / r)[w_] +
                         (guide ? guide->Incoming() / (4.0 * kPi) : 0.0));
     }
@@ -196,7 +189,7 @@ class Tracer {
                Pcg32& rng, Tally& tally) {
     const glsl::AtmosphereParameters& g = medium_.geometry();
     const double reference = weight;
-    int forced = directions_.empty() ? kForcedSegments : kMaxEventsPerPath;
+    int forced = directions_ ? kMaxEventsPerPath : kForcedSegments;
     double sum = 0.0;
     for (;;) {
       if (at_vertex) {
@@ -215,18 +208,19 @@ class Tracer {
           if (pick < sigma_[i]) break;
           pick -= sigma_[i];
         }
-        const DirectionGuide* guide = NearestGuide(x);
+        const DirectionGuide* guide = GuideAt(x);
+        const GuideFrame frame = guide ? GuideFrame(x, sun_) : GuideFrame();
         dvec3 next;
         if (guide && rng.Uniform() >= kPhaseShare) {
           const double u_cell = rng.Uniform(), u1 = rng.Uniform();
-          next = guide->Sample(u_cell, u1, rng.Uniform());
+          next = guide->Sample(frame, u_cell, u1, rng.Uniform());
         } else {
           next = DirectionAround(direction, SamplePhaseCosine(medium_.phase(c), rng), rng.Uniform());
         }
         if (guide) {
           // The mixture's density against the phase function it stands for.
           const double phase = PhaseMixture(glm::dot(direction, next), sigma_s);
-          weight *= phase / (kPhaseShare * phase + (1.0 - kPhaseShare) * guide->Pdf(next));
+          weight *= phase / (kPhaseShare * phase + (1.0 - kPhaseShare) * guide->Pdf(frame, next));
         }
         direction = next;
         at_vertex = false;
@@ -284,7 +278,7 @@ class Tracer {
 
   const LayeredMedium& medium_;
   const SunlightTable& sunlight_;
-  const std::vector<DirectionGuide>& directions_;  // empty: phase sampling alone
+  const DirectionGuideField* directions_;  // null: phase sampling alone
   const Settings& settings_;
   dvec3 sun_;
   int w_;
@@ -418,6 +412,13 @@ Atmosphere Checked(const Atmosphere& atmosphere) {
 
 PathTracer::PathTracer(const Atmosphere& atmosphere) : medium_(Checked(atmosphere)), sunlight_(medium_) {}
 
+const std::vector<DirectionGuideField>& PathTracer::TwilightGuides() const {
+  std::call_once(guides_->built, [&] {
+    for (int w = 0; w < kWavelengthCount; ++w) guides_->per_wavelength.emplace_back(medium_, sunlight_, w);
+  });
+  return guides_->per_wavelength;
+}
+
 Spectrum PathTracer::SunTransmittance(const dvec3& point, const dvec3& sun, Spectrum* error) const {
   const glsl::AtmosphereParameters& g = medium_.geometry();
   *error = Spectrum(0.0);
@@ -464,25 +465,20 @@ Result PathTracer::Evaluate(const RayQuery& query, const Settings& settings, uin
   // Per wavelength, the density of the paths' first vertices along the view
   // ray, guided by the sunlight on its pieces.
   std::vector<RaySegment::Mixture> view_densities;
-  std::vector<DirectionGuide> direction_guides[kWavelengthCount];
+  // In twilight the direction guides (single scattering alone continues no
+  // path: no use for them).
   const dvec3 view_start = segment.length() > 0.0 ? segment.origin() : query.camera;
-  // (Single scattering alone continues no path: no use for them.)
   const bool twilight = glm::dot(glm::normalize(view_start), sun) < kGuideSunCosine && settings.max_order != 1;
+  const std::vector<DirectionGuideField>* guides = twilight ? &TwilightGuides() : nullptr;
   for (int w = 0; w < kWavelengthCount; ++w) {
-    if (twilight && segment.length() > 0.0) {
-      for (int k = 0; k < kDirectionGuides; ++k) {
-        const dvec3 point = segment.origin() + segment.length() * (k + 0.5) / kDirectionGuides * view;
-        direction_guides[w].emplace_back(medium_, sunlight_, point, sun, w);
-      }
-    }
     view_densities.push_back(segment.MakeMixture(
-        w, Tracer(medium_, sunlight_, direction_guides[w], settings, sun, w).SourcePieces(segment, view),
+        w, Tracer(medium_, sunlight_, guides ? &(*guides)[w] : nullptr, settings, sun, w).SourcePieces(segment, view),
         kUnguidedShare));
   }
   auto run_block = [&](int64_t b) {
     Tally& tally = tallies[b];
     for (int w = 0; w < kWavelengthCount; ++w) {
-      Tracer tracer(medium_, sunlight_, direction_guides[w], settings, sun, w);
+      Tracer tracer(medium_, sunlight_, guides ? &(*guides)[w] : nullptr, settings, sun, w);
       for (int j = 0; j < kPathsPerBlock; ++j) {
         const uint64_t path = static_cast<uint64_t>(b) * kPathsPerBlock + j;
         Pcg32 rng = PathGenerator(settings.seed, stream, kRadianceEstimator, w, path);

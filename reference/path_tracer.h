@@ -17,10 +17,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "bake/atmosphere.h"
+#include "reference/direction_guide.h"
 #include "reference/layered_medium.h"
 #include "reference/sunlight_table.h"
 #include "shaders_runtime/query.h"
@@ -122,8 +126,17 @@ class PathTracer {
   Spectrum SunTransmittance(const glm::dvec3& point, const glm::dvec3& sun, Spectrum* error) const;
 
  private:
+  // The twilight direction guides per wavelength, built at the first query
+  // that needs them.
+  struct GuideFields {
+    std::once_flag built;
+    std::vector<DirectionGuideField> per_wavelength;
+  };
+  const std::vector<DirectionGuideField>& TwilightGuides() const;
+
   LayeredMedium medium_;
   SunlightTable sunlight_;  // where to look for sunlit scattering
+  std::shared_ptr<GuideFields> guides_ = std::make_shared<GuideFields>();
 };
 
 }  // namespace skybake::reference

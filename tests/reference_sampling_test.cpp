@@ -292,7 +292,8 @@ TEST(ReferenceSampling, DirectionGuideSamplesItsOwnDensity) {
   for (double altitude : {0.0, 20000.0}) {
     const dvec3 point(0.0, 0.0, medium.bottom_radius() + altitude);
     for (int w = 0; w < kWavelengthCount; ++w) {
-      const DirectionGuide guide(medium, sunlight, point, sun, w);
+      const DirectionGuide guide(medium, sunlight, glm::length(point), glm::dot(point, sun) / glm::length(point), w);
+      const GuideFrame frame(point, sun);
       ASSERT_TRUE(guide.usable());
       std::vector<double> expected(kRegions * kRegions, 0.0), observed(kRegions * kRegions, 0.0);
       double total = 0.0;
@@ -302,7 +303,7 @@ TEST(ReferenceSampling, DirectionGuideSamplesItsOwnDensity) {
         for (int j = 0; j < kFine; ++j) {
           const double phi = 2.0 * kPi * (j + 0.5) / kFine;
           const dvec3 d(s * std::cos(phi), s * std::sin(phi), c);
-          const double p = guide.Pdf(d) * cell;
+          const double p = guide.Pdf(frame, d) * cell;
           total += p;
           expected[region(d)] += p;
         }
@@ -312,9 +313,9 @@ TEST(ReferenceSampling, DirectionGuideSamplesItsOwnDensity) {
       const int n = 200000;
       for (int k = 0; k < n; ++k) {
         const double u = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-        const dvec3 d = guide.Sample(u, u1, u2);
+        const dvec3 d = guide.Sample(frame, u, u1, u2);
         ASSERT_NEAR(glm::length(d), 1.0, 1e-12);
-        ASSERT_GT(guide.Pdf(d), 0.0);
+        ASSERT_GT(guide.Pdf(frame, d), 0.0);
         observed[region(d)] += 1.0 / n;
       }
       for (int r = 0; r < kRegions * kRegions; ++r) {
