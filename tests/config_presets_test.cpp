@@ -115,16 +115,23 @@ TEST(Presets, OzoneTentProfile) {
   for (size_t i = 0; i < corners.size(); ++i) EXPECT_NEAR(breakpoints[i], corners[i], 1e-6);
 }
 
+// A published aerosol: its scattering, its phase function and the altitude
+// at which its exponential density has fallen to 1/e.
+void ExpectAerosol(const Constituent& c, const Spectrum& scattering, PhaseKind phase, double g, double scale_height_m) {
+  SCOPED_TRACE("constituent " + c.name);
+  ExpectSpectrumEq(c.scattering_per_m, scattering, "scattering");
+  EXPECT_EQ(c.phase.kind, phase);
+  EXPECT_EQ(c.phase.g, g);
+  EXPECT_NEAR(c.density.At(scale_height_m), std::exp(-1.0), 1e-15);
+}
+
 TEST(Presets, EarthClear2008HasBrunetonNeyretParameters) {
   Atmosphere clear = LoadPreset("earth-clear-2008");
   ASSERT_EQ(clear.constituents.size(), 2u);  // no ozone
   ExpectIdentical(Find(clear, "rayleigh"), Find(LoadPreset("earth"), "rayleigh"));
   const Constituent& mie = Find(clear, "mie");
-  ExpectSpectrumEq(mie.scattering_per_m, Spectrum(2e-5), "mie scattering");
+  ExpectAerosol(mie, Spectrum(2e-5), PhaseKind::kCornetteShanks, 0.76, 1200.0);
   EXPECT_NEAR(mie.scattering_per_m[1] / mie.Extinction()[1], 0.9, 1e-12);
-  EXPECT_EQ(mie.phase.kind, PhaseKind::kCornetteShanks);
-  EXPECT_EQ(mie.phase.g, 0.76);
-  EXPECT_NEAR(mie.density.At(1200.0), std::exp(-1.0), 1e-15);
 }
 
 TEST(Presets, HazeAndFogFollowHoffmanPreetham) {
@@ -148,11 +155,9 @@ TEST(Presets, HazeAndFogFollowHoffmanPreetham) {
     ExpectIdentical(Find(atmosphere, "rayleigh"), Find(earth, "rayleigh"));
     ExpectIdentical(Find(atmosphere, "ozone"), Find(earth, "ozone"));
     const Constituent& haze = Find(atmosphere, "haze");
-    ExpectSpectrumEq(haze.scattering_per_m, expected.scattering, "haze scattering");
+    // Optical length 1.25 km.
+    ExpectAerosol(haze, expected.scattering, PhaseKind::kHenyeyGreenstein, expected.g, 1250.0);
     ExpectSpectrumEq(haze.absorption_per_m, Spectrum(0.0), "haze absorption");
-    EXPECT_EQ(haze.phase.kind, PhaseKind::kHenyeyGreenstein);
-    EXPECT_EQ(haze.phase.g, expected.g);
-    EXPECT_NEAR(haze.density.At(1250.0), std::exp(-1.0), 1e-15);  // optical length 1.25 km
   }
 }
 
@@ -171,11 +176,8 @@ TEST(Presets, MarsIsLitByTheSunAt1524AU) {
   ExpectSpectrumEq(gas.scattering_per_m, Spectrum(19.918e-6, 13.57e-6, 5.75e-6), "gas");
   EXPECT_NEAR(gas.density.At(11000.0), std::exp(-1.0), 1e-15);
   const Constituent& dust = Find(mars, "dust");
-  ExpectSpectrumEq(dust.scattering_per_m, Spectrum(53.6e-6), "dust");
+  ExpectAerosol(dust, Spectrum(53.6e-6), PhaseKind::kHenyeyGreenstein, 0.85, 3100.0);
   EXPECT_NEAR(dust.scattering_per_m[0] / dust.Extinction()[0], 0.99, 1e-12);
-  EXPECT_EQ(dust.phase.kind, PhaseKind::kHenyeyGreenstein);
-  EXPECT_EQ(dust.phase.g, 0.85);
-  EXPECT_NEAR(dust.density.At(3100.0), std::exp(-1.0), 1e-15);
 }
 
 
