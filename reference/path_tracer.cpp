@@ -106,24 +106,6 @@ class Tracer {
     return directions_->At(r, glm::dot(x, sun_) / r);
   }
 
-  // Per piece of the view segment (along `direction`), an estimate at its
-  // middle of the light a vertex there scatters into the ray: the sunlight
-  // (SunlightTable) times the phase function, plus the single-scattered
-  // light of the nearest direction guide spread evenly over the sphere.
-  std::vector<double> SourcePieces(const RaySegment& segment, const dvec3& direction) {
-    std::vector<double> weights;
-    for (double t : segment.PieceMiddles()) {
-      const dvec3 x = segment.origin() + t * direction;
-      const double r = glm::length(x);
-      const double sigma_s = medium_.Scattering(r, w_, sigma_.data());
-      const double direct = sigma_s > 0.0 ? PhaseMixture(glm::dot(sun_, direction), sigma_s) : 0.0;
-      const DirectionGuide* guide = GuideAt(x);
-      weights.push_back(direct * sunlight_.At(r, glm::dot(x, sun_) / r)[w_] +
-                        (guide ? guide->Incoming() / (4.0 * kPi) : 0.0));
-    }
-    return weights;
-  }
-
   // Per piece of `segment` (along `direction`), the tabulated sunlight at
   // its middle: the guide of MakeMixture.
   std::vector<double> SunlitPieces(const RaySegment& segment, const dvec3& direction) const {
@@ -132,6 +114,23 @@ class Tracer {
       const dvec3 x = segment.origin() + t * direction;
       const double r = glm::length(x);
       weights.push_back(sunlight_.At(r, glm::dot(x, sun_) / r)[w_]);
+    }
+    return weights;
+  }
+
+  // Per piece of the view segment (along `direction`), an estimate at its
+  // middle of the light a vertex there scatters into the ray: the sunlight
+  // (SunlitPieces) times the phase function, plus the single-scattered light
+  // of the direction guide there spread evenly over the sphere.
+  std::vector<double> SourcePieces(const RaySegment& segment, const dvec3& direction) {
+    std::vector<double> weights = SunlitPieces(segment, direction);
+    const std::vector<double> middles = segment.PieceMiddles();
+    for (std::size_t k = 0; k < middles.size(); ++k) {
+      const dvec3 x = segment.origin() + middles[k] * direction;
+      const double sigma_s = medium_.Scattering(glm::length(x), w_, sigma_.data());
+      const double direct = sigma_s > 0.0 ? PhaseMixture(glm::dot(sun_, direction), sigma_s) : 0.0;
+      const DirectionGuide* guide = GuideAt(x);
+      weights[k] = direct * weights[k] + (guide ? guide->Incoming() / (4.0 * kPi) : 0.0);
     }
     return weights;
   }
