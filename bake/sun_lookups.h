@@ -180,8 +180,8 @@ class SunAtPoints {
       const float a1 = plane1[t00] + fx * (plane1[t10] - plane1[t00]), b1 = plane1[t01] + fx * (plane1[t11] - plane1[t01]);
       const float a2 = plane2[t00] + fx * (plane2[t10] - plane2[t00]), b2 = plane2[t01] + fx * (plane2[t11] - plane2[t01]);
       tau0[l] = a0 + fy * (b0 - a0), tau1[l] = a1 + fy * (b1 - a1), tau2[l] = a2 + fy * (b2 - a2);
-      const float horizon = -rho / r, half_disc = bottom / r * angular_radius;
-      visible[l] = glsl_float::SunVisibleFractionAboveHorizon(mu_s[l], horizon, half_disc);
+      visible[l] = glsl_float::SunVisibleFractionAboveHorizon(mu_s[l], glsl_float::HorizonZenithCosine(bottom, r),
+                                                              bottom / r * angular_radius);
     }
   }
 
