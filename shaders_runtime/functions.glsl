@@ -306,27 +306,67 @@ vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(Transmittance
          SunVisibleFraction(atmosphere, r, mu_s);
 }
 
+// Below this sun cosine (84 degrees) table lookups interpolate
+// geometrically along mu_s (SunCosineMix).
+const Number LOW_SUN_MU_S = 0.1;
+
+// Interpolation between two table texels a and b along the sun's cosine (or
+// between two nu slices of one mu_s texel column), at position t in [0, 1]:
+// linear, or, where `low_sun` (the texel with the lower sun has mu_s below
+// LOW_SUN_MU_S), geometric, a^(1 - t) b^t. From low sun to the end of
+// twilight the light falls by orders of magnitude over a few mu_s texels,
+// about as exp(-h / H) with h the height of the Earth's shadow (or, before
+// sunset, the sun's air mass), and linear interpolation overestimates such a
+// fall by up to (a + b) / (2 sqrt(a b)) at mid-texel: 1.7 times at a tenfold
+// fall. Where one side is dark (0), the result falls to it within the texel.
+vec4 SunCosineMix(vec4 a, vec4 b, Number t, bool low_sun) {
+  if (!low_sun) return mix(a, b, t);
+  vec4 dark = vec4(1e-30);
+  return exp(mix(log(max(a, dark)), log(max(b, dark)), t)) * step(dark, max(a, b));
+}
+
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-// 4D lookup: trilinear in (mu_s, mu, r) by the texture unit, linear in nu
-// between the two neighbouring nu slices.
+// 4D lookup: four fetches, at the two mu_s texel columns either side of
+// mu_s and the two nu slices either side of nu, each bilinear in (mu, r) by
+// the texture unit; then nu and mu_s by SunCosineMix.
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
-  Number tex_coord_x = uvwz.x * Number(atmosphere.scattering_nu_size - 1);
-  Number tex_x = floor(tex_coord_x);
-  Number lerp = tex_coord_x - tex_x;
   Number nu_size = Number(atmosphere.scattering_nu_size);
-  vec3 uvw0 = vec3((tex_x + uvwz.y) / nu_size, uvwz.z, uvwz.w);
-  vec3 uvw1 = vec3((tex_x + 1.0 + uvwz.y) / nu_size, uvwz.z, uvwz.w);
-  return texture(scattering_texture, uvw0) * (1.0 - lerp) + texture(scattering_texture, uvw1) * lerp;
+  Number nu_coord = uvwz.x * (nu_size - 1.0);
+  Number nu_slice = min(floor(nu_coord), nu_size - 2.0);
+  Number nu_t = nu_coord - nu_slice;
+  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  Number mu_s_coord = uvwz.y * mu_s_size - 0.5;
+  Number mu_s_column = clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
+  Number mu_s_t = clamp(mu_s_coord - mu_s_column, 0.0, 1.0);
+  Number x_below = (mu_s_column + 0.5) / mu_s_size, x_above = (mu_s_column + 1.5) / mu_s_size;
+  Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
+  bool low_sun_below = x_below < x_low_sun, low_sun_above = x_above < x_low_sun;
+  vec4 below = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w)),
+                            texture(scattering_texture, vec3((nu_slice + 1.0 + x_below) / nu_size, uvwz.z, uvwz.w)),
+                            nu_t, low_sun_below);
+  vec4 above = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_above) / nu_size, uvwz.z, uvwz.w)),
+                            texture(scattering_texture, vec3((nu_slice + 1.0 + x_above) / nu_size, uvwz.z, uvwz.w)),
+                            nu_t, low_sun_above);
+  return SunCosineMix(below, above, mu_s_t, low_sun_below);
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+// Bilinear in r by the texture unit at the two mu_s texel columns either
+// side of mu_s, then SunCosineMix along mu_s: two fetches.
 vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) irradiance_texture,
                    Number r, Number mu_s) {
   vec2 uv = GetIrradianceTextureUvFromRMuS(atmosphere, r, mu_s);
-  return vec3(texture(irradiance_texture, uv));
+  Number width = Number(atmosphere.irradiance_width);
+  Number mu_s_coord = uv.x * width - 0.5;
+  Number mu_s_column = clamp(floor(mu_s_coord), 0.0, width - 2.0);
+  Number mu_s_t = clamp(mu_s_coord - mu_s_column, 0.0, 1.0);
+  Number mu_s_below = atmosphere.mu_s_min + (1.0 - atmosphere.mu_s_min) * mu_s_column / (width - 1.0);
+  vec4 below = texture(irradiance_texture, vec2((mu_s_column + 0.5) / width, uv.y));
+  vec4 above = texture(irradiance_texture, vec2((mu_s_column + 1.5) / width, uv.y));
+  return vec3(SunCosineMix(below, above, mu_s_t, mu_s_below < LOW_SUN_MU_S));
 }
 #endif
 

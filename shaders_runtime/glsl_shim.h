@@ -35,6 +35,7 @@ using glm::min;
 using glm::mix;
 using glm::normalize;
 using glm::smoothstep;
+using glm::step;
 using std::exp;
 using std::floor;
 using std::log;
