@@ -46,8 +46,7 @@ double AutoExposureEv(const Image& image) {
   const std::size_t pixels = std::size_t(image.width) * image.height;
   std::vector<double> sky, lit;
   for (std::size_t i = 0; i < pixels; ++i) {
-    double y = 0.0;
-    for (int c = 0; c < 3; ++c) y += report::kLuminanceWeights[c] * image.rgb[3 * i + c];
+    const double y = report::Luminance(glm::dvec3(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]));
     if (!(y > 0.0)) continue;
     lit.push_back(y);
     if (i < image.sky.size() && image.sky[i]) sky.push_back(y);

@@ -7,6 +7,7 @@
 #include "bake/bake.h"
 #include "bake/scene.h"
 #include "plot/plot.h"
+#include "report/error_stats.h"
 #include "shaders_runtime/twin.h"
 
 namespace skybake::render {
@@ -41,12 +42,44 @@ std::string MissingTable(const LutSet& luts, const std::string& table) {
   return why + " (scene '" + luts.scene->name + "')";
 }
 
+// The problem a scene has with a sky query from `altitude_m` with the sun at
+// `sun_zenith_deg`; empty where the set covers it.
+std::string SkyQueryProblem(const LutSet& luts, double altitude_m, double sun_zenith_deg) {
+  if (!luts.scene) return "";
+  Query sky;
+  sky.altitude_m = altitude_m, sky.sun_zenith_deg = sun_zenith_deg;
+  std::vector<std::string> unused;
+  return SceneQueryProblem(*luts.scene, luts.parameters.bottom_radius, false, &sky, &unused);
+}
+
+constexpr double kSunsetCameraAltitudeM = 1.0;
+constexpr double kSunsetFirstSunDeg = 85.0;
+
 }  // namespace
+
+SunsetCurves ComputeSunsetCurves(const Twin& twin) {
+  const glsl::AtmosphereParameters& p = twin.parameters();
+  const double lowest_sun_deg = std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
+  const vec3 camera(0.0, 0.0, p.bottom_radius + kSunsetCameraAltitudeM);
+  const double horizon = 88.0 * kDegree;
+  const vec3 sunward(std::sin(horizon), 0.0, std::cos(horizon)), antisolar(-sunward.x, 0.0, sunward.z);
+  SunsetCurves curves;
+  for (int i = 0; kSunsetFirstSunDeg + 0.05 * i <= lowest_sun_deg + 1e-9; ++i) {
+    const double sun_zenith = kSunsetFirstSunDeg + 0.05 * i;
+    const vec3 sun(std::sin(sun_zenith * kDegree), 0.0, std::cos(sun_zenith * kDegree));
+    curves.sun_zenith_deg.push_back(sun_zenith);
+    curves.zenith.push_back(report::Luminance(twin.SkyRadiance(camera, vec3(0.0, 0.0, 1.0), sun, nullptr)));
+    curves.sunward_horizon.push_back(report::Luminance(twin.SkyRadiance(camera, sunward, sun, nullptr)));
+    curves.antisolar_horizon.push_back(report::Luminance(twin.SkyRadiance(camera, antisolar, sun, nullptr)));
+  }
+  return curves;
+}
 
 PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, const std::string& caption) {
   const Twin twin(MakeTwinTables(luts));
   const vec3& wavelengths_nm = luts.atmosphere.wavelengths_nm;
   const glsl::AtmosphereParameters& p = twin.parameters();
+  const double lowest_sun_deg = std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
   PlotFiles files;
 
   {
@@ -82,13 +115,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
   const double sky_camera_altitude_m = 1.0;
   std::vector<double> sky_sun_zeniths;
   for (double sun_zenith : {0.0, 45.0, 80.0, 90.0}) {
-    std::string problem;
-    if (luts.scene) {
-      Query sky;
-      sky.altitude_m = sky_camera_altitude_m, sky.sun_zenith_deg = sun_zenith;
-      std::vector<std::string> unused;
-      problem = SceneQueryProblem(*luts.scene, p.bottom_radius, false, &sky, &unused);
-    }
+    const std::string problem = SkyQueryProblem(luts, sky_camera_altitude_m, sun_zenith);
     if (problem.empty()) {
       sky_sun_zeniths.push_back(sun_zenith);
     } else if (twin.has_scattering()) {
@@ -131,7 +158,6 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
     LinePlot plot;
     plot.title = "Irradiance on horizontal ground";
     plot.caption = caption;
-    double lowest_sun_deg = std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
     plot.x = {"sun zenith angle (degrees)", false, 0.0, lowest_sun_deg};
     plot.y = {"irradiance (W m^-2 nm^-1)", false, 0.0, {}};
     const vec3 point(0.0, 0.0, p.bottom_radius), normal(0.0, 0.0, 1.0);
@@ -155,6 +181,36 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
       plot.series.push_back(std::move(sky));
     }
     Write(plot, dir, "lut_irradiance", &files);
+  }
+
+  std::string sunset_problem = twin.has_scattering() ? "" : MissingTable(luts, "scattering");
+  for (double sun_zenith : {kSunsetFirstSunDeg, lowest_sun_deg}) {
+    if (sunset_problem.empty()) sunset_problem = SkyQueryProblem(luts, kSunsetCameraAltitudeM, sun_zenith);
+  }
+  if (sunset_problem.empty() && lowest_sun_deg <= kSunsetFirstSunDeg) {
+    sunset_problem = "the atmosphere's lowest sun is above 85 deg";
+  }
+  if (!sunset_problem.empty()) {
+    files.left_out.push_back("lut_sunset: " + sunset_problem);
+  } else {
+    const SunsetCurves curves = ComputeSunsetCurves(twin);
+    LinePlot plot;
+    plot.title = "Sky luminance from the ground through sunset and twilight";
+    plot.caption = caption;
+    plot.x = {"sun zenith angle (degrees)", false, kSunsetFirstSunDeg, lowest_sun_deg};
+    plot.y = {"luminance of the three channels (W m^-2 sr^-1 nm^-1, Rec. 709 weights)", true, {}, {}};
+    const std::pair<const char*, const std::vector<double>*> views[] = {
+        {"zenith", &curves.zenith},
+        {"2 deg above the horizon, toward the sun", &curves.sunward_horizon},
+        {"2 deg above the horizon, away from the sun", &curves.antisolar_horizon}};
+    for (const auto& [name, values] : views) {
+      PlotSeries s;
+      s.name = name;
+      s.x = curves.sun_zenith_deg;
+      s.y = *values;
+      plot.series.push_back(std::move(s));
+    }
+    Write(plot, dir, "lut_sunset", &files);
   }
   return files;
 }

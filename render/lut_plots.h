@@ -7,7 +7,9 @@
 //                                plane, vs signed view zenith (negative: away
 //                                from the sun), for sun zeniths 0, 45, 80, 90;
 //   lut_irradiance.{svg,png}     direct sun and sky irradiance on horizontal
-//                                ground vs sun zenith.
+//                                ground vs sun zenith;
+//   lut_sunset.{svg,png}         sky luminance through sunset and twilight
+//                                (SunsetCurves).
 // A scene's bake (bake/scene.h) holds only some tables and covers only some
 // cameras and suns: a plot whose table the set leaves out is not drawn, the
 // sky radiance plot keeps only the sun zeniths the scene covers at the
@@ -22,6 +24,7 @@
 
 namespace skybake {
 struct LutSet;
+class Twin;
 }
 
 namespace skybake::render {
@@ -33,6 +36,17 @@ struct PlotFiles {
   // "lut_irradiance: the set has no irradiance table (...)".
   std::vector<std::string> left_out;
 };
+
+// Sky luminance (report::Luminance of the three channels) seen from 1 m
+// above the ground through sunset and twilight: at the zenith, and 2 degrees
+// above the horizon toward the sun and away from it, for sun zenith angles
+// from 85 degrees to the table's lowest sun (102 for earth) in 0.05 degree
+// steps. The tests hold these to falling smoothly (docs/accuracy.md).
+struct SunsetCurves {
+  std::vector<double> sun_zenith_deg;
+  std::vector<double> zenith, sunward_horizon, antisolar_horizon;
+};
+SunsetCurves ComputeSunsetCurves(const Twin& twin);
 
 // Writes the plots of `luts` into `dir` (which must exist), each file
 // atomically. `caption` goes under each plot (e.g. the command line).

@@ -8,10 +8,6 @@
 
 namespace skybake::report {
 
-double Luminance(const glm::dvec3& rgb) {
-  return kLuminanceWeights[0] * rgb.x + kLuminanceWeights[1] * rgb.y + kLuminanceWeights[2] * rgb.z;
-}
-
 double LuminanceStandardError(const glm::dvec3& e) {
   double variance = 0.0;
   for (int c = 0; c < 3; ++c) variance += kLuminanceWeights[c] * kLuminanceWeights[c] * e[c] * e[c];

@@ -25,7 +25,9 @@ inline constexpr double kNoiseStandardErrors = 2.0;
 // displays them (red, green, blue).
 inline constexpr double kLuminanceWeights[3] = {0.2126, 0.7152, 0.0722};
 
-double Luminance(const glm::dvec3& rgb);
+inline double Luminance(const glm::dvec3& rgb) {
+  return kLuminanceWeights[0] * rgb.x + kLuminanceWeights[1] * rgb.y + kLuminanceWeights[2] * rgb.z;
+}
 // The standard error of the luminance of independent channel estimates.
 double LuminanceStandardError(const glm::dvec3& standard_error);
 

@@ -128,8 +128,8 @@ TEST_F(BakedSetTest, InfoPlotsTableSlicesOfABakedSet) {
             0)
       << err;
   json report = json::parse(out);
-  ASSERT_EQ(report["plots"].size(), 6u) << report["plots"];
-  for (const char* stem : {"lut_transmittance", "lut_sky_radiance", "lut_irradiance"}) {
+  ASSERT_EQ(report["plots"].size(), 8u) << report["plots"];
+  for (const char* stem : {"lut_transmittance", "lut_sky_radiance", "lut_irradiance", "lut_sunset"}) {
     for (const char* extension : {".svg", ".png"}) {
       const fs::path file = plots / (std::string(stem) + extension);
       ASSERT_TRUE(fs::exists(file)) << file;

@@ -83,12 +83,15 @@ TEST(NewcomerDefects, D01_InfoPlotOnSceneBakeWithoutIrradiance) {
                                                "lut_transmittance.png", "lut_transmittance.svg"}));
   for (const std::string& f : written) EXPECT_GT(fs::file_size(plots / f), 0u) << f;
   EXPECT_FALSE(fs::exists(plots / "lut_irradiance.svg"));
-  // One stderr line names the plot left out and the table it needs.
-  ASSERT_EQ(report["plots_left_out"].size(), 1u) << report["plots_left_out"];
+  // One stderr line per plot left out names what it needs: the irradiance
+  // table, and for the sunset plot suns below the scene's [0, 90] degrees.
+  ASSERT_EQ(report["plots_left_out"].size(), 2u) << report["plots_left_out"];
   const std::vector<std::string> lines = Lines(err);
-  ASSERT_EQ(lines.size(), 1u) << err;
+  ASSERT_EQ(lines.size(), 2u) << err;
   EXPECT_NE(lines[0].find("lut_irradiance"), std::string::npos) << err;
   EXPECT_NE(lines[0].find("irradiance table"), std::string::npos) << err;
+  EXPECT_NE(lines[1].find("lut_sunset"), std::string::npos) << err;
+  EXPECT_NE(lines[1].find("outside the scene's [0, 90]"), std::string::npos) << err;
 
   // `render --plots` on the same set writes the same plots.
   const fs::path images = dir.path() / "images";
@@ -168,8 +171,8 @@ TEST(NewcomerDefects, D11_PngsCarrySrgbChunk) {
       EXPECT_TRUE(srgb < data) << entry.path() << ": no sRGB chunk before the image data";
     }
   }
-  // 4 views, the contact sheet and 3 plots from render; 3 plots from info.
-  EXPECT_EQ(pngs, 4 + 1 + 3 + 3);
+  // 4 views, the contact sheet and 4 plots from render; 4 plots from info.
+  EXPECT_EQ(pngs, 4 + 1 + 4 + 4);
 }
 
 // On a terminal the render progress bar is redrawn at most
