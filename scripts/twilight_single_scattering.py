@@ -7,8 +7,11 @@ for sun zenith angles from 80 to 100 degrees with `skybake eval`, and with
 `skybake reference --max-order 1`, whose single scattering converges in
 twilight (docs/reference.md, "Twilight"); prints per sun range the RMS,
 median and largest relative error over the cases and the three wavelengths,
-and, where the exact single scattering is 0 (the view ray wholly in the
-Earth's shadow), the largest value the tables give:
+then the same over the values the eye could see, those whose exact value is
+at least 1e-9 W m^-2 sr^-1 nm^-1 (a third of the moonless night sky at
+550 nm, about 2e-4 cd/m^2); and, where the exact single scattering is 0
+(the view ray wholly in the Earth's shadow), the largest value the tables
+give:
 
     /usr/bin/python3 scripts/twilight_single_scattering.py build/cli/skybake [PATHS [BAKE OPTION ...]]
 
@@ -30,6 +33,7 @@ VIEWS = [0, 45, 80, 85, 88]
 AZIMUTHS = [0, 90, 180]
 ALTITUDES = [0, 1000, 10000]
 CHANNELS = ["680nm", "550nm", "440nm"]
+VISIBLE = 1e-9
 RANGES = [("sun 80-90", 80, 90), ("sun 90-96", 90, 96), ("sun 96-100", 96, 100)]
 
 
@@ -55,7 +59,7 @@ def main():
         exact = list(csv.DictReader(io.StringIO(
             run(skybake, "reference", "earth", "--in", queries, "--paths", paths, "--max-order", "1", "-q"))))
     for name, low, high in RANGES:
-        errors, dark = [], []
+        errors, visible, dark = [], [], []
         for t, e in zip(table, exact):
             sun = float(e["sun_zenith_deg"])
             if not (low <= sun <= high) or (sun == low and low != RANGES[0][1]):
@@ -64,17 +68,23 @@ def main():
                 baked, truth = float(t["radiance_" + c]), float(e["radiance_" + c])
                 if truth > 0.0:
                     errors.append((baked - truth) / truth)
+                    if truth >= VISIBLE:
+                        visible.append(errors[-1])
                 else:
                     dark.append(baked)
-        rms = math.sqrt(sum(x * x for x in errors) / len(errors))
-        magnitudes = sorted(abs(x) for x in errors)
-        line = (f"{name}: {len(errors)} values, relative error RMS {100 * rms:.3g}%, "
-                f"median |.| {100 * statistics.median(magnitudes):.3g}%, "
-                f"90th percentile {100 * magnitudes[int(0.9 * len(magnitudes))]:.3g}%, "
-                f"max {100 * magnitudes[-1]:.3g}%")
+        line = f"{name}: {summary(errors)}; of them at least {VISIBLE:g}: {summary(visible)}"
         if dark:
             line += f"; exactly dark: {len(dark)} values, tables up to {max(dark):.3g} W m^-2 sr^-1 nm^-1"
         print(line)
+
+
+def summary(errors):
+    rms = math.sqrt(sum(x * x for x in errors) / len(errors))
+    magnitudes = sorted(abs(x) for x in errors)
+    return (f"{len(errors)} values, relative error RMS {100 * rms:.3g}%, "
+            f"median |.| {100 * statistics.median(magnitudes):.3g}%, "
+            f"90th percentile {100 * magnitudes[int(0.9 * len(magnitudes))]:.3g}%, "
+            f"max {100 * magnitudes[-1]:.3g}%")
 
 
 if __name__ == "__main__":
