@@ -179,12 +179,31 @@ Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s
   return GetTextureCoordFromUnitRange(min(x, 1.0), atmosphere.scattering_mu_s_size);
 }
 
-// r through its distance to the horizon rho, over the table's radii.
-Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number rho) {
+// r over the table's radii: rows at evenly spaced distances to the horizon
+// rho, which crowds them near the ground (at h = rho^2 / (r + bottom)), and
+// between two rows linear in rho, except for a ray that hits the ground.
+// Such a ray gathers light about in proportion to its length d, and at the
+// lower half's mu coordinate x (below) d = h (1 - x) + rho x: there the
+// position between the rows is linear in that d at the ray's own x. (Linear
+// in rho, a camera 10 m up looking straight down, d = h, read 150 % high
+// between the rows at 0 and 63 m.)
+Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r, Number rho,
+                              bool ray_r_mu_intersects_ground, Number x_mu) {
   Number rho_min = HorizonDistance(atmosphere, atmosphere.scattering_r_min);
   Number rho_max = HorizonDistance(atmosphere, atmosphere.scattering_r_max);
-  Number x = (rho - rho_min) / (rho_max - rho_min);
-  return GetTextureCoordFromUnitRange(clamp(x, 0.0, 1.0), atmosphere.scattering_r_size);
+  Number last_row = Number(atmosphere.scattering_r_size - 1);
+  Number position = clamp((rho - rho_min) / (rho_max - rho_min), 0.0, 1.0) * last_row;
+  if (!ray_r_mu_intersects_ground) return (position + 0.5) / (last_row + 1.0);
+  Number row = min(floor(position), last_row - 1.0);
+  Number rho_below = mix(rho_min, rho_max, row / last_row);
+  Number rho_above = mix(rho_min, rho_max, (row + 1.0) / last_row);
+  Number bottom = atmosphere.bottom_radius;
+  Number h_below = rho_below * rho_below / (sqrt(rho_below * rho_below + bottom * bottom) + bottom);
+  Number h_above = rho_above * rho_above / (sqrt(rho_above * rho_above + bottom * bottom) + bottom);
+  Number d_below = mix(h_below, rho_below, x_mu), d_above = mix(h_above, rho_above, x_mu);
+  Number d = mix(r - bottom, rho, x_mu);
+  Number t = clamp((d - d_below) / (d_above - d_below), 0.0, 1.0);
+  return (row + t + 0.5) / (last_row + 1.0);
 }
 
 // 4D scattering table, stored as a 3D texture: x packs nu (slowest) and mu_s,
@@ -193,27 +212,28 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
                                           Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   Number H = HorizonDistanceAtTop(atmosphere);
   Number rho = HorizonDistance(atmosphere, r);
-  Number u_r = GetScatteringTextureUR(atmosphere, rho);
 
   Number half_mu_size = Number(atmosphere.scattering_mu_size / 2);
   Number u_mu;
+  Number x_mu;
   if (ray_r_mu_intersects_ground) {
     // Distance to the ground, between r - bottom (looking straight down) and
     // rho (the horizon), mapped to the lower half.
     Number d = DistanceToBottomAtmosphereBoundary(atmosphere, r, mu);
     Number d_min = r - atmosphere.bottom_radius;
     Number d_max = rho;
-    Number x = d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min);
-    u_mu = 0.5 - 0.5 * (0.5 / half_mu_size + x * (1.0 - 1.0 / half_mu_size));
+    x_mu = d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min);
+    u_mu = 0.5 - 0.5 * (0.5 / half_mu_size + x_mu * (1.0 - 1.0 / half_mu_size));
   } else {
     // Distance to the top boundary, between top - r (straight up) and
     // rho + H (the horizon), mapped to the upper half.
     Number d = DistanceToTopAtmosphereBoundary(atmosphere, r, mu);
     Number d_min = atmosphere.top_radius - r;
     Number d_max = rho + H;
-    Number x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
-    u_mu = 0.5 + 0.5 * (0.5 / half_mu_size + x * (1.0 - 1.0 / half_mu_size));
+    x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+    u_mu = 0.5 + 0.5 * (0.5 / half_mu_size + x_mu * (1.0 - 1.0 / half_mu_size));
   }
+  Number u_r = GetScatteringTextureUR(atmosphere, r, rho, ray_r_mu_intersects_ground, x_mu);
 
   Number u_nu = ScatteringUnitNu(nu);
   return vec4(u_nu, GetScatteringTextureUMuS(atmosphere, mu_s), u_mu, u_r);
