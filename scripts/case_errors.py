@@ -1,9 +1,11 @@
 #!/usr/bin/python3
 """Relative error of a baked set against the committed Monte Carlo reference.
 
-Answers reference/cases/earth.csv and earth_aerial_horizon.csv with
-`skybake eval` from LUT_DIR and prints, per case group and quantity, the RMS
-and largest relative error over the cases and the three wavelengths:
+Answers reference/cases/earth.csv, earth_aerial_horizon.csv and
+earth_twilight.csv with `skybake eval` from LUT_DIR and prints, per case
+group and quantity, the RMS and largest relative error over the cases and
+the three wavelengths, and the reference's largest relative standard error
+there (an error below about twice it is noise):
 
     /usr/bin/python3 scripts/case_errors.py build/cli/skybake LUT_DIR
 
@@ -35,10 +37,15 @@ def report(baked, reference, quantities):
                 key = f"{quantity}_{c}"
                 if not r.get(key) or not b.get(key) or float(r[key]) <= 0.0:
                     continue
-                groups.setdefault(f"{r['group']}: {quantity}", []).append(float(b[key]) / float(r[key]) - 1.0)
-    for name, errors in sorted(groups.items()):
+                stderr = r.get(f"{quantity}_stderr_{c}") or "0"
+                groups.setdefault(f"{r['group']}: {quantity}", []).append(
+                    (float(b[key]) / float(r[key]) - 1.0, float(stderr) / float(r[key])))
+    for name, values in sorted(groups.items()):
+        errors = [e for e, _ in values]
         rms = math.sqrt(sum(e * e for e in errors) / len(errors))
-        print(f"{name:40s} RMS {100 * rms:8.3f}%  max {100 * max(abs(e) for e in errors):8.3f}%  ({len(errors)} values)")
+        noise = max(s for _, s in values)
+        print(f"{name:52s} RMS {100 * rms:8.3f}%  max {100 * max(abs(e) for e in errors):8.3f}%  "
+              f"({len(errors)} values; reference standard error up to {100 * noise:.3g}%)")
 
 
 def main():
@@ -46,7 +53,8 @@ def main():
         sys.exit(__doc__)
     skybake, lut_dir = sys.argv[1], sys.argv[2]
     for cases, quantities in [("earth", ["radiance", "sky_irradiance"]),
-                              ("earth_aerial_horizon", ["radiance", "transmittance"])]:
+                              ("earth_aerial_horizon", ["radiance", "transmittance"]),
+                              ("earth_twilight", ["radiance", "sky_irradiance"])]:
         with open(CASES / f"{cases}_reference.csv") as f:
             reference = list(csv.DictReader(f))
         report(evaluate(skybake, lut_dir, f"{cases}.csv"), reference, quantities)

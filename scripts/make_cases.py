@@ -1,8 +1,14 @@
 #!/usr/bin/env python3
-"""Writes the report's fixed case set (docs/report.md) to stdout.
+"""Writes the report's fixed case set (docs/report.md), or the dense twilight set
+(docs/accuracy.md, "Twilight case set"), to stdout.
 
-The case set is a grid per group, so it is regenerated exactly by
+Each case set is a grid per group, so it is regenerated exactly by
     /usr/bin/python3 scripts/make_cases.py > reference/cases/earth.csv
+    /usr/bin/python3 scripts/make_cases.py twilight > reference/cases/earth_twilight.csv
+
+The twilight set's reference values, with their standard errors, were computed with
+    build/cli/skybake reference earth --in reference/cases/earth_twilight.csv \
+        --out reference/cases/earth_twilight_reference.csv --paths 49152 --seed 1 --threads 2 -q
 Columns are those of `skybake eval` plus `group`; empty distance_m means the
 whole ray (sky radiance), empty normal_zenith_deg means no irradiance.
 """
@@ -44,10 +50,47 @@ def rows():
         yield "irradiance", altitude, 0, sun, 0, "", 0
 
 
+# The sun from 88 to 102 degrees in 1 degree steps. Sky from the ground: the
+# zenith; 85 and 89 degrees toward and away from the sun (the bright and the
+# dark horizon); 60 and 80 degrees away from the sun, into the Earth's shadow
+# as it rises. From 10 km: the zenith, 85 degrees either way, 95 degrees down
+# toward the sun. From space (100 km): through the limb, 95, 99 and 102
+# degrees, either way. Sky irradiance on horizontal ground at 0 and 10 km to
+# sun 100 degrees. Aerial perspective from 100 m at low sun (84-90 degrees):
+# views 60 and 85 degrees, either way, over 1, 5 and 20 km. The group names
+# the sun range, so that `scripts/case_errors.py` reports each.
+SUNS = range(88, 103)
+
+
+def sun_range(sun):
+    for low, high in [(88, 90), (91, 96), (97, 100), (101, 102)]:
+        if low <= sun <= high:
+            return f"{low}-{high}"
+    raise ValueError(sun)
+
+
+def twilight_rows():
+    for sun in SUNS:
+        group = "twilight_sky_sun_" + sun_range(sun)
+        yield group, 0, 0, sun, 0, "", ""
+        for view, azimuth in itertools.product([85, 89], [0, 180]):
+            yield group, 0, view, sun, azimuth, "", ""
+        for view in [60, 80]:
+            yield group, 0, view, sun, 180, "", ""
+        for view, azimuth in [(0, 0), (85, 0), (85, 180), (95, 0)]:
+            yield group, 10000, view, sun, azimuth, "", ""
+        for view, azimuth in itertools.product([95, 99, 102], [0, 180]):
+            yield group, 100000, view, sun, azimuth, "", ""
+    for sun, altitude in itertools.product(range(88, 101), [0, 10000]):
+        yield "twilight_irradiance_sun_88-100", altitude, 0, sun, 0, "", 0
+    for sun, view, azimuth, distance in itertools.product([84, 86, 88, 90], [60, 85], [0, 180], [1000, 5000, 20000]):
+        yield "low_sun_aerial_perspective_sun_84-90", 100, view, sun, azimuth, distance, ""
+
+
 def main():
     out = sys.stdout
     out.write(",".join(COLUMNS) + "\n")
-    for row in rows():
+    for row in twilight_rows() if sys.argv[1:] == ["twilight"] else rows():
         out.write(",".join(str(v) for v in row) + "\n")
 
 

@@ -345,10 +345,24 @@ vec4 SunCosineMix(vec4 a, vec4 b, Number t, bool low_sun) {
   return exp(mix(log(max(a, dark)), log(max(b, dark)), t)) * step(dark, max(a, b));
 }
 
+// The position t between two mu_s texels, in [0, 1], except below the
+// table's lowest sun (t < 0) among low suns, where the geometric blend goes
+// on: the light keeps falling as it fell between the two lowest texels.
+Number SunCosinePosition(Number t, bool low_sun) {
+  return low_sun ? min(t, 1.0) : clamp(t, 0.0, 1.0);
+}
+
+// SunCosineMix, never brighter than the lowest texel below the table's
+// lowest sun (where the two lowest texels did not fall, the blend would rise).
+vec4 SunBelowTableMix(vec4 a, vec4 b, Number t, bool low_sun) {
+  vec4 blend = SunCosineMix(a, b, t, low_sun);
+  return t < 0.0 ? min(blend, a) : blend;
+}
+
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 // 4D lookup: four fetches, at the two mu_s texel columns either side of
 // mu_s and the two nu slices either side of nu, each bilinear in (mu, r) by
-// the texture unit; then nu and mu_s by SunCosineMix.
+// the texture unit; then nu by SunCosineMix and mu_s by SunBelowTableMix.
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
@@ -359,34 +373,34 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
   Number mu_s_coord = uvwz.y * mu_s_size - 0.5;
   Number mu_s_column = clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
-  Number mu_s_t = clamp(mu_s_coord - mu_s_column, 0.0, 1.0);
   Number x_below = (mu_s_column + 0.5) / mu_s_size, x_above = (mu_s_column + 1.5) / mu_s_size;
   Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
   bool low_sun_below = x_below < x_low_sun, low_sun_above = x_above < x_low_sun;
+  Number mu_s_t = SunCosinePosition(mu_s_coord - mu_s_column, low_sun_below);
   vec4 below = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w)),
                             texture(scattering_texture, vec3((nu_slice + 1.0 + x_below) / nu_size, uvwz.z, uvwz.w)),
                             nu_t, low_sun_below);
   vec4 above = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_above) / nu_size, uvwz.z, uvwz.w)),
                             texture(scattering_texture, vec3((nu_slice + 1.0 + x_above) / nu_size, uvwz.z, uvwz.w)),
                             nu_t, low_sun_above);
-  return SunCosineMix(below, above, mu_s_t, low_sun_below);
+  return SunBelowTableMix(below, above, mu_s_t, low_sun_below);
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 // Bilinear in r by the texture unit at the two mu_s texel columns either
-// side of mu_s, then SunCosineMix along mu_s: two fetches.
+// side of mu_s, then SunBelowTableMix along mu_s: two fetches.
 vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) irradiance_texture,
                    Number r, Number mu_s) {
   vec2 uv = GetIrradianceTextureUvFromRMuS(atmosphere, r, mu_s);
   Number width = Number(atmosphere.irradiance_width);
-  Number mu_s_coord = uv.x * width - 0.5;
+  Number mu_s_coord = (mu_s - atmosphere.mu_s_min) / (1.0 - atmosphere.mu_s_min) * (width - 1.0);
   Number mu_s_column = clamp(floor(mu_s_coord), 0.0, width - 2.0);
-  Number mu_s_t = clamp(mu_s_coord - mu_s_column, 0.0, 1.0);
   Number mu_s_below = atmosphere.mu_s_min + (1.0 - atmosphere.mu_s_min) * mu_s_column / (width - 1.0);
+  bool low_sun = mu_s_below < LOW_SUN_MU_S;
   vec4 below = texture(irradiance_texture, vec2((mu_s_column + 0.5) / width, uv.y));
   vec4 above = texture(irradiance_texture, vec2((mu_s_column + 1.5) / width, uv.y));
-  return vec3(SunCosineMix(below, above, mu_s_t, mu_s_below < LOW_SUN_MU_S));
+  return vec3(SunBelowTableMix(below, above, SunCosinePosition(mu_s_coord - mu_s_column, low_sun), low_sun));
 }
 #endif
 

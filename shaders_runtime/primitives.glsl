@@ -65,9 +65,10 @@ Number SunVisibleFractionAboveHorizon(Number mu_s, Number horizon_cosine, Number
 // from a = (d - d_min) / (d_max - d_min), the sun ray's distance d to the top
 // from the ground over its range, and inverse_A = 1 / A, A the same for
 // scattering_mu_s_min: (1 - a / A) / (1 + a), which gives low suns (a near
-// A) more texels. (1 / A is a constant of the table, computed once.)
+// A) more texels, and is negative below scattering_mu_s_min, where the
+// lookups extrapolate. (1 / A is a constant of the table, computed once.)
 Number ScatteringUnitMuSFromDistance(Number a, Number inverse_A) {
-  return max(Number(1.0) - a * inverse_A, Number(0.0)) / (Number(1.0) + a);
+  return (Number(1.0) - a * inverse_A) / (Number(1.0) + a);
 }
 
 // The scattering table's unit nu: (nu + 1) / 2 over the slices.

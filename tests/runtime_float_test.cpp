@@ -98,15 +98,15 @@ TEST(RuntimeFloat, SunVisibleFractionWithinTenUlps) {
 }
 
 TEST(RuntimeFloat, ScatteringUnitCoordinatesWithinFourUlps) {
-  // a / A <= 1 where the result is not clamped to 0: the product, the
-  // subtraction from 1 and the division add an absolute error of at most
-  // about 3 eps.
+  // The product, the subtraction from 1 and the division add an absolute
+  // error of at most about 3 eps times the size of a / A, which exceeds 1
+  // below scattering_mu_s_min (a > A, a negative result).
   for (double big_a : {1e-3, 0.05, 0.3, 0.6, 1.0})
     for (int i = 0; i <= 1000; ++i) {
       const float a = float(i / 1000.0), inverse_a = float(1.0 / big_a);
       EXPECT_LE(std::abs(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) -
                          glsl::ScatteringUnitMuSFromDistance(a, inverse_a)),
-                4.0 * kEps)
+                4.0 * kEps * std::max(1.0, double(a) * inverse_a))
           << "a " << a << " A " << big_a;
     }
   for (double nu : Cosines())

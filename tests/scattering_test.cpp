@@ -207,6 +207,39 @@ TEST(SingleScattering, LowSunLookupsBetweenTexelsFollowTheFall) {
   EXPECT_LT(geometric_rms, 0.25);
 }
 
+// Below the table's lowest sun the lookups go on falling from the two lowest
+// mu_s texels instead of holding the lowest one, and never rise above it:
+// sky and irradiance for the sun down to 10 degrees below the lowest sun.
+TEST(Twilight, LookupsBelowTheLowestSunKeepFalling) {
+  const LutSet luts = Bake(testing::Earth(), BakeSettings{});
+  const Twin twin(MakeTwinTables(luts));
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  const double lowest = std::acos(p.scattering_mu_s_min);
+  for (double altitude : {0.0, 10000.0, 59000.0}) {
+    const double r = p.bottom_radius + altitude;
+    for (double mu : {1.0, 0.2, -0.05}) {
+      const bool ground = glsl::RayIntersectsGround(p, r, mu);
+      glsl::vec4 previous = twin.Scattering(r, mu, p.scattering_mu_s_min, mu * p.scattering_mu_s_min, ground);
+      glsl::vec3 previous_irradiance = twin.Irradiance(r, p.mu_s_min);
+      for (int step = 1; step <= 20; ++step) {
+        const double mu_s = std::cos(lowest + step * 0.5 * kPi / 180.0);
+        const glsl::vec4 value = twin.Scattering(r, mu, mu_s, mu * mu_s, ground);
+        const glsl::vec3 irradiance = twin.Irradiance(r, mu_s);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_LE(value[c], previous[c]) << "altitude " << altitude << " mu " << mu << " step " << step;
+          EXPECT_LE(irradiance[c], previous_irradiance[c]) << "altitude " << altitude << " step " << step;
+          EXPECT_GE(value[c], 0.0);
+        }
+        previous = value, previous_irradiance = irradiance;
+      }
+      const glsl::vec4 lowest_value = twin.Scattering(r, mu, p.scattering_mu_s_min, mu * p.scattering_mu_s_min, ground);
+      if (lowest_value[0] > 0.0) {  // 0: a ray of length 0 (from the ground, down)
+        EXPECT_LT(previous[0], lowest_value[0]) << "altitude " << altitude << " mu " << mu << ": no fall at all";
+      }
+    }
+  }
+}
+
 // Looking down from a low camera, the sun overhead: the ray gathers light
 // about in proportion to its length, between r rows that sit at 0, 63, 250
 // and 563 m. Every such lookup of the default tables within 1 % of the
