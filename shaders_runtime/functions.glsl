@@ -331,7 +331,8 @@ vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(Transmittance
 const Number LOW_SUN_MU_S = 0.1;
 
 // Interpolation between two table texels a and b along the sun's cosine (or
-// between two nu slices of one mu_s texel column), at position t in [0, 1]:
+// between two nu slices of one mu_s texel column), at position t in [0, 1]
+// (below 0 under the table's lowest sun, see SunBelowTableMix):
 // linear, or, where `low_sun` (the texel with the lower sun has mu_s below
 // LOW_SUN_MU_S), geometric, a^(1 - t) b^t. From low sun to the end of
 // twilight the light falls by orders of magnitude over a few mu_s texels,
