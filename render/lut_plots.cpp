@@ -52,6 +52,11 @@ std::string SkyQueryProblem(const LutSet& luts, double altitude_m, double sun_ze
   return SceneQueryProblem(*luts.scene, luts.parameters.bottom_radius, false, &sky, &unused);
 }
 
+// The zenith angle of the lowest sun the tables cover, in degrees.
+double LowestSunZenithDeg(const glsl::AtmosphereParameters& p) {
+  return std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
+}
+
 constexpr double kSunsetCameraAltitudeM = 1.0;
 constexpr double kSunsetFirstSunDeg = 85.0;
 
@@ -59,7 +64,7 @@ constexpr double kSunsetFirstSunDeg = 85.0;
 
 SunsetCurves ComputeSunsetCurves(const Twin& twin) {
   const glsl::AtmosphereParameters& p = twin.parameters();
-  const double lowest_sun_deg = std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
+  const double lowest_sun_deg = LowestSunZenithDeg(p);
   const vec3 camera(0.0, 0.0, p.bottom_radius + kSunsetCameraAltitudeM);
   const double horizon = 88.0 * kDegree;
   const vec3 sunward(std::sin(horizon), 0.0, std::cos(horizon)), antisolar(-sunward.x, 0.0, sunward.z);
@@ -79,7 +84,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
   const Twin twin(MakeTwinTables(luts));
   const vec3& wavelengths_nm = luts.atmosphere.wavelengths_nm;
   const glsl::AtmosphereParameters& p = twin.parameters();
-  const double lowest_sun_deg = std::acos(std::clamp(p.mu_s_min, -1.0, 1.0)) / kDegree;
+  const double lowest_sun_deg = LowestSunZenithDeg(p);
   PlotFiles files;
 
   {

@@ -110,7 +110,7 @@ TEST(ReportCases, ReferenceCoversTheCasesWithSmallDaylightNoise) {
   EXPECT_LE(worst_daylight, 0.003);
 }
 
-// The dense twilight set (scripts/make_twilight_cases.py, docs/accuracy.md):
+// The dense twilight set (scripts/make_cases.py twilight, docs/accuracy.md):
 // its reference has every case, and standard errors no larger than those it
 // was committed with, per sun range, for the sky radiance and the sky
 // irradiance (the largest relative standard error of any channel).

@@ -207,11 +207,17 @@ TEST(SingleScattering, LowSunLookupsBetweenTexelsFollowTheFall) {
   EXPECT_LT(geometric_rms, 0.25);
 }
 
+// The default bake of earth, all orders.
+const LutSet& DefaultEarth() {
+  static const LutSet luts = Bake(testing::Earth(), BakeSettings{});
+  return luts;
+}
+
 // Below the table's lowest sun the lookups go on falling from the two lowest
 // mu_s texels instead of holding the lowest one, and never rise above it:
 // sky and irradiance for the sun down to 10 degrees below the lowest sun.
 TEST(Twilight, LookupsBelowTheLowestSunKeepFalling) {
-  const LutSet luts = Bake(testing::Earth(), BakeSettings{});
+  const LutSet& luts = DefaultEarth();
   const Twin twin(MakeTwinTables(luts));
   const glsl::AtmosphereParameters& p = luts.parameters;
   const double lowest = std::acos(p.scattering_mu_s_min);
@@ -237,6 +243,40 @@ TEST(Twilight, LookupsBelowTheLowestSunKeepFalling) {
         EXPECT_LT(previous[0], lowest_value[0]) << "altitude " << altitude << " mu " << mu << ": no fall at all";
       }
     }
+  }
+}
+
+// Through sunset and twilight the sky's luminance at the zenith and near
+// the horizon, toward and away from the sun, falls at every 0.05 degree
+// step of the sun, and falls smoothly: no step where a mu_s texel column or a scattering order takes over. A step
+// or a kink shows as the fall of ln L over one 0.05 degree step changing
+// abruptly at the next. Linear interpolation between the mu_s texels of
+// the same tables changes it by up to 3.7 times (at the zenith 3.0, toward
+// the sun 2.1); this lookup by at most 1.54, where the sun's disc sets.
+// The bound, 2, sits between the two.
+TEST(Twilight, SkyLuminanceFallsSmoothlyThroughSunset) {
+  const LutSet& luts = DefaultEarth();
+  const Twin twin(MakeTwinTables(luts));
+  const render::SunsetCurves curves = render::ComputeSunsetCurves(twin);
+  ASSERT_EQ(curves.sun_zenith_deg.size(), 341u);  // 85 to 102 degrees
+  const std::pair<const char*, const std::vector<double>*> views[] = {
+      {"zenith", &curves.zenith}, {"sunward", &curves.sunward_horizon}, {"antisolar", &curves.antisolar_horizon}};
+  for (const auto& [name, luminance] : views) {
+    std::vector<double> fall;  // ln L(i) - ln L(i + 1) > 0
+    for (std::size_t i = 0; i + 1 < luminance->size(); ++i) {
+      ASSERT_GT((*luminance)[i + 1], 0.0) << name << " at sun " << curves.sun_zenith_deg[i + 1];
+      ASSERT_LT((*luminance)[i + 1], (*luminance)[i]) << name << " at sun " << curves.sun_zenith_deg[i + 1];
+      fall.push_back(std::log((*luminance)[i] / (*luminance)[i + 1]));
+    }
+    double worst = 1.0, worst_sun = 0.0;
+    for (std::size_t i = 0; i + 1 < fall.size(); ++i) {
+      const double change = std::max(fall[i] / fall[i + 1], fall[i + 1] / fall[i]);
+      if (change > worst) worst = change, worst_sun = curves.sun_zenith_deg[i + 1];
+    }
+    std::printf("%s: luminance %.3g at sun 85 deg to %.3g at 102; largest change of the fall of ln L from "
+                "one 0.05 degree step to the next: x%.3g (sun %.2f deg)\n",
+                name, luminance->front(), luminance->back(), worst, worst_sun);
+    EXPECT_LT(worst, 2.0) << name;
   }
 }
 
@@ -422,47 +462,6 @@ TEST(Bake, PackingSingleMieIntoAlphaKeepsItsRedChannel) {
     }
   }
   EXPECT_EQ(compared, 9);
-}
-
-}  // namespace
-}  // namespace skybake
-
-namespace skybake {
-namespace {
-
-// Item 4 of the twilight work: through sunset and twilight the sky's
-// luminance at the zenith and near the horizon, toward and away from the
-// sun, falls at every 0.05 degree step of the sun, and falls smoothly: no
-// step where a mu_s texel column or a scattering order takes over. A step
-// or a kink shows as the fall of ln L over one 0.05 degree step changing
-// abruptly at the next. Linear interpolation between the mu_s texels of
-// the same tables changes it by up to 3.7 times (at the zenith 3.0, toward
-// the sun 2.1); this lookup by at most 1.54, where the sun's disc sets.
-// The bound, 2, sits between the two.
-TEST(Twilight, SkyLuminanceFallsSmoothlyThroughSunset) {
-  const LutSet luts = Bake(testing::Earth(), BakeSettings{});
-  const Twin twin(MakeTwinTables(luts));
-  const render::SunsetCurves curves = render::ComputeSunsetCurves(twin);
-  ASSERT_EQ(curves.sun_zenith_deg.size(), 341u);  // 85 to 102 degrees
-  const std::pair<const char*, const std::vector<double>*> views[] = {
-      {"zenith", &curves.zenith}, {"sunward", &curves.sunward_horizon}, {"antisolar", &curves.antisolar_horizon}};
-  for (const auto& [name, luminance] : views) {
-    std::vector<double> fall;  // ln L(i) - ln L(i + 1) > 0
-    for (std::size_t i = 0; i + 1 < luminance->size(); ++i) {
-      ASSERT_GT((*luminance)[i + 1], 0.0) << name << " at sun " << curves.sun_zenith_deg[i + 1];
-      ASSERT_LT((*luminance)[i + 1], (*luminance)[i]) << name << " at sun " << curves.sun_zenith_deg[i + 1];
-      fall.push_back(std::log((*luminance)[i] / (*luminance)[i + 1]));
-    }
-    double worst = 1.0, worst_sun = 0.0;
-    for (std::size_t i = 0; i + 1 < fall.size(); ++i) {
-      const double change = std::max(fall[i] / fall[i + 1], fall[i + 1] / fall[i]);
-      if (change > worst) worst = change, worst_sun = curves.sun_zenith_deg[i + 1];
-    }
-    std::printf("%s: luminance %.3g at sun 85 deg to %.3g at 102; largest change of the fall of ln L from "
-                "one 0.05 degree step to the next: x%.3g (sun %.2f deg)\n",
-                name, luminance->front(), luminance->back(), worst, worst_sun);
-    EXPECT_LT(worst, 2.0) << name;
-  }
 }
 
 }  // namespace
