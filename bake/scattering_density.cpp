@@ -16,6 +16,25 @@
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
+namespace {
+// Width in cos(theta) (about 6 degrees) of the band above the horizon that
+// AppendSkyRule resolves on its own.
+constexpr double kHorizonBand = 0.1;
+
+// A Gauss-Legendre rule in cos(theta) over the sky above a horizon of
+// zenith cosine `horizon`: n nodes above kHorizonBand, and n / 2 more
+// (at least one) in the band just above the horizon. After sunset nearly
+// all the light a point receives comes from within a few degrees above its
+// horizon toward the sun (the lit air hundreds of kilometres away, seen
+// over the shadow); a rule spanning [horizon, 1] puts one or two nodes
+// there, and misses or overweights that light differently at each
+// wavelength.
+void AppendSkyRule(int n, double horizon, std::vector<double>& cosines, std::vector<double>& weights) {
+  AppendGaussLegendre(std::max(1, n / 2), horizon, horizon + kHorizonBand, cosines, weights);
+  AppendGaussLegendre(n, horizon + kHorizonBand, 1.0, cosines, weights);
+}
+}  // namespace
+
 vec3 Baker::DirectIrradiance(double r, double mu_s) const {
   // Cosine factor averaged over the sun's disc when it straddles the horizon.
   double alpha = params_.sun_angular_radius;
@@ -81,19 +100,20 @@ void Baker::ComputeScatteringDensity(int order) {
     const vec3 zenith(0.0, 0.0, 1.0);
     const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
 
-    // Polar nodes in cos(theta), a Gauss-Legendre rule on each side of the
-    // horizon: the incident radiance jumps there (long grazing sky paths
-    // above, the ground below), which a rule spanning it converges on slowly.
+    // Polar nodes in cos(theta): half of `polar` below the horizon, half in
+    // the sky above it (AppendSkyRule, which adds the band next to it). The
+    // incident radiance jumps at the horizon (long grazing sky paths above,
+    // the ground below), which a rule spanning it converges on slowly.
     std::vector<double> cosines, cosine_weights;
     const double horizon = glsl::HorizonZenithCosine(params_.bottom_radius, r);
     AppendGaussLegendre(polar / 2, -1.0, horizon, cosines, cosine_weights);
-    AppendGaussLegendre(polar - polar / 2, horizon, 1.0, cosines, cosine_weights);
+    AppendSkyRule(polar - polar / 2, horizon, cosines, cosine_weights);
 
     // Incoming radiance (of the previous order) from every direction.
     std::vector<vec3> directions, radiance;
     std::vector<double> solid_angles;
-    directions.reserve(polar * azimuths);
-    for (int l = 0; l < polar; ++l) {
+    directions.reserve(cosines.size() * azimuths);
+    for (int l = 0; l < int(cosines.size()); ++l) {
       double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
       bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
       double ground_distance = 0.0;
@@ -162,22 +182,25 @@ void Baker::ComputeScatteringDensity(int order) {
 void Baker::ComputeIndirectIrradiance(int order) {
   const int width = irradiance_.width, height = irradiance_.height;
   const int polar = settings_.sphere_samples, azimuths = 4 * settings_.sphere_samples;
-  const double d_theta = 0.5 * kPi / polar, d_phi = 2.0 * kPi / azimuths;
+  const double d_phi = 2.0 * kPi / azimuths;
+  // Polar nodes in cos(theta) over the upper hemisphere: the irradiance is
+  // the integral of L cos(theta) d cos(theta) d phi.
+  std::vector<double> cosines, cosine_weights;
+  AppendSkyRule(polar, 0.0, cosines, cosine_weights);
   tbb::parallel_for(0, height, [&](int y) {
     for (int x = 0; x < width; ++x) {
       double r, mu_s;
       glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu_s);
       const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
       vec3 result(0.0);
-      for (int l = 0; l < polar; ++l) {
-        double theta = (l + 0.5) * d_theta;
-        double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+      for (std::size_t l = 0; l < cosines.size(); ++l) {
+        const double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
         const IncidentAlongNu incident_ring(*this, order, r, cos_theta, mu_s, false);
         for (int m = 0; m < azimuths; ++m) {
           double phi = (m + 0.5) * d_phi;
           vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
           double nu = glsl::ClampCosine(glm::dot(omega, sun));
-          result += incident_ring.At(nu) * (cos_theta * sin_theta * d_theta * d_phi);
+          result += incident_ring.At(nu) * (cos_theta * cosine_weights[l] * d_phi);
         }
       }
       delta_irradiance_.Store(x, y, 0, vec4(result, 0.0));

@@ -81,7 +81,7 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
   cmd->add_option("--ray-samples", settings.ray_samples, "Intervals per ray for inscattering integrals")
       ->capture_default_str();
   cmd->add_option("--sphere-samples", settings.sphere_samples,
-                  "Polar directions for integrals over the sphere (azimuths: twice as many)")
+                  "Polar directions for integrals over the sphere (azimuths: twice as many), and half as many again in the band just above the horizon")
       ->capture_default_str();
   cmd->add_option("--higher-order-divisor", settings.higher_order_divisor,
                   "Orders >= 2 on a grid with the scattering r and mu sizes divided by this (1 = full)")
