@@ -217,10 +217,9 @@ class MuSCoordinate {
     for (int j = 0; j < count; ++j) {
       const float d = glsl_float::DistanceToSphereFromInside(bottom * mu_s[j], c);
       const float a = (d - d_min) * inverse_span;
-      const float unclamped = glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale;
-      const float position = unclamped < last ? unclamped : last;
-      const int truncated = static_cast<int>(position);
-      const int i = truncated < 0 ? 0 : (truncated > last_left ? last_left : truncated);
+      // (The lower clamp only keeps the conversion to int in range.)
+      const float position = ClampFloat(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale, -1e6f, last);
+      const int i = std::max(std::min(static_cast<int>(position), last_left), 0);
       left[j] = i;
       weight[j] = position - float(i);
     }
