@@ -37,35 +37,6 @@ inline float ExpFloat(float x) {
   return p * scale;
 }
 
-// ln(max(x, lower)) for a positive normal float `lower` (>= 2^-126) and any
-// x but NaN (0 and negative x give ln(lower)), within 2 float ulps or 2^-24
-// absolute: y = m 2^e with m in [sqrt(1/2), sqrt(2)), ln y = e ln2 +
-// ln(1 + u), u = m - 1, by u - u^2 / 2 + u^3 P(u) with Cephes logf's
-// minimax polynomial P; no division. The max and the choice of m are taken
-// on the bits as integers (for floats of one sign their order is the
-// integers'), which keeps a loop calling it vectorisable.
-inline float LogFloat(float x, float lower) {
-  const std::int32_t x_bits = __builtin_bit_cast(std::int32_t, x), lower_bits = __builtin_bit_cast(std::int32_t, lower);
-  const std::int32_t bits = x_bits < lower_bits ? lower_bits : x_bits;
-  const std::int32_t mantissa_bits = (bits & 0x007fffff) | 0x3f800000;  // m in [1, 2)
-  const std::int32_t high = mantissa_bits > 0x3fb504f3 ? 1 : 0;         // m > sqrt(2): halve it
-  const float u = __builtin_bit_cast(float, mantissa_bits - (high << 23)) - 1.0f;
-  const float e = static_cast<float>((bits >> 23) - 127 + high);
-  float p = 7.0376836292e-2f;
-  p = p * u - 1.1514610310e-1f;
-  p = p * u + 1.1676998740e-1f;
-  p = p * u - 1.2420140846e-1f;
-  p = p * u + 1.4249322787e-1f;
-  p = p * u - 1.6668057665e-1f;
-  p = p * u + 2.0000714765e-1f;
-  p = p * u - 2.4999993993e-1f;
-  p = p * u + 3.3333331174e-1f;
-  const float u2 = u * u;
-  // ln2 split in two so that e times the first part is exact (|e| < 2^8).
-  const float small = u * u2 * p + e * -2.12194440e-4f - 0.5f * u2;
-  return (u + small) + e * 0.693359375f;
-}
-
 // (exp(lambda) - 1) / lambda, the integral over [0, 1] of exp(lambda s),
 // for |lambda| <= 0.1 (its Taylor series to lambda^4, error below 1.5e-8).
 inline float ExpRampSmall(float lambda) {

@@ -67,20 +67,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         weight[k + 1][c] += w.second;
       }
     }
-    // ln J at each sample's (r, mu) for every (nu, mu_s) texel of the
-    // density grid: J interpolated linearly in r and mu (as the texture unit
-    // does), once per sample. Along mu_s and nu J is then interpolated
-    // geometrically (GeometricBlendOfLogs), and below the grid's lowest sun
-    // the fall of its two lowest columns goes on, never above the lowest,
-    // as glsl::GetScattering reads a low sun. After sunset J falls by orders
-    // of magnitude from one mu_s texel to the next, and along a ray into
-    // the Earth's shadow the sun sinks by several texels: a linear blend
-    // overestimates such a fall by up to (a + b) / (2 sqrt(a b)) and lit the
-    // shadow with the light of its edge. In daylight the two blends differ by
-    // far less than the grid's own interpolation error. (Geometric in r and
-    // mu too would save the logarithm per sample, but a geometric blend is
-    // never above the linear one, and there the difference is large enough
-    // to unbalance the energy of a conservative atmosphere: stress_set_test.)
+    // J at each sample's (r, mu) for every (nu, mu_s) texel of the density
+    // grid: the texture's r and mu interpolation, done once per sample.
     std::vector<int> samples;  // those with a non-zero weight
     std::vector<float> planes;
     planes.reserve(std::size_t(n + 1) * 4 * plane_width);
@@ -103,15 +91,13 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       const std::size_t offset = planes.size();
       planes.resize(offset + std::size_t(4) * plane_width);
       float* plane = &planes[offset];
-#pragma omp simd
-      for (int i = 0; i < 4 * plane_width; ++i)
-        plane[i] = LogFloat(w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i], kDarkTexel);
+      for (int i = 0; i < 4 * plane_width; ++i) plane[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
       samples.push_back(k);
     }
 
     // Per distinct sun direction of the ray: its nu taps in the density
     // grid (nu is the same all along the ray), then per sample its mu_s
-    // taps and J (GeometricBlendOfLogs), vectorised over the directions.
+    // taps and J, vectorised over the directions.
     const SunDirections directions = RaySunDirections(columns, ray.mu);
     const int count = static_cast<int>(directions.nu.size());
     std::vector<float> mu_s(directions.mu_s.begin(), directions.mu_s.end()), nu(directions.nu.begin(), directions.nu.end());
@@ -143,10 +129,11 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         float* value = source.empty() ? values.data() : &source[(std::size_t(k) * 3 + c) * count];
 #pragma omp simd
         for (int j = 0; j < count; ++j) {
-          const int left = mu_s_left[j];
-          const int a = nu_row0[j] + 4 * left + c, b = nu_row1[j] + 4 * left + c;
-          value[j] =
-              GeometricBlendOfLogs(plane[a], plane[b], plane[a + 4], plane[b + 4], nu_weight[j], mu_s_weight[j]);
+          const int a = nu_row0[j] + 4 * mu_s_left[j] + c, b = nu_row1[j] + 4 * mu_s_left[j] + c;
+          const float f = mu_s_weight[j];
+          const float along_a = plane[a] + f * (plane[a + 4] - plane[a]);
+          const float along_b = plane[b] + f * (plane[b + 4] - plane[b]);
+          value[j] = along_a + nu_weight[j] * (along_b - along_a);
           sum[j] += w * value[j];
         }
       }

@@ -190,8 +190,8 @@ class SunAtPoints {
   const ChannelPlanes& transmittance_;  // optical depth
 };
 
-// glsl::GetScattering's position along mu_s in float, as a left texel column
-// and the weight of the right one (vectorisable): the same primitives, with
+// glsl::GetScatteringTextureUMuS in float, as the left tap and weight of the
+// linear interpolation along mu_s (vectorisable): the same primitives, with
 // the linear maps of the distance to its unit range and of the unit range to
 // texels hoisted into constants.
 class MuSCoordinate {
@@ -205,10 +205,9 @@ class MuSCoordinate {
     last_ = float(grid.scattering_mu_s_size - 1), last_left_ = grid.scattering_mu_s_size - 2;
     scale_ = float((grid.scattering_mu_s_size - 1) / glsl::GetScatteringUnitMuS(grid, grid.scattering_mu_s_max));
   }
-  // For `count` sun cosines: the position along the mu_s axis in texels (at
-  // most size - 1, below 0 under the lowest column) split into a left column
-  // (whose right neighbour exists) and the weight of the right one (negative
-  // under the lowest column).
+  // For `count` sun cosines: the position along the mu_s axis in texels
+  // (in [0, size - 1]) split into a left tap (whose right neighbour exists)
+  // and the weight of the right one.
   void Taps(const float* mu_s, int count, int* left, float* weight) const {
     const float bottom = bottom_, c = c_, d_min = d_min_, inverse_span = inverse_span_, inverse_a = inverse_a_;
     const float last = last_, scale = scale_;
@@ -217,9 +216,8 @@ class MuSCoordinate {
     for (int j = 0; j < count; ++j) {
       const float d = glsl_float::DistanceToSphereFromInside(bottom * mu_s[j], c);
       const float a = (d - d_min) * inverse_span;
-      // (The lower clamp only keeps the conversion to int in range.)
-      const float position = ClampFloat(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale, -1e6f, last);
-      const int i = std::max(std::min(static_cast<int>(position), last_left), 0);
+      const float position = ClampFloat(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale, 0.0f, last);
+      const int i = std::min(static_cast<int>(position), last_left);
       left[j] = i;
       weight[j] = position - float(i);
     }
@@ -229,26 +227,4 @@ class MuSCoordinate {
   float bottom_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, inverse_span_ = 0.0f, inverse_a_ = 0.0f, last_ = 0.0f, scale_ = 0.0f;
   int last_left_ = 0;
 };
-
-// The floor under which glsl::SunCosineMix takes a texel as dark, as the
-// logarithms GeometricBlendOfLogs receives are floored.
-constexpr float kDarkTexel = 1e-30f;
-
-// The geometric blend of four texels of a scattering grid, from their
-// logarithms floored at kDarkTexel (log_a*: the lower nu slice, log_*0: the
-// lower mu_s column): along nu at both columns, then along mu_s, one
-// bilinear blend of the logarithms and one exp; below the grid's lowest sun
-// (mu_s_t < 0) never brighter than the lowest column; 0 where the blend is
-// dark (at or below kDarkTexel: four dark texels, or a fall below the
-// lowest sun past it). This is glsl::GetScattering's blend for a low sun
-// (SunCosineMix, SunBelowTableMix) up to float rounding, except that a
-// blend the runtime puts below kDarkTexel is 0 here.
-inline float GeometricBlendOfLogs(float log_a0, float log_b0, float log_a1, float log_b1, float nu_t, float mu_s_t) {
-  const float dark_log = LogFloat(kDarkTexel, kDarkTexel);
-  const float below = log_a0 + nu_t * (log_b0 - log_a0), above = log_a1 + nu_t * (log_b1 - log_a1);
-  const float rise = above - below;
-  const float no_rise = rise < 0.0f ? 0.0f : rise;  // below the lowest sun, no rise
-  const float blend = below + mu_s_t * (mu_s_t < 0.0f ? no_rise : rise);
-  return blend <= dark_log ? 0.0f : ExpFloat(blend);
-}
 }  // namespace skybake::detail
