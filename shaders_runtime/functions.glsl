@@ -198,9 +198,8 @@ Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r, Num
   Number rho_below = mix(rho_min, rho_max, row / last_row);
   Number rho_above = mix(rho_min, rho_max, (row + 1.0) / last_row);
   Number bottom = atmosphere.bottom_radius;
-  Number h_below = rho_below * rho_below / (sqrt(rho_below * rho_below + bottom * bottom) + bottom);
-  Number h_above = rho_above * rho_above / (sqrt(rho_above * rho_above + bottom * bottom) + bottom);
-  Number d_below = mix(h_below, rho_below, x_mu), d_above = mix(h_above, rho_above, x_mu);
+  Number d_below = mix(HeightFromHorizonDistance(bottom, rho_below), rho_below, x_mu);
+  Number d_above = mix(HeightFromHorizonDistance(bottom, rho_above), rho_above, x_mu);
   Number d = mix(r - bottom, rho, x_mu);
   Number t = clamp((d - d_below) / (d_above - d_below), 0.0, 1.0);
   return (row + t + 0.5) / (last_row + 1.0);

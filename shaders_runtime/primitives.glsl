@@ -41,6 +41,13 @@ Number DistanceToHorizon(Number bottom_radius, Number r) {
   return SafeSqrt((r - bottom_radius) * (r + bottom_radius));
 }
 
+// The height above the ground of the point whose distance to the horizon is
+// rho (the inverse of DistanceToHorizon): rho^2 / (r + bottom_radius) with
+// r = sqrt(rho^2 + bottom_radius^2), free of the cancellation of r - bottom.
+Number HeightFromHorizonDistance(Number bottom_radius, Number rho) {
+  return rho * rho / (sqrt(rho * rho + bottom_radius * bottom_radius) + bottom_radius);
+}
+
 // Cosine of the zenith angle of the geometric horizon seen from radius
 // r >= bottom_radius: -sqrt(r^2 - bottom^2) / r, written through the distance
 // to the horizon rather than as -sqrt(1 - (bottom / r)^2), whose 1 - ... loses
