@@ -60,20 +60,16 @@ Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r,
   // otherwise the texture unit's linear blend. (The density's rings sit on
   // the columns themselves.)
   const vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(grid, r, mu, mu_s, 0.0, intersects_ground);
-  const double mu_s_size = grid.scattering_mu_s_size;
-  const double mu_s_coord = uvwz.y * mu_s_size - 0.5;
-  const double column = std::clamp(std::floor(mu_s_coord), 0.0, mu_s_size - 2.0);
-  const double x_below = (column + 0.5) / mu_s_size;
-  const bool low_sun = x_below < glsl::GetScatteringTextureUMuS(grid, glsl::LOW_SUN_MU_S);
-  const double mu_s_t = glsl::SunCosinePosition(mu_s_coord - column, low_sun);
+  double x_below, x_above, mu_s_t;
+  bool low_sun;
+  glsl::GetScatteringMuSColumns(grid, uvwz.y, x_below, x_above, mu_s_t, low_sun);
   const bool between_columns = low_sun && std::abs(mu_s_t) > 1e-9 && std::abs(1.0 - mu_s_t) > 1e-9;
   auto slices = [&](const Texture& table, std::vector<vec3>& out) {
     const glsl::sampler3D sampler{&table};
     for (int slice = 0; slice <= nu_size_; ++slice) {
       if (between_columns) {
         const vec4 below = glsl::texture(sampler, glsl::vec3((slice + x_below) / nu_size_, uvwz.z, uvwz.w));
-        const vec4 above =
-            glsl::texture(sampler, glsl::vec3((slice + x_below + 1.0 / mu_s_size) / nu_size_, uvwz.z, uvwz.w));
+        const vec4 above = glsl::texture(sampler, glsl::vec3((slice + x_above) / nu_size_, uvwz.z, uvwz.w));
         out.push_back(vec3(glsl::SunBelowTableMix(below, above, mu_s_t, true)));
       } else {
         out.push_back(vec3(glsl::texture(sampler, glsl::vec3((slice + uvwz.y) / nu_size_, uvwz.z, uvwz.w))));

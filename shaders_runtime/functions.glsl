@@ -360,6 +360,20 @@ vec4 SunBelowTableMix(vec4 a, vec4 b, Number t, bool low_sun) {
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+// The two scattering-table mu_s texel columns a lookup at unit mu_s u_mu_s
+// blends: their x coordinates within a nu slice, the position between them
+// (SunCosinePosition) and whether the lower one is a low sun.
+void GetScatteringMuSColumns(IN(AtmosphereParameters) atmosphere, Number u_mu_s, OUT(Number) x_below,
+                             OUT(Number) x_above, OUT(Number) mu_s_t, OUT(bool) low_sun_below) {
+  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  Number mu_s_coord = u_mu_s * mu_s_size - 0.5;
+  Number mu_s_column = clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
+  x_below = (mu_s_column + 0.5) / mu_s_size;
+  x_above = (mu_s_column + 1.5) / mu_s_size;
+  low_sun_below = x_below < GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
+  mu_s_t = SunCosinePosition(mu_s_coord - mu_s_column, low_sun_below);
+}
+
 // 4D lookup: four fetches, at the two mu_s texel columns either side of
 // mu_s and the two nu slices either side of nu, each bilinear in (mu, r) by
 // the texture unit; then nu by SunCosineMix and mu_s by SunBelowTableMix.
@@ -370,13 +384,12 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   Number nu_coord = uvwz.x * (nu_size - 1.0);
   Number nu_slice = min(floor(nu_coord), nu_size - 2.0);
   Number nu_t = nu_coord - nu_slice;
-  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
-  Number mu_s_coord = uvwz.y * mu_s_size - 0.5;
-  Number mu_s_column = clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
-  Number x_below = (mu_s_column + 0.5) / mu_s_size, x_above = (mu_s_column + 1.5) / mu_s_size;
-  Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
-  bool low_sun_below = x_below < x_low_sun, low_sun_above = x_above < x_low_sun;
-  Number mu_s_t = SunCosinePosition(mu_s_coord - mu_s_column, low_sun_below);
+  Number x_below;
+  Number x_above;
+  Number mu_s_t;
+  bool low_sun_below;
+  GetScatteringMuSColumns(atmosphere, uvwz.y, x_below, x_above, mu_s_t, low_sun_below);
+  bool low_sun_above = x_above < GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
   vec4 below = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w)),
                             texture(scattering_texture, vec3((nu_slice + 1.0 + x_below) / nu_size, uvwz.z, uvwz.w)),
                             nu_t, low_sun_below);
