@@ -1,5 +1,5 @@
-# `cmake --install BUILD --prefix PREFIX` puts the command-line tool, the
-# loader library (skybake::formats: LoadLutSet and the manifest, with the
+# `cmake --install BUILD --prefix PREFIX` puts the command-line tool and its
+# image module, the loader library (skybake::formats: LoadLutSet and the manifest, with the
 # LutSet of skybake::bake, the CPU twin of skybake::runtime and the errors
 # of skybake::core), their headers
 # and the runtime GLSL into PREFIX, with a CMake package:
@@ -24,6 +24,8 @@ foreach(target skybake_core skybake_runtime skybake_bake skybake_formats)
 endforeach()
 
 install(TARGETS skybake RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The image module, where plot/image_library.cpp looks beside bin/.
+install(TARGETS skybake_images LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/skybake)
 install(TARGETS skybake_core skybake_runtime skybake_bake skybake_formats EXPORT skybakeTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 foreach(dir core bake formats shaders_runtime)

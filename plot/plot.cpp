@@ -6,12 +6,9 @@
 #include <cstdio>
 #include <sstream>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
-
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "plot/image_library.h"
 
 namespace skybake {
 
@@ -434,73 +431,60 @@ std::vector<unsigned char> RasterizePlot(const LinePlot& plot) {
 
 void WriteSrgbPng(const std::filesystem::path& path, int width, int height, const unsigned char* rgb,
                   const std::vector<std::pair<std::string, std::string>>& text) {
-  using namespace OIIO;
-  ImageSpec spec(width, height, 3, TypeDesc::UINT8);
-  for (const auto& [key, value] : text) spec.attribute(key, value);
-  // OpenImageIO's PNG writer turns this colour space into the sRGB chunk.
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  ImageBuf image(spec);
-  image.set_pixels(ROI::All(), TypeDesc::UINT8, rgb);
+  const image_module::Functions& images = ImageModule();
   WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
-    // The temporary name has no .png extension, so name the format explicitly.
-    if (!image.write(temp.string(), TypeDesc::UINT8, "png"))
-      throw IoError(path.string() + ": cannot write PNG: " + image.geterror());
+    const std::string error = images.write_srgb_png(temp.string(), width, height, rgb, text);
+    if (!error.empty()) throw IoError(path.string() + ": " + error);
   });
 }
 
 bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
-  using namespace OIIO;
+  using image_module::AlignX;
+  using image_module::AlignY;
+  const image_module::Functions& images = ImageModule();
   PlotFrame f = LayoutPlot(plot);
   std::vector<unsigned char> pixels = RasterizePlot(plot);
-  ImageBuf image(ImageSpec(plot.width_px, plot.height_px, 3, TypeDesc::UINT8));
-  image.set_pixels(ROI::All(), TypeDesc::UINT8, pixels.data());
+  const image_module::Rgb8Canvas canvas{plot.width_px, plot.height_px, pixels.data()};
 
-  std::string font;
-  for (const char* candidate : {"DejaVuSans", "LiberationSans-Regular", "FreeSans"}) {
-    if (ImageBufAlgo::text_size("0", 12, candidate).defined()) {
-      font = candidate;
-      break;
-    }
-  }
+  const std::string font = images.find_font();
   if (!font.empty()) {
     const float ink[3] = {0.2f, 0.2f, 0.2f}, grey[3] = {0.4f, 0.4f, 0.4f};
-    auto text = [&](double x, double y, const std::string& s, double size, ImageBufAlgo::TextAlignX ax,
-                    const float* color = nullptr) {
+    auto text = [&](double x, double y, const std::string& s, double size, AlignX ax, const float* color = nullptr) {
       if (s.empty()) return;
-      ImageBufAlgo::render_text(image, static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), s,
-                                static_cast<int>(size), font, cspan<float>(color ? color : ink, 3), ax,
-                                ImageBufAlgo::TextAlignY::Baseline);
+      images.draw_text(canvas, static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), s,
+                       static_cast<int>(size), font, color ? color : ink, ax, AlignY::kBaseline);
     };
-    using AX = ImageBufAlgo::TextAlignX;
-    for (double t : f.x_ticks) text(f.PixelX(t), f.bottom + 20, FormatTick(t, f.x_log), kTickLabelSize, AX::Center);
-    for (double t : f.y_ticks) text(f.left - 8, f.PixelY(t) + 4, FormatTick(t, f.y_log), kTickLabelSize, AX::Right);
-    text(0.5 * (f.left + f.right), f.top - 16, plot.title, kTitleSize, AX::Center);
-    text(0.5 * (f.left + f.right), f.bottom + 42, plot.x.label, kAxisLabelSize, AX::Center);
-    text(10, plot.height_px - 8, Caption(plot), kCaptionSize, AX::Left, grey);
+    for (double t : f.x_ticks) text(f.PixelX(t), f.bottom + 20, FormatTick(t, f.x_log), kTickLabelSize, AlignX::kCenter);
+    for (double t : f.y_ticks) text(f.left - 8, f.PixelY(t) + 4, FormatTick(t, f.y_log), kTickLabelSize, AlignX::kRight);
+    text(0.5 * (f.left + f.right), f.top - 16, plot.title, kTitleSize, AlignX::kCenter);
+    text(0.5 * (f.left + f.right), f.bottom + 42, plot.x.label, kAxisLabelSize, AlignX::kCenter);
+    text(10, plot.height_px - 8, Caption(plot), kCaptionSize, AlignX::kLeft, grey);
     LegendBox legend = PlaceLegend(plot, f);
     for (size_t k = 0; k < legend.entries.size(); ++k) {
       double y = legend.y + kLegendPad + kLegendRow * (k + 0.5) - 2;
       text(legend.x + 2 * kLegendPad + kLegendSample, y + 4, plot.series[legend.entries[k]].name, kTickLabelSize,
-           AX::Left);
+           AlignX::kLeft);
     }
-    if (!plot.y.label.empty()) {
-      // Render horizontally on white, turn a quarter to read bottom to top, paste in the margin.
-      ROI size = ImageBufAlgo::text_size(plot.y.label, static_cast<int>(kAxisLabelSize), font);
-      if (size.defined()) {
-        ImageBuf label(ImageSpec(size.width() + 4, size.height() + 4, 3, TypeDesc::UINT8));
-        const float white[3] = {1, 1, 1};
-        ImageBufAlgo::fill(label, white);
-        ImageBufAlgo::render_text(label, 2, 2 - size.ybegin, plot.y.label, static_cast<int>(kAxisLabelSize), font,
-                                  cspan<float>(ink, 3));
-        ImageBuf turned = ImageBufAlgo::rotate270(label);
-        int x = std::max(0, 18 - turned.spec().width / 2);
-        int y = static_cast<int>(0.5 * (f.top + f.bottom)) - turned.spec().height / 2;
-        ImageBufAlgo::paste(image, x, std::max(0, y), 0, 0, turned);
+    int box[4];
+    if (!plot.y.label.empty() && images.text_box(plot.y.label, static_cast<int>(kAxisLabelSize), font, box)) {
+      // Drawn horizontally on white, turned a quarter to read bottom to top,
+      // and copied into the left margin.
+      const int w = box[2] - box[0] + 4, h = box[3] - box[1] + 4;
+      std::vector<unsigned char> label(std::size_t(3) * w * h, 255);
+      images.draw_text({w, h, label.data()}, 2, 2 - box[1], plot.y.label, static_cast<int>(kAxisLabelSize), font,
+                       ink, AlignX::kLeft, AlignY::kBaseline);
+      // Turned: h wide, w high; its pixel (i, j) is the label's (w - 1 - j, i).
+      const int x0 = std::max(0, 18 - h / 2);
+      const int y0 = std::max(0, static_cast<int>(0.5 * (f.top + f.bottom)) - w / 2);
+      for (int j = 0; j < w && y0 + j < plot.height_px; ++j) {
+        for (int i = 0; i < h && x0 + i < plot.width_px; ++i) {
+          const unsigned char* from = &label[3 * (std::size_t(i) * w + (w - 1 - j))];
+          std::copy(from, from + 3, &pixels[3 * (std::size_t(y0 + j) * plot.width_px + (x0 + i))]);
+        }
       }
     }
   }
 
-  image.get_pixels(ROI::All(), TypeDesc::UINT8, pixels.data());
   // The caption (who made the plot) also goes into the PNG's text chunks.
   std::vector<std::pair<std::string, std::string>> text;
   if (!plot.caption.empty()) text.push_back({"ImageDescription", plot.caption});

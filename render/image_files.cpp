@@ -3,11 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "plot/image_library.h"
 #include "plot/plot.h"
 #include "report/error_stats.h"
 
@@ -15,23 +13,8 @@ namespace skybake::render {
 
 namespace {
 
-void Annotate(OIIO::ImageSpec* spec, const Attributes& attributes) {
-  for (const auto& [key, value] : attributes) spec->attribute(key, value);
-}
-
-void WriteAtomically(const std::filesystem::path& path, const OIIO::ImageBuf& image, OIIO::TypeDesc type,
-                     const char* format) {
-  WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
-    // The temporary name has no image extension, so name the format explicitly.
-    if (!image.write(temp.string(), type, format))
-      throw IoError(path.string() + ": cannot write " + format + ": " + image.geterror());
-  });
-}
-
-std::string FindFont() {
-  for (const char* candidate : {"DejaVuSans", "LiberationSans-Regular", "FreeSans"})
-    if (OIIO::ImageBufAlgo::text_size("0", 12, candidate).defined()) return candidate;
-  return "";
+void ThrowIfFailed(const std::filesystem::path& path, const std::string& error) {
+  if (!error.empty()) throw IoError(path.string() + ": " + error);
 }
 
 }  // namespace
@@ -58,35 +41,26 @@ double AutoExposureEv(const Image& image) {
   return std::log2(-std::log(1.0 - kAutoExposureMidGrey) / *median);
 }
 
+double SrgbEncode(double linear) {
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
 Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone) {
-  using namespace OIIO;
-  double scale = std::exp2(tone.exposure_ev);
-  std::vector<float> display(image.rgb.size());
-  for (std::size_t i = 0; i < display.size(); ++i) {
-    double x = std::max(0.0, double(image.rgb[i])) * scale / tone.white[static_cast<int>(i % 3)];
-    display[i] = static_cast<float>(1.0 - std::exp(-x));
+  const double scale = std::exp2(tone.exposure_ev);
+  Rgb8 out{image.width, image.height, std::vector<std::uint8_t>(image.rgb.size())};
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+    const double x = std::max(0.0, double(image.rgb[i])) * scale / tone.white[static_cast<int>(i % 3)];
+    const double display = 1.0 - std::exp(-x);
+    out.rgb[i] = static_cast<std::uint8_t>(std::lround(std::clamp(SrgbEncode(display), 0.0, 1.0) * 255.0));
   }
-  ImageBuf linear(ImageSpec(image.width, image.height, 3, TypeDesc::FLOAT), display.data());
-  ImageBuf srgb;
-  if (!ImageBufAlgo::colorconvert(srgb, linear, "linear", "sRGB"))
-    throw InternalError("render: colour conversion linear -> sRGB failed: " + srgb.geterror());
-  Rgb8 out{image.width, image.height, std::vector<std::uint8_t>(display.size())};
-  std::vector<float> encoded(display.size());
-  srgb.get_pixels(ROI::All(), TypeDesc::FLOAT, encoded.data());
-  for (std::size_t i = 0; i < encoded.size(); ++i)
-    out.rgb[i] = static_cast<std::uint8_t>(std::lround(std::clamp(encoded[i], 0.0f, 1.0f) * 255.0f));
   return out;
 }
 
 void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes) {
-  using namespace OIIO;
-  ImageSpec spec(image.width, image.height, 3, TypeDesc::FLOAT);
-  spec.channelnames = {"R", "G", "B"};
-  spec.attribute("compression", "zip");
-  Annotate(&spec, attributes);
-  ImageBuf buffer(spec);
-  buffer.set_pixels(ROI::All(), TypeDesc::FLOAT, image.rgb.data());
-  WriteAtomically(path, buffer, TypeDesc::FLOAT, "openexr");
+  const image_module::Functions& images = ImageModule();
+  WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
+    ThrowIfFailed(path, images.write_linear_exr(temp.string(), image.width, image.height, image.rgb.data(), attributes));
+  });
 }
 
 void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes) {
@@ -94,20 +68,15 @@ void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attrib
 }
 
 Rgb8 ReadPng(const std::filesystem::path& path) {
-  using namespace OIIO;
-  ImageBuf buffer(path.string());
-  if (!buffer.read(0, 0, true, TypeDesc::UINT8) || buffer.spec().nchannels < 3)
-    throw IoError(path.string() + ": cannot read an RGB PNG: " + buffer.geterror());
-  Rgb8 out{buffer.spec().width, buffer.spec().height, {}};
-  out.rgb.resize(std::size_t(3) * out.width * out.height);
-  buffer.get_pixels(ROI(0, out.width, 0, out.height, 0, 1, 0, 3), TypeDesc::UINT8, out.rgb.data());
+  Rgb8 out;
+  ThrowIfFailed(path, ImageModule().read_rgb8(path.string(), &out.width, &out.height, &out.rgb));
   return out;
 }
 
 Rgb8 ContactSheet(const std::vector<std::vector<const Rgb8*>>& columns, const std::vector<std::string>& labels,
                   int gap) {
-  using namespace OIIO;
-  std::string font = labels.empty() ? "" : FindFont();
+  const image_module::Functions& images = ImageModule();
+  const std::string font = labels.empty() ? "" : images.find_font();
   const int label_height = font.empty() ? 0 : 22;
   int width = gap, height = 0;
   for (const auto& column : columns) {
@@ -119,28 +88,28 @@ Rgb8 ContactSheet(const std::vector<std::vector<const Rgb8*>>& columns, const st
     width += column_width + gap;
     height = std::max(height, column_height);
   }
-  const float background[3] = {0.08f, 0.08f, 0.08f}, ink[3] = {0.9f, 0.9f, 0.9f};
-  ImageBuf sheet(ImageSpec(width, std::max(height, 1), 3, TypeDesc::FLOAT));
-  ImageBufAlgo::fill(sheet, background);
+  const std::uint8_t background = 20;  // 0.08 of full scale
+  const float ink[3] = {0.9f, 0.9f, 0.9f};
+  Rgb8 sheet{width, std::max(height, 1), {}};
+  sheet.rgb.assign(std::size_t(3) * sheet.width * sheet.height, background);
   int x = gap;
   for (std::size_t c = 0; c < columns.size(); ++c) {
     int y = gap + label_height, column_width = 0;
     for (const Rgb8* image : columns[c]) {
-      ImageBuf tile(ImageSpec(image->width, image->height, 3, TypeDesc::UINT8));
-      tile.set_pixels(ROI::All(), TypeDesc::UINT8, image->rgb.data());
-      ImageBufAlgo::paste(sheet, x, y, 0, 0, tile);
+      for (int row = 0; row < image->height; ++row) {
+        const std::uint8_t* from = &image->rgb[3 * std::size_t(row) * image->width];
+        std::copy(from, from + 3 * image->width, &sheet.rgb[3 * (std::size_t(y + row) * sheet.width + x)]);
+      }
       y += image->height + gap;
       column_width = std::max(column_width, image->width);
     }
-    if (!font.empty() && c < labels.size())
-      ImageBufAlgo::render_text(sheet, x + column_width / 2, gap + label_height - 6, labels[c], 14, font,
-                                cspan<float>(ink, 3), ImageBufAlgo::TextAlignX::Center);
+    if (!font.empty() && c < labels.size()) {
+      images.draw_text({sheet.width, sheet.height, sheet.rgb.data()}, x + column_width / 2, gap + label_height - 6,
+                       labels[c], 14, font, ink, image_module::AlignX::kCenter, image_module::AlignY::kBaseline);
+    }
     x += column_width + gap;
   }
-  Rgb8 out{sheet.spec().width, sheet.spec().height, {}};
-  out.rgb.resize(std::size_t(3) * out.width * out.height);
-  sheet.get_pixels(ROI::All(), TypeDesc::UINT8, out.rgb.data());
-  return out;
+  return sheet;
 }
 
 }  // namespace skybake::render

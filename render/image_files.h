@@ -9,8 +9,7 @@
 //   3. tone curve: d = 1 - exp(-x) per channel (monotonic, linear near black,
 //      saturates highlights such as the sun smoothly instead of clipping);
 //   4. d, taken as linear sRGB (the three wavelengths stand for the primaries),
-//      is encoded with the sRGB transfer function by OpenImageIO's colour
-//      management (ImageBufAlgo::colorconvert "linear" -> "sRGB") and rounded
+//      is encoded with the sRGB transfer function (SrgbEncode) and rounded
 //      to 8 bits.
 #pragma once
 
@@ -49,6 +48,11 @@ struct Rgb8 {
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgb;
 };
+
+// The sRGB transfer function of IEC 61966-2-1, linear 0-1 to encoded 0-1:
+//   12.92 v                   for v <= 0.0031308,
+//   1.055 v^(1/2.4) - 0.055   above.
+double SrgbEncode(double linear);
 
 Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone);
 

@@ -2,7 +2,8 @@
 # `cmake --install` end to end: installs the build into a temporary prefix,
 # builds examples/install_consumer against the installed package
 # (find_package(skybake), skybake::formats), bakes a small set with the
-# installed skybake and loads it with the consumer.
+# installed skybake and loads it with the consumer; the installed skybake
+# writes a plot through its installed image module.
 #   install_check.sh BUILD_DIR SOURCE_DIR WORK_DIR
 set -eu
 build=$1 source=$2 work=$3
@@ -21,4 +22,9 @@ cmake --build "$work/consumer" >"$work/build.log"
 out=$("$work/consumer/load_set" "$work/set")
 echo "$out"
 echo "$out" | grep -qx "scattering 32x32x8" || { echo "install_check: unexpected output"; exit 1; }
+# The installed skybake writes images through its installed image module.
+LD_DEBUG=files "$work/prefix/bin/skybake" info "$work/set" --plot "$work/plots" >"$work/plot.log" 2>&1
+grep -q "$work/prefix/lib[^ ]*/skybake/libskybake_images.so" "$work/plot.log" ||
+  { echo "install_check: the installed image module was not the one loaded"; exit 1; }
+[ -s "$work/plots/lut_transmittance.png" ] || { echo "install_check: no plot written"; exit 1; }
 echo "install_check: the installed package loads a set baked by the installed skybake"

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <map>
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
@@ -181,6 +183,48 @@ TEST(Render, MatchesGolden) {
   // The tolerance is tight enough to see a 2-degree change of the sun.
   Difference moved = Compare(GoldenCandidate(62.0), golden);
   EXPECT_TRUE(moved.max > 3 || moved.mean > 0.5) << moved.max << " " << moved.mean;
+}
+
+// The tone map's sRGB encoding against OpenImageIO's colour management, an
+// independent implementation of the same standard, over the whole 0-1 range
+// (both in float at least: within 1e-5).
+TEST(Render, SrgbEncodingMatchesOpenImageIO) {
+  const int n = 4097;
+  std::vector<float> linear(3 * n);
+  for (int i = 0; i < 3 * n; ++i) linear[i] = float(i / 3) / float(n - 1);
+  OIIO::ImageBuf in(OIIO::ImageSpec(n, 1, 3, OIIO::TypeDesc::FLOAT), linear.data()), out;
+  ASSERT_TRUE(OIIO::ImageBufAlgo::colorconvert(out, in, "linear", "sRGB")) << out.geterror();
+  std::vector<float> encoded(3 * n);
+  out.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, encoded.data());
+  double worst = 0.0;
+  for (int i = 0; i < 3 * n; ++i) worst = std::max(worst, std::abs(render::SrgbEncode(linear[i]) - encoded[i]));
+  EXPECT_LT(worst, 1e-5);
+  // The two branches meet at the breakpoint (continuity of the standard).
+  EXPECT_NEAR(render::SrgbEncode(0.0031308), 12.92 * 0.0031308, 1e-6);
+  EXPECT_DOUBLE_EQ(render::SrgbEncode(1.0), 1.0);
+}
+
+// A bake writes no image, so it must not load OpenImageIO's libraries (about
+// half a second per command); the image module loads them when an image is
+// written. The dynamic loader's own trace says which files were opened.
+TEST(RenderCli, OnlyCommandsThatWriteImagesLoadOpenImageIO) {
+  TempDir dir;
+  std::string out, err;
+  fs::path lut = dir.path() / "earth";
+  ASSERT_EQ(RunCommand("LD_DEBUG=files " + Skybake() + " bake earth --quiet -o " + ShellQuote(lut) + kSmallBake,
+                       dir, &out, &err),
+            0)
+      << err;
+  EXPECT_NE(err.find("libtbb"), std::string::npos) << "no loader trace";
+  EXPECT_EQ(err.find("libOpenImageIO"), std::string::npos);
+  ASSERT_EQ(RunCommand("LD_DEBUG=files " + Skybake() + " info " + ShellQuote(lut) + " --plot " +
+                           ShellQuote(dir.path() / "plots"),
+                       dir, &out, &err),
+            0)
+      << err;
+  EXPECT_NE(err.find("libskybake_images.so"), std::string::npos);
+  EXPECT_NE(err.find("libOpenImageIO"), std::string::npos);
+  EXPECT_GT(render::ReadPng(dir.path() / "plots" / "lut_transmittance.png").width, 0);
 }
 
 // The command end to end: sizes of every output, the JSON report on stdout,

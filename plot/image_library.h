@@ -1,0 +1,15 @@
+// Access to the image module (plot/image_module.h), loaded on first use:
+// installed, from PREFIX/lib/skybake beside the executable's PREFIX/bin; in
+// the build tree, from build/lib (SKYBAKE_IMAGE_MODULE_DIR, set by
+// plot/CMakeLists.txt).
+#pragma once
+
+#include "plot/image_module.h"
+
+namespace skybake {
+
+// The module's functions. IoError naming the file if it cannot be loaded or
+// was built from another version of the interface.
+const image_module::Functions& ImageModule();
+
+}  // namespace skybake
