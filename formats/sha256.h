@@ -1,6 +1,6 @@
-// SHA-256 (FIPS 180-4, section 6.2) for the checksums in the manifest. Small
-// and dependency-free on purpose: the manifest needs a digest that any engine
-// can recompute with its platform's library.
+// SHA-256 (FIPS 180-4) for the checksums in the manifest, which any engine
+// can recompute with its platform's library. Computed by OpenSSL's
+// libcrypto, which uses the CPU's SHA instructions where it has them.
 #pragma once
 
 #include <array>
@@ -9,22 +9,22 @@
 #include <string>
 #include <string_view>
 
+struct evp_md_ctx_st;
+
 namespace skybake {
 
 class Sha256 {
  public:
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
   void Update(const void* data, std::size_t size);
   // The 32-byte digest; the object must not be updated afterwards.
   std::array<std::uint8_t, 32> Finish();
 
  private:
-  void Compress(const std::uint8_t* block);
-
-  std::array<std::uint32_t, 8> state_;
-  std::array<std::uint8_t, 64> buffer_;
-  std::size_t buffered_ = 0;
-  std::uint64_t total_bytes_ = 0;
+  evp_md_ctx_st* context_;
 };
 
 // Lower-case hexadecimal digest of `bytes` (64 characters).
