@@ -120,7 +120,9 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   const int channels = static_cast<int>(image.channel_names.size());
   const int rows = image.height * image.depth;  // the atlas
   Imf::Header header(image.width, rows);
-  header.compression() = Imf::ZIP_COMPRESSION;
+  if (image.exr_compression == ExrCompression::kOther) throw InternalError("EXR encode: no compression chosen");
+  header.compression() =
+      image.exr_compression == ExrCompression::kZip ? Imf::ZIP_COMPRESSION : Imf::NO_COMPRESSION;
   const bool half = image.pixel_type == PixelType::kHalf;
   for (const std::string& name : image.channel_names) {
     header.channels().insert(name, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
@@ -181,6 +183,9 @@ TableImage DecodeExr(const std::vector<std::uint8_t>& bytes, const std::string& 
     const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
     const long long rows = static_cast<long long>(window.max.y) - window.min.y + 1;
     if (width <= 0 || rows <= 0) throw IoError(source + ": corrupt EXR: empty data window");
+    image.exr_compression = header.compression() == Imf::ZIP_COMPRESSION ? ExrCompression::kZip
+                            : header.compression() == Imf::NO_COMPRESSION ? ExrCompression::kNone
+                                                                          : ExrCompression::kOther;
     for (auto it = header.begin(); it != header.end(); ++it) {
       if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
         if (std::strncmp(it.name(), "skybake.", 8) == 0) image.metadata[it.name()] = text->value();
@@ -332,7 +337,35 @@ std::string TableImage::StorageName() const {
   if (format == FileFormat::kKtx2) {
     return pixel_type == PixelType::kHalf ? "VK_FORMAT_R16G16B16A16_SFLOAT" : "VK_FORMAT_R32G32B32A32_SFLOAT";
   }
-  return std::string("EXR ") + ToString(pixel_type) + " ZIP";
+  const char* compression = exr_compression == ExrCompression::kZip    ? "ZIP"
+                            : exr_compression == ExrCompression::kNone ? "uncompressed"
+                                                                       : "other compression";
+  return std::string("EXR ") + ToString(pixel_type) + " " + compression;
+}
+
+void ChooseExrCompression(TableImage* image) {
+  if (image->format != FileFormat::kExr) return;
+  constexpr int kBlockRows = 16, kSampleBlocks = 16;  // OpenEXR's ZIP block: 16 scanlines
+  const int rows = image->height * image->depth;
+  const int blocks = (rows + kBlockRows - 1) / kBlockRows;
+  const int step = std::max(1, blocks / kSampleBlocks);
+  TableImage sample;
+  sample.format = FileFormat::kExr;
+  sample.pixel_type = image->pixel_type;
+  sample.width = image->width;
+  sample.channel_names = image->channel_names;
+  const std::size_t row_values = std::size_t(image->width) * image->channel_names.size();
+  for (int block = 0; block < blocks; block += step) {
+    const int first = block * kBlockRows, count = std::min(kBlockRows, rows - first);
+    const auto begin = image->values.begin() + std::ptrdiff_t(first * row_values);
+    sample.values.insert(sample.values.end(), begin, begin + std::ptrdiff_t(count * row_values));
+    sample.height += count;
+  }
+  sample.exr_compression = ExrCompression::kNone;
+  const double stored = double(EncodeExr(sample).size());
+  sample.exr_compression = ExrCompression::kZip;
+  const double zipped = double(EncodeExr(sample).size());
+  image->exr_compression = zipped <= (1.0 - kExrZipMinimumSaving) * stored ? ExrCompression::kZip : ExrCompression::kNone;
 }
 
 std::vector<std::string> StoredChannels(const TableImage& image) {

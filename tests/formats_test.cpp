@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/file_io.h"
 #include "formats/ktx2.h"
 #include "formats/table_file.h"
 #include "formats/table_stats.h"
@@ -144,6 +145,44 @@ TEST(TableFile, ExrAtlasAsAnIndependentReaderSeesIt) {
       }
     }
   }
+}
+
+// ZIP only where it saves at least a tenth: a smooth table (a gradient) is
+// zipped, one of random mantissas is stored uncompressed; both read back bit
+// for bit, an independent reader (OpenImageIO) sees the codec, and the
+// storage name says which.
+TEST(TableFile, ExrIsZippedOnlyWhereItPays) {
+  TempDir dir;
+  TableImage smooth = MakeImage(FileFormat::kExr, PixelType::kFloat, 64, 32, 8, true, 3);
+  for (std::size_t i = 0; i < smooth.values.size(); ++i) smooth.values[i] = float(i / 3 % 64) / 64.0f;
+  TableImage noisy = MakeImage(FileFormat::kExr, PixelType::kFloat, 64, 32, 8, true, 3);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(1.0f, 2.0f);
+  for (float& v : noisy.values) v = uniform(random);
+  struct Case {
+    TableImage* image;
+    ExrCompression expected;
+    const char* oiio_name;
+    const char* storage;
+  };
+  for (const Case& c : {Case{&smooth, ExrCompression::kZip, "zip", "EXR float ZIP"},
+                        Case{&noisy, ExrCompression::kNone, "none", "EXR float uncompressed"}}) {
+    ChooseExrCompression(c.image);
+    EXPECT_EQ(c.image->exr_compression, c.expected) << c.storage;
+    EXPECT_EQ(c.image->StorageName(), c.storage);
+    const fs::path path = dir.path() / (std::string(c.oiio_name) + ".exr");
+    WriteTableImage(path, *c.image);
+    OIIO::ImageBuf buffer(path.string());
+    ASSERT_TRUE(buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT)) << buffer.geterror();
+    EXPECT_EQ(buffer.spec().get_string_attribute("compression"), c.oiio_name);
+    const TableImage back = DecodeTableImage(ReadFileBytes(path), path.string());
+    EXPECT_EQ(back.exr_compression, c.expected);
+    ASSERT_EQ(back.values.size(), c.image->values.size());
+    for (std::size_t i = 0; i < back.values.size(); ++i) ASSERT_TRUE(SameBits(back.values[i], c.image->values[i])) << i;
+  }
+  // The smooth image shrinks; the noisy one is stored at its raw size.
+  EXPECT_LT(fs::file_size(dir.path() / "zip.exr"), 0.5 * smooth.values.size() * 4);
+  EXPECT_GE(fs::file_size(dir.path() / "none.exr"), noisy.values.size() * 4);
 }
 
 // KTX2 3D tables are real 3D textures (pixelDepth = depth), 2D ones have 0.
