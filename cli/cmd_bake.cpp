@@ -34,6 +34,7 @@ struct BakeOptions {
   BakeSettingsOptions bake;
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
+  std::string ktx2_supercompression = "none";
   bool json = false;
   bool quiet = false;
   std::string scene;
@@ -52,6 +53,7 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   job.formats = o.formats;
   job.formats_given = o.format_option != nullptr && o.format_option->count() > 0;
   job.half = o.half;
+  job.ktx2_zstd_level = ParseKtx2Supercompression(o.ktx2_supercompression);
   job.compare_full = o.compare_full;
   job.reference_file = o.reference;
   job.clean = o.clean;
@@ -171,6 +173,8 @@ void AddBakeCommand(CLI::App& app) {
                   "With --compare-full: reference values (skybake reference over a case set with a group column); "
                   "default: the committed one for earth");
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
+  cmd->add_option("--ktx2-supercompression", o->ktx2_supercompression, kKtx2SupercompressionHelp)
+      ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
   cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");
   cmd->callback([o] { RunBake(*o); });

@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "core/errors.h"
 #include "core/file_io.h"
@@ -29,6 +30,7 @@ struct ConvertOptions {
   std::string input;
   std::string output;
   bool half = false;
+  std::string ktx2_supercompression = "none";
   bool to_float = false;
   double floor = kDefaultHalfErrorFloor;
   bool json = false;
@@ -38,6 +40,7 @@ void RunConvert(const ConvertOptions& o) {
   const std::optional<FileFormat> target = FileFormatOfPath(o.output);
   if (!target) throw UsageError(o.output + ": the output name must end in .exr or .ktx2");
   if (o.half && o.to_float) throw UsageError("--half and --float exclude each other");
+  const int zstd_level = ParseKtx2Supercompression(o.ktx2_supercompression);
   if (!(o.floor > 0.0)) throw UsageError("--floor must be positive");
 
   // Writing over a file a manifest lists would leave the set failing its
@@ -69,6 +72,7 @@ void RunConvert(const ConvertOptions& o) {
     for (std::size_t i = 0; i < in.TexelCount(); ++i) out.values[i * channels.size() + c] = in.values[i * in_stride + from];
   }
   ChooseExrCompression(&out);
+  if (out.format == FileFormat::kKtx2) out.ktx2_zstd_level = zstd_level;
   WriteTableImage(o.output, out);
   const std::uint64_t written = fs::file_size(o.output);
 
@@ -114,6 +118,8 @@ void AddConvertCommand(CLI::App& app) {
   cmd->add_option("output", o->output, "Output file (.exr or .ktx2), written atomically")->required();
   cmd->add_flag("--half", o->half, "Store half floats");
   cmd->add_flag("--float", o->to_float, "Store float32");
+  cmd->add_option("--ktx2-supercompression", o->ktx2_supercompression, kKtx2SupercompressionHelp)
+      ->capture_default_str();
   cmd->add_option("--floor", o->floor,
                   "Smallest |value| the half relative error is measured over (default 2^-14, the smallest normal half)");
   cmd->add_flag("--json", o->json, "Print a machine-readable report on stdout");

@@ -1,5 +1,8 @@
 #include "cli/command_line.h"
 
+#include "core/errors.h"
+#include "formats/ktx2.h"
+
 namespace skybake::cli {
 
 namespace {
@@ -28,5 +31,20 @@ void SetCommandLine(int argc, char** argv) {
 }
 
 const std::string& CommandLine() { return Storage(); }
+
+int ParseKtx2Supercompression(const std::string& value) {
+  if (value == "none") return 0;
+  if (value == "zstd") return ktx2::kZstdDefaultLevel;
+  const std::string prefix = "zstd:";
+  if (value.compare(0, prefix.size(), prefix) == 0) {
+    const std::string digits = value.substr(prefix.size());
+    if (!digits.empty() && digits.size() <= 2 && digits.find_first_not_of("0123456789") == std::string::npos) {
+      const int level = std::stoi(digits);
+      if (level >= ktx2::kZstdMinLevel && level <= ktx2::kZstdMaxLevel) return level;
+    }
+  }
+  throw UsageError("--ktx2-supercompression: '" + value + "' is not none, zstd or zstd:LEVEL with LEVEL " +
+                   std::to_string(ktx2::kZstdMinLevel) + " to " + std::to_string(ktx2::kZstdMaxLevel));
+}
 
 }  // namespace skybake::cli

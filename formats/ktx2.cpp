@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include <Imath/half.h>
+#include <zstd.h>
 
 #include "core/errors.h"
 #include "core/file_io.h"
@@ -241,6 +242,57 @@ class Reader {
   const std::string& source_;
 };
 
+// The most a supercompressed level may inflate to: 2 GiB, eight times the
+// largest table skybake bakes in a day's use, so that a small corrupt file
+// cannot make the reader allocate without bound.
+constexpr std::uint64_t kMaxInflatedLevelBytes = std::uint64_t(1) << 31;
+
+// Zstandard (§3.8, scheme notes): one frame holding the whole level.
+std::vector<std::uint8_t> ZstdCompress(const std::vector<std::uint8_t>& data, int level) {
+  if (level < kZstdMinLevel || level > kZstdMaxLevel) {
+    throw InternalError("KTX2 encode: zstd level " + std::to_string(level) + " outside " +
+                        std::to_string(kZstdMinLevel) + ".." + std::to_string(kZstdMaxLevel));
+  }
+  std::vector<std::uint8_t> out(ZSTD_compressBound(data.size()));
+  const std::size_t written = ZSTD_compress(out.data(), out.size(), data.data(), data.size(), level);
+  if (ZSTD_isError(written)) throw InternalError(std::string("KTX2 encode: zstd: ") + ZSTD_getErrorName(written));
+  out.resize(written);
+  return out;
+}
+
+// The level inflated: exactly `length` bytes from Zstandard frames (skippable
+// frames allowed, §3.8 scheme notes), or IoError.
+std::vector<std::uint8_t> ZstdDecompress(const std::uint8_t* data, std::uint64_t size, std::uint64_t length,
+                                         const Reader& reader) {
+  if (length > kMaxInflatedLevelBytes) {
+    reader.Unsupported("level of " + std::to_string(length) + " bytes after inflation (skybake reads up to " +
+                       std::to_string(kMaxInflatedLevelBytes) + ")");
+  }
+  // A first frame that states its content size (zstd's encoder writes it)
+  // must not promise more than the index does, checked before the level's
+  // memory is set aside (further frames may hold the rest).
+  const unsigned long long declared = ZSTD_getFrameContentSize(data, static_cast<std::size_t>(size));
+  if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != ZSTD_CONTENTSIZE_ERROR && declared > length) {
+    reader.Corrupt("level data: its zstd frame declares " + std::to_string(declared) +
+                   " bytes, uncompressedByteLength is " + std::to_string(length));
+  }
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(length));
+  // One byte of room more than expected, so that a level inflating to more
+  // than uncompressedByteLength is told apart from one that fits exactly.
+  out.resize(out.size() + 1);
+  const std::size_t inflated = ZSTD_decompress(out.data(), out.size(), data, static_cast<std::size_t>(size));
+  if (ZSTD_isError(inflated)) {
+    reader.Corrupt(std::string("level data: zstd: ") + ZSTD_getErrorName(inflated));
+  }
+  if (inflated != length) {
+    reader.Corrupt("level data: inflates to " +
+                   (inflated > length ? "more than " + std::to_string(length) : std::to_string(inflated)) +
+                   " bytes, uncompressedByteLength is " + std::to_string(length));
+  }
+  out.resize(static_cast<std::size_t>(length));
+  return out;
+}
+
 }  // namespace
 
 bool IsSupportedFormat(std::uint32_t vk_format) {
@@ -315,10 +367,15 @@ std::vector<std::uint8_t> Encode(const Texture& texture) {
 
   const std::uint64_t dfd_length = 4 * DfdWords(format).size();
   const std::uint64_t kvd_offset = kDfdOffset + dfd_length;  // DFD, then KVD (§2)
-  // No supercompression global data, so the level follows the key/value data
-  // after mipPadding (§3.13.2).
-  const std::uint64_t level_offset = AlignUp(kvd_offset + kvd_length, LevelAlignment(format));
-  const std::uint64_t file_size = level_offset + level_length;
+  const bool zstd = texture.supercompression == Supercompression::kZstd;
+  std::vector<std::uint8_t> deflated;
+  if (zstd) deflated = ZstdCompress(texture.data, texture.zstd_level);
+  const std::uint64_t stored_length = zstd ? deflated.size() : level_length;
+  // No supercompression global data, so the level follows the key/value data,
+  // after mipPadding only without supercompression (§3.13.2: a deflated level
+  // is aligned to 1).
+  const std::uint64_t level_offset = AlignUp(kvd_offset + kvd_length, zstd ? 1 : LevelAlignment(format));
+  const std::uint64_t file_size = level_offset + stored_length;
   if (kvd_length > std::numeric_limits<std::uint32_t>::max() || file_size < level_offset) {
     throw InputError("KTX2 encode: key/value data or level too large");
   }
@@ -333,7 +390,7 @@ std::vector<std::uint8_t> Encode(const Texture& texture) {
   PutU32(out, 32, 0);                                                                // layerCount: not an array
   PutU32(out, 36, 1);                                                                // faceCount: not a cubemap
   PutU32(out, 40, 1);                                                                // levelCount (see ktx2.h)
-  PutU32(out, 44, 0);                                                                // supercompressionScheme
+  PutU32(out, 44, static_cast<std::uint32_t>(texture.supercompression));            // supercompressionScheme
   PutU32(out, 48, static_cast<std::uint32_t>(kDfdOffset));                           // dfdByteOffset
   PutU32(out, 52, static_cast<std::uint32_t>(dfd_length));                           // dfdByteLength
   PutU32(out, 56, kvd_length ? static_cast<std::uint32_t>(kvd_offset) : 0);          // kvdByteOffset
@@ -341,7 +398,7 @@ std::vector<std::uint8_t> Encode(const Texture& texture) {
   PutU64(out, 64, 0);                                                                // sgdByteOffset
   PutU64(out, 72, 0);                                                                // sgdByteLength
   PutU64(out, kHeaderSize + 0, level_offset);                                        // levels[0].byteOffset
-  PutU64(out, kHeaderSize + 8, level_length);                                        // levels[0].byteLength
+  PutU64(out, kHeaderSize + 8, stored_length);                                       // levels[0].byteLength
   PutU64(out, kHeaderSize + 16, level_length);                                       // .uncompressedByteLength
 
   std::size_t at = kDfdOffset;
@@ -356,7 +413,8 @@ std::vector<std::uint8_t> Encode(const Texture& texture) {
     std::memcpy(out.data() + at + 4 + key.size() + 1, value.data(), value.size());
     at += 4 + static_cast<std::size_t>(AlignUp(entry_length, 4));  // NULs and padding stay 0
   }
-  if (level_length) std::memcpy(out.data() + level_offset, texture.data.data(), texture.data.size());
+  const std::vector<std::uint8_t>& stored = zstd ? deflated : texture.data;
+  if (!stored.empty()) std::memcpy(out.data() + level_offset, stored.data(), stored.size());
   return out;
 }
 
@@ -394,7 +452,12 @@ Texture Decode(const std::vector<std::uint8_t>& bytes, const std::string& source
   const std::uint64_t sgd_length = GetU64(bytes, 72);
 
   // Header fields (§3.2-§3.8, §4.1).
-  if (supercompression != 0) reader.Unsupported("supercompressionScheme " + std::to_string(supercompression));
+  if (supercompression != static_cast<std::uint32_t>(Supercompression::kNone) &&
+      supercompression != static_cast<std::uint32_t>(Supercompression::kZstd)) {
+    reader.Unsupported("supercompressionScheme " + std::to_string(supercompression) +
+                       " (skybake reads 0, none, and 2, Zstandard)");
+  }
+  const bool zstd = supercompression == static_cast<std::uint32_t>(Supercompression::kZstd);
   if (!IsSupportedFormat(vk_format)) {
     reader.Unsupported("vkFormat " + std::to_string(vk_format) +
                        " (skybake reads VK_FORMAT_R16_SFLOAT, VK_FORMAT_R32_SFLOAT, "
@@ -515,16 +578,16 @@ Texture Decode(const std::vector<std::uint8_t>& bytes, const std::string& source
     reader.Corrupt("header: " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(depth) +
                    " texture size overflows");
   }
-  if (level_uncompressed_length != level_length) {
+  if (!zstd && level_uncompressed_length != level_length) {
     reader.Corrupt("level index: uncompressedByteLength " + std::to_string(level_uncompressed_length) +
                    " differs from byteLength " + std::to_string(level_length));
   }
-  if (level_length != expected_level_length) {
-    reader.Corrupt("level index: byteLength " + std::to_string(level_length) + ", expected " +
-                   std::to_string(expected_level_length) + " for " + std::to_string(width) + "x" +
+  if (level_uncompressed_length != expected_level_length) {
+    reader.Corrupt("level index: uncompressedByteLength " + std::to_string(level_uncompressed_length) +
+                   ", expected " + std::to_string(expected_level_length) + " for " + std::to_string(width) + "x" +
                    std::to_string(height) + "x" + std::to_string(depth) + " " + FormatName(format));
   }
-  const std::uint64_t expected_level_offset = AlignUp(kvd_end, LevelAlignment(format));
+  const std::uint64_t expected_level_offset = AlignUp(kvd_end, zstd ? 1 : LevelAlignment(format));
   if (level_offset != expected_level_offset) {
     reader.Corrupt("level index: byteOffset " + std::to_string(level_offset) + ", expected " +
                    std::to_string(expected_level_offset));
@@ -537,7 +600,12 @@ Texture Decode(const std::vector<std::uint8_t>& bytes, const std::string& source
   if (size != level_offset + level_length) {
     reader.Corrupt("file: " + std::to_string(size - level_offset - level_length) + " bytes after the level data");
   }
-  texture.data.assign(bytes.begin() + static_cast<std::ptrdiff_t>(level_offset), bytes.end());
+  if (zstd) {
+    texture.supercompression = Supercompression::kZstd;
+    texture.data = ZstdDecompress(bytes.data() + level_offset, level_length, level_uncompressed_length, reader);
+  } else {
+    texture.data.assign(bytes.begin() + static_cast<std::ptrdiff_t>(level_offset), bytes.end());
+  }
   return texture;
 }
 

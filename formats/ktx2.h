@@ -4,8 +4,9 @@
 // comments refer to the KTX 2.0 specification unless marked "KDF".
 //
 // Scope: uncompressed float textures, one mip level, no arrays, no cubemaps,
-// no supercompression. 2D textures have depth 0; 3D textures (the 4D
-// inscatter table is stored as one) have depth > 0.
+// stored as is or supercompressed with Zstandard (§3.8 scheme 2, RFC 8478).
+// 2D textures have depth 0; 3D textures (the 4D inscatter table is stored as
+// one) have depth > 0.
 //
 // Encode writes levelCount = 1 (not 0): §3.7 gives 1 the meaning "only the
 // base level, and the texture isn't meant to have other levels", naming a LUT
@@ -43,6 +44,14 @@ inline constexpr const char kWriterKey[] = "KTXwriter";
 inline constexpr const char kOrientationKey[] = "KTXorientation";
 inline constexpr const char kSkybakeKeyPrefix[] = "skybake.";
 
+// supercompressionScheme values (§3.8) skybake writes and reads.
+enum class Supercompression : std::uint32_t { kNone = 0, kZstd = 2 };
+// Zstandard's levels (1 fastest ... 22 smallest) and the one used where none
+// is named, zstd's own default: on the default set's float tables the
+// levels up to 15 store within 1 % of each other, and 3 takes about 0.2 s
+// per 16.8 MB table where 19 takes 20 s for 3 % less.
+inline constexpr int kZstdMinLevel = 1, kZstdMaxLevel = 22, kZstdDefaultLevel = 3;
+
 struct Texture {
   VkFormat format = VkFormat::kR32G32B32A32Sfloat;
   std::uint32_t width = 0, height = 0, depth = 0;  // depth 0 = 2D texture
@@ -54,6 +63,10 @@ struct Texture {
   // unless present; other keys must start with "skybake.". Decode returns
   // every key in the file, each value without its terminating NUL.
   std::map<std::string, std::string> key_values;
+  // How the level is stored in the file: Encode compresses `data` (always
+  // the inflated level) at zstd_level; Decode inflates it and says which.
+  Supercompression supercompression = Supercompression::kNone;
+  int zstd_level = kZstdDefaultLevel;
 
   bool Is3D() const { return depth > 0; }
   // Number of texels in level 0: width * height * max(1, depth).
@@ -68,7 +81,8 @@ std::vector<std::uint8_t> Encode(const Texture& texture);
 
 // Parses and validates a whole file image: identifier, header, index offsets
 // and lengths against the file size, the DFD against the format, the level
-// size against the dimensions, the key/value data, the padding. Throws
+// size against the dimensions (after inflation: one complete Zstandard frame
+// of exactly uncompressedByteLength bytes), the key/value data, the padding. Throws
 // IoError "<source_name>: not a KTX2 file", "...: truncated ...",
 // "...: corrupt ..." or "...: unsupported ..." (a valid KTX2 file outside the
 // scope above). Never reads outside `bytes`.

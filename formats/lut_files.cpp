@@ -35,6 +35,11 @@ FileFormat ChooseFormat(const Manifest& manifest, const std::vector<TableDescrip
   return manifest.table_files.empty() ? FileFormat::kExr : manifest.table_files.front().format;
 }
 
+bool IsHalf(const TableDescription& table, const WriteOptions& options) {
+  return options.half ||
+         std::find(options.half_tables.begin(), options.half_tables.end(), table.name) != options.half_tables.end();
+}
+
 // The staged writing of WriteLutSet.
 WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescription>& tables, const fs::path& dir,
                            const WriteOptions& options) {
@@ -50,20 +55,13 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   struct Encoded {
     const TableDescription* table;
     FileFormat format;
-    PixelType type;
     TableImage image;
     std::vector<std::uint8_t> bytes;
     std::string sha256;
   };
   std::vector<Encoded> files;
-  auto is_half = [&](const TableDescription& table) {
-    return options.half ||
-           std::find(options.half_tables.begin(), options.half_tables.end(), table.name) != options.half_tables.end();
-  };
   for (const TableDescription& table : tables) {
-    for (FileFormat format : options.formats) {
-      files.push_back({&table, format, is_half(table) ? PixelType::kHalf : PixelType::kFloat, {}, {}, {}});
-    }
+    for (FileFormat format : options.formats) files.push_back({&table, format, {}, {}, {}});
   }
   // One file per task (the default partitioner would hand both large EXR
   // files, neighbours in the list, to the same thread).
@@ -72,7 +70,7 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           Encoded& f = files[i];
-          f.image = MakeTableImage(luts, *f.table, f.format, f.type);
+          f.image = MakeTableFileImage(luts, *f.table, f.format, options);
           f.bytes = EncodeTableImage(f.image);
           f.sha256 = Sha256Hex(f.bytes.data(), f.bytes.size());
         }
@@ -86,7 +84,7 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
     f.bytes = {}, f.image = {};
   }
   for (const TableDescription& table : tables) {
-    if (is_half(table)) {
+    if (IsHalf(table, options)) {
       const TableImage image = MakeTableImage(luts, table, options.formats.front(), PixelType::kFloat);
       report.half_errors.emplace_back(table.name, MeasureHalfError(image.values));
     }
@@ -140,6 +138,13 @@ std::vector<std::string> StaleFiles(const fs::path& dir, const std::vector<std::
 }
 
 }  // namespace
+
+TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table, FileFormat format,
+                              const WriteOptions& options) {
+  TableImage image = MakeTableImage(luts, table, format, IsHalf(table, options) ? PixelType::kHalf : PixelType::kFloat);
+  if (format == FileFormat::kKtx2) image.ktx2_zstd_level = options.ktx2_zstd_level;
+  return image;
+}
 
 WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOptions& options) {
   if (options.formats.empty()) throw InternalError("WriteLutSet: no file format requested");

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "formats/lut_tables.h"
 #include "formats/table_file.h"
 #include "formats/table_stats.h"
 
@@ -33,6 +34,8 @@ struct WriteOptions {
   std::vector<FileFormat> formats = {FileFormat::kExr, FileFormat::kKtx2};
   bool half = false;          // store half floats instead of float32
   std::vector<std::string> half_tables;  // tables stored as half even without `half` (a scene's precision)
+  // KTX2 files Zstandard-supercompressed at this level (1-22), 0: stored as is.
+  int ktx2_zstd_level = 0;
   std::string command_line;   // recorded in the manifest
   std::vector<ShaderFile> shaders;  // written and listed under "shaders"
   // Remove the files of an earlier set in the directory that the new set does
@@ -61,6 +64,11 @@ struct WriteReport {
 // the new set does not list (see WriteOptions::clean; anything that no
 // earlier skybake set listed is never removed).
 WriteReport WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
+
+// The image of `table` that WriteLutSet encodes into its `format` file: the
+// pixel type and KTX2 supercompression `options` ask for.
+TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table, FileFormat format,
+                              const WriteOptions& options);
 
 struct LoadOptions {
   // The format to read. Unset: KTX2 if the manifest lists it for every table

@@ -278,6 +278,10 @@ std::vector<std::uint8_t> EncodeKtx2(const TableImage& image) {
   texture.data = ktx2::PackFloats(texture.format, rgba);
   texture.key_values = image.metadata;
   texture.key_values[kSizeKey] = SizeString(image.width, image.height, image.depth, image.is_3d);
+  if (image.ktx2_zstd_level != 0) {
+    texture.supercompression = ktx2::Supercompression::kZstd;
+    texture.zstd_level = image.ktx2_zstd_level;
+  }
   return ktx2::Encode(texture);
 }
 
@@ -290,6 +294,7 @@ TableImage DecodeKtx2(const std::vector<std::uint8_t>& bytes, const std::string&
   TableImage image;
   image.format = FileFormat::kKtx2;
   image.pixel_type = ktx2::BytesPerChannel(texture.format) == 2 ? PixelType::kHalf : PixelType::kFloat;
+  if (texture.supercompression == ktx2::Supercompression::kZstd) image.ktx2_zstd_level = ktx2::kZstdDefaultLevel;
   image.is_3d = texture.Is3D();
   if (texture.TexelCount() * 4 > kMaxValues) {
     throw IoError(source + ": KTX2 texture larger than skybake reads");
@@ -335,7 +340,9 @@ std::optional<FileFormat> FileFormatOfPath(const fs::path& path) {
 
 std::string TableImage::StorageName() const {
   if (format == FileFormat::kKtx2) {
-    return pixel_type == PixelType::kHalf ? "VK_FORMAT_R16G16B16A16_SFLOAT" : "VK_FORMAT_R32G32B32A32_SFLOAT";
+    return std::string(pixel_type == PixelType::kHalf ? "VK_FORMAT_R16G16B16A16_SFLOAT"
+                                                      : "VK_FORMAT_R32G32B32A32_SFLOAT") +
+           (ktx2_zstd_level != 0 ? ", zstd" : "");
   }
   const char* compression = exr_compression == ExrCompression::kZip    ? "ZIP"
                             : exr_compression == ExrCompression::kNone ? "uncompressed"

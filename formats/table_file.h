@@ -70,10 +70,15 @@ struct TableImage {
   Metadata metadata;
   // OpenEXR only: as decoded, or as ChooseExrCompression set it for writing.
   ExrCompression exr_compression = ExrCompression::kZip;
+  // KTX2 only: the level stored as is (0) or Zstandard-supercompressed at
+  // this level (1-22, ktx2::kZstd*Level); a decoded zstd file reads
+  // ktx2::kZstdDefaultLevel, the level itself not being recorded.
+  int ktx2_zstd_level = 0;
 
   std::size_t TexelCount() const { return std::size_t(width) * height * depth; }
-  // "VK_FORMAT_R32G32B32A32_SFLOAT" for KTX2; for OpenEXR "EXR float ZIP" or
-  // "EXR float uncompressed" (half likewise).
+  // "VK_FORMAT_R32G32B32A32_SFLOAT" (", zstd" appended when supercompressed)
+  // for KTX2; for OpenEXR "EXR float ZIP" or "EXR float uncompressed" (half
+  // likewise).
   std::string StorageName() const;
 };
 

@@ -41,11 +41,8 @@ __attribute__((format(printf, 2, 3))) void Append(std::string* out, const char* 
 std::uint64_t TableFileBytes(const LutSet& luts, const WriteOptions& options) {
   std::uint64_t bytes = 0;
   for (const TableDescription& table : DescribeTables(luts)) {
-    const bool half = options.half || std::find(options.half_tables.begin(), options.half_tables.end(),
-                                                table.name) != options.half_tables.end();
     for (FileFormat format : options.formats) {
-      bytes += EncodeTableImage(MakeTableImage(luts, table, format, half ? PixelType::kHalf : PixelType::kFloat))
-                   .size();
+      bytes += EncodeTableImage(MakeTableFileImage(luts, table, format, options)).size();
     }
   }
   return bytes;
@@ -216,6 +213,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   WriteOptions write_options;
   write_options.formats = ParseFormats(out.formats);
   write_options.half = job.half;
+  write_options.ktx2_zstd_level = job.ktx2_zstd_level;
   if (scene) write_options.half_tables = SceneHalfTables(scene->scene);
   write_options.command_line = job.command_line;
   write_options.clean = job.clean;

@@ -29,6 +29,7 @@ struct BakeJob {
   std::vector<std::string> formats = {"exr", "ktx2"};  // file formats by name; a scene names its own
   bool formats_given = false;  // the formats were asked for, which a scene refuses
   bool half = false;           // every table as half floats
+  int ktx2_zstd_level = 0;     // WriteOptions::ktx2_zstd_level
   bool compare_full = false;   // with a scene: also bake the full set (not written) and compare
   std::string reference_file;  // with compare_full; empty: the committed one (earth only)
   bool runtime = true;         // write the GLSL runtime (shaders_runtime/snippet.h) beside the tables

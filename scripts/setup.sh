@@ -8,7 +8,7 @@ packages=(
   libopenexr-dev openexr
   libopenimageio-dev openimageio-tools
   libceres-dev libglm-dev libtbb-dev
-  libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libssl-dev
+  libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libssl-dev libzstd-dev
   libgtest-dev libbenchmark-dev
   glslang-tools fonts-dejavu-core
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri

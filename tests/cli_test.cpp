@@ -82,6 +82,18 @@ TEST(CliBake, BakeErrors) {
   EXPECT_EQ(Lines(err).size(), 1u) << err;
   EXPECT_EQ(RunCommand(Skybake() + " bake no-such-atmosphere -o " + ShellQuote(dir.path() / "x"), dir), 3);
   EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + " --orders 0", dir), 1);
+  // A supercompression that is not none, zstd or zstd:1..22: a usage error
+  // naming the option, before anything is baked or written.
+  for (const char* value : {"zstd:0", "zstd:23", "zstd:", "zlib", "zstd:3x"}) {
+    EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "y") +
+                             " --ktx2-supercompression " + value + kSmallBake,
+                         dir, nullptr, &err),
+              1)
+        << value;
+    EXPECT_EQ(Lines(err).size(), 1u) << err;
+    EXPECT_NE(err.find("--ktx2-supercompression"), std::string::npos) << err;
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "y"));
 }
 
 class EvalTest : public ::testing::Test {

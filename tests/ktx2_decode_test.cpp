@@ -195,7 +195,7 @@ TEST(Ktx2Decode, ReportsValidButUnsupportedFilesAsUnsupported) {
   };
   Bytes g;
   g = f, SetU32(g, 40, 3), expect_unsupported(g, "3 mip levels");
-  g = f, SetU32(g, 44, 2), expect_unsupported(g, "supercompressionScheme 2");
+  g = f, SetU32(g, 44, 3), expect_unsupported(g, "supercompressionScheme 3");  // ZLIB
   g = f, SetU32(g, 12, 37), expect_unsupported(g, "vkFormat 37");
   g = f, SetU32(g, 32, 2), expect_unsupported(g, "array");
   g = f, SetU32(g, 36, 6), expect_unsupported(g, "cubemap");

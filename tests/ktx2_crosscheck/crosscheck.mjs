@@ -1,5 +1,6 @@
-// Cross-checks skybake's KTX2 writer with an independent parser, ktx-parse
-// (pinned in package.json / package-lock.json).
+// Cross-checks skybake's KTX2 writer with an independent parser, ktx-parse,
+// and an independent Zstandard decoder, fzstd (both pinned in package.json /
+// package-lock.json).
 //
 //   node crosscheck.mjs --tests-exe <skybake_tests> --skybake-exe <skybake> --work-dir <dir>
 //
@@ -17,7 +18,9 @@
 //    SHA-256 and size against the manifest (node:crypto), header and DFD as
 //    above, the key/value data against the manifest's description of the
 //    table, every texel finite and non-negative (decoded here, halves too),
-//    and ktx-parse's byte-for-byte re-serialisation.
+//    and ktx-parse's byte-for-byte re-serialisation. One set is
+//    zstd-supercompressed (--ktx2-supercompression): its levels, inflated by
+//    an independent decoder (fzstd), must equal the float set's bytes.
 //
 // Exit codes: 0 all agree, 1 a disagreement or error, 77 skipped because npm
 // or the npm registry is unavailable (ctest SKIP_RETURN_CODE).
@@ -70,17 +73,18 @@ const NETWORK_ERROR = /ENOTFOUND|EAI_AGAIN|ECONNREFUSED|ECONNRESET|ETIMEDOUT|ENE
 
 function installParser(workDir) {
   const here = path.dirname(fileURLToPath(import.meta.url));
-  const pinned = JSON.parse(fs.readFileSync(path.join(here, 'package.json'), 'utf8')).dependencies['ktx-parse'];
+  const dependencies = JSON.parse(fs.readFileSync(path.join(here, 'package.json'), 'utf8')).dependencies;
+  const pinned = dependencies['ktx-parse'];
   for (const file of ['package.json', 'package-lock.json']) {
     const source = fs.readFileSync(path.join(here, file));
     const target = path.join(workDir, file);
     if (!fs.existsSync(target) || !fs.readFileSync(target).equals(source)) fs.writeFileSync(target, source);
   }
-  const installedManifest = path.join(workDir, 'node_modules', 'ktx-parse', 'package.json');
-  const installed = fs.existsSync(installedManifest)
-    ? JSON.parse(fs.readFileSync(installedManifest, 'utf8')).version
-    : null;
-  if (installed !== pinned) {
+  const installedVersion = (name) => {
+    const manifest = path.join(workDir, 'node_modules', name, 'package.json');
+    return fs.existsSync(manifest) ? JSON.parse(fs.readFileSync(manifest, 'utf8')).version : null;
+  };
+  if (Object.entries(dependencies).some(([name, version]) => installedVersion(name) !== version)) {
     const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
     const run = spawnSync(npm, ['ci', '--no-audit', '--no-fund', '--loglevel=error', '--fetch-retries=1'], {
       cwd: workDir,
@@ -99,9 +103,12 @@ function installParser(workDir) {
   return pinned;
 }
 
+// ktx-parse, with fzstd's Zstandard decoder as parser.inflateZstd.
 async function importParser(workDir) {
   const require = createRequire(path.join(workDir, 'package.json'));
-  return import(pathToFileURL(require.resolve('ktx-parse')).href);
+  const parser = await import(pathToFileURL(require.resolve('ktx-parse')).href);
+  const fzstd = await import(pathToFileURL(require.resolve('fzstd')).href);
+  return { ...parser, inflateZstd: fzstd.decompress };
 }
 
 // --- What the specifications require for skybake's four formats -----------
@@ -264,6 +271,8 @@ function halfToFloat(h) {
   return sign * (1 + m / 1024) * 2 ** (e - 15);
 }
 
+// Checks one KTX2 file of a baked set; returns its level, inflated where the
+// file is zstd-supercompressed.
 function checkBakedFile(parser, setDir, manifest, table, entry, problems) {
   const problem = (what) => problems.push(`${path.basename(setDir)}/${entry.file}: ${what}`);
   const expectEqual = (what, actual, expected) => {
@@ -281,8 +290,9 @@ function checkBakedFile(parser, setDir, manifest, table, entry, problems) {
     container = parser.read(bytes);
   } catch (error) {
     problem(`ktx-parse cannot read it: ${error.message}`);
-    return;
+    return null;
   }
+  const zstd = entry.storage.endsWith(', zstd');
   const half = entry.pixel_type === 'half';
   const vkFormat = half ? 97 : 109;
   const format = FORMATS[vkFormat];
@@ -295,7 +305,9 @@ function checkBakedFile(parser, setDir, manifest, table, entry, problems) {
   expectEqual('layerCount', container.layerCount, 0);
   expectEqual('faceCount', container.faceCount, 1);
   expectEqual('levelCount', container.levelCount, 1);
-  expectEqual('supercompressionScheme', container.supercompressionScheme, 0);
+  // KTX 2.0 supercompressionScheme: 2 is Zstandard; the DFD keeps the
+  // pre-deflation values (bytesPlane included).
+  expectEqual('supercompressionScheme', container.supercompressionScheme, zstd ? 2 : 0);
   const expectedDescriptor = expectedDfd(format);
   const dfd = container.dataFormatDescriptor[0] || {};
   for (const field of Object.keys(expectedDescriptor)) expectEqual(`DFD ${field}`, dfd[field], expectedDescriptor[field]);
@@ -334,13 +346,23 @@ function checkBakedFile(parser, setDir, manifest, table, entry, problems) {
   const bytesPerTexel = (format.channels * format.bits) / 8;
   if (!level) {
     problem('no level');
-    return;
+    return null;
   }
-  expectEqual('level byteLength', level.levelData.byteLength, texels * bytesPerTexel);
-  const view = new DataView(level.levelData.buffer, level.levelData.byteOffset, level.levelData.byteLength);
+  expectEqual('level uncompressedByteLength', level.uncompressedByteLength, texels * bytesPerTexel);
+  let data = level.levelData;
+  if (zstd) {
+    try {
+      data = parser.inflateZstd(level.levelData);
+    } catch (error) {
+      problem(`fzstd cannot inflate the level: ${error.message}`);
+      return null;
+    }
+  }
+  expectEqual('level bytes (inflated)', data.byteLength, texels * bytesPerTexel);
+  const view = new DataView(data.buffer, data.byteOffset, data.byteLength);
   const meaningful = table.channels.length;
   let bad = 0;
-  for (let i = 0; i < texels * 4 && (i + 1) * (format.bits / 8) <= level.levelData.byteLength; i++) {
+  for (let i = 0; i < texels * 4 && (i + 1) * (format.bits / 8) <= data.byteLength; i++) {
     const value = half ? halfToFloat(view.getUint16(i * 2, true)) : view.getFloat32(i * 4, true);
     const padding = i % 4 >= meaningful;
     if (!Number.isFinite(value) || value < 0 || (padding && value !== 0)) {
@@ -352,30 +374,46 @@ function checkBakedFile(parser, setDir, manifest, table, entry, problems) {
   const rewritten = parser.write(container, { keepWriter: true });
   const at = compareBytes(rewritten, bytes);
   if (at >= 0) problem(`ktx-parse re-serialises it differently from byte ${at}`);
+  return data;
 }
 
 function checkBakedSets(parser, skybakeExe, workDir) {
   const bakedDir = path.join(workDir, 'baked');
   fs.rmSync(bakedDir, { recursive: true, force: true });
-  const variants = { float: [], half: ['--half'], 'pack-mie': ['--pack-mie'] };
+  const variants = {
+    float: [],
+    half: ['--half'],
+    'pack-mie': ['--pack-mie'],
+    zstd: ['--ktx2-supercompression', 'zstd:9'],
+  };
   const problems = [];
+  const levels = {};  // variant -> table -> level bytes (inflated)
   let files = 0;
   for (const [name, extra] of Object.entries(variants)) {
     const setDir = path.join(bakedDir, name);
     bake(skybakeExe, setDir, extra);
     const manifest = JSON.parse(fs.readFileSync(path.join(setDir, 'skybake.json'), 'utf8'));
+    levels[name] = {};
     for (const table of manifest.tables) {
       for (const entry of table.files) {
         if (entry.format !== 'ktx2') continue;
         const before = problems.length;
-        checkBakedFile(parser, setDir, manifest, table, entry, problems);
+        levels[name][table.name] = checkBakedFile(parser, setDir, manifest, table, entry, problems);
         files++;
         console.log(`${problems.length === before ? 'ok  ' : 'FAIL'} baked/${name}/${entry.file}`);
       }
     }
   }
-  // float and half: four tables each; packed single Mie: three.
-  if (files !== 11) problems.push(`expected 11 KTX2 files in the baked sets' manifests, found ${files}`);
+  // float, half and zstd: four tables each; packed single Mie: three.
+  if (files !== 15) problems.push(`expected 15 KTX2 files in the baked sets' manifests, found ${files}`);
+  // The same bake with and without supercompression: the inflated levels are
+  // the float set's bytes exactly.
+  for (const [tableName, level] of Object.entries(levels.zstd)) {
+    const plain = levels.float[tableName];
+    if (level && plain && compareBytes(level, plain) >= 0) {
+      problems.push(`baked/zstd/${tableName}.ktx2: inflated level differs from the float set's at byte ${compareBytes(level, plain)}`);
+    }
+  }
   return { problems, files };
 }
 
@@ -400,7 +438,7 @@ async function main() {
   const baked = checkBakedSets(parser, path.resolve(args['skybake-exe']), workDir);
   problems.push(...baked.problems);
   if (problems.length > 0) fail(`ktx-parse ${version} disagrees:\n  ${problems.join('\n  ')}`);
-  console.log(`ktx2 cross-check: ${manifest.length} sample files and ${baked.files} baked files read by ktx-parse ${version}; header, DFD, key/value data and level agree, and ktx-parse re-serialises them byte for byte`);
+  console.log(`ktx2 cross-check: ${manifest.length} sample files and ${baked.files} baked files read by ktx-parse ${version}; header, DFD, key/value data and level agree (zstd levels inflated by fzstd equal the uncompressed bake's), and ktx-parse re-serialises them byte for byte`);
 }
 
 main().catch((error) => fail(error.stack || String(error)));
