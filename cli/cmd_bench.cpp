@@ -1,18 +1,22 @@
 // `skybake bench`: times each phase of a bake (files written included) over
 // several runs and reports medians and the peak resident memory, optionally
 // with the cost of scaling the work (each table axis doubled, orders 1-8,
-// 1 vs 2 threads). docs/benchmark.md holds its table (scripts/bench.sh).
+// 1, 2 and all threads), each with its own peak memory. docs/benchmark.md
+// holds its table (scripts/bench.sh).
+#include <malloc.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -47,11 +51,26 @@ double Median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// Peak resident memory of this process so far (Linux reports KiB).
+// Peak resident memory of this process since the last ResetPeakResident
+// (Linux: VmHWM of /proc/self/status, in kB); getrusage's maximum as a
+// fallback.
 double PeakResidentMiB() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.compare(0, 6, "VmHWM:") == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;
+}
+
+// Returns the memory freed so far to the system (the bake's allocator keeps
+// it otherwise, cli/main.cpp) and restarts the peak resident set size at the
+// current one (Linux's /proc/self/clear_refs "5"), so that each
+// configuration's peak is its own.
+void ResetPeakResident() {
+  malloc_trim(0);
+  std::ofstream("/proc/self/clear_refs") << "5";
 }
 
 // Per-phase seconds of `runs` bakes of one configuration, files written.
@@ -102,7 +121,11 @@ std::vector<Variant> ScalingVariants() {
   for (int orders = 1; orders <= 8; ++orders) {
     v.push_back({"orders " + std::to_string(orders), [orders](BakeSettings& s) { s.orders = orders; }});
   }
-  for (int threads = 1; threads <= 2; ++threads) {
+  // 1, 2 and, where the machine has more, all its cores.
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<int> thread_counts = {1, 2};
+  if (cores > 2) thread_counts.push_back(cores);
+  for (int threads : thread_counts) {
     v.push_back({"threads " + std::to_string(threads), [threads](BakeSettings& s) { s.threads = threads; }});
   }
   return v;
@@ -118,20 +141,22 @@ void RunBench(const BenchOptions& o) {
   const std::filesystem::path dir = scratch ? scratch->path() : std::filesystem::path(o.output_dir);
   EnsureWritableDirectory(dir);
 
+  ResetPeakResident();
   Measurement base = Measure(atmosphere, settings, o.runs, dir);
-  // Taken before the scaling runs, whose larger tables would raise it.
-  double peak_mib = PeakResidentMiB();
-  double base_total = Median(base.seconds["total"]);
+  const double peak_mib = PeakResidentMiB();
+  const double base_total = Median(base.seconds["total"]);
 
   std::vector<std::pair<std::string, BakeSettings>> variants;
-  std::vector<double> variant_totals;
+  std::vector<double> variant_totals, variant_peaks;
   if (o.scaling) {
     for (const Variant& v : ScalingVariants()) {
       BakeSettings changed = settings;
       v.change(changed);
       changed.Validate();
       variants.emplace_back(v.name, changed);
+      ResetPeakResident();
       variant_totals.push_back(Median(Measure(atmosphere, changed, o.runs, dir).seconds["total"]));
+      variant_peaks.push_back(PeakResidentMiB());
     }
   }
 
@@ -144,7 +169,8 @@ void RunBench(const BenchOptions& o) {
     for (size_t i = 0; i < variants.size(); ++i) {
       scaling.push_back({{"variant", variants[i].first},
                          {"settings", DescribeSettings(variants[i].second, SettingsDetail::kOrdersAndThreads)},
-                         {"median_seconds", variant_totals[i]}});
+                         {"median_seconds", variant_totals[i]},
+                         {"peak_resident_mib", variant_peaks[i]}});
     }
     nlohmann::json j = {{"atmosphere", atmosphere.name},
                         {"settings", DescribeSettings(settings, SettingsDetail::kOrdersAndThreads)},
@@ -166,10 +192,10 @@ void RunBench(const BenchOptions& o) {
   }
   std::printf("| **total** | **%.3f** |\n\npeak resident memory: %.0f MiB\n", base_total, peak_mib);
   if (o.scaling) {
-    std::printf("\n| variant | median total (s) | x base |\n|---|---:|---:|\n");
+    std::printf("\n| variant | median total (s) | x base | peak memory (MiB) | x base |\n|---|---:|---:|---:|---:|\n");
     for (size_t i = 0; i < variants.size(); ++i) {
-      std::printf("| %s | %.3f | %.2f |\n", variants[i].first.c_str(), variant_totals[i],
-                  variant_totals[i] / base_total);
+      std::printf("| %s | %.3f | %.2f | %.0f | %.2f |\n", variants[i].first.c_str(), variant_totals[i],
+                  variant_totals[i] / base_total, variant_peaks[i], variant_peaks[i] / peak_mib);
     }
   }
 }
@@ -184,7 +210,7 @@ void AddBenchCommand(CLI::App& app) {
   cmd->add_option("--runs", o->runs, "Bakes per configuration; medians are reported")->capture_default_str();
   o->bake.AddTo(cmd);
   cmd->add_flag("--scaling", o->scaling,
-                "Also time each table axis doubled, orders 1 to 8, and 1 and 2 threads (total time only)");
+                "Also time each table axis doubled, orders 1 to 8, and 1, 2 and all threads (total time and peak memory)");
   cmd->add_option("-o,--output", o->output_dir,
                   "Directory the bakes write to (default: a temporary one, removed afterwards)");
   cmd->add_flag("--json", o->json, "Print the figures as JSON instead of Markdown tables");

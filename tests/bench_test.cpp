@@ -2,6 +2,9 @@
 // speed targets live in docs/benchmark.md, measured by scripts/bench.sh).
 #include <gtest/gtest.h>
 
+#include <map>
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "test_util.h"
@@ -47,6 +50,26 @@ TEST(CliBench, JsonHasMediansPerPhaseAndPeakMemory) {
   EXPECT_GT(phase_sum, 0.0);
   EXPECT_GT(j["peak_resident_mib"].get<double>(), 1.0);
   EXPECT_TRUE(j["scaling"].empty());
+}
+
+// Each scaling configuration's peak memory is its own: a doubled scattering
+// axis raises it, and the smaller configurations measured after it (orders 1)
+// do not inherit it.
+TEST(CliBench, ScalingMeasuresEachConfigurationsOwnPeakMemory) {
+  TempDir dir;
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + " bench earth --runs 1 --scaling --json --scattering-size 16 64 16 4 "
+                                   "--transmittance-size 64 16 --irradiance-size 16 4 --ray-samples 32",
+                       dir, &out, &err),
+            0)
+      << err;
+  const nlohmann::json j = nlohmann::json::parse(out);
+  std::map<std::string, double> peak;
+  for (const auto& row : j["scaling"]) peak[row["variant"].get<std::string>()] = row["peak_resident_mib"].get<double>();
+  const double base = j["peak_resident_mib"].get<double>();
+  ASSERT_TRUE(peak.count("scattering r x2") && peak.count("orders 1") && peak.count("threads 1")) << out;
+  EXPECT_GT(peak["scattering r x2"], 1.15 * base) << out;
+  EXPECT_LT(peak["orders 1"], peak["scattering r x2"]) << out;
 }
 
 TEST(CliBench, Errors) {
