@@ -66,13 +66,15 @@ int Fail(bool json, skybake::ExitCode code, const std::string& message, const sk
   return static_cast<int>(code);
 }
 
-// A bake allocates and frees tables of 4 to 17 MiB in every phase. glibc
-// serves blocks above 128 KiB with their own mmap and unmaps them when they
-// are freed, so every new table faults in all its pages again (about a
-// tenth of the default bake's time). With the threshold at its largest,
-// 32 MiB, and no trimming, freed tables stay in the heap and are reused.
+// A bake allocates and frees tables of 4 to 17 MiB (more at larger sizes)
+// in every phase. glibc serves blocks above 128 KiB with their own mmap and
+// unmaps them when they are freed, so every new table faults in all its
+// pages again (about a tenth of the default bake's time). With mmap off and
+// no trimming, freed tables stay in the heap and are reused. (Raising the
+// mmap threshold instead stops at 32 MiB, and a table twice the default
+// size, 33.5 MiB, would be mapped afresh again.)
 void KeepFreedTablesForReuse() {
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_MMAP_MAX, 0);
   mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
 }
 
