@@ -380,7 +380,11 @@ std::vector<std::uint8_t> Encode(const Texture& texture) {
     throw InputError("KTX2 encode: key/value data or level too large");
   }
 
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(file_size), 0);
+  // Everything before the level zero-filled (padding included); the level is
+  // appended, not written over zeros.
+  std::vector<std::uint8_t> out;
+  out.reserve(static_cast<std::size_t>(file_size));
+  out.resize(static_cast<std::size_t>(level_offset), 0);
   std::memcpy(out.data(), kIdentifier, sizeof(kIdentifier));
   PutU32(out, 12, static_cast<std::uint32_t>(format));                               // vkFormat
   PutU32(out, 16, static_cast<std::uint32_t>(BytesPerChannel(format)));              // typeSize (§3.3)
@@ -414,7 +418,7 @@ std::vector<std::uint8_t> Encode(const Texture& texture) {
     at += 4 + static_cast<std::size_t>(AlignUp(entry_length, 4));  // NULs and padding stay 0
   }
   const std::vector<std::uint8_t>& stored = zstd ? deflated : texture.data;
-  if (!stored.empty()) std::memcpy(out.data() + level_offset, stored.data(), stored.size());
+  out.insert(out.end(), stored.begin(), stored.end());
   return out;
 }
 
@@ -616,14 +620,31 @@ void WriteFile(const std::filesystem::path& path, const Texture& texture) {
 
 Texture ReadFile(const std::filesystem::path& path) { return Decode(ReadFileBytes(path), path.string()); }
 
-std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& values) {
+std::vector<std::uint8_t> PackChannels(VkFormat format, const float* values, std::size_t texels, int channels) {
+  const int stored = ChannelCount(format);
+  if (channels < 1 || channels > stored) {
+    throw InternalError("KTX2 pack: " + std::to_string(channels) + " channels for " + FormatName(format));
+  }
   const std::size_t channel_bytes = BytesPerChannel(format);
-  std::vector<std::uint8_t> out(values.size() * channel_bytes);
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const std::uint32_t bits = channel_bytes == 2 ? Imath::half(values[i]).bits() : FloatBits(values[i]);
-    for (std::size_t b = 0; b < channel_bytes; ++b) out[i * channel_bytes + b] = static_cast<std::uint8_t>(bits >> (8 * b));
+  std::vector<std::uint8_t> out(texels * stored * channel_bytes, 0);
+  for (std::size_t i = 0; i < texels; ++i) {
+    for (int c = 0; c < channels; ++c) {
+      const float v = values[i * channels + c];
+      const std::uint32_t bits = channel_bytes == 2 ? Imath::half(v).bits() : FloatBits(v);
+      std::uint8_t* to = &out[(i * stored + c) * channel_bytes];
+      for (std::size_t b = 0; b < channel_bytes; ++b) to[b] = static_cast<std::uint8_t>(bits >> (8 * b));
+    }
   }
   return out;
+}
+
+std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& values) {
+  const int channels = ChannelCount(format);
+  if (values.size() % channels != 0) {
+    throw InternalError("KTX2 pack: " + std::to_string(values.size()) + " values is not a whole number of " +
+                        FormatName(format) + " texels");
+  }
+  return PackChannels(format, values.data(), values.size() / channels, channels);
 }
 
 std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data) {

@@ -97,6 +97,9 @@ Texture ReadFile(const std::filesystem::path& path);
 // formats converted with round-to-nearest-even (Imath::half). `values`
 // holds ChannelCount(format) floats per texel.
 std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& values);
+// The same from `channels` (1 to ChannelCount(format)) floats per texel, the
+// format's other channels 0 (an RGB table in an RGBA format).
+std::vector<std::uint8_t> PackChannels(VkFormat format, const float* values, std::size_t texels, int channels);
 std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data);
 
 }  // namespace skybake::ktx2

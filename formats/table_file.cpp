@@ -271,11 +271,8 @@ std::vector<std::uint8_t> EncodeKtx2(const TableImage& image) {
   texture.width = static_cast<std::uint32_t>(image.width);
   texture.height = static_cast<std::uint32_t>(image.height);
   texture.depth = image.is_3d ? static_cast<std::uint32_t>(image.depth) : 0;
-  std::vector<float> rgba(image.TexelCount() * 4, 0.0f);  // alpha 0 where the table has none
-  for (std::size_t i = 0; i < image.TexelCount(); ++i) {
-    for (std::size_t c = 0; c < channels; ++c) rgba[4 * i + c] = image.values[channels * i + c];
-  }
-  texture.data = ktx2::PackFloats(texture.format, rgba);
+  // Alpha 0 where the table has none.
+  texture.data = ktx2::PackChannels(texture.format, image.values.data(), image.TexelCount(), static_cast<int>(channels));
   texture.key_values = image.metadata;
   texture.key_values[kSizeKey] = SizeString(image.width, image.height, image.depth, image.is_3d);
   if (image.ktx2_zstd_level != 0) {
