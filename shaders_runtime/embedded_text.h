@@ -1,5 +1,6 @@
 // Text files compiled into the program from the source tree (see
-// cmake/EmbedText.cmake): the atmosphere presets and the GLSL runtime.
+// cmake/EmbedText.cmake): the atmosphere presets, the GLSL runtime and the
+// published spectral data.
 #pragma once
 
 #include <string_view>
@@ -16,5 +17,7 @@ struct EmbeddedText {
 extern const std::vector<EmbeddedText> kPresetFiles;
 // shaders_runtime/*.glsl
 extern const std::vector<EmbeddedText> kRuntimeShaderFiles;
+// data/*.csv (data/README.md)
+extern const std::vector<EmbeddedText> kSpectralDataFiles;
 
 }  // namespace skybake

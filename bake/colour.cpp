@@ -1,0 +1,128 @@
+#include "bake/colour.h"
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "core/errors.h"
+#include "shaders_runtime/embedded_text.h"
+
+namespace skybake {
+
+namespace {
+
+// Reads one of data/*.csv: '#' comment lines, a header, then rows of a
+// wavelength and `columns` values on a uniform grid.
+SpectralTable ReadTable(std::string_view name, int columns) {
+  const auto file = std::find_if(kSpectralDataFiles.begin(), kSpectralDataFiles.end(),
+                                 [&](const EmbeddedText& f) { return f.name == name; });
+  if (file == kSpectralDataFiles.end()) throw InternalError("no embedded data file " + std::string(name));
+  SpectralTable table;
+  std::istringstream in{std::string(file->text)};
+  std::vector<double> wavelengths;
+  bool header = true;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {
+      header = false;
+      continue;
+    }
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream row(line);
+    double wavelength = 0.0;
+    glm::dvec3 value(0.0);
+    row >> wavelength;
+    for (int c = 0; c < columns; ++c) row >> value[c];
+    if (!row) throw InternalError(std::string(name) + ": malformed row '" + line + "'");
+    wavelengths.push_back(wavelength);
+    table.values.push_back(value);
+  }
+  if (wavelengths.size() < 2) throw InternalError(std::string(name) + ": fewer than two rows");
+  table.first_nm = wavelengths.front();
+  table.step_nm = wavelengths[1] - wavelengths[0];
+  for (std::size_t i = 0; i < wavelengths.size(); ++i) {
+    if (std::abs(wavelengths[i] - table.WavelengthNm(i)) > 1e-9) {
+      throw InternalError(std::string(name) + ": wavelengths not on a uniform grid");
+    }
+  }
+  return table;
+}
+
+// The value at `nm` of the spectrum linear between the samples, 0 outside.
+double Interpolate(const std::vector<double>& wavelength_nm, const std::vector<double>& value, double nm) {
+  if (nm < wavelength_nm.front() || nm > wavelength_nm.back()) return 0.0;
+  const auto upper = std::upper_bound(wavelength_nm.begin(), wavelength_nm.end(), nm);
+  if (upper == wavelength_nm.end()) return value.back();
+  const std::size_t i = std::size_t(upper - wavelength_nm.begin());
+  const double a = wavelength_nm[i - 1], b = wavelength_nm[i];
+  return value[i - 1] + (value[i] - value[i - 1]) * (nm - a) / (b - a);
+}
+
+}  // namespace
+
+const SpectralTable& Cie1931Observer() {
+  static const SpectralTable table = ReadTable("cie1931_2deg_observer_5nm.csv", 3);
+  return table;
+}
+
+const SpectralTable& CieD65() {
+  static const SpectralTable table = ReadTable("cie_d65_5nm.csv", 1);
+  return table;
+}
+
+glm::dvec3 SpectrumToXyz(const std::vector<double>& wavelength_nm, const std::vector<double>& value) {
+  if (wavelength_nm.size() != value.size() || wavelength_nm.empty()) {
+    throw InternalError("SpectrumToXyz: " + std::to_string(wavelength_nm.size()) + " wavelengths, " +
+                        std::to_string(value.size()) + " values");
+  }
+  if (!std::is_sorted(wavelength_nm.begin(), wavelength_nm.end())) {
+    throw InternalError("SpectrumToXyz: wavelengths not increasing");
+  }
+  const SpectralTable& observer = Cie1931Observer();
+  glm::dvec3 xyz(0.0);
+  const std::size_t n = observer.values.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    // Trapezoid weights: half a step at both ends of the grid.
+    const double weight = (i == 0 || i + 1 == n ? 0.5 : 1.0) * observer.step_nm;
+    xyz += weight * Interpolate(wavelength_nm, value, observer.WavelengthNm(i)) * observer.values[i];
+  }
+  return xyz;
+}
+
+std::vector<glm::dvec3> XyzWeights(const std::vector<double>& wavelength_nm) {
+  std::vector<glm::dvec3> weights;
+  std::vector<double> unit(wavelength_nm.size(), 0.0);
+  for (std::size_t i = 0; i < wavelength_nm.size(); ++i) {
+    unit[i] = 1.0;
+    weights.push_back(SpectrumToXyz(wavelength_nm, unit));
+    unit[i] = 0.0;
+  }
+  return weights;
+}
+
+glm::dvec2 Chromaticity(const glm::dvec3& xyz) {
+  const double sum = xyz.x + xyz.y + xyz.z;
+  return sum > 0.0 ? glm::dvec2(xyz.x, xyz.y) / sum : glm::dvec2(0.0);
+}
+
+glm::dmat3 RgbToXyzMatrix(const glm::dvec2& red, const glm::dvec2& green, const glm::dvec2& blue,
+                          const glm::dvec2& white) {
+  // XYZ of chromaticity (x, y) at Y = 1: (x / y, 1, (1 - x - y) / y).
+  auto xyz = [](const glm::dvec2& c) { return glm::dvec3(c.x / c.y, 1.0, (1.0 - c.x - c.y) / c.y); };
+  const glm::dmat3 primaries(xyz(red), xyz(green), xyz(blue));  // columns
+  const glm::dvec3 scale = glm::inverse(primaries) * xyz(white);
+  return glm::dmat3(primaries[0] * scale.x, primaries[1] * scale.y, primaries[2] * scale.z);
+}
+
+const glm::dmat3& LinearSrgbToXyz() {
+  static const glm::dmat3 m = RgbToXyzMatrix({0.64, 0.33}, {0.30, 0.60}, {0.15, 0.06}, {0.3127, 0.3290});
+  return m;
+}
+
+const glm::dmat3& XyzToLinearSrgb() {
+  static const glm::dmat3 m = glm::inverse(LinearSrgbToXyz());
+  return m;
+}
+
+}  // namespace skybake
