@@ -73,8 +73,13 @@ StagedFiles::~StagedFiles() {
 }
 
 void StagedFiles::Write(const fs::path& path, std::string_view bytes) {
-  staged_.push_back({TemporarySibling(path), path});
-  WriteWholeFile(staged_.back().temp, path, bytes);
+  fs::path temp = TemporarySibling(path);
+  {
+    // Listed before it exists, so that the destructor removes a partial file.
+    std::lock_guard<std::mutex> lock(mutex_);
+    staged_.push_back({temp, path});
+  }
+  WriteWholeFile(temp, path, bytes);
 }
 
 void StagedFiles::Commit() {

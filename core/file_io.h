@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,6 +25,8 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view byt
 // write failed), it removes its temporary files and every earlier file of the
 // same names is left intact. Commit() refuses up front a final name it could
 // not replace (a directory), so that no rename of the set has happened yet.
+// Write() may run on several threads at once; the order written is then the
+// order the writes began.
 class StagedFiles {
  public:
   StagedFiles() = default;
@@ -37,6 +40,7 @@ class StagedFiles {
   struct Staged {
     std::filesystem::path temp, path;
   };
+  std::mutex mutex_;  // guards staged_
   std::vector<Staged> staged_;
 };
 

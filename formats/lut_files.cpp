@@ -49,19 +49,20 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   // interrupt part-way leaves the previous set (files and manifest) as it was.
   InterruptScope interrupts;
   StagedFiles staged;
-  // Each table file is encoded and hashed on its own thread (zip
-  // compression of the EXR files is most of the writing), then written in
-  // a fixed order.
+  // Each table file is encoded, hashed and written (under its temporary
+  // name) on its own thread, its bytes freed as soon as they are written
+  // (zip compression of the EXR files is most of the writing); the manifest
+  // lists them in a fixed order.
   struct Encoded {
     const TableDescription* table;
     FileFormat format;
-    TableImage image;
-    std::vector<std::uint8_t> bytes;
+    TableImage image;  // its values released once encoded
+    std::size_t bytes = 0;
     std::string sha256;
   };
   std::vector<Encoded> files;
   for (const TableDescription& table : tables) {
-    for (FileFormat format : options.formats) files.push_back({&table, format, {}, {}, {}});
+    for (FileFormat format : options.formats) files.push_back({&table, format, {}, 0, {}});
   }
   // One file per task (the default partitioner would hand both large EXR
   // files, neighbours in the list, to the same thread).
@@ -71,17 +72,19 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           Encoded& f = files[i];
           f.image = MakeTableFileImage(luts, *f.table, f.format, options);
-          f.bytes = EncodeTableImage(f.image);
-          f.sha256 = Sha256Hex(f.bytes.data(), f.bytes.size());
+          const std::vector<std::uint8_t> bytes = EncodeTableImage(f.image);
+          f.image.values = {};
+          f.bytes = bytes.size();
+          f.sha256 = Sha256Hex(bytes.data(), bytes.size());
+          staged.Write(dir / (f.table->name + FileExtension(f.format)),
+                       std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
         }
       },
       tbb::simple_partitioner());
-  for (Encoded& f : files) {
+  for (const Encoded& f : files) {
     const std::string file = f.table->name + FileExtension(f.format);
-    staged.Write(dir / file, std::string_view(reinterpret_cast<const char*>(f.bytes.data()), f.bytes.size()));
-    manifest.AddTableFile(*f.table, file, f.image, f.bytes.size(), f.sha256);
-    report.files.push_back({f.table->name, file, f.bytes.size()});
-    f.bytes = {}, f.image = {};
+    manifest.AddTableFile(*f.table, file, f.image, f.bytes, f.sha256);
+    report.files.push_back({f.table->name, file, f.bytes});
   }
   for (const TableDescription& table : tables) {
     if (IsHalf(table, options)) {
