@@ -66,7 +66,8 @@ struct WriteReport {
 WriteReport WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
 
 // The image of `table` that WriteLutSet encodes into its `format` file: the
-// pixel type and KTX2 supercompression `options` ask for.
+// pixel type and KTX2 supercompression `options` ask for, and for OpenEXR the
+// compression ChooseExrCompression picks.
 TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table, FileFormat format,
                               const WriteOptions& options);
 

@@ -251,7 +251,6 @@ TableImage MakeTableImage(const LutSet& luts, const TableDescription& table, Fil
     for (std::size_t c = 0; c < channels; ++c) image.values[i * channels + c] = texture.texels[4 * i + c];
   }
   image.metadata = TableMetadata(luts, table);
-  ChooseExrCompression(&image);
   return image;
 }
 

@@ -59,8 +59,7 @@ Metadata TableMetadata(const LutSet& luts, const TableDescription& table);
 
 // A table's texels as a TableImage of its meaningful channels, and back (the
 // image's channels must include the table's; a KTX2 alpha that pads an RGB
-// table is dropped). An OpenEXR image gets the compression
-// ChooseExrCompression picks.
+// table is dropped).
 TableImage MakeTableImage(const LutSet& luts, const TableDescription& table, FileFormat format, PixelType type);
 void CopyTableImage(const TableImage& image, const TableDescription& table, glsl::Texture* texture,
                     const std::string& source);
