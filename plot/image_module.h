@@ -18,12 +18,12 @@
 namespace skybake::image_module {
 
 // Bumped whenever Functions changes, so a stale module is refused.
-inline constexpr int kVersion = 1;
+inline constexpr int kVersion = 2;
 
 using Attributes = std::vector<std::pair<std::string, std::string>>;
 
+// Where a text's anchor point is along its baseline.
 enum class AlignX { kLeft, kRight, kCenter };
-enum class AlignY { kBaseline, kTop };
 
 // 8-bit RGB pixels, row-major from the top.
 struct Rgb8Canvas {
@@ -50,10 +50,10 @@ struct Functions {
   // The pixel box [x0, y0, x1, y1) `text` covers when drawn at the origin
   // on its baseline; false if the font cannot draw it.
   bool (*text_box)(const std::string& text, int size, const std::string& font, int box[4]);
-  // Draws `text` in `color` (linear 0-1 per channel) onto the canvas,
-  // anchored at (x, y) as the alignments say.
+  // Draws `text` in `color` (linear 0-1 per channel) onto the canvas, its
+  // baseline through (x, y), anchored there as `align_x` says.
   void (*draw_text)(const Rgb8Canvas& canvas, int x, int y, const std::string& text, int size,
-                    const std::string& font, const float color[3], AlignX align_x, AlignY align_y);
+                    const std::string& font, const float color[3], AlignX align_x);
 };
 
 }  // namespace skybake::image_module

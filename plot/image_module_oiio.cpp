@@ -70,14 +70,14 @@ bool TextBox(const std::string& text, int size, const std::string& font, int box
 }
 
 void DrawText(const Rgb8Canvas& canvas, int x, int y, const std::string& text, int size, const std::string& font,
-              const float color[3], AlignX align_x, AlignY align_y) {
+              const float color[3], AlignX align_x) {
   // Draws in place: the ImageBuf wraps the canvas's pixels.
   ImageBuf image(ImageSpec(canvas.width, canvas.height, 3, TypeDesc::UINT8), canvas.rgb);
   const auto ax = align_x == AlignX::kLeft    ? ImageBufAlgo::TextAlignX::Left
                   : align_x == AlignX::kRight ? ImageBufAlgo::TextAlignX::Right
                                               : ImageBufAlgo::TextAlignX::Center;
-  const auto ay = align_y == AlignY::kTop ? ImageBufAlgo::TextAlignY::Top : ImageBufAlgo::TextAlignY::Baseline;
-  ImageBufAlgo::render_text(image, x, y, text, size, font, cspan<float>(color, 3), ax, ay);
+  ImageBufAlgo::render_text(image, x, y, text, size, font, cspan<float>(color, 3), ax,
+                            ImageBufAlgo::TextAlignY::Baseline);
 }
 
 constexpr Functions kFunctions{kVersion, WriteSrgbPng, WriteLinearExr, ReadRgb8, FindFont, TextBox, DrawText};

@@ -440,7 +440,6 @@ void WriteSrgbPng(const std::filesystem::path& path, int width, int height, cons
 
 bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
   using image_module::AlignX;
-  using image_module::AlignY;
   const image_module::Functions& images = ImageModule();
   PlotFrame f = LayoutPlot(plot);
   std::vector<unsigned char> pixels = RasterizePlot(plot);
@@ -452,7 +451,7 @@ bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
     auto text = [&](double x, double y, const std::string& s, double size, AlignX ax, const float* color = nullptr) {
       if (s.empty()) return;
       images.draw_text(canvas, static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), s,
-                       static_cast<int>(size), font, color ? color : ink, ax, AlignY::kBaseline);
+                       static_cast<int>(size), font, color ? color : ink, ax);
     };
     for (double t : f.x_ticks) text(f.PixelX(t), f.bottom + 20, FormatTick(t, f.x_log), kTickLabelSize, AlignX::kCenter);
     for (double t : f.y_ticks) text(f.left - 8, f.PixelY(t) + 4, FormatTick(t, f.y_log), kTickLabelSize, AlignX::kRight);
@@ -472,7 +471,7 @@ bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
       const int w = box[2] - box[0] + 4, h = box[3] - box[1] + 4;
       std::vector<unsigned char> label(std::size_t(3) * w * h, 255);
       images.draw_text({w, h, label.data()}, 2, 2 - box[1], plot.y.label, static_cast<int>(kAxisLabelSize), font,
-                       ink, AlignX::kLeft, AlignY::kBaseline);
+                       ink, AlignX::kLeft);
       // Turned: h wide, w high; its pixel (i, j) is the label's (w - 1 - j, i).
       const int x0 = std::max(0, 18 - h / 2);
       const int y0 = std::max(0, static_cast<int>(0.5 * (f.top + f.bottom)) - w / 2);

@@ -105,7 +105,7 @@ Rgb8 ContactSheet(const std::vector<std::vector<const Rgb8*>>& columns, const st
     }
     if (!font.empty() && c < labels.size()) {
       images.draw_text({sheet.width, sheet.height, sheet.rgb.data()}, x + column_width / 2, gap + label_height - 6,
-                       labels[c], 14, font, ink, image_module::AlignX::kCenter, image_module::AlignY::kBaseline);
+                       labels[c], 14, font, ink, image_module::AlignX::kCenter);
     }
     x += column_width + gap;
   }
