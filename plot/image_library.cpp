@@ -55,4 +55,8 @@ const image_module::Functions& ImageModule() {
   return functions;
 }
 
+void ThrowIfImageError(const std::filesystem::path& path, const std::string& error) {
+  if (!error.empty()) throw IoError(path.string() + ": " + error);
+}
+
 }  // namespace skybake

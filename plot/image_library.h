@@ -4,6 +4,9 @@
 // plot/CMakeLists.txt).
 #pragma once
 
+#include <filesystem>
+#include <string>
+
 #include "plot/image_module.h"
 
 namespace skybake {
@@ -11,5 +14,9 @@ namespace skybake {
 // The module's functions. IoError naming the file if it cannot be loaded or
 // was built from another version of the interface.
 const image_module::Functions& ImageModule();
+
+// The error a module function returned, as an IoError naming `path`; nothing
+// if it returned "".
+void ThrowIfImageError(const std::filesystem::path& path, const std::string& error);
 
 }  // namespace skybake

@@ -433,8 +433,7 @@ void WriteSrgbPng(const std::filesystem::path& path, int width, int height, cons
                   const std::vector<std::pair<std::string, std::string>>& text) {
   const image_module::Functions& images = ImageModule();
   WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
-    const std::string error = images.write_srgb_png(temp.string(), width, height, rgb, text);
-    if (!error.empty()) throw IoError(path.string() + ": " + error);
+    ThrowIfImageError(path, images.write_srgb_png(temp.string(), width, height, rgb, text));
   });
 }
 

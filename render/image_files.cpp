@@ -3,21 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/errors.h"
 #include "core/file_io.h"
 #include "plot/image_library.h"
 #include "plot/plot.h"
 #include "report/error_stats.h"
 
 namespace skybake::render {
-
-namespace {
-
-void ThrowIfFailed(const std::filesystem::path& path, const std::string& error) {
-  if (!error.empty()) throw IoError(path.string() + ": " + error);
-}
-
-}  // namespace
 
 glsl::vec3 WhiteBalance(const glsl::vec3& solar_irradiance) {
   double mean = (solar_irradiance.x + solar_irradiance.y + solar_irradiance.z) / 3.0;
@@ -59,7 +50,8 @@ Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone) {
 void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes) {
   const image_module::Functions& images = ImageModule();
   WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
-    ThrowIfFailed(path, images.write_linear_exr(temp.string(), image.width, image.height, image.rgb.data(), attributes));
+    ThrowIfImageError(path,
+                      images.write_linear_exr(temp.string(), image.width, image.height, image.rgb.data(), attributes));
   });
 }
 
@@ -69,7 +61,7 @@ void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attrib
 
 Rgb8 ReadPng(const std::filesystem::path& path) {
   Rgb8 out;
-  ThrowIfFailed(path, ImageModule().read_rgb8(path.string(), &out.width, &out.height, &out.rgb));
+  ThrowIfImageError(path, ImageModule().read_rgb8(path.string(), &out.width, &out.height, &out.rgb));
   return out;
 }
 
