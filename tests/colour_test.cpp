@@ -20,6 +20,13 @@ std::vector<double> Wavelengths(const SpectralTable& t) {
   return nm;
 }
 
+// The XYZ of illuminant D65's tabulated spectrum.
+glm::dvec3 D65Xyz() {
+  std::vector<double> power;
+  for (const glm::dvec3& p : CieD65().values) power.push_back(p.x);
+  return SpectrumToXyz(Wavelengths(CieD65()), power);
+}
+
 TEST(Colour, TablesHoldThePublishedValues) {
   const SpectralTable& cmf = Cie1931Observer();
   ASSERT_EQ(cmf.values.size(), 95u);  // 360 to 830 nm
@@ -53,11 +60,7 @@ TEST(Colour, EqualEnergySpectrumIsTheEqualEnergyWhite) {
 
 TEST(Colour, D65HasItsPublishedChromaticity) {
   // CIE 015:2018 table 3 (2 degree observer): x = 0.31272, y = 0.32903.
-  const glm::dvec2 xy = Chromaticity(SpectrumToXyz(Wavelengths(CieD65()), [] {
-    std::vector<double> v;
-    for (const glm::dvec3& p : CieD65().values) v.push_back(p.x);
-    return v;
-  }()));
+  const glm::dvec2 xy = Chromaticity(D65Xyz());
   EXPECT_NEAR(xy.x, 0.31272, 5e-5);
   EXPECT_NEAR(xy.y, 0.32903, 5e-5);
 }
@@ -82,9 +85,7 @@ TEST(Colour, SrgbMatricesAreThoseOfIec61966) {
 }
 
 TEST(Colour, D65IsSrgbWhite) {
-  std::vector<double> power;
-  for (const glm::dvec3& p : CieD65().values) power.push_back(p.x);
-  const glm::dvec3 xyz = SpectrumToXyz(Wavelengths(CieD65()), power);
+  const glm::dvec3 xyz = D65Xyz();
   const glm::dvec3 rgb = XyzToLinearSrgb() * (xyz / xyz.y);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb[c], 1.0, 5e-4) << c;
 }
