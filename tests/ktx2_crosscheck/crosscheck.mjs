@@ -410,9 +410,8 @@ function checkBakedSets(parser, skybakeExe, workDir) {
   // the float set's bytes exactly.
   for (const [tableName, level] of Object.entries(levels.zstd)) {
     const plain = levels.float[tableName];
-    if (level && plain && compareBytes(level, plain) >= 0) {
-      problems.push(`baked/zstd/${tableName}.ktx2: inflated level differs from the float set's at byte ${compareBytes(level, plain)}`);
-    }
+    const at = level && plain ? compareBytes(level, plain) : -1;
+    if (at >= 0) problems.push(`baked/zstd/${tableName}.ktx2: inflated level differs from the float set's at byte ${at}`);
   }
   return { problems, files };
 }
