@@ -33,6 +33,8 @@ vec4 texture(const CountingSampler3D& s, const vec3& uvw) {
 #define TransmittanceTexture CountingSampler2D
 #define ScatteringTexture CountingSampler3D
 #define IrradianceTexture CountingSampler2D
+#define SampleTexture2D texture
+#define SampleTexture3D texture
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
 #include "shaders_runtime/functions.glsl"
@@ -43,6 +45,8 @@ vec4 texture(const CountingSampler3D& s, const vec3& uvw) {
 #undef TransmittanceTexture
 #undef ScatteringTexture
 #undef IrradianceTexture
+#undef SampleTexture2D
+#undef SampleTexture3D
 
 }  // namespace
 }  // namespace skybake::glsl

@@ -150,7 +150,7 @@ vec3 IntegrateSegment(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTextu
 vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
                                      IN(TransmittanceTexture) transmittance_texture,
                                      IN(ScatteringTexture) scattering_texture,
-                                     IN(ScatteringTexture) single_mie_scattering_texture, vec3 camera,
+                                     IN(ScatteringTexture) single_mie_scattering_texture, IN(vec3) camera,
                                      IN(vec3) point, Number shadow_length, IN(vec3) sun_direction,
                                      OUT(vec3) transmittance) {
   // A point that coincides with the camera once rounded (a distance below the
@@ -170,8 +170,7 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
     transmittance = vec3(1.0);
     return vec3(0.0);
   }
-  camera = start;
-  Number d = max(length(point - camera), 0.0);
+  Number d = max(length(point - start), 0.0);
   Number lit = max(d - max(shadow_length, 0.0), 0.0);
   bool ray_r_mu_intersects_ground = RayIntersectsGround(atmosphere, r, mu);
 
@@ -252,7 +251,7 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
 // and the transmittance between them.
 vec3 GetSkyRadianceToPoint(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
                            IN(ScatteringTexture) scattering_texture,
-                           IN(ScatteringTexture) single_mie_scattering_texture, vec3 camera, IN(vec3) point,
+                           IN(ScatteringTexture) single_mie_scattering_texture, IN(vec3) camera, IN(vec3) point,
                            IN(vec3) sun_direction, OUT(vec3) transmittance) {
   return GetSkyRadianceToPointWithShadow(atmosphere, transmittance_texture, scattering_texture,
                                          single_mie_scattering_texture, camera, point, 0.0, sun_direction,

@@ -14,6 +14,10 @@ precision highp sampler3D;
 #define TransmittanceTexture sampler2D
 #define ScatteringTexture sampler3D
 #define IrradianceTexture sampler2D
+// Bilinear / trilinear lookups of a table (each language's own sampling; the
+// WGSL translation samples a separate texture with a shared sampler).
+#define SampleTexture2D texture
+#define SampleTexture3D texture
 
 const Number PI = 3.14159265358979323846;
 

@@ -264,7 +264,7 @@ vec3 GetOpticalDepthToTopAtmosphereBoundary(IN(AtmosphereParameters) atmosphere,
                                             IN(TransmittanceTexture) transmittance_texture,
                                             Number r, Number mu) {
   vec2 uv = GetTransmittanceTextureUvFromRMu(atmosphere, r, mu);
-  return vec3(texture(transmittance_texture, uv));
+  return vec3(SampleTexture2D(transmittance_texture, uv));
 }
 
 vec3 GetTransmittanceToTopAtmosphereBoundary(IN(AtmosphereParameters) atmosphere,
@@ -390,11 +390,11 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   bool low_sun_below;
   GetScatteringMuSColumns(atmosphere, uvwz.y, x_below, x_above, mu_s_t, low_sun_below);
   bool low_sun_above = x_above < GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
-  vec4 below = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w)),
-                            texture(scattering_texture, vec3((nu_slice + 1.0 + x_below) / nu_size, uvwz.z, uvwz.w)),
+  vec4 below = SunCosineMix(SampleTexture3D(scattering_texture, vec3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w)),
+                            SampleTexture3D(scattering_texture, vec3((nu_slice + 1.0 + x_below) / nu_size, uvwz.z, uvwz.w)),
                             nu_t, low_sun_below);
-  vec4 above = SunCosineMix(texture(scattering_texture, vec3((nu_slice + x_above) / nu_size, uvwz.z, uvwz.w)),
-                            texture(scattering_texture, vec3((nu_slice + 1.0 + x_above) / nu_size, uvwz.z, uvwz.w)),
+  vec4 above = SunCosineMix(SampleTexture3D(scattering_texture, vec3((nu_slice + x_above) / nu_size, uvwz.z, uvwz.w)),
+                            SampleTexture3D(scattering_texture, vec3((nu_slice + 1.0 + x_above) / nu_size, uvwz.z, uvwz.w)),
                             nu_t, low_sun_above);
   return SunBelowTableMix(below, above, mu_s_t, low_sun_below);
 }
@@ -411,8 +411,8 @@ vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) ir
   Number mu_s_column = clamp(floor(mu_s_coord), 0.0, width - 2.0);
   Number mu_s_below = atmosphere.mu_s_min + (1.0 - atmosphere.mu_s_min) * mu_s_column / (width - 1.0);
   bool low_sun = mu_s_below < LOW_SUN_MU_S;
-  vec4 below = texture(irradiance_texture, vec2((mu_s_column + 0.5) / width, uv.y));
-  vec4 above = texture(irradiance_texture, vec2((mu_s_column + 1.5) / width, uv.y));
+  vec4 below = SampleTexture2D(irradiance_texture, vec2((mu_s_column + 0.5) / width, uv.y));
+  vec4 above = SampleTexture2D(irradiance_texture, vec2((mu_s_column + 1.5) / width, uv.y));
   return vec3(SunBelowTableMix(below, above, SunCosinePosition(mu_s_coord - mu_s_column, low_sun), low_sun));
 }
 #endif

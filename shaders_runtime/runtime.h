@@ -14,6 +14,8 @@
 #define TransmittanceTexture sampler2D
 #define ScatteringTexture sampler3D
 #define IrradianceTexture sampler2D
+#define SampleTexture2D texture
+#define SampleTexture3D texture
 
 namespace skybake::glsl {
 namespace {
@@ -31,3 +33,5 @@ namespace {
 #undef TransmittanceTexture
 #undef ScatteringTexture
 #undef IrradianceTexture
+#undef SampleTexture2D
+#undef SampleTexture3D
