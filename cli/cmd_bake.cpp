@@ -22,6 +22,7 @@
 #include "core/file_io.h"
 #include "core/interrupt.h"
 #include "report/bake_pipeline.h"
+#include "shaders_runtime/snippet.h"
 
 namespace skybake::cli {
 
@@ -35,6 +36,7 @@ struct BakeOptions {
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
   std::string ktx2_supercompression = "none";
+  std::vector<std::string> runtime = {"glsl", "hlsl", "msl", "wgsl"};
   bool json = false;
   bool quiet = false;
   std::string scene;
@@ -42,6 +44,18 @@ struct BakeOptions {
   std::string reference;
   CLI::Option* format_option = nullptr;
 };
+
+// The value of --runtime: shading languages by name, or "none".
+std::vector<ShadingLanguage> ParseRuntimeLanguages(const std::vector<std::string>& names) {
+  if (names.size() == 1 && names[0] == "none") return {};
+  std::vector<ShadingLanguage> languages;
+  for (const std::string& name : names) {
+    const std::optional<ShadingLanguage> language = ParseShadingLanguage(name);
+    if (!language) throw UsageError("--runtime: '" + name + "' is not glsl, hlsl, msl, wgsl or none");
+    if (std::find(languages.begin(), languages.end(), *language) == languages.end()) languages.push_back(*language);
+  }
+  return languages;
+}
 
 // Bakes one atmosphere into `output_dir` (report/bake_pipeline.h), with the
 // phases and the summary on stderr unless --quiet; the --json report of it.
@@ -54,6 +68,7 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   job.formats_given = o.format_option != nullptr && o.format_option->count() > 0;
   job.half = o.half;
   job.ktx2_zstd_level = ParseKtx2Supercompression(o.ktx2_supercompression);
+  job.runtime_languages = ParseRuntimeLanguages(o.runtime);
   job.compare_full = o.compare_full;
   job.reference_file = o.reference;
   job.clean = o.clean;
@@ -174,6 +189,11 @@ void AddBakeCommand(CLI::App& app) {
                   "default: the committed one for earth");
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
   cmd->add_option("--ktx2-supercompression", o->ktx2_supercompression, kKtx2SupercompressionHelp)
+      ->capture_default_str();
+  cmd->add_option("--runtime", o->runtime,
+                  "Shading languages of the runtime written beside the tables, comma-separated: glsl (OpenGL, "
+                  "Vulkan), hlsl (Unity, Unreal), msl (Metal), wgsl (WebGPU); or none (default glsl,hlsl,msl,wgsl)")
+      ->delimiter(',')
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a machine-readable report (tables, sizes, orders, timings) on stdout");
   cmd->add_flag("-q,--quiet", o->quiet, "Do not print per-phase timings on stderr");

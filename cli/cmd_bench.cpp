@@ -86,11 +86,11 @@ struct Measurement {
 
 Measurement Measure(const Atmosphere& atmosphere, const BakeSettings& settings, int runs,
                     const std::filesystem::path& dir) {
-  // The bake pipeline of `skybake bake` without the GLSL runtime: the tables
+  // The bake pipeline of `skybake bake` without the runtime: the tables
   // and the manifest, in EXR and KTX2.
   report::BakeJob job;
   job.settings = settings;
-  job.runtime = false;
+  job.runtime_languages.clear();
   job.command_line = CommandLine();
   Measurement m;
   for (int run = 0; run < runs; ++run) {

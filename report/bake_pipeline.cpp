@@ -256,9 +256,10 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     scene->full_table_bytes = TableFileBytes(full, full_options);
     if (reference) scene->accuracy = MeasureSceneAccuracy(*reference, scene->scene, out.luts, full);
   }
-  // The GLSL runtime goes beside the tables, its constants from this bake's parameters.
-  if (job.runtime) {
-    for (SnippetFile& f : RuntimeSnippetFiles(out.luts.parameters, atmosphere.wavelengths_nm, atmosphere.name, parts)) {
+  // The runtime goes beside the tables, its constants from this bake's parameters.
+  for (ShadingLanguage language : job.runtime_languages) {
+    for (SnippetFile& f :
+         RuntimeSnippetFiles(language, out.luts.parameters, atmosphere.wavelengths_nm, atmosphere.name, parts)) {
       write_options.shaders.push_back(ShaderFile{f.file, std::move(f.text), f.description});
     }
   }

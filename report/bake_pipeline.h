@@ -20,6 +20,7 @@
 #include "bake/scene.h"
 #include "formats/lut_files.h"
 #include "report/scene_accuracy.h"
+#include "shaders_runtime/snippet.h"
 
 namespace skybake::report {
 
@@ -32,7 +33,8 @@ struct BakeJob {
   int ktx2_zstd_level = 0;     // WriteOptions::ktx2_zstd_level
   bool compare_full = false;   // with a scene: also bake the full set (not written) and compare
   std::string reference_file;  // with compare_full; empty: the committed one (earth only)
-  bool runtime = true;         // write the GLSL runtime (shaders_runtime/snippet.h) beside the tables
+  // The runtime's languages written beside the tables (shaders_runtime/snippet.h); empty: none.
+  std::vector<ShadingLanguage> runtime_languages{std::begin(kShadingLanguages), std::end(kShadingLanguages)};
   bool clean = false;          // WriteOptions::clean
   std::string command_line;    // recorded in the manifest
 };

@@ -87,7 +87,7 @@ LadderBake BakeAndWriteTables(const Atmosphere& atmosphere, const BakeSettings& 
                               const std::filesystem::path& dir) {
   BakeJob job;
   job.settings = settings;
-  job.runtime = false;
+  job.runtime_languages.clear();
   BakeOutcome outcome = BakeAndWrite(atmosphere, job, dir);
   LadderBake b;
   b.report = outcome.report;

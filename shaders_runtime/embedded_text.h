@@ -15,7 +15,7 @@ struct EmbeddedText {
 
 // examples/atmospheres/*.toml
 extern const std::vector<EmbeddedText> kPresetFiles;
-// shaders_runtime/*.glsl
+// shaders_runtime/*.glsl and shaders_runtime/generated/*
 extern const std::vector<EmbeddedText> kRuntimeShaderFiles;
 // data/*.csv (data/README.md)
 extern const std::vector<EmbeddedText> kSpectralDataFiles;

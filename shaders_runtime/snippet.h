@@ -1,11 +1,15 @@
-// The GLSL snippet a bake ships beside its tables: definitions.glsl, a
-// generated constants file, and functions.glsl, to be concatenated in that
-// order after the engine's #version line. The constants come from the same
-// AtmosphereParameters the manifest records, so snippet and tables cannot
-// disagree.
+// The runtime a bake ships beside its tables, in each shading language: the
+// definitions, a generated constants file, and the functions, to be
+// concatenated in that order (GLSL: after the engine's #version line). The
+// constants come from the same AtmosphereParameters the manifest records, so
+// snippet and tables cannot disagree. The GLSL is the source of every
+// function; the HLSL, MSL and WGSL files are its translations
+// (shaders_runtime/generated/, written by scripts/translate_runtime.sh).
 #pragma once
 
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "shaders_runtime/glsl_shim.h"
@@ -26,10 +30,21 @@ struct SnippetParts {
   bool aerial_perspective = true;  // GetSkyRadianceToPoint[WithShadow]; needs scattering
 };
 
-// `atmosphere_constants.glsl`: `const AtmosphereParameters ATMOSPHERE`, the
-// wavelengths, and #defines saying which tables and functions exist.
-std::string AtmosphereConstantsGlsl(const glsl::AtmosphereParameters& parameters, const glsl::vec3& wavelengths_nm,
-                                    const std::string& atmosphere_name, const SnippetParts& parts = {});
+// GLSL (OpenGL 3.3 / ES 3.0, and Vulkan GLSL 4.50), HLSL (Unity, Unreal),
+// Metal Shading Language, WGSL (WebGPU).
+enum class ShadingLanguage { kGlsl, kHlsl, kMsl, kWgsl };
+inline constexpr ShadingLanguage kShadingLanguages[] = {ShadingLanguage::kGlsl, ShadingLanguage::kHlsl,
+                                                        ShadingLanguage::kMsl, ShadingLanguage::kWgsl};
+// "glsl", "hlsl", "msl", "wgsl"; parsing returns nullopt for anything else.
+const char* ShadingLanguageName(ShadingLanguage language);
+std::optional<ShadingLanguage> ParseShadingLanguage(std::string_view name);
+
+// `atmosphere_constants.<ext>`: the constant ATMOSPHERE, the wavelengths, and
+// the SKYBAKE_HAS_* switches saying which tables and functions exist
+// (#defines; WGSL, which has no preprocessor: boolean constants).
+std::string AtmosphereConstants(ShadingLanguage language, const glsl::AtmosphereParameters& parameters,
+                                const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name,
+                                const SnippetParts& parts = {});
 
 // The sources of the shipped functions.glsl, in their order of definition:
 // scalar primitives, phase functions, geometry, parameterization, lookups and
@@ -40,13 +55,14 @@ inline constexpr const char* kRuntimeFunctionSources[] = {"primitives.glsl", "ph
 // The shipped functions.glsl: the kRuntimeFunctionSources joined.
 std::string RuntimeFunctionsGlsl();
 
-// The shipped files, in the order a shader must include them.
-std::vector<SnippetFile> RuntimeSnippetFiles(const glsl::AtmosphereParameters& parameters,
+// The shipped files of one language, in the order a shader must include them.
+std::vector<SnippetFile> RuntimeSnippetFiles(ShadingLanguage language, const glsl::AtmosphereParameters& parameters,
                                              const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name,
                                              const SnippetParts& parts = {});
 
 // The files of RuntimeSnippetFiles joined into one source (no #version line).
-std::string RuntimeSnippetSource(const glsl::AtmosphereParameters& parameters, const glsl::vec3& wavelengths_nm,
-                                 const std::string& atmosphere_name, const SnippetParts& parts = {});
+std::string RuntimeSnippetSource(ShadingLanguage language, const glsl::AtmosphereParameters& parameters,
+                                 const glsl::vec3& wavelengths_nm, const std::string& atmosphere_name,
+                                 const SnippetParts& parts = {});
 
 }  // namespace skybake

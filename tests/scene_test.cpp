@@ -302,7 +302,7 @@ TEST(SceneSnippet, PrunedGlslCompilesAndLacksTheFunctionsLeftOut) {
                                    SnippetParts{true, false, true}}) {
     SCOPED_TRACE("scattering " + std::to_string(parts.scattering) + " irradiance " +
                  std::to_string(parts.irradiance) + " aerial " + std::to_string(parts.aerial_perspective));
-    const std::string snippet = RuntimeSnippetSource(p, earth.wavelengths_nm, earth.name, parts);
+    const std::string snippet = RuntimeSnippetSource(ShadingLanguage::kGlsl, p, earth.wavelengths_nm, earth.name, parts);
     for (const char* version : {"#version 300 es\n", "#version 330 core\n"}) {
       SCOPED_TRACE(version);
       std::string out;
@@ -364,7 +364,10 @@ TEST(SceneBake, WritesAndLoadsOnlyTheKeptTables) {
   std::vector<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(lut)) files.push_back(entry.path().filename());
   std::sort(files.begin(), files.end());
-  EXPECT_EQ(files, (std::vector<std::string>{"atmosphere_constants.glsl", "definitions.glsl", "functions.glsl",
+  EXPECT_EQ(files, (std::vector<std::string>{"atmosphere_constants.glsl", "atmosphere_constants.hlsl",
+                                             "atmosphere_constants.metal", "atmosphere_constants.wgsl",
+                                             "definitions.glsl", "definitions.hlsl", "definitions.metal",
+                                             "functions.glsl", "functions.hlsl", "functions.metal", "functions.wgsl",
                                              "scattering.ktx2", "skybake.json", "transmittance.ktx2"}));
   const Manifest manifest = ReadManifest(lut);
   ASSERT_TRUE(manifest.luts.scene.has_value());

@@ -28,9 +28,10 @@
 import { spawnSync } from 'node:child_process';
 import crypto from 'node:crypto';
 import fs from 'node:fs';
-import { createRequire } from 'node:module';
 import path from 'node:path';
-import { fileURLToPath, pathToFileURL } from 'node:url';
+import { fileURLToPath } from 'node:url';
+
+import { importInstalled, installPinned } from '../../scripts/npm_pinned.mjs';
 
 const SKIP = 77;
 
@@ -68,46 +69,15 @@ function writeSamples(testsExe, sampleDir) {
   if (!/\[ {2}PASSED {2}\] 1 test/.test(run.stdout)) fail(`the sample writer did not run:\n${run.stdout}`);
 }
 
-// npm errors that mean "no registry here", as opposed to a broken lock file.
-const NETWORK_ERROR = /ENOTFOUND|EAI_AGAIN|ECONNREFUSED|ECONNRESET|ETIMEDOUT|ENETUNREACH|EHOSTUNREACH|socket hang up|network|fetch failed|E50[234]/i;
-
 function installParser(workDir) {
   const here = path.dirname(fileURLToPath(import.meta.url));
-  const dependencies = JSON.parse(fs.readFileSync(path.join(here, 'package.json'), 'utf8')).dependencies;
-  const pinned = dependencies['ktx-parse'];
-  for (const file of ['package.json', 'package-lock.json']) {
-    const source = fs.readFileSync(path.join(here, file));
-    const target = path.join(workDir, file);
-    if (!fs.existsSync(target) || !fs.readFileSync(target).equals(source)) fs.writeFileSync(target, source);
-  }
-  const installedVersion = (name) => {
-    const manifest = path.join(workDir, 'node_modules', name, 'package.json');
-    return fs.existsSync(manifest) ? JSON.parse(fs.readFileSync(manifest, 'utf8')).version : null;
-  };
-  if (Object.entries(dependencies).some(([name, version]) => installedVersion(name) !== version)) {
-    const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
-    const run = spawnSync(npm, ['ci', '--no-audit', '--no-fund', '--loglevel=error', '--fetch-retries=1'], {
-      cwd: workDir,
-      encoding: 'utf8',
-      timeout: 240000,
-    });
-    if (run.error && run.error.code === 'ENOENT') skip('npm is not installed');
-    if (run.error && run.error.code === 'ETIMEDOUT') skip('npm ci timed out (registry unreachable?)');
-    if (run.error) fail(`cannot run npm: ${run.error.message}`);
-    const output = `${run.stdout}\n${run.stderr}`.trim();
-    if (run.status !== 0) {
-      if (NETWORK_ERROR.test(output)) skip(`the npm registry is unavailable:\n${output}`);
-      fail(`npm ci failed:\n${output}`);
-    }
-  }
-  return pinned;
+  return installPinned(here, workDir, { skip, fail })['ktx-parse'];
 }
 
 // ktx-parse, with fzstd's Zstandard decoder as parser.inflateZstd.
 async function importParser(workDir) {
-  const require = createRequire(path.join(workDir, 'package.json'));
-  const parser = await import(pathToFileURL(require.resolve('ktx-parse')).href);
-  const fzstd = await import(pathToFileURL(require.resolve('fzstd')).href);
+  const parser = await importInstalled(workDir, 'ktx-parse');
+  const fzstd = await importInstalled(workDir, 'fzstd');
   return { ...parser, inflateZstd: fzstd.decompress };
 }
 

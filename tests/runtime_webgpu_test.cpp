@@ -1,0 +1,130 @@
+// The WGSL runtime (the shipped translation, shaders_runtime/generated/) run as
+// a compute shader on a real WebGPU implementation, Dawn (the npm package
+// webgpu, tests/runtime_webgpu/run_wgsl.mjs), over the queries of
+// runtime_gl_test.cpp, against the CPU twin at that test's tolerances.
+// Dawn runs here on OpenGL ES (llvmpipe) at the compatibility feature level,
+// which cannot filter float32 textures: the tables go up as rgba16float, and
+// the twin reads the same half-rounded tables.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bake/config.h"
+#include "report/quality_ladder.h"
+#include "shaders_runtime/snippet.h"
+#include "tests/runtime_queries.h"
+#include "tests/test_atmospheres.h"
+#include "tests/test_util.h"
+
+namespace skybake {
+namespace {
+
+// The test's compute main() in WGSL, the same switch as runtime_gl_test.cpp's
+// kMain. The runtime's functions.wgsl expects the engine to declare
+// skybake_linear_sampler.
+const char* const kWgslMain = R"(
+@group(0) @binding(0) var transmittance_texture: texture_2d<f32>;
+@group(0) @binding(1) var scattering_texture: texture_3d<f32>;
+@group(0) @binding(2) var single_mie_scattering_texture: texture_3d<f32>;
+@group(0) @binding(3) var irradiance_texture: texture_2d<f32>;
+@group(0) @binding(4) var<storage, read> skybake_inputs: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> skybake_outputs: array<vec4<f32>>;
+@group(0) @binding(6) var skybake_linear_sampler: sampler;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+  let item = id.x;
+  if (item >= arrayLength(&skybake_outputs)) { return; }
+  let a = skybake_inputs[4u * item];
+  let camera = a.xyz;
+  let view = skybake_inputs[4u * item + 1u].xyz;
+  let sun = skybake_inputs[4u * item + 2u].xyz;
+  let shadow_length = skybake_inputs[4u * item + 2u].w;
+  let extra = skybake_inputs[4u * item + 3u].xyz;
+  let what = i32(a.w);
+  var t = vec3<f32>(0.0);
+  var sky = vec3<f32>(0.0);
+  var v = vec3<f32>(0.0);
+  if (what <= 1) {
+    v = GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
+                       camera, view, sun, &t);
+    if (what == 1) { v = t; }
+  } else if (what <= 3) {
+    v = GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
+                              camera, extra, sun, &t);
+    if (what == 3) { v = t; }
+  } else if (what <= 5) {
+    v = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, camera, extra, sun, &sky);
+    if (what == 5) { v = sky; }
+  } else if (what == 6) {
+    v = GetTransmittanceToSun(ATMOSPHERE, transmittance_texture, length(camera), dot(camera, sun) / length(camera));
+  } else if (what == 7) {
+    v = GetSolarRadiance(ATMOSPHERE);
+  } else {
+    v = GetSkyRadianceToPointWithShadow(ATMOSPHERE, transmittance_texture, scattering_texture,
+                                        single_mie_scattering_texture, camera, extra, shadow_length, sun, &t);
+  }
+  skybake_outputs[item] = vec4<f32>(v, 1.0);
+}
+)";
+
+void WriteFloats(const std::filesystem::path& file, const float* values, size_t count) {
+  std::ofstream out(file, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(values), static_cast<std::streamsize>(count * sizeof(float)));
+}
+
+TEST(RuntimeOnWebGpu, WgslMatchesTheCppTwin) {
+  if (std::string(SKYBAKE_NODE_EXECUTABLE).empty()) GTEST_SKIP() << "node is not installed";
+  const LutSet luts =
+      report::RoundToHalf(Bake(LoadAtmosphere("earth"), testing::RuntimeTestSettings(false)));
+  const std::vector<testing::RuntimeQuery> queries =
+      testing::MakeRuntimeQueries(luts.parameters.bottom_radius, luts.parameters.top_radius);
+  ASSERT_GE(queries.size(), 1000u);
+
+  testing::TempDir dir;
+  nlohmann::json job = {{"shader", "runtime.wgsl"}, {"inputs", "inputs.f32"}, {"items", queries.size()},
+                        {"output", "outputs.f32"},  {"input_binding", 4},   {"output_binding", 5},
+                        {"sampler_binding", 6},     {"textures", nlohmann::json::array()}};
+  testing::WriteText(dir.path() / "runtime.wgsl",
+                     RuntimeSnippetSource(ShadingLanguage::kWgsl, luts.parameters, luts.atmosphere.wavelengths_nm,
+                                          luts.atmosphere.name) +
+                         kWgslMain);
+  const glsl::Texture* tables[] = {&luts.transmittance, &luts.scattering, &luts.single_mie_scattering,
+                                   &luts.irradiance};
+  for (int binding = 0; binding < 4; ++binding) {
+    const glsl::Texture& t = *tables[binding];
+    const std::string file = "texture" + std::to_string(binding) + ".f32";
+    WriteFloats(dir.path() / file, t.texels.data(), t.texels.size());
+    job["textures"].push_back(
+        {{"binding", binding}, {"width", t.width}, {"height", t.height}, {"depth", t.depth}, {"file", file}});
+  }
+  const std::vector<std::array<float, 4>> inputs = testing::RuntimeQueryInputs(queries);
+  WriteFloats(dir.path() / "inputs.f32", inputs[0].data(), inputs.size() * 4);
+  testing::WriteText(dir.path() / "job.json", job.dump(2));
+
+  const std::filesystem::path script = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/runtime_webgpu/run_wgsl.mjs";
+  std::string out, err;
+  const int status = testing::RunCommand(testing::ShellQuote(SKYBAKE_NODE_EXECUTABLE) + " " +
+                                             testing::ShellQuote(script) + " --work-dir " +
+                                             testing::ShellQuote(SKYBAKE_NPM_WORK_DIR "/runtime_webgpu") +
+                                             " --job " + testing::ShellQuote(dir.path()),
+                                         dir, &out, &err);
+  if (status == 77) GTEST_SKIP() << out << err;
+  ASSERT_EQ(status, 0) << out << err;
+
+  std::ifstream in(dir.path() / "outputs.f32", std::ios::binary);
+  std::vector<std::array<float, 4>> outputs(queries.size());
+  in.read(reinterpret_cast<char*>(outputs.data()), static_cast<std::streamsize>(outputs.size() * sizeof(outputs[0])));
+  ASSERT_TRUE(in) << "the runner wrote too few outputs";
+  std::string device = out.substr(0, out.find('\n'));
+  testing::ExpectMatchesTwin("WGSL on " + device, luts, queries, outputs);
+}
+
+}  // namespace
+}  // namespace skybake
