@@ -10,8 +10,9 @@ packages=(
   libceres-dev libglm-dev libtbb-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libssl-dev libzstd-dev
   libgtest-dev libbenchmark-dev
-  glslang-tools fonts-dejavu-core
+  glslang-tools spirv-cross fonts-dejavu-core
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
+  libvulkan-dev mesa-vulkan-drivers
   nodejs
 )
 

@@ -5,4 +5,4 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 node "$root/shaders_runtime/translate/translate.mjs" --out "$root/shaders_runtime/generated" \
-  --work-dir "${SKYBAKE_NPM_WORK_DIR:-$root/build/runtime_translate}"
+  --work-dir "${SKYBAKE_NPM_WORK_DIR:-$root/build/tests/npm/runtime_translate}"

@@ -3,6 +3,10 @@
 // source of every function body; the translations are generated files.
 //
 //   node translate.mjs --out <dir> --work-dir <dir>
+//   node translate.mjs --check <dir> --work-dir <dir>
+//
+// --check translates into a scratch folder and fails, naming the files, if
+// <dir> (the committed shaders_runtime/generated) differs: a stale translation.
 //
 // - HLSL and MSL: glslang compiles the runtime, with reachability_main.glsl as
 //   a compute entry point, to SPIR-V; spirv-cross translates it. Each
@@ -46,7 +50,8 @@ function parseArgs(argv) {
     if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
     args[argv[i].slice(2)] = argv[i + 1];
   }
-  for (const required of ['out', 'work-dir']) if (!args[required]) fail(`missing --${required}`);
+  if (!args['work-dir']) fail('missing --work-dir');
+  if (!args.out === !args.check) fail('give one of --out and --check');
   return args;
 }
 
@@ -204,6 +209,18 @@ async function main() {
   const scratch = fs.mkdtempSync(path.join(os.tmpdir(), 'skybake-translate-'));
   try {
     const files = { ...translateThroughSpirv(scratch), ...(await translateWgsl(workDir)) };
+    if (args.check) {
+      const committed = fs.readdirSync(args.check).sort();
+      const stale = Object.keys(files).filter(
+        (name) => !committed.includes(name) || fs.readFileSync(path.join(args.check, name), 'utf8') !== files[name]);
+      const extra = committed.filter((name) => !(name in files));
+      if (stale.length || extra.length) {
+        fail(`${args.check} is stale: ${[...stale, ...extra].join(', ')} differ from a fresh translation; ` +
+             'run scripts/translate_runtime.sh');
+      }
+      console.log(`${Object.keys(files).join(', ')}: identical to a fresh translation`);
+      return;
+    }
     fs.mkdirSync(args.out, { recursive: true });
     for (const [name, text] of Object.entries(files)) fs.writeFileSync(path.join(args.out, name), text);
     console.log(`wrote ${Object.keys(files).join(', ')} to ${args.out}`);
