@@ -1,7 +1,8 @@
-// The engine-loading example (examples/engine): on a small bake it renders,
-// through OpenGL ES on Mesa (headless), the fisheye sky and the aerial view
-// that `skybake render` draws through the CPU twin, and the two agree; on a
-// scene's bake it draws what the pruned snippet can.
+// The engine examples (examples/engine): on a small bake each renders,
+// headless, through OpenGL ES on Mesa or a Vulkan compute shader on lavapipe,
+// the fisheye sky and the aerial view that `skybake render` draws through the
+// CPU twin, and they agree; on a scene's bake each draws what the pruned
+// snippet can.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -27,7 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-#ifdef SKYBAKE_ENGINE_EXAMPLE_EXE
+#if defined(SKYBAKE_ENGINE_EXAMPLE_EXE) || defined(SKYBAKE_VULKAN_EXAMPLE_EXE)
 
 render::Image ReadExr(const fs::path& path) {
   auto input = OIIO::ImageInput::open(path.string());
@@ -42,14 +43,6 @@ render::Image ReadExr(const fs::path& path) {
   for (std::size_t i = 0; i < std::size_t(spec.width) * spec.height; ++i)
     for (int c = 0; c < 3; ++c) image.rgb[3 * i + c] = pixels[i * spec.nchannels + c];
   return image;
-}
-
-// The example under test, quoted for a shell: SKYBAKE_TEST_ENGINE_EXAMPLE_EXE
-// points the tests at another build (for example an older one, to see a
-// regression test fail there).
-std::string EngineExample() {
-  const char* other = std::getenv("SKYBAKE_TEST_ENGINE_EXAMPLE_EXE");
-  return testing::ShellQuote(other != nullptr && *other != '\0' ? other : SKYBAKE_ENGINE_EXAMPLE_EXE);
 }
 
 const char* const kSmallBake =
@@ -110,7 +103,7 @@ void ExpectViewMatchesTwin(const Twin& twin, render::View view, const render::Vi
   std::cout << name << ": " << compared << " values, max relative difference GPU vs twin " << worst << "\n";
 }
 
-TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
+void ExpectRendersTheViewsOfSkybakeRender(const std::string& example, const char* no_device) {
   testing::TempDir dir;
   const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
   std::string err;
@@ -118,10 +111,10 @@ TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
                                 nullptr, &err),
             0)
       << err;
-  int code = testing::RunCommand(EngineExample() + " " + testing::ShellQuote(lut) + " " +
+  int code = testing::RunCommand(example + " " + testing::ShellQuote(lut) + " " +
                                      testing::ShellQuote(images) + " --size 64 --sun-zenith 60 --sun-azimuth 30",
                                  dir, nullptr, &err);
-  if (code == 3 && err.find("no headless OpenGL") != std::string::npos) GTEST_SKIP() << err;
+  if (code == 3 && err.find(no_device) != std::string::npos) GTEST_SKIP() << err;
   ASSERT_EQ(code, 0) << err;
 
   const LutSet luts = LoadLutSet(lut);
@@ -140,7 +133,7 @@ TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
 // no irradiance table and so no GetSunAndSkyIrradiance. The example draws
 // the sky as the twin does and the ground lit by the direct sun only: the
 // twin's aerial view with an irradiance table of zeros (no sky light).
-TEST(NewcomerDefects, D03_EngineExampleLoadsSceneBake) {
+void ExpectDrawsWhatASceneBakeHolds(const std::string& example, const char* no_device) {
   testing::TempDir dir;
   const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
   const std::string scene = std::string(SKYBAKE_SOURCE_DIR) + "/examples/scenes/ground-daytime-game.toml";
@@ -152,10 +145,10 @@ TEST(NewcomerDefects, D03_EngineExampleLoadsSceneBake) {
       << err;
   LutSet luts = LoadLutSet(lut);
   ASSERT_TRUE(luts.irradiance.empty());
-  int code = testing::RunCommand(EngineExample() + " " + testing::ShellQuote(lut) + " " +
+  int code = testing::RunCommand(example + " " + testing::ShellQuote(lut) + " " +
                                      testing::ShellQuote(images) + " --size 64 --sun-zenith 60 --sun-azimuth 30",
                                  dir, nullptr, &err);
-  if (code == 3 && err.find("no headless OpenGL") != std::string::npos) GTEST_SKIP() << err;
+  if (code == 3 && err.find(no_device) != std::string::npos) GTEST_SKIP() << err;
   ASSERT_EQ(code, 0) << err;
   EXPECT_NE(err.find("direct sun only"), std::string::npos) << err;
 
@@ -171,10 +164,9 @@ TEST(NewcomerDefects, D03_EngineExampleLoadsSceneBake) {
     ExpectViewMatchesTwin(twin, view, settings, images);
 }
 
-TEST(EngineExample, BadInputIsOneLineAndAnExitCodeWithNothingWritten) {
+void ExpectBadInputIsOneLineAndAnExitCode(const std::string& example) {
   testing::TempDir dir;
   const fs::path images = dir.path() / "images";
-  const std::string example = EngineExample();
   struct Case {
     std::string arguments;
     int code;
@@ -191,6 +183,32 @@ TEST(EngineExample, BadInputIsOneLineAndAnExitCodeWithNothingWritten) {
   }
 }
 
+
+#endif
+
+#ifdef SKYBAKE_ENGINE_EXAMPLE_EXE
+
+// The example under test, quoted for a shell: SKYBAKE_TEST_ENGINE_EXAMPLE_EXE
+// points the tests at another build (for example an older one, to see a
+// regression test fail there).
+std::string EngineExample() {
+  const char* other = std::getenv("SKYBAKE_TEST_ENGINE_EXAMPLE_EXE");
+  return testing::ShellQuote(other != nullptr && *other != '\0' ? other : SKYBAKE_ENGINE_EXAMPLE_EXE);
+}
+
+TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
+  ExpectRendersTheViewsOfSkybakeRender(EngineExample(), "no headless OpenGL");
+}
+
+TEST(NewcomerDefects, D03_EngineExampleLoadsSceneBake) {
+  ExpectDrawsWhatASceneBakeHolds(EngineExample(), "no headless OpenGL");
+}
+
+TEST(EngineExample, BadInputIsOneLineAndAnExitCodeWithNothingWritten) {
+  ExpectBadInputIsOneLineAndAnExitCode(EngineExample());
+}
+
+
 #else
 
 TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
@@ -199,6 +217,30 @@ TEST(EngineExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
 
 TEST(NewcomerDefects, D03_EngineExampleLoadsSceneBake) {
   GTEST_SKIP() << "the engine example was not built (no EGL or OpenGL ES 3 headers)";
+}
+
+#endif
+
+#ifdef SKYBAKE_VULKAN_EXAMPLE_EXE
+
+// The Vulkan example (a compute shader, the snippet compiled to SPIR-V) draws
+// the same pictures, on lavapipe here.
+TEST(VulkanExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
+  ExpectRendersTheViewsOfSkybakeRender(testing::ShellQuote(SKYBAKE_VULKAN_EXAMPLE_EXE), "no Vulkan device");
+}
+
+TEST(VulkanExample, DrawsWhatASceneBakeHolds) {
+  ExpectDrawsWhatASceneBakeHolds(testing::ShellQuote(SKYBAKE_VULKAN_EXAMPLE_EXE), "no Vulkan device");
+}
+
+TEST(VulkanExample, BadInputIsOneLineAndAnExitCodeWithNothingWritten) {
+  ExpectBadInputIsOneLineAndAnExitCode(testing::ShellQuote(SKYBAKE_VULKAN_EXAMPLE_EXE));
+}
+
+#else
+
+TEST(VulkanExample, RendersTheViewsOfSkybakeRenderOnTheGpu) {
+  GTEST_SKIP() << "the Vulkan example was not built (no Vulkan headers and loader, or no glslangValidator)";
 }
 
 #endif

@@ -17,16 +17,15 @@
 #include <vector>
 
 #include "bake/config.h"
+#include "examples/engine/vulkan_compute.h"
 #include "shaders_runtime/snippet.h"
 #include "tests/runtime_queries.h"
 #include "tests/test_atmospheres.h"
 #include "tests/test_util.h"
-#include "tests/vulkan_compute.h"
 
 namespace skybake {
 namespace {
 
-using testing::VulkanCompute;
 
 // The test's compute main() in Vulkan GLSL: explicit bindings as an engine
 // declares them, the same switch as runtime_gl_test.cpp's kMain.
@@ -170,7 +169,7 @@ class RuntimeOnVulkan : public ::testing::Test {
     ASSERT_GE(queries.size(), 1000u);
     const auto samplers = hlsl ? VulkanCompute::Samplers::kSeparate : VulkanCompute::Samplers::kCombined;
     testing::ExpectMatchesTwin(std::string(hlsl ? "HLSL" : "Vulkan GLSL 4.50") + " on " + vk->Description(), luts,
-                               queries, vk->Run(spirv, samplers, testing::RuntimeQueryInputs(queries), 4));
+                               queries, vk->Run(spirv, samplers, testing::RuntimeQueryInputs(queries), queries.size()));
   }
 
   static LutSet* luts_;

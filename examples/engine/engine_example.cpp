@@ -38,127 +38,36 @@
 #include "formats/table_file.h"
 #include "render/image_files.h"
 #include "render/views.h"
+#include "examples/engine/example_views.h"
 
 namespace fs = std::filesystem;
-using skybake::kPi;
 using skybake::glsl::vec3;
+using namespace skybake::engine_example;
 
 namespace {
 
-constexpr double kDegree = kPi / 180.0;
-constexpr double kAerialPitchDeg = 7.0;  // as render/views.cpp
-
-// The shader an engine would write around the snippet: one ray per pixel,
-// sky (with the sun's disc) where it misses the ground, lit ground seen
-// through the atmosphere where it hits it. The pixel-to-ray mappings and the
-// shading are those of render/views.cpp.
-//
-// A scene's bake (examples/scenes/README.md) ships a pruned snippet:
-// atmosphere_constants.glsl sets SKYBAKE_HAS_SCATTERING_TEXTURE,
-// SKYBAKE_HAS_IRRADIANCE_TEXTURE and SKYBAKE_HAS_AERIAL_PERSPECTIVE, and
-// functions.glsl compiles only the functions whose tables exist, so the
-// shader calls a function only under its macro and draws what the set holds:
-//   no scattering table:  a black sky (the sun's disc still dims through the
-//                         air by the transmittance table);
-//   no aerial perspective: the ground unveiled (no in-scattering, no
-//                         extinction between it and the camera);
-//   no irradiance table:  the ground lit by the direct sun only (as
-//                         GetSunAndSkyIrradiance computes it, without the sky
-//                         term), as an engine that lights it by its own
-//                         probes would have them add the rest.
-const char* const kFragmentMain = R"(
+// The fragment shader an engine would write around the snippet: the view's
+// values as uniforms, the shading of pixel_radiance.glsl.
+const char* const kFragmentUniforms = R"(
 uniform sampler2D transmittance_texture;
 uniform sampler3D scattering_texture;
 uniform sampler3D single_mie_scattering_texture;
 uniform sampler2D irradiance_texture;
-uniform int view;           // 0: fisheye, 1: aerial
+uniform int view;
 uniform vec2 image_size;
 uniform float camera_altitude;
 uniform vec3 sun_direction;
-uniform vec3 forward;       // aerial camera basis
+uniform vec3 forward;
 uniform vec3 right;
 uniform vec3 camera_up;
 uniform vec3 ground_albedo;
-uniform float cos_disc;     // the drawn sun disc: at least one pixel wide,
-uniform float disc_scale;   // its radiance scaled to keep the sun's irradiance
+uniform float cos_disc;
+uniform float disc_scale;
 out vec4 radiance_out;
-
-vec3 Sky(vec3 camera, vec3 dir, out vec3 transmittance) {
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-  return GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
-                        camera, dir, sun_direction, transmittance);
-#else
-  float r = ClampRadius(ATMOSPHERE, length(camera));
-  transmittance = GetTransmittanceToTopAtmosphereBoundary(ATMOSPHERE, transmittance_texture, r,
-                                                          ClampCosine(dot(camera, dir) / length(camera)));
-  return vec3(0.0);
-#endif
-}
-
-vec3 GroundLight(vec3 point, vec3 normal) {
-#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
-  vec3 sky_irradiance;
-  vec3 sun_irradiance = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, point, normal,
-                                               sun_direction, sky_irradiance);
-  return sun_irradiance + sky_irradiance;
-#else
-  float r = ClampRadius(ATMOSPHERE, length(point));
-  float mu_s = ClampCosine(dot(point, sun_direction) / length(point));
-  return ATMOSPHERE.solar_irradiance * GetTransmittanceToSun(ATMOSPHERE, transmittance_texture, r, mu_s) *
-         max(dot(normal, sun_direction), 0.0);
-#endif
-}
-
-vec3 AerialPerspective(vec3 camera, vec3 point, out vec3 transmittance) {
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-  return GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
-                               camera, point, sun_direction, transmittance);
-#else
-  transmittance = vec3(1.0);
-  return vec3(0.0);
-#endif
-}
-
+)";
+const char* const kFragmentMain = R"(
 void main() {
-  // Pixel centre, measured from the image's top-left corner.
-  vec2 p = vec2(gl_FragCoord.x, image_size.y - gl_FragCoord.y);
-  vec3 dir;
-  if (view == 0) {
-    vec2 d = (image_size.x / 2.0 - p) / (image_size.x / 2.0);
-    float rho = length(d);
-    if (rho > 1.0) {
-      radiance_out = vec4(0.0, 0.0, 0.0, 1.0);
-      return;
-    }
-    float theta = rho * PI / 2.0;
-    float phi = atan(d.y, d.x);
-    dir = vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
-  } else {
-    float u = 2.0 * p.x / image_size.x - 1.0;
-    float v = (1.0 - 2.0 * p.y / image_size.y) * (image_size.y / image_size.x);
-    dir = normalize(forward + right * u + camera_up * v);
-  }
-  float bottom = ATMOSPHERE.bottom_radius;
-  vec3 camera = vec3(0.0, 0.0, bottom + camera_altitude);
-  // Distance to the ground, in the form without cancellation: products of
-  // radii near 6.4e6 m would lose everything in float.
-  float b = camera.z * dir.z;
-  float c = camera_altitude * (2.0 * bottom + camera_altitude);
-  float disc = b * b - c;
-  vec3 radiance;
-  if (b < 0.0 && disc >= 0.0) {
-    float t = c / (sqrt(disc) - b);
-    vec3 normal = normalize(camera + dir * t);
-    vec3 point = normal * bottom;
-    vec3 transmittance;
-    vec3 inscatter = AerialPerspective(camera, point, transmittance);
-    radiance = ground_albedo / PI * GroundLight(point, normal) * transmittance + inscatter;
-  } else {
-    vec3 transmittance;
-    radiance = Sky(camera, dir, transmittance);
-    if (dot(dir, sun_direction) > cos_disc) radiance += GetSolarRadiance(ATMOSPHERE) * transmittance * disc_scale;
-  }
-  radiance_out = vec4(radiance, 1.0);
+  radiance_out = vec4(PixelRadiance(vec2(gl_FragCoord.x, image_size.y - gl_FragCoord.y)), 1.0);
 }
 )";
 
@@ -169,16 +78,6 @@ void main() {
   gl_Position = vec4(p, 0.0, 1.0);
 }
 )";
-
-struct Arguments {
-  std::string lut_dir;
-  std::string output_dir;
-  double sun_zenith_deg = 30.0;
-  double sun_azimuth_deg = 0.0;
-  int size = 256;
-  double altitude_m = 100.0;
-  std::string format;  // empty: what LoadLutSet prefers
-};
 
 // A current OpenGL ES 3.0 context on EGL's surfaceless platform (the
 // approach of tests/gl_context.cpp); rendering goes to framebuffer objects.
@@ -274,37 +173,10 @@ GLuint CompileShader(GLenum type, const std::string& source) {
   return shader;
 }
 
-// The snippet exactly as the bake shipped it, in the documented order.
-std::string ShippedSnippet(const fs::path& lut_dir) {
-  std::string source;
-  for (const char* file : {"definitions.glsl", "atmosphere_constants.glsl", "functions.glsl"})
-    source += skybake::ReadFileText(lut_dir / file);
-  return source;
-}
-
 void Run(const Arguments& args) {
-  if (args.size < 4 || args.size > 4096) throw skybake::UsageError("--size must be in 4..4096");
-  if (!(args.altitude_m >= 0.0 && args.altitude_m <= 1e5)) throw skybake::UsageError("--altitude must be in 0..1e5 m");
-  if (!(args.sun_zenith_deg >= 0.0 && args.sun_zenith_deg <= 180.0))
-    throw skybake::UsageError("--sun-zenith must be in 0..180 degrees");
-  if (!std::isfinite(args.sun_azimuth_deg)) throw skybake::UsageError("--sun-azimuth must be a finite angle");
-  skybake::LoadOptions load_options;
-  if (!args.format.empty()) {
-    load_options.format = skybake::ParseFileFormat(args.format);
-    if (!load_options.format) throw skybake::UsageError("--format must be ktx2 or exr, not '" + args.format + "'");
-  }
-  const fs::path lut_dir(args.lut_dir);
-  const skybake::LutSet luts = skybake::LoadLutSet(lut_dir, load_options);
-  const std::string snippet = ShippedSnippet(lut_dir);
-
-  // What a scene's bake leaves out, and so what the shader draws without
-  // (kFragmentMain); the snippet's macros say the same.
-  const bool aerial_perspective = !luts.scene || luts.scene->effects.aerial_perspective;
-  if (luts.scattering.empty()) std::fputs("skybake_engine_example: no scattering table: the sky is black\n", stderr);
-  if (!aerial_perspective)
-    std::fputs("skybake_engine_example: no aerial-perspective functions: the ground is drawn unveiled\n", stderr);
-  if (luts.irradiance.empty())
-    std::fputs("skybake_engine_example: no irradiance table: the ground is lit by the direct sun only\n", stderr);
+  const LoadedSet set = LoadSet(args);
+  const skybake::LutSet& luts = set.luts;
+  const std::vector<View> views = MakeViews(args, luts);
 
   HeadlessContext context;
   const skybake::glsl::Texture& single_mie =
@@ -324,7 +196,8 @@ void Run(const Arguments& args) {
   for (const Binding& b : bindings) textures.push_back(b.table->empty() ? 0 : UploadTable(*b.table));
 
   GLuint vertex = CompileShader(GL_VERTEX_SHADER, kVertexShader);
-  GLuint fragment = CompileShader(GL_FRAGMENT_SHADER, "#version 300 es\n" + snippet + kFragmentMain);
+  GLuint fragment = CompileShader(GL_FRAGMENT_SHADER, "#version 300 es\n" + set.snippet + kFragmentUniforms +
+                                                          PixelRadianceGlsl() + kFragmentMain);
   GLuint program = glCreateProgram();
   glAttachShader(program, vertex);
   glAttachShader(program, fragment);
@@ -344,43 +217,22 @@ void Run(const Arguments& args) {
   glGenVertexArrays(1, &vao);
   glBindVertexArray(vao);
 
-  const double sz = args.sun_zenith_deg * kDegree, az = args.sun_azimuth_deg * kDegree;
-  const vec3 sun(std::sin(sz) * std::cos(az), std::sin(sz) * std::sin(az), std::cos(sz));
-  const double pitch = kAerialPitchDeg * kDegree;
-  const vec3 level(std::cos(az), std::sin(az), 0.0), up(0.0, 0.0, 1.0);
-  const vec3 forward = level * std::cos(pitch) - up * std::sin(pitch);
-  const vec3 right(std::sin(az), -std::cos(az), 0.0);
-  const vec3 camera_up = level * std::sin(pitch) + up * std::cos(pitch);
   auto uniform3 = [&](const char* name, const vec3& v) {
     glUniform3f(glGetUniformLocation(program, name), float(v.x), float(v.y), float(v.z));
   };
-  uniform3("sun_direction", sun);
-  uniform3("forward", forward);
-  uniform3("right", right);
-  uniform3("camera_up", camera_up);
-  uniform3("ground_albedo", vec3(luts.atmosphere.ground_albedo));
-  glUniform1f(glGetUniformLocation(program, "camera_altitude"), float(args.altitude_m));
-
-  const skybake::render::ToneMap tone{3.3, skybake::render::WhiteBalance(luts.parameters.solar_irradiance)};
-  const fs::path out_dir(args.output_dir);
-  skybake::EnsureWritableDirectory(out_dir);
-  struct ViewSpec {
-    const char* name;
-    int view;
-    int height;
-    double pixel_angle;  // as render/views.cpp, for the drawn sun disc
-  };
-  const ViewSpec views[] = {{"fisheye", 0, args.size, kPi / args.size},
-                            {"aerial", 1, std::max(1, args.size / 4), (kPi / 2) / args.size}};
   std::vector<skybake::render::Image> rendered;
-  for (const ViewSpec& v : views) {
-    const int width = args.size, height = v.height;
-    double sun_radius = luts.parameters.sun_angular_radius;
-    double cos_disc = std::cos(std::max(sun_radius, v.pixel_angle));
+  for (const View& v : views) {
+    const int width = v.width, height = v.height;
     glUniform1i(glGetUniformLocation(program, "view"), v.view);
     glUniform2f(glGetUniformLocation(program, "image_size"), float(width), float(height));
-    glUniform1f(glGetUniformLocation(program, "cos_disc"), float(cos_disc));
-    glUniform1f(glGetUniformLocation(program, "disc_scale"), float((1.0 - std::cos(sun_radius)) / (1.0 - cos_disc)));
+    glUniform1f(glGetUniformLocation(program, "camera_altitude"), v.camera_altitude);
+    uniform3("sun_direction", v.sun_direction);
+    uniform3("forward", v.forward);
+    uniform3("right", v.right);
+    uniform3("camera_up", v.camera_up);
+    uniform3("ground_albedo", v.ground_albedo);
+    glUniform1f(glGetUniformLocation(program, "cos_disc"), v.cos_disc);
+    glUniform1f(glGetUniformLocation(program, "disc_scale"), v.disc_scale);
 
     // The render target is created on a unit of its own: units 0-3 hold the tables.
     GLuint target = 0, framebuffer = 0;
@@ -410,21 +262,12 @@ void Run(const Arguments& args) {
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
         const float* in = &rgba[4 * (std::size_t(height - 1 - y) * width + x)];
-        for (int c = 0; c < 3; ++c) {
-          if (!std::isfinite(in[c])) throw skybake::InternalError(std::string(v.name) + ": a pixel is not finite");
-          image.rgb[3 * (std::size_t(y) * width + x) + c] = in[c];
-        }
+        for (int c = 0; c < 3; ++c) image.rgb[3 * (std::size_t(y) * width + x) + c] = in[c];
       }
     }
     rendered.push_back(std::move(image));
   }
-  // Written only once every view has rendered, each file atomically.
-  for (std::size_t i = 0; i < rendered.size(); ++i) {
-    const skybake::render::Attributes attributes = {{"skybake:view", views[i].name}};
-    skybake::render::WriteLinearExr(out_dir / (std::string(views[i].name) + ".exr"), rendered[i], attributes);
-    skybake::render::WritePng(out_dir / (std::string(views[i].name) + ".png"),
-                              skybake::render::ToneMapToSrgb(rendered[i], tone), attributes);
-  }
+  WriteViews(args, luts, views, rendered);
   glDeleteVertexArrays(1, &vao);
   glDeleteProgram(program);
   glDeleteShader(vertex);
@@ -436,33 +279,8 @@ void Run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Loads a baked set, uploads it to OpenGL ES 3.0 (headless, EGL surfaceless) and renders the "
-               "fisheye sky and the aerial view of the ground with the shipped GLSL snippet, to EXR and PNG."};
-  app.name("skybake_engine_example");
-  Arguments args;
-  app.add_option("LUT_DIR", args.lut_dir, "A directory written by skybake bake")->required();
-  app.add_option("OUT_DIR", args.output_dir, "Where to write fisheye.{exr,png} and aerial.{exr,png}")->required();
-  app.add_option("--sun-zenith", args.sun_zenith_deg, "Sun zenith angle, degrees")->capture_default_str();
-  app.add_option("--sun-azimuth", args.sun_azimuth_deg, "Sun azimuth (the aerial view looks toward it), degrees")
-      ->capture_default_str();
-  app.add_option("--size", args.size, "Image width in pixels (the aerial view is a quarter as high)")
-      ->capture_default_str();
-  app.add_option("--altitude", args.altitude_m, "Camera altitude, metres")->capture_default_str();
-  app.add_option("--format", args.format, "Table files to read: ktx2 or exr (default: KTX2 if listed)");
-  try {
-    app.parse(argc, argv);
-    Run(args);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "skybake_engine_example: %s (see --help)\n", e.what());
-    return static_cast<int>(skybake::ExitCode::kUsage);
-  } catch (const skybake::Error& e) {
-    std::fprintf(stderr, "skybake_engine_example: %s\n", e.what());
-    return static_cast<int>(e.code());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "skybake_engine_example: internal error: %s\n", e.what());
-    return static_cast<int>(skybake::ExitCode::kInternal);
-  }
-  return 0;
+  return RunExample(argc, argv, "skybake_engine_example",
+                    "Loads a baked set, uploads it to OpenGL ES 3.0 (headless, EGL surfaceless) and renders the "
+                    "fisheye sky and the aerial view of the ground with the shipped GLSL snippet, to EXR and PNG.",
+                    Run);
 }

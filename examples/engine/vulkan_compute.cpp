@@ -1,4 +1,4 @@
-#include "tests/vulkan_compute.h"
+#include "examples/engine/vulkan_compute.h"
 
 #include <cstring>
 #include <stdexcept>
@@ -7,7 +7,7 @@
 #include <vulkan/vulkan.h>
 #endif
 
-namespace skybake::testing {
+namespace skybake {
 
 #if SKYBAKE_HAVE_VULKAN
 
@@ -42,9 +42,80 @@ struct VulkanCompute::Impl {
   };
   Texture textures[kTextureCount];
 
+  // The pipeline of the last Run, kept for the next one with the same shader
+  // (compiling it is most of a run's time on lavapipe).
+  struct Pipeline {
+    std::vector<std::uint32_t> spirv;
+    Samplers samplers = Samplers::kCombined;
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+  } cached;
+
+  void DestroyPipeline(Pipeline* p) {
+    if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
+    if (p->module) vkDestroyShaderModule(device, p->module, nullptr);
+    if (p->layout) vkDestroyPipelineLayout(device, p->layout, nullptr);
+    if (p->set_layout) vkDestroyDescriptorSetLayout(device, p->set_layout, nullptr);
+    *p = Pipeline{};
+  }
+
+  // The pipeline for `spirv` and `samplers`: the cached one, or a new one.
+  const Pipeline& PipelineFor(const std::vector<std::uint32_t>& spirv, Samplers samplers) {
+    if (cached.pipeline && cached.spirv == spirv && cached.samplers == samplers) return cached;
+    DestroyPipeline(&cached);
+    Pipeline p;
+    p.spirv = spirv;
+    p.samplers = samplers;
+    const bool combined = samplers == Samplers::kCombined;
+    for (int i = 0; i < kTextureCount; ++i) {
+      p.bindings.push_back({uint32_t(i),
+                            combined ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1,
+                            VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    }
+    for (int b : {kInputBinding, kOutputBinding}) {
+      p.bindings.push_back({uint32_t(b), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    }
+    if (!combined) {
+      p.bindings.push_back(
+          {uint32_t(kSamplerBinding), VK_DESCRIPTOR_TYPE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    }
+    try {
+      VkDescriptorSetLayoutCreateInfo set_layout_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+      set_layout_info.bindingCount = uint32_t(p.bindings.size());
+      set_layout_info.pBindings = p.bindings.data();
+      Check(vkCreateDescriptorSetLayout(device, &set_layout_info, nullptr, &p.set_layout),
+            "vkCreateDescriptorSetLayout");
+      VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+      layout_info.setLayoutCount = 1;
+      layout_info.pSetLayouts = &p.set_layout;
+      Check(vkCreatePipelineLayout(device, &layout_info, nullptr, &p.layout), "vkCreatePipelineLayout");
+      VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+      module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
+      module_info.pCode = spirv.data();
+      Check(vkCreateShaderModule(device, &module_info, nullptr, &p.module), "vkCreateShaderModule");
+      VkComputePipelineCreateInfo pipeline_info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+      pipeline_info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+      pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+      pipeline_info.stage.module = p.module;
+      pipeline_info.stage.pName = "main";
+      pipeline_info.layout = p.layout;
+      Check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &p.pipeline),
+            "vkCreateComputePipelines");
+    } catch (...) {
+      DestroyPipeline(&p);
+      throw;
+    }
+    cached = std::move(p);
+    return cached;
+  }
+
   ~Impl() {
     if (device) {
       vkDeviceWaitIdle(device);
+      DestroyPipeline(&cached);
       for (Texture& t : textures) DestroyTexture(&t);
       if (sampler) vkDestroySampler(device, sampler, nullptr);
       if (pool) vkDestroyCommandPool(device, pool, nullptr);
@@ -255,69 +326,30 @@ void VulkanCompute::SetTexture(int binding, int width, int height, int depth, co
   Check(vkCreateImageView(d.device, &view_info, nullptr, &t.view), "vkCreateImageView");
 }
 
-std::vector<Vec4> VulkanCompute::Run(const std::vector<std::uint32_t>& spirv, Samplers samplers,
-                                     const std::vector<Vec4>& inputs, int inputs_per_item) {
+std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint32_t>& spirv, Samplers samplers,
+                                                    const std::vector<std::array<float, 4>>& inputs,
+                                                    std::size_t items) {
   Impl& d = *impl_;
   for (const Impl::Texture& t : d.textures) {
     if (!t.view) throw std::runtime_error("every texture binding needs a texture before Run");
   }
-  const size_t items = inputs.size() / inputs_per_item;
   if (items == 0) return {};
+  if (inputs.empty()) throw std::runtime_error("a compute run needs inputs");
   const bool combined = samplers == Samplers::kCombined;
 
-  std::vector<VkDescriptorSetLayoutBinding> bindings;
-  for (int i = 0; i < kTextureCount; ++i) {
-    bindings.push_back({uint32_t(i),
-                        combined ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1,
-                        VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  }
-  for (int b : {kInputBinding, kOutputBinding}) {
-    bindings.push_back({uint32_t(b), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  }
-  if (!combined) {
-    bindings.push_back({uint32_t(kSamplerBinding), VK_DESCRIPTOR_TYPE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  }
+  const Impl::Pipeline& p = d.PipelineFor(spirv, samplers);
 
   // Everything created here is destroyed at the end, also on an error.
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-  VkShaderModule module = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
   Impl::Buffer input_buffer, output_buffer;
   auto release = [&] {
     if (descriptor_pool) vkDestroyDescriptorPool(d.device, descriptor_pool, nullptr);
-    if (pipeline) vkDestroyPipeline(d.device, pipeline, nullptr);
-    if (module) vkDestroyShaderModule(d.device, module, nullptr);
-    if (pipeline_layout) vkDestroyPipelineLayout(d.device, pipeline_layout, nullptr);
-    if (set_layout) vkDestroyDescriptorSetLayout(d.device, set_layout, nullptr);
     d.DestroyBuffer(&input_buffer);
     d.DestroyBuffer(&output_buffer);
   };
   try {
-    VkDescriptorSetLayoutCreateInfo set_layout_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    set_layout_info.bindingCount = uint32_t(bindings.size());
-    set_layout_info.pBindings = bindings.data();
-    Check(vkCreateDescriptorSetLayout(d.device, &set_layout_info, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
-    VkPipelineLayoutCreateInfo pipeline_layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    pipeline_layout_info.setLayoutCount = 1;
-    pipeline_layout_info.pSetLayouts = &set_layout;
-    Check(vkCreatePipelineLayout(d.device, &pipeline_layout_info, nullptr, &pipeline_layout), "vkCreatePipelineLayout");
-    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
-    module_info.pCode = spirv.data();
-    Check(vkCreateShaderModule(d.device, &module_info, nullptr, &module), "vkCreateShaderModule");
-    VkComputePipelineCreateInfo pipeline_info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    pipeline_info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeline_info.stage.module = module;
-    pipeline_info.stage.pName = "main";
-    pipeline_info.layout = pipeline_layout;
-    Check(vkCreateComputePipelines(d.device, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
-          "vkCreateComputePipelines");
-
-    input_buffer = d.MakeBuffer(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, inputs.size() * sizeof(Vec4), inputs.data());
-    output_buffer = d.MakeBuffer(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, items * sizeof(Vec4), nullptr);
+    input_buffer = d.MakeBuffer(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, inputs.size() * sizeof(inputs[0]), inputs.data());
+    output_buffer = d.MakeBuffer(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, items * sizeof(inputs[0]), nullptr);
 
     std::vector<VkDescriptorPoolSize> sizes = {
         {combined ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, kTextureCount},
@@ -331,7 +363,7 @@ std::vector<Vec4> VulkanCompute::Run(const std::vector<std::uint32_t>& spirv, Sa
     VkDescriptorSetAllocateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     set_info.descriptorPool = descriptor_pool;
     set_info.descriptorSetCount = 1;
-    set_info.pSetLayouts = &set_layout;
+    set_info.pSetLayouts = &p.set_layout;
     VkDescriptorSet set;
     Check(vkAllocateDescriptorSets(d.device, &set_info, &set), "vkAllocateDescriptorSets");
 
@@ -347,7 +379,7 @@ std::vector<Vec4> VulkanCompute::Run(const std::vector<std::uint32_t>& spirv, Sa
       w.dstSet = set;
       w.dstBinding = uint32_t(i);
       w.descriptorCount = 1;
-      w.descriptorType = bindings[i].descriptorType;
+      w.descriptorType = p.bindings[i].descriptorType;
       w.pImageInfo = &image_infos[i];
       writes.push_back(w);
     }
@@ -372,8 +404,8 @@ std::vector<Vec4> VulkanCompute::Run(const std::vector<std::uint32_t>& spirv, Sa
     vkUpdateDescriptorSets(d.device, uint32_t(writes.size()), writes.data(), 0, nullptr);
 
     d.Submit([&](VkCommandBuffer commands) {
-      vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-      vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1, &set, 0, nullptr);
+      vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+      vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
       vkCmdDispatch(commands, uint32_t((items + 63) / 64), 1, 1);
       VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
@@ -381,7 +413,7 @@ std::vector<Vec4> VulkanCompute::Run(const std::vector<std::uint32_t>& spirv, Sa
       vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier,
                            0, nullptr, 0, nullptr);
     });
-    std::vector<Vec4> outputs(items);
+    std::vector<std::array<float, 4>> outputs(items);
     void* mapped;
     Check(vkMapMemory(d.device, output_buffer.memory, 0, output_buffer.size, 0, &mapped), "vkMapMemory");
     std::memcpy(outputs.data(), mapped, output_buffer.size);
@@ -405,7 +437,8 @@ std::unique_ptr<VulkanCompute> VulkanCompute::Create(std::string* why_not) {
   return nullptr;
 }
 void VulkanCompute::SetTexture(int, int, int, int, const std::vector<float>&) {}
-std::vector<Vec4> VulkanCompute::Run(const std::vector<std::uint32_t>&, Samplers, const std::vector<Vec4>&, int) {
+std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint32_t>&, Samplers,
+                                                    const std::vector<std::array<float, 4>>&, std::size_t) {
   return {};
 }
 std::string VulkanCompute::Description() const { return {}; }
@@ -415,4 +448,4 @@ std::string VulkanCompute::Description() const { return {}; }
 VulkanCompute::VulkanCompute() : impl_(std::make_unique<Impl>()) {}
 VulkanCompute::~VulkanCompute() = default;
 
-}  // namespace skybake::testing
+}  // namespace skybake

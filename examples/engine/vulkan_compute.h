@@ -1,29 +1,31 @@
-// A headless Vulkan device for tests that run compute shaders on a real
-// driver (Mesa's lavapipe here: Vulkan on the CPU) and read the results back.
+// A headless Vulkan device that runs one compute shader over a number of
+// items with the runtime's four tables bound, and reads one vec4 per item
+// back: what the Vulkan engine example (vulkan_example.cpp) renders with, and
+// what the runtime tests run the Vulkan GLSL and the HLSL on. No window
+// system or GPU is needed: Mesa's lavapipe runs Vulkan on the CPU.
 //
 // Typical use:
 //   std::string why;
-//   auto vk = skybake::testing::VulkanCompute::Create(&why);
-//   if (!vk) GTEST_SKIP() << why;
+//   auto vk = skybake::VulkanCompute::Create(&why);
+//   if (!vk) ... why says what is missing
 //   vk->SetTexture(0, width, height, 1, rgba);
-//   auto out = vk->Run(spirv, VulkanCompute::Samplers::kCombined, inputs, 4);
+//   auto out = vk->Run(spirv, VulkanCompute::Samplers::kCombined, inputs, items);
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
-namespace skybake::testing {
-
-using Vec4 = std::array<float, 4>;
+namespace skybake {
 
 class VulkanCompute {
  public:
   // The tables' bindings are 0 to kTextureCount - 1.
   static constexpr int kTextureCount = 4;
-  static constexpr int kInputBinding = 4;    // readonly buffer of vec4: the items' inputs
+  static constexpr int kInputBinding = 4;    // readonly buffer of vec4: the shader's inputs
   static constexpr int kOutputBinding = 5;   // buffer of vec4: one per item
   static constexpr int kSamplerBinding = 6;  // with Samplers::kSeparate
 
@@ -47,12 +49,12 @@ class VulkanCompute {
   void SetTexture(int binding, int width, int height, int depth, const std::vector<float>& rgba);
 
   // Runs the compute shader `spirv` (entry point "main", 64 invocations per
-  // workgroup in x) over inputs.size() / inputs_per_item items: invocation i
-  // reads inputs i*inputs_per_item ... and writes output i; invocations past
-  // the last item must write nothing (the output buffer's length is the item
-  // count). Throws std::runtime_error on any Vulkan error.
-  std::vector<Vec4> Run(const std::vector<std::uint32_t>& spirv, Samplers samplers, const std::vector<Vec4>& inputs,
-                        int inputs_per_item);
+  // workgroup in x) over `items` items: invocation i writes output i,
+  // reading what it needs of `inputs`; invocations past the last item must
+  // write nothing (the output buffer's length is the item count). Throws
+  // std::runtime_error on any Vulkan error.
+  std::vector<std::array<float, 4>> Run(const std::vector<std::uint32_t>& spirv, Samplers samplers,
+                                        const std::vector<std::array<float, 4>>& inputs, std::size_t items);
 
  private:
   struct Impl;
@@ -60,4 +62,4 @@ class VulkanCompute {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace skybake::testing
+}  // namespace skybake
