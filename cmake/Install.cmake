@@ -34,7 +34,8 @@ foreach(dir core bake formats shaders_runtime)
 endforeach()
 install(FILES ${PROJECT_BINARY_DIR}/generated/core/version.h DESTINATION ${SKYBAKE_INSTALL_INCLUDEDIR}/core)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/shaders_runtime/ DESTINATION ${CMAKE_INSTALL_DATADIR}/skybake/shaders_runtime
-        FILES_MATCHING PATTERN "*.glsl" PATTERN "README.md")
+        FILES_MATCHING PATTERN "*.glsl" PATTERN "*.hlsl" PATTERN "*.metal" PATTERN "*.wgsl" PATTERN "README.md"
+        PATTERN "translate" EXCLUDE)
 
 install(EXPORT skybakeTargets NAMESPACE skybake:: DESTINATION ${SKYBAKE_INSTALL_CMAKEDIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/skybakeConfig.cmake.in
