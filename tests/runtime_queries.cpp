@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -11,6 +14,7 @@
 #include "shaders_runtime/query.h"
 #include "shaders_runtime/runtime.h"
 #include "tests/test_atmospheres.h"
+#include "tests/test_util.h"
 
 namespace skybake::testing {
 
@@ -190,5 +194,36 @@ void ExpectMatchesTwin(const std::string& description, const LutSet& luts, const
   for (const auto& [group, value] : worst_by_group) std::cout << "  group " << group << ": " << value << "\n";
 }
 
+
+std::vector<std::uint32_t> CompileToSpirv(const std::string& source, bool hlsl, std::string* log) {
+  TempDir dir;
+  const std::filesystem::path file = dir.path() / (hlsl ? "runtime.hlsl" : "runtime.comp");
+  const std::filesystem::path spirv = dir.path() / "runtime.spv";
+  WriteText(file, source);
+  const std::string command = ShellQuote(SKYBAKE_GLSLANG_VALIDATOR) + " -V -S comp " +
+                              (hlsl ? "-D -e main " : "") + "-o " + ShellQuote(spirv) + " " +
+                              ShellQuote(file);
+  if (RunCommand(command, dir, log) != 0) return {};
+  std::ifstream in(spirv, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::uint32_t> words(bytes.size() / 4);
+  std::memcpy(words.data(), bytes.data(), words.size() * 4);
+  return words;
+}
+
+int RunWgslJob(const std::filesystem::path& job_dir, std::string* output) {
+  if (std::string(SKYBAKE_NODE_EXECUTABLE).empty()) {
+    *output = "node is not installed";
+    return 77;
+  }
+  TempDir dir;
+  const std::filesystem::path script = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/runtime_webgpu/run_wgsl.mjs";
+  std::string out, err;
+  const int status = RunCommand(ShellQuote(SKYBAKE_NODE_EXECUTABLE) + " " + ShellQuote(script) + " --work-dir " +
+                                    ShellQuote(SKYBAKE_NPM_WORK_DIR "/runtime_webgpu") + " --job " + ShellQuote(job_dir),
+                                dir, &out, &err);
+  *output = out + err;
+  return status;
+}
 
 }  // namespace skybake::testing

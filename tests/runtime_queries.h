@@ -4,6 +4,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -57,5 +59,13 @@ glsl::vec3 EvaluateTwin(const LutSet& luts, const RuntimeQuery& query);
 // differences under `description`.
 void ExpectMatchesTwin(const std::string& description, const LutSet& luts, const std::vector<RuntimeQuery>& queries,
                        const std::vector<std::array<float, 4>>& outputs);
+
+// glslangValidator's SPIR-V for a compute shader in GLSL or HLSL (entry point
+// main), or empty with the compiler's log in `log`.
+std::vector<std::uint32_t> CompileToSpirv(const std::string& source, bool hlsl, std::string* log);
+
+// Runs tests/runtime_webgpu/run_wgsl.mjs on the job in `job_dir` (its
+// job.json); returns its exit code (77: skipped) with its output in `output`.
+int RunWgslJob(const std::filesystem::path& job_dir, std::string* output);
 
 }  // namespace skybake::testing

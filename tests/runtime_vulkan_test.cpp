@@ -118,24 +118,6 @@ void main(uint3 id : SV_DispatchThreadID) {
 }
 )";
 
-// glslangValidator's SPIR-V for a compute shader in GLSL or HLSL, or empty
-// with its log in `log`.
-std::vector<std::uint32_t> CompileToSpirv(const std::string& source, bool hlsl, std::string* log) {
-  testing::TempDir dir;
-  const std::filesystem::path file = dir.path() / (hlsl ? "runtime.hlsl" : "runtime.comp");
-  const std::filesystem::path spirv = dir.path() / "runtime.spv";
-  testing::WriteText(file, source);
-  const std::string command = testing::ShellQuote(SKYBAKE_GLSLANG_VALIDATOR) + " -V -S comp " +
-                              (hlsl ? "-D -e main " : "") + "-o " + testing::ShellQuote(spirv) + " " +
-                              testing::ShellQuote(file);
-  if (testing::RunCommand(command, dir, log) != 0) return {};
-  std::ifstream in(spirv, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::vector<std::uint32_t> words(bytes.size() / 4);
-  std::memcpy(words.data(), bytes.data(), words.size() * 4);
-  return words;
-}
-
 std::string RuntimeSource(ShadingLanguage language, const LutSet& luts, const SnippetParts& parts = {}) {
   return RuntimeSnippetSource(language, luts.parameters, luts.atmosphere.wavelengths_nm, luts.atmosphere.name, parts);
 }
@@ -162,7 +144,7 @@ class RuntimeOnVulkan : public ::testing::Test {
       vk->SetTexture(binding, t.width, t.height, t.depth, t.texels);
     }
     std::string log;
-    const std::vector<std::uint32_t> spirv = CompileToSpirv(source, hlsl, &log);
+    const std::vector<std::uint32_t> spirv = testing::CompileToSpirv(source, hlsl, &log);
     ASSERT_FALSE(spirv.empty()) << log;
     const std::vector<testing::RuntimeQuery> queries =
         testing::MakeRuntimeQueries(luts.parameters.bottom_radius, luts.parameters.top_radius);
@@ -212,7 +194,7 @@ TEST(RuntimeHlsl, SceneSwitchesLeaveOutTheFunctionsOfMissingTables) {
                    std::to_string(parts.irradiance) + " aerial " + std::to_string(parts.aerial_perspective) +
                    ", calling " + calls[k]);
       std::string log;
-      EXPECT_EQ(!CompileToSpirv(shader(parts, calls[k]), true, &log).empty(), has[k]) << log;
+      EXPECT_EQ(!testing::CompileToSpirv(shader(parts, calls[k]), true, &log).empty(), has[k]) << log;
     }
   }
 }

@@ -80,7 +80,6 @@ void WriteFloats(const std::filesystem::path& file, const float* values, size_t 
 }
 
 TEST(RuntimeOnWebGpu, WgslMatchesTheCppTwin) {
-  if (std::string(SKYBAKE_NODE_EXECUTABLE).empty()) GTEST_SKIP() << "node is not installed";
   const LutSet luts =
       report::RoundToHalf(Bake(LoadAtmosphere("earth"), testing::RuntimeTestSettings(false)));
   const std::vector<testing::RuntimeQuery> queries =
@@ -108,15 +107,10 @@ TEST(RuntimeOnWebGpu, WgslMatchesTheCppTwin) {
   WriteFloats(dir.path() / "inputs.f32", inputs[0].data(), inputs.size() * 4);
   testing::WriteText(dir.path() / "job.json", job.dump(2));
 
-  const std::filesystem::path script = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/runtime_webgpu/run_wgsl.mjs";
-  std::string out, err;
-  const int status = testing::RunCommand(testing::ShellQuote(SKYBAKE_NODE_EXECUTABLE) + " " +
-                                             testing::ShellQuote(script) + " --work-dir " +
-                                             testing::ShellQuote(SKYBAKE_NPM_WORK_DIR "/runtime_webgpu") +
-                                             " --job " + testing::ShellQuote(dir.path()),
-                                         dir, &out, &err);
-  if (status == 77) GTEST_SKIP() << out << err;
-  ASSERT_EQ(status, 0) << out << err;
+  std::string out;
+  const int status = testing::RunWgslJob(dir.path(), &out);
+  if (status == 77) GTEST_SKIP() << out;
+  ASSERT_EQ(status, 0) << out;
 
   std::ifstream in(dir.path() / "outputs.f32", std::ios::binary);
   std::vector<std::array<float, 4>> outputs(queries.size());

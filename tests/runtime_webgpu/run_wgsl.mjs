@@ -5,9 +5,10 @@
 //   node run_wgsl.mjs --work-dir <dir> --job <dir>
 //
 // <job>/job.json names the shader (entry point "main", workgroup size 64),
-// the inputs (float32, inputs_per_item vec4 per item), the textures
-// (float32 RGBA texels, x fastest, already representable as half floats) and
-// the output file, which receives one vec4 of float32 per item.
+// the inputs (float32 vec4s), the textures (float32 RGBA texels, x fastest,
+// already representable as half floats) and the output file, which receives
+// one vec4 of float32 per item. With "compile_only": true it names only the
+// shader, which must compile and make a compute pipeline.
 //
 // Dawn finds no Vulkan adapter on this Mesa; it runs on OpenGL ES
 // (EGL surfaceless, llvmpipe) at the WebGPU compatibility feature level.
@@ -90,6 +91,15 @@ async function main() {
   const messages = (await module.getCompilationInfo()).messages.filter((m) => m.type === 'error');
   if (messages.length) {
     fail(`the WGSL does not compile:\n${messages.map((m) => `${m.lineNum}:${m.linePos}: ${m.message}`).join('\n')}`);
+  }
+  if (job.compile_only) {
+    device.pushErrorScope('validation');
+    device.createComputePipeline({ layout: 'auto', compute: { module, entryPoint: 'main' } });
+    const error = await device.popErrorScope();
+    if (error) fail(`no compute pipeline: ${error.message}`);
+    console.log('compiles');
+    device.destroy();
+    process.exit(0);
   }
 
   const entries = [];
