@@ -28,32 +28,11 @@ import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
-import { importInstalled, installPinned } from '../../scripts/npm_pinned.mjs';
+import { importInstalled, installPinned, parseArgs, toolExits } from '../../scripts/node_tool.mjs';
 
-const SKIP = 77;
+const { skip, fail } = toolExits('runtime translation');
 const here = path.dirname(fileURLToPath(import.meta.url));
 const runtimeDir = path.dirname(here);
-
-function skip(message) {
-  console.log(`SKIPPED: runtime translation not run: ${message}`);
-  process.exit(SKIP);
-}
-
-function fail(message) {
-  console.error(`FAILED: ${message}`);
-  process.exit(1);
-}
-
-function parseArgs(argv) {
-  const args = {};
-  for (let i = 0; i < argv.length; i += 2) {
-    if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
-    args[argv[i].slice(2)] = argv[i + 1];
-  }
-  if (!args['work-dir']) fail('missing --work-dir');
-  if (!args.out === !args.check) fail('give one of --out and --check');
-  return args;
-}
 
 // The runtime's sources in their order of definition (snippet.h's
 // kRuntimeFunctionSources, read from there so the two cannot differ).
@@ -203,7 +182,8 @@ async function translateWgsl(workDir) {
 }
 
 async function main() {
-  const args = parseArgs(process.argv.slice(2));
+  const args = parseArgs(process.argv.slice(2), ['work-dir'], fail);
+  if (!args.out === !args.check) fail('give one of --out and --check');
   const workDir = path.resolve(args['work-dir']);
   fs.mkdirSync(workDir, { recursive: true });
   const scratch = fs.mkdtempSync(path.join(os.tmpdir(), 'skybake-translate-'));

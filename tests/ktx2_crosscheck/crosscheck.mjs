@@ -31,31 +31,9 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
-import { importInstalled, installPinned } from '../../scripts/npm_pinned.mjs';
+import { importInstalled, installPinned, parseArgs, toolExits } from '../../scripts/node_tool.mjs';
 
-const SKIP = 77;
-
-function skip(message) {
-  console.log(`SKIPPED: ktx2 cross-check not run: ${message}`);
-  process.exit(SKIP);
-}
-
-function fail(message) {
-  console.error(`FAILED: ${message}`);
-  process.exit(1);
-}
-
-function parseArgs(argv) {
-  const args = {};
-  for (let i = 0; i < argv.length; i += 2) {
-    if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
-    args[argv[i].slice(2)] = argv[i + 1];
-  }
-  for (const required of ['tests-exe', 'skybake-exe', 'work-dir']) {
-    if (!args[required]) fail(`missing --${required}`);
-  }
-  return args;
-}
+const { skip, fail } = toolExits('ktx2 cross-check');
 
 function writeSamples(testsExe, sampleDir) {
   fs.rmSync(sampleDir, { recursive: true, force: true });
@@ -387,7 +365,7 @@ function checkBakedSets(parser, skybakeExe, workDir) {
 }
 
 async function main() {
-  const args = parseArgs(process.argv.slice(2));
+  const args = parseArgs(process.argv.slice(2), ['tests-exe', 'skybake-exe', 'work-dir'], fail);
   const workDir = path.resolve(args['work-dir']);
   fs.mkdirSync(workDir, { recursive: true });
   const sampleDir = path.join(workDir, 'samples');

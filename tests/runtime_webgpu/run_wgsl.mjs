@@ -23,29 +23,9 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
-import { importInstalled, installPinned } from '../../scripts/npm_pinned.mjs';
+import { importInstalled, installPinned, parseArgs, toolExits } from '../../scripts/node_tool.mjs';
 
-const SKIP = 77;
-
-function skip(message) {
-  console.log(`SKIPPED: WGSL not run: ${message}`);
-  process.exit(SKIP);
-}
-
-function fail(message) {
-  console.error(`FAILED: ${message}`);
-  process.exit(1);
-}
-
-function parseArgs(argv) {
-  const args = {};
-  for (let i = 0; i < argv.length; i += 2) {
-    if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
-    args[argv[i].slice(2)] = argv[i + 1];
-  }
-  for (const required of ['work-dir', 'job']) if (!args[required]) fail(`missing --${required}`);
-  return args;
-}
+const { skip, fail } = toolExits('WGSL');
 
 // IEEE 754 binary16 bits of a float32 that is exactly representable as one.
 function halfBits(value) {
@@ -70,7 +50,7 @@ function readFloats(file) {
 }
 
 async function main() {
-  const args = parseArgs(process.argv.slice(2));
+  const args = parseArgs(process.argv.slice(2), ['work-dir', 'job'], fail);
   const here = path.dirname(fileURLToPath(import.meta.url));
   installPinned(here, path.resolve(args['work-dir']), { skip, fail });
   const { create, globals } = await importInstalled(path.resolve(args['work-dir']), 'webgpu');

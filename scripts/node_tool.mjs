@@ -1,14 +1,43 @@
-// Installs the npm packages a directory's package.json / package-lock.json
-// pin into a work directory (`npm ci`, skipped when the pinned versions are
-// already there) and imports them from it. Used by the node tools and checks
-// that need an npm package (tests/ktx2_crosscheck, shaders_runtime/translate,
-// tests/runtime_webgpu).
+// What skybake's node tools and checks share (tests/ktx2_crosscheck,
+// shaders_runtime/translate, tests/runtime_webgpu): their exits (0, 1 with
+// FAILED, 77 with SKIPPED, as ctest's SKIP_RETURN_CODE reads them), their
+// `--name value` arguments, and the npm packages they pin, installed into a
+// work directory (`npm ci`, skipped when the pinned versions are already
+// there) and imported from it.
 
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
+
+export const SKIP = 77;
+
+// skip(message) and fail(message) for the tool that does `what`.
+export function toolExits(what) {
+  return {
+    skip(message) {
+      console.log(`SKIPPED: ${what} not run: ${message}`);
+      process.exit(SKIP);
+    },
+    fail(message) {
+      console.error(`FAILED: ${message}`);
+      process.exit(1);
+    },
+  };
+}
+
+// `--name value` pairs as { name: value }; fail() on anything else or a
+// missing `required` name.
+export function parseArgs(argv, required, fail) {
+  const args = {};
+  for (let i = 0; i < argv.length; i += 2) {
+    if (!argv[i].startsWith('--') || i + 1 >= argv.length) fail(`bad arguments: ${argv.join(' ')}`);
+    args[argv[i].slice(2)] = argv[i + 1];
+  }
+  for (const name of required) if (!args[name]) fail(`missing --${name}`);
+  return args;
+}
 
 // npm errors that mean "no registry here", as opposed to a broken lock file.
 const NETWORK_ERROR = /ENOTFOUND|EAI_AGAIN|ECONNREFUSED|ECONNRESET|ETIMEDOUT|ENETUNREACH|EHOSTUNREACH|socket hang up|network|fetch failed|E50[234]/i;
