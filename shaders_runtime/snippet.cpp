@@ -29,7 +29,7 @@ struct ConstantSyntax {
   const char* struct_constant;   // declares ATMOSPHERE, up to its name
   const char* struct_open;       // after "ATMOSPHERE = "
   const char* struct_close;
-  const char* array_open;        // a profile array of ALTITUDE_PROFILE_SIZE vec3s
+  std::string array_open;        // a profile array of ALTITUDE_PROFILE_SIZE vec3s
   const char* array_close;
 };
 
@@ -41,7 +41,8 @@ const ConstantSyntax& Syntax(ShadingLanguage language) {
   static const ConstantSyntax msl_syntax{"metal", "float3(", "constant float3 ", "constant AtmosphereParameters ",
                                          "{", "}", "{", "}"};
   static const ConstantSyntax wgsl_syntax{"wgsl", "vec3<f32>(", "const ", "const ", "AtmosphereParameters(", ")",
-                                          "array<vec3<f32>, 64>(", ")"};
+                                          "array<vec3<f32>, " + std::to_string(glsl::ALTITUDE_PROFILE_SIZE) + ">(",
+                                          ")"};
   switch (language) {
     case ShadingLanguage::kGlsl: return glsl_syntax;
     case ShadingLanguage::kHlsl: return hlsl_syntax;
