@@ -1,5 +1,6 @@
 #include "shaders_runtime/snippet.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <stdexcept>
@@ -69,6 +70,33 @@ std::string_view EmbeddedShader(const std::string& name) {
   for (const EmbeddedText& file : kRuntimeShaderFiles)
     if (file.name == name) return file.text;
   throw std::logic_error("runtime shader " + name + " is not embedded");
+}
+
+// functions.wgsl without the functions whose tables `parts` leaves out.
+// WGSL has no preprocessor; translate.mjs marks each function that needs a
+// table with a line "// skybake: needs FLAG [&& FLAG]" before it, and naga
+// closes every function with a "}" line of its own.
+std::string WgslFunctionsFor(std::string_view text, const SnippetParts& parts) {
+  const std::pair<std::string_view, bool> switches[] = {{"SKYBAKE_HAS_SCATTERING_TEXTURE", parts.scattering},
+                                                        {"SKYBAKE_HAS_IRRADIANCE_TEXTURE", parts.irradiance},
+                                                        {"SKYBAKE_HAS_AERIAL_PERSPECTIVE", parts.aerial_perspective}};
+  constexpr std::string_view kMarker = "// skybake: needs ";
+  std::string out;
+  bool skipping = false;
+  for (size_t start = 0; start < text.size();) {
+    const size_t end = std::min(text.find('\n', start), text.size());
+    const std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    if (skipping) {
+      skipping = line != "}";
+      continue;
+    }
+    if (line.substr(0, kMarker.size()) == kMarker) {
+      for (const auto& [name, on] : switches) skipping = skipping || (!on && line.find(name) != std::string_view::npos);
+    }
+    if (!skipping) out.append(line).append("\n");
+  }
+  return out;
 }
 
 }  // namespace
@@ -164,9 +192,13 @@ std::vector<SnippetFile> RuntimeSnippetFiles(ShadingLanguage language, const gls
   SnippetFile constants{"atmosphere_constants." + ext,
                         AtmosphereConstants(language, parameters, wavelengths_nm, atmosphere_name, parts),
                         name + " runtime: this bake's constants (ATMOSPHERE)"};
-  SnippetFile functions{"functions." + ext,
-                        language == ShadingLanguage::kGlsl ? RuntimeFunctionsGlsl()
-                                                           : std::string(EmbeddedShader("functions." + ext)),
+  std::string functions_text;
+  switch (language) {
+    case ShadingLanguage::kGlsl: functions_text = RuntimeFunctionsGlsl(); break;
+    case ShadingLanguage::kWgsl: functions_text = WgslFunctionsFor(EmbeddedShader("functions.wgsl"), parts); break;
+    default: functions_text = EmbeddedShader("functions." + ext);  // #if on the switches, as the GLSL
+  }
+  SnippetFile functions{"functions." + ext, std::move(functions_text),
                         name + " runtime: sky radiance, aerial perspective, irradiance"};
   // WGSL declarations are order-independent: the structs travel with the functions.
   if (language == ShadingLanguage::kWgsl) return {std::move(constants), std::move(functions)};

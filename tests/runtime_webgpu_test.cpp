@@ -122,3 +122,54 @@ TEST(RuntimeOnWebGpu, WgslMatchesTheCppTwin) {
 
 }  // namespace
 }  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// A scene's WGSL leaves out the functions of the tables the scene does
+// without (WGSL has no preprocessor: the bake drops them by the marks the
+// translation puts on them), and what remains compiles on Dawn with a main()
+// that calls each function kept.
+TEST(RuntimeWgsl, SceneLeavesOutTheFunctionsOfMissingTables) {
+  const Atmosphere earth = LoadAtmosphere("earth");
+  const glsl::AtmosphereParameters p = MakeAtmosphereParameters(earth, testing::SmallBakeSettings());
+  struct Entry {
+    const char* function;
+    const char* call;
+  };
+  const Entry entries[] = {
+      {"fn GetSkyRadiance(", "GetSkyRadiance(ATMOSPHERE, t2, t3, t3, x, x, x, &t)"},
+      {"fn GetSunAndSkyIrradiance(", "GetSunAndSkyIrradiance(ATMOSPHERE, t2, t2, x, x, x, &t)"},
+      {"fn GetSkyRadianceToPoint(", "GetSkyRadianceToPoint(ATMOSPHERE, t2, t3, t3, x, x, x, &t)"}};
+  for (const SnippetParts parts : {SnippetParts{true, true, true}, SnippetParts{true, false, false},
+                                   SnippetParts{false, true, false}, SnippetParts{true, false, true}}) {
+    SCOPED_TRACE(std::string("scattering ") + std::to_string(parts.scattering) + " irradiance " +
+                 std::to_string(parts.irradiance) + " aerial " + std::to_string(parts.aerial_perspective));
+    const std::string wgsl = RuntimeSnippetSource(ShadingLanguage::kWgsl, p, earth.wavelengths_nm, earth.name, parts);
+    const bool has[] = {parts.scattering, parts.irradiance, parts.aerial_perspective};
+    std::string calls;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(wgsl.find(entries[k].function) != std::string::npos, has[k]) << entries[k].function;
+      if (has[k]) calls += "  v += " + std::string(entries[k].call) + ";\n";
+    }
+    EXPECT_NE(wgsl.find("fn GetTransmittanceToSun("), std::string::npos);
+    testing::TempDir dir;
+    testing::WriteText(dir.path() / "sky.wgsl",
+                       wgsl + "@group(0) @binding(0) var t2: texture_2d<f32>;\n"
+                              "@group(0) @binding(1) var t3: texture_3d<f32>;\n"
+                              "@group(0) @binding(2) var skybake_linear_sampler: sampler;\n"
+                              "@group(0) @binding(3) var<storage, read_write> o: array<vec4<f32>>;\n"
+                              "@compute @workgroup_size(1)\nfn main() {\n  let x = vec3<f32>(0.0, 0.0, 6.4e6);\n"
+                              "  var t = vec3<f32>(0.0);\n"
+                              "  var v = GetTransmittanceToSun(ATMOSPHERE, t2, 6.4e6, 0.5);\n" +
+                              calls + "  o[0] = vec4<f32>(v + t, 1.0);\n}\n");
+    testing::WriteText(dir.path() / "job.json", nlohmann::json{{"shader", "sky.wgsl"}, {"compile_only", true}}.dump());
+    std::string out;
+    const int status = testing::RunWgslJob(dir.path(), &out);
+    if (status == 77) GTEST_SKIP() << out;
+    EXPECT_EQ(status, 0) << out;
+  }
+}
+
+}  // namespace
+}  // namespace skybake

@@ -605,6 +605,7 @@ fn GetTransmittanceTextureUvFromRMu(atmosphere_20: AtmosphereParameters, r_22: f
     return vec2<f32>(_e54, _e58);
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringUnitMuS(atmosphere_22: AtmosphereParameters, mu_s_3: f32) -> f32 {
     var atmosphere_23: AtmosphereParameters;
     var mu_s_4: f32;
@@ -649,6 +650,7 @@ fn GetScatteringUnitMuS(atmosphere_22: AtmosphereParameters, mu_s_3: f32) -> f32
     return _e52;
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringTextureUMuS(atmosphere_24: AtmosphereParameters, mu_s_5: f32) -> f32 {
     var atmosphere_25: AtmosphereParameters;
     var mu_s_6: f32;
@@ -669,6 +671,7 @@ fn GetScatteringTextureUMuS(atmosphere_24: AtmosphereParameters, mu_s_5: f32) ->
     return _e24;
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringTextureUR(atmosphere_26: AtmosphereParameters, r_24: f32, rho_3: f32, ray_r_mu_intersects_ground_2: bool, x_mu_1: f32) -> f32 {
     var atmosphere_27: AtmosphereParameters;
     var r_25: f32;
@@ -758,6 +761,7 @@ fn GetScatteringTextureUR(atmosphere_26: AtmosphereParameters, r_24: f32, rho_3:
     return (((_e112 + _e113) + 0.5f) / (_e117 + 1f));
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_26: f32, mu_17: f32, mu_s_7: f32, nu_9: f32, ray_r_mu_intersects_ground_4: bool) -> vec4<f32> {
     var atmosphere_29: AtmosphereParameters;
     var r_27: f32;
@@ -878,6 +882,7 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_2
     return vec4<f32>(_e126, _e129, _e130, _e131);
 }
 
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
 fn GetIrradianceTextureUvFromRMuS(atmosphere_30: AtmosphereParameters, r_28: f32, mu_s_9: f32) -> vec2<f32> {
     var atmosphere_31: AtmosphereParameters;
     var r_29: f32;
@@ -1170,6 +1175,7 @@ fn SunBelowTableMix(a_7: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
     return _e29;
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringMuSColumns(atmosphere_44: AtmosphereParameters, u_mu_s: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
     var atmosphere_45: AtmosphereParameters;
     var u_mu_s_1: f32;
@@ -1205,6 +1211,7 @@ fn GetScatteringMuSColumns(atmosphere_44: AtmosphereParameters, u_mu_s: f32, x_b
     return;
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScattering(atmosphere_46: AtmosphereParameters, scattering_texture: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_15: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
     var atmosphere_47: AtmosphereParameters;
     var r_43: f32;
@@ -1297,6 +1304,7 @@ fn GetScattering(atmosphere_46: AtmosphereParameters, scattering_texture: textur
     return _e130;
 }
 
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
 fn GetIrradiance(atmosphere_48: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_17: f32) -> vec3<f32> {
     var atmosphere_49: AtmosphereParameters;
     var r_45: f32;
@@ -1356,6 +1364,7 @@ fn GetIrradiance(atmosphere_48: AtmosphereParameters, irradiance_texture: textur
     return vec3<f32>(_e90.xyz);
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn MiePhaseFunction(atmosphere_50: AtmosphereParameters, nu_13: f32) -> f32 {
     var atmosphere_51: AtmosphereParameters;
     var nu_14: f32;
@@ -1379,6 +1388,7 @@ fn MiePhaseFunction(atmosphere_50: AtmosphereParameters, nu_13: f32) -> f32 {
     return 0f;
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetCombinedScattering(atmosphere_52: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_19: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_53: AtmosphereParameters;
     var r_47: f32;
@@ -1436,6 +1446,7 @@ fn GetCombinedScattering(atmosphere_52: AtmosphereParameters, scattering_texture
     return vec3<f32>(_e69.xyz);
 }
 
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetSkyRadiance(atmosphere_54: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_55: AtmosphereParameters;
     var camera_5: vec3<f32>;
@@ -1501,6 +1512,7 @@ fn GetSkyRadiance(atmosphere_54: AtmosphereParameters, transmittance_texture_5: 
     return ((_e69 * _e71) + (_e73 * _e76));
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn DistanceInsideScatteringRadii(atmosphere_56: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
     var atmosphere_57: AtmosphereParameters;
     var r_50: f32;
@@ -1551,6 +1563,7 @@ fn DistanceInsideScatteringRadii(atmosphere_56: AtmosphereParameters, r_49: f32,
     return _e66;
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn ProfileSampleAltitude(atmosphere_58: AtmosphereParameters, i: i32) -> f32 {
     var atmosphere_59: AtmosphereParameters;
     var i_1: i32;
@@ -1567,6 +1580,7 @@ fn ProfileSampleAltitude(atmosphere_58: AtmosphereParameters, i: i32) -> f32 {
     return (((_e21.top_radius - _e23.bottom_radius) * _e26) * _e28);
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn InterpolateCoefficient(a_9: f32, b_4: f32, f: f32) -> f32 {
     var a_10: f32;
     var b_5: f32;
@@ -1594,6 +1608,7 @@ fn InterpolateCoefficient(a_9: f32, b_4: f32, f: f32) -> f32 {
     return _e36;
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn InterpolateCoefficients(a_11: vec3<f32>, b_6: vec3<f32>, f_2: f32) -> vec3<f32> {
     var a_12: vec3<f32>;
     var b_7: vec3<f32>;
@@ -1617,6 +1632,7 @@ fn InterpolateCoefficients(a_11: vec3<f32>, b_6: vec3<f32>, f_2: f32) -> vec3<f3
     return vec3<f32>(_e20, _e26, _e32);
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn GetCoefficientsAtAltitude(atmosphere_60: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_61: AtmosphereParameters;
     var altitude_1: f32;
@@ -1670,6 +1686,7 @@ fn GetCoefficientsAtAltitude(atmosphere_60: AtmosphereParameters, altitude: f32,
     return _e95;
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
     var local_11: f32;
@@ -1688,6 +1705,7 @@ fn MeanAttenuation(depth: f32) -> f32 {
     return _e27;
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_51: f32, mu_34: f32, mu_s_22: f32, nu_18: f32, d_15: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_63: AtmosphereParameters;
     var r_52: f32;
@@ -1845,6 +1863,7 @@ fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6
     return _e210;
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_65: AtmosphereParameters;
     var camera_7: vec3<f32>;
@@ -2118,6 +2137,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     return ((_e351 * _e353) + (_e355 * _e358));
 }
 
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn GetSkyRadianceToPoint(atmosphere_66: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_67: AtmosphereParameters;
     var camera_9: vec3<f32>;
@@ -2136,6 +2156,7 @@ fn GetSkyRadianceToPoint(atmosphere_66: AtmosphereParameters, transmittance_text
     return _e28;
 }
 
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
 fn GetSunAndSkyIrradiance(atmosphere_68: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_69: AtmosphereParameters;
     var point_5: vec3<f32>;

@@ -17,7 +17,9 @@
 //   function that disappears without a table is wrapped in `#if` on its flag.
 // - WGSL: naga (the npm package naga-wasm, pinned in package-lock.json and
 //   installed into <work-dir>) reads the GLSL with separate_samplers.glsl and
-//   writes WGSL. WGSL has no preprocessor: it ships every function.
+//   writes WGSL. WGSL has no preprocessor: the functions that need a table
+//   carry a marker line instead, found the same way, by which the bake
+//   leaves them out (snippet.cpp).
 //
 // Needs glslangValidator, spirv-cross, node and npm. Exit code 77: a tool or
 // the npm registry is unavailable.
@@ -51,6 +53,24 @@ const FLAGS = {
   SKYBAKE_HAS_IRRADIANCE_TEXTURE: [],
   SKYBAKE_HAS_AERIAL_PERSPECTIVE: [],
 };
+
+// The translations made to recover the switches: all tables, and without
+// each table (and what needs it).
+function variants() {
+  const result = { all: [] };
+  for (const [flag, implied] of Object.entries(FLAGS)) result[flag] = [flag, ...implied];
+  return result;
+}
+
+// The switches function `name` needs: those without which it is not in the
+// translation (namesWithout[flag]: the function names translated without
+// that table). Aerial perspective implies the scattering table.
+function requiredFlags(name, namesWithout) {
+  const needs = Object.keys(FLAGS).filter((flag) => !namesWithout[flag].has(name));
+  return needs.includes('SKYBAKE_HAS_AERIAL_PERSPECTIVE')
+    ? needs.filter((flag) => flag !== 'SKYBAKE_HAS_SCATTERING_TEXTURE')
+    : needs;
+}
 
 // The runtime as one GLSL 4.50 compute shader; `off` lists the switches set to 0.
 function runtimeGlsl(off, middle, tail) {
@@ -127,10 +147,8 @@ function header(comment, file, how) {
 // HLSL and MSL through SPIR-V and spirv-cross, with #if guards.
 function translateThroughSpirv(workDir) {
   const tail = read('translate/reachability_main.glsl');
-  const variants = { all: [] };
-  for (const [flag, implied] of Object.entries(FLAGS)) variants[flag] = [flag, ...implied];
   const translations = { hlsl: {}, msl: {} };
-  for (const [variant, off] of Object.entries(variants)) {
+  for (const [variant, off] of Object.entries(variants())) {
     const source = path.join(workDir, `runtime_${variant}.comp`);
     const spirv = path.join(workDir, `runtime_${variant}.spv`);
     fs.writeFileSync(source, runtimeGlsl(off, '', tail));
@@ -142,11 +160,10 @@ function translateThroughSpirv(workDir) {
   const files = {};
   for (const [language, byVariant] of Object.entries(translations)) {
     const all = byVariant.all;
+    const namesWithout = Object.fromEntries(Object.keys(FLAGS).map((flag) => [flag, byVariant[flag].functions]));
     const functions = [];
     for (const [name, text] of all.functions) {
-      let needs = Object.keys(FLAGS).filter((flag) => !byVariant[flag].functions.has(name));
-      // Aerial perspective implies the scattering table.
-      if (needs.includes('SKYBAKE_HAS_AERIAL_PERSPECTIVE')) needs = needs.filter((f) => f !== 'SKYBAKE_HAS_SCATTERING_TEXTURE');
+      const needs = requiredFlags(name, namesWithout);
       functions.push(needs.length ? `#if ${needs.join(' && ')}\n${text}\n#endif` : text);
     }
     const extension = language === 'hlsl' ? 'hlsl' : 'metal';
@@ -159,25 +176,39 @@ function translateThroughSpirv(workDir) {
   return files;
 }
 
-// WGSL through naga's GLSL front end.
+// WGSL through naga's GLSL front end. WGSL has no preprocessor, so each
+// function that needs a table is marked with a line
+// `// skybake: needs SKYBAKE_HAS_... [&& ...]` before it, which the bake reads
+// to leave the function out of a scene's set that lacks the table.
 async function translateWgsl(workDir) {
   installPinned(here, workDir, { skip, fail });
   const naga = await importInstalled(workDir, 'naga-wasm');
-  const source = runtimeGlsl([], read('translate/separate_samplers.glsl'), 'layout(local_size_x = 1) in;\nvoid main() {}\n');
-  let wgsl;
-  try {
-    const module = naga.parseGlsl(source, { stage: 'compute' });
-    wgsl = naga.writeWgsl(module, naga.validate(module));
-  } catch (error) {
-    fail(`naga: ${error.formatted ?? error}`);
+  const translate = (off) => {
+    const source = runtimeGlsl(off, read('translate/separate_samplers.glsl'),
+                               'layout(local_size_x = 1) in;\nvoid main() {}\n');
+    try {
+      const module = naga.parseGlsl(source, { stage: 'compute' });
+      return topLevelItems(naga.writeWgsl(module, naga.validate(module)))
+        .filter((item) => !/^fn main(_1)?\(|^@compute|var skybake_linear_sampler/m.test(item));
+    } catch (error) {
+      return fail(`naga: ${error.formatted ?? error}`);
+    }
+  };
+  const functionName = (item) => (item.match(/^fn (\w+)\(/m) || [])[1];
+  const namesWithout = {};
+  for (const [variant, off] of Object.entries(variants())) {
+    if (variant !== 'all') namesWithout[variant] = new Set(translate(off).map(functionName).filter(Boolean));
   }
-  const kept = topLevelItems(wgsl).filter(
-    (item) => !/^fn main(_1)?\(|^@compute|var skybake_linear_sampler/m.test(item));
+  const items = translate([]).map((item) => {
+    const name = functionName(item);
+    const needs = name ? requiredFlags(name, namesWithout) : [];
+    return needs.length ? `// skybake: needs ${needs.join(' && ')}\n${item}` : item;
+  });
   return {
     'functions.wgsl': header('//', 'functions.wgsl', `naga ${naga.nagaVersion}, GLSL front end, WGSL back end`) +
       '// Declare `@group(G) @binding(B) var skybake_linear_sampler: sampler;` (linear filtering, clamp to edge)\n' +
       '// in your module; the bake\'s atmosphere_constants.wgsl holds ATMOSPHERE and the SKYBAKE_HAS_* flags.\n' +
-      kept.join('\n\n') + '\n',
+      items.join('\n\n') + '\n',
   };
 }
 
