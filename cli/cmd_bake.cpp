@@ -50,6 +50,7 @@ std::vector<ShadingLanguage> ParseRuntimeLanguages(const std::vector<std::string
   if (names.size() == 1 && names[0] == "none") return {};
   std::vector<ShadingLanguage> languages;
   for (const std::string& name : names) {
+    if (name == "none") throw UsageError("--runtime: none cannot be combined with languages");
     const std::optional<ShadingLanguage> language = ParseShadingLanguage(name);
     if (!language) throw UsageError("--runtime: '" + name + "' is not glsl, hlsl, msl, wgsl or none");
     if (std::find(languages.begin(), languages.end(), *language) == languages.end()) languages.push_back(*language);

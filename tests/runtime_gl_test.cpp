@@ -145,7 +145,11 @@ TEST(RuntimeSnippet, BakeWritesTheLanguagesAskedFor) {
   EXPECT_TRUE(ReadManifest(dir.path() / "b").shader_files.empty());
   EXPECT_NE(testing::RunCommand(bake + testing::ShellQuote(dir.path() / "c") + " --runtime glsl,spirv", dir, nullptr, &err), 0);
   EXPECT_NE(err.find("--runtime: 'spirv' is not glsl, hlsl, msl, wgsl or none"), std::string::npos) << err;
+  EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "c"));
+  EXPECT_NE(testing::RunCommand(bake + testing::ShellQuote(dir.path() / "d") + " --runtime none,glsl", dir, nullptr, &err), 0);
+  EXPECT_NE(err.find("--runtime: none cannot be combined with languages"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "d"));
 }
 
 // ---- glslangValidator ----
