@@ -226,4 +226,11 @@ int RunWgslJob(const std::filesystem::path& job_dir, std::string* output) {
   return status;
 }
 
+int CompileWgsl(const std::string& source, std::string* output) {
+  TempDir dir;
+  WriteText(dir.path() / "shader.wgsl", source);
+  WriteText(dir.path() / "job.json", R"({"shader": "shader.wgsl", "compile_only": true})");
+  return RunWgslJob(dir.path(), output);
+}
+
 }  // namespace skybake::testing

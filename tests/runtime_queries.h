@@ -68,4 +68,8 @@ std::vector<std::uint32_t> CompileToSpirv(const std::string& source, bool hlsl, 
 // job.json); returns its exit code (77: skipped) with its output in `output`.
 int RunWgslJob(const std::filesystem::path& job_dir, std::string* output);
 
+// The same runner's compile-only job: `source` must compile on Dawn into a
+// compute pipeline (entry point main). Its exit code (77: skipped) and output.
+int CompileWgsl(const std::string& source, std::string* output);
+
 }  // namespace skybake::testing
