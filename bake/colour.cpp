@@ -1,48 +1,26 @@
 #include "bake/colour.h"
 
 #include <algorithm>
-#include <sstream>
+#include <cmath>
 #include <string>
 #include <string_view>
 
+#include "bake/spectral_data.h"
 #include "core/errors.h"
-#include "shaders_runtime/embedded_text.h"
 
 namespace skybake {
 
 namespace {
 
-// Reads one of data/*.csv: '#' comment lines, a header, then rows of a
-// wavelength and `columns` values on a uniform grid.
+// One of data/*.csv on a uniform wavelength grid.
 SpectralTable ReadTable(std::string_view name, int columns) {
-  const auto file = std::find_if(kSpectralDataFiles.begin(), kSpectralDataFiles.end(),
-                                 [&](const EmbeddedText& f) { return f.name == name; });
-  if (file == kSpectralDataFiles.end()) throw InternalError("no embedded data file " + std::string(name));
+  const SpectralData data = ReadSpectralData(name, columns);
   SpectralTable table;
-  std::istringstream in{std::string(file->text)};
-  std::vector<double> wavelengths;
-  bool header = true;
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    if (header) {
-      header = false;
-      continue;
-    }
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream row(line);
-    double wavelength = 0.0;
-    glm::dvec3 value(0.0);
-    row >> wavelength;
-    for (int c = 0; c < columns; ++c) row >> value[c];
-    if (!row) throw InternalError(std::string(name) + ": malformed row '" + line + "'");
-    wavelengths.push_back(wavelength);
-    table.values.push_back(value);
-  }
-  if (wavelengths.size() < 2) throw InternalError(std::string(name) + ": fewer than two rows");
-  table.first_nm = wavelengths.front();
-  table.step_nm = wavelengths[1] - wavelengths[0];
-  for (std::size_t i = 0; i < wavelengths.size(); ++i) {
-    if (std::abs(wavelengths[i] - table.WavelengthNm(i)) > 1e-9) {
+  table.first_nm = data.wavelength_nm.front();
+  table.step_nm = data.wavelength_nm[1] - data.wavelength_nm[0];
+  table.values = data.values;
+  for (std::size_t i = 0; i < data.wavelength_nm.size(); ++i) {
+    if (std::abs(data.wavelength_nm[i] - table.WavelengthNm(i)) > 1e-9) {
       throw InternalError(std::string(name) + ": wavelengths not on a uniform grid");
     }
   }

@@ -25,6 +25,7 @@
 #include <toml++/toml.h>
 
 #include "bake/physics.h"
+#include "bake/spectral_data.h"
 #include "bake/toml_input.h"
 #include "core/constants.h"
 #include "core/errors.h"
@@ -166,6 +167,9 @@ constexpr PhaseName kPhaseNames[] = {
     {"cornette-shanks", PhaseKind::kCornetteShanks},
 };
 
+// The published solar spectrum `sun.irradiance_w_m2_nm` can name.
+constexpr std::string_view kAstmG173 = "astm-g173";
+
 // The three table forms of a coefficient (see examples/atmospheres/README.md).
 enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex };
 struct CoefficientFormKeys {
@@ -279,11 +283,37 @@ class FileReader : public TomlReader {
         ReadSpectrum(Require(planet, "planet", "ground_albedo"), "planet.ground_albedo", kUnit);
   }
 
+  // The sun's irradiance at the wavelengths: a number, 3 numbers, or
+  // "astm-g173", the 10 nm bin means of the ASTM G173-03 extraterrestrial
+  // spectrum from each wavelength up (bake/spectral_data.h).
+  Spectrum ReadSolarIrradiance(const toml::node& node, const Spectrum& wavelengths_nm) const {
+    const std::string path = "sun.irradiance_w_m2_nm";
+    if (!node.is_string()) {
+      if (!node.is_number() && !node.is_array())
+        report_.Fail(path, "expected a number, an array of 3 numbers or \"" + std::string(kAstmG173) + "\", got " +
+                               TypeName(node));
+      return ReadSpectrum(node, path, kNonNegative);
+    }
+    const std::string name = **node.as_string();
+    if (name != kAstmG173) {
+      report_.Fail(path, "unknown spectrum \"" + name + "\" (expected \"" + std::string(kAstmG173) + "\")");
+    }
+    Spectrum irradiance;
+    for (int i = 0; i < kWavelengthCount; ++i) {
+      if (!(wavelengths_nm[i] >= 280.0 && wavelengths_nm[i] + 10.0 <= 4000.0)) {
+        report_.Fail(path, "\"" + std::string(kAstmG173) + "\" covers 280 to 4000 nm; a 10 nm bin from " +
+                               FormatNumber(wavelengths_nm[i]) + " nm is outside it");
+      }
+      irradiance[i] = AstmG173ExtraterrestrialBinMean(wavelengths_nm[i]);
+    }
+    return irradiance;
+  }
+
   void ReadSun(const toml::table& sun, Atmosphere& atmosphere) const {
     CheckKeys(sun, "sun", {"irradiance_w_m2_nm", "angular_radius_rad", "angular_radius_deg",
                            "lowest_zenith_deg", "mu_s_min"});
-    atmosphere.solar_irradiance = ReadSpectrum(Require(sun, "sun", "irradiance_w_m2_nm"),
-                                               "sun.irradiance_w_m2_nm", kNonNegative);
+    atmosphere.solar_irradiance =
+        ReadSolarIrradiance(Require(sun, "sun", "irradiance_w_m2_nm"), atmosphere.wavelengths_nm);
     auto [radius_key, radius] = ExactlyOne(sun, "sun", {"angular_radius_rad", "angular_radius_deg"});
     atmosphere.sun_angular_radius_rad =
         radius_key == 0 ? ReadNumber(*radius, "sun.angular_radius_rad", kSunRadiusRad)
