@@ -170,8 +170,8 @@ constexpr PhaseName kPhaseNames[] = {
 // The published solar spectrum `sun.irradiance_w_m2_nm` can name.
 constexpr std::string_view kAstmG173 = "astm-g173";
 
-// The three table forms of a coefficient (see examples/atmospheres/README.md).
-enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex };
+// The table forms of a coefficient (see examples/atmospheres/README.md).
+enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex, kTabulated };
 struct CoefficientFormKeys {
   CoefficientForm form;
   std::vector<std::string_view> keys;
@@ -181,10 +181,11 @@ const CoefficientFormKeys kCoefficientForms[] = {
     {CoefficientForm::kAngstrom, {"angstrom_reference", "reference_nm", "exponent"}},
     {CoefficientForm::kRefractiveIndex,
      {"refractive_index", "number_density_per_m3", "depolarization"}},
+    {CoefficientForm::kTabulated, {"wavelength_nm", "per_m"}},
 };
 constexpr const char* kCoefficientFormsText =
-    "{ rayleigh_at_1um }, { angstrom_reference, reference_nm, exponent } or "
-    "{ refractive_index, number_density_per_m3, depolarization }";
+    "{ rayleigh_at_1um }, { angstrom_reference, reference_nm, exponent }, "
+    "{ refractive_index, number_density_per_m3, depolarization } or { wavelength_nm, per_m }";
 
 // A length given as <base>_km or <base>_m, as written and in metres.
 struct Length {
@@ -383,6 +384,45 @@ class FileReader : public TomlReader {
     return phase;
   }
 
+  // A published spectrum as (wavelength, value) pairs, linear between them,
+  // at the three wavelengths; each must lie within the table.
+  Spectrum ReadTabulatedSpectrum(const toml::table& table, const std::string& path,
+                                 const Spectrum& wavelengths_nm) const {
+    const std::string wavelengths_path = path + ".wavelength_nm", values_path = path + ".per_m";
+    auto read_array = [&](const std::string& key, const std::string& key_path, const Interval& interval) {
+      const toml::array* array = Require(table, path, key).as_array();
+      if (!array) report_.Fail(key_path, "expected an array of numbers");
+      std::vector<double> values;
+      for (std::size_t i = 0; i < array->size(); ++i) {
+        values.push_back(ReadNumber(*array->get(i), Index(key_path, i), interval));
+      }
+      return values;
+    };
+    const std::vector<double> nm = read_array("wavelength_nm", wavelengths_path, kPositive);
+    const std::vector<double> values = read_array("per_m", values_path, kNonNegative);
+    if (nm.size() < 2) report_.Fail(wavelengths_path, "needs at least 2 wavelengths");
+    if (values.size() != nm.size()) {
+      report_.Fail(values_path, "has " + std::to_string(values.size()) + " values for " + std::to_string(nm.size()) +
+                                    " wavelengths");
+    }
+    for (std::size_t i = 1; i < nm.size(); ++i) {
+      if (!(nm[i] > nm[i - 1])) report_.Fail(Index(wavelengths_path, i), "must exceed the wavelength before it");
+    }
+    Spectrum result;
+    for (int c = 0; c < kWavelengthCount; ++c) {
+      const double w = wavelengths_nm[c];
+      if (!(w >= nm.front() && w <= nm.back())) {
+        report_.Fail(wavelengths_path, "covers " + FormatNumber(nm.front()) + " to " + FormatNumber(nm.back()) +
+                                           " nm, not the wavelength " + FormatNumber(w) + " nm");
+      }
+      const std::size_t i = std::min<std::size_t>(
+          std::size_t(std::upper_bound(nm.begin(), nm.end(), w) - nm.begin()), nm.size() - 1);
+      const double f = (w - nm[i - 1]) / (nm[i] - nm[i - 1]);
+      result[c] = values[i - 1] + (values[i] - values[i - 1]) * f;
+    }
+    return result;
+  }
+
   Spectrum ReadCoefficient(const toml::node& node, const std::string& path,
                            const Spectrum& wavelengths_nm) const {
     if (node.is_number() || node.is_array()) return ReadSpectrum(node, path, kNonNegative);
@@ -442,6 +482,9 @@ class FileReader : public TomlReader {
           result[i] = RayleighScatteringCoefficient(n, density, p, wavelengths_nm[i] * 1e-9);
         break;
       }
+      case CoefficientForm::kTabulated:
+        result = ReadTabulatedSpectrum(*table, path, wavelengths_nm);
+        break;
     }
     for (int i = 0; i < kWavelengthCount; ++i) {
       if (!std::isfinite(result[i]))

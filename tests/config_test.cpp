@@ -157,6 +157,23 @@ density = { layers = [{ constant_term = 1.0 }] }
   EXPECT_EQ(Find(a, "aerosol").phase.g, -0.3);
 }
 
+// A published spectrum as (wavelength, value) pairs: linear between them,
+// exact at a tabulated wavelength.
+TEST(Config, TabulatedCoefficientInterpolatesLinearlyInWavelength) {
+  Atmosphere a = ParseMinimalWith(R"(
+[spectrum]
+wavelengths_nm = [680.0, 600.0, 440.0]
+[constituents.ozone]
+scattering_per_m = 0.0
+absorption_per_m = { wavelength_nm = [400.0, 500.0, 600.0, 700.0], per_m = [0.0, 1.0e-6, 2.0e-6, 0.5e-6] }
+density = { layers = [{ constant_term = 1.0 }] }
+)");
+  const Spectrum& absorption = Find(a, "ozone").absorption_per_m;
+  EXPECT_DOUBLE_EQ(absorption[0], 2.0e-6 + (0.5e-6 - 2.0e-6) * 0.8);  // 680 nm, 4/5 of the way to 700
+  EXPECT_EQ(absorption[1], 2.0e-6);                                    // 600 nm, a tabulated wavelength
+  EXPECT_DOUBLE_EQ(absorption[2], 0.4e-6);                             // 440 nm
+}
+
 TEST(Config, TabulatedProfileInterpolatesLinearly) {
   Atmosphere a = ParseMinimalWith(R"(
 [constituents.layer]
