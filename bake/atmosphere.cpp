@@ -4,19 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include "core/interpolation.h"
 #include "shaders_runtime/primitives.h"
 
 namespace skybake {
 
 double DensityProfile::At(double altitude_m) const {
   if (kind == Kind::kTabulated) {
-    if (altitudes_m.empty()) return 0.0;
-    if (altitude_m <= altitudes_m.front()) return densities.front();
-    if (altitude_m >= altitudes_m.back()) return densities.back();
-    auto upper = std::upper_bound(altitudes_m.begin(), altitudes_m.end(), altitude_m);
-    size_t i = static_cast<size_t>(upper - altitudes_m.begin());
-    double t = (altitude_m - altitudes_m[i - 1]) / (altitudes_m[i] - altitudes_m[i - 1]);
-    return densities[i - 1] + t * (densities[i] - densities[i - 1]);
+    return altitudes_m.empty() ? 0.0 : PiecewiseLinear(altitudes_m, densities, altitude_m);
   }
   double layer_base = 0.0;
   for (size_t i = 0; i < layers.size(); ++i) {

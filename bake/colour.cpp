@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "bake/spectral_data.h"
+#include "core/interpolation.h"
 #include "core/errors.h"
 
 namespace skybake {
@@ -30,11 +31,7 @@ SpectralTable ReadTable(std::string_view name, int columns) {
 // The value at `nm` of the spectrum linear between the samples, 0 outside.
 double Interpolate(const std::vector<double>& wavelength_nm, const std::vector<double>& value, double nm) {
   if (nm < wavelength_nm.front() || nm > wavelength_nm.back()) return 0.0;
-  const auto upper = std::upper_bound(wavelength_nm.begin(), wavelength_nm.end(), nm);
-  if (upper == wavelength_nm.end()) return value.back();
-  const std::size_t i = std::size_t(upper - wavelength_nm.begin());
-  const double a = wavelength_nm[i - 1], b = wavelength_nm[i];
-  return value[i - 1] + (value[i] - value[i - 1]) * (nm - a) / (b - a);
+  return PiecewiseLinear(wavelength_nm, value, nm);
 }
 
 }  // namespace

@@ -30,6 +30,7 @@
 #include "core/constants.h"
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "core/interpolation.h"
 
 namespace skybake {
 
@@ -415,10 +416,7 @@ class FileReader : public TomlReader {
         report_.Fail(wavelengths_path, "covers " + FormatNumber(nm.front()) + " to " + FormatNumber(nm.back()) +
                                            " nm, not the wavelength " + FormatNumber(w) + " nm");
       }
-      const std::size_t i = std::min<std::size_t>(
-          std::size_t(std::upper_bound(nm.begin(), nm.end(), w) - nm.begin()), nm.size() - 1);
-      const double f = (w - nm[i - 1]) / (nm[i] - nm[i - 1]);
-      result[c] = values[i - 1] + (values[i] - values[i - 1]) * f;
+      result[c] = PiecewiseLinear(nm, values, w);
     }
     return result;
   }
