@@ -71,8 +71,7 @@ void RunConvert(const ConvertOptions& o) {
                              in.channel_names.begin();
     for (std::size_t i = 0; i < in.TexelCount(); ++i) out.values[i * channels.size() + c] = in.values[i * in_stride + from];
   }
-  ChooseExrCompression(&out);
-  if (out.format == FileFormat::kKtx2) out.ktx2_zstd_level = zstd_level;
+  ChooseFileStorage(&out, zstd_level);
   WriteTableImage(o.output, out);
   const std::uint64_t written = fs::file_size(o.output);
 

@@ -145,8 +145,7 @@ std::vector<std::string> StaleFiles(const fs::path& dir, const std::vector<std::
 TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table, FileFormat format,
                               const WriteOptions& options) {
   TableImage image = MakeTableImage(luts, table, format, IsHalf(table, options) ? PixelType::kHalf : PixelType::kFloat);
-  ChooseExrCompression(&image);
-  if (format == FileFormat::kKtx2) image.ktx2_zstd_level = options.ktx2_zstd_level;
+  ChooseFileStorage(&image, options.ktx2_zstd_level);
   return image;
 }
 

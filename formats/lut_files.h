@@ -66,8 +66,7 @@ struct WriteReport {
 WriteReport WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
 
 // The image of `table` that WriteLutSet encodes into its `format` file: the
-// pixel type and KTX2 supercompression `options` ask for, and for OpenEXR the
-// compression ChooseExrCompression picks.
+// pixel type `options` asks for, the storage ChooseFileStorage picks.
 TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table, FileFormat format,
                               const WriteOptions& options);
 

@@ -372,6 +372,11 @@ void ChooseExrCompression(TableImage* image) {
   image->exr_compression = zipped <= (1.0 - kExrZipMinimumSaving) * stored ? ExrCompression::kZip : ExrCompression::kNone;
 }
 
+void ChooseFileStorage(TableImage* image, int ktx2_zstd_level) {
+  ChooseExrCompression(image);
+  if (image->format == FileFormat::kKtx2) image->ktx2_zstd_level = ktx2_zstd_level;
+}
+
 std::vector<std::string> StoredChannels(const TableImage& image) {
   return image.format == FileFormat::kKtx2 ? kRgba : image.channel_names;
 }

@@ -91,6 +91,11 @@ struct TableImage {
 inline constexpr double kExrZipMinimumSaving = 0.10;
 void ChooseExrCompression(TableImage* image);
 
+// The storage of a file about to be written: for OpenEXR the compression
+// ChooseExrCompression picks, for KTX2 Zstandard supercompression at
+// `ktx2_zstd_level` (0: stored as is).
+void ChooseFileStorage(TableImage* image, int ktx2_zstd_level);
+
 // The channels the file holds: R,G,B,A for every KTX2 table (RGB tables are
 // padded), the image's own channels for OpenEXR.
 std::vector<std::string> StoredChannels(const TableImage& image);
