@@ -1,6 +1,7 @@
 #include "shaders_runtime/snippet.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstdio>
 #include <stdexcept>
@@ -72,14 +73,19 @@ std::string_view EmbeddedShader(const std::string& name) {
   throw std::logic_error("runtime shader " + name + " is not embedded");
 }
 
+// The switches saying which of the optional tables' functions exist, with
+// their values for `parts`.
+std::array<std::pair<const char*, bool>, 3> TableSwitches(const SnippetParts& parts) {
+  return {{{"SKYBAKE_HAS_SCATTERING_TEXTURE", parts.scattering},
+           {"SKYBAKE_HAS_IRRADIANCE_TEXTURE", parts.irradiance},
+           {"SKYBAKE_HAS_AERIAL_PERSPECTIVE", parts.aerial_perspective}}};
+}
+
 // functions.wgsl without the functions whose tables `parts` leaves out.
 // WGSL has no preprocessor; translate.mjs marks each function that needs a
 // table with a line "// skybake: needs FLAG [&& FLAG]" before it, and naga
 // closes every function with a "}" line of its own.
 std::string WgslFunctionsFor(std::string_view text, const SnippetParts& parts) {
-  const std::pair<std::string_view, bool> switches[] = {{"SKYBAKE_HAS_SCATTERING_TEXTURE", parts.scattering},
-                                                        {"SKYBAKE_HAS_IRRADIANCE_TEXTURE", parts.irradiance},
-                                                        {"SKYBAKE_HAS_AERIAL_PERSPECTIVE", parts.aerial_perspective}};
   constexpr std::string_view kMarker = "// skybake: needs ";
   std::string out;
   bool skipping = false;
@@ -92,7 +98,9 @@ std::string WgslFunctionsFor(std::string_view text, const SnippetParts& parts) {
       continue;
     }
     if (line.substr(0, kMarker.size()) == kMarker) {
-      for (const auto& [name, on] : switches) skipping = skipping || (!on && line.find(name) != std::string_view::npos);
+      for (const auto& [name, on] : TableSwitches(parts)) {
+        skipping = skipping || (!on && line.find(name) != std::string_view::npos);
+      }
     }
     if (!skipping) out.append(line).append("\n");
   }
@@ -140,9 +148,7 @@ std::string AtmosphereConstants(ShadingLanguage language, const glsl::Atmosphere
        (wgsl ? std::string("Include with functions.wgsl (WGSL declarations may come in any order).\n")
              : "Include after definitions." + ext + " and before functions." + ext + ".\n");
   s += flag("SKYBAKE_HAS_TRANSMITTANCE_TEXTURE", true);
-  s += flag("SKYBAKE_HAS_SCATTERING_TEXTURE", parts.scattering);
-  s += flag("SKYBAKE_HAS_IRRADIANCE_TEXTURE", parts.irradiance);
-  s += flag("SKYBAKE_HAS_AERIAL_PERSPECTIVE", parts.aerial_perspective);
+  for (const auto& [name, on] : TableSwitches(parts)) s += flag(name, on);
   s += std::string(wgsl ? "// false" : "// 0") + ": single Mie is packed into the scattering table's alpha; pass the scattering\n" +
        "// texture as single_mie_scattering_texture too.\n";
   s += flag("SKYBAKE_HAS_SINGLE_MIE_SCATTERING_TEXTURE", parts.scattering && separate_mie);
