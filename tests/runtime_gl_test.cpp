@@ -31,54 +31,20 @@ namespace {
 
 using glsl::vec3;
 using testing::GlContext;
-using namespace testing;  // RuntimeOutput's names, as the GLSL main() below spells them
+using namespace testing;  // RuntimeOutput's names
 
-// A main() that calls the snippet's entry points. Inputs per item: camera +
-// output, view ray, sun direction + shadow length, point (aerial) or normal
-// (irradiance).
-const char* const kMain = R"(
+// A main() that evaluates one query (EvaluateQuery, tests/runtime_queries.h)
+// per fragment.
+const std::string kMain = std::string(R"(
 uniform sampler2D transmittance_texture;
 uniform sampler3D scattering_texture;
 uniform sampler3D single_mie_scattering_texture;
 uniform sampler2D irradiance_texture;
+)") + kGlslEvaluateQuery + R"(
 void main() {
-  vec4 a = skybake_input(0);
-  vec3 camera = a.xyz, view = skybake_input(1).xyz, sun = skybake_input(2).xyz, extra = skybake_input(3).xyz;
-  float shadow_length = skybake_input(2).w;
-  int what = int(a.w);
-  vec3 t, sky, v = vec3(0.0);
-  // A scene's snippet lacks the functions of the tables it left out.
-  if (what <= 1) {
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-    v = GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
-                       camera, view, sun, t);
-    if (what == 1) v = t;
-#endif
-  } else if (what <= 3) {
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-    v = GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture,
-                              single_mie_scattering_texture, camera, extra, sun, t);
-    if (what == 3) v = t;
-#endif
-  } else if (what <= 5) {
-#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
-    v = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, camera, extra, sun, sky);
-    if (what == 5) v = sky;
-#endif
-  } else if (what == 6) {
-    v = GetTransmittanceToSun(ATMOSPHERE, transmittance_texture, length(camera), dot(camera, sun) / length(camera));
-  } else if (what == 7) {
-    v = GetSolarRadiance(ATMOSPHERE);
-  } else {
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-    v = GetSkyRadianceToPointWithShadow(ATMOSPHERE, transmittance_texture, scattering_texture,
-                                        single_mie_scattering_texture, camera, extra, shadow_length, sun, t);
-#endif
-  }
-  skybake_output = vec4(v, 1.0);
+  skybake_output = vec4(EvaluateQuery(skybake_input(0), skybake_input(1), skybake_input(2), skybake_input(3)), 1.0);
 }
 )";
-
 
 std::string FragmentSource(const LutSet& luts, const SnippetParts& parts = {}) {
   return RuntimeSnippetSource(ShadingLanguage::kGlsl, luts.parameters, luts.atmosphere.wavelengths_nm, luts.atmosphere.name, parts) + kMain;

@@ -3,9 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -127,6 +124,43 @@ std::vector<RuntimeQuery> MakeRuntimeQueries(double bottom_radius, double top_ra
   return items;
 }
 
+const char* const kGlslEvaluateQuery = R"(
+vec3 EvaluateQuery(vec4 camera_what, vec4 view_ray, vec4 sun_shadow, vec4 extra_point) {
+  vec3 camera = camera_what.xyz, view = view_ray.xyz, sun = sun_shadow.xyz, extra = extra_point.xyz;
+  float shadow_length = sun_shadow.w;
+  int what = int(camera_what.w);
+  vec3 t, sky, v = vec3(0.0);
+  if (what <= 1) {
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+    v = GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
+                       camera, view, sun, t);
+    if (what == 1) v = t;
+#endif
+  } else if (what <= 3) {
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+    v = GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture,
+                              single_mie_scattering_texture, camera, extra, sun, t);
+    if (what == 3) v = t;
+#endif
+  } else if (what <= 5) {
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+    v = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, camera, extra, sun, sky);
+    if (what == 5) v = sky;
+#endif
+  } else if (what == 6) {
+    v = GetTransmittanceToSun(ATMOSPHERE, transmittance_texture, length(camera), dot(camera, sun) / length(camera));
+  } else if (what == 7) {
+    v = GetSolarRadiance(ATMOSPHERE);
+  } else {
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+    v = GetSkyRadianceToPointWithShadow(ATMOSPHERE, transmittance_texture, scattering_texture,
+                                        single_mie_scattering_texture, camera, extra, shadow_length, sun, t);
+#endif
+  }
+  return v;
+}
+)";
+
 std::vector<std::array<float, 4>> RuntimeQueryInputs(const std::vector<RuntimeQuery>& queries) {
   std::vector<std::array<float, 4>> inputs;
   for (const RuntimeQuery& item : queries) {
@@ -194,22 +228,6 @@ void ExpectMatchesTwin(const std::string& description, const LutSet& luts, const
   for (const auto& [group, value] : worst_by_group) std::cout << "  group " << group << ": " << value << "\n";
 }
 
-
-std::vector<std::uint32_t> CompileToSpirv(const std::string& source, bool hlsl, std::string* log) {
-  TempDir dir;
-  const std::filesystem::path file = dir.path() / (hlsl ? "runtime.hlsl" : "runtime.comp");
-  const std::filesystem::path spirv = dir.path() / "runtime.spv";
-  WriteText(file, source);
-  const std::string command = ShellQuote(SKYBAKE_GLSLANG_VALIDATOR) + " -V -S comp " +
-                              (hlsl ? "-D -e main " : "") + "-o " + ShellQuote(spirv) + " " +
-                              ShellQuote(file);
-  if (RunCommand(command, dir, log) != 0) return {};
-  std::ifstream in(spirv, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::vector<std::uint32_t> words(bytes.size() / 4);
-  std::memcpy(words.data(), bytes.data(), words.size() * 4);
-  return words;
-}
 
 int RunWgslJob(const std::filesystem::path& job_dir, std::string* output) {
   if (std::string(SKYBAKE_NODE_EXECUTABLE).empty()) {

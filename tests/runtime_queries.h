@@ -46,6 +46,14 @@ struct RuntimeQuery {
 // axis, so its distance to the centre is exact in float) for every case group.
 std::vector<RuntimeQuery> MakeRuntimeQueries(double bottom_radius, double top_radius);
 
+// EvaluateQuery(vec4 camera_what, vec4 view, vec4 sun_shadow, vec4 extra) in
+// GLSL: the query's output from its four inputs (RuntimeQueryInputs),
+// through the snippet's entry points and the samplers transmittance_texture,
+// scattering_texture, single_mie_scattering_texture and irradiance_texture,
+// which the shader declares before it. A scene's snippet lacks the functions
+// of the tables it left out; their outputs read 0.
+extern const char* const kGlslEvaluateQuery;
+
 // The four vec4 inputs of each query, as every test main() reads them:
 // camera + what, view ray, sun direction + shadow length, point (aerial) or
 // normal (irradiance).
@@ -59,10 +67,6 @@ glsl::vec3 EvaluateTwin(const LutSet& luts, const RuntimeQuery& query);
 // differences under `description`.
 void ExpectMatchesTwin(const std::string& description, const LutSet& luts, const std::vector<RuntimeQuery>& queries,
                        const std::vector<std::array<float, 4>>& outputs);
-
-// glslangValidator's SPIR-V for a compute shader in GLSL or HLSL (entry point
-// main), or empty with the compiler's log in `log`.
-std::vector<std::uint32_t> CompileToSpirv(const std::string& source, bool hlsl, std::string* log);
 
 // Runs tests/runtime_webgpu/run_wgsl.mjs on the job in `job_dir` (its
 // job.json); returns its exit code (77: skipped) with its output in `output`.

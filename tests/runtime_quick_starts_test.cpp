@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bake/config.h"
+#include "examples/engine/vulkan_compute.h"
 #include "shaders_runtime/snippet.h"
 #include "tests/runtime_queries.h"
 #include "tests/test_atmospheres.h"
@@ -80,7 +81,7 @@ TEST_F(QuickStarts, UnityHlslCompiles) {
                              "  float3 t;\n  o[0] = float4(SkyRadiance(float3(0.0, 0.0, 6.4e6), float3(0.0, 0.0, 1.0),"
                              " float3(0.0, 0.0, 1.0), t) + t, 1.0);\n}\n";
   std::string log;
-  EXPECT_FALSE(testing::CompileToSpirv(source, true, &log).empty()) << log;
+  EXPECT_FALSE(CompileComputeShader(SKYBAKE_GLSLANG_VALIDATOR, source, true, &log).empty()) << log;
 }
 
 TEST_F(QuickStarts, VulkanGlslCompiles) {
@@ -95,7 +96,7 @@ TEST_F(QuickStarts, VulkanGlslCompiles) {
                              "    GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, camera,"
                              " up, up, sky) + sky, 1.0);\n}\n";
   std::string log;
-  EXPECT_FALSE(testing::CompileToSpirv(source, false, &log).empty()) << log;
+  EXPECT_FALSE(CompileComputeShader(SKYBAKE_GLSLANG_VALIDATOR, source, false, &log).empty()) << log;
 }
 
 TEST(QuickStartsOnWebGpu, WgslCompilesIntoAComputePipeline) {

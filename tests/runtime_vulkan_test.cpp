@@ -8,10 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,10 +23,9 @@
 namespace skybake {
 namespace {
 
-
 // The test's compute main() in Vulkan GLSL: explicit bindings as an engine
-// declares them, the same switch as runtime_gl_test.cpp's kMain.
-const char* const kVulkanGlslMain = R"(
+// declares them, a query per invocation (EvaluateQuery, tests/runtime_queries.h).
+const std::string kVulkanGlslMain = std::string(R"(
 layout(set = 0, binding = 0) uniform sampler2D transmittance_texture;
 layout(set = 0, binding = 1) uniform sampler3D scattering_texture;
 layout(set = 0, binding = 2) uniform sampler3D single_mie_scattering_texture;
@@ -37,39 +33,16 @@ layout(set = 0, binding = 3) uniform sampler2D irradiance_texture;
 layout(std430, set = 0, binding = 4) readonly buffer Inputs { vec4 skybake_inputs[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Outputs { vec4 skybake_outputs[]; };
 layout(local_size_x = 64) in;
+)") + testing::kGlslEvaluateQuery + R"(
 void main() {
   uint item = gl_GlobalInvocationID.x;
   if (item >= uint(skybake_outputs.length())) return;
-  vec4 a = skybake_inputs[4u * item];
-  vec3 camera = a.xyz, view = skybake_inputs[4u * item + 1u].xyz, sun = skybake_inputs[4u * item + 2u].xyz;
-  vec3 extra = skybake_inputs[4u * item + 3u].xyz;
-  float shadow_length = skybake_inputs[4u * item + 2u].w;
-  int what = int(a.w);
-  vec3 t, sky, v = vec3(0.0);
-  if (what <= 1) {
-    v = GetSkyRadiance(ATMOSPHERE, transmittance_texture, scattering_texture, single_mie_scattering_texture,
-                       camera, view, sun, t);
-    if (what == 1) v = t;
-  } else if (what <= 3) {
-    v = GetSkyRadianceToPoint(ATMOSPHERE, transmittance_texture, scattering_texture,
-                              single_mie_scattering_texture, camera, extra, sun, t);
-    if (what == 3) v = t;
-  } else if (what <= 5) {
-    v = GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, camera, extra, sun, sky);
-    if (what == 5) v = sky;
-  } else if (what == 6) {
-    v = GetTransmittanceToSun(ATMOSPHERE, transmittance_texture, length(camera), dot(camera, sun) / length(camera));
-  } else if (what == 7) {
-    v = GetSolarRadiance(ATMOSPHERE);
-  } else {
-    v = GetSkyRadianceToPointWithShadow(ATMOSPHERE, transmittance_texture, scattering_texture,
-                                        single_mie_scattering_texture, camera, extra, shadow_length, sun, t);
-  }
-  skybake_outputs[item] = vec4(v, 1.0);
+  skybake_outputs[item] = vec4(EvaluateQuery(skybake_inputs[4u * item], skybake_inputs[4u * item + 1u],
+                                             skybake_inputs[4u * item + 2u], skybake_inputs[4u * item + 3u]), 1.0);
 }
 )";
 
-// The same main() in HLSL: each texture with the sampler (the translation
+// The same query in HLSL: each texture with the sampler (the translation
 // takes a Texture and a SamplerState for each table).
 const char* const kHlslMain = R"(
 [[vk::binding(0)]] Texture2D<float4> transmittance_texture;
@@ -144,7 +117,7 @@ class RuntimeOnVulkan : public ::testing::Test {
       vk->SetTexture(binding, t.width, t.height, t.depth, t.texels);
     }
     std::string log;
-    const std::vector<std::uint32_t> spirv = testing::CompileToSpirv(source, hlsl, &log);
+    const std::vector<std::uint32_t> spirv = CompileComputeShader(SKYBAKE_GLSLANG_VALIDATOR, source, hlsl, &log);
     ASSERT_FALSE(spirv.empty()) << log;
     const std::vector<testing::RuntimeQuery> queries =
         testing::MakeRuntimeQueries(luts.parameters.bottom_radius, luts.parameters.top_radius);
@@ -194,7 +167,8 @@ TEST(RuntimeHlsl, SceneSwitchesLeaveOutTheFunctionsOfMissingTables) {
                    std::to_string(parts.irradiance) + " aerial " + std::to_string(parts.aerial_perspective) +
                    ", calling " + calls[k]);
       std::string log;
-      EXPECT_EQ(!testing::CompileToSpirv(shader(parts, calls[k]), true, &log).empty(), has[k]) << log;
+      EXPECT_EQ(!CompileComputeShader(SKYBAKE_GLSLANG_VALIDATOR, shader(parts, calls[k]), true, &log).empty(), has[k])
+          << log;
     }
   }
 }

@@ -1,6 +1,11 @@
 #include "examples/engine/vulkan_compute.h"
 
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
 #include <stdexcept>
 
 #if SKYBAKE_HAVE_VULKAN
@@ -351,10 +356,8 @@ std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint
     input_buffer = d.MakeBuffer(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, inputs.size() * sizeof(inputs[0]), inputs.data());
     output_buffer = d.MakeBuffer(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, items * sizeof(inputs[0]), nullptr);
 
-    std::vector<VkDescriptorPoolSize> sizes = {
-        {combined ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, kTextureCount},
-        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
-    if (!combined) sizes.push_back({VK_DESCRIPTOR_TYPE_SAMPLER, 1});
+    std::vector<VkDescriptorPoolSize> sizes;  // one descriptor per binding of the pipeline's layout
+    for (const VkDescriptorSetLayoutBinding& b : p.bindings) sizes.push_back({b.descriptorType, 1});
     VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pool_info.maxSets = 1;
     pool_info.poolSizeCount = uint32_t(sizes.size());
@@ -444,6 +447,34 @@ std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint
 std::string VulkanCompute::Description() const { return {}; }
 
 #endif
+
+std::vector<std::uint32_t> CompileComputeShader(const std::string& compiler, const std::string& source, bool hlsl,
+                                                std::string* log) {
+  namespace fs = std::filesystem;
+  std::random_device random;
+  const fs::path dir = fs::temp_directory_path() / ("skybake_spirv_" + std::to_string(random()));
+  fs::create_directories(dir);
+  struct Remove {
+    fs::path dir;
+    ~Remove() {
+      std::error_code ignored;
+      fs::remove_all(dir, ignored);
+    }
+  } remove{dir};
+  const fs::path file = dir / "shader", spirv = dir / "shader.spv", output = dir / "log.txt";
+  std::ofstream(file, std::ios::binary) << source;
+  const std::string command = "'" + compiler + "' -V --target-env vulkan1.1 -S comp " + (hlsl ? "-D -e main " : "") +
+                              "-o '" + spirv.string() + "' '" + file.string() + "' > '" + output.string() + "' 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream log_file(output);
+  log->assign(std::istreambuf_iterator<char>(log_file), std::istreambuf_iterator<char>());
+  if (status != 0) return {};
+  std::ifstream in(spirv, std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::uint32_t> words(bytes.size() / 4);
+  std::memcpy(words.data(), bytes.data(), words.size() * 4);
+  return words;
+}
 
 VulkanCompute::VulkanCompute() : impl_(std::make_unique<Impl>()) {}
 VulkanCompute::~VulkanCompute() = default;

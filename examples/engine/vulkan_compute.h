@@ -62,4 +62,10 @@ class VulkanCompute {
   std::unique_ptr<Impl> impl_;
 };
 
+// SPIR-V of a compute shader (entry point "main") compiled by the
+// glslangValidator at `compiler` for Vulkan 1.1: GLSL, or HLSL with `hlsl`.
+// Empty if it does not compile, with the compiler's output in `log`.
+std::vector<std::uint32_t> CompileComputeShader(const std::string& compiler, const std::string& source, bool hlsl,
+                                                std::string* log);
+
 }  // namespace skybake

@@ -15,21 +15,15 @@
 // Exit codes as skybake's: 1 usage, 2 invalid input, 3 I/O (including: no
 // Vulkan device), 4 internal.
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <memory>
-#include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/errors.h"
-#include "core/file_io.h"
 #include "examples/engine/example_views.h"
 #include "examples/engine/vulkan_compute.h"
 
-namespace fs = std::filesystem;
 using namespace skybake::engine_example;
 using skybake::VulkanCompute;
 
@@ -89,32 +83,19 @@ std::vector<std::array<float, 4>> ViewValues(const View& v) {
           {f(v.ground_albedo.x), f(v.ground_albedo.y), f(v.ground_albedo.z), 0.0f}};
 }
 
-// SPIR-V of a Vulkan GLSL compute shader, by glslangValidator.
+// SPIR-V of the compute shader (glslangValidator -V, as an asset pipeline's
+// shader step would); InputError with the compiler's first error otherwise.
 std::vector<std::uint32_t> CompileCompute(const std::string& source) {
-  std::random_device random;
-  const fs::path dir = fs::temp_directory_path() / ("skybake_vulkan_example_" + std::to_string(random()));
-  fs::create_directories(dir);
-  struct Remove {
-    fs::path dir;
-    ~Remove() {
-      std::error_code ignored;
-      fs::remove_all(dir, ignored);
-    }
-  } remove{dir};
-  const fs::path file = dir / "sky.comp", spirv = dir / "sky.spv", log = dir / "log.txt";
-  skybake::WriteFileAtomically(file, source);
-  const std::string command = std::string("'") + SKYBAKE_GLSLANG_VALIDATOR + "' -V --target-env vulkan1.1 -o '" +
-                              spirv.string() + "' '" + file.string() + "' > '" + log.string() + "' 2>&1";
-  if (std::system(command.c_str()) != 0) {
+  std::string log;
+  std::vector<std::uint32_t> spirv = skybake::CompileComputeShader(SKYBAKE_GLSLANG_VALIDATOR, source, false, &log);
+  if (spirv.empty()) {
+    std::istringstream lines(log);
     std::string first_error;
-    for (std::ifstream in(log); std::getline(in, first_error);)
-      if (first_error.find("ERROR") != std::string::npos) break;
+    while (std::getline(lines, first_error) && first_error.find("ERROR") == std::string::npos) {
+    }
     throw skybake::InputError("the compute shader does not compile: " + first_error);
   }
-  const std::vector<std::uint8_t> bytes = skybake::ReadFileBytes(spirv, "the SPIR-V");
-  std::vector<std::uint32_t> words(bytes.size() / 4);
-  std::memcpy(words.data(), bytes.data(), words.size() * 4);
-  return words;
+  return spirv;
 }
 
 void Run(const Arguments& args) {
