@@ -42,17 +42,27 @@ constexpr int kForcedSegments = 1;
 
 // On the view ray and the forced segments, distances are drawn from a
 // mixture: with this share from extinction x transmittance, otherwise from
-// that density weighted by the sunlight at each piece (SunlightTable), so
-// that after sunset, when only a thin high shell is lit, paths still find it.
+// that density weighted by an estimate of the light scattered toward the
+// ray at each piece (SourcePieces; on a daylight path's forced segment, the
+// sunlight alone, SunlitPieces), so that after sunset, when only a thin
+// high shell is lit, paths still find it.
 constexpr double kUnguidedShare = 0.5;
 
 // Directions after a scattering event are drawn from a mixture with the same
 // aim: with this share from the phase function, otherwise from the
-// DirectionGuide for the vertex's altitude and sun cosine, when the sun's
-// zenith cosine where the view ray starts is below kGuideSunCosine (in
-// daylight the phase function alone does well).
-constexpr double kPhaseShare = 0.5;
+// direction guides around the vertex (GuideMixture), when the sun's zenith
+// cosine where the view ray starts is below kGuideSunCosine (in daylight
+// the phase function alone does well). The guides hold kGuideOrders orders
+// of scattered light: a third changed nothing measurable (docs/reference.md).
+constexpr double kPhaseShare = 0.25;
 constexpr double kGuideSunCosine = 0.1;
+constexpr int kGuideOrders = 2;
+
+// In twilight Russian roulette keeps at least this share of the paths it
+// tests: with survival w / w0 alone, a path whose weight fell a hundredfold
+// on its way up through thin air came back once in a hundred with a
+// hundredfold weight, the heavy tail of the deep-twilight estimates.
+constexpr double kTwilightSurvival = 0.5;
 
 enum Estimator : uint64_t { kRadianceEstimator = 1, kIrradianceEstimator = 2 };
 
@@ -99,15 +109,15 @@ class Tracer {
     return Trace(camera + t_in * direction, 0.0, direction, weight, 0.0, 0, false, rng, tally);
   }
 
-  // The usable direction guide for the point x, or null.
-  const DirectionGuide* GuideAt(const dvec3& x) const {
-    if (!directions_) return nullptr;
+  // The direction guides around the point x (none without a field).
+  GuideMixture GuideAt(const dvec3& x) const {
+    if (!directions_) return GuideMixture();
     const double r = glm::length(x);
     return directions_->At(r, glm::dot(x, sun_) / r);
   }
 
   // Per piece of `segment` (along `direction`), the tabulated sunlight at
-  // its middle: the guide of MakeMixture.
+  // its middle.
   std::vector<double> SunlitPieces(const RaySegment& segment, const dvec3& direction) const {
     std::vector<double> weights;
     for (double t : segment.PieceMiddles()) {
@@ -118,10 +128,11 @@ class Tracer {
     return weights;
   }
 
-  // Per piece of the view segment (along `direction`), an estimate at its
-  // middle of the light a vertex there scatters into the ray: the sunlight
-  // (SunlitPieces) times the phase function, plus the single-scattered light
-  // of the direction guide there spread evenly over the sphere.
+  // Per piece of `segment` (along `direction`), an estimate at its middle of
+  // the light a vertex there scatters into the ray: the sunlight
+  // (SunlitPieces) times the phase function, plus the light the direction
+  // guides there say arrives, spread evenly over the sphere: the guide of
+  // MakeMixture.
   std::vector<double> SourcePieces(const RaySegment& segment, const dvec3& direction) {
     std::vector<double> weights = SunlitPieces(segment, direction);
     const std::vector<double> middles = segment.PieceMiddles();
@@ -129,8 +140,8 @@ class Tracer {
       const dvec3 x = segment.origin() + middles[k] * direction;
       const double sigma_s = medium_.Scattering(glm::length(x), w_, sigma_.data());
       const double direct = sigma_s > 0.0 ? PhaseMixture(glm::dot(sun_, direction), sigma_s) : 0.0;
-      const DirectionGuide* guide = GuideAt(x);
-      weights[k] = direct * weights[k] + (guide ? guide->Incoming() / (4.0 * kPi) : 0.0);
+      const GuideMixture guide = GuideAt(x);
+      weights[k] = direct * weights[k] + (guide.usable() ? guide.Incoming() / (4.0 * kPi) : 0.0);
     }
     return weights;
   }
@@ -160,13 +171,15 @@ class Tracer {
   }
 
   // Russian roulette against the weight the path started with: survival
-  // probability weight / reference, so survivors carry the reference weight.
-  static bool Survives(double& weight, double reference, Pcg32& rng) {
+  // probability q = weight / reference (at least kTwilightSurvival in
+  // twilight), survivors weighted by 1 / q.
+  bool Survives(double& weight, double reference, Pcg32& rng) const {
     if (!(weight > 0.0)) return false;
     double q = weight / reference;
     if (q >= 1.0) return true;
+    if (directions_) q = std::max(q, kTwilightSurvival);
     if (rng.Uniform() >= q) return false;
-    weight = reference;
+    weight /= q;
     return true;
   }
 
@@ -207,19 +220,19 @@ class Tracer {
           if (pick < sigma_[i]) break;
           pick -= sigma_[i];
         }
-        const DirectionGuide* guide = GuideAt(x);
-        const GuideFrame frame = guide ? GuideFrame(x, sun_) : GuideFrame();
+        const GuideMixture guide = GuideAt(x);
+        const GuideFrame frame = guide.usable() ? GuideFrame(x, sun_) : GuideFrame();
         dvec3 next;
-        if (guide && rng.Uniform() >= kPhaseShare) {
-          const double u_cell = rng.Uniform(), u1 = rng.Uniform();
-          next = guide->Sample(frame, u_cell, u1, rng.Uniform());
+        if (guide.usable() && rng.Uniform() >= kPhaseShare) {
+          const double u_guide = rng.Uniform(), u_cell = rng.Uniform(), u1 = rng.Uniform();
+          next = guide.Sample(frame, u_guide, u_cell, u1, rng.Uniform());
         } else {
           next = DirectionAround(direction, SamplePhaseCosine(medium_.phase(c), rng), rng.Uniform());
         }
-        if (guide) {
+        if (guide.usable()) {
           // The mixture's density against the phase function it stands for.
           const double phase = PhaseMixture(glm::dot(direction, next), sigma_s);
-          weight *= phase / (kPhaseShare * phase + (1.0 - kPhaseShare) * guide->Pdf(frame, next));
+          weight *= phase / (kPhaseShare * phase + (1.0 - kPhaseShare) * guide.Pdf(frame, next));
         }
         direction = next;
         at_vertex = false;
@@ -235,7 +248,8 @@ class Tracer {
         RaySegment segment(medium_, x, direction, 0.0, RaySegment::Table::kSampling);
         if (!segment.hits_ground()) {
           double t, transmittance_over_pdf;
-          const RaySegment::Mixture density = segment.MakeMixture(w_, SunlitPieces(segment, direction), kUnguidedShare);
+          const RaySegment::Mixture density = segment.MakeMixture(
+              w_, directions_ ? SourcePieces(segment, direction) : SunlitPieces(segment, direction), kUnguidedShare);
           if (!segment.SampleMixture(medium_, density, rng.Uniform(), &t, &transmittance_over_pdf)) return sum;
           ++events;
           ++tally.vertices;
@@ -288,7 +302,10 @@ class Tracer {
 // Directions for the sky irradiance: a mixture of cosine-weighted sampling
 // about the normal and a lobe around the sun (the most forward-peaked phase
 // function of the atmosphere), combined by the mixture pdf (one-sample MIS,
-// balance heuristic), so the bright circumsolar sky is not left to chance.
+// balance heuristic), so the bright circumsolar sky is not left to chance;
+// in twilight half of the directions come from the direction guides at the
+// camera, which know that the light comes from the lit air low toward the
+// sun.
 class IrradianceSampler {
  public:
   IrradianceSampler(const LayeredMedium& medium, const dvec3& normal, const dvec3& sun)
@@ -304,11 +321,21 @@ class IrradianceSampler {
     lobe_probability_ = has_lobe_ ? kLobeProbability : 0.0;
   }
 
-  // A direction from the stratified (u1, u2) and the technique choice u;
-  // `weight` = cos / pdf (0 below the surface).
-  dvec3 Sample(double u, double u1, double u2, Pcg32& rng, double* weight) const {
-    dvec3 direction = u < lobe_probability_ ? DirectionAround(sun_, SamplePhaseCosine(lobe_, rng), u2)
-                                            : SampleCosineHemisphere(normal_, u1, u2);
+  // A direction from the stratified (u1, u2) and the technique choice u,
+  // with the guides `guide` in `frame` where usable; `weight` = cos / pdf (0
+  // below the surface).
+  dvec3 Sample(double u, double u1, double u2, const GuideMixture& guide, const GuideFrame& frame, Pcg32& rng,
+               double* weight) const {
+    const double guide_share = guide.usable() ? kGuideShare : 0.0;
+    dvec3 direction;
+    if (u < guide_share) {
+      const double u_guide = rng.Uniform(), u_cell = rng.Uniform(), v1 = rng.Uniform();
+      direction = guide.Sample(frame, u_guide, u_cell, v1, rng.Uniform());
+    } else {
+      u = (u - guide_share) / (1.0 - guide_share);
+      direction = u < lobe_probability_ ? DirectionAround(sun_, SamplePhaseCosine(lobe_, rng), u2)
+                                        : SampleCosineHemisphere(normal_, u1, u2);
+    }
     double cosine = glm::dot(normal_, direction);
     if (!(cosine > 0.0)) {
       *weight = 0.0;
@@ -316,12 +343,13 @@ class IrradianceSampler {
     }
     double pdf = (1.0 - lobe_probability_) * cosine / kPi;
     if (has_lobe_) pdf += lobe_probability_ * lobe_.Evaluate(glm::dot(sun_, direction));
+    if (guide_share > 0.0) pdf = (1.0 - guide_share) * pdf + guide_share * guide.Pdf(frame, direction);
     *weight = cosine / pdf;
     return direction;
   }
 
  private:
-  static constexpr double kLobeProbability = 0.3;
+  static constexpr double kLobeProbability = 0.3, kGuideShare = 0.5;
   dvec3 normal_, sun_;
   PhaseFunction lobe_;
   bool has_lobe_ = false;
@@ -413,7 +441,11 @@ PathTracer::PathTracer(const Atmosphere& atmosphere) : medium_(Checked(atmospher
 
 const std::vector<DirectionGuideField>& PathTracer::TwilightGuides() const {
   std::call_once(guides_->built, [&] {
-    for (int w = 0; w < kWavelengthCount; ++w) guides_->per_wavelength.emplace_back(medium_, sunlight_, w);
+    for (int w = 0; w < kWavelengthCount; ++w) {
+      DirectionGuideField field(medium_, sunlight_, nullptr, w);
+      for (int pass = 1; pass < kGuideOrders; ++pass) field = DirectionGuideField(medium_, sunlight_, &field, w);
+      guides_->per_wavelength.push_back(std::move(field));
+    }
   });
   return guides_->per_wavelength;
 }
@@ -474,6 +506,12 @@ Result PathTracer::Evaluate(const RayQuery& query, const Settings& settings, uin
         w, Tracer(medium_, sunlight_, guides ? &(*guides)[w] : nullptr, settings, sun, w).SourcePieces(segment, view),
         kUnguidedShare));
   }
+  const GuideFrame camera_frame(query.camera, sun);
+  std::vector<GuideMixture> camera_guides(kWavelengthCount);
+  for (int w = 0; w < kWavelengthCount && guides; ++w) {
+    const double r = glm::length(query.camera);
+    camera_guides[w] = (*guides)[w].At(r, glm::dot(query.camera, sun) / r);
+  }
   auto run_block = [&](int64_t b) {
     Tally& tally = tallies[b];
     for (int w = 0; w < kWavelengthCount; ++w) {
@@ -491,7 +529,8 @@ Result PathTracer::Evaluate(const RayQuery& query, const Settings& settings, uin
         double u1 = (j % kSide + irradiance_rng.Uniform()) / kSide;
         double u2 = (j / kSide + irradiance_rng.Uniform()) / kSide;
         double weight;
-        dvec3 direction = hemisphere.Sample(technique, u1, u2, irradiance_rng, &weight);
+        dvec3 direction =
+            hemisphere.Sample(technique, u1, u2, camera_guides[w], camera_frame, irradiance_rng, &weight);
         if (weight > 0.0) {
           irradiance_sums[b][w] += tracer.Incoming(query.camera, direction, weight, irradiance_rng, tally);
         }

@@ -3,6 +3,7 @@
 // depths, free flights). Tolerances: see reference_test_util.h.
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -274,54 +275,75 @@ TEST(ReferenceSampling, GuidedDistancesAreUnbiased) {
 
 TEST(ReferenceSampling, DirectionGuideSamplesItsOwnDensity) {
   // Sample and Pdf describe the same density: Pdf integrates to 1 over the
-  // sphere (on a grid 16 x 16 times finer than its cells), and the fraction
+  // sphere (on a grid 8 times finer than its azimuth cells and spaced
+  // about half its thinnest zenith cells, next to the horizon), and the fraction
   // of 200 000 samples in each of 8 x 8 regions (in the world's cos z and
   // azimuth, not the guide's own frame) matches the integral of Pdf there
   // within 4.5 binomial standard deviations plus 2e-4 (the grid's edges).
-  // After sunset, from the ground and from 20 km, at each wavelength.
+  // After sunset, from the ground and from 20 km: each wavelength's guide,
+  // and the mixtures of the field around those points.
   LayeredMedium medium(Earth());
   const SunlightTable sunlight(medium);
   const dvec3 sun(std::sin(98.0 * kDegree), 0.0, std::cos(98.0 * kDegree));
-  constexpr int kRegions = 8, kFine = 512;
+  constexpr int kRegions = 8, kFineZenith = 8192, kFineAzimuth = 256;
   auto region = [](const dvec3& d) {
     const int i = std::clamp(static_cast<int>((d.z + 1.0) * 0.5 * kRegions), 0, kRegions - 1);
     double phi = std::atan2(d.y, d.x);
     if (phi < 0.0) phi += 2.0 * kPi;
     return i * kRegions + std::clamp(static_cast<int>(phi / (2.0 * kPi) * kRegions), 0, kRegions - 1);
   };
+  // Sample(u_guide, u_cell, u1, u2) and Pdf of a guide or a mixture of them.
+  auto check = [&](auto sample, auto pdf, const std::string& label) {
+    std::vector<double> expected(kRegions * kRegions, 0.0), observed(kRegions * kRegions, 0.0);
+    double total = 0.0;
+    const double cell = (2.0 / kFineZenith) * (2.0 * kPi / kFineAzimuth);
+    for (int i = 0; i < kFineZenith; ++i) {
+      const double c = -1.0 + 2.0 * (i + 0.5) / kFineZenith, s = std::sqrt(1.0 - c * c);
+      for (int j = 0; j < kFineAzimuth; ++j) {
+        const double phi = 2.0 * kPi * (j + 0.5) / kFineAzimuth;
+        const dvec3 d(s * std::cos(phi), s * std::sin(phi), c);
+        const double p = pdf(d) * cell;
+        total += p;
+        expected[region(d)] += p;
+      }
+    }
+    EXPECT_NEAR(total, 1.0, 1e-3) << label;
+    Pcg32 rng(7, 8);
+    const int n = 200000;
+    for (int k = 0; k < n; ++k) {
+      const double u_guide = rng.Uniform(), u = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+      const dvec3 d = sample(u_guide, u, u1, u2);
+      ASSERT_NEAR(glm::length(d), 1.0, 1e-12) << label;
+      ASSERT_GT(pdf(d), 0.0) << label;
+      observed[region(d)] += 1.0 / n;
+    }
+    for (int r = 0; r < kRegions * kRegions; ++r) {
+      const double sigma = std::sqrt(expected[r] * (1.0 - expected[r]) / n);
+      EXPECT_NEAR(observed[r], expected[r], 4.5 * sigma + 2e-4) << label << " region " << r;
+    }
+  };
   for (double altitude : {0.0, 20000.0}) {
     const dvec3 point(0.0, 0.0, medium.bottom_radius() + altitude);
+    const GuideFrame frame(point, sun);
+    const double r = glm::length(point), mu_s = glm::dot(point, sun) / r;
     for (int w = 0; w < kWavelengthCount; ++w) {
-      const DirectionGuide guide(medium, sunlight, glm::length(point), glm::dot(point, sun) / glm::length(point), w);
-      const GuideFrame frame(point, sun);
+      const DirectionGuide guide(medium, sunlight, nullptr, r, mu_s, w);
       ASSERT_TRUE(guide.usable());
-      std::vector<double> expected(kRegions * kRegions, 0.0), observed(kRegions * kRegions, 0.0);
-      double total = 0.0;
-      const double cell = (2.0 / kFine) * (2.0 * kPi / kFine);
-      for (int i = 0; i < kFine; ++i) {
-        const double c = -1.0 + 2.0 * (i + 0.5) / kFine, s = std::sqrt(1.0 - c * c);
-        for (int j = 0; j < kFine; ++j) {
-          const double phi = 2.0 * kPi * (j + 0.5) / kFine;
-          const dvec3 d(s * std::cos(phi), s * std::sin(phi), c);
-          const double p = guide.Pdf(frame, d) * cell;
-          total += p;
-          expected[region(d)] += p;
-        }
-      }
-      EXPECT_NEAR(total, 1.0, 1e-3) << altitude << " " << w;
-      Pcg32 rng(7, 8);
-      const int n = 200000;
-      for (int k = 0; k < n; ++k) {
-        const double u = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-        const dvec3 d = guide.Sample(frame, u, u1, u2);
-        ASSERT_NEAR(glm::length(d), 1.0, 1e-12);
-        ASSERT_GT(guide.Pdf(frame, d), 0.0);
-        observed[region(d)] += 1.0 / n;
-      }
-      for (int r = 0; r < kRegions * kRegions; ++r) {
-        const double sigma = std::sqrt(expected[r] * (1.0 - expected[r]) / n);
-        EXPECT_NEAR(observed[r], expected[r], 4.5 * sigma + 2e-4) << altitude << " " << w << " region " << r;
-      }
+      check([&](double, double u, double u1, double u2) { return guide.Sample(frame, u, u1, u2); },
+            [&](const dvec3& d) { return guide.Pdf(frame, d); },
+            "guide at " + std::to_string(altitude) + " m, wavelength " + std::to_string(w));
+    }
+    // The field's mixture of four guides around the point (its altitude and
+    // sun cosine lie between the field's nodes), single and double scattering.
+    const DirectionGuideField single(medium, sunlight, nullptr, 0);
+    const DirectionGuideField twice(medium, sunlight, &single, 0);
+    for (const DirectionGuideField* field : {&single, &twice}) {
+      const GuideMixture mixture = field->At(r + 1500.0, mu_s);
+      ASSERT_TRUE(mixture.usable());
+      check([&](double ug, double u, double u1, double u2) { return mixture.Sample(frame, ug, u, u1, u2); },
+            [&](const dvec3& d) { return mixture.Pdf(frame, d); },
+            std::string(field == &single ? "single" : "double") + " scattering mixture at " +
+                std::to_string(altitude) + " m");
     }
   }
 }
