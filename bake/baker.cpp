@@ -99,7 +99,16 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     // one, their densities, for the final gather.
     const Texture& newest = gather_at_end ? scattering_density_ : delta_multiple_;
     Phase(prefix + "multiple scattering", [&] {
-      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, atmosphere_grid_);
+      // The second order's J falls by orders of magnitude from one mu_s
+      // column to the next after sunset, and along a ray into the Earth's
+      // shadow the sun sinks by several columns: it is gathered following
+      // its own fall. The later orders are gathered linearly: weights that
+      // depend on each order's values would make the orders' operator
+      // nonlinear, and the extrapolated tail then misses by more than 1 %
+      // (Orders.AutoWithTail... on the stiff slab; docs/accuracy.md).
+      const MuSFall fall = order == 2 ? MuSFallOf(scattering_density_) : MuSFall();
+      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, atmosphere_grid_,
+                                        order == 2 ? &fall : nullptr);
       AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
     report_.orders_used = order;

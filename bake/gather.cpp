@@ -9,13 +9,62 @@
 
 #include <tbb/parallel_for.h>
 
+#include "bake/float_math.h"
 #include "bake/grids.h"
+#include "bake/sun_lookups.h"
 #include "core/constants.h"
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
+
+namespace {
+// The largest ln of the ratio of J between neighbouring columns that
+// MuSFall keeps (a fall by 5e8).
+constexpr float kLargestLogRatio = 20.0f;
+// How far below the grid's lowest sun, in texels, the gather continues the
+// fall of the two lowest columns.
+constexpr float kLowestPosition = -8.0f;
+
+// The weight of the right column at position f (in texels from the left
+// one, below 0 under the lowest column) for a pair whose J falls by
+// exp(log_ratio) from right to left: (exp(f L) - 1) / (exp(L) - 1), which
+// reads J = a exp(f L) exactly when J is exponential between the columns
+// (b = a exp(L)) and is linear in a and b. Without a fall (inverse 0), f,
+// and the lowest column held below it.
+inline float FallWeight(float f, float log_ratio, float inverse_ratio_minus_one) {
+  return inverse_ratio_minus_one == 0.0f ? (f > 0.0f ? f : 0.0f)
+                                         : (ExpFloat(f * log_ratio) - 1.0f) * inverse_ratio_minus_one;
+}
+}  // namespace
+
+Baker::MuSFall Baker::MuSFallOf(const Texture& density) const {
+  const SunColumns columns(atmosphere_grid_);
+  const int mu_s_size = atmosphere_grid_.scattering_mu_s_size, nu_size = atmosphere_grid_.scattering_nu_size;
+  MuSFall fall;
+  while (fall.falling_columns < mu_s_size - 1 && columns.mu_s[fall.falling_columns] < 0.0) ++fall.falling_columns;
+  const int columns_per_row = nu_size * fall.falling_columns;
+  fall.log_ratio.assign(std::size_t(density.height) * density.depth * columns_per_row, 0.0f);
+  fall.inverse_ratio_minus_one.assign(fall.log_ratio.size(), 0.0f);
+  ForEachRow(density, [&](int row, std::size_t first, std::size_t) {
+    for (int nu = 0; nu < nu_size; ++nu) {
+      for (int column = 0; column < fall.falling_columns; ++column) {
+        // J summed over the channels: one fall for the three.
+        const float* a = &density.texels[first + std::size_t(4) * (nu * mu_s_size + column)];
+        const double sum_a = double(a[0]) + a[1] + a[2], sum_b = double(a[4]) + a[5] + a[6];
+        if (!(sum_a > 0.0 && sum_b > 0.0)) continue;
+        const double log_ratio = std::min(std::log(sum_b / sum_a), double(kLargestLogRatio));
+        if (!(log_ratio > 1e-3)) continue;
+        const std::size_t i = std::size_t(row) * columns_per_row + nu * fall.falling_columns + column;
+        fall.log_ratio[i] = float(log_ratio);
+        fall.inverse_ratio_minus_one[i] = float(1.0 / std::expm1(log_ratio));
+      }
+    }
+  });
+  return fall;
+}
+
 Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
-                               const AtmosphereParameters& density_grid) const {
+                               const AtmosphereParameters& density_grid, const MuSFall* fall) const {
   Texture result = ScatteringGridTexture(grid);
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
@@ -70,6 +119,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // J at each sample's (r, mu) for every (nu, mu_s) texel of the density
     // grid: the texture's r and mu interpolation, done once per sample.
     std::vector<int> samples;  // those with a non-zero weight
+    std::vector<std::size_t> fall_rows;  // per sample, MuSFall's row nearest it
     std::vector<float> planes;
     planes.reserve(std::size_t(n + 1) * 4 * plane_width);
     for (int k = 0; k <= n; ++k) {
@@ -93,6 +143,10 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       float* plane = &planes[offset];
       for (int i = 0; i < 4 * plane_width; ++i) plane[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
       samples.push_back(k);
+      if (fall) {
+        const std::size_t row = std::size_t(fz < 0.5 ? z0 : z1) * density.height + (fy < 0.5 ? y0 : y1);
+        fall_rows.push_back(row * density_nu_size * fall->falling_columns);
+      }
     }
 
     // Per distinct sun direction of the ray: its nu taps in the density
@@ -102,11 +156,13 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     const int count = static_cast<int>(directions.nu.size());
     std::vector<float> mu_s(directions.mu_s.begin(), directions.mu_s.end()), nu(directions.nu.begin(), directions.nu.end());
     std::vector<int> nu_row0(count), nu_row1(count);  // offsets of the nu rows in a plane
+    std::vector<int> fall_row0(count), fall_row1(count);  // and in a row of MuSFall
     std::vector<float> nu_weight(count);
     for (int j = 0; j < count; ++j) {
       const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (density_nu_size - 1);
       const int nu0 = std::min(int(std::floor(nu_coord)), density_nu_size - 1), nu1 = std::min(nu0 + 1, density_nu_size - 1);
       nu_row0[j] = 4 * nu0 * density_mu_s_size, nu_row1[j] = 4 * nu1 * density_mu_s_size;
+      if (fall) fall_row0[j] = nu0 * fall->falling_columns, fall_row1[j] = nu1 * fall->falling_columns;
       nu_weight[j] = float(nu_coord - nu0);
     }
     const MuSCoordinate mu_s_coordinate(density_grid);
@@ -116,13 +172,36 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     std::vector<float> sums[3], source;  // source: J per sample, channel and direction, for thick intervals
     for (auto& sum : sums) sum.assign(count, 0.0f);
     if (!thick_intervals.empty()) source.assign(std::size_t(n + 1) * 3 * count, 0.0f);
+    const bool shaped = fall != nullptr;
+    std::vector<float> fall_weight_a(shaped ? count : 0), fall_weight_b(shaped ? count : 0);
     for (std::size_t i = 0; i < samples.size(); ++i) {
       const int k = samples[i];
       const float* plane = &planes[i * std::size_t(4) * plane_width];
       const float from_mu_s = float(ray.r / ray.radius[k]), from_nu = float(ray.t[k] / ray.radius[k]);
 #pragma omp simd
       for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
-      mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data());
+      mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data(),
+                           shaped ? kLowestPosition : 0.0f);
+      // The weights of the right columns of the two nu rows: mu_s_weight,
+      // or with a fall, weights that follow it (the same for the three
+      // channels).
+      const float* weight_a = mu_s_weight.data();
+      const float* weight_b = mu_s_weight.data();
+      if (shaped) {
+        const float* log_ratio = &fall->log_ratio[fall_rows[i]];
+        const float* inverse = &fall->inverse_ratio_minus_one[fall_rows[i]];
+        const int falling = fall->falling_columns;
+#pragma omp simd
+        for (int j = 0; j < count; ++j) {
+          const int left = mu_s_left[j];
+          const int column = left < falling ? left : falling - 1;  // any, when the pair does not fall
+          const int a = fall_row0[j] + column, b = fall_row1[j] + column;
+          const float inverse_a = left < falling ? inverse[a] : 0.0f, inverse_b = left < falling ? inverse[b] : 0.0f;
+          fall_weight_a[j] = FallWeight(mu_s_weight[j], log_ratio[a], inverse_a);
+          fall_weight_b[j] = FallWeight(mu_s_weight[j], log_ratio[b], inverse_b);
+        }
+        weight_a = fall_weight_a.data(), weight_b = fall_weight_b.data();
+      }
       for (int c = 0; c < 3; ++c) {
         const float w = float(weight[k][c]);
         float* sum = sums[c].data();
@@ -130,10 +209,11 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
 #pragma omp simd
         for (int j = 0; j < count; ++j) {
           const int a = nu_row0[j] + 4 * mu_s_left[j] + c, b = nu_row1[j] + 4 * mu_s_left[j] + c;
-          const float f = mu_s_weight[j];
-          const float along_a = plane[a] + f * (plane[a + 4] - plane[a]);
-          const float along_b = plane[b] + f * (plane[b + 4] - plane[b]);
-          value[j] = along_a + nu_weight[j] * (along_b - along_a);
+          const float along_a = plane[a] + weight_a[j] * (plane[a + 4] - plane[a]);
+          const float along_b = plane[b] + weight_b[j] * (plane[b + 4] - plane[b]);
+          // Never negative below the lowest column, where the columns may
+          // rise faster than their fall says (without a fall, never below 0).
+          value[j] = std::max(along_a + nu_weight[j] * (along_b - along_a), 0.0f);
           sum[j] += w * value[j];
         }
       }
