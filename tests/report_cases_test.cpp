@@ -125,14 +125,14 @@ TEST(ReportCases, TwilightReferenceCoversItsCasesWithItsStatedNoise) {
     for (size_t c = 0; c < cases.header.size(); ++c) EXPECT_EQ(ref.fields[i][c], cases.fields[i][c]) << "row " << i;
   }
   // Per group: the quantity measured and the largest relative standard error
-  // allowed: 1 % where the reference converges (to sun 93 degrees), else
-  // the committed file's own largest, rounded up (docs/accuracy.md).
+  // allowed: 1 % to sun 100 degrees and 3 % beyond, what the case set is
+  // computed for (scripts/make_cases.py, docs/accuracy.md).
   const std::map<std::string, std::pair<std::string, double>> stated = {
       {"twilight_sky_sun_88-90", {"radiance", 0.01}},
-      {"twilight_sky_sun_91-96", {"radiance", 0.30}},
-      {"twilight_sky_sun_97-100", {"radiance", 0.18}},
-      {"twilight_sky_sun_101-102", {"radiance", 0.38}},
-      {"twilight_irradiance_sun_88-100", {"sky_irradiance", 0.26}},
+      {"twilight_sky_sun_91-96", {"radiance", 0.01}},
+      {"twilight_sky_sun_97-100", {"radiance", 0.01}},
+      {"twilight_sky_sun_101-102", {"radiance", 0.03}},
+      {"twilight_irradiance_sun_88-100", {"sky_irradiance", 0.01}},
       {"low_sun_aerial_perspective_sun_84-90", {"radiance", 0.01}}};
   std::map<std::string, double> worst;
   for (size_t i = 0; i < ref.queries.size(); ++i) {
