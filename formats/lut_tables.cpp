@@ -125,7 +125,9 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
   irradiance.width = p.irradiance_width;
   irradiance.height = p.irradiance_height;
   irradiance.axes = {{"x", "mu_s", p.irradiance_width, p.mu_s_min, 1.0, "1",
-                      "x = (mu_s - mu_s_min) / (1 - mu_s_min)" + std::string(kTexelCentres)},
+                      "x = (mu_s - mu_s_min) / (knee - mu_s_min) / 2 below knee, 1/2 + (mu_s - knee) / (1 - knee) / 2 "
+                      "above; knee = 0.1 where mu_s_min < 0.1, else (mu_s_min + 1) / 2" +
+                          std::string(kTexelCentres)},
                      RAxis("y", p.irradiance_height, p, std::string(kRhoOverH) + std::string(kTexelCentres))};
   irradiance.layout = "x = mu_s (" + std::to_string(p.irradiance_width) + "), y = r (" +
                       std::to_string(p.irradiance_height) + ")";

@@ -239,16 +239,45 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
 }
 #endif
 
+// Below this sun cosine (84 degrees) table lookups interpolate
+// geometrically along mu_s (SunCosineMix).
+const Number LOW_SUN_MU_S = 0.1;
+
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
-// Irradiance table: x = mu_s (linear over [mu_s_min, 1]), y = r (as rho / H).
-// r as rho / H, like the other tables: texels crowd near the ground, where
-// the sky irradiance falls fastest with altitude (linear in r, 16 texels
-// read 4% high at 1 and 10 km). mu_s over the covered [mu_s_min, 1] only:
-// below the horizon the irradiance falls by an order of magnitude within a
-// few degrees, and texels below mu_s_min would be wasted.
+// Irradiance table: x = mu_s (over [mu_s_min, 1], see below), y = r (as
+// rho / H). r as rho / H, like the other tables: texels crowd near the
+// ground, where the sky irradiance falls fastest with altitude (linear in
+// r, 16 texels read 4% high at 1 and 10 km). mu_s over the covered
+// [mu_s_min, 1] only: below the horizon the irradiance falls by an order of
+// magnitude within a few degrees, and texels below mu_s_min would be
+// wasted.
+//
+// Along mu_s, half of the columns lie evenly over [mu_s_min, knee] and half
+// over [knee, 1], knee = LOW_SUN_MU_S when mu_s_min is below it (else the
+// middle of the range, which makes the axis linear): from low sun to the
+// end of twilight the sky irradiance falls by orders of magnitude, and in
+// daylight it changes slowly (docs/accuracy.md measures both).
+Number IrradianceKneeMuS(IN(AtmosphereParameters) atmosphere) {
+  return atmosphere.mu_s_min < LOW_SUN_MU_S ? LOW_SUN_MU_S : 0.5 * (atmosphere.mu_s_min + 1.0);
+}
+
+// The unit x in [0, 1] of mu_s in [mu_s_min, 1] (below 0 under mu_s_min).
+Number GetIrradianceUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
+  Number knee = IrradianceKneeMuS(atmosphere);
+  return mu_s < knee ? 0.5 * (mu_s - atmosphere.mu_s_min) / (knee - atmosphere.mu_s_min)
+                     : 0.5 + 0.5 * (mu_s - knee) / (1.0 - knee);
+}
+
+// Its inverse.
+Number GetIrradianceMuSFromUnit(IN(AtmosphereParameters) atmosphere, Number x) {
+  Number knee = IrradianceKneeMuS(atmosphere);
+  return x < 0.5 ? atmosphere.mu_s_min + 2.0 * x * (knee - atmosphere.mu_s_min)
+                 : knee + (2.0 * x - 1.0) * (1.0 - knee);
+}
+
 vec2 GetIrradianceTextureUvFromRMuS(IN(AtmosphereParameters) atmosphere, Number r, Number mu_s) {
   Number x_r = HorizonDistance(atmosphere, r) / HorizonDistanceAtTop(atmosphere);
-  Number x_mu_s = clamp((mu_s - atmosphere.mu_s_min) / (1.0 - atmosphere.mu_s_min), 0.0, 1.0);
+  Number x_mu_s = clamp(GetIrradianceUnitMuS(atmosphere, mu_s), 0.0, 1.0);
   return vec2(GetTextureCoordFromUnitRange(x_mu_s, atmosphere.irradiance_width),
               GetTextureCoordFromUnitRange(x_r, atmosphere.irradiance_height));
 }
@@ -324,10 +353,6 @@ vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(Transmittance
   return GetTransmittanceToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, mu_s) *
          SunVisibleFraction(atmosphere, r, mu_s);
 }
-
-// Below this sun cosine (84 degrees) table lookups interpolate
-// geometrically along mu_s (SunCosineMix).
-const Number LOW_SUN_MU_S = 0.1;
 
 // Interpolation between two table texels a and b along the sun's cosine (or
 // between two nu slices of one mu_s texel column), at position t in [0, 1]
@@ -407,9 +432,9 @@ vec3 GetIrradiance(IN(AtmosphereParameters) atmosphere, IN(IrradianceTexture) ir
                    Number r, Number mu_s) {
   vec2 uv = GetIrradianceTextureUvFromRMuS(atmosphere, r, mu_s);
   Number width = Number(atmosphere.irradiance_width);
-  Number mu_s_coord = (mu_s - atmosphere.mu_s_min) / (1.0 - atmosphere.mu_s_min) * (width - 1.0);
+  Number mu_s_coord = GetIrradianceUnitMuS(atmosphere, mu_s) * (width - 1.0);
   Number mu_s_column = clamp(floor(mu_s_coord), 0.0, width - 2.0);
-  Number mu_s_below = atmosphere.mu_s_min + (1.0 - atmosphere.mu_s_min) * mu_s_column / (width - 1.0);
+  Number mu_s_below = GetIrradianceMuSFromUnit(atmosphere, mu_s_column / (width - 1.0));
   bool low_sun = mu_s_below < LOW_SUN_MU_S;
   vec4 below = SampleTexture2D(irradiance_texture, vec2((mu_s_column + 0.5) / width, uv.y));
   vec4 above = SampleTexture2D(irradiance_texture, vec2((mu_s_column + 1.5) / width, uv.y));

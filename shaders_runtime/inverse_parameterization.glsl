@@ -64,7 +64,7 @@ void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2
   Number x_r = GetUnitRangeFromTextureCoord(uv.y, atmosphere.irradiance_height);
   Number rho = HorizonDistanceAtTop(atmosphere) * x_r;
   r = sqrt(rho * rho + atmosphere.bottom_radius * atmosphere.bottom_radius);
-  mu_s = ClampCosine(atmosphere.mu_s_min + x_mu_s * (1.0 - atmosphere.mu_s_min));
+  mu_s = ClampCosine(GetIrradianceMuSFromUnit(atmosphere, x_mu_s));
 }
 
 // The texture coordinates uvwz of texel (x, y, z) of a scattering table as

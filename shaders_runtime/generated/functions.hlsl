@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _758 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _769 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_758)
+    if (!_769)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _621 = mu < 0.0f;
-    bool _633;
-    if (_621)
+    bool _632 = mu < 0.0f;
+    bool _644;
+    if (_632)
     {
-        _633 = (((r * r) * mu) * mu) >= c;
+        _644 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _633 = _621;
+        _644 = _632;
     }
-    return _633;
+    return _644;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _402;
+    float _413;
     if (r_mu > 0.0f)
     {
-        _402 = c / (r_mu + s);
+        _413 = c / (r_mu + s);
     }
     else
     {
-        _402 = s - r_mu;
+        _413 = s - r_mu;
     }
-    float param_1 = _402;
+    float param_1 = _413;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _851;
+    float _862;
     if (d_max > d_min)
     {
-        _851 = (d - d_min) / (d_max - d_min);
+        _862 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _851 = 0.0f;
+        _862 = 0.0f;
     }
-    float x_mu = _851;
+    float x_mu = _862;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1111;
+        float _1122;
         if (d_max == d_min)
         {
-            _1111 = 0.0f;
+            _1122 = 0.0f;
         }
         else
         {
-            _1111 = (d - d_min) / (d_max - d_min);
+            _1122 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1111;
+        x_mu = _1122;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1155;
+        float _1166;
         if (d_max_1 > d_min_1)
         {
-            _1155 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1166 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1155 = 0.0f;
+            _1166 = 0.0f;
         }
-        x_mu = _1155;
+        x_mu = _1166;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1455;
+    float _1541;
     if (low_sun)
     {
-        _1455 = min(t, 1.0f);
+        _1541 = min(t, 1.0f);
     }
     else
     {
-        _1455 = clamp(t, 0.0f, 1.0f);
+        _1541 = clamp(t, 0.0f, 1.0f);
     }
-    return _1455;
+    return _1541;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -394,16 +394,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1478;
+    float4 _1564;
     if (t < 0.0f)
     {
-        _1478 = min(blend, a);
+        _1564 = min(blend, a);
     }
     else
     {
-        _1478 = blend;
+        _1564 = blend;
     }
-    return _1478;
+    return _1564;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -464,16 +464,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _1805;
+        float3 _1884;
         if (scattering.x > 0.0f)
         {
-            _1805 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _1884 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _1805 = 0.0f.xxx;
+            _1884 = 0.0f.xxx;
         }
-        single_mie_scattering = _1805;
+        single_mie_scattering = _1884;
     }
     else
     {
@@ -545,13 +545,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _1873 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _1952 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_1873)
+    if (!_1952)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -560,19 +560,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _1893;
+    float3 _1972;
     if (ray_r_mu_intersects_ground)
     {
-        _1893 = 0.0f.xxx;
+        _1972 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _1893 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _1972 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _1893;
+    transmittance = _1972;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -580,9 +580,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _1920 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _1999 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _1920;
+    float3 scattering = _1999;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -623,16 +623,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2014;
+    float _2093;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2014 = a * exp(f * log(b / a));
+        _2093 = a * exp(f * log(b / a));
     }
     else
     {
-        _2014 = lerp(a, b, f);
+        _2093 = lerp(a, b, f);
     }
-    return _2014;
+    return _2093;
 }
 #endif
 
@@ -705,16 +705,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2146;
+    float _2225;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2146 = 1.0f - (0.5f * depth);
+        _2225 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2146 = (1.0f - exp(-depth)) / depth;
+        _2225 = (1.0f - exp(-depth)) / depth;
     }
-    return _2146;
+    return _2225;
 }
 #endif
 
@@ -745,10 +745,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_4);
         AtmosphereParameters param_5 = atmosphere;
         float param_6 = altitude;
-        float3 _2234 = GetCoefficientsAtAltitude(param_5, param_6, param_7, param_8);
+        float3 _2313 = GetCoefficientsAtAltitude(param_5, param_6, param_7, param_8);
         float3 mie_scattering = param_7;
         float3 rayleigh_scattering = param_8;
-        float3 extinction = _2234;
+        float3 extinction = _2313;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = r_t;
         float param_11 = mu_s_t;
@@ -845,22 +845,22 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _637;
+    float _648;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _637 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _648 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _637 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _648 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _637;
+    return _648;
 }
 #endif
 
@@ -873,16 +873,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _1976;
+    float _2055;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _1976 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2055 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _1976 = up;
+        _2055 = up;
     }
-    return _1976;
+    return _2055;
 }
 #endif
 
@@ -905,13 +905,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _2380 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2459 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2380)
+    if (!_2459)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -951,11 +951,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2475 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _2554 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2475;
+        lit_optical_depth = _2554;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -969,11 +969,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2509 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _2588 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2509;
+        optical_depth += _2588;
     }
     if (direct < 1.0f)
     {
@@ -992,9 +992,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _2552 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _2631 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _2552;
+    float3 scattering = _2631;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1015,11 +1015,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _2600 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _2679 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _2600;
+        float3 far_optical_depth = _2679;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1039,9 +1039,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _2654 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _2733 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _2654);
+            scattering -= (exp(-far_optical_depth) * _2733);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1062,9 +1062,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _2719 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _2798 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _2719;
+    float3 scattering_p = _2798;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1084,9 +1084,43 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _2763 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _2842 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _2763;
+    return _2842;
+}
+#endif
+
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+float IrradianceKneeMuS(AtmosphereParameters atmosphere)
+{
+    float _1220;
+    if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
+    {
+        _1220 = 0.100000001490116119384765625f;
+    }
+    else
+    {
+        _1220 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+    }
+    return _1220;
+}
+#endif
+
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
+{
+    AtmosphereParameters param = atmosphere;
+    float knee = IrradianceKneeMuS(param);
+    float _1238;
+    if (mu_s < knee)
+    {
+        _1238 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+    }
+    else
+    {
+        _1238 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+    }
+    return _1238;
 }
 #endif
 
@@ -1097,12 +1131,32 @@ float2 GetIrradianceTextureUvFromRMuS(AtmosphereParameters atmosphere, float r, 
     float param_1 = r;
     AtmosphereParameters param_2 = atmosphere;
     float x_r = HorizonDistance(param, param_1) / HorizonDistanceAtTop(param_2);
-    float x_mu_s = clamp((mu_s - atmosphere.mu_s_min) / (1.0f - atmosphere.mu_s_min), 0.0f, 1.0f);
-    float param_3 = x_mu_s;
-    int param_4 = atmosphere.irradiance_width;
-    float param_5 = x_r;
-    int param_6 = atmosphere.irradiance_height;
-    return float2(GetTextureCoordFromUnitRange(param_3, param_4), GetTextureCoordFromUnitRange(param_5, param_6));
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = mu_s;
+    float x_mu_s = clamp(GetIrradianceUnitMuS(param_3, param_4), 0.0f, 1.0f);
+    float param_5 = x_mu_s;
+    int param_6 = atmosphere.irradiance_width;
+    float param_7 = x_r;
+    int param_8 = atmosphere.irradiance_height;
+    return float2(GetTextureCoordFromUnitRange(param_5, param_6), GetTextureCoordFromUnitRange(param_7, param_8));
+}
+#endif
+
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
+{
+    AtmosphereParameters param = atmosphere;
+    float knee = IrradianceKneeMuS(param);
+    float _1269;
+    if (x < 0.5f)
+    {
+        _1269 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+    }
+    else
+    {
+        _1269 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+    }
+    return _1269;
 }
 #endif
 
@@ -1114,19 +1168,23 @@ float3 GetIrradiance(AtmosphereParameters atmosphere, Texture2D<float4> irradian
     float param_2 = mu_s;
     float2 uv = GetIrradianceTextureUvFromRMuS(param, param_1, param_2);
     float width = float(atmosphere.irradiance_width);
-    float mu_s_coord = ((mu_s - atmosphere.mu_s_min) / (1.0f - atmosphere.mu_s_min)) * (width - 1.0f);
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = mu_s;
+    float mu_s_coord = GetIrradianceUnitMuS(param_3, param_4) * (width - 1.0f);
     float mu_s_column = clamp(floor(mu_s_coord), 0.0f, width - 2.0f);
-    float mu_s_below = atmosphere.mu_s_min + (((1.0f - atmosphere.mu_s_min) * mu_s_column) / (width - 1.0f));
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = mu_s_column / (width - 1.0f);
+    float mu_s_below = GetIrradianceMuSFromUnit(param_5, param_6);
     bool low_sun = mu_s_below < 0.100000001490116119384765625f;
     float4 below = irradiance_texture_1.SampleLevel(_irradiance_texture_1_sampler, float2((mu_s_column + 0.5f) / width, uv.y), 0.0f);
     float4 above = irradiance_texture_1.SampleLevel(_irradiance_texture_1_sampler, float2((mu_s_column + 1.5f) / width, uv.y), 0.0f);
-    float param_3 = mu_s_coord - mu_s_column;
-    bool param_4 = low_sun;
-    float4 param_5 = below;
-    float4 param_6 = above;
-    float param_7 = SunCosinePosition(param_3, param_4);
+    float param_7 = mu_s_coord - mu_s_column;
     bool param_8 = low_sun;
-    return float3(SunBelowTableMix(param_5, param_6, param_7, param_8).xyz);
+    float4 param_9 = below;
+    float4 param_10 = above;
+    float param_11 = SunCosinePosition(param_7, param_8);
+    bool param_12 = low_sun;
+    return float3(SunBelowTableMix(param_9, param_10, param_11, param_12).xyz);
 }
 #endif
 

@@ -883,71 +883,147 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_2
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_30: AtmosphereParameters, r_28: f32, mu_s_9: f32) -> vec2<f32> {
+fn IrradianceKneeMuS(atmosphere_30: AtmosphereParameters) -> f32 {
     var atmosphere_31: AtmosphereParameters;
-    var r_29: f32;
+    var local_5: f32;
+
+    atmosphere_31 = atmosphere_30;
+    let _e9 = atmosphere_31;
+    if (_e9.mu_s_min < LOW_SUN_MU_S) {
+        local_5 = LOW_SUN_MU_S;
+    } else {
+        let _e13 = atmosphere_31;
+        local_5 = (0.5f * (_e13.mu_s_min + 1f));
+    }
+    let _e19 = local_5;
+    return _e19;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceUnitMuS(atmosphere_32: AtmosphereParameters, mu_s_9: f32) -> f32 {
+    var atmosphere_33: AtmosphereParameters;
     var mu_s_10: f32;
+    var knee: f32;
+    var local_6: f32;
+
+    atmosphere_33 = atmosphere_32;
+    mu_s_10 = mu_s_9;
+    let _e11 = atmosphere_33;
+    let _e12 = IrradianceKneeMuS(_e11);
+    knee = _e12;
+    let _e14 = mu_s_10;
+    let _e15 = knee;
+    if (_e14 < _e15) {
+        let _e18 = mu_s_10;
+        let _e19 = atmosphere_33;
+        let _e23 = knee;
+        let _e24 = atmosphere_33;
+        local_6 = ((0.5f * (_e18 - _e19.mu_s_min)) / (_e23 - _e24.mu_s_min));
+    } else {
+        let _e30 = mu_s_10;
+        let _e31 = knee;
+        let _e35 = knee;
+        local_6 = (0.5f + ((0.5f * (_e30 - _e31)) / (1f - _e35)));
+    }
+    let _e40 = local_6;
+    return _e40;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceMuSFromUnit(atmosphere_34: AtmosphereParameters, x_3: f32) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
+    var x_4: f32;
+    var knee_1: f32;
+    var local_7: f32;
+
+    atmosphere_35 = atmosphere_34;
+    x_4 = x_3;
+    let _e11 = atmosphere_35;
+    let _e12 = IrradianceKneeMuS(_e11);
+    knee_1 = _e12;
+    let _e14 = x_4;
+    if (_e14 < 0.5f) {
+        let _e17 = atmosphere_35;
+        let _e20 = x_4;
+        let _e22 = knee_1;
+        let _e23 = atmosphere_35;
+        local_7 = (_e17.mu_s_min + ((2f * _e20) * (_e22 - _e23.mu_s_min)));
+    } else {
+        let _e28 = knee_1;
+        let _e30 = x_4;
+        let _e35 = knee_1;
+        local_7 = (_e28 + (((2f * _e30) - 1f) * (1f - _e35)));
+    }
+    let _e40 = local_7;
+    return _e40;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceTextureUvFromRMuS(atmosphere_36: AtmosphereParameters, r_28: f32, mu_s_11: f32) -> vec2<f32> {
+    var atmosphere_37: AtmosphereParameters;
+    var r_29: f32;
+    var mu_s_12: f32;
     var x_r_1: f32;
     var x_mu_s: f32;
 
-    atmosphere_31 = atmosphere_30;
+    atmosphere_37 = atmosphere_36;
     r_29 = r_28;
-    mu_s_10 = mu_s_9;
-    let _e12 = atmosphere_31;
-    let _e13 = r_29;
-    let _e14 = HorizonDistance(_e12, _e13);
-    let _e15 = atmosphere_31;
-    let _e16 = HorizonDistanceAtTop(_e15);
-    x_r_1 = (_e14 / _e16);
-    let _e19 = mu_s_10;
-    let _e20 = atmosphere_31;
-    let _e24 = atmosphere_31;
-    x_mu_s = clamp(((_e19 - _e20.mu_s_min) / (1f - _e24.mu_s_min)), 0f, 1f);
-    let _e32 = x_mu_s;
-    let _e33 = atmosphere_31;
-    let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_width);
-    let _e36 = x_r_1;
-    let _e37 = atmosphere_31;
-    let _e39 = GetTextureCoordFromUnitRange(_e36, _e37.irradiance_height);
-    return vec2<f32>(_e35, _e39);
+    mu_s_12 = mu_s_11;
+    let _e13 = atmosphere_37;
+    let _e14 = r_29;
+    let _e15 = HorizonDistance(_e13, _e14);
+    let _e16 = atmosphere_37;
+    let _e17 = HorizonDistanceAtTop(_e16);
+    x_r_1 = (_e15 / _e17);
+    let _e20 = atmosphere_37;
+    let _e21 = mu_s_12;
+    let _e22 = GetIrradianceUnitMuS(_e20, _e21);
+    x_mu_s = clamp(_e22, 0f, 1f);
+    let _e27 = x_mu_s;
+    let _e28 = atmosphere_37;
+    let _e30 = GetTextureCoordFromUnitRange(_e27, _e28.irradiance_width);
+    let _e31 = x_r_1;
+    let _e32 = atmosphere_37;
+    let _e34 = GetTextureCoordFromUnitRange(_e31, _e32.irradiance_height);
+    return vec2<f32>(_e30, _e34);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_32: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
-    var atmosphere_33: AtmosphereParameters;
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_38: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
+    var atmosphere_39: AtmosphereParameters;
     var r_31: f32;
     var mu_20: f32;
     var uv_2: vec2<f32>;
 
-    atmosphere_33 = atmosphere_32;
+    atmosphere_39 = atmosphere_38;
     r_31 = r_30;
     mu_20 = mu_19;
-    let _e13 = atmosphere_33;
-    let _e14 = r_31;
-    let _e15 = mu_20;
-    let _e16 = GetTransmittanceTextureUvFromRMu(_e13, _e14, _e15);
-    uv_2 = _e16;
-    let _e18 = uv_2;
-    let _e19 = SampleTexture2D(transmittance_texture, _e18);
-    return vec3<f32>(_e19.xyz);
+    let _e14 = atmosphere_39;
+    let _e15 = r_31;
+    let _e16 = mu_20;
+    let _e17 = GetTransmittanceTextureUvFromRMu(_e14, _e15, _e16);
+    uv_2 = _e17;
+    let _e19 = uv_2;
+    let _e20 = SampleTexture2D(transmittance_texture, _e19);
+    return vec3<f32>(_e20.xyz);
 }
 
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_34: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
-    var atmosphere_35: AtmosphereParameters;
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
+    var atmosphere_41: AtmosphereParameters;
     var r_33: f32;
     var mu_22: f32;
 
-    atmosphere_35 = atmosphere_34;
+    atmosphere_41 = atmosphere_40;
     r_33 = r_32;
     mu_22 = mu_21;
-    let _e13 = atmosphere_35;
-    let _e14 = r_33;
-    let _e15 = mu_22;
-    let _e16 = GetOpticalDepthToTopAtmosphereBoundary(_e13, transmittance_texture_1, _e14, _e15);
-    return exp(-(_e16));
+    let _e14 = atmosphere_41;
+    let _e15 = r_33;
+    let _e16 = mu_22;
+    let _e17 = GetOpticalDepthToTopAtmosphereBoundary(_e14, transmittance_texture_1, _e15, _e16);
+    return exp(-(_e17));
 }
 
-fn GetOpticalDepth(atmosphere_36: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_11: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
-    var atmosphere_37: AtmosphereParameters;
+fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_11: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
+    var atmosphere_43: AtmosphereParameters;
     var r_35: f32;
     var mu_24: f32;
     var d_12: f32;
@@ -958,142 +1034,142 @@ fn GetOpticalDepth(atmosphere_36: AtmosphereParameters, transmittance_texture_2:
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_37 = atmosphere_36;
+    atmosphere_43 = atmosphere_42;
     r_35 = r_34;
     mu_24 = mu_23;
     d_12 = d_11;
     ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
-    let _e17 = atmosphere_37;
-    let _e18 = r_35;
-    let _e19 = mu_24;
-    let _e20 = d_12;
-    let _e21 = RadiusAtDistance(_e17, _e18, _e19, _e20);
-    r_d_2 = _e21;
-    let _e23 = r_35;
-    let _e24 = mu_24;
-    let _e25 = d_12;
-    let _e26 = r_d_2;
-    let _e27 = CosineAtDistance(_e23, _e24, _e25, _e26);
-    mu_d = _e27;
-    let _e30 = ray_r_mu_intersects_ground_7;
-    let _e31 = mu_d;
-    if (_e30 || (_e31 < 0f)) {
+    let _e18 = atmosphere_43;
+    let _e19 = r_35;
+    let _e20 = mu_24;
+    let _e21 = d_12;
+    let _e22 = RadiusAtDistance(_e18, _e19, _e20, _e21);
+    r_d_2 = _e22;
+    let _e24 = r_35;
+    let _e25 = mu_24;
+    let _e26 = d_12;
+    let _e27 = r_d_2;
+    let _e28 = CosineAtDistance(_e24, _e25, _e26, _e27);
+    mu_d = _e28;
+    let _e31 = ray_r_mu_intersects_ground_7;
+    let _e32 = mu_d;
+    if (_e31 || (_e32 < 0f)) {
         {
-            let _e35 = atmosphere_37;
-            let _e36 = r_d_2;
-            let _e37 = mu_d;
-            let _e39 = GetOpticalDepthToTopAtmosphereBoundary(_e35, transmittance_texture_2, _e36, -(_e37));
-            let _e40 = atmosphere_37;
-            let _e41 = r_35;
-            let _e42 = mu_24;
-            let _e44 = GetOpticalDepthToTopAtmosphereBoundary(_e40, transmittance_texture_2, _e41, -(_e42));
-            tau = (_e39 - _e44);
+            let _e36 = atmosphere_43;
+            let _e37 = r_d_2;
+            let _e38 = mu_d;
+            let _e40 = GetOpticalDepthToTopAtmosphereBoundary(_e36, transmittance_texture_2, _e37, -(_e38));
+            let _e41 = atmosphere_43;
+            let _e42 = r_35;
+            let _e43 = mu_24;
+            let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
+            tau = (_e40 - _e45);
         }
     } else {
-        let _e46 = mu_24;
-        if (_e46 >= 0f) {
+        let _e47 = mu_24;
+        if (_e47 >= 0f) {
             {
-                let _e49 = atmosphere_37;
-                let _e50 = r_35;
-                let _e51 = mu_24;
-                let _e52 = GetOpticalDepthToTopAtmosphereBoundary(_e49, transmittance_texture_2, _e50, _e51);
-                let _e53 = atmosphere_37;
-                let _e54 = r_d_2;
-                let _e55 = mu_d;
-                let _e56 = GetOpticalDepthToTopAtmosphereBoundary(_e53, transmittance_texture_2, _e54, _e55);
-                tau = (_e52 - _e56);
+                let _e50 = atmosphere_43;
+                let _e51 = r_35;
+                let _e52 = mu_24;
+                let _e53 = GetOpticalDepthToTopAtmosphereBoundary(_e50, transmittance_texture_2, _e51, _e52);
+                let _e54 = atmosphere_43;
+                let _e55 = r_d_2;
+                let _e56 = mu_d;
+                let _e57 = GetOpticalDepthToTopAtmosphereBoundary(_e54, transmittance_texture_2, _e55, _e56);
+                tau = (_e53 - _e57);
             }
         } else {
             {
-                let _e58 = atmosphere_37;
-                let _e59 = r_35;
-                let _e61 = mu_24;
+                let _e59 = atmosphere_43;
+                let _e60 = r_35;
                 let _e62 = mu_24;
-                let _e65 = SafeSqrt((1f - (_e61 * _e62)));
-                let _e67 = ClampRadius(_e58, (_e59 * _e65));
-                r_low = _e67;
-                let _e69 = atmosphere_37;
-                let _e70 = r_low;
-                let _e72 = GetOpticalDepthToTopAtmosphereBoundary(_e69, transmittance_texture_2, _e70, 0f);
-                tau_low = _e72;
-                let _e74 = tau_low;
-                let _e75 = atmosphere_37;
-                let _e76 = r_35;
-                let _e77 = mu_24;
-                let _e79 = GetOpticalDepthToTopAtmosphereBoundary(_e75, transmittance_texture_2, _e76, -(_e77));
-                let _e84 = tau_low;
-                let _e85 = atmosphere_37;
-                let _e86 = r_d_2;
-                let _e87 = mu_d;
-                let _e88 = GetOpticalDepthToTopAtmosphereBoundary(_e85, transmittance_texture_2, _e86, _e87);
-                tau = (max((_e74 - _e79), vec3(0f)) + max((_e84 - _e88), vec3(0f)));
+                let _e63 = mu_24;
+                let _e66 = SafeSqrt((1f - (_e62 * _e63)));
+                let _e68 = ClampRadius(_e59, (_e60 * _e66));
+                r_low = _e68;
+                let _e70 = atmosphere_43;
+                let _e71 = r_low;
+                let _e73 = GetOpticalDepthToTopAtmosphereBoundary(_e70, transmittance_texture_2, _e71, 0f);
+                tau_low = _e73;
+                let _e75 = tau_low;
+                let _e76 = atmosphere_43;
+                let _e77 = r_35;
+                let _e78 = mu_24;
+                let _e80 = GetOpticalDepthToTopAtmosphereBoundary(_e76, transmittance_texture_2, _e77, -(_e78));
+                let _e85 = tau_low;
+                let _e86 = atmosphere_43;
+                let _e87 = r_d_2;
+                let _e88 = mu_d;
+                let _e89 = GetOpticalDepthToTopAtmosphereBoundary(_e86, transmittance_texture_2, _e87, _e88);
+                tau = (max((_e75 - _e80), vec3(0f)) + max((_e85 - _e89), vec3(0f)));
             }
         }
     }
-    let _e94 = tau;
-    return max(_e94, vec3(0f));
+    let _e95 = tau;
+    return max(_e95, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_38: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_13: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
-    var atmosphere_39: AtmosphereParameters;
+fn GetTransmittance(atmosphere_44: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_13: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
+    var atmosphere_45: AtmosphereParameters;
     var r_37: f32;
     var mu_26: f32;
     var d_14: f32;
     var ray_r_mu_intersects_ground_9: bool;
 
-    atmosphere_39 = atmosphere_38;
+    atmosphere_45 = atmosphere_44;
     r_37 = r_36;
     mu_26 = mu_25;
     d_14 = d_13;
     ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e17 = atmosphere_39;
-    let _e18 = r_37;
-    let _e19 = mu_26;
-    let _e20 = d_14;
-    let _e21 = ray_r_mu_intersects_ground_9;
-    let _e22 = GetOpticalDepth(_e17, transmittance_texture_3, _e18, _e19, _e20, _e21);
-    return exp(-(_e22));
+    let _e18 = atmosphere_45;
+    let _e19 = r_37;
+    let _e20 = mu_26;
+    let _e21 = d_14;
+    let _e22 = ray_r_mu_intersects_ground_9;
+    let _e23 = GetOpticalDepth(_e18, transmittance_texture_3, _e19, _e20, _e21, _e22);
+    return exp(-(_e23));
 }
 
-fn SunVisibleFraction(atmosphere_40: AtmosphereParameters, r_38: f32, mu_s_11: f32) -> f32 {
-    var atmosphere_41: AtmosphereParameters;
+fn SunVisibleFraction(atmosphere_46: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
+    var atmosphere_47: AtmosphereParameters;
     var r_39: f32;
-    var mu_s_12: f32;
+    var mu_s_14: f32;
     var sin_theta_h: f32;
 
-    atmosphere_41 = atmosphere_40;
+    atmosphere_47 = atmosphere_46;
     r_39 = r_38;
-    mu_s_12 = mu_s_11;
-    let _e12 = atmosphere_41;
-    let _e14 = r_39;
-    sin_theta_h = (_e12.bottom_radius / _e14);
-    let _e17 = mu_s_12;
-    let _e18 = atmosphere_41;
-    let _e20 = r_39;
-    let _e21 = HorizonZenithCosine(_e18.bottom_radius, _e20);
-    let _e22 = sin_theta_h;
-    let _e23 = atmosphere_41;
-    let _e26 = SunVisibleFractionAboveHorizon(_e17, _e21, (_e22 * _e23.sun_angular_radius));
-    return _e26;
+    mu_s_14 = mu_s_13;
+    let _e13 = atmosphere_47;
+    let _e15 = r_39;
+    sin_theta_h = (_e13.bottom_radius / _e15);
+    let _e18 = mu_s_14;
+    let _e19 = atmosphere_47;
+    let _e21 = r_39;
+    let _e22 = HorizonZenithCosine(_e19.bottom_radius, _e21);
+    let _e23 = sin_theta_h;
+    let _e24 = atmosphere_47;
+    let _e27 = SunVisibleFractionAboveHorizon(_e18, _e22, (_e23 * _e24.sun_angular_radius));
+    return _e27;
 }
 
-fn GetTransmittanceToSun(atmosphere_42: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_13: f32) -> vec3<f32> {
-    var atmosphere_43: AtmosphereParameters;
+fn GetTransmittanceToSun(atmosphere_48: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
+    var atmosphere_49: AtmosphereParameters;
     var r_41: f32;
-    var mu_s_14: f32;
+    var mu_s_16: f32;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_49 = atmosphere_48;
     r_41 = r_40;
-    mu_s_14 = mu_s_13;
-    let _e13 = atmosphere_43;
-    let _e14 = r_41;
-    let _e15 = mu_s_14;
-    let _e16 = GetTransmittanceToTopAtmosphereBoundary(_e13, transmittance_texture_4, _e14, _e15);
-    let _e17 = atmosphere_43;
-    let _e18 = r_41;
-    let _e19 = mu_s_14;
-    let _e20 = SunVisibleFraction(_e17, _e18, _e19);
-    return (_e16 * _e20);
+    mu_s_16 = mu_s_15;
+    let _e14 = atmosphere_49;
+    let _e15 = r_41;
+    let _e16 = mu_s_16;
+    let _e17 = GetTransmittanceToTopAtmosphereBoundary(_e14, transmittance_texture_4, _e15, _e16);
+    let _e18 = atmosphere_49;
+    let _e19 = r_41;
+    let _e20 = mu_s_16;
+    let _e21 = SunVisibleFraction(_e18, _e19, _e20);
+    return (_e17 * _e21);
 }
 
 fn SunCosineMix(a_5: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
@@ -1128,19 +1204,19 @@ fn SunCosineMix(a_5: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
     var t_4: f32;
     var low_sun_3: bool;
-    var local_5: f32;
+    var local_8: f32;
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
     let _e11 = low_sun_3;
     if _e11 {
         let _e12 = t_4;
-        local_5 = min(_e12, 1f);
+        local_8 = min(_e12, 1f);
     } else {
         let _e15 = t_4;
-        local_5 = clamp(_e15, 0f, 1f);
+        local_8 = clamp(_e15, 0f, 1f);
     }
-    let _e20 = local_5;
+    let _e20 = local_8;
     return _e20;
 }
 
@@ -1150,7 +1226,7 @@ fn SunBelowTableMix(a_7: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
     var t_6: f32;
     var low_sun_5: bool;
     var blend: vec4<f32>;
-    var local_6: vec4<f32>;
+    var local_9: vec4<f32>;
 
     a_8 = a_7;
     b_3 = b_2;
@@ -1166,26 +1242,26 @@ fn SunBelowTableMix(a_7: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
     if (_e21 < 0f) {
         let _e24 = blend;
         let _e25 = a_8;
-        local_6 = min(_e24, _e25);
+        local_9 = min(_e24, _e25);
     } else {
         let _e27 = blend;
-        local_6 = _e27;
+        local_9 = _e27;
     }
-    let _e29 = local_6;
+    let _e29 = local_9;
     return _e29;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_44: AtmosphereParameters, u_mu_s: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_45: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_50: AtmosphereParameters, u_mu_s: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_51: AtmosphereParameters;
     var u_mu_s_1: f32;
     var mu_s_size: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_45 = atmosphere_44;
+    atmosphere_51 = atmosphere_50;
     u_mu_s_1 = u_mu_s;
-    let _e15 = atmosphere_45;
+    let _e15 = atmosphere_51;
     mu_s_size = f32(_e15.scattering_mu_s_size);
     let _e19 = u_mu_s_1;
     let _e20 = mu_s_size;
@@ -1200,7 +1276,7 @@ fn GetScatteringMuSColumns(atmosphere_44: AtmosphereParameters, u_mu_s: f32, x_b
     let _e41 = mu_s_size;
     (*x_above) = ((_e38 + 1.5f) / _e41);
     let _e43 = (*x_below);
-    let _e44 = atmosphere_45;
+    let _e44 = atmosphere_51;
     let _e45 = GetScatteringTextureUMuS(_e44, LOW_SUN_MU_S);
     (*low_sun_below) = (_e43 < _e45);
     let _e47 = mu_s_coord;
@@ -1212,11 +1288,11 @@ fn GetScatteringMuSColumns(atmosphere_44: AtmosphereParameters, u_mu_s: f32, x_b
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_46: AtmosphereParameters, scattering_texture: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_15: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
-    var atmosphere_47: AtmosphereParameters;
+fn GetScattering(atmosphere_52: AtmosphereParameters, scattering_texture: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
+    var atmosphere_53: AtmosphereParameters;
     var r_43: f32;
     var mu_28: f32;
-    var mu_s_16: f32;
+    var mu_s_18: f32;
     var nu_12: f32;
     var ray_r_mu_intersects_ground_11: bool;
     var uvwz: vec4<f32>;
@@ -1232,21 +1308,21 @@ fn GetScattering(atmosphere_46: AtmosphereParameters, scattering_texture: textur
     var below: vec4<f32>;
     var above: vec4<f32>;
 
-    atmosphere_47 = atmosphere_46;
+    atmosphere_53 = atmosphere_52;
     r_43 = r_42;
     mu_28 = mu_27;
-    mu_s_16 = mu_s_15;
+    mu_s_18 = mu_s_17;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e20 = atmosphere_47;
+    let _e20 = atmosphere_53;
     let _e21 = r_43;
     let _e22 = mu_28;
-    let _e23 = mu_s_16;
+    let _e23 = mu_s_18;
     let _e24 = nu_12;
     let _e25 = ray_r_mu_intersects_ground_11;
     let _e26 = GetScatteringTextureUvwzFromRMuMuSNu(_e20, _e21, _e22, _e23, _e24, _e25);
     uvwz = _e26;
-    let _e28 = atmosphere_47;
+    let _e28 = atmosphere_53;
     nu_size = f32(_e28.scattering_nu_size);
     let _e32 = uvwz;
     let _e34 = nu_size;
@@ -1257,11 +1333,11 @@ fn GetScattering(atmosphere_46: AtmosphereParameters, scattering_texture: textur
     let _e46 = nu_coord;
     let _e47 = nu_slice;
     nu_t = (_e46 - _e47);
-    let _e54 = atmosphere_47;
+    let _e54 = atmosphere_53;
     let _e55 = uvwz;
     GetScatteringMuSColumns(_e54, _e55.y, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
     let _e65 = x_above_1;
-    let _e66 = atmosphere_47;
+    let _e66 = atmosphere_53;
     let _e67 = GetScatteringTextureUMuS(_e66, LOW_SUN_MU_S);
     low_sun_above = (_e65 < _e67);
     let _e70 = nu_slice;
@@ -1305,10 +1381,10 @@ fn GetScattering(atmosphere_46: AtmosphereParameters, scattering_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_48: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_17: f32) -> vec3<f32> {
-    var atmosphere_49: AtmosphereParameters;
+fn GetIrradiance(atmosphere_54: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
+    var atmosphere_55: AtmosphereParameters;
     var r_45: f32;
-    var mu_s_18: f32;
+    var mu_s_20: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
@@ -1318,69 +1394,69 @@ fn GetIrradiance(atmosphere_48: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_49 = atmosphere_48;
+    atmosphere_55 = atmosphere_54;
     r_45 = r_44;
-    mu_s_18 = mu_s_17;
-    let _e14 = atmosphere_49;
+    mu_s_20 = mu_s_19;
+    let _e14 = atmosphere_55;
     let _e15 = r_45;
-    let _e16 = mu_s_18;
+    let _e16 = mu_s_20;
     let _e17 = GetIrradianceTextureUvFromRMuS(_e14, _e15, _e16);
     uv_3 = _e17;
-    let _e19 = atmosphere_49;
+    let _e19 = atmosphere_55;
     width = f32(_e19.irradiance_width);
-    let _e23 = mu_s_18;
-    let _e24 = atmosphere_49;
-    let _e28 = atmosphere_49;
-    let _e32 = width;
-    mu_s_coord_1 = (((_e23 - _e24.mu_s_min) / (1f - _e28.mu_s_min)) * (_e32 - 1f));
-    let _e37 = mu_s_coord_1;
-    let _e40 = width;
-    mu_s_column_1 = clamp(floor(_e37), 0f, (_e40 - 2f));
-    let _e45 = atmosphere_49;
-    let _e48 = atmosphere_49;
-    let _e51 = mu_s_column_1;
+    let _e23 = atmosphere_55;
+    let _e24 = mu_s_20;
+    let _e25 = GetIrradianceUnitMuS(_e23, _e24);
+    let _e26 = width;
+    mu_s_coord_1 = (_e25 * (_e26 - 1f));
+    let _e31 = mu_s_coord_1;
+    let _e34 = width;
+    mu_s_column_1 = clamp(floor(_e31), 0f, (_e34 - 2f));
+    let _e39 = atmosphere_55;
+    let _e40 = mu_s_column_1;
+    let _e41 = width;
+    let _e45 = GetIrradianceMuSFromUnit(_e39, (_e40 / (_e41 - 1f)));
+    mu_s_below = _e45;
+    let _e47 = mu_s_below;
+    low_sun_6 = (_e47 < LOW_SUN_MU_S);
+    let _e50 = mu_s_column_1;
     let _e53 = width;
-    mu_s_below = (_e45.mu_s_min + (((1f - _e48.mu_s_min) * _e51) / (_e53 - 1f)));
-    let _e59 = mu_s_below;
-    low_sun_6 = (_e59 < LOW_SUN_MU_S);
-    let _e62 = mu_s_column_1;
-    let _e65 = width;
-    let _e67 = uv_3;
-    let _e70 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e62 + 0.5f) / _e65), _e67.y));
-    below_1 = _e70;
-    let _e72 = mu_s_column_1;
-    let _e75 = width;
-    let _e77 = uv_3;
-    let _e80 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e72 + 1.5f) / _e75), _e77.y));
-    above_1 = _e80;
-    let _e82 = below_1;
-    let _e83 = above_1;
-    let _e84 = mu_s_coord_1;
-    let _e85 = mu_s_column_1;
-    let _e87 = low_sun_6;
-    let _e88 = SunCosinePosition((_e84 - _e85), _e87);
-    let _e89 = low_sun_6;
-    let _e90 = SunBelowTableMix(_e82, _e83, _e88, _e89);
-    return vec3<f32>(_e90.xyz);
+    let _e55 = uv_3;
+    let _e58 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e50 + 0.5f) / _e53), _e55.y));
+    below_1 = _e58;
+    let _e60 = mu_s_column_1;
+    let _e63 = width;
+    let _e65 = uv_3;
+    let _e68 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e60 + 1.5f) / _e63), _e65.y));
+    above_1 = _e68;
+    let _e70 = below_1;
+    let _e71 = above_1;
+    let _e72 = mu_s_coord_1;
+    let _e73 = mu_s_column_1;
+    let _e75 = low_sun_6;
+    let _e76 = SunCosinePosition((_e72 - _e73), _e75);
+    let _e77 = low_sun_6;
+    let _e78 = SunBelowTableMix(_e70, _e71, _e76, _e77);
+    return vec3<f32>(_e78.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_50: AtmosphereParameters, nu_13: f32) -> f32 {
-    var atmosphere_51: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_56: AtmosphereParameters, nu_13: f32) -> f32 {
+    var atmosphere_57: AtmosphereParameters;
     var nu_14: f32;
 
-    atmosphere_51 = atmosphere_50;
+    atmosphere_57 = atmosphere_56;
     nu_14 = nu_13;
-    let _e11 = atmosphere_51;
+    let _e11 = atmosphere_57;
     if (_e11.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e14 = atmosphere_51;
+        let _e14 = atmosphere_57;
         let _e16 = nu_14;
         let _e17 = HenyeyGreensteinPhaseFunction(_e14.mie_g, _e16);
         return _e17;
     }
-    let _e18 = atmosphere_51;
+    let _e18 = atmosphere_57;
     if (_e18.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e21 = atmosphere_51;
+        let _e21 = atmosphere_57;
         let _e23 = nu_14;
         let _e24 = CornetteShanksPhaseFunction(_e21.mie_g, _e23);
         return _e24;
@@ -1389,31 +1465,31 @@ fn MiePhaseFunction(atmosphere_50: AtmosphereParameters, nu_13: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_52: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_19: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_53: AtmosphereParameters;
+fn GetCombinedScattering(atmosphere_58: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_59: AtmosphereParameters;
     var r_47: f32;
     var mu_30: f32;
-    var mu_s_20: f32;
+    var mu_s_22: f32;
     var nu_16: f32;
     var ray_r_mu_intersects_ground_13: bool;
     var scattering: vec4<f32>;
-    var local_7: vec3<f32>;
+    var local_10: vec3<f32>;
 
-    atmosphere_53 = atmosphere_52;
+    atmosphere_59 = atmosphere_58;
     r_47 = r_46;
     mu_30 = mu_29;
-    mu_s_20 = mu_s_19;
+    mu_s_22 = mu_s_21;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e22 = atmosphere_53;
+    let _e22 = atmosphere_59;
     let _e23 = r_47;
     let _e24 = mu_30;
-    let _e25 = mu_s_20;
+    let _e25 = mu_s_22;
     let _e26 = nu_16;
     let _e27 = ray_r_mu_intersects_ground_13;
     let _e28 = GetScattering(_e22, scattering_texture_1, _e23, _e24, _e25, _e26, _e27);
     scattering = _e28;
-    let _e30 = atmosphere_53;
+    let _e30 = atmosphere_59;
     if (_e30.single_mie_in_scattering_alpha == 1i) {
         {
             let _e34 = scattering;
@@ -1421,21 +1497,21 @@ fn GetCombinedScattering(atmosphere_52: AtmosphereParameters, scattering_texture
                 let _e38 = scattering;
                 let _e41 = scattering;
                 let _e44 = scattering;
-                let _e48 = atmosphere_53;
-                let _e50 = atmosphere_53;
-                local_7 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
+                let _e48 = atmosphere_59;
+                let _e50 = atmosphere_59;
+                local_10 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_7 = vec3(0f);
+                local_10 = vec3(0f);
             }
-            let _e59 = local_7;
+            let _e59 = local_10;
             (*single_mie_scattering) = _e59;
         }
     } else {
         {
-            let _e60 = atmosphere_53;
+            let _e60 = atmosphere_59;
             let _e61 = r_47;
             let _e62 = mu_30;
-            let _e63 = mu_s_20;
+            let _e63 = mu_s_22;
             let _e64 = nu_16;
             let _e65 = ray_r_mu_intersects_ground_13;
             let _e66 = GetScattering(_e60, single_mie_scattering_texture, _e61, _e62, _e63, _e64, _e65);
@@ -1447,57 +1523,57 @@ fn GetCombinedScattering(atmosphere_52: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_54: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_55: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_60: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_61: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
     var start_1: vec3<f32>;
     var r_48: f32;
     var mu_31: f32;
-    var mu_s_21: f32;
+    var mu_s_23: f32;
     var nu_17: f32;
     var ray_r_mu_intersects_ground_14: bool;
-    var local_8: vec3<f32>;
+    var local_11: vec3<f32>;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_55 = atmosphere_54;
+    atmosphere_61 = atmosphere_60;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e24 = atmosphere_55;
+    let _e24 = atmosphere_61;
     let _e25 = camera_5;
     let _e26 = view_ray_5;
     let _e27 = sun_direction_3;
-    let _e38 = GetViewRayStart(_e24, _e25, _e26, _e27, (&start_1), (&r_48), (&mu_31), (&mu_s_21), (&nu_17));
+    let _e38 = GetViewRayStart(_e24, _e25, _e26, _e27, (&start_1), (&r_48), (&mu_31), (&mu_s_23), (&nu_17));
     if !(_e38) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e44 = atmosphere_55;
+    let _e44 = atmosphere_61;
     let _e45 = r_48;
     let _e46 = mu_31;
     let _e47 = RayIntersectsGround(_e44, _e45, _e46);
     ray_r_mu_intersects_ground_14 = _e47;
     let _e49 = ray_r_mu_intersects_ground_14;
     if _e49 {
-        local_8 = vec3(0f);
+        local_11 = vec3(0f);
     } else {
-        let _e52 = atmosphere_55;
+        let _e52 = atmosphere_61;
         let _e53 = r_48;
         let _e54 = mu_31;
         let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_5, _e53, _e54);
-        local_8 = _e55;
+        local_11 = _e55;
     }
-    let _e57 = local_8;
+    let _e57 = local_11;
     (*transmittance) = _e57;
-    let _e59 = atmosphere_55;
+    let _e59 = atmosphere_61;
     let _e60 = r_48;
     let _e61 = mu_31;
-    let _e62 = mu_s_21;
+    let _e62 = mu_s_23;
     let _e63 = nu_17;
     let _e64 = ray_r_mu_intersects_ground_14;
     let _e67 = GetCombinedScattering(_e59, scattering_texture_2, single_mie_scattering_texture_1, _e60, _e61, _e62, _e63, _e64, (&single_mie_scattering_1));
@@ -1506,15 +1582,15 @@ fn GetSkyRadiance(atmosphere_54: AtmosphereParameters, transmittance_texture_5: 
     let _e70 = nu_17;
     let _e71 = RayleighPhaseFunction(_e70);
     let _e73 = single_mie_scattering_1;
-    let _e74 = atmosphere_55;
+    let _e74 = atmosphere_61;
     let _e75 = nu_17;
     let _e76 = MiePhaseFunction(_e74, _e75);
     return ((_e69 * _e71) + (_e73 * _e76));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_56: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
-    var atmosphere_57: AtmosphereParameters;
+fn DistanceInsideScatteringRadii(atmosphere_62: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
+    var atmosphere_63: AtmosphereParameters;
     var r_50: f32;
     var mu_33: f32;
     var r_max: f32;
@@ -1522,14 +1598,14 @@ fn DistanceInsideScatteringRadii(atmosphere_56: AtmosphereParameters, r_49: f32,
     var across: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_9: f32;
+    var local_12: f32;
 
-    atmosphere_57 = atmosphere_56;
+    atmosphere_63 = atmosphere_62;
     r_50 = r_49;
     mu_33 = mu_32;
-    let _e14 = atmosphere_57;
+    let _e14 = atmosphere_63;
     r_max = _e14.scattering_r_max;
-    let _e17 = atmosphere_57;
+    let _e17 = atmosphere_63;
     r_min = _e17.scattering_r_min;
     let _e20 = r_50;
     let _e21 = r_50;
@@ -1554,29 +1630,29 @@ fn DistanceInsideScatteringRadii(atmosphere_56: AtmosphereParameters, r_49: f32,
         let _e56 = r_50;
         let _e58 = mu_33;
         let _e60 = down_discriminant;
-        local_9 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
+        local_12 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
     } else {
         let _e64 = up;
-        local_9 = _e64;
+        local_12 = _e64;
     }
-    let _e66 = local_9;
+    let _e66 = local_12;
     return _e66;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_58: AtmosphereParameters, i: i32) -> f32 {
-    var atmosphere_59: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_64: AtmosphereParameters, i: i32) -> f32 {
+    var atmosphere_65: AtmosphereParameters;
     var i_1: i32;
-    var x_3: f32;
+    var x_5: f32;
 
-    atmosphere_59 = atmosphere_58;
+    atmosphere_65 = atmosphere_64;
     i_1 = i;
     let _e13 = i_1;
-    x_3 = (f32(_e13) / 63f);
-    let _e21 = atmosphere_59;
-    let _e23 = atmosphere_59;
-    let _e26 = x_3;
-    let _e28 = x_3;
+    x_5 = (f32(_e13) / 63f);
+    let _e21 = atmosphere_65;
+    let _e23 = atmosphere_65;
+    let _e26 = x_5;
+    let _e28 = x_5;
     return (((_e21.top_radius - _e23.bottom_radius) * _e26) * _e28);
 }
 
@@ -1585,7 +1661,7 @@ fn InterpolateCoefficient(a_9: f32, b_4: f32, f: f32) -> f32 {
     var a_10: f32;
     var b_5: f32;
     var f_1: f32;
-    var local_10: f32;
+    var local_13: f32;
 
     a_10 = a_9;
     b_5 = b_4;
@@ -1597,14 +1673,14 @@ fn InterpolateCoefficient(a_9: f32, b_4: f32, f: f32) -> f32 {
         let _e23 = f_1;
         let _e24 = b_5;
         let _e25 = a_10;
-        local_10 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
+        local_13 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
     } else {
         let _e31 = a_10;
         let _e32 = b_5;
         let _e33 = f_1;
-        local_10 = mix(_e31, _e32, _e33);
+        local_13 = mix(_e31, _e32, _e33);
     }
-    let _e36 = local_10;
+    let _e36 = local_13;
     return _e36;
 }
 
@@ -1633,54 +1709,54 @@ fn InterpolateCoefficients(a_11: vec3<f32>, b_6: vec3<f32>, f_2: f32) -> vec3<f3
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_60: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_61: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_66: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_67: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_4: f32;
+    var x_6: f32;
     var i_2: i32;
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_67 = atmosphere_66;
     altitude_1 = altitude;
-    let _e15 = atmosphere_61;
-    let _e17 = atmosphere_61;
+    let _e15 = atmosphere_67;
+    let _e17 = atmosphere_67;
     height = (_e15.top_radius - _e17.bottom_radius);
     let _e21 = altitude_1;
     let _e22 = height;
-    x_4 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
-    let _e34 = x_4;
+    x_6 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
+    let _e34 = x_6;
     i_2 = min(i32(_e34), 62i);
-    let _e41 = atmosphere_61;
+    let _e41 = atmosphere_67;
     let _e42 = i_2;
     let _e43 = ProfileSampleAltitude(_e41, _e42);
     h0_ = _e43;
     let _e45 = altitude_1;
     let _e46 = h0_;
-    let _e48 = atmosphere_61;
+    let _e48 = atmosphere_67;
     let _e49 = i_2;
     let _e52 = ProfileSampleAltitude(_e48, (_e49 + 1i));
     let _e53 = h0_;
     f_4 = clamp(((_e45 - _e46) / (_e52 - _e53)), 0f, 1f);
     let _e60 = i_2;
-    let _e63 = atmosphere_61.mie_scattering_profile[_e60];
+    let _e63 = atmosphere_67.mie_scattering_profile[_e60];
     let _e64 = i_2;
-    let _e69 = atmosphere_61.mie_scattering_profile[(_e64 + 1i)];
+    let _e69 = atmosphere_67.mie_scattering_profile[(_e64 + 1i)];
     let _e70 = f_4;
     let _e71 = InterpolateCoefficients(_e63, _e69, _e70);
     (*mie_scattering) = _e71;
     let _e72 = i_2;
-    let _e75 = atmosphere_61.rayleigh_scattering_profile[_e72];
+    let _e75 = atmosphere_67.rayleigh_scattering_profile[_e72];
     let _e76 = i_2;
-    let _e81 = atmosphere_61.rayleigh_scattering_profile[(_e76 + 1i)];
+    let _e81 = atmosphere_67.rayleigh_scattering_profile[(_e76 + 1i)];
     let _e82 = f_4;
     let _e83 = InterpolateCoefficients(_e75, _e81, _e82);
     (*rayleigh_scattering) = _e83;
     let _e84 = i_2;
-    let _e87 = atmosphere_61.extinction_profile[_e84];
+    let _e87 = atmosphere_67.extinction_profile[_e84];
     let _e88 = i_2;
-    let _e93 = atmosphere_61.extinction_profile[(_e88 + 1i)];
+    let _e93 = atmosphere_67.extinction_profile[(_e88 + 1i)];
     let _e94 = f_4;
     let _e95 = InterpolateCoefficients(_e87, _e93, _e94);
     return _e95;
@@ -1689,28 +1765,28 @@ fn GetCoefficientsAtAltitude(atmosphere_60: AtmosphereParameters, altitude: f32,
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_11: f32;
+    var local_14: f32;
 
     depth_1 = depth;
     let _e11 = depth_1;
     if (_e11 < 0.0001f) {
         let _e16 = depth_1;
-        local_11 = (1f - (0.5f * _e16));
+        local_14 = (1f - (0.5f * _e16));
     } else {
         let _e20 = depth_1;
         let _e24 = depth_1;
-        local_11 = ((1f - exp(-(_e20))) / _e24);
+        local_14 = ((1f - exp(-(_e20))) / _e24);
     }
-    let _e27 = local_11;
+    let _e27 = local_14;
     return _e27;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_51: f32, mu_34: f32, mu_s_22: f32, nu_18: f32, d_15: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_63: AtmosphereParameters;
+fn IntegrateSegment(atmosphere_68: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_51: f32, mu_34: f32, mu_s_24: f32, nu_18: f32, d_15: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_69: AtmosphereParameters;
     var r_52: f32;
     var mu_35: f32;
-    var mu_s_23: f32;
+    var mu_s_25: f32;
     var nu_19: f32;
     var d_16: f32;
     var dt: f32;
@@ -1735,10 +1811,10 @@ fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_63 = atmosphere_62;
+    atmosphere_69 = atmosphere_68;
     r_52 = r_51;
     mu_35 = mu_34;
-    mu_s_23 = mu_s_22;
+    mu_s_25 = mu_s_24;
     nu_19 = nu_18;
     d_16 = d_15;
     let _e25 = d_16;
@@ -1755,14 +1831,14 @@ fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6
             let _e59 = dt;
             let _e60 = k_2;
             t_7 = (_e59 * f32(_e60));
-            let _e64 = atmosphere_63;
+            let _e64 = atmosphere_69;
             let _e65 = r_52;
             let _e66 = mu_35;
             let _e67 = t_7;
             let _e68 = RadiusAtDistance(_e64, _e65, _e66, _e67);
             r_t = _e68;
             let _e70 = r_52;
-            let _e71 = atmosphere_63;
+            let _e71 = atmosphere_69;
             let _e74 = t_7;
             let _e75 = t_7;
             let _e77 = r_52;
@@ -1771,21 +1847,21 @@ fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6
             let _e84 = r_52;
             altitude_2 = ((_e70 - _e71.bottom_radius) + ((_e74 * (_e75 + ((2f * _e77) * _e79))) / (_e83 + _e84)));
             let _e89 = r_52;
-            let _e90 = mu_s_23;
+            let _e90 = mu_s_25;
             let _e92 = t_7;
             let _e93 = nu_19;
             let _e96 = r_t;
             let _e98 = ClampCosine((((_e89 * _e90) + (_e92 * _e93)) / _e96));
             mu_s_t_2 = _e98;
-            let _e102 = atmosphere_63;
+            let _e102 = atmosphere_69;
             let _e103 = altitude_2;
             let _e108 = GetCoefficientsAtAltitude(_e102, _e103, (&mie_scattering_1), (&rayleigh_scattering_1));
             extinction = _e108;
-            let _e110 = atmosphere_63;
+            let _e110 = atmosphere_69;
             let _e111 = r_t;
             let _e112 = mu_s_t_2;
             let _e113 = GetOpticalDepthToTopAtmosphereBoundary(_e110, transmittance_texture_6, _e111, _e112);
-            let _e116 = atmosphere_63;
+            let _e116 = atmosphere_69;
             let _e117 = r_t;
             let _e118 = mu_s_t_2;
             let _e119 = SunVisibleFraction(_e116, _e117, _e118);
@@ -1854,18 +1930,18 @@ fn IntegrateSegment(atmosphere_62: AtmosphereParameters, transmittance_texture_6
         }
     }
     let _e202 = (*single_rayleigh);
-    let _e203 = atmosphere_63;
+    let _e203 = atmosphere_69;
     (*single_rayleigh) = (_e202 * _e203.solar_irradiance);
     let _e206 = (*single_mie);
-    let _e207 = atmosphere_63;
+    let _e207 = atmosphere_69;
     (*single_mie) = (_e206 * _e207.solar_irradiance);
     let _e210 = optical_depth;
     return _e210;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_65: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_71: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -1875,7 +1951,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     var start_2: vec3<f32>;
     var r_53: f32;
     var mu_36: f32;
-    var mu_s_24: f32;
+    var mu_s_26: f32;
     var nu_20: f32;
     var d_17: f32;
     var lit: f32;
@@ -1908,7 +1984,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_65 = atmosphere_64;
+    atmosphere_71 = atmosphere_70;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -1926,11 +2002,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     }
     let _e36 = camera_to_point;
     view_ray_6 = normalize(_e36);
-    let _e44 = atmosphere_65;
+    let _e44 = atmosphere_71;
     let _e45 = camera_7;
     let _e46 = view_ray_6;
     let _e47 = sun_direction_5;
-    let _e58 = GetViewRayStart(_e44, _e45, _e46, _e47, (&start_2), (&r_53), (&mu_36), (&mu_s_24), (&nu_20));
+    let _e58 = GetViewRayStart(_e44, _e45, _e46, _e47, (&start_2), (&r_53), (&mu_36), (&mu_s_26), (&nu_20));
     if !(_e58) {
         {
             (*transmittance_1) = vec3(1f);
@@ -1943,12 +2019,12 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e71 = d_17;
     let _e72 = shadow_length_1;
     lit = max((_e71 - max(_e72, 0f)), 0f);
-    let _e79 = atmosphere_65;
+    let _e79 = atmosphere_71;
     let _e80 = r_53;
     let _e81 = mu_36;
     let _e82 = RayIntersectsGround(_e79, _e80, _e81);
     ray_r_mu_intersects_ground_15 = _e82;
-    let _e84 = atmosphere_65;
+    let _e84 = atmosphere_71;
     let _e85 = r_53;
     let _e86 = mu_36;
     let _e87 = lit;
@@ -1961,7 +2037,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e94 = CosineAtDistance(_e90, _e91, _e92, _e93);
     mu_p = _e94;
     let _e96 = r_53;
-    let _e97 = mu_s_24;
+    let _e97 = mu_s_26;
     let _e99 = lit;
     let _e100 = nu_20;
     let _e103 = r_p;
@@ -1974,10 +2050,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e135 = lit_direct;
     if (_e135 > 0f) {
         {
-            let _e138 = atmosphere_65;
+            let _e138 = atmosphere_71;
             let _e139 = r_53;
             let _e140 = mu_36;
-            let _e141 = mu_s_24;
+            let _e141 = mu_s_26;
             let _e142 = nu_20;
             let _e143 = lit;
             let _e150 = IntegrateSegment(_e138, transmittance_texture_7, _e139, _e140, _e141, _e142, _e143, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
@@ -1992,7 +2068,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     if ((_e153 > 0f) && (_e156 < _e157)) {
         {
             let _e163 = optical_depth_1;
-            let _e164 = atmosphere_65;
+            let _e164 = atmosphere_71;
             let _e165 = r_p;
             let _e166 = mu_p;
             let _e167 = mu_s_p;
@@ -2006,7 +2082,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e180 = direct;
     if (_e180 < 1f) {
         {
-            let _e183 = atmosphere_65;
+            let _e183 = atmosphere_71;
             let _e184 = r_53;
             let _e185 = mu_36;
             let _e186 = d_17;
@@ -2019,10 +2095,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     }
     let _e193 = optical_depth_1;
     (*transmittance_1) = exp(-(_e193));
-    let _e197 = atmosphere_65;
+    let _e197 = atmosphere_71;
     let _e198 = r_53;
     let _e199 = mu_36;
-    let _e200 = mu_s_24;
+    let _e200 = mu_s_26;
     let _e201 = nu_20;
     let _e202 = ray_r_mu_intersects_ground_15;
     let _e205 = GetCombinedScattering(_e197, scattering_texture_3, single_mie_scattering_texture_2, _e198, _e199, _e200, _e201, _e202, (&single_mie_scattering_2));
@@ -2030,23 +2106,23 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e207 = lit;
     if (_e207 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e209 = atmosphere_65;
+            let _e209 = atmosphere_71;
             let _e210 = r_53;
             let _e211 = mu_36;
             let _e212 = ray_r_mu_intersects_ground_15;
             let _e213 = DistanceToNearestAtmosphereBoundary(_e209, _e210, _e211, _e212);
             boundary = _e213;
             let _e215 = boundary;
-            let _e217 = atmosphere_65;
+            let _e217 = atmosphere_71;
             let _e218 = r_53;
             let _e219 = mu_36;
             let _e220 = DistanceInsideScatteringRadii(_e217, _e218, _e219);
             let _e222 = lit;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e215), _e220), _e222);
-            let _e228 = atmosphere_65;
+            let _e228 = atmosphere_71;
             let _e229 = r_53;
             let _e230 = mu_36;
-            let _e231 = mu_s_24;
+            let _e231 = mu_s_26;
             let _e232 = nu_20;
             let _e233 = far;
             let _e240 = IntegrateSegment(_e228, transmittance_texture_7, _e229, _e230, _e231, _e232, _e233, (&far_rayleigh), (&far_mie), (&far_weight));
@@ -2055,7 +2131,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
             let _e243 = boundary;
             if (_e242 < _e243) {
                 {
-                    let _e245 = atmosphere_65;
+                    let _e245 = atmosphere_71;
                     let _e246 = r_53;
                     let _e247 = mu_36;
                     let _e248 = far;
@@ -2063,7 +2139,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
                     r_far = _e249;
                     let _e252 = scattering_3;
                     let _e253 = far_optical_depth;
-                    let _e256 = atmosphere_65;
+                    let _e256 = atmosphere_71;
                     let _e257 = r_far;
                     let _e258 = r_53;
                     let _e259 = mu_36;
@@ -2071,7 +2147,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
                     let _e261 = r_far;
                     let _e262 = CosineAtDistance(_e258, _e259, _e260, _e261);
                     let _e263 = r_53;
-                    let _e264 = mu_s_24;
+                    let _e264 = mu_s_26;
                     let _e266 = far;
                     let _e267 = nu_20;
                     let _e270 = r_far;
@@ -2092,13 +2168,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
             let _e297 = nu_20;
             let _e298 = RayleighPhaseFunction(_e297);
             let _e300 = single_mie_1;
-            let _e301 = atmosphere_65;
+            let _e301 = atmosphere_71;
             let _e302 = nu_20;
             let _e303 = MiePhaseFunction(_e301, _e302);
             return (((_e294 + _e295) * _e298) + (_e300 * _e303));
         }
     }
-    let _e306 = atmosphere_65;
+    let _e306 = atmosphere_71;
     let _e307 = r_53;
     let _e308 = mu_36;
     let _e309 = lit;
@@ -2107,7 +2183,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e312 = lit_optical_depth;
     let _e313 = lit_direct;
     lit_transmittance = exp(-(mix(_e311, _e312, vec3(_e313))));
-    let _e320 = atmosphere_65;
+    let _e320 = atmosphere_71;
     let _e321 = r_p;
     let _e322 = mu_p;
     let _e323 = mu_s_p;
@@ -2131,24 +2207,24 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_64: AtmosphereParameters, transmit
     let _e352 = nu_20;
     let _e353 = RayleighPhaseFunction(_e352);
     let _e355 = single_mie_scattering_2;
-    let _e356 = atmosphere_65;
+    let _e356 = atmosphere_71;
     let _e357 = nu_20;
     let _e358 = MiePhaseFunction(_e356, _e357);
     return ((_e351 * _e353) + (_e355 * _e358));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_66: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_67: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_72: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_67 = atmosphere_66;
+    atmosphere_73 = atmosphere_72;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e21 = atmosphere_67;
+    let _e21 = atmosphere_73;
     let _e22 = camera_9;
     let _e23 = point_3;
     let _e25 = sun_direction_7;
@@ -2157,19 +2233,19 @@ fn GetSkyRadianceToPoint(atmosphere_66: AtmosphereParameters, transmittance_text
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_68: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_69: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_74: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_75: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
     var r_54: f32;
-    var mu_s_25: f32;
+    var mu_s_27: f32;
 
-    atmosphere_69 = atmosphere_68;
+    atmosphere_75 = atmosphere_74;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e20 = atmosphere_69;
+    let _e20 = atmosphere_75;
     let _e21 = point_5;
     let _e23 = ClampRadius(_e20, length(_e21));
     r_54 = _e23;
@@ -2177,31 +2253,31 @@ fn GetSunAndSkyIrradiance(atmosphere_68: AtmosphereParameters, transmittance_tex
     let _e26 = sun_direction_9;
     let _e28 = point_5;
     let _e31 = ClampCosine((dot(_e25, _e26) / length(_e28)));
-    mu_s_25 = _e31;
-    let _e33 = atmosphere_69;
+    mu_s_27 = _e31;
+    let _e33 = atmosphere_75;
     let _e34 = r_54;
-    let _e35 = mu_s_25;
+    let _e35 = mu_s_27;
     let _e36 = GetIrradiance(_e33, irradiance_texture_1, _e34, _e35);
     let _e38 = normal_1;
     let _e39 = point_5;
     let _e41 = point_5;
     (*sky_irradiance) = ((_e36 * (1f + (dot(_e38, _e39) / length(_e41)))) * 0.5f);
-    let _e48 = atmosphere_69;
-    let _e50 = atmosphere_69;
+    let _e48 = atmosphere_75;
+    let _e50 = atmosphere_75;
     let _e51 = r_54;
-    let _e52 = mu_s_25;
+    let _e52 = mu_s_27;
     let _e53 = GetTransmittanceToSun(_e50, transmittance_texture_9, _e51, _e52);
     let _e55 = normal_1;
     let _e56 = sun_direction_9;
     return ((_e48.solar_irradiance * _e53) * max(dot(_e55, _e56), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_70: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_76: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
 
-    atmosphere_71 = atmosphere_70;
-    let _e11 = atmosphere_71;
-    let _e13 = atmosphere_71;
-    let _e16 = atmosphere_71;
+    atmosphere_77 = atmosphere_76;
+    let _e11 = atmosphere_77;
+    let _e13 = atmosphere_77;
+    let _e16 = atmosphere_77;
     return (_e11.solar_irradiance / vec3(((PI * _e13.sun_angular_radius) * _e16.sun_angular_radius)));
 }
