@@ -54,7 +54,7 @@ class DirectionGuide {
   // Its density per steradian.
   double Pdf(const GuideFrame& frame, const glm::dvec3& direction) const;
 
-  // The estimate's integral over the sphere: the single-scattered light
+  // The estimate's integral over the sphere: the light it estimates
   // arriving at the point from all directions (per unit solar irradiance).
   double Incoming() const { return total_; }
 

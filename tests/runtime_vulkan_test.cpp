@@ -25,15 +25,11 @@ namespace {
 
 // The test's compute main() in Vulkan GLSL: explicit bindings as an engine
 // declares them, a query per invocation (EvaluateQuery, tests/runtime_queries.h).
-const std::string kVulkanGlslMain = std::string(R"(
-layout(set = 0, binding = 0) uniform sampler2D transmittance_texture;
-layout(set = 0, binding = 1) uniform sampler3D scattering_texture;
-layout(set = 0, binding = 2) uniform sampler3D single_mie_scattering_texture;
-layout(set = 0, binding = 3) uniform sampler2D irradiance_texture;
+const std::string kVulkanGlslMain = std::string(VulkanCompute::kGlslTables) + R"(
 layout(std430, set = 0, binding = 4) readonly buffer Inputs { vec4 skybake_inputs[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Outputs { vec4 skybake_outputs[]; };
 layout(local_size_x = 64) in;
-)") + testing::kGlslEvaluateQuery + R"(
+)" + testing::kGlslEvaluateQuery + R"(
 void main() {
   uint item = gl_GlobalInvocationID.x;
   if (item >= uint(skybake_outputs.length())) return;

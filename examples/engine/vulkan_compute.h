@@ -25,6 +25,13 @@ class VulkanCompute {
  public:
   // The tables' bindings are 0 to kTextureCount - 1.
   static constexpr int kTextureCount = 4;
+  // The tables at those bindings, declared in Vulkan GLSL as a compute
+  // shader around the runtime declares them (Samplers::kCombined).
+  static constexpr const char kGlslTables[] =
+      "layout(set = 0, binding = 0) uniform sampler2D transmittance_texture;\n"
+      "layout(set = 0, binding = 1) uniform sampler3D scattering_texture;\n"
+      "layout(set = 0, binding = 2) uniform sampler3D single_mie_scattering_texture;\n"
+      "layout(set = 0, binding = 3) uniform sampler2D irradiance_texture;\n";
   static constexpr int kInputBinding = 4;    // readonly buffer of vec4: the shader's inputs
   static constexpr int kOutputBinding = 5;   // buffer of vec4: one per item
   static constexpr int kSamplerBinding = 6;  // with Samplers::kSeparate

@@ -29,15 +29,11 @@ using skybake::VulkanCompute;
 
 namespace {
 
-// The compute shader around the snippet and pixel_radiance.glsl: the tables
-// at explicit bindings 0-3 (VulkanCompute's layout), the view's values read
-// from a buffer into the globals pixel_radiance.glsl reads, one pixel per
-// invocation, rows from the top.
+// The compute shader around the snippet and pixel_radiance.glsl: after the
+// tables (VulkanCompute::kGlslTables), the view's values read from a buffer
+// into the globals pixel_radiance.glsl reads, one pixel per invocation, rows
+// from the top.
 const char* const kComputeDeclarations = R"(
-layout(set = 0, binding = 0) uniform sampler2D transmittance_texture;
-layout(set = 0, binding = 1) uniform sampler3D scattering_texture;
-layout(set = 0, binding = 2) uniform sampler3D single_mie_scattering_texture;
-layout(set = 0, binding = 3) uniform sampler2D irradiance_texture;
 layout(std430, set = 0, binding = 4) readonly buffer ViewValues { vec4 view_values[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Pixels { vec4 radiance_out[]; };
 layout(local_size_x = 64) in;
@@ -103,7 +99,8 @@ void Run(const Arguments& args) {
   const skybake::LutSet& luts = set.luts;
   const std::vector<View> views = MakeViews(args, luts);
   const std::vector<std::uint32_t> spirv =
-      CompileCompute("#version 450\n" + set.snippet + kComputeDeclarations + PixelRadianceGlsl() + kComputeMain);
+      CompileCompute("#version 450\n" + set.snippet + VulkanCompute::kGlslTables + kComputeDeclarations +
+                     PixelRadianceGlsl() + kComputeMain);
 
   std::string why_not;
   std::unique_ptr<VulkanCompute> vk = VulkanCompute::Create(&why_not);
