@@ -152,6 +152,10 @@ struct ScatteringTexel {
   bool ray_intersects_ground = false;
 };
 ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z);
+// A slice whose grid nu lies past the range its (mu, mu_s) allow holds, in
+// the tables as written, the light to which the lookup's blend extends from
+// the allowed part of its interval, at most this many times the light there.
+inline constexpr double kLargestExtension = 2.0;
 // nu clamped to the range that the view and sun cosines mu and mu_s allow.
 double ClampedNu(double nu, double mu, double mu_s);
 

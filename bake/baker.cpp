@@ -38,6 +38,7 @@ LutSet Baker::AssembleTables(Texture transmittance, Texture irradiance, Texture 
   result.parameters = params_;
   result.transmittance = std::move(transmittance);
   result.irradiance = std::move(irradiance);
+  ExtendSlicesPastTheirRange(params_, single_mie);
   if (params_.single_mie_in_scattering_alpha == 1) {
     for (size_t i = 0; i < scattering.texels.size(); i += 4) scattering.texels[i + 3] = single_mie.texels[i];
   } else {
@@ -152,7 +153,10 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
 
 Texture Baker::ScatteringTable() const {
   Texture table = single_.rayleigh;
-  if (report_.orders_used < 2) return table;
+  if (report_.orders_used < 2) {
+    ExtendSlicesPastTheirRange(params_, table);
+    return table;
+  }
   const Texture higher = GatherAtEnd() ? GatherAlongRays(params_, higher_orders_, atmosphere_grid_) : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;
   const std::vector<double> packing = PackingFactors(params_);
@@ -162,7 +166,59 @@ Texture Baker::ScatteringTable() const {
       for (int c = 0; c < 3; ++c) table.texels[i + c] += float(higher.texels[i + c] * factor);
     }
   });
+  // At a slice's clamped nu the runtime multiplies the higher orders by the
+  // Rayleigh phase there, not at the slice's own nu.
+  ExtendSlicesPastTheirRange(params_, table, [&](int x, int y, int z) {
+    const double nu = GetScatteringTexel(params_, x, y, z).nu;
+    return vec3(single_.rayleigh.Fetch(x, y, z)) + vec3(higher.Fetch(x, y, z)) / glsl::RayleighPhaseFunction(nu);
+  });
   return table;
+}
+
+void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture& table,
+                                       const std::function<vec3(int x, int y, int z)>& edge_value) {
+  const int nu_size = grid.scattering_nu_size, mu_s_size = grid.scattering_mu_s_size;
+  const double spacing = 2.0 / (nu_size - 1);
+  const Texture stored = table;
+  const SunColumns columns(grid);
+  tbb::parallel_for(0, grid.scattering_mu_size * grid.scattering_r_size, [&](int row) {
+    const int y = row % grid.scattering_mu_size, z = row / grid.scattering_mu_size;
+    const double mu = GetScatteringTexel(grid, 0, y, z).mu;
+    for (int column = 0; column < mu_s_size; ++column) {
+      const double mu_s = columns.mu_s[column];
+      const double spread = glsl::SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
+      const double lowest = mu * mu_s - spread, highest = mu * mu_s + spread;
+      const bool geometric = mu_s < glsl::LOW_SUN_MU_S;  // SunCosineMix's blend for this column
+      for (int k = 0; k + 1 < nu_size; ++k) {
+        const double nu_k = -1.0 + k * spacing;
+        const double start = std::max(nu_k, lowest), end = std::min(nu_k + spacing, highest);
+        const bool k_clamped = start > nu_k, next_clamped = end < nu_k + spacing;
+        // Intervals wholly inside or outside the range, or with too little
+        // of it inside to extend from, keep their slices.
+        if (!(k_clamped || next_clamped) || end - start < kSmallestExtendedFraction * spacing) continue;
+        const int x0 = k * mu_s_size + column, x1 = x0 + mu_s_size;
+        const vec3 at_start = k_clamped && edge_value ? edge_value(x0, y, z) : vec3(stored.Fetch(x0, y, z));
+        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z) : vec3(stored.Fetch(x1, y, z));
+        const double t_start = (start - nu_k) / spacing, t_end = (end - nu_k) / spacing;
+        vec4 value0 = stored.Fetch(x0, y, z), value1 = stored.Fetch(x1, y, z);
+        for (int c = 0; c < 3; ++c) {
+          if (geometric && !(at_start[c] > 0.0 && at_end[c] > 0.0)) continue;
+          const double a = geometric ? std::log(at_start[c]) : at_start[c];
+          const double b = geometric ? std::log(at_end[c]) : at_end[c];
+          // The line through (t_start, a) and (t_end, b), at t = 0 and 1,
+          // at most kLargestExtension times the larger end.
+          const double slope = (b - a) / (t_end - t_start);
+          const double largest = geometric ? std::max(a, b) + std::log(kLargestExtension)
+                                           : kLargestExtension * std::max(a, b);
+          const double v0 = std::min(a - slope * t_start, largest), v1 = std::min(b + slope * (1.0 - t_end), largest);
+          if (k_clamped) value0[c] = float(geometric ? std::exp(v0) : std::max(v0, 0.0));
+          if (next_clamped) value1[c] = float(geometric ? std::exp(v1) : std::max(v1, 0.0));
+        }
+        if (k_clamped) table.Store(x0, y, z, value0);
+        if (next_clamped) table.Store(x1, y, z, value1);
+      }
+    }
+  });
 }
 
 std::vector<double> Baker::PackingFactors(const AtmosphereParameters& grid) {

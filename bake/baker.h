@@ -27,6 +27,7 @@
 // transmittances do), so a thin haze layer seen on a steep ray needs no more
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,24 @@ class Baker {
   const SingleScattering& GridSingle() const { return TableRestricted() ? grid_single_ : single_; }
   // The scattering table: single Rayleigh plus the higher orders.
   Texture ScatteringTable() const;
+  // Where the range of nu that a texel's (mu, mu_s) allow ends inside a nu
+  // slice interval, the slice past the range holds the light at the range's
+  // edge (its clamped nu), and GetScattering, which blends two slices at
+  // nu's position on the slice grid, would read the edge short of it. This
+  // gives each such slice the value to which GetScattering's blend between
+  // the two ends of the allowed part of its interval extends (linear, or
+  // geometric for a low sun as in SunCosineMix), so that the lookup returns
+  // the light at the edge and follows its change toward it. `edge_value`:
+  // the light a clamped texel stands for, in the units the lookup blends
+  // (none: the texel's own value).
+  static void ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture& table,
+                                         const std::function<vec3(int x, int y, int z)>& edge_value = nullptr);
+  // Intervals with less than this fraction of them allowed keep their
+  // slices; an extended slice holds at most kLargestExtension times the
+  // light at the larger end of the allowed part (on Earth the cap holds
+  // back 0.5 % of the single Mie table's extended values, and none of the
+  // scattering table's).
+  static constexpr double kSmallestExtendedFraction = 0.125;
   // MultipleScatteringPackingFactor per nu index of a grid.
   static std::vector<double> PackingFactors(const AtmosphereParameters& grid);
   // Mean over the texels of a table on a scattering grid, each times the

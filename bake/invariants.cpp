@@ -198,17 +198,21 @@ EnergyBounds ComputeEnergyBounds(const LutSet& luts, const BakeReport& report) {
 InvariantReport CheckTableInvariants(const LutSet& luts, const BakeReport& report) {
   InvariantReport result;
   const EnergyBounds bounds = ComputeEnergyBounds(luts, report);
-  auto check = [&](const char* table, const glsl::Texture& texture, const Spectrum& bound, bool rayleigh_encoded) {
+  auto check = [&](const char* table, const glsl::Texture& texture, const Spectrum& bound, bool four_d,
+                   bool rayleigh_encoded) {
     for (int z = 0; z < texture.depth; ++z) {
       for (int y = 0; y < texture.height; ++y) {
         for (int x = 0; x < texture.width; ++x) {
           glsl::vec4 texel = texture.Fetch(x, y, z);
-          double phase = rayleigh_encoded ? glsl::RayleighPhaseFunction(GetScatteringTexel(luts.parameters, x, y, z).nu)
-                                          : 1.0;
+          // 4D tables: slices past their range hold up to kLargestExtension
+          // times the light at its edge.
+          const ScatteringTexel t = four_d ? GetScatteringTexel(luts.parameters, x, y, z) : ScatteringTexel();
+          const double phase = rayleigh_encoded ? glsl::RayleighPhaseFunction(t.nu) : 1.0;
+          const double extension = four_d && t.nu != t.grid_nu ? kLargestExtension : 1.0;
           for (int c = 0; c < 4; ++c) {
             ++result.values_checked;
             double value = texel[c];
-            bool bounded = c == 3 || !(value * phase > bound[c] * kBoundSlack);
+            bool bounded = c == 3 || !(value * phase > bound[c] * extension * kBoundSlack);
             if (!std::isfinite(value) || value < 0.0 || !bounded) {
               char buffer[200];
               std::snprintf(buffer, sizeof buffer, "%s texel (%d, %d, %d) channel %d = %.6g is %s", table, x, y, z, c,
@@ -222,11 +226,11 @@ InvariantReport CheckTableInvariants(const LutSet& luts, const BakeReport& repor
   };
   const Spectrum unbounded(std::numeric_limits<double>::infinity());
   // Optical depth: finite and >= 0 is what makes every transmittance <= 1.
-  check("transmittance (optical depth)", luts.transmittance, unbounded, false);
-  check("irradiance", luts.irradiance, bounds.sky_irradiance, false);
-  check("scattering", luts.scattering, bounds.radiance * 0.5, true);
+  check("transmittance (optical depth)", luts.transmittance, unbounded, false, false);
+  check("irradiance", luts.irradiance, bounds.sky_irradiance, false, false);
+  check("scattering", luts.scattering, bounds.radiance * 0.5, true, true);
   if (!luts.single_mie_scattering.empty()) {
-    check("single Mie scattering", luts.single_mie_scattering, bounds.single_scattering, false);
+    check("single Mie scattering", luts.single_mie_scattering, bounds.single_scattering, true, false);
   }
   return result;
 }

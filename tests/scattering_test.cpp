@@ -114,8 +114,16 @@ TEST(SingleScattering, MatchesBruteForceQuadratureWithinHalfPercent) {
   for (const auto& [x, y, z] : texels) {
     ScatteringTexel t = GetScatteringTexel(p, x, y, z);
     SingleScattering expected = BruteForceSingleScattering(luts.atmosphere, p, t);
-    glsl::vec4 rayleigh = luts.scattering.Fetch(x, y, z);
-    glsl::vec4 mie = luts.single_mie_scattering.Fetch(x, y, z);
+    // A slice past the range of nu that (mu, mu_s) allow holds what the
+    // lookup's blend extends to (Baker::ExtendSlicesPastTheirRange): there
+    // the lookup at the texel's own, clamped nu is the light it stands for.
+    const bool extended = t.nu != t.grid_nu;
+    auto value = [&](const glsl::Texture& table) {
+      return extended ? glsl::GetScattering(p, glsl::sampler3D{&table}, t.r, t.mu, t.mu_s, t.nu, t.ray_intersects_ground)
+                      : table.Fetch(x, y, z);
+    };
+    glsl::vec4 rayleigh = value(luts.scattering);
+    glsl::vec4 mie = value(luts.single_mie_scattering);
     bool twilight = t.mu_s < 0.0;
     for (int c = 0; c < 3; ++c) {
       // Values far below the table's scale (the sun hidden for all but a
