@@ -179,7 +179,9 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
                                        const std::function<vec3(int x, int y, int z)>& edge_value) {
   const int nu_size = grid.scattering_nu_size, mu_s_size = grid.scattering_mu_s_size;
   const double spacing = 2.0 / (nu_size - 1);
-  const Texture stored = table;
+  // Rows are independent, and within a row each slice past the range is
+  // read (for its own edge value) and written once, by the interval whose
+  // allowed part it extends; the slices inside the range are only read.
   const SunColumns columns(grid);
   tbb::parallel_for(0, grid.scattering_mu_size * grid.scattering_r_size, [&](int row) {
     const int y = row % grid.scattering_mu_size, z = row / grid.scattering_mu_size;
@@ -197,10 +199,10 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
         // of it inside to extend from, keep their slices.
         if (!(k_clamped || next_clamped) || end - start < kSmallestExtendedFraction * spacing) continue;
         const int x0 = k * mu_s_size + column, x1 = x0 + mu_s_size;
-        const vec3 at_start = k_clamped && edge_value ? edge_value(x0, y, z) : vec3(stored.Fetch(x0, y, z));
-        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z) : vec3(stored.Fetch(x1, y, z));
+        const vec3 at_start = k_clamped && edge_value ? edge_value(x0, y, z) : vec3(table.Fetch(x0, y, z));
+        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z) : vec3(table.Fetch(x1, y, z));
         const double t_start = (start - nu_k) / spacing, t_end = (end - nu_k) / spacing;
-        vec4 value0 = stored.Fetch(x0, y, z), value1 = stored.Fetch(x1, y, z);
+        vec4 value0 = table.Fetch(x0, y, z), value1 = table.Fetch(x1, y, z);
         for (int c = 0; c < 3; ++c) {
           if (geometric && !(at_start[c] > 0.0 && at_end[c] > 0.0)) continue;
           const double a = geometric ? std::log(at_start[c]) : at_start[c];
