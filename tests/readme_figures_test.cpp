@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/manifest.h"
 #include "test_util.h"
 
 namespace skybake {
@@ -320,6 +321,16 @@ TEST(NewcomerDefects, D10_EveryMarkedBlockNamesItsCommand) {
     }
   }
   EXPECT_GE(blocks, 7);
+}
+
+// docs/manifest.md states the schema version skybake writes, in its title
+// and in its table of keys.
+TEST(NewcomerDefects, D10_ManifestPageStatesTheSchemaVersionWritten) {
+  const std::string text = ReadText(kSourceDir / "docs/manifest.md");
+  const std::string version = std::to_string(kManifestSchemaVersion);
+  EXPECT_NE(text.find("(schema version " + version + ")"), std::string::npos) << "docs/manifest.md's title";
+  EXPECT_NE(text.find("| `schema_version` | `" + version + "` |"), std::string::npos)
+      << "docs/manifest.md's table of keys";
 }
 
 }  // namespace
