@@ -291,6 +291,17 @@ TEST(Twilight, SkyLuminanceFallsSmoothlyThroughSunset) {
   }
 }
 
+// The default tables' errors per case group against a committed reference
+// file in reference/cases, through the CPU twin of the runtime.
+std::vector<report::GroupErrors> DefaultEarthErrors(const std::string& file) {
+  const LutSet& luts = DefaultEarth();
+  const Twin twin(MakeTwinTables(luts));
+  const report::ReferenceSet reference = report::ParseReference(
+      testing::ReadText(std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/" + file), file, luts.atmosphere);
+  return report::MeasureErrors(reference,
+                               [&](const report::ReferenceCase& c) { return report::EvaluateTwin(twin, c); });
+}
+
 // The default tables after sunset against the twilight case set's
 // reference (reference/cases/earth_twilight_reference.csv, standard errors
 // up to 1 % to sun 100 degrees): the RMS relative error over the cases and
@@ -299,13 +310,7 @@ TEST(Twilight, SkyLuminanceFallsSmoothlyThroughSunset) {
 // sun 91-96 degrees and 436 % at 97-100; following its fall, 10.5 % and
 // 94 % (docs/accuracy.md). The bounds sit between; the aim is 5 %.
 TEST(Twilight, SkyAfterSunsetAgainstTheReference) {
-  const LutSet& luts = DefaultEarth();
-  const Twin twin(MakeTwinTables(luts));
-  const report::ReferenceSet reference = report::ParseReference(
-      testing::ReadText(std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/earth_twilight_reference.csv"),
-      "earth_twilight_reference.csv", luts.atmosphere);
-  const std::vector<report::GroupErrors> errors = report::MeasureErrors(
-      reference, [&](const report::ReferenceCase& c) { return report::EvaluateTwin(twin, c); });
+  const std::vector<report::GroupErrors> errors = DefaultEarthErrors("earth_twilight_reference.csv");
   for (const auto& [group, bound] : {std::pair<const char*, double>{"twilight_sky_sun_91-96", 0.14},
                                      std::pair<const char*, double>{"twilight_sky_sun_97-100", 1.5}}) {
     const report::GroupErrors& e = report::FindGroup(errors, group);
@@ -328,13 +333,7 @@ TEST(Twilight, SkyAfterSunsetAgainstTheReference) {
 // ExtendSlicesPastTheirRange) it read 3.85 % / 17.5 %, channels 4.07 /
 // 4.01 / 4.28 %; after, 1.67 % / 3.49 %, channels 2.21 / 1.79 / 2.90 %.
 TEST(Twilight, ReportGroupWithinItsTargets) {
-  const LutSet& luts = DefaultEarth();
-  const Twin twin(MakeTwinTables(luts));
-  const report::ReferenceSet reference = report::ParseReference(
-      testing::ReadText(std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/earth_reference.csv"),
-      "earth_reference.csv", luts.atmosphere);
-  const std::vector<report::GroupErrors> errors = report::MeasureErrors(
-      reference, [&](const report::ReferenceCase& c) { return report::EvaluateTwin(twin, c); });
+  const std::vector<report::GroupErrors> errors = DefaultEarthErrors("earth_reference.csv");
   const report::GroupErrors& twilight = report::FindGroup(errors, "twilight");
   std::printf("twilight: luminance RMS %.3g max %.3g; channels RMS %.3g %.3g %.3g\n",
               twilight.luminance.rms_relative, twilight.luminance.max_relative, twilight.channel[0].rms_relative,
