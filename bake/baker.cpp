@@ -178,7 +178,6 @@ Texture Baker::ScatteringTable() const {
 void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture& table,
                                        const std::function<vec3(int x, int y, int z)>& edge_value) {
   const int nu_size = grid.scattering_nu_size, mu_s_size = grid.scattering_mu_s_size;
-  const double spacing = 2.0 / (nu_size - 1);
   // Rows are independent, and within a row each slice past the range is
   // read (for its own edge value) and written once, by the interval whose
   // allowed part it extends; the slices inside the range are only read.
@@ -188,17 +187,16 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
     const double mu = GetScatteringTexel(grid, 0, y, z).mu;
     for (int column = 0; column < mu_s_size; ++column) {
       const double mu_s = columns.mu_s[column];
-      const double spread = glsl::SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
-      const double lowest = mu * mu_s - spread, highest = mu * mu_s + spread;
+      const double lowest = ClampedNu(-1.0, mu, mu_s), highest = ClampedNu(1.0, mu, mu_s);
       const bool geometric = mu_s < glsl::LOW_SUN_MU_S;  // SunCosineMix's blend for this column
       for (int k = 0; k + 1 < nu_size; ++k) {
-        const double nu_k = -1.0 + k * spacing;
+        const int x0 = k * mu_s_size + column, x1 = x0 + mu_s_size;
+        const double nu_k = columns.grid_nu[x0], spacing = columns.grid_nu[x1] - nu_k;
         const double start = std::max(nu_k, lowest), end = std::min(nu_k + spacing, highest);
         const bool k_clamped = start > nu_k, next_clamped = end < nu_k + spacing;
         // Intervals wholly inside or outside the range, or with too little
         // of it inside to extend from, keep their slices.
         if (!(k_clamped || next_clamped) || end - start < kSmallestExtendedFraction * spacing) continue;
-        const int x0 = k * mu_s_size + column, x1 = x0 + mu_s_size;
         const vec3 at_start = k_clamped && edge_value ? edge_value(x0, y, z) : vec3(table.Fetch(x0, y, z));
         const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z) : vec3(table.Fetch(x1, y, z));
         const double t_start = (start - nu_k) / spacing, t_end = (end - nu_k) / spacing;
