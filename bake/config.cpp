@@ -171,8 +171,11 @@ constexpr PhaseName kPhaseNames[] = {
 // The published solar spectrum `sun.irradiance_w_m2_nm` can name.
 constexpr std::string_view kAstmG173 = "astm-g173";
 
+// The published cross-sections `{ cross_section = ... }` can name.
+constexpr std::string_view kOzone233K = "ozone-233k";
+
 // The table forms of a coefficient (see examples/atmospheres/README.md).
-enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex, kTabulated };
+enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex, kTabulated, kCrossSection };
 struct CoefficientFormKeys {
   CoefficientForm form;
   std::vector<std::string_view> keys;
@@ -183,10 +186,12 @@ const CoefficientFormKeys kCoefficientForms[] = {
     {CoefficientForm::kRefractiveIndex,
      {"refractive_index", "number_density_per_m3", "depolarization"}},
     {CoefficientForm::kTabulated, {"wavelength_nm", "per_m"}},
+    {CoefficientForm::kCrossSection, {"cross_section", "molecules_per_m3"}},
 };
 constexpr const char* kCoefficientFormsText =
     "{ rayleigh_at_1um }, { angstrom_reference, reference_nm, exponent }, "
-    "{ refractive_index, number_density_per_m3, depolarization } or { wavelength_nm, per_m }";
+    "{ refractive_index, number_density_per_m3, depolarization }, { wavelength_nm, per_m } or "
+    "{ cross_section, molecules_per_m3 }";
 
 // A length given as <base>_km or <base>_m, as written and in metres.
 struct Length {
@@ -197,7 +202,11 @@ struct Length {
 
 class FileReader : public TomlReader {
  public:
-  using TomlReader::TomlReader;
+  // With `wavelengths_nm`, the atmosphere is read at those wavelengths
+  // instead of the file's [spectrum] (a spectral bake's batches); values
+  // given once per file wavelength then have no meaning and are errors.
+  FileReader(const std::string& source, std::optional<Spectrum> wavelengths_nm)
+      : TomlReader(source), wavelengths_override_(wavelengths_nm) {}
 
   Atmosphere Read(const toml::table& root) {
     CheckKeys(root, "", {"name", "description", "planet", "spectrum", "sun", "constituents"});
@@ -215,6 +224,7 @@ class FileReader : public TomlReader {
       if (const toml::node* node = spectrum->get("wavelengths_nm"))
         atmosphere.wavelengths_nm = ReadArray3(*node, "spectrum.wavelengths_nm", kPositive);
     }
+    if (wavelengths_override_) atmosphere.wavelengths_nm = *wavelengths_override_;
 
     ReadSun(RequireTable(root, "", "sun"), atmosphere);
 
@@ -256,6 +266,10 @@ class FileReader : public TomlReader {
     if (node.is_number()) return Spectrum(ReadNumber(node, path, interval));
     if (!node.is_array())
       report_.Fail(path, "expected a number or an array of 3 numbers, got " + TypeName(node));
+    if (wavelengths_override_) {
+      report_.Fail(path, "gives a value at each of spectrum.wavelengths_nm only; a spectral bake needs it at "
+                         "any wavelength: one number, a law, a tabulated spectrum or a cross-section");
+    }
     return ReadArray3(node, path, interval);
   }
 
@@ -483,6 +497,30 @@ class FileReader : public TomlReader {
       case CoefficientForm::kTabulated:
         result = ReadTabulatedSpectrum(*table, path, wavelengths_nm);
         break;
+      case CoefficientForm::kCrossSection: {
+        // beta = sigma(lambda) N, sigma linear between the published samples.
+        const std::string name = RequireString(*table, path, "cross_section");
+        if (name != kOzone233K) {
+          report_.Fail(path + ".cross_section",
+                       "unknown cross-section \"" + name + "\" (expected \"" + std::string(kOzone233K) + "\")");
+        }
+        const double molecules = ReadNumber(Require(*table, path, "molecules_per_m3"),
+                                            path + ".molecules_per_m3", kNonNegative);
+        const SpectralData& sigma = OzoneCrossSection233K();
+        std::vector<double> values;
+        for (const glm::dvec3& v : sigma.values) values.push_back(v.x);
+        for (int i = 0; i < kWavelengthCount; ++i) {
+          const double w = wavelengths_nm[i];
+          if (!(w >= sigma.wavelength_nm.front() && w <= sigma.wavelength_nm.back())) {
+            report_.Fail(path + ".cross_section", "\"" + name + "\" covers " +
+                                                      FormatNumber(sigma.wavelength_nm.front()) + " to " +
+                                                      FormatNumber(sigma.wavelength_nm.back()) +
+                                                      " nm, not the wavelength " + FormatNumber(w) + " nm");
+          }
+          result[i] = molecules * PiecewiseLinear(sigma.wavelength_nm, values, w);
+        }
+        break;
+      }
     }
     for (int i = 0; i < kWavelengthCount; ++i) {
       if (!std::isfinite(result[i]))
@@ -544,13 +582,15 @@ class FileReader : public TomlReader {
     return values;
   }
 
+  std::optional<Spectrum> wavelengths_override_;
 };
 
 }  // namespace
 
-Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name) {
+Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name,
+                           std::optional<Spectrum> wavelengths_nm) {
   toml::table root = ParseDocument(toml_text, source_name);
-  Atmosphere atmosphere = FileReader(source_name).Read(root);
+  Atmosphere atmosphere = FileReader(source_name, wavelengths_nm).Read(root);
   Validate(atmosphere, source_name);
   return atmosphere;
 }

@@ -6,6 +6,7 @@
 // is documented in examples/atmospheres/README.md.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,8 +17,12 @@
 namespace skybake {
 
 // Parses and validates an atmosphere description. `source_name` prefixes
-// error messages (usually the file's base name).
-Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name);
+// error messages (usually the file's base name). With `wavelengths_nm`, every
+// per-wavelength value is taken at those wavelengths instead of the file's
+// [spectrum] (the batches of a spectral bake, bake/spectral.h); a value the
+// file gives as an array of 3 then has no meaning there and is an InputError.
+Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name,
+                           std::optional<Spectrum> wavelengths_nm = std::nullopt);
 
 // How messages name an input: "standard input" for "-", else the file name.
 std::string InputName(const std::string& path);
@@ -31,6 +36,15 @@ std::string InputName(const std::string& path);
 //   otherwise a file.
 // A missing or unreadable file is an IoError.
 Atmosphere LoadAtmosphere(const std::string& file_or_preset);
+
+// The text of the atmosphere `file_or_preset` names (LoadAtmosphere's rule)
+// and the name its messages use, read once: a spectral bake parses it at
+// each batch of wavelengths.
+struct AtmosphereSource {
+  std::string text;
+  std::string name;
+};
+AtmosphereSource ReadAtmosphereSource(const std::string& file_or_preset);
 
 // The name a batch bake gives the output of `file_or_preset`: the preset's
 // name, or the file name without ".toml".

@@ -72,14 +72,23 @@ std::optional<std::string> NamedPreset(const std::string& file_or_preset) {
 
 }  // namespace
 
-Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
-  if (std::optional<std::string> preset = NamedPreset(file_or_preset)) return LoadPreset(*preset);
+AtmosphereSource ReadAtmosphereSource(const std::string& file_or_preset) {
+  if (std::optional<std::string> preset = NamedPreset(file_or_preset)) {
+    const EmbeddedText* file = FindPreset(*preset);
+    if (!file) throw InputError(*preset + ": no such preset (see skybake presets)");
+    return {std::string(file->text), std::string(file->name)};
+  }
   const std::filesystem::path path(file_or_preset);
   std::error_code error;
   if (!SpelledAsPath(file_or_preset) && !std::filesystem::exists(path, error)) {
     throw IoError(file_or_preset + ": no such file or preset (see skybake presets)", ErrorLocation(file_or_preset));
   }
-  return ParseAtmosphere(ReadFileText(path, "an atmosphere file"), InputName(file_or_preset));
+  return {ReadFileText(path, "an atmosphere file"), InputName(file_or_preset)};
+}
+
+Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
+  const AtmosphereSource source = ReadAtmosphereSource(file_or_preset);
+  return ParseAtmosphere(source.text, source.name);
 }
 
 std::string InputName(const std::string& path) {

@@ -44,6 +44,11 @@ const SpectralData& AstmG173() {
   return data;
 }
 
+const SpectralData& OzoneCrossSection233K() {
+  static const SpectralData data = ReadSpectralData("ozone_cross_section_233k_10nm.csv", 1);
+  return data;
+}
+
 double AstmG173ExtraterrestrialBinMean(double from_nm, double width_nm) {
   const SpectralData& data = AstmG173();
   double sum = 0.0;

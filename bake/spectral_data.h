@@ -1,6 +1,7 @@
 // The published spectra compiled in from data/ (data/README.md): reading
-// them, and the solar spectrum (ASTM G173-03) with the bin means an
-// atmosphere file's `sun.irradiance_w_m2_nm = "astm-g173"` takes.
+// them, the solar spectrum (ASTM G173-03) with the bin means an atmosphere
+// file's `sun.irradiance_w_m2_nm = "astm-g173"` takes, and ozone's absorption
+// cross-section (`{ cross_section = "ozone-233k", ... }`).
 #pragma once
 
 #include <string_view>
@@ -31,5 +32,10 @@ const SpectralData& AstmG173();
 // their lower edge), which the presets' three values follow.
 // InputError if the bin holds no sample.
 double AstmG173ExtraterrestrialBinMean(double from_nm, double width_nm = 10.0);
+
+// data/ozone_cross_section_233k_10nm.csv: ozone's absorption cross-section
+// at 233 K (Serdyuchenko et al. 2014), m^2, 10 nm bin means named by their
+// lower edge, 360-830 nm (in x).
+const SpectralData& OzoneCrossSection233K();
 
 }  // namespace skybake

@@ -71,7 +71,11 @@ TEST(Presets, EarthHasBruneton2017Parameters) {
   EXPECT_EQ(earth.top_radius_m, 6420e3);
   ExpectSpectrumEq(earth.ground_albedo, Spectrum(0.1), "albedo");
   ExpectSpectrumEq(earth.wavelengths_nm, Spectrum(680.0, 550.0, 440.0), "wavelengths");
-  ExpectSpectrumEq(earth.solar_irradiance, Spectrum(1.474, 1.8504, 1.91198), "irradiance");
+  // The sun and ozone come from the published spectra (spectral_data_test
+  // checks them); at these wavelengths they are Bruneton's values to the
+  // digits he gives.
+  const Spectrum sun(1.474, 1.8504, 1.91198);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(earth.solar_irradiance[i], sun[i], 5e-6 * sun[i]);
   EXPECT_EQ(earth.sun_angular_radius_rad, 0.004675);
   EXPECT_NEAR(earth.mu_s_min, -0.2079, 1e-4);
   ASSERT_EQ(earth.constituents.size(), 3u);
@@ -95,7 +99,8 @@ TEST(Presets, EarthHasBruneton2017Parameters) {
 
   const Constituent& ozone = Find(earth, "ozone");
   ExpectSpectrumEq(ozone.scattering_per_m, Spectrum(0.0), "ozone scattering");
-  ExpectSpectrumEq(ozone.absorption_per_m, Spectrum(0.650e-6, 1.881e-6, 0.085e-6), "ozone");
+  const Spectrum bruneton_ozone(0.650e-6, 1.881e-6, 0.085e-6);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(ozone.absorption_per_m[i], bruneton_ozone[i], 5e-4 * bruneton_ozone[i]);
 }
 
 TEST(Presets, OzoneTentProfile) {

@@ -107,3 +107,58 @@ TEST(AstmG173, AtmosphereFilesNameItForTheSun) {
 
 }  // namespace
 }  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// Ozone's Chappuis band: the absorption cross-section peaks near 602 nm at
+// about 5e-21 cm^2 (5e-25 m^2), weakly dependent on temperature
+// (Gorshelev et al. 2014; Burrows et al. 1999 list 5.2e-21 cm^2 at 293 K),
+// and falls by three orders of magnitude to the minimum between the Huggins
+// and Chappuis bands near 370-380 nm. The 10 nm bin holding 602 nm must be
+// the table's largest and within 10% of 5e-25 m^2 (the spread of the
+// published maxima), and the smallest bin lies between 360 and 390 nm.
+TEST(OzoneCrossSection, ChappuisBandPeaksNear602NanometresAtItsPublishedSize) {
+  const SpectralData& sigma = OzoneCrossSection233K();
+  ASSERT_EQ(sigma.wavelength_nm.size(), 48u);
+  EXPECT_EQ(sigma.wavelength_nm.front(), 360.0);
+  EXPECT_EQ(sigma.wavelength_nm.back(), 830.0);
+  std::size_t peak = 0, trough = 0;
+  for (std::size_t i = 0; i < sigma.values.size(); ++i) {
+    if (sigma.values[i].x > sigma.values[peak].x) peak = i;
+    if (sigma.values[i].x < sigma.values[trough].x) trough = i;
+  }
+  EXPECT_EQ(sigma.wavelength_nm[peak], 600.0);  // the bin [600, 610) nm
+  EXPECT_NEAR(sigma.values[peak].x, 5e-25, 0.5e-25);
+  EXPECT_GE(sigma.wavelength_nm[trough], 360.0);
+  EXPECT_LE(sigma.wavelength_nm[trough], 390.0);
+  EXPECT_LT(sigma.values[trough].x, 1e-3 * sigma.values[peak].x);
+}
+
+// The earth preset's ozone: the cross-section times 300 Dobson units
+// (2.687e20 molecules m^-2 each) spread over its tent profile, whose integral
+// is 15 km; at 680/550/440 nm the 3-digit values of Bruneton's 2017
+// parameters, which were rounded from the same products.
+TEST(OzoneCrossSection, EarthPresetHoldsThreeHundredDobsonUnits) {
+  const Atmosphere earth = LoadAtmosphere("earth");
+  const Constituent* ozone = nullptr;
+  for (const Constituent& c : earth.constituents) {
+    if (c.name == "ozone") ozone = &c;
+  }
+  ASSERT_NE(ozone, nullptr);
+  double column = 0.0;  // integral of the density over altitude, m
+  for (double h = 5.0; h < 60000.0; h += 10.0) column += ozone->density.At(h) * 10.0;
+  EXPECT_NEAR(column, 15000.0, 1.0);
+  const SpectralData& sigma = OzoneCrossSection233K();
+  const std::size_t at_550 = 19;
+  ASSERT_EQ(sigma.wavelength_nm[at_550], 550.0);
+  const double molecules = ozone->absorption_per_m[1] / sigma.values[at_550].x;
+  EXPECT_NEAR(molecules * column / 2.687e20, 300.0, 0.01);
+  const Spectrum bruneton(0.650e-6, 1.881e-6, 0.085e-6);
+  for (int i = 0; i < kWavelengthCount; ++i) {
+    EXPECT_NEAR(ozone->absorption_per_m[i], bruneton[i], 0.0005 * bruneton[i]) << earth.wavelengths_nm[i] << " nm";
+  }
+}
+
+}  // namespace
+}  // namespace skybake
