@@ -95,6 +95,13 @@ struct BakeSettings {
 // the 4D tables' texels, rounded up.
 double EstimatedBakeBytes(const BakeSettings& settings);
 
+// The colour of a spectral bake (bake/spectral.h): its tables hold CIE 1931
+// XYZ in photometric units (Y in cd m^-2, lux for irradiance) of the
+// spectrum sampled at these wavelengths instead of one wavelength per channel.
+struct SpectralColour {
+  std::vector<double> wavelengths_nm;
+};
+
 // The baked tables and the constants the runtime needs to sample them.
 struct LutSet {
   Atmosphere atmosphere;
@@ -111,6 +118,9 @@ struct LutSet {
   // The scene the set was baked for, if any: its tables are those
   // PlanScene keeps (formats/lut_tables.h lists only those).
   std::optional<Scene> scene;
+  // Set for a spectral bake: the channels are X, Y, Z, not the atmosphere's
+  // wavelengths.
+  std::optional<SpectralColour> colour;
 };
 
 struct BakeTiming {

@@ -11,12 +11,14 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/config.h"
+#include "bake/spectral.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "reference/path_tracer.h"
 #include "reference/query_csv.h"
+#include "reference/spectral_reference.h"
 
 namespace skybake::cli {
 
@@ -28,6 +30,7 @@ struct ReferenceOptions {
   std::string output;
   std::string sun_transmittance = "quadrature";
   reference::Settings settings;
+  int wavelengths = 0;
   bool quiet = false;
 };
 
@@ -41,26 +44,37 @@ void RunReference(const ReferenceOptions& o) {
   }
   settings.Validate();
   QueryTable table = ParseQueryCsv(ReadFileText(o.input), InputName(o.input));
-  Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
-  reference::PathTracer tracer(atmosphere);
+  const AtmosphereSource source = ReadAtmosphereSource(o.atmosphere);
+  const Atmosphere atmosphere = ParseAtmosphere(source.text, source.name);
 
-  ProgressBar bar("reference", table.queries.size(), o.quiet);
   std::vector<reference::Result> results;
-  int64_t truncated = 0;
-  for (size_t row = 0; row < table.queries.size(); ++row) {
-    // The row number separates the random streams of the rows.
-    results.push_back(tracer.Evaluate(table.queries[row], settings, row));
-    truncated += results.back().statistics.truncated;
-    bar.Advance();
+  ChannelNames channels;
+  if (o.wavelengths > 0) {
+    const SpectralBatches batches = MakeSpectralBatches(SpectralWavelengths(o.wavelengths));
+    ProgressBar bar("reference", table.queries.size() * batches.size(), o.quiet);
+    results = reference::EvaluateSpectral(source, batches, table.queries, settings, [&] { bar.Advance(); });
+    bar.Finish();
+    channels = XyzChannels();
+  } else {
+    reference::PathTracer tracer(atmosphere);
+    ProgressBar bar("reference", table.queries.size(), o.quiet);
+    for (size_t row = 0; row < table.queries.size(); ++row) {
+      // The row number separates the random streams of the rows.
+      results.push_back(tracer.Evaluate(table.queries[row], settings, row));
+      bar.Advance();
+    }
+    bar.Finish();
+    channels = WavelengthChannels(atmosphere.wavelengths_nm);
   }
-  bar.Finish();
+  int64_t truncated = 0;
+  for (const reference::Result& result : results) truncated += result.statistics.truncated;
   if (truncated > 0 && !o.quiet) {
     std::fprintf(stderr,
                  "skybake: warning: %lld paths reached %d scattering events and were stopped (optically very "
                  "thick medium); the radiance of those paths' later orders is missing\n",
                  static_cast<long long>(truncated), reference::kMaxEventsPerPath);
   }
-  std::string out = reference::FormatResultCsv(table, results, atmosphere.wavelengths_nm);
+  std::string out = reference::FormatResultCsv(table, results, channels);
   if (o.output.empty() || o.output == "-") {
     std::fputs(out.c_str(), stdout);
   } else {
@@ -89,6 +103,11 @@ void AddReferenceCommand(CLI::App& app) {
   cmd->add_option("--max-order", o->settings.max_order,
                   "Highest scattering order (scattering events + ground reflections; 1 = single scattering); "
                   "0 = all orders")
+      ->capture_default_str();
+  cmd->add_option("--wavelengths", o->wavelengths,
+                  "Spectral: this many wavelengths (>= 3) evenly over 360-830 nm, three per run of the path "
+                  "tracer, and the results in CIE XYZ (columns _X, _Y, _Z; Y in cd m^-2, lux for irradiance); "
+                  "0 = the atmosphere's own three wavelengths")
       ->capture_default_str();
   cmd->add_option("--seed", o->settings.seed, "Random seed; the results depend on it, not on --threads")
       ->capture_default_str();

@@ -50,6 +50,18 @@ std::string WavelengthName(double nm) {
   return buffer;
 }
 
+ChannelNames WavelengthChannels(const Spectrum& wavelengths_nm) {
+  ChannelNames names;
+  for (int c = 0; c < kWavelengthCount; ++c) names[c] = WavelengthName(wavelengths_nm[c]);
+  return names;
+}
+
+ChannelNames XyzChannels() { return {"X", "Y", "Z"}; }
+
+ChannelNames TableChannels(const LutSet& luts) {
+  return luts.colour ? XyzChannels() : WavelengthChannels(luts.atmosphere.wavelengths_nm);
+}
+
 size_t QueryTable::ResultColumn(const std::string& name) const {
   auto it = std::find(result_columns.begin(), result_columns.end(), name);
   if (it == result_columns.end()) throw InputError(source_name + ": missing column '" + name + "'");

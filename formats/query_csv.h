@@ -5,9 +5,11 @@
 // (docs/eval.md, docs/report.md).
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
+#include "bake/bake.h"
 #include "shaders_runtime/query.h"
 
 namespace skybake {
@@ -41,5 +43,13 @@ QueryTable ParseQueryCsv(const std::string& text, const std::string& source_name
 
 // "680nm" for 680, "532.5nm" for 532.5: the suffix of per-wavelength columns.
 std::string WavelengthName(double nm);
+
+// The suffixes of per-channel columns: a wavelength's name per channel, or
+// "X", "Y", "Z" for a spectral bake or reference (bake/spectral.h).
+using ChannelNames = std::array<std::string, kWavelengthCount>;
+ChannelNames WavelengthChannels(const Spectrum& wavelengths_nm);
+ChannelNames XyzChannels();
+// A table set's: XYZ when it is spectral.
+ChannelNames TableChannels(const LutSet& luts);
 
 }  // namespace skybake

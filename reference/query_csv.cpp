@@ -11,10 +11,10 @@
 
 namespace skybake::reference {
 
-std::vector<std::string> ResultColumns(const QueryTable& table, const Spectrum& wavelengths_nm) {
+std::vector<std::string> ResultColumns(const QueryTable& table, const ChannelNames& channels) {
   std::vector<std::string> columns = table.header;
   auto add = [&](const char* quantity) {
-    for (int w = 0; w < kWavelengthCount; ++w) columns.push_back(quantity + WavelengthName(wavelengths_nm[w]));
+    for (int w = 0; w < kWavelengthCount; ++w) columns.push_back(quantity + channels[w]);
   };
   add("radiance_");
   add("radiance_stderr_");
@@ -29,9 +29,9 @@ std::vector<std::string> ResultColumns(const QueryTable& table, const Spectrum& 
 }
 
 std::string FormatResultCsv(const QueryTable& table, const std::vector<Result>& results,
-                            const Spectrum& wavelengths_nm) {
+                            const ChannelNames& channels) {
   std::string out;
-  std::vector<std::string> columns = ResultColumns(table, wavelengths_nm);
+  std::vector<std::string> columns = ResultColumns(table, channels);
   for (size_t i = 0; i < columns.size(); ++i) out += (i ? "," : "") + columns[i];
   out += "\n";
   for (size_t row = 0; row < table.fields.size(); ++row) {

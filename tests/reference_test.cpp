@@ -498,7 +498,7 @@ TEST(ReferenceCsv, ParsesQueriesAndWritesResults) {
   settings.paths = 2 * kPathsPerBlock;
   std::vector<Result> results;
   for (size_t i = 0; i < table.queries.size(); ++i) results.push_back(tracer.Evaluate(table.queries[i], settings, i));
-  std::string csv = FormatResultCsv(table, results, a.wavelengths_nm);
+  std::string csv = FormatResultCsv(table, results, WavelengthChannels(a.wavelengths_nm));
   std::string header = csv.substr(0, csv.find('\n'));
   EXPECT_EQ(header,
             "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,normal_zenith_deg,"
