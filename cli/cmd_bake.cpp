@@ -35,6 +35,7 @@ struct BakeOptions {
   BakeSettingsOptions bake;
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
+  int wavelengths = 0;
   std::string ktx2_supercompression = "none";
   std::vector<std::string> runtime = {"glsl", "hlsl", "msl", "wgsl"};
   bool json = false;
@@ -61,8 +62,10 @@ std::vector<ShadingLanguage> ParseRuntimeLanguages(const std::vector<std::string
 // Bakes one atmosphere into `output_dir` (report/bake_pipeline.h), with the
 // phases and the summary on stderr unless --quiet; the --json report of it.
 nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, const std::string& output_dir) {
-  const Atmosphere atmosphere = LoadAtmosphere(atmosphere_arg);
   report::BakeJob job;
+  job.spectral_source = ReadAtmosphereSource(atmosphere_arg);
+  job.wavelengths = o.wavelengths;
+  const Atmosphere atmosphere = ParseAtmosphere(job.spectral_source.text, job.spectral_source.name);
   job.settings = o.bake.Resolve();
   job.scene_file = o.scene;
   job.formats = o.formats;
@@ -188,6 +191,11 @@ void AddBakeCommand(CLI::App& app) {
   cmd->add_option("--reference", o->reference,
                   "With --compare-full: reference values (skybake reference over a case set with a group column); "
                   "default: the committed one for earth");
+  cmd->add_option("--wavelengths", o->wavelengths,
+                  "Spectral: bake this many wavelengths (>= 3; 15 is a good default) evenly over 360-830 nm, three "
+                  "at a time, into tables in CIE 1931 XYZ, Y in cd m^-2 (docs/colour.md); 0 = the atmosphere's own "
+                  "three wavelengths, one per channel")
+      ->capture_default_str();
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
   cmd->add_option("--ktx2-supercompression", o->ktx2_supercompression, kKtx2SupercompressionHelp)
       ->capture_default_str();

@@ -55,8 +55,7 @@ void RunEval(const EvalOptions& o) {
 
   std::string out;
   for (size_t i = 0; i < table.header.size(); ++i) out += (i ? "," : "") + table.header[i];
-  std::vector<std::string> wavelengths;
-  for (int c = 0; c < kWavelengthCount; ++c) wavelengths.push_back(WavelengthName(luts.atmosphere.wavelengths_nm[c]));
+  const ChannelNames wavelengths = TableChannels(luts);
   for (const char* quantity : {"radiance_", "transmittance_"}) {
     for (const std::string& w : wavelengths) out += "," + std::string(quantity) + w;
   }

@@ -92,17 +92,25 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
   const glsl::AtmosphereParameters& p = luts.parameters;
   const Spectrum& w = luts.atmosphere.wavelengths_nm;
   const bool packed = p.single_mie_in_scattering_alpha == 1;
+  // A spectral set's channels are CIE XYZ (wavelength 0: no one wavelength).
+  const bool colour = luts.colour.has_value();
   auto rgb = [&](const std::string& what) {
     std::vector<TableChannel> channels;
     const char* names[3] = {"R", "G", "B"};
-    for (int c = 0; c < 3; ++c) channels.push_back({names[c], w[c], what + " at " + Nm(w[c])});
+    const char* xyz[3] = {"X", "Y", "Z"};
+    for (int c = 0; c < 3; ++c) {
+      channels.push_back(colour ? TableChannel{names[c], 0.0, "CIE " + std::string(xyz[c]) + " of " + what}
+                                : TableChannel{names[c], w[c], what + " at " + Nm(w[c])});
+    }
     return channels;
   };
   std::vector<TableDescription> tables;
 
   TableDescription transmittance;
   transmittance.name = "transmittance";
-  transmittance.encoding = "optical depth to the top of the atmosphere (transmittance = exp(-value))";
+  transmittance.encoding = colour ? "optical depth of sunlight's colour to the top of the atmosphere (the sun's "
+                                    "XYZ through the ray = exp(-value) times its XYZ)"
+                                  : "optical depth to the top of the atmosphere (transmittance = exp(-value))";
   transmittance.units = "1";
   transmittance.channels = rgb("optical depth");
   transmittance.width = p.transmittance_width;
@@ -120,7 +128,7 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
   TableDescription irradiance;
   irradiance.name = "irradiance";
   irradiance.encoding = "indirect irradiance on a horizontal surface (the direct sun is computed at run time)";
-  irradiance.units = "W m^-2 nm^-1";
+  irradiance.units = colour ? "lx (Y; X and Z alike)" : "W m^-2 nm^-1";
   irradiance.channels = rgb("indirect irradiance");
   irradiance.width = p.irradiance_width;
   irradiance.height = p.irradiance_height;
@@ -163,7 +171,7 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
     t.width = p.scattering_nu_size * p.scattering_mu_s_size;
     t.height = p.scattering_mu_size;
     t.depth = p.scattering_r_size;
-    t.units = "W m^-2 sr^-1 nm^-1";
+    t.units = colour ? "cd m^-2 (Y; X and Z alike)" : "W m^-2 sr^-1 nm^-1";
     return t;
   };
 
@@ -214,9 +222,15 @@ const glsl::Texture& TableTexture(const LutSet& luts, const std::string& name) {
 }
 
 Metadata TableMetadata(const LutSet& luts, const TableDescription& table) {
+  // The channels' wavelengths, or those a spectral set's XYZ integrates.
   const Spectrum& w = luts.atmosphere.wavelengths_nm;
-  char wavelengths[96];
-  std::snprintf(wavelengths, sizeof(wavelengths), "%.17g,%.17g,%.17g", w.x, w.y, w.z);
+  const std::vector<double> listed = luts.colour ? luts.colour->wavelengths_nm : std::vector<double>{w.x, w.y, w.z};
+  std::string wavelengths;
+  for (double nm : listed) {
+    char number[32];
+    std::snprintf(number, sizeof(number), "%.17g", nm);
+    wavelengths += (wavelengths.empty() ? "" : ",") + std::string(number);
+  }
   std::string channels;
   for (const TableChannel& c : table.channels) channels += (channels.empty() ? "" : ",") + c.name;
   return Metadata{

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 
+#include "bake/colour.h"
 #include "bake/config.h"
+#include "bake/spectral.h"
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "core/version.h"
@@ -99,6 +101,49 @@ void ManifestWriter::AddShaderFile(const std::string& file, std::string_view byt
       {{"file", file}, {"description", description}, {"bytes", bytes.size()}, {"sha256", Sha256Hex(bytes)}});
 }
 
+namespace {
+
+// A spectral set's "colour": what its channels are, and the altitude
+// profiles of its parameters, which are not those of the atmosphere at any
+// three wavelengths (bake/spectral.h) and so are stored, not recomputed.
+ordered_json ColourToJson(const LutSet& luts) {
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  auto profile = [](const glsl::vec3* values) {
+    ordered_json list = ordered_json::array();
+    for (int i = 0; i < glsl::ALTITUDE_PROFILE_SIZE; ++i) list.push_back({values[i].x, values[i].y, values[i].z});
+    return list;
+  };
+  const glm::dmat3& m = XyzToLinearSrgb();
+  ordered_json to_srgb = ordered_json::array();
+  for (int row = 0; row < 3; ++row) to_srgb.push_back({m[0][row], m[1][row], m[2][row]});
+  return {{"space", "CIE 1931 XYZ"},
+          {"observer", "CIE 1931 2 degree"},
+          {"units", "photometric: Y is luminance in cd m^-2 (illuminance in lx for irradiance), X and Z alike"},
+          {"luminous_efficacy_lm_per_w", kLuminousEfficacyLmPerW},
+          {"wavelengths_nm", luts.colour->wavelengths_nm},
+          {"xyz_to_linear_srgb", to_srgb},
+          {"transmittance", "of sunlight's colour: exp(-depth) is the sun's XYZ through the ray over its XYZ"},
+          {"extinction_profile", profile(p.extinction_profile)},
+          {"mie_scattering_profile", profile(p.mie_scattering_profile)},
+          {"rayleigh_scattering_profile", profile(p.rayleigh_scattering_profile)}};
+}
+
+void ColourProfilesFromJson(const json& colour, glsl::AtmosphereParameters* p) {
+  auto read = [&](const char* key, glsl::vec3* values) {
+    const json& list = colour.at(key);
+    if (list.size() != glsl::ALTITUDE_PROFILE_SIZE) throw IoError(std::string(key) + ": wrong length");
+    for (int i = 0; i < glsl::ALTITUDE_PROFILE_SIZE; ++i) {
+      values[i] = glsl::vec3(list.at(i).at(0).get<double>(), list.at(i).at(1).get<double>(),
+                             list.at(i).at(2).get<double>());
+    }
+  };
+  read("extinction_profile", p->extinction_profile);
+  read("mie_scattering_profile", p->mie_scattering_profile);
+  read("rayleigh_scattering_profile", p->rayleigh_scattering_profile);
+}
+
+}  // namespace
+
 std::string ManifestWriter::Text() const {
   const Spectrum& w = luts_.atmosphere.wavelengths_nm;
   ordered_json manifest = {
@@ -106,7 +151,8 @@ std::string ManifestWriter::Text() const {
       {"schema_version", kManifestSchemaVersion},
       {"generator", "skybake " SKYBAKE_VERSION},
       {"command", command_line_},
-      {"wavelengths_nm", {w.x, w.y, w.z}},
+      {"wavelengths_nm", luts_.colour ? ordered_json(luts_.colour->wavelengths_nm) : ordered_json({w.x, w.y, w.z})},
+      {"colour", luts_.colour ? ColourToJson(luts_) : ordered_json(nullptr)},
       {"parameters", ParametersToJson(luts_.parameters)},
       {"parameterization", ParameterizationToJson(luts_.parameters)},
       {"bake", SettingsJson(luts_.settings, SettingsFields::kManifest, luts_.orders_used)},
@@ -177,8 +223,14 @@ Manifest ReadManifest(const fs::path& dir) {
     LutSet& luts = m.luts;
     luts.parameters = ParametersFromJson(m.document.at("parameters"));
     luts.atmosphere = ParseAtmosphere(m.document.at("atmosphere_toml").get<std::string>(), where);
-    // The coefficient profiles are a function of the atmosphere, not stored twice.
-    SetAltitudeProfiles(luts.atmosphere, &luts.parameters);
+    const json& colour = m.document.at("colour");
+    if (colour.is_null()) {
+      // The coefficient profiles are a function of the atmosphere, not stored twice.
+      SetAltitudeProfiles(luts.atmosphere, &luts.parameters);
+    } else {
+      luts.colour = SpectralColour{colour.at("wavelengths_nm").get<std::vector<double>>()};
+      ColourProfilesFromJson(colour, &luts.parameters);
+    }
     const json& bake = m.document.at("bake");
     BakeSettings& s = luts.settings;
     const json& orders = bake.at("orders");

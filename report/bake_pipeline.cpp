@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "bake/spectral.h"
 #include "core/constants.h"
 #include "core/errors.h"
 #include "core/file_io.h"
@@ -200,6 +201,19 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   } else if (job.compare_full) {
     throw UsageError("--compare-full: needs --scene");
   }
+  if (job.wavelengths > 0 && scene) throw UsageError("--wavelengths: a scene's bake has the atmosphere's three");
+  if (job.wavelengths > 0 && job.settings.pack_single_mie_in_alpha) {
+    throw UsageError("--pack-mie: a spectral bake keeps single Mie in its own table (its alpha would hold one "
+                     "wavelength, not a colour)");
+  }
+  // Resolved before baking, so that a file that is not spectral fails at once.
+  std::optional<SpectralBatches> batches;
+  if (job.wavelengths > 0) {
+    batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths));
+    for (const Spectrum& nm : batches->batch_wavelengths_nm) {
+      ParseAtmosphere(job.spectral_source.text, job.spectral_source.name, nm);
+    }
+  }
   if (!job.reference_file.empty() && !job.compare_full) throw UsageError("--reference: needs --compare-full");
   // Read before baking, so that a bad file fails at once.
   std::optional<ReferenceSet> reference;
@@ -234,8 +248,10 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     if (on_step) on_step(line);
   };
   step("baking " + atmosphere.name);
-  out.luts = Bake(atmosphere, out.settings, &out.report, phase_done);
+  out.luts = batches ? BakeSpectral(job.spectral_source, *batches, out.settings, &out.report, phase_done)
+                    : Bake(atmosphere, out.settings, &out.report, phase_done);
   SnippetParts parts;
+  parts.channels_are_xyz = out.luts.colour.has_value();
   if (scene) {
     out.luts.scene = scene->scene;
     parts.scattering = scene->plan.scattering;

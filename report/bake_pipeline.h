@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
+#include "bake/config.h"
 #include "bake/scene.h"
 #include "formats/lut_files.h"
 #include "report/scene_accuracy.h"
@@ -36,6 +37,11 @@ struct BakeJob {
   // The runtime's languages written beside the tables (shaders_runtime/snippet.h); empty: none.
   std::vector<ShadingLanguage> runtime_languages{std::begin(kShadingLanguages), std::end(kShadingLanguages)};
   bool clean = false;          // WriteOptions::clean
+  // A spectral bake (bake/spectral.h) of this many wavelengths, reading
+  // `spectral_source` (the atmosphere's text) at each batch; 0: the
+  // atmosphere's own three wavelengths.
+  int wavelengths = 0;
+  AtmosphereSource spectral_source;
   std::string command_line;    // recorded in the manifest
 };
 

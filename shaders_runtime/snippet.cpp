@@ -152,10 +152,18 @@ std::string AtmosphereConstants(ShadingLanguage language, const glsl::Atmosphere
   s += std::string(wgsl ? "// false" : "// 0") + ": single Mie is packed into the scattering table's alpha; pass the scattering\n" +
        "// texture as single_mie_scattering_texture too.\n";
   s += flag("SKYBAKE_HAS_SINGLE_MIE_SCATTERING_TEXTURE", parts.scattering && separate_mie);
-  s += "// Wavelength of each RGB channel, nm.\n";
-  s += vec3_constant("SKYBAKE_WAVELENGTHS_NM", wavelengths_nm);
+  if (parts.channels_are_xyz) {
+    s += "// The channels are CIE 1931 XYZ of a spectral bake: Y is luminance in cd m^-2 (illuminance in lx),\n"
+         "// X and Z alike; the manifest's colour.xyz_to_linear_srgb converts to linear sRGB. No one wavelength\n"
+         "// per channel: SKYBAKE_WAVELENGTHS_NM is 0.\n";
+  } else {
+    s += "// Wavelength of each RGB channel, nm.\n";
+  }
+  s += flag("SKYBAKE_CHANNELS_ARE_XYZ", parts.channels_are_xyz);
+  s += vec3_constant("SKYBAKE_WAVELENGTHS_NM", parts.channels_are_xyz ? glsl::vec3(0.0) : wavelengths_nm);
   s += syntax.struct_constant + std::string("ATMOSPHERE = ") + syntax.struct_open + "\n";
-  s += "    " + Vec3Literal(syntax, p.solar_irradiance) + ",  // solar_irradiance, W m^-2 nm^-1\n";
+  s += "    " + Vec3Literal(syntax, p.solar_irradiance) +
+       (parts.channels_are_xyz ? ",  // solar_irradiance, XYZ (Y in lx)\n" : ",  // solar_irradiance, W m^-2 nm^-1\n");
   s += "    " + FloatLiteral(p.sun_angular_radius) + ",  // sun_angular_radius, rad\n";
   s += "    " + FloatLiteral(p.bottom_radius) + ",  // bottom_radius, m\n";
   s += "    " + FloatLiteral(p.top_radius) + ",  // top_radius, m\n";

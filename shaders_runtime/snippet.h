@@ -28,6 +28,9 @@ struct SnippetParts {
   bool scattering = true;          // sky radiance (GetSkyRadiance and the 4D lookups)
   bool irradiance = true;          // GetSunAndSkyIrradiance and the irradiance lookups
   bool aerial_perspective = true;  // GetSkyRadianceToPoint[WithShadow]; needs scattering
+  // The tables of a spectral bake: every radiance is CIE XYZ (bake/spectral.h),
+  // which the constants' comments and SKYBAKE_CHANNELS_ARE_XYZ say.
+  bool channels_are_xyz = false;
 };
 
 // GLSL (OpenGL 3.3 / ES 3.0, and Vulkan GLSL 4.50), HLSL (Unity, Unreal),
