@@ -221,7 +221,19 @@ def stress(skybake):
     replace_block("docs/stability.md", "stress", "stress", text)
 
 
-PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report}
+def colour(skybake):
+    spectral, three = WORK / "colour" / "spectral", WORK / "colour" / "three"
+    for directory, options in ((spectral, ["--wavelengths", "15"]), (three, [])):
+        shutil.rmtree(directory, ignore_errors=True)
+        run([skybake, "bake", "earth", "-o", str(directory), "-q", "--runtime", "none", *options])
+    text = run(["/usr/bin/python3", "scripts/colour_errors.py", skybake, str(spectral), str(three), "--markdown"])
+    shutil.rmtree(WORK / "colour", ignore_errors=True)
+    replace_block("docs/colour.md", "colour-errors", "colour", text)
+    replace_block("README.md", "colour-errors", "colour", text)
+
+
+PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report,
+         "colour": colour}
 
 
 def main():
