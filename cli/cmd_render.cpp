@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
+#include "bake/colour.h"
 #include "bake/scene.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -123,7 +124,11 @@ void RunRender(const RenderArguments& args) {
 
   TwinTables tables = MakeTwinTables(luts);
   Twin twin(tables);
-  const glsl::vec3 white = render::WhiteBalance(luts.parameters.solar_irradiance);
+  // A spectral set's twin answers CIE XYZ (docs/colour.md): its images are
+  // converted to linear sRGB, whose white is D65, and not white-balanced to
+  // the sun; a three-wavelength set's are balanced so that sunlight is neutral.
+  const bool colour = luts.colour.has_value();
+  const glsl::vec3 white = colour ? glsl::vec3(1.0) : render::WhiteBalance(luts.parameters.solar_irradiance);
   const glsl::vec3 albedo = args.ground_albedo >= 0.0 ? glsl::vec3(args.ground_albedo) : luts.atmosphere.ground_albedo;
 
   std::size_t total_rows = 0;
@@ -149,20 +154,30 @@ void RunRender(const RenderArguments& args) {
       settings.camera_altitude_m = args.altitude_m;
       settings.ground_albedo = albedo;
       render::Image image = render::RenderView(twin, view, settings, [&](int rows) { bar.Advance(rows); });
+      if (colour) {
+        for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
+          const glm::dvec3 rgb = XyzToLinearSrgb() * glm::dvec3(image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]);
+          for (int c = 0; c < 3; ++c) image.rgb[i + c] = float(rgb[c]);
+        }
+      }
 
       std::string stem = std::string(render::ToString(view)) + "_" + ZenithTag(zenith);
       render::Attributes exr_attributes = common;
       exr_attributes.push_back({"skybake.view", render::ToString(view)});
       exr_attributes.push_back({"skybake.sun_zenith_deg", std::to_string(zenith)});
-      exr_attributes.push_back({"skybake.units", "W m^-2 sr^-1 nm^-1 (linear radiance, R G B = the tables' wavelengths)"});
+      exr_attributes.push_back(
+          {"skybake.units", colour ? "cd m^-2 (linear sRGB: Rec. 709 primaries, D65 white, from the set's CIE XYZ)"
+                                   : "W m^-2 sr^-1 nm^-1 (linear radiance, R G B = the tables' wavelengths)"});
       render::WriteLinearExr(out_dir / (stem + ".exr"), image, exr_attributes);
       const double exposure_ev = fixed_exposure ? *fixed_exposure : render::AutoExposureEv(image);
       render::Rgb8 png = render::ToneMapToSrgb(image, render::ToneMap{exposure_ev, white});
       render::Attributes png_attributes = common;
-      char description[192];
+      char description[256];
       std::snprintf(description, sizeof(description),
-                    "%s view, sun zenith %g deg, exposure %.4g EV (%s), tone curve 1 - exp(-x), sRGB",
-                    render::ToString(view), zenith, exposure_ev, fixed_exposure ? "fixed" : "auto");
+                    "%s view, sun zenith %g deg, exposure %.4g EV (%s), tone curve 1 - exp(-x), sRGB, white "
+                    "balance: %s",
+                    render::ToString(view), zenith, exposure_ev, fixed_exposure ? "fixed" : "auto",
+                    colour ? "none (D65, from CIE XYZ)" : "sunlight neutral");
       char exposure_line[128];
       std::snprintf(exposure_line, sizeof(exposure_line), "render: %s sun zenith %g deg: exposure %.4g EV (%s)",
                     render::ToString(view), zenith, exposure_ev, fixed_exposure ? "fixed" : "auto");

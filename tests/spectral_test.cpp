@@ -4,8 +4,10 @@
 // the default spectral Earth against the spectral reference.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -319,6 +321,69 @@ TEST(SpectralBake, WrittenSetLoadsBackAsColour) {
   EXPECT_EQ(TableChannels(loaded), XyzChannels());
   const std::string manifest = testing::ReadText(dir.path() / "set" / "skybake.json");
   EXPECT_NE(manifest.find("\"space\": \"CIE 1931 XYZ\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace skybake
+
+namespace skybake {
+namespace {
+
+const char* kSmallSpectralBake =
+    " --wavelengths 6 --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4"
+    " --ray-samples 32 --sphere-samples 8 --orders 2 -q";
+
+// The command line end to end: `bake --wavelengths` writes a set whose
+// `eval` columns are X, Y, Z, which `render` draws, and whose daylight
+// zenith, converted to linear sRGB with the matrix the manifest gives, is
+// blue (B > G > R); a file that gives values per file wavelength fails with
+// one line and exit 2, leaving no folder.
+TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
+  const testing::TempDir dir;
+  const std::string set = (dir.path() / "set").string();
+  std::string out, err;
+  ASSERT_EQ(testing::RunCommand(testing::Skybake() + " bake earth -o " + testing::ShellQuote(set) + kSmallSpectralBake,
+                                dir, &out, &err),
+            0)
+      << err;
+  const std::filesystem::path queries = dir.path() / "q.csv";
+  testing::WriteText(queries, "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,0,30,0\n");
+  ASSERT_EQ(testing::RunCommand(testing::Skybake() + " eval " + testing::ShellQuote(set) + " --in " +
+                                    testing::ShellQuote(queries.string()),
+                                dir, &out, &err),
+            0)
+      << err;
+  EXPECT_EQ(out.rfind("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,radiance_X,radiance_Y,"
+                      "radiance_Z,",
+                      0),
+            0u)
+      << out;
+  const std::string images = (dir.path() / "images").string();
+  ASSERT_EQ(testing::RunCommand(testing::Skybake() + " render " + testing::ShellQuote(set) + " -o " +
+                                    testing::ShellQuote(images) + " --views fisheye --sun-zenith 30 --size 32 -q",
+                                dir, &out, &err),
+            0)
+      << err;
+  const LutSet luts = LoadLutSet(set);
+  const Twin twin(MakeTwinTables(luts));
+  Query zenith;
+  zenith.sun_zenith_deg = 30.0;
+  glsl::vec3 transmittance;
+  const glm::dvec3 xyz = report::QuerySkyRadiance(
+      twin, zenith, MakeQueryGeometry(zenith, luts.parameters.bottom_radius), &transmittance);
+  const glm::dvec3 rgb = XyzToLinearSrgb() * xyz;
+  EXPECT_GT(rgb.z, rgb.y);
+  EXPECT_GT(rgb.y, rgb.x);
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / "fisheye_sz30.png"));
+
+  const std::string haze = (dir.path() / "haze").string();
+  EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake light-haze -o " + testing::ShellQuote(haze) +
+                                    kSmallSpectralBake,
+                                dir, &out, &err),
+            2);
+  EXPECT_NE(err.find("gives a value at each of spectrum.wavelengths_nm only"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(std::filesystem::exists(haze));
 }
 
 }  // namespace
