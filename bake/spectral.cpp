@@ -42,10 +42,6 @@ SpectralBatches MakeSpectralBatches(const std::vector<double>& wavelengths_nm) {
   return batches;
 }
 
-}  // namespace skybake
-
-namespace skybake {
-
 namespace {
 
 // Per texel and channel, the sum over batches of to_xyz times the batch's

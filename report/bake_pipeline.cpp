@@ -202,11 +202,8 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     throw UsageError("--compare-full: needs --scene");
   }
   if (job.wavelengths > 0 && scene) throw UsageError("--wavelengths: a scene's bake has the atmosphere's three");
-  if (job.wavelengths > 0 && job.settings.pack_single_mie_in_alpha) {
-    throw UsageError("--pack-mie: a spectral bake keeps single Mie in its own table (its alpha would hold one "
-                     "wavelength, not a colour)");
-  }
-  // Resolved before baking, so that a file that is not spectral fails at once.
+  // Resolved before baking, so that a file that is not spectral fails at once
+  // (BakeSpectral refuses settings it cannot take before baking, too).
   std::optional<SpectralBatches> batches;
   if (job.wavelengths > 0) {
     batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths));

@@ -337,7 +337,7 @@ const char* kSmallSpectralBake =
 // `eval` columns are X, Y, Z, which `render` draws, and whose daylight
 // zenith, converted to linear sRGB with the matrix the manifest gives, is
 // blue (B > G > R); a file that gives values per file wavelength fails with
-// one line and exit 2, leaving no folder.
+// one line and exit 2, leaving no folder, and so does --pack-mie.
 TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
   const testing::TempDir dir;
   const std::string set = (dir.path() / "set").string();
@@ -384,6 +384,14 @@ TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
   EXPECT_NE(err.find("gives a value at each of spectrum.wavelengths_nm only"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_FALSE(std::filesystem::exists(haze));
+  // Single Mie packed into alpha would hold one wavelength, not a colour.
+  const std::string packed = (dir.path() / "packed").string();
+  EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake earth --pack-mie -o " + testing::ShellQuote(packed) +
+                                    kSmallSpectralBake,
+                                dir, &out, &err),
+            2);
+  EXPECT_NE(err.find("--pack-mie: a spectral bake keeps single Mie in its own table"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(packed));
 }
 
 }  // namespace
