@@ -49,7 +49,7 @@ void RunReference(const ReferenceOptions& o) {
 
   std::vector<reference::Result> results;
   ChannelNames channels;
-  if (o.wavelengths > 0) {
+  if (o.wavelengths != 0) {
     const SpectralBatches batches = MakeSpectralBatches(SpectralWavelengths(o.wavelengths));
     ProgressBar bar("reference", table.queries.size() * batches.size(), o.quiet);
     results = reference::EvaluateSpectral(source, batches, table.queries, settings, [&] { bar.Advance(); });

@@ -39,7 +39,8 @@ struct BakeJob {
   bool clean = false;          // WriteOptions::clean
   // A spectral bake (bake/spectral.h) of this many wavelengths, reading
   // `spectral_source` (the atmosphere's text) at each batch; 0: the
-  // atmosphere's own three wavelengths.
+  // atmosphere's own three wavelengths (SpectralWavelengths refuses 1, 2 and
+  // negative counts).
   int wavelengths = 0;
   AtmosphereSource spectral_source;
   std::string command_line;    // recorded in the manifest

@@ -337,7 +337,8 @@ const char* kSmallSpectralBake =
 // `eval` columns are X, Y, Z, which `render` draws, and whose daylight
 // zenith, converted to linear sRGB with the matrix the manifest gives, is
 // blue (B > G > R); a file that gives values per file wavelength fails with
-// one line and exit 2, leaving no folder, and so does --pack-mie.
+// one line and exit 2, leaving no folder, and so do --pack-mie and fewer
+// than three wavelengths.
 TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
   const testing::TempDir dir;
   const std::string set = (dir.path() / "set").string();
@@ -392,6 +393,16 @@ TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
             2);
   EXPECT_NE(err.find("--pack-mie: a spectral bake keeps single Mie in its own table"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(packed));
+  for (const char* count : {"2", "-3"}) {
+    EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake earth --wavelengths " + count + " -o " +
+                                      testing::ShellQuote(packed),
+                                  dir, &out, &err),
+              2)
+        << count;
+    EXPECT_NE(err.find("a spectral bake needs at least 3 wavelengths, not " + std::string(count)), std::string::npos)
+        << err;
+    EXPECT_FALSE(std::filesystem::exists(packed));
+  }
 }
 
 }  // namespace
