@@ -377,31 +377,26 @@ TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
   EXPECT_GT(rgb.y, rgb.x);
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / "fisheye_sz30.png"));
 
-  const std::string haze = (dir.path() / "haze").string();
-  EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake light-haze -o " + testing::ShellQuote(haze) +
-                                    kSmallSpectralBake,
-                                dir, &out, &err),
-            2);
-  EXPECT_NE(err.find("gives a value at each of spectrum.wavelengths_nm only"), std::string::npos) << err;
-  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-  EXPECT_FALSE(std::filesystem::exists(haze));
-  // Single Mie packed into alpha would hold one wavelength, not a colour.
-  const std::string packed = (dir.path() / "packed").string();
-  EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake earth --pack-mie -o " + testing::ShellQuote(packed) +
-                                    kSmallSpectralBake,
-                                dir, &out, &err),
-            2);
-  EXPECT_NE(err.find("--pack-mie: a spectral bake keeps single Mie in its own table"), std::string::npos) << err;
-  EXPECT_FALSE(std::filesystem::exists(packed));
-  for (const char* count : {"2", "-3"}) {
-    EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake earth --wavelengths " + count + " -o " +
-                                      testing::ShellQuote(packed),
+  // Refused, one line, exit 2, no folder: a file with values per file
+  // wavelength, single Mie packed into alpha (one wavelength, not a colour),
+  // fewer than three wavelengths.
+  struct Refusal {
+    std::string arguments, message;
+  };
+  const std::string refused = (dir.path() / "refused").string();
+  for (const Refusal& r :
+       {Refusal{"light-haze" + std::string(kSmallSpectralBake), "gives a value at each of spectrum.wavelengths_nm only"},
+        Refusal{"earth --pack-mie" + std::string(kSmallSpectralBake),
+                "--pack-mie: a spectral bake keeps single Mie in its own table"},
+        Refusal{"earth --wavelengths 2", "a spectral bake needs at least 3 wavelengths, not 2"},
+        Refusal{"earth --wavelengths -3", "a spectral bake needs at least 3 wavelengths, not -3"}}) {
+    SCOPED_TRACE(r.arguments);
+    EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake " + r.arguments + " -o " + testing::ShellQuote(refused),
                                   dir, &out, &err),
-              2)
-        << count;
-    EXPECT_NE(err.find("a spectral bake needs at least 3 wavelengths, not " + std::string(count)), std::string::npos)
-        << err;
-    EXPECT_FALSE(std::filesystem::exists(packed));
+              2);
+    EXPECT_NE(err.find(r.message), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_FALSE(std::filesystem::exists(refused));
   }
 }
 
