@@ -121,6 +121,12 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
                      "wavelength, not a colour)");
   }
   if (settings.scattering_range) throw InputError("a spectral bake covers the whole atmosphere (no scene range)");
+  // Every batch's atmosphere first, so that a file not defined at some
+  // wavelength fails before anything is baked.
+  std::vector<Atmosphere> atmospheres;
+  for (const Spectrum& nm : batches.batch_wavelengths_nm) {
+    atmospheres.push_back(ParseAtmosphere(source.text, source.name, nm));
+  }
   LutSet out;
   out.atmosphere = ParseAtmosphere(source.text, source.name);
   out.colour = SpectralColour{batches.wavelengths_nm};
@@ -132,7 +138,7 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
   BakeReport total;
   for (std::size_t b = 0; b < batches.size(); ++b) {
     const Spectrum& nm = batches.batch_wavelengths_nm[b];
-    const Atmosphere atmosphere = ParseAtmosphere(source.text, source.name, nm);
+    const Atmosphere& atmosphere = atmospheres[b];
     char name[64];
     std::snprintf(name, sizeof(name), "%.0f-%.0f nm: ", nm.x, nm.z);
     BakeReport batch_report;
@@ -149,7 +155,6 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
     const glm::dmat3& m = batches.to_xyz[b];
     if (b == 0) {
       out.settings = luts.settings;
-      out.orders_used = luts.orders_used;
       out.parameters = luts.parameters;
       irradiance.emplace(luts.irradiance);
       scattering.emplace(luts.scattering);

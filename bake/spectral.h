@@ -51,7 +51,7 @@ SpectralBatches MakeSpectralBatches(const std::vector<double>& wavelengths_nm);
 //   -ln(XYZ of E T / XYZ of E) per channel, so that the sun's colour through
 //   the atmosphere is exact at the texels; light from elsewhere (an object
 //   behind aerial perspective) attenuates by the sun's spectrum's mean, an
-//   approximation (docs/accuracy.md measures it);
+//   approximation (docs/colour.md measures it);
 // - the parameters' solar irradiance is the sun's XYZ, and the altitude
 //   profiles of the aerial-perspective march are the coefficients averaged
 //   over the sun's spectrum per channel, exact to first order in the
@@ -59,8 +59,9 @@ SpectralBatches MakeSpectralBatches(const std::vector<double>& wavelengths_nm);
 // The result's `atmosphere` is the file at its own three wavelengths (its
 // geometry and constituents for the manifest); `colour` says the tables are
 // XYZ. `progress` sees each batch's phases, named with the batch.
-// InputError for settings a spectral bake cannot take (single Mie packed in
-// the scattering table's alpha, a scattering range).
+// InputError, before anything is baked, for settings a spectral bake cannot
+// take (single Mie packed in the scattering table's alpha, a scattering
+// range) and for an atmosphere not defined at every batch's wavelengths.
 LutSet BakeSpectral(const AtmosphereSource& atmosphere, const SpectralBatches& batches, const BakeSettings& settings,
                     BakeReport* report = nullptr, const BakeProgress& progress = nullptr);
 

@@ -128,10 +128,13 @@ ordered_json ColourToJson(const LutSet& luts) {
           {"rayleigh_scattering_profile", profile(p.rayleigh_scattering_profile)}};
 }
 
-void ColourProfilesFromJson(const json& colour, glsl::AtmosphereParameters* p) {
+void ColourProfilesFromJson(const json& colour, const std::string& where, glsl::AtmosphereParameters* p) {
   auto read = [&](const char* key, glsl::vec3* values) {
     const json& list = colour.at(key);
-    if (list.size() != glsl::ALTITUDE_PROFILE_SIZE) throw IoError(std::string(key) + ": wrong length");
+    if (list.size() != glsl::ALTITUDE_PROFILE_SIZE) {
+      throw IoError(where + ": colour." + key + " holds " + std::to_string(list.size()) + " values, not " +
+                    std::to_string(glsl::ALTITUDE_PROFILE_SIZE));
+    }
     for (int i = 0; i < glsl::ALTITUDE_PROFILE_SIZE; ++i) {
       values[i] = glsl::vec3(list.at(i).at(0).get<double>(), list.at(i).at(1).get<double>(),
                              list.at(i).at(2).get<double>());
@@ -229,7 +232,7 @@ Manifest ReadManifest(const fs::path& dir) {
       SetAltitudeProfiles(luts.atmosphere, &luts.parameters);
     } else {
       luts.colour = SpectralColour{colour.at("wavelengths_nm").get<std::vector<double>>()};
-      ColourProfilesFromJson(colour, &luts.parameters);
+      ColourProfilesFromJson(colour, where, &luts.parameters);
     }
     const json& bake = m.document.at("bake");
     BakeSettings& s = luts.settings;

@@ -202,15 +202,8 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     throw UsageError("--compare-full: needs --scene");
   }
   if (job.wavelengths != 0 && scene) throw UsageError("--wavelengths: a scene's bake has the atmosphere's three");
-  // Resolved before baking, so that a file that is not spectral fails at once
-  // (BakeSpectral refuses settings it cannot take before baking, too).
   std::optional<SpectralBatches> batches;
-  if (job.wavelengths != 0) {
-    batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths));
-    for (const Spectrum& nm : batches->batch_wavelengths_nm) {
-      ParseAtmosphere(job.spectral_source.text, job.spectral_source.name, nm);
-    }
-  }
+  if (job.wavelengths != 0) batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths));
   if (!job.reference_file.empty() && !job.compare_full) throw UsageError("--reference: needs --compare-full");
   // Read before baking, so that a bad file fails at once.
   std::optional<ReferenceSet> reference;
