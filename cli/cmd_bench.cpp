@@ -1,8 +1,8 @@
 // `skybake bench`: times each phase of a bake (files written included) over
 // several runs and reports medians and the peak resident memory, optionally
 // with the cost of scaling the work (each table axis doubled, orders 1-8,
-// 1, 2 and all threads), each with its own peak memory. docs/benchmark.md
-// holds its table (scripts/bench.sh).
+// 3, 15 and 45 wavelengths, 1, 2 and all threads), each with its own peak
+// memory. docs/benchmark.md holds its table (scripts/bench.sh).
 #include <malloc.h>
 #include <sys/resource.h>
 
@@ -40,6 +40,7 @@ struct BenchOptions {
   std::string atmosphere = "earth";
   std::string output_dir;  // empty: a temporary directory, removed afterwards
   BakeSettingsOptions bake;
+  int wavelengths = 0;  // as `bake --wavelengths`: 0 is the atmosphere's own three
   int runs = 5;
   bool scaling = false;
   bool json = false;
@@ -84,12 +85,21 @@ struct Measurement {
   std::map<std::string, std::vector<double>> seconds;  // phase (and "total") -> one value per run
 };
 
-Measurement Measure(const Atmosphere& atmosphere, const BakeSettings& settings, int runs,
-                    const std::filesystem::path& dir) {
+// What one configuration bakes: the settings and, as `bake --wavelengths`,
+// the number of wavelengths (0: the atmosphere's own three).
+struct BenchConfiguration {
+  BakeSettings settings;
+  int wavelengths = 0;
+};
+
+Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere,
+                    const BenchConfiguration& configuration, int runs, const std::filesystem::path& dir) {
   // The bake pipeline of `skybake bake` without the runtime: the tables
   // and the manifest, in EXR and KTX2.
   report::BakeJob job;
-  job.settings = settings;
+  job.settings = configuration.settings;
+  job.wavelengths = configuration.wavelengths;
+  job.spectral_source = source;
   job.runtime_languages.clear();
   job.command_line = CommandLine();
   Measurement m;
@@ -110,37 +120,48 @@ Measurement Measure(const Atmosphere& atmosphere, const BakeSettings& settings, 
 // The scaling runs: the base configuration with one thing changed.
 struct Variant {
   std::string name;
-  std::function<void(BakeSettings&)> change;
+  std::function<void(BenchConfiguration&)> change;
 };
 
 std::vector<Variant> ScalingVariants() {
   std::vector<Variant> v = {
-      {"transmittance mu x2", [](BakeSettings& s) { s.transmittance_width *= 2; }},
-      {"transmittance r x2", [](BakeSettings& s) { s.transmittance_height *= 2; }},
-      {"irradiance mu_s x2", [](BakeSettings& s) { s.irradiance_width *= 2; }},
-      {"irradiance r x2", [](BakeSettings& s) { s.irradiance_height *= 2; }},
-      {"scattering r x2", [](BakeSettings& s) { s.scattering_r_size *= 2; }},
-      {"scattering mu x2", [](BakeSettings& s) { s.scattering_mu_size *= 2; }},
-      {"scattering mu_s x2", [](BakeSettings& s) { s.scattering_mu_s_size *= 2; }},
-      {"scattering nu x2", [](BakeSettings& s) { s.scattering_nu_size *= 2; }},
+      {"transmittance mu x2", [](BenchConfiguration& c) { c.settings.transmittance_width *= 2; }},
+      {"transmittance r x2", [](BenchConfiguration& c) { c.settings.transmittance_height *= 2; }},
+      {"irradiance mu_s x2", [](BenchConfiguration& c) { c.settings.irradiance_width *= 2; }},
+      {"irradiance r x2", [](BenchConfiguration& c) { c.settings.irradiance_height *= 2; }},
+      {"scattering r x2", [](BenchConfiguration& c) { c.settings.scattering_r_size *= 2; }},
+      {"scattering mu x2", [](BenchConfiguration& c) { c.settings.scattering_mu_size *= 2; }},
+      {"scattering mu_s x2", [](BenchConfiguration& c) { c.settings.scattering_mu_s_size *= 2; }},
+      {"scattering nu x2", [](BenchConfiguration& c) { c.settings.scattering_nu_size *= 2; }},
   };
   for (int orders = 1; orders <= 8; ++orders) {
-    v.push_back({"orders " + std::to_string(orders), [orders](BakeSettings& s) { s.orders = orders; }});
+    v.push_back({"orders " + std::to_string(orders), [orders](BenchConfiguration& c) { c.settings.orders = orders; }});
+  }
+  // Three wavelengths (the atmosphere's own, one per channel), and spectral
+  // bakes of 15 and 45 in batches of three (bake/spectral.h).
+  v.push_back({"wavelengths 3", [](BenchConfiguration& c) { c.wavelengths = 0; }});
+  for (int wavelengths : {15, 45}) {
+    v.push_back({"wavelengths " + std::to_string(wavelengths),
+                 [wavelengths](BenchConfiguration& c) { c.wavelengths = wavelengths; }});
   }
   // 1, 2 and, where the machine has more, all its cores.
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   std::vector<int> thread_counts = {1, 2};
   if (cores > 2) thread_counts.push_back(cores);
   for (int threads : thread_counts) {
-    v.push_back({"threads " + std::to_string(threads), [threads](BakeSettings& s) { s.threads = threads; }});
+    v.push_back({"threads " + std::to_string(threads), [threads](BenchConfiguration& c) { c.settings.threads = threads; }});
   }
   return v;
 }
 
+int WavelengthCount(const BenchConfiguration& c) { return c.wavelengths == 0 ? kWavelengthCount : c.wavelengths; }
+
 void RunBench(const BenchOptions& o) {
   if (o.runs < 1 || o.runs > 1000) throw UsageError("--runs = " + std::to_string(o.runs) + " must be in [1, 1000]");
-  Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
-  const BakeSettings settings = o.bake.Resolve();
+  const AtmosphereSource source = ReadAtmosphereSource(o.atmosphere);
+  const Atmosphere atmosphere = ParseAtmosphere(source.text, source.name);
+  const BenchConfiguration base_configuration{o.bake.Resolve(), o.wavelengths};
+  const BakeSettings& settings = base_configuration.settings;
 
   std::optional<ScratchDirectory> scratch;
   if (o.output_dir.empty()) scratch.emplace("skybake_bench_");
@@ -148,20 +169,20 @@ void RunBench(const BenchOptions& o) {
   EnsureWritableDirectory(dir);
 
   ResetPeakResident();
-  Measurement base = Measure(atmosphere, settings, o.runs, dir);
+  Measurement base = Measure(source, atmosphere, base_configuration, o.runs, dir);
   const double peak_mib = PeakResidentMiB();
   const double base_total = Median(base.seconds["total"]);
 
-  std::vector<std::pair<std::string, BakeSettings>> variants;
+  std::vector<std::pair<std::string, BenchConfiguration>> variants;
   std::vector<double> variant_totals, variant_peaks;
   if (o.scaling) {
     for (const Variant& v : ScalingVariants()) {
-      BakeSettings changed = settings;
+      BenchConfiguration changed = base_configuration;
       v.change(changed);
-      changed.Validate();
+      changed.settings.Validate();
       variants.emplace_back(v.name, changed);
       ResetPeakResident();
-      variant_totals.push_back(Median(Measure(atmosphere, changed, o.runs, dir).seconds["total"]));
+      variant_totals.push_back(Median(Measure(source, atmosphere, changed, o.runs, dir).seconds["total"]));
       variant_peaks.push_back(PeakResidentMiB());
     }
   }
@@ -174,12 +195,14 @@ void RunBench(const BenchOptions& o) {
     nlohmann::json scaling = nlohmann::json::array();
     for (size_t i = 0; i < variants.size(); ++i) {
       scaling.push_back({{"variant", variants[i].first},
-                         {"settings", DescribeSettings(variants[i].second, SettingsDetail::kOrdersAndThreads)},
+                         {"settings", DescribeSettings(variants[i].second.settings, SettingsDetail::kOrdersAndThreads)},
+                         {"wavelengths", WavelengthCount(variants[i].second)},
                          {"median_seconds", variant_totals[i]},
                          {"peak_resident_mib", variant_peaks[i]}});
     }
     nlohmann::json j = {{"atmosphere", atmosphere.name},
                         {"settings", DescribeSettings(settings, SettingsDetail::kOrdersAndThreads)},
+                        {"wavelengths", WavelengthCount(base_configuration)},
                         {"runs", o.runs},
                         {"phases", phases},
                         {"median_total_seconds", base_total},
@@ -190,8 +213,9 @@ void RunBench(const BenchOptions& o) {
     return;
   }
   const std::string runs = o.runs == 1 ? "one run" : "median of " + std::to_string(o.runs) + " runs";
-  std::printf("%s: %s, files written; %s\n\n", atmosphere.name.c_str(),
-              DescribeSettings(settings, SettingsDetail::kOrdersAndThreads).c_str(), runs.c_str());
+  std::printf("%s: %s, %d wavelengths, files written; %s\n\n", atmosphere.name.c_str(),
+              DescribeSettings(settings, SettingsDetail::kOrdersAndThreads).c_str(),
+              WavelengthCount(base_configuration), runs.c_str());
   std::printf("| phase | median (s) |\n|---|---:|\n");
   for (const std::string& phase : base.phases) {
     std::printf("| %s | %.3f |\n", phase.c_str(), Median(base.seconds[phase]));
@@ -215,8 +239,12 @@ void AddBenchCommand(CLI::App& app) {
   cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->capture_default_str();
   cmd->add_option("--runs", o->runs, "Bakes per configuration; medians are reported")->capture_default_str();
   o->bake.AddTo(cmd);
+  cmd->add_option("--wavelengths", o->wavelengths,
+                  "Time a spectral bake of this many wavelengths, as bake --wavelengths; 0 = the atmosphere's own three")
+      ->capture_default_str();
   cmd->add_flag("--scaling", o->scaling,
-                "Also time each table axis doubled, orders 1 to 8, and 1, 2 and all threads (total time and peak memory)");
+                "Also time each table axis doubled, orders 1 to 8, 3, 15 and 45 wavelengths, and 1, 2 and all threads "
+                "(total time and peak memory)");
   cmd->add_option("-o,--output", o->output_dir,
                   "Directory the bakes write to (default: a temporary one, removed afterwards)");
   cmd->add_flag("--json", o->json, "Print the figures as JSON instead of Markdown tables");

@@ -70,6 +70,14 @@ TEST(CliBench, ScalingMeasuresEachConfigurationsOwnPeakMemory) {
   ASSERT_TRUE(peak.count("scattering r x2") && peak.count("orders 1") && peak.count("threads 1")) << out;
   EXPECT_GT(peak["scattering r x2"], 1.15 * base) << out;
   EXPECT_LT(peak["orders 1"], peak["scattering r x2"]) << out;
+  // The wavelength axis bakes what it names.
+  std::map<std::string, int> wavelengths;
+  for (const auto& row : j["scaling"]) wavelengths[row["variant"].get<std::string>()] = row["wavelengths"].get<int>();
+  EXPECT_EQ(j["wavelengths"].get<int>(), 3);
+  EXPECT_EQ(wavelengths["wavelengths 3"], 3);
+  EXPECT_EQ(wavelengths["wavelengths 15"], 15);
+  EXPECT_EQ(wavelengths["wavelengths 45"], 45);
+  EXPECT_EQ(wavelengths["orders 1"], 3);
 }
 
 TEST(CliBench, Errors) {
@@ -78,6 +86,8 @@ TEST(CliBench, Errors) {
   EXPECT_EQ(RunCommand(Skybake() + " bench earth --runs 0", dir, nullptr, &err), 1);
   EXPECT_NE(err.find("--runs"), std::string::npos) << err;
   EXPECT_EQ(RunCommand(Skybake() + " bench no-such-planet --runs 1", dir, nullptr, &err), 3);  // no such file
+  EXPECT_EQ(RunCommand(Skybake() + " bench earth --runs 1 --wavelengths 2", dir, nullptr, &err), 2);
+  EXPECT_NE(err.find("at least 3 wavelengths"), std::string::npos) << err;
   EXPECT_EQ(RunCommand(Skybake() + " bench earth --scattering-size 4 7 4 2 --runs 1", dir, nullptr, &err), 1);
   EXPECT_NE(err.find("must be even"), std::string::npos) << err;
 }
