@@ -81,6 +81,11 @@ glm::dvec2 Chromaticity(const glm::dvec3& xyz) {
   return sum > 0.0 ? glm::dvec2(xyz.x, xyz.y) / sum : glm::dvec2(0.0);
 }
 
+glm::dvec2 UcsChromaticity(const glm::dvec3& xyz) {
+  const double denominator = xyz.x + 15.0 * xyz.y + 3.0 * xyz.z;
+  return denominator > 0.0 ? glm::dvec2(4.0 * xyz.x, 9.0 * xyz.y) / denominator : glm::dvec2(0.0);
+}
+
 glm::dmat3 RgbToXyzMatrix(const glm::dvec2& red, const glm::dvec2& green, const glm::dvec2& blue,
                           const glm::dvec2& white) {
   // XYZ of chromaticity (x, y) at Y = 1: (x / y, 1, (1 - x - y) / y).

@@ -34,6 +34,9 @@ std::vector<glm::dvec3> XyzWeights(const std::vector<double>& wavelength_nm);
 
 // CIE 1931 chromaticity (x, y) = (X, Y) / (X + Y + Z).
 glm::dvec2 Chromaticity(const glm::dvec3& xyz);
+// CIE 1976 UCS chromaticity (u', v') = (4X, 9Y) / (X + 15Y + 3Z), where
+// distances are closer to perceived colour differences than in (x, y).
+glm::dvec2 UcsChromaticity(const glm::dvec3& xyz);
 
 // The matrix from linear RGB to XYZ of an RGB space given by the
 // chromaticities of its primaries and of its white (scaled so that RGB

@@ -26,6 +26,8 @@ struct ReportOptions {
   std::string atmosphere;
   std::string output_dir;
   std::string reference;  // empty: the committed reference, for earth only
+  int wavelengths = kDefaultSpectralWavelengths;  // of the colour section's spectral bake; 0: none
+  std::string spectral_reference;                 // empty: the committed one, for earth only
   BakeSettingsOptions bake;
   bool quick = false;
   std::vector<int> march_steps;  // empty: 4 8 16 32 (quick: 4 8)
@@ -35,9 +37,12 @@ struct ReportOptions {
 };
 
 void RunReport(const ReportOptions& o) {
-  const Atmosphere atmosphere = LoadAtmosphere(o.atmosphere);
   report::ReportRequest request;
+  request.source = ReadAtmosphereSource(o.atmosphere);
+  const Atmosphere atmosphere = ParseAtmosphere(request.source.text, request.source.name);
   request.reference_file = o.reference;
+  request.wavelengths = o.wavelengths;
+  request.spectral_reference_file = o.spectral_reference;
   request.base = o.bake.Resolve();
   request.quick = o.quick;
   request.march_steps = o.march_steps;
@@ -68,6 +73,13 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("--reference", o->reference,
                   "Reference values (skybake reference over a case set with a group column); "
                   "default: the committed one, for earth only");
+  cmd->add_option("--wavelengths", o->wavelengths,
+                  "Colour section: bake the base settings at this many wavelengths and measure them, and the base "
+                  "bake read as sRGB, against the spectral reference (0: no colour section)")
+      ->capture_default_str();
+  cmd->add_option("--spectral-reference", o->spectral_reference,
+                  "Spectral reference for the colour section (skybake reference --wavelengths N over a case set with "
+                  "a group column); default: the committed one, for earth only");
   o->bake.AddTo(cmd);
   cmd->add_flag("--quick", o->quick,
                 "A small ladder (orders 1-3, transmittance and irradiance sizes, half) and fewer timing passes");

@@ -19,17 +19,21 @@ constexpr const char* kSkyIrradiance = "sky_irradiance";
 }  // namespace
 
 ReferenceSet ParseReference(const std::string& text, const std::string& source_name, const Atmosphere& atmosphere) {
+  return ParseReference(text, source_name, WavelengthChannels(atmosphere.wavelengths_nm),
+                        "a reference for " + atmosphere.name);
+}
+
+ReferenceSet ParseReference(const std::string& text, const std::string& source_name, const ChannelNames& channels,
+                            const std::string& expected) {
   QueryTable table = ParseQueryCsv(text, source_name, ExtraColumns::kKeepAsResults);
   if (!table.has_group) throw InputError(source_name + ": a reference file needs a group column (docs/report.md)");
-  std::vector<std::string> names;
-  for (int c = 0; c < kWavelengthCount; ++c) names.push_back(WavelengthName(atmosphere.wavelengths_nm[c]));
   auto columns = [&](const std::string& quantity) {
     std::vector<size_t> indices;
-    for (const std::string& name : names) {
+    for (const std::string& name : channels) {
       auto it = std::find(table.result_columns.begin(), table.result_columns.end(), quantity + name);
       if (it == table.result_columns.end()) {
-        throw InputError(source_name + ": no column " + quantity + name + ": not a reference for " +
-                         atmosphere.name + " (compute one with skybake reference and pass it with --reference)");
+        throw InputError(source_name + ": no column " + quantity + name + ": not " + expected +
+                         " (compute one with skybake reference and pass it with --reference)");
       }
       indices.push_back(static_cast<size_t>(it - table.result_columns.begin()));
     }

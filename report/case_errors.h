@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bake/atmosphere.h"
+#include "formats/query_csv.h"
 #include "report/error_stats.h"
 #include "shaders_runtime/query.h"
 
@@ -37,6 +38,11 @@ struct ReferenceSet {
 // without the per-wavelength columns of `atmosphere`'s wavelengths (a
 // reference computed for another atmosphere).
 ReferenceSet ParseReference(const std::string& text, const std::string& source_name, const Atmosphere& atmosphere);
+// The same for a reference whose columns are named by `channels` (XYZ for a
+// spectral reference); `expected` says what it should be in the error
+// ("a reference for earth").
+ReferenceSet ParseReference(const std::string& text, const std::string& source_name, const ChannelNames& channels,
+                            const std::string& expected);
 
 // The reference in `file`, or where `file` is empty the one committed for
 // `atmosphere` (reference_files.h); nullopt if there is none.

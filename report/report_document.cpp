@@ -116,6 +116,14 @@ std::string ReportMarkdown(const ReportDocument& d) {
   for (const ReportRow& r : d.rows) {
     if (!r.note.empty()) out += "\n" + r.name + ": " + r.note + "\n";
   }
+  if (d.colour) {
+    out += "\n### Colour (against " + d.spectral_reference +
+           ")\n\nThe base settings baked at " + std::to_string(d.colour->wavelengths) +
+           " wavelengths (tables in CIE XYZ), and the base bake's three wavelengths read as linear sRGB, against the "
+           "spectral reference converted exactly: relative error of the luminance Y, and the chromaticity "
+           "difference Δu′v′ (CIE 1976 UCS).\n\n" +
+           ColourMarkdown(*d.colour);
+  }
   return out;
 }
 
@@ -148,12 +156,17 @@ json ReportJson(const ReportDocument& d) {
     }
     entries.push_back(j);
   }
-  return {{"atmosphere", d.atmosphere},
-          {"reference", d.reference},
-          {"command_line", d.command_line},
-          {"noise_standard_errors", kNoiseStandardErrors},
-          {"luminance_weights", kLuminanceWeights},
-          {"rows", entries}};
+  json document = {{"atmosphere", d.atmosphere},
+                   {"reference", d.reference},
+                   {"command_line", d.command_line},
+                   {"noise_standard_errors", kNoiseStandardErrors},
+                   {"luminance_weights", kLuminanceWeights},
+                   {"rows", entries}};
+  if (d.colour) {
+    document["colour"] = ColourJson(*d.colour);
+    document["colour"]["reference"] = d.spectral_reference;
+  }
+  return document;
 }
 
 std::string ReportCsv(const ReportDocument& d) {

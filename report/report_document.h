@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "bake/bake.h"
 #include "plot/plot.h"
 #include "report/case_errors.h"
+#include "report/colour_errors.h"
 
 namespace skybake::report {
 
@@ -40,6 +42,10 @@ struct ReportDocument {
   std::vector<std::string> wavelengths;  // "680nm", ... (the per-channel column names)
   std::string plotted_group;             // "daylight", or the first group without one
   std::vector<ReportRow> rows;           // the ladder's bakes, then the models
+  // The base settings baked spectrally, and the base bake read as sRGB,
+  // against the spectral reference; absent without one (colour_errors.h).
+  std::optional<ColourErrors> colour;
+  std::string spectral_reference;  // its source name
 };
 
 // The error the plot and the Pareto front use: the luminance RMS of

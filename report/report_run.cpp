@@ -7,6 +7,7 @@
 #include "core/file_io.h"
 #include "formats/lut_tables.h"
 #include "formats/query_csv.h"
+#include "report/colour_errors.h"
 #include "report/quality_ladder.h"
 #include "report/run_time_models.h"
 
@@ -82,6 +83,13 @@ ReportDocument MeasureReport(const Atmosphere& atmosphere, const ReportRequest& 
   if (request.passes < 0 || passes > 10000) {
     throw InputError("--passes = " + std::to_string(request.passes) + " must be in [1, 10000]");
   }
+  std::optional<ReferenceSet> spectral_reference;
+  if (request.wavelengths != 0) {
+    SpectralWavelengths(request.wavelengths);  // refuses a count that cannot be baked, before any bake
+    spectral_reference = LoadSpectralReference(request.spectral_reference_file, atmosphere.name);
+  } else if (!request.spectral_reference_file.empty()) {
+    throw InputError("--spectral-reference: needs --wavelengths N (N >= 3) to bake against it");
+  }
   EnsureWritableDirectory(output_dir);
 
   auto progress = [&](const std::string& line) {
@@ -122,6 +130,16 @@ ReportDocument MeasureReport(const Atmosphere& atmosphere, const ReportRequest& 
   // The run-time models, on the base tables where they need tables.
   progress("run-time models: table lookup, Hoffman & Preetham (fitting the sky dome), ray march");
   AddModels(atmosphere, reference, plan.base, base_tables, march_steps, passes, &document);
+
+  if (spectral_reference) {
+    progress("colour: the base settings at " + std::to_string(request.wavelengths) + " wavelengths");
+    BakeReport timing;
+    const LutSet spectral = BakeSpectral(request.source, MakeSpectralBatches(SpectralWavelengths(request.wavelengths)),
+                                         plan.base, &timing);
+    document.colour = MeasureColourErrors(*spectral_reference, spectral, base_tables);
+    document.colour->spectral_bake_seconds = timing.total_seconds;
+    document.spectral_reference = spectral_reference->source_name;
+  }
   return document;
 }
 

@@ -9,12 +9,20 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "bake/config.h"
+#include "bake/spectral.h"
 #include "report/report_document.h"
 
 namespace skybake::report {
 
 struct ReportRequest {
   std::string reference_file;  // empty: the committed reference (earth only)
+  // The colour section (colour_errors.h): the atmosphere's text, baked at
+  // `wavelengths` (0: no colour section), against `spectral_reference_file`
+  // (empty: the committed one, earth only; none: no colour section).
+  AtmosphereSource source;
+  int wavelengths = kDefaultSpectralWavelengths;
+  std::string spectral_reference_file;
   BakeSettings base;           // the ladder's base bake
   bool quick = false;          // the quick ladder and fewer timing passes
   std::vector<int> march_steps;  // ray-march step counts; empty: 4 8 16 32 (quick: 4 8)
@@ -23,8 +31,9 @@ struct ReportRequest {
   std::function<void(const std::string&)> progress;  // a line per step; may be empty
 };
 
-// Checks the request (InputError without a reference for the atmosphere or
-// for step counts or passes out of range, UsageError for auto orders) and
+// Checks the request (InputError without a reference for the atmosphere, for
+// a spectral reference file given with no wavelengths to bake, or for step
+// counts, passes or wavelengths out of range, UsageError for auto orders) and
 // that `output_dir` is a writable directory (creating it), then bakes the
 // ladder in a scratch folder removed afterwards and measures every row.
 ReportDocument MeasureReport(const Atmosphere& atmosphere, const ReportRequest& request,

@@ -23,8 +23,10 @@ Parts (figure blocks, the page, the commands run):
            `skybake bake --help`; instant
   stress   stress (docs/stability.md): `skybake stress --json`; about half a minute
   bench    bench (docs/benchmark.md): scripts/bench.sh (RUNS=5: about 7 minutes)
-  report   report (docs/accuracy.md), docs/images/report/: `/usr/bin/time -v
-           skybake report earth -o build/figures/report` (a few minutes)
+  report   report (docs/accuracy.md), docs/images/report/, and the report's
+           colour section as colour-errors (docs/colour.md, README.md):
+           `/usr/bin/time -v skybake report earth -o build/figures/report`
+           (a few minutes)
 
 bench and report time the machine: run them with nothing else running.
 """
@@ -171,6 +173,10 @@ def report(skybake):
             f"memory {peak:.0f} MiB (`/usr/bin/time -v`), {os.cpu_count()} cores, load average {load:.1f} at the "
             f"start (0 on an idle machine; more slows the bake times).\n\n" + tables)
     replace_block("docs/accuracy.md", "report", "report", text)
+    # The report's colour section, its table and the line under it, also in docs/colour.md and the README.
+    colour = tables[tables.index("| case group |", tables.index("### Colour")):].strip() + "\n"
+    replace_block("docs/colour.md", "colour-errors", "report", colour)
+    replace_block("README.md", "colour-errors", "report", colour)
 
 
 # What each atmosphere of bake/stress_set.cpp pushes to an extreme.
@@ -221,19 +227,7 @@ def stress(skybake):
     replace_block("docs/stability.md", "stress", "stress", text)
 
 
-def colour(skybake):
-    spectral, three = WORK / "colour" / "spectral", WORK / "colour" / "three"
-    for directory, options in ((spectral, ["--wavelengths", "15"]), (three, [])):
-        shutil.rmtree(directory, ignore_errors=True)
-        run([skybake, "bake", "earth", "-o", str(directory), "-q", "--runtime", "none", *options])
-    text = run(["/usr/bin/python3", "scripts/colour_errors.py", skybake, str(spectral), str(three), "--markdown"])
-    shutil.rmtree(WORK / "colour", ignore_errors=True)
-    replace_block("docs/colour.md", "colour-errors", "colour", text)
-    replace_block("README.md", "colour-errors", "colour", text)
-
-
-PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report,
-         "colour": colour}
+PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report}
 
 
 def main():

@@ -10,8 +10,8 @@
 #   scripts/figures.sh cli        # presets and bake defaults (docs/cli.md)
 #   scripts/figures.sh stress     # the stress set's table (docs/stability.md, about half a minute)
 #   scripts/figures.sh bench      # docs/benchmark.md (scripts/bench.sh, about 7 minutes)
-#   scripts/figures.sh report     # docs/accuracy.md and docs/images/report/ (skybake report, a few minutes)
-#   scripts/figures.sh colour     # the spectral bake's colour error (docs/colour.md, README.md; a minute)
+#   scripts/figures.sh report     # docs/accuracy.md, docs/images/report/ and the colour error in
+#                                 # docs/colour.md and README.md (skybake report, a few minutes)
 #   scripts/figures.sh images     # the gallery and the engine example's images (scripts/gallery.sh,
 #                                 # scripts/engine_example_images.sh)
 #   scripts/figures.sh all        # everything above (about 12 minutes)
@@ -26,9 +26,9 @@ images=0
 for arg in "${@:-fast}"; do
   case "$arg" in
     fast) parts+=(sizes orders cli) ;;
-    all) parts+=(sizes orders cli stress bench report colour); images=1 ;;
+    all) parts+=(sizes orders cli stress bench report); images=1 ;;
     images) images=1 ;;
-    sizes | orders | cli | stress | bench | report | colour) parts+=("$arg") ;;
+    sizes | orders | cli | stress | bench | report) parts+=("$arg") ;;
     *) sed -n '2,20p' "${BASH_SOURCE[0]}" >&2; exit 1 ;;
   esac
 done

@@ -65,6 +65,14 @@ TEST(Colour, D65HasItsPublishedChromaticity) {
   EXPECT_NEAR(xy.y, 0.32903, 5e-5);
 }
 
+TEST(Colour, D65HasItsPublishedUcsChromaticity) {
+  // CIE 015:2018 table 3 (2 degree observer), to the four decimals printed:
+  // u' = 0.1978, v' = 0.4683.
+  const glm::dvec2 uv = UcsChromaticity(D65Xyz());
+  EXPECT_NEAR(uv.x, 0.1978, 1e-4);
+  EXPECT_NEAR(uv.y, 0.4683, 1e-4);
+}
+
 TEST(Colour, SrgbMatricesAreThoseOfIec61966) {
   // IEC 61966-2-1 prints the matrix to XYZ to four decimals, and the inverse
   // of that rounded matrix, again to four decimals, which therefore differs

@@ -300,7 +300,7 @@ TEST(NewcomerDefects, D10_CaseSetCountsMatch) {
 // Every marked block has both markers and names a part of scripts/figures.sh
 // that writes it, so a reader knows which command regenerates it.
 TEST(NewcomerDefects, D10_EveryMarkedBlockNamesItsCommand) {
-  const std::set<std::string> parts = {"sizes", "orders", "cli", "stress", "bench", "report", "colour"};
+  const std::set<std::string> parts = {"sizes", "orders", "cli", "stress", "bench", "report"};
   std::string script = ReadText(kSourceDir / "scripts/figures.py");
   int blocks = 0;
   std::vector<fs::path> pages = {kSourceDir / "README.md"};

@@ -14,6 +14,7 @@
 #include "bake/bake.h"
 #include "core/errors.h"
 #include "report/case_errors.h"
+#include "report/colour_errors.h"
 #include "report/error_stats.h"
 #include "report/quality_ladder.h"
 #include "report/ray_march.h"
@@ -296,6 +297,27 @@ TEST(ReportCommand, QuickLadderWritesTablesCsvJsonAndPlots) {
     for (const char* bad : {",nan", ",-nan", ",inf", ",-inf"}) EXPECT_EQ(line.find(bad), std::string::npos) << line;
   }
 
+  // The colour section: the base settings at 15 wavelengths against the
+  // committed spectral reference, and the base bake read as sRGB, every
+  // group measured on the same cases for both, every figure finite (how
+  // close they are at default sizes: SpectralBake.DefaultEarthAgainstTheSpectralReference).
+  EXPECT_NE(stdout_text.find("### Colour (against earth_spectral_reference.csv)"), std::string::npos);
+  const nlohmann::json& colour = j["colour"];
+  EXPECT_EQ(colour["wavelengths"], 15);
+  EXPECT_EQ(colour["reference"], "earth_spectral_reference.csv");
+  ASSERT_EQ(colour["groups"].size(), std::size(report::kColourGroups));
+  for (std::size_t i = 0; i < colour["groups"].size(); ++i) {
+    const nlohmann::json& g = colour["groups"][i];
+    EXPECT_EQ(g["group"], report::kColourGroups[i]);
+    EXPECT_GT(g["spectral"]["cases"].get<int>(), 0) << g;
+    EXPECT_EQ(g["spectral"]["cases"], g["as_srgb"]["cases"]) << g;
+    for (const char* set : {"spectral", "as_srgb"}) {
+      for (const char* figure : {"luminance_rms", "luminance_max", "delta_uv_rms", "delta_uv_max"}) {
+        EXPECT_TRUE(std::isfinite(g[set][figure].get<double>())) << g;
+      }
+    }
+  }
+
   EXPECT_NE(testing::ReadText(out / "error_vs_bake_time.svg").find("<svg"), std::string::npos);
   auto png = OIIO::ImageInput::open((out / "error_vs_bake_time.png").string());
   ASSERT_TRUE(png);
@@ -320,6 +342,32 @@ TEST(ReportCommand, AnAtmosphereWithoutReferenceIsAOneLineInputError) {
                                 dir, nullptr, &stderr_text),
             3);
   EXPECT_EQ(testing::Lines(stderr_text).size(), 1u) << stderr_text;
+}
+
+// The colour section's options: a count that cannot be baked, or a spectral
+// reference with nothing to bake against it, is a one-line error before any
+// bake, with no output folder; --wavelengths 0 leaves the section out.
+TEST(ReportCommand, ColourSectionOptions) {
+  testing::TempDir dir;
+  const std::filesystem::path out = dir.path() / "report";
+  std::string stdout_text, stderr_text;
+  for (const std::string& options : {std::string(" --wavelengths 2"), std::string(" --wavelengths -4"),
+                                     std::string(" --wavelengths 0 --spectral-reference r.csv")}) {
+    EXPECT_EQ(testing::RunCommand(testing::Skybake() + " report earth -o " + testing::ShellQuote(out.string()) +
+                                      QuickReportArguments() + options,
+                                  dir, nullptr, &stderr_text),
+              2)
+        << options;
+    EXPECT_EQ(testing::Lines(stderr_text).size(), 1u) << stderr_text;
+    EXPECT_FALSE(std::filesystem::exists(out)) << options;
+  }
+  ASSERT_EQ(testing::RunCommand(testing::Skybake() + " report earth -o " + testing::ShellQuote(out.string()) +
+                                    QuickReportArguments() + " --wavelengths 0",
+                                dir, &stdout_text, &stderr_text),
+            0)
+      << stderr_text;
+  EXPECT_EQ(stdout_text.find("### Colour"), std::string::npos);
+  EXPECT_FALSE(nlohmann::json::parse(testing::ReadText(out / "report.json")).contains("colour"));
 }
 
 }  // namespace
