@@ -182,6 +182,7 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
   out.single_mie_scattering = single_mie->Texture();
   out.transmittance = transmittance->Texture();
   out.parameters.solar_irradiance = sun_xyz;
+  out.parameters.transmittance_is_colour = 1;
   auto per_sun = [&](const glsl::vec3& v) {
     glsl::vec3 r(0.0);
     for (int c = 0; c < 3; ++c) r[c] = sun_xyz[c] > 0.0 ? v[c] / sun_xyz[c] : 0.0;

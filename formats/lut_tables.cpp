@@ -47,6 +47,7 @@ ordered_json ParametersToJson(const glsl::AtmosphereParameters& p) {
       {"mie_g", p.mie_g},
       {"mie_to_rayleigh_scattering_ratio", Vec3ToJson(p.mie_to_rayleigh_scattering_ratio)},
       {"single_mie_in_scattering_alpha", p.single_mie_in_scattering_alpha},
+      {"transmittance_is_colour", p.transmittance_is_colour},
       {"transmittance_width", p.transmittance_width},
       {"transmittance_height", p.transmittance_height},
       {"scattering_r_size", p.scattering_r_size},
@@ -73,6 +74,9 @@ glsl::AtmosphereParameters ParametersFromJson(const json& j) {
   p.mie_g = j.at("mie_g").get<double>();
   p.mie_to_rayleigh_scattering_ratio = Vec3FromJson(j.at("mie_to_rayleigh_scattering_ratio"));
   p.single_mie_in_scattering_alpha = j.at("single_mie_in_scattering_alpha").get<int>();
+  // (Absent from the manifests of earlier versions, whose runtime subtracted
+  // table values for colour tables too.)
+  p.transmittance_is_colour = j.value("transmittance_is_colour", 0);
   p.transmittance_width = j.at("transmittance_width").get<int>();
   p.transmittance_height = j.at("transmittance_height").get<int>();
   p.scattering_r_size = j.at("scattering_r_size").get<int>();

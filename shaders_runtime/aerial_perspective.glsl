@@ -76,6 +76,48 @@ vec3 GetCoefficientsAtAltitude(IN(AtmosphereParameters) atmosphere, Number altit
   return InterpolateCoefficients(atmosphere.extinction_profile[i], atmosphere.extinction_profile[i + 1], f);
 }
 
+// The altitude at distance t along the ray (r, mu), whose radius there is
+// r_t: the start's plus the rise along the ray, so that it does not inherit
+// the rounding of a radius near 6.4e6 m in float.
+Number AltitudeAtDistance(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number t, Number r_t) {
+  return r - atmosphere.bottom_radius + t * (t + 2.0 * r * mu) / (r_t + r);
+}
+
+// The optical depth of the segment of length d from radius r in direction
+// mu, by the trapezoidal rule on the extinction profile (as IntegrateSegment
+// below).
+vec3 IntegrateSegmentOpticalDepth(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number d) {
+  Number dt = d / Number(SEGMENT_INTERVALS);
+  vec3 optical_depth = vec3(0.0);
+  vec3 previous_extinction = vec3(0.0);
+  for (int k = 0; k <= SEGMENT_INTERVALS; ++k) {
+    Number t = dt * Number(k);
+    Number r_t = RadiusAtDistance(atmosphere, r, mu, t);
+    vec3 mie_scattering;
+    vec3 rayleigh_scattering;
+    vec3 extinction = GetCoefficientsAtAltitude(atmosphere, AltitudeAtDistance(atmosphere, r, mu, t, r_t),
+                                                mie_scattering, rayleigh_scattering);
+    if (k > 0) optical_depth += (previous_extinction + extinction) * (0.5 * dt);
+    previous_extinction = extinction;
+  }
+  return optical_depth;
+}
+
+// The optical depth of a segment longer than the direct integration covers:
+// two lookups of the transmittance table (GetOpticalDepth), exact at one
+// wavelength per channel. A colour's optical depths do not add
+// (transmittance_is_colour): the difference of the whole rays' optical depths
+// of sunlight's colour from the two ends is that of the wavelengths that
+// survive the longer ray, too small for the segment (it took 15 to 22 % off
+// the aerial perspective over 30 km near the horizon, docs/colour.md), so
+// for colour the segment is integrated along itself.
+vec3 LongSegmentOpticalDepth(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                             Number r, Number mu, Number d, bool ray_r_mu_intersects_ground) {
+  return atmosphere.transmittance_is_colour != 0
+             ? IntegrateSegmentOpticalDepth(atmosphere, r, mu, d)
+             : GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground);
+}
+
 // Along the segment of length d from radius r in direction mu, for the sun
 // at (mu_s, nu), by the trapezoidal rule: the optical depth (returned); the
 // single scattering of the groups the scattering table holds (divided by the
@@ -104,9 +146,7 @@ vec3 IntegrateSegment(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTextu
   for (int k = 0; k <= SEGMENT_INTERVALS; ++k) {
     Number t = dt * Number(k);
     Number r_t = RadiusAtDistance(atmosphere, r, mu, t);
-    // The altitude as the camera's plus the rise along the ray, so that it
-    // does not inherit the rounding of a radius near 6.4e6 m in float.
-    Number altitude = r - atmosphere.bottom_radius + t * (t + 2.0 * r * mu) / (r_t + r);
+    Number altitude = AltitudeAtDistance(atmosphere, r, mu, t, r_t);
     Number mu_s_t = ClampCosine((r * mu_s + t * nu) / r_t);
     vec3 mie_scattering;
     vec3 rayleigh_scattering;
@@ -200,7 +240,8 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
                                       unused_rayleigh, unused_mie, unused_weight);
   }
   if (direct < 1.0) {
-    optical_depth = mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground),
+    optical_depth = mix(LongSegmentOpticalDepth(atmosphere, transmittance_texture, r, mu, d,
+                                                ray_r_mu_intersects_ground),
                         optical_depth, direct);
   }
   transmittance = exp(-optical_depth);
@@ -234,8 +275,8 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
   }
   // A longer sunlit part: the table method, with its transmittance and single
   // Mie blended from the direct integration up to twice DIRECT_SEGMENT_LENGTH.
-  vec3 lit_transmittance = exp(-mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, lit,
-                                                    ray_r_mu_intersects_ground),
+  vec3 lit_transmittance = exp(-mix(LongSegmentOpticalDepth(atmosphere, transmittance_texture, r, mu, lit,
+                                                            ray_r_mu_intersects_ground),
                                     lit_optical_depth, lit_direct));
   vec3 single_mie_scattering_p;
   vec3 scattering_p = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r_p,

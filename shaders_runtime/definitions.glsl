@@ -50,6 +50,13 @@ struct AtmosphereParameters {
   // bake packed its red channel into the scattering table.
   vec3 mie_to_rayleigh_scattering_ratio;
   int single_mie_in_scattering_alpha;  // 1 if packed, 0 if a separate table
+  // 1 where the channels are colour (CIE XYZ of a spectral bake), 0 where
+  // each is one wavelength. A colour's transmittance table holds the optical
+  // depth of sunlight's colour, which does not add along a ray (light that
+  // crosses two stretches is not attenuated by the product of their colour
+  // transmittances), so aerial perspective then integrates a segment's
+  // optical depth along it instead of subtracting two table values.
+  int transmittance_is_colour;
   // Table sizes.
   int transmittance_width;   // mu
   int transmittance_height;  // r

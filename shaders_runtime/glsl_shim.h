@@ -58,6 +58,7 @@ struct AtmosphereParameters {
   Number mie_g = 0.0;
   vec3 mie_to_rayleigh_scattering_ratio{0.0};
   int single_mie_in_scattering_alpha = 0;
+  int transmittance_is_colour = 0;
   int transmittance_width = 0;
   int transmittance_height = 0;
   int scattering_r_size = 0;

@@ -172,6 +172,7 @@ std::string AtmosphereConstants(ShadingLanguage language, const glsl::Atmosphere
   s += "    " + FloatLiteral(p.mie_g) + ",  // mie_g\n";
   s += "    " + Vec3Literal(syntax, p.mie_to_rayleigh_scattering_ratio) + ",  // mie_to_rayleigh_scattering_ratio\n";
   s += "    " + std::to_string(p.single_mie_in_scattering_alpha) + ",  // single_mie_in_scattering_alpha\n";
+  s += "    " + std::to_string(p.transmittance_is_colour) + ",  // transmittance_is_colour\n";
   s += "    " + std::to_string(p.transmittance_width) + ", " + std::to_string(p.transmittance_height) +
        ",  // transmittance_width (mu), transmittance_height (r)\n";
   s += "    " + std::to_string(p.scattering_r_size) + ", " + std::to_string(p.scattering_mu_size) + ", " +

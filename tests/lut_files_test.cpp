@@ -157,6 +157,7 @@ TEST_F(LutFilesTest, ManifestListsEveryFileWithMatchingChecksum) {
   EXPECT_EQ(manifest["command"], "skybake bake earth -o somewhere");
   EXPECT_EQ(manifest["wavelengths_nm"], json::array({680.0, 550.0, 440.0}));
   EXPECT_EQ(manifest["parameters"]["scattering_mu_size"], 32);
+  EXPECT_EQ(manifest["parameters"]["transmittance_is_colour"], 0);  // one wavelength per channel
   EXPECT_EQ(manifest["atmosphere"]["name"], "earth");
   EXPECT_TRUE(manifest["shaders"].is_array());
   EXPECT_TRUE(manifest["shaders"].empty());

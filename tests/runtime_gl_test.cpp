@@ -16,6 +16,7 @@
 #include "bake/bake.h"
 #include "bake/config.h"
 #include "bake/scene.h"
+#include "bake/spectral.h"
 #include "formats/lut_files.h"
 #include "formats/manifest.h"
 #include "shaders_runtime/query.h"
@@ -236,6 +237,29 @@ TEST_P(SnippetOnMesa, PrunedForASceneMatchesTheCppTwin) {
   SnippetParts parts;
   parts.irradiance = false;
   ExpectGlMatchesTwin(gl.get(), luts, FragmentSource(luts, parts), items);
+}
+
+// A spectral set's snippet (tables in XYZ, transmittance_is_colour: aerial
+// perspective integrates its long segments' optical depth instead of reading
+// the table) gives the twin's numbers on every query.
+TEST_P(SnippetOnMesa, SpectralSetMatchesTheCppTwin) {
+  std::string why_not;
+  std::unique_ptr<GlContext> gl = GlContext::Create(GetParam(), &why_not);
+  if (!gl) GTEST_SKIP() << why_not;
+  static const LutSet luts = BakeSpectral(ReadAtmosphereSource("earth"), MakeSpectralBatches(SpectralWavelengths(6)),
+                                          testing::RuntimeTestSettings(false));
+  ASSERT_EQ(luts.parameters.transmittance_is_colour, 1);
+  auto upload = [&](const char* sampler, const glsl::Texture& t) {
+    gl->SetTexture(sampler, t.width, t.height, t.depth, t.texels);
+  };
+  upload("transmittance_texture", luts.transmittance);
+  upload("scattering_texture", luts.scattering);
+  upload("single_mie_scattering_texture", luts.single_mie_scattering);
+  upload("irradiance_texture", luts.irradiance);
+  SnippetParts parts;
+  parts.channels_are_xyz = true;
+  ExpectGlMatchesTwin(gl.get(), luts, FragmentSource(luts, parts),
+                      testing::MakeRuntimeQueries(luts.parameters.bottom_radius, luts.parameters.top_radius));
 }
 
 INSTANTIATE_TEST_SUITE_P(Apis, SnippetOnMesa,

@@ -11,6 +11,7 @@ struct AtmosphereParameters
     float mie_g;
     float3 mie_to_rayleigh_scattering_ratio;
     int single_mie_in_scattering_alpha;
+    int transmittance_is_colour;
     int transmittance_width;
     int transmittance_height;
     int scattering_r_size;

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _769 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _792 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_769)
+    if (!_792)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _632 = mu < 0.0f;
-    bool _644;
-    if (_632)
+    bool _655 = mu < 0.0f;
+    bool _667;
+    if (_655)
     {
-        _644 = (((r * r) * mu) * mu) >= c;
+        _667 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _644 = _632;
+        _667 = _655;
     }
-    return _644;
+    return _667;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _413;
+    float _436;
     if (r_mu > 0.0f)
     {
-        _413 = c / (r_mu + s);
+        _436 = c / (r_mu + s);
     }
     else
     {
-        _413 = s - r_mu;
+        _436 = s - r_mu;
     }
-    float param_1 = _413;
+    float param_1 = _436;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _862;
+    float _885;
     if (d_max > d_min)
     {
-        _862 = (d - d_min) / (d_max - d_min);
+        _885 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _862 = 0.0f;
+        _885 = 0.0f;
     }
-    float x_mu = _862;
+    float x_mu = _885;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1122;
+        float _1145;
         if (d_max == d_min)
         {
-            _1122 = 0.0f;
+            _1145 = 0.0f;
         }
         else
         {
-            _1122 = (d - d_min) / (d_max - d_min);
+            _1145 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1122;
+        x_mu = _1145;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1166;
+        float _1189;
         if (d_max_1 > d_min_1)
         {
-            _1166 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1189 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1166 = 0.0f;
+            _1189 = 0.0f;
         }
-        x_mu = _1166;
+        x_mu = _1189;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1541;
+    float _1564;
     if (low_sun)
     {
-        _1541 = min(t, 1.0f);
+        _1564 = min(t, 1.0f);
     }
     else
     {
-        _1541 = clamp(t, 0.0f, 1.0f);
+        _1564 = clamp(t, 0.0f, 1.0f);
     }
-    return _1541;
+    return _1564;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -394,16 +394,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1564;
+    float4 _1587;
     if (t < 0.0f)
     {
-        _1564 = min(blend, a);
+        _1587 = min(blend, a);
     }
     else
     {
-        _1564 = blend;
+        _1587 = blend;
     }
-    return _1564;
+    return _1587;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -464,16 +464,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _1884;
+        float3 _1907;
         if (scattering.x > 0.0f)
         {
-            _1884 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _1907 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _1884 = 0.0f.xxx;
+            _1907 = 0.0f.xxx;
         }
-        single_mie_scattering = _1884;
+        single_mie_scattering = _1907;
     }
     else
     {
@@ -545,13 +545,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _1952 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _1975 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_1952)
+    if (!_1975)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -560,19 +560,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _1972;
+    float3 _1995;
     if (ray_r_mu_intersects_ground)
     {
-        _1972 = 0.0f.xxx;
+        _1995 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _1972 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _1995 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _1972;
+    transmittance = _1995;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -580,9 +580,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _1999 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2022 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _1999;
+    float3 scattering = _2022;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -613,6 +613,13 @@ float CosineAtDistance(float r, float mu, float d, float r_d)
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float AltitudeAtDistance(AtmosphereParameters atmosphere, float r, float mu, float t, float r_t)
+{
+    return (r - atmosphere.bottom_radius) + ((t * (t + ((2.0f * r) * mu))) / (r_t + r));
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 {
     float x = float(i) / 63.0f;
@@ -623,16 +630,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2093;
+    float _2116;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2093 = a * exp(f * log(b / a));
+        _2116 = a * exp(f * log(b / a));
     }
     else
     {
-        _2093 = lerp(a, b, f);
+        _2116 = lerp(a, b, f);
     }
-    return _2093;
+    return _2116;
 }
 #endif
 
@@ -705,16 +712,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2225;
+    float _2368;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2225 = 1.0f - (0.5f * depth);
+        _2368 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2225 = (1.0f - exp(-depth)) / depth;
+        _2368 = (1.0f - exp(-depth)) / depth;
     }
-    return _2225;
+    return _2368;
 }
 #endif
 
@@ -730,8 +737,8 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
     single_rayleigh = 0.0f.xxx;
     single_mie = 0.0f.xxx;
     scattering_weight = 0.0f.xxx;
-    float3 param_7;
-    float3 param_8;
+    float3 param_12;
+    float3 param_13;
     for (int k = 0; k <= 16; k++)
     {
         float t = dt * float(k);
@@ -740,22 +747,27 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float param_2 = mu;
         float param_3 = t;
         float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
-        float altitude = (r - atmosphere.bottom_radius) + ((t * (t + ((2.0f * r) * mu))) / (r_t + r));
-        float param_4 = ((r * mu_s) + (t * nu)) / r_t;
-        float mu_s_t = ClampCosine(param_4);
-        AtmosphereParameters param_5 = atmosphere;
-        float param_6 = altitude;
-        float3 _2313 = GetCoefficientsAtAltitude(param_5, param_6, param_7, param_8);
-        float3 mie_scattering = param_7;
-        float3 rayleigh_scattering = param_8;
-        float3 extinction = _2313;
-        AtmosphereParameters param_9 = atmosphere;
-        float param_10 = r_t;
-        float param_11 = mu_s_t;
-        AtmosphereParameters param_12 = atmosphere;
-        float param_13 = r_t;
-        float param_14 = mu_s_t;
-        float3 sunlight = exp(-GetOpticalDepthToTopAtmosphereBoundary(param_9, transmittance_texture_1, _transmittance_texture_1_sampler, param_10, param_11)) * SunVisibleFraction(param_12, param_13, param_14);
+        AtmosphereParameters param_4 = atmosphere;
+        float param_5 = r;
+        float param_6 = mu;
+        float param_7 = t;
+        float param_8 = r_t;
+        float altitude = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
+        float param_9 = ((r * mu_s) + (t * nu)) / r_t;
+        float mu_s_t = ClampCosine(param_9);
+        AtmosphereParameters param_10 = atmosphere;
+        float param_11 = altitude;
+        float3 _2448 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 mie_scattering = param_12;
+        float3 rayleigh_scattering = param_13;
+        float3 extinction = _2448;
+        AtmosphereParameters param_14 = atmosphere;
+        float param_15 = r_t;
+        float param_16 = mu_s_t;
+        AtmosphereParameters param_17 = atmosphere;
+        float param_18 = r_t;
+        float param_19 = mu_s_t;
+        float3 sunlight = exp(-GetOpticalDepthToTopAtmosphereBoundary(param_14, transmittance_texture_1, _transmittance_texture_1_sampler, param_15, param_16)) * SunVisibleFraction(param_17, param_18, param_19);
         float3 rayleigh = rayleigh_scattering * sunlight;
         float3 mie = mie_scattering * sunlight;
         float3 scattering = rayleigh_scattering + mie_scattering;
@@ -763,10 +775,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         {
             float3 interval_depth = (previous_extinction + extinction) * (0.5f * dt);
             float3 start_transmittance = exp(-optical_depth);
-            float param_15 = interval_depth.x;
-            float param_16 = interval_depth.y;
-            float param_17 = interval_depth.z;
-            float3 mean_transmittance = start_transmittance * float3(MeanAttenuation(param_15), MeanAttenuation(param_16), MeanAttenuation(param_17));
+            float param_20 = interval_depth.x;
+            float param_21 = interval_depth.y;
+            float param_22 = interval_depth.z;
+            float3 mean_transmittance = start_transmittance * float3(MeanAttenuation(param_20), MeanAttenuation(param_21), MeanAttenuation(param_22));
             single_rayleigh += (((previous_rayleigh + rayleigh) * (0.5f * dt)) * mean_transmittance);
             single_mie += (((previous_mie + mie) * (0.5f * dt)) * mean_transmittance);
             scattering_weight += (((previous_scattering + scattering) * (0.5f * dt)) * mean_transmittance);
@@ -779,6 +791,43 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
     }
     single_rayleigh *= atmosphere.solar_irradiance;
     single_mie *= atmosphere.solar_irradiance;
+    return optical_depth;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, float mu, float d)
+{
+    float dt = d / 16.0f;
+    float3 optical_depth = 0.0f.xxx;
+    float3 previous_extinction = 0.0f.xxx;
+    float3 param_11;
+    float3 param_12;
+    for (int k = 0; k <= 16; k++)
+    {
+        float t = dt * float(k);
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        float param_3 = t;
+        float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
+        AtmosphereParameters param_4 = atmosphere;
+        float param_5 = r;
+        float param_6 = mu;
+        float param_7 = t;
+        float param_8 = r_t;
+        AtmosphereParameters param_9 = atmosphere;
+        float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
+        float3 _2313 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 mie_scattering = param_11;
+        float3 rayleigh_scattering = param_12;
+        float3 extinction = _2313;
+        if (k > 0)
+        {
+            optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
+        }
+        previous_extinction = extinction;
+    }
     return optical_depth;
 }
 #endif
@@ -843,24 +892,49 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
+{
+    float3 _2338;
+    if (atmosphere.transmittance_is_colour != 0)
+    {
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        float param_3 = d;
+        _2338 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+    }
+    else
+    {
+        AtmosphereParameters param_4 = atmosphere;
+        float param_5 = r;
+        float param_6 = mu;
+        float param_7 = d;
+        bool param_8 = ray_r_mu_intersects_ground;
+        _2338 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+    }
+    return _2338;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _648;
+    float _671;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _648 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _671 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _648 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _671 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _648;
+    return _671;
 }
 #endif
 
@@ -873,16 +947,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2055;
+    float _2078;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2055 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2078 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2055 = up;
+        _2078 = up;
     }
-    return _2055;
+    return _2078;
 }
 #endif
 
@@ -905,13 +979,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _2459 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2594 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2459)
+    if (!_2594)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -951,11 +1025,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2554 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _2689 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2554;
+        lit_optical_depth = _2689;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -969,11 +1043,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2588 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _2723 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2588;
+        optical_depth += _2723;
     }
     if (direct < 1.0f)
     {
@@ -982,7 +1056,7 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float param_41 = mu;
         float param_42 = d;
         bool param_43 = ray_r_mu_intersects_ground;
-        optical_depth = lerp(GetOpticalDepth(param_39, transmittance_texture_1, _transmittance_texture_1_sampler, param_40, param_41, param_42, param_43), optical_depth, direct.xxx);
+        optical_depth = lerp(LongSegmentOpticalDepth(param_39, transmittance_texture_1, _transmittance_texture_1_sampler, param_40, param_41, param_42, param_43), optical_depth, direct.xxx);
     }
     transmittance = exp(-optical_depth);
     AtmosphereParameters param_44 = atmosphere;
@@ -992,9 +1066,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _2631 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _2766 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _2631;
+    float3 scattering = _2766;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1015,11 +1089,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _2679 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _2814 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _2679;
+        float3 far_optical_depth = _2814;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1039,9 +1113,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _2733 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _2868 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _2733);
+            scattering -= (exp(-far_optical_depth) * _2868);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1054,7 +1128,7 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_88 = mu;
     float param_89 = lit;
     bool param_90 = ray_r_mu_intersects_ground;
-    float3 lit_transmittance = exp(-lerp(GetOpticalDepth(param_86, transmittance_texture_1, _transmittance_texture_1_sampler, param_87, param_88, param_89, param_90), lit_optical_depth, lit_direct.xxx));
+    float3 lit_transmittance = exp(-lerp(LongSegmentOpticalDepth(param_86, transmittance_texture_1, _transmittance_texture_1_sampler, param_87, param_88, param_89, param_90), lit_optical_depth, lit_direct.xxx));
     AtmosphereParameters param_91 = atmosphere;
     float param_92 = r_p;
     float param_93 = mu_p;
@@ -1062,9 +1136,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _2798 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _2933 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _2798;
+    float3 scattering_p = _2933;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1084,25 +1158,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _2842 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _2977 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _2842;
+    return _2977;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1220;
+    float _1243;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1220 = 0.100000001490116119384765625f;
+        _1243 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1220 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1243 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1220;
+    return _1243;
 }
 #endif
 
@@ -1111,16 +1185,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1238;
+    float _1261;
     if (mu_s < knee)
     {
-        _1238 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1261 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1238 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1261 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1238;
+    return _1261;
 }
 #endif
 
@@ -1147,16 +1221,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1269;
+    float _1292;
     if (x < 0.5f)
     {
-        _1269 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1292 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1269 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1292 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1269;
+    return _1292;
 }
 #endif
 

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _769 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _792 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_769)
+    if (!_792)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _632 = mu < 0.0;
-    bool _644;
-    if (_632)
+    bool _655 = mu < 0.0;
+    bool _667;
+    if (_655)
     {
-        _644 = (((r * r) * mu) * mu) >= c;
+        _667 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _644 = _632;
+        _667 = _655;
     }
-    return _644;
+    return _667;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _413;
+    float _436;
     if (r_mu > 0.0)
     {
-        _413 = c / (r_mu + s);
+        _436 = c / (r_mu + s);
     }
     else
     {
-        _413 = s - r_mu;
+        _436 = s - r_mu;
     }
-    float param_1 = _413;
+    float param_1 = _436;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _862;
+    float _885;
     if (d_max > d_min)
     {
-        _862 = (d - d_min) / (d_max - d_min);
+        _885 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _862 = 0.0;
+        _885 = 0.0;
     }
-    float x_mu = _862;
+    float x_mu = _885;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -323,16 +323,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1122;
+        float _1145;
         if (d_max == d_min)
         {
-            _1122 = 0.0;
+            _1145 = 0.0;
         }
         else
         {
-            _1122 = (d - d_min) / (d_max - d_min);
+            _1145 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1122;
+        x_mu = _1145;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +343,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1166;
+        float _1189;
         if (d_max_1 > d_min_1)
         {
-            _1166 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1189 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1166 = 0.0;
+            _1189 = 0.0;
         }
-        x_mu = _1166;
+        x_mu = _1189;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,16 +372,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1541;
+    float _1564;
     if (low_sun)
     {
-        _1541 = fast::min(t, 1.0);
+        _1564 = fast::min(t, 1.0);
     }
     else
     {
-        _1541 = fast::clamp(t, 0.0, 1.0);
+        _1564 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1541;
+    return _1564;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -421,16 +421,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1564;
+    float4 _1587;
     if (t < 0.0)
     {
-        _1564 = fast::min(blend, a);
+        _1587 = fast::min(blend, a);
     }
     else
     {
-        _1564 = blend;
+        _1587 = blend;
     }
-    return _1564;
+    return _1587;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -493,16 +493,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _1884;
+        float3 _1907;
         if (scattering.x > 0.0)
         {
-            _1884 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _1907 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _1884 = float3(0.0);
+            _1907 = float3(0.0);
         }
-        single_mie_scattering = _1884;
+        single_mie_scattering = _1907;
     }
     else
     {
@@ -579,13 +579,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _1952 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _1975 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_1952)
+    if (!_1975)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -594,19 +594,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _1972;
+    float3 _1995;
     if (ray_r_mu_intersects_ground)
     {
-        _1972 = float3(0.0);
+        _1995 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _1972 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _1995 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _1972;
+    transmittance = _1995;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -614,9 +614,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _1999 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2022 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _1999;
+    float3 scattering = _2022;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -651,6 +651,14 @@ float CosineAtDistance(thread const float& r, thread const float& mu, thread con
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 static inline __attribute__((always_inline))
+float AltitudeAtDistance(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& t, thread const float& r_t)
+{
+    return (r - atmosphere.bottom_radius) + ((t * (t + ((2.0 * r) * mu))) / (r_t + r));
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
 float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, thread const int& i)
 {
     float x = float(i) / 63.0;
@@ -662,16 +670,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2093;
+    float _2116;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2093 = a * exp(f * log(b / a));
+        _2116 = a * exp(f * log(b / a));
     }
     else
     {
-        _2093 = mix(a, b, f);
+        _2116 = mix(a, b, f);
     }
-    return _2093;
+    return _2116;
 }
 #endif
 
@@ -750,16 +758,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2225;
+    float _2368;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2225 = 1.0 - (0.5 * depth);
+        _2368 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2225 = (1.0 - exp(-depth)) / depth;
+        _2368 = (1.0 - exp(-depth)) / depth;
     }
-    return _2225;
+    return _2368;
 }
 #endif
 
@@ -776,8 +784,8 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
     single_rayleigh = float3(0.0);
     single_mie = float3(0.0);
     scattering_weight = float3(0.0);
-    float3 param_7;
-    float3 param_8;
+    float3 param_12;
+    float3 param_13;
     for (int k = 0; k <= 16; k++)
     {
         float t = dt * float(k);
@@ -786,22 +794,27 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float param_2 = mu;
         float param_3 = t;
         float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
-        float altitude = (r - atmosphere.bottom_radius) + ((t * (t + ((2.0 * r) * mu))) / (r_t + r));
-        float param_4 = ((r * mu_s) + (t * nu)) / r_t;
-        float mu_s_t = ClampCosine(param_4);
-        AtmosphereParameters param_5 = atmosphere;
-        float param_6 = altitude;
-        float3 _2313 = GetCoefficientsAtAltitude(param_5, param_6, param_7, param_8);
-        float3 mie_scattering = param_7;
-        float3 rayleigh_scattering = param_8;
-        float3 extinction = _2313;
-        AtmosphereParameters param_9 = atmosphere;
-        float param_10 = r_t;
-        float param_11 = mu_s_t;
-        AtmosphereParameters param_12 = atmosphere;
-        float param_13 = r_t;
-        float param_14 = mu_s_t;
-        float3 sunlight = exp(-GetOpticalDepthToTopAtmosphereBoundary(param_9, transmittance_texture, transmittance_textureSmplr, param_10, param_11)) * SunVisibleFraction(param_12, param_13, param_14);
+        AtmosphereParameters param_4 = atmosphere;
+        float param_5 = r;
+        float param_6 = mu;
+        float param_7 = t;
+        float param_8 = r_t;
+        float altitude = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
+        float param_9 = ((r * mu_s) + (t * nu)) / r_t;
+        float mu_s_t = ClampCosine(param_9);
+        AtmosphereParameters param_10 = atmosphere;
+        float param_11 = altitude;
+        float3 _2448 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 mie_scattering = param_12;
+        float3 rayleigh_scattering = param_13;
+        float3 extinction = _2448;
+        AtmosphereParameters param_14 = atmosphere;
+        float param_15 = r_t;
+        float param_16 = mu_s_t;
+        AtmosphereParameters param_17 = atmosphere;
+        float param_18 = r_t;
+        float param_19 = mu_s_t;
+        float3 sunlight = exp(-GetOpticalDepthToTopAtmosphereBoundary(param_14, transmittance_texture, transmittance_textureSmplr, param_15, param_16)) * SunVisibleFraction(param_17, param_18, param_19);
         float3 rayleigh = rayleigh_scattering * sunlight;
         float3 mie = mie_scattering * sunlight;
         float3 scattering = rayleigh_scattering + mie_scattering;
@@ -809,10 +822,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         {
             float3 interval_depth = (previous_extinction + extinction) * (0.5 * dt);
             float3 start_transmittance = exp(-optical_depth);
-            float param_15 = interval_depth.x;
-            float param_16 = interval_depth.y;
-            float param_17 = interval_depth.z;
-            float3 mean_transmittance = start_transmittance * float3(MeanAttenuation(param_15), MeanAttenuation(param_16), MeanAttenuation(param_17));
+            float param_20 = interval_depth.x;
+            float param_21 = interval_depth.y;
+            float param_22 = interval_depth.z;
+            float3 mean_transmittance = start_transmittance * float3(MeanAttenuation(param_20), MeanAttenuation(param_21), MeanAttenuation(param_22));
             single_rayleigh += (((previous_rayleigh + rayleigh) * (0.5 * dt)) * mean_transmittance);
             single_mie += (((previous_mie + mie) * (0.5 * dt)) * mean_transmittance);
             scattering_weight += (((previous_scattering + scattering) * (0.5 * dt)) * mean_transmittance);
@@ -825,6 +838,44 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
     }
     single_rayleigh *= atmosphere.solar_irradiance;
     single_mie *= atmosphere.solar_irradiance;
+    return optical_depth;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& d)
+{
+    float dt = d / 16.0;
+    float3 optical_depth = float3(0.0);
+    float3 previous_extinction = float3(0.0);
+    float3 param_11;
+    float3 param_12;
+    for (int k = 0; k <= 16; k++)
+    {
+        float t = dt * float(k);
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        float param_3 = t;
+        float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
+        AtmosphereParameters param_4 = atmosphere;
+        float param_5 = r;
+        float param_6 = mu;
+        float param_7 = t;
+        float param_8 = r_t;
+        AtmosphereParameters param_9 = atmosphere;
+        float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
+        float3 _2313 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 mie_scattering = param_11;
+        float3 rayleigh_scattering = param_12;
+        float3 extinction = _2313;
+        if (k > 0)
+        {
+            optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
+        }
+        previous_extinction = extinction;
+    }
     return optical_depth;
 }
 #endif
@@ -891,24 +942,50 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 static inline __attribute__((always_inline))
+float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
+{
+    float3 _2338;
+    if (atmosphere.transmittance_is_colour != 0)
+    {
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        float param_3 = d;
+        _2338 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+    }
+    else
+    {
+        AtmosphereParameters param_4 = atmosphere;
+        float param_5 = r;
+        float param_6 = mu;
+        float param_7 = d;
+        bool param_8 = ray_r_mu_intersects_ground;
+        _2338 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+    }
+    return _2338;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _648;
+    float _671;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _648 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _671 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _648 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _671 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _648;
+    return _671;
 }
 #endif
 
@@ -922,16 +999,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2055;
+    float _2078;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2055 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2078 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2055 = up;
+        _2078 = up;
     }
-    return _2055;
+    return _2078;
 }
 #endif
 
@@ -955,13 +1032,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _2459 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2594 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2459)
+    if (!_2594)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1001,11 +1078,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2554 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _2689 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2554;
+        lit_optical_depth = _2689;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1019,11 +1096,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2588 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _2723 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2588;
+        optical_depth += _2723;
     }
     if (direct < 1.0)
     {
@@ -1032,7 +1109,7 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float param_41 = mu;
         float param_42 = d;
         bool param_43 = ray_r_mu_intersects_ground;
-        optical_depth = mix(GetOpticalDepth(param_39, transmittance_texture, transmittance_textureSmplr, param_40, param_41, param_42, param_43), optical_depth, float3(direct));
+        optical_depth = mix(LongSegmentOpticalDepth(param_39, transmittance_texture, transmittance_textureSmplr, param_40, param_41, param_42, param_43), optical_depth, float3(direct));
     }
     transmittance = exp(-optical_depth);
     AtmosphereParameters param_44 = atmosphere;
@@ -1042,9 +1119,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _2631 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _2766 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _2631;
+    float3 scattering = _2766;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1065,11 +1142,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _2679 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _2814 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _2679;
+        float3 far_optical_depth = _2814;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1089,9 +1166,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _2733 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _2868 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _2733);
+            scattering -= (exp(-far_optical_depth) * _2868);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1104,7 +1181,7 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_88 = mu;
     float param_89 = lit;
     bool param_90 = ray_r_mu_intersects_ground;
-    float3 lit_transmittance = exp(-mix(GetOpticalDepth(param_86, transmittance_texture, transmittance_textureSmplr, param_87, param_88, param_89, param_90), lit_optical_depth, float3(lit_direct)));
+    float3 lit_transmittance = exp(-mix(LongSegmentOpticalDepth(param_86, transmittance_texture, transmittance_textureSmplr, param_87, param_88, param_89, param_90), lit_optical_depth, float3(lit_direct)));
     AtmosphereParameters param_91 = atmosphere;
     float param_92 = r_p;
     float param_93 = mu_p;
@@ -1112,9 +1189,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _2798 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _2933 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _2798;
+    float3 scattering_p = _2933;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1135,9 +1212,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _2842 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _2977 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _2842;
+    return _2977;
 }
 #endif
 
@@ -1145,16 +1222,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1220;
+    float _1243;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1220 = 0.100000001490116119384765625;
+        _1243 = 0.100000001490116119384765625;
     }
     else
     {
-        _1220 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1243 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1220;
+    return _1243;
 }
 #endif
 
@@ -1164,16 +1241,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1238;
+    float _1261;
     if (mu_s < knee)
     {
-        _1238 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1261 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1238 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1261 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1238;
+    return _1261;
 }
 #endif
 
@@ -1202,16 +1279,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1269;
+    float _1292;
     if (x < 0.5)
     {
-        _1269 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1292 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1269 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1292 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1269;
+    return _1292;
 }
 #endif
 

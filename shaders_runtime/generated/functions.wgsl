@@ -12,6 +12,7 @@ struct AtmosphereParameters {
     mie_g: f32,
     mie_to_rayleigh_scattering_ratio: vec3<f32>,
     single_mie_in_scattering_alpha: i32,
+    transmittance_is_colour: i32,
     transmittance_width: i32,
     transmittance_height: i32,
     scattering_r_size: i32,
@@ -1763,46 +1764,171 @@ fn GetCoefficientsAtAltitude(atmosphere_66: AtmosphereParameters, altitude: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn AltitudeAtDistance(atmosphere_68: AtmosphereParameters, r_51: f32, mu_34: f32, t_7: f32, r_t: f32) -> f32 {
+    var atmosphere_69: AtmosphereParameters;
+    var r_52: f32;
+    var mu_35: f32;
+    var t_8: f32;
+    var r_t_1: f32;
+
+    atmosphere_69 = atmosphere_68;
+    r_52 = r_51;
+    mu_35 = mu_34;
+    t_8 = t_7;
+    r_t_1 = r_t;
+    let _e19 = r_52;
+    let _e20 = atmosphere_69;
+    let _e23 = t_8;
+    let _e24 = t_8;
+    let _e26 = r_52;
+    let _e28 = mu_35;
+    let _e32 = r_t_1;
+    let _e33 = r_52;
+    return ((_e19 - _e20.bottom_radius) + ((_e23 * (_e24 + ((2f * _e26) * _e28))) / (_e32 + _e33)));
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn IntegrateSegmentOpticalDepth(atmosphere_70: AtmosphereParameters, r_53: f32, mu_36: f32, d_15: f32) -> vec3<f32> {
+    var atmosphere_71: AtmosphereParameters;
+    var r_54: f32;
+    var mu_37: f32;
+    var d_16: f32;
+    var dt: f32;
+    var optical_depth: vec3<f32> = vec3(0f);
+    var previous_extinction: vec3<f32> = vec3(0f);
+    var k_2: i32 = 0i;
+    var t_9: f32;
+    var r_t_2: f32;
+    var mie_scattering_1: vec3<f32>;
+    var rayleigh_scattering_1: vec3<f32>;
+    var extinction: vec3<f32>;
+
+    atmosphere_71 = atmosphere_70;
+    r_54 = r_53;
+    mu_37 = mu_36;
+    d_16 = d_15;
+    let _e17 = d_16;
+    dt = (_e17 / 16f);
+    loop {
+        let _e30 = k_2;
+        if !((_e30 <= SEGMENT_INTERVALS)) {
+            break;
+        }
+        {
+            let _e36 = dt;
+            let _e37 = k_2;
+            t_9 = (_e36 * f32(_e37));
+            let _e41 = atmosphere_71;
+            let _e42 = r_54;
+            let _e43 = mu_37;
+            let _e44 = t_9;
+            let _e45 = RadiusAtDistance(_e41, _e42, _e43, _e44);
+            r_t_2 = _e45;
+            let _e49 = atmosphere_71;
+            let _e50 = atmosphere_71;
+            let _e51 = r_54;
+            let _e52 = mu_37;
+            let _e53 = t_9;
+            let _e54 = r_t_2;
+            let _e55 = AltitudeAtDistance(_e50, _e51, _e52, _e53, _e54);
+            let _e60 = GetCoefficientsAtAltitude(_e49, _e55, (&mie_scattering_1), (&rayleigh_scattering_1));
+            extinction = _e60;
+            let _e62 = k_2;
+            if (_e62 > 0i) {
+                let _e65 = optical_depth;
+                let _e66 = previous_extinction;
+                let _e67 = extinction;
+                let _e70 = dt;
+                optical_depth = (_e65 + ((_e66 + _e67) * (0.5f * _e70)));
+            }
+            let _e74 = extinction;
+            previous_extinction = _e74;
+        }
+        continuing {
+            let _e33 = k_2;
+            k_2 = (_e33 + 1i);
+        }
+    }
+    let _e75 = optical_depth;
+    return _e75;
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn LongSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_17: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
+    var r_56: f32;
+    var mu_39: f32;
+    var d_18: f32;
+    var ray_r_mu_intersects_ground_16: bool;
+    var local_14: vec3<f32>;
+
+    atmosphere_73 = atmosphere_72;
+    r_56 = r_55;
+    mu_39 = mu_38;
+    d_18 = d_17;
+    ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
+    let _e20 = atmosphere_73;
+    if (_e20.transmittance_is_colour != 0i) {
+        let _e24 = atmosphere_73;
+        let _e25 = r_56;
+        let _e26 = mu_39;
+        let _e27 = d_18;
+        let _e28 = IntegrateSegmentOpticalDepth(_e24, _e25, _e26, _e27);
+        local_14 = _e28;
+    } else {
+        let _e29 = atmosphere_73;
+        let _e30 = r_56;
+        let _e31 = mu_39;
+        let _e32 = d_18;
+        let _e33 = ray_r_mu_intersects_ground_16;
+        let _e34 = GetOpticalDepth(_e29, transmittance_texture_6, _e30, _e31, _e32, _e33);
+        local_14 = _e34;
+    }
+    let _e36 = local_14;
+    return _e36;
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_14: f32;
+    var local_15: f32;
 
     depth_1 = depth;
     let _e11 = depth_1;
     if (_e11 < 0.0001f) {
         let _e16 = depth_1;
-        local_14 = (1f - (0.5f * _e16));
+        local_15 = (1f - (0.5f * _e16));
     } else {
         let _e20 = depth_1;
         let _e24 = depth_1;
-        local_14 = ((1f - exp(-(_e20))) / _e24);
+        local_15 = ((1f - exp(-(_e20))) / _e24);
     }
-    let _e27 = local_14;
+    let _e27 = local_15;
     return _e27;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_68: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_51: f32, mu_34: f32, mu_s_24: f32, nu_18: f32, d_15: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_69: AtmosphereParameters;
-    var r_52: f32;
-    var mu_35: f32;
+fn IntegrateSegment(atmosphere_74: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_19: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_75: AtmosphereParameters;
+    var r_58: f32;
+    var mu_41: f32;
     var mu_s_25: f32;
     var nu_19: f32;
-    var d_16: f32;
-    var dt: f32;
-    var optical_depth: vec3<f32> = vec3(0f);
-    var previous_extinction: vec3<f32> = vec3(0f);
+    var d_20: f32;
+    var dt_1: f32;
+    var optical_depth_1: vec3<f32> = vec3(0f);
+    var previous_extinction_1: vec3<f32> = vec3(0f);
     var previous_rayleigh: vec3<f32> = vec3(0f);
     var previous_mie: vec3<f32> = vec3(0f);
     var previous_scattering: vec3<f32> = vec3(0f);
-    var k_2: i32 = 0i;
-    var t_7: f32;
-    var r_t: f32;
+    var k_3: i32 = 0i;
+    var t_10: f32;
+    var r_t_3: f32;
     var altitude_2: f32;
     var mu_s_t_2: f32;
-    var mie_scattering_1: vec3<f32>;
-    var rayleigh_scattering_1: vec3<f32>;
-    var extinction: vec3<f32>;
+    var mie_scattering_2: vec3<f32>;
+    var rayleigh_scattering_2: vec3<f32>;
+    var extinction_1: vec3<f32>;
     var sunlight: vec3<f32>;
     var rayleigh: vec3<f32>;
     var mie: vec3<f32>;
@@ -1811,137 +1937,135 @@ fn IntegrateSegment(atmosphere_68: AtmosphereParameters, transmittance_texture_6
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_69 = atmosphere_68;
-    r_52 = r_51;
-    mu_35 = mu_34;
+    atmosphere_75 = atmosphere_74;
+    r_58 = r_57;
+    mu_41 = mu_40;
     mu_s_25 = mu_s_24;
     nu_19 = nu_18;
-    d_16 = d_15;
-    let _e25 = d_16;
-    dt = (_e25 / 16f);
+    d_20 = d_19;
+    let _e25 = d_20;
+    dt_1 = (_e25 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
     (*scattering_weight) = vec3(0f);
     loop {
-        let _e53 = k_2;
+        let _e53 = k_3;
         if !((_e53 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e59 = dt;
-            let _e60 = k_2;
-            t_7 = (_e59 * f32(_e60));
-            let _e64 = atmosphere_69;
-            let _e65 = r_52;
-            let _e66 = mu_35;
-            let _e67 = t_7;
+            let _e59 = dt_1;
+            let _e60 = k_3;
+            t_10 = (_e59 * f32(_e60));
+            let _e64 = atmosphere_75;
+            let _e65 = r_58;
+            let _e66 = mu_41;
+            let _e67 = t_10;
             let _e68 = RadiusAtDistance(_e64, _e65, _e66, _e67);
-            r_t = _e68;
-            let _e70 = r_52;
-            let _e71 = atmosphere_69;
-            let _e74 = t_7;
-            let _e75 = t_7;
-            let _e77 = r_52;
-            let _e79 = mu_35;
-            let _e83 = r_t;
-            let _e84 = r_52;
-            altitude_2 = ((_e70 - _e71.bottom_radius) + ((_e74 * (_e75 + ((2f * _e77) * _e79))) / (_e83 + _e84)));
-            let _e89 = r_52;
-            let _e90 = mu_s_25;
-            let _e92 = t_7;
-            let _e93 = nu_19;
-            let _e96 = r_t;
-            let _e98 = ClampCosine((((_e89 * _e90) + (_e92 * _e93)) / _e96));
-            mu_s_t_2 = _e98;
-            let _e102 = atmosphere_69;
-            let _e103 = altitude_2;
-            let _e108 = GetCoefficientsAtAltitude(_e102, _e103, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e108;
-            let _e110 = atmosphere_69;
-            let _e111 = r_t;
-            let _e112 = mu_s_t_2;
-            let _e113 = GetOpticalDepthToTopAtmosphereBoundary(_e110, transmittance_texture_6, _e111, _e112);
-            let _e116 = atmosphere_69;
-            let _e117 = r_t;
-            let _e118 = mu_s_t_2;
-            let _e119 = SunVisibleFraction(_e116, _e117, _e118);
-            sunlight = (exp(-(_e113)) * _e119);
-            let _e122 = rayleigh_scattering_1;
-            let _e123 = sunlight;
-            rayleigh = (_e122 * _e123);
-            let _e126 = mie_scattering_1;
-            let _e127 = sunlight;
-            mie = (_e126 * _e127);
-            let _e130 = rayleigh_scattering_1;
-            let _e131 = mie_scattering_1;
-            scattering_2 = (_e130 + _e131);
-            let _e134 = k_2;
-            if (_e134 > 0i) {
+            r_t_3 = _e68;
+            let _e70 = atmosphere_75;
+            let _e71 = r_58;
+            let _e72 = mu_41;
+            let _e73 = t_10;
+            let _e74 = r_t_3;
+            let _e75 = AltitudeAtDistance(_e70, _e71, _e72, _e73, _e74);
+            altitude_2 = _e75;
+            let _e77 = r_58;
+            let _e78 = mu_s_25;
+            let _e80 = t_10;
+            let _e81 = nu_19;
+            let _e84 = r_t_3;
+            let _e86 = ClampCosine((((_e77 * _e78) + (_e80 * _e81)) / _e84));
+            mu_s_t_2 = _e86;
+            let _e90 = atmosphere_75;
+            let _e91 = altitude_2;
+            let _e96 = GetCoefficientsAtAltitude(_e90, _e91, (&mie_scattering_2), (&rayleigh_scattering_2));
+            extinction_1 = _e96;
+            let _e98 = atmosphere_75;
+            let _e99 = r_t_3;
+            let _e100 = mu_s_t_2;
+            let _e101 = GetOpticalDepthToTopAtmosphereBoundary(_e98, transmittance_texture_7, _e99, _e100);
+            let _e104 = atmosphere_75;
+            let _e105 = r_t_3;
+            let _e106 = mu_s_t_2;
+            let _e107 = SunVisibleFraction(_e104, _e105, _e106);
+            sunlight = (exp(-(_e101)) * _e107);
+            let _e110 = rayleigh_scattering_2;
+            let _e111 = sunlight;
+            rayleigh = (_e110 * _e111);
+            let _e114 = mie_scattering_2;
+            let _e115 = sunlight;
+            mie = (_e114 * _e115);
+            let _e118 = rayleigh_scattering_2;
+            let _e119 = mie_scattering_2;
+            scattering_2 = (_e118 + _e119);
+            let _e122 = k_3;
+            if (_e122 > 0i) {
                 {
-                    let _e137 = previous_extinction;
-                    let _e138 = extinction;
-                    let _e141 = dt;
-                    interval_depth = ((_e137 + _e138) * (0.5f * _e141));
-                    let _e145 = optical_depth;
-                    start_transmittance = exp(-(_e145));
-                    let _e149 = start_transmittance;
-                    let _e150 = interval_depth;
-                    let _e152 = MeanAttenuation(_e150.x);
-                    let _e153 = interval_depth;
-                    let _e155 = MeanAttenuation(_e153.y);
-                    let _e156 = interval_depth;
-                    let _e158 = MeanAttenuation(_e156.z);
-                    mean_transmittance = (_e149 * vec3<f32>(_e152, _e155, _e158));
-                    let _e162 = (*single_rayleigh);
-                    let _e163 = previous_rayleigh;
-                    let _e164 = rayleigh;
-                    let _e167 = dt;
-                    let _e170 = mean_transmittance;
-                    (*single_rayleigh) = (_e162 + (((_e163 + _e164) * (0.5f * _e167)) * _e170));
-                    let _e173 = (*single_mie);
-                    let _e174 = previous_mie;
-                    let _e175 = mie;
-                    let _e178 = dt;
-                    let _e181 = mean_transmittance;
-                    (*single_mie) = (_e173 + (((_e174 + _e175) * (0.5f * _e178)) * _e181));
-                    let _e184 = (*scattering_weight);
-                    let _e185 = previous_scattering;
-                    let _e186 = scattering_2;
-                    let _e189 = dt;
-                    let _e192 = mean_transmittance;
-                    (*scattering_weight) = (_e184 + (((_e185 + _e186) * (0.5f * _e189)) * _e192));
-                    let _e195 = optical_depth;
-                    let _e196 = interval_depth;
-                    optical_depth = (_e195 + _e196);
+                    let _e125 = previous_extinction_1;
+                    let _e126 = extinction_1;
+                    let _e129 = dt_1;
+                    interval_depth = ((_e125 + _e126) * (0.5f * _e129));
+                    let _e133 = optical_depth_1;
+                    start_transmittance = exp(-(_e133));
+                    let _e137 = start_transmittance;
+                    let _e138 = interval_depth;
+                    let _e140 = MeanAttenuation(_e138.x);
+                    let _e141 = interval_depth;
+                    let _e143 = MeanAttenuation(_e141.y);
+                    let _e144 = interval_depth;
+                    let _e146 = MeanAttenuation(_e144.z);
+                    mean_transmittance = (_e137 * vec3<f32>(_e140, _e143, _e146));
+                    let _e150 = (*single_rayleigh);
+                    let _e151 = previous_rayleigh;
+                    let _e152 = rayleigh;
+                    let _e155 = dt_1;
+                    let _e158 = mean_transmittance;
+                    (*single_rayleigh) = (_e150 + (((_e151 + _e152) * (0.5f * _e155)) * _e158));
+                    let _e161 = (*single_mie);
+                    let _e162 = previous_mie;
+                    let _e163 = mie;
+                    let _e166 = dt_1;
+                    let _e169 = mean_transmittance;
+                    (*single_mie) = (_e161 + (((_e162 + _e163) * (0.5f * _e166)) * _e169));
+                    let _e172 = (*scattering_weight);
+                    let _e173 = previous_scattering;
+                    let _e174 = scattering_2;
+                    let _e177 = dt_1;
+                    let _e180 = mean_transmittance;
+                    (*scattering_weight) = (_e172 + (((_e173 + _e174) * (0.5f * _e177)) * _e180));
+                    let _e183 = optical_depth_1;
+                    let _e184 = interval_depth;
+                    optical_depth_1 = (_e183 + _e184);
                 }
             }
-            let _e198 = extinction;
-            previous_extinction = _e198;
-            let _e199 = rayleigh;
-            previous_rayleigh = _e199;
-            let _e200 = mie;
-            previous_mie = _e200;
-            let _e201 = scattering_2;
-            previous_scattering = _e201;
+            let _e186 = extinction_1;
+            previous_extinction_1 = _e186;
+            let _e187 = rayleigh;
+            previous_rayleigh = _e187;
+            let _e188 = mie;
+            previous_mie = _e188;
+            let _e189 = scattering_2;
+            previous_scattering = _e189;
         }
         continuing {
-            let _e56 = k_2;
-            k_2 = (_e56 + 1i);
+            let _e56 = k_3;
+            k_3 = (_e56 + 1i);
         }
     }
-    let _e202 = (*single_rayleigh);
-    let _e203 = atmosphere_69;
-    (*single_rayleigh) = (_e202 * _e203.solar_irradiance);
-    let _e206 = (*single_mie);
-    let _e207 = atmosphere_69;
-    (*single_mie) = (_e206 * _e207.solar_irradiance);
-    let _e210 = optical_depth;
-    return _e210;
+    let _e190 = (*single_rayleigh);
+    let _e191 = atmosphere_75;
+    (*single_rayleigh) = (_e190 * _e191.solar_irradiance);
+    let _e194 = (*single_mie);
+    let _e195 = atmosphere_75;
+    (*single_mie) = (_e194 * _e195.solar_irradiance);
+    let _e198 = optical_depth_1;
+    return _e198;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -1949,13 +2073,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_2: vec3<f32>;
-    var r_53: f32;
-    var mu_36: f32;
+    var r_59: f32;
+    var mu_42: f32;
     var mu_s_26: f32;
     var nu_20: f32;
-    var d_17: f32;
+    var d_21: f32;
     var lit: f32;
-    var ray_r_mu_intersects_ground_15: bool;
+    var ray_r_mu_intersects_ground_17: bool;
     var r_p: f32;
     var mu_p: f32;
     var mu_s_p: f32;
@@ -1965,7 +2089,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
     var single_mie_1: vec3<f32> = vec3(0f);
     var lit_weight: vec3<f32> = vec3(0f);
     var lit_optical_depth: vec3<f32> = vec3(0f);
-    var optical_depth_1: vec3<f32>;
+    var optical_depth_2: vec3<f32>;
     var unused_rayleigh: vec3<f32>;
     var unused_mie: vec3<f32>;
     var unused_weight: vec3<f32>;
@@ -1984,7 +2108,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_71 = atmosphere_70;
+    atmosphere_77 = atmosphere_76;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -2002,11 +2126,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
     }
     let _e36 = camera_to_point;
     view_ray_6 = normalize(_e36);
-    let _e44 = atmosphere_71;
+    let _e44 = atmosphere_77;
     let _e45 = camera_7;
     let _e46 = view_ray_6;
     let _e47 = sun_direction_5;
-    let _e58 = GetViewRayStart(_e44, _e45, _e46, _e47, (&start_2), (&r_53), (&mu_36), (&mu_s_26), (&nu_20));
+    let _e58 = GetViewRayStart(_e44, _e45, _e46, _e47, (&start_2), (&r_59), (&mu_42), (&mu_s_26), (&nu_20));
     if !(_e58) {
         {
             (*transmittance_1) = vec3(1f);
@@ -2015,145 +2139,145 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
     }
     let _e64 = point_1;
     let _e65 = start_2;
-    d_17 = max(length((_e64 - _e65)), 0f);
-    let _e71 = d_17;
+    d_21 = max(length((_e64 - _e65)), 0f);
+    let _e71 = d_21;
     let _e72 = shadow_length_1;
     lit = max((_e71 - max(_e72, 0f)), 0f);
-    let _e79 = atmosphere_71;
-    let _e80 = r_53;
-    let _e81 = mu_36;
+    let _e79 = atmosphere_77;
+    let _e80 = r_59;
+    let _e81 = mu_42;
     let _e82 = RayIntersectsGround(_e79, _e80, _e81);
-    ray_r_mu_intersects_ground_15 = _e82;
-    let _e84 = atmosphere_71;
-    let _e85 = r_53;
-    let _e86 = mu_36;
+    ray_r_mu_intersects_ground_17 = _e82;
+    let _e84 = atmosphere_77;
+    let _e85 = r_59;
+    let _e86 = mu_42;
     let _e87 = lit;
     let _e88 = RadiusAtDistance(_e84, _e85, _e86, _e87);
     r_p = _e88;
-    let _e90 = r_53;
-    let _e91 = mu_36;
+    let _e90 = r_59;
+    let _e91 = mu_42;
     let _e92 = lit;
     let _e93 = r_p;
     let _e94 = CosineAtDistance(_e90, _e91, _e92, _e93);
     mu_p = _e94;
-    let _e96 = r_53;
+    let _e96 = r_59;
     let _e97 = mu_s_26;
     let _e99 = lit;
     let _e100 = nu_20;
     let _e103 = r_p;
     let _e105 = ClampCosine((((_e96 * _e97) + (_e99 * _e100)) / _e103));
     mu_s_p = _e105;
-    let _e111 = d_17;
+    let _e111 = d_21;
     direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e111));
     let _e119 = lit;
     lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e119));
     let _e135 = lit_direct;
     if (_e135 > 0f) {
         {
-            let _e138 = atmosphere_71;
-            let _e139 = r_53;
-            let _e140 = mu_36;
+            let _e138 = atmosphere_77;
+            let _e139 = r_59;
+            let _e140 = mu_42;
             let _e141 = mu_s_26;
             let _e142 = nu_20;
             let _e143 = lit;
-            let _e150 = IntegrateSegment(_e138, transmittance_texture_7, _e139, _e140, _e141, _e142, _e143, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
+            let _e150 = IntegrateSegment(_e138, transmittance_texture_8, _e139, _e140, _e141, _e142, _e143, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
             lit_optical_depth = _e150;
         }
     }
     let _e151 = lit_optical_depth;
-    optical_depth_1 = _e151;
+    optical_depth_2 = _e151;
     let _e153 = direct;
     let _e156 = lit;
-    let _e157 = d_17;
+    let _e157 = d_21;
     if ((_e153 > 0f) && (_e156 < _e157)) {
         {
-            let _e163 = optical_depth_1;
-            let _e164 = atmosphere_71;
+            let _e163 = optical_depth_2;
+            let _e164 = atmosphere_77;
             let _e165 = r_p;
             let _e166 = mu_p;
             let _e167 = mu_s_p;
             let _e168 = nu_20;
-            let _e169 = d_17;
+            let _e169 = d_21;
             let _e170 = lit;
-            let _e178 = IntegrateSegment(_e164, transmittance_texture_7, _e165, _e166, _e167, _e168, (_e169 - _e170), (&unused_rayleigh), (&unused_mie), (&unused_weight));
-            optical_depth_1 = (_e163 + _e178);
+            let _e178 = IntegrateSegment(_e164, transmittance_texture_8, _e165, _e166, _e167, _e168, (_e169 - _e170), (&unused_rayleigh), (&unused_mie), (&unused_weight));
+            optical_depth_2 = (_e163 + _e178);
         }
     }
     let _e180 = direct;
     if (_e180 < 1f) {
         {
-            let _e183 = atmosphere_71;
-            let _e184 = r_53;
-            let _e185 = mu_36;
-            let _e186 = d_17;
-            let _e187 = ray_r_mu_intersects_ground_15;
-            let _e188 = GetOpticalDepth(_e183, transmittance_texture_7, _e184, _e185, _e186, _e187);
-            let _e189 = optical_depth_1;
+            let _e183 = atmosphere_77;
+            let _e184 = r_59;
+            let _e185 = mu_42;
+            let _e186 = d_21;
+            let _e187 = ray_r_mu_intersects_ground_17;
+            let _e188 = LongSegmentOpticalDepth(_e183, transmittance_texture_8, _e184, _e185, _e186, _e187);
+            let _e189 = optical_depth_2;
             let _e190 = direct;
-            optical_depth_1 = mix(_e188, _e189, vec3(_e190));
+            optical_depth_2 = mix(_e188, _e189, vec3(_e190));
         }
     }
-    let _e193 = optical_depth_1;
+    let _e193 = optical_depth_2;
     (*transmittance_1) = exp(-(_e193));
-    let _e197 = atmosphere_71;
-    let _e198 = r_53;
-    let _e199 = mu_36;
+    let _e197 = atmosphere_77;
+    let _e198 = r_59;
+    let _e199 = mu_42;
     let _e200 = mu_s_26;
     let _e201 = nu_20;
-    let _e202 = ray_r_mu_intersects_ground_15;
+    let _e202 = ray_r_mu_intersects_ground_17;
     let _e205 = GetCombinedScattering(_e197, scattering_texture_3, single_mie_scattering_texture_2, _e198, _e199, _e200, _e201, _e202, (&single_mie_scattering_2));
     scattering_3 = _e205;
     let _e207 = lit;
     if (_e207 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e209 = atmosphere_71;
-            let _e210 = r_53;
-            let _e211 = mu_36;
-            let _e212 = ray_r_mu_intersects_ground_15;
+            let _e209 = atmosphere_77;
+            let _e210 = r_59;
+            let _e211 = mu_42;
+            let _e212 = ray_r_mu_intersects_ground_17;
             let _e213 = DistanceToNearestAtmosphereBoundary(_e209, _e210, _e211, _e212);
             boundary = _e213;
             let _e215 = boundary;
-            let _e217 = atmosphere_71;
-            let _e218 = r_53;
-            let _e219 = mu_36;
+            let _e217 = atmosphere_77;
+            let _e218 = r_59;
+            let _e219 = mu_42;
             let _e220 = DistanceInsideScatteringRadii(_e217, _e218, _e219);
             let _e222 = lit;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e215), _e220), _e222);
-            let _e228 = atmosphere_71;
-            let _e229 = r_53;
-            let _e230 = mu_36;
+            let _e228 = atmosphere_77;
+            let _e229 = r_59;
+            let _e230 = mu_42;
             let _e231 = mu_s_26;
             let _e232 = nu_20;
             let _e233 = far;
-            let _e240 = IntegrateSegment(_e228, transmittance_texture_7, _e229, _e230, _e231, _e232, _e233, (&far_rayleigh), (&far_mie), (&far_weight));
+            let _e240 = IntegrateSegment(_e228, transmittance_texture_8, _e229, _e230, _e231, _e232, _e233, (&far_rayleigh), (&far_mie), (&far_weight));
             far_optical_depth = _e240;
             let _e242 = far;
             let _e243 = boundary;
             if (_e242 < _e243) {
                 {
-                    let _e245 = atmosphere_71;
-                    let _e246 = r_53;
-                    let _e247 = mu_36;
+                    let _e245 = atmosphere_77;
+                    let _e246 = r_59;
+                    let _e247 = mu_42;
                     let _e248 = far;
                     let _e249 = RadiusAtDistance(_e245, _e246, _e247, _e248);
                     r_far = _e249;
                     let _e252 = scattering_3;
                     let _e253 = far_optical_depth;
-                    let _e256 = atmosphere_71;
+                    let _e256 = atmosphere_77;
                     let _e257 = r_far;
-                    let _e258 = r_53;
-                    let _e259 = mu_36;
+                    let _e258 = r_59;
+                    let _e259 = mu_42;
                     let _e260 = far;
                     let _e261 = r_far;
                     let _e262 = CosineAtDistance(_e258, _e259, _e260, _e261);
-                    let _e263 = r_53;
+                    let _e263 = r_59;
                     let _e264 = mu_s_26;
                     let _e266 = far;
                     let _e267 = nu_20;
                     let _e270 = r_far;
                     let _e272 = ClampCosine((((_e263 * _e264) + (_e266 * _e267)) / _e270));
                     let _e273 = nu_20;
-                    let _e274 = ray_r_mu_intersects_ground_15;
+                    let _e274 = ray_r_mu_intersects_ground_17;
                     let _e277 = GetCombinedScattering(_e256, scattering_texture_3, single_mie_scattering_texture_2, _e257, _e262, _e272, _e273, _e274, (&unused_far_mie));
                     scattering_3 = (_e252 - (exp(-(_e253)) * _e277));
                 }
@@ -2168,27 +2292,27 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
             let _e297 = nu_20;
             let _e298 = RayleighPhaseFunction(_e297);
             let _e300 = single_mie_1;
-            let _e301 = atmosphere_71;
+            let _e301 = atmosphere_77;
             let _e302 = nu_20;
             let _e303 = MiePhaseFunction(_e301, _e302);
             return (((_e294 + _e295) * _e298) + (_e300 * _e303));
         }
     }
-    let _e306 = atmosphere_71;
-    let _e307 = r_53;
-    let _e308 = mu_36;
+    let _e306 = atmosphere_77;
+    let _e307 = r_59;
+    let _e308 = mu_42;
     let _e309 = lit;
-    let _e310 = ray_r_mu_intersects_ground_15;
-    let _e311 = GetOpticalDepth(_e306, transmittance_texture_7, _e307, _e308, _e309, _e310);
+    let _e310 = ray_r_mu_intersects_ground_17;
+    let _e311 = LongSegmentOpticalDepth(_e306, transmittance_texture_8, _e307, _e308, _e309, _e310);
     let _e312 = lit_optical_depth;
     let _e313 = lit_direct;
     lit_transmittance = exp(-(mix(_e311, _e312, vec3(_e313))));
-    let _e320 = atmosphere_71;
+    let _e320 = atmosphere_77;
     let _e321 = r_p;
     let _e322 = mu_p;
     let _e323 = mu_s_p;
     let _e324 = nu_20;
-    let _e325 = ray_r_mu_intersects_ground_15;
+    let _e325 = ray_r_mu_intersects_ground_17;
     let _e328 = GetCombinedScattering(_e320, scattering_texture_3, single_mie_scattering_texture_2, _e321, _e322, _e323, _e324, _e325, (&single_mie_scattering_p));
     scattering_p = _e328;
     let _e330 = scattering_3;
@@ -2207,77 +2331,77 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_70: AtmosphereParameters, transmit
     let _e352 = nu_20;
     let _e353 = RayleighPhaseFunction(_e352);
     let _e355 = single_mie_scattering_2;
-    let _e356 = atmosphere_71;
+    let _e356 = atmosphere_77;
     let _e357 = nu_20;
     let _e358 = MiePhaseFunction(_e356, _e357);
     return ((_e351 * _e353) + (_e355 * _e358));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_72: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_78: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_79: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_73 = atmosphere_72;
+    atmosphere_79 = atmosphere_78;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e21 = atmosphere_73;
+    let _e21 = atmosphere_79;
     let _e22 = camera_9;
     let _e23 = point_3;
     let _e25 = sun_direction_7;
-    let _e28 = GetSkyRadianceToPointWithShadow(_e21, transmittance_texture_8, scattering_texture_4, single_mie_scattering_texture_3, _e22, _e23, 0f, _e25, transmittance_2);
+    let _e28 = GetSkyRadianceToPointWithShadow(_e21, transmittance_texture_9, scattering_texture_4, single_mie_scattering_texture_3, _e22, _e23, 0f, _e25, transmittance_2);
     return _e28;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_74: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_75: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_80: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_54: f32;
+    var r_60: f32;
     var mu_s_27: f32;
 
-    atmosphere_75 = atmosphere_74;
+    atmosphere_81 = atmosphere_80;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e20 = atmosphere_75;
+    let _e20 = atmosphere_81;
     let _e21 = point_5;
     let _e23 = ClampRadius(_e20, length(_e21));
-    r_54 = _e23;
+    r_60 = _e23;
     let _e25 = point_5;
     let _e26 = sun_direction_9;
     let _e28 = point_5;
     let _e31 = ClampCosine((dot(_e25, _e26) / length(_e28)));
     mu_s_27 = _e31;
-    let _e33 = atmosphere_75;
-    let _e34 = r_54;
+    let _e33 = atmosphere_81;
+    let _e34 = r_60;
     let _e35 = mu_s_27;
     let _e36 = GetIrradiance(_e33, irradiance_texture_1, _e34, _e35);
     let _e38 = normal_1;
     let _e39 = point_5;
     let _e41 = point_5;
     (*sky_irradiance) = ((_e36 * (1f + (dot(_e38, _e39) / length(_e41)))) * 0.5f);
-    let _e48 = atmosphere_75;
-    let _e50 = atmosphere_75;
-    let _e51 = r_54;
+    let _e48 = atmosphere_81;
+    let _e50 = atmosphere_81;
+    let _e51 = r_60;
     let _e52 = mu_s_27;
-    let _e53 = GetTransmittanceToSun(_e50, transmittance_texture_9, _e51, _e52);
+    let _e53 = GetTransmittanceToSun(_e50, transmittance_texture_10, _e51, _e52);
     let _e55 = normal_1;
     let _e56 = sun_direction_9;
     return ((_e48.solar_irradiance * _e53) * max(dot(_e55, _e56), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_76: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_82: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_83: AtmosphereParameters;
 
-    atmosphere_77 = atmosphere_76;
-    let _e11 = atmosphere_77;
-    let _e13 = atmosphere_77;
-    let _e16 = atmosphere_77;
+    atmosphere_83 = atmosphere_82;
+    let _e11 = atmosphere_83;
+    let _e13 = atmosphere_83;
+    let _e16 = atmosphere_83;
     return (_e11.solar_irradiance / vec3(((PI * _e13.sun_angular_radius) * _e16.sun_angular_radius)));
 }
