@@ -95,13 +95,13 @@ glm::dmat3 RgbToXyzMatrix(const glm::dvec2& red, const glm::dvec2& green, const 
   return glm::dmat3(primaries[0] * scale.x, primaries[1] * scale.y, primaries[2] * scale.z);
 }
 
-const glm::dmat3& LinearSrgbToXyz() {
+const glm::dmat3& LinearSrgbToXyzMatrix() {
   static const glm::dmat3 m = RgbToXyzMatrix({0.64, 0.33}, {0.30, 0.60}, {0.15, 0.06}, {0.3127, 0.3290});
   return m;
 }
 
-const glm::dmat3& XyzToLinearSrgb() {
-  static const glm::dmat3 m = glm::inverse(LinearSrgbToXyz());
+const glm::dmat3& XyzToLinearSrgbMatrix() {
+  static const glm::dmat3 m = glm::inverse(LinearSrgbToXyzMatrix());
   return m;
 }
 

@@ -46,7 +46,7 @@ glm::dmat3 RgbToXyzMatrix(const glm::dvec2& red, const glm::dvec2& green, const 
                           const glm::dvec2& white);
 // Linear sRGB (IEC 61966-2-1: primaries (0.64, 0.33), (0.30, 0.60),
 // (0.15, 0.06), white D65 (0.3127, 0.3290)) to XYZ and back.
-const glm::dmat3& LinearSrgbToXyz();
-const glm::dmat3& XyzToLinearSrgb();
+const glm::dmat3& LinearSrgbToXyzMatrix();
+const glm::dmat3& XyzToLinearSrgbMatrix();
 
 }  // namespace skybake

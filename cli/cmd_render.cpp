@@ -156,7 +156,7 @@ void RunRender(const RenderArguments& args) {
       render::Image image = render::RenderView(twin, view, settings, [&](int rows) { bar.Advance(rows); });
       if (colour) {
         for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
-          const glm::dvec3 rgb = XyzToLinearSrgb() * glm::dvec3(image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]);
+          const glm::dvec3 rgb = XyzToLinearSrgbMatrix() * glm::dvec3(image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]);
           for (int c = 0; c < 3; ++c) image.rgb[i + c] = float(rgb[c]);
         }
       }

@@ -113,7 +113,7 @@ ordered_json ColourToJson(const LutSet& luts) {
     for (int i = 0; i < glsl::ALTITUDE_PROFILE_SIZE; ++i) list.push_back({values[i].x, values[i].y, values[i].z});
     return list;
   };
-  const glm::dmat3& m = XyzToLinearSrgb();
+  const glm::dmat3& m = XyzToLinearSrgbMatrix();
   ordered_json to_srgb = ordered_json::array();
   for (int row = 0; row < 3; ++row) to_srgb.push_back({m[0][row], m[1][row], m[2][row]});
   return {{"space", "CIE 1931 XYZ"},

@@ -121,7 +121,7 @@ ColourErrors MeasureColourErrors(const ReferenceSet& reference, const LutSet& sp
   ColourErrors errors;
   errors.wavelengths = static_cast<int>(spectral.colour->wavelengths_nm.size());
   const std::vector<glm::dvec3> colour = AnswerInXyz(reference, spectral, glm::dmat3(1.0));
-  const std::vector<glm::dvec3> as_srgb = AnswerInXyz(reference, three_wavelength, LinearSrgbToXyz());
+  const std::vector<glm::dvec3> as_srgb = AnswerInXyz(reference, three_wavelength, LinearSrgbToXyzMatrix());
 
   // Least squares over the daylight radiances: scale minimises
   // sum (scale * Y - Y_reference)^2.

@@ -320,3 +320,15 @@ vec3 GetSunAndSkyIrradiance(IN(AtmosphereParameters) atmosphere, IN(Transmittanc
 vec3 GetSolarRadiance(IN(AtmosphereParameters) atmosphere) {
   return atmosphere.solar_irradiance / (PI * atmosphere.sun_angular_radius * atmosphere.sun_angular_radius);
 }
+
+// Linear sRGB (IEC 61966-2-1: Rec. 709 primaries, white D65) of CIE 1931 XYZ,
+// for what a spectral set's functions return (SKYBAKE_CHANNELS_ARE_XYZ): the
+// rows of the inverse of the primaries' XYZ matrix, which bake/colour.cpp
+// derives from their chromaticities (Colour.RuntimeConvertsXyzToLinearSrgb
+// holds the two equal). D65 white gives (1, 1, 1); a colour outside the
+// gamut (a saturated twilight) gives a negative channel.
+vec3 XyzToLinearSrgb(IN(vec3) xyz) {
+  return vec3(dot(vec3(3.2409699, -1.5373832, -0.4986108), xyz),
+              dot(vec3(-0.9692436, 1.8759675, 0.0415551), xyz),
+              dot(vec3(0.0556301, -0.2039770, 1.0569715), xyz));
+}

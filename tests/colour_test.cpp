@@ -9,6 +9,7 @@
 
 #include "bake/colour.h"
 #include "report/error_stats.h"
+#include "shaders_runtime/runtime.h"
 
 namespace skybake {
 namespace {
@@ -79,22 +80,38 @@ TEST(Colour, SrgbMatricesAreThoseOfIec61966) {
   // from the exact inverse by up to 4e-4 (3.2406 against 3.24097).
   const double to_xyz[3][3] = {{0.4124, 0.3576, 0.1805}, {0.2126, 0.7152, 0.0722}, {0.0193, 0.1192, 0.9505}};
   const double to_rgb[3][3] = {{3.2406, -1.5372, -0.4986}, {-0.9689, 1.8758, 0.0415}, {0.0557, -0.2040, 1.0570}};
-  const glm::dmat3 identity = XyzToLinearSrgb() * LinearSrgbToXyz();
+  const glm::dmat3 identity = XyzToLinearSrgbMatrix() * LinearSrgbToXyzMatrix();
   for (int row = 0; row < 3; ++row) {
     for (int column = 0; column < 3; ++column) {
       // glm matrices are indexed [column][row].
-      EXPECT_NEAR(LinearSrgbToXyz()[column][row], to_xyz[row][column], 6e-5) << row << "," << column;
-      EXPECT_NEAR(XyzToLinearSrgb()[column][row], to_rgb[row][column], 5e-4) << row << "," << column;
+      EXPECT_NEAR(LinearSrgbToXyzMatrix()[column][row], to_xyz[row][column], 6e-5) << row << "," << column;
+      EXPECT_NEAR(XyzToLinearSrgbMatrix()[column][row], to_rgb[row][column], 5e-4) << row << "," << column;
       EXPECT_NEAR(identity[column][row], row == column ? 1.0 : 0.0, 1e-12);
     }
   }
   // Y's row is Rec. 709's luminance, the report's weights.
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(LinearSrgbToXyz()[c][1], report::kLuminanceWeights[c], 6e-5);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(LinearSrgbToXyzMatrix()[c][1], report::kLuminanceWeights[c], 6e-5);
+}
+
+// The runtime's XyzToLinearSrgb (its matrix written out in
+// aerial_perspective.glsl) is the matrix derived here from the primaries,
+// to the 7 decimals it is written with, and turns the sRGB white (x, y) =
+// (0.3127, 0.3290) at Y = 1 into (1, 1, 1).
+TEST(Colour, RuntimeConvertsXyzToLinearSrgb) {
+  for (int k = 0; k < 3; ++k) {
+    glm::dvec3 unit(0.0);
+    unit[k] = 1.0;
+    const glm::dvec3 runtime = glsl::XyzToLinearSrgb(unit), derived = XyzToLinearSrgbMatrix() * unit;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(runtime[c], derived[c], 1e-6) << k << " " << c;
+  }
+  const glm::dvec3 white(0.3127 / 0.3290, 1.0, (1.0 - 0.3127 - 0.3290) / 0.3290);
+  const glm::dvec3 rgb = glsl::XyzToLinearSrgb(white);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb[c], 1.0, 1e-6) << c;
 }
 
 TEST(Colour, D65IsSrgbWhite) {
   const glm::dvec3 xyz = D65Xyz();
-  const glm::dvec3 rgb = XyzToLinearSrgb() * (xyz / xyz.y);
+  const glm::dvec3 rgb = XyzToLinearSrgbMatrix() * (xyz / xyz.y);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb[c], 1.0, 5e-4) << c;
 }
 

@@ -362,7 +362,7 @@ TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
   glsl::vec3 transmittance;
   const glm::dvec3 xyz = report::QuerySkyRadiance(
       twin, zenith, MakeQueryGeometry(zenith, luts.parameters.bottom_radius), &transmittance);
-  const glm::dvec3 rgb = XyzToLinearSrgb() * xyz;
+  const glm::dvec3 rgb = XyzToLinearSrgbMatrix() * xyz;
   EXPECT_GT(rgb.z, rgb.y);
   EXPECT_GT(rgb.y, rgb.x);
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / "fisheye_sz30.png"));

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _792 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _796 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_792)
+    if (!_796)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _655 = mu < 0.0f;
-    bool _667;
-    if (_655)
+    bool _659 = mu < 0.0f;
+    bool _671;
+    if (_659)
     {
-        _667 = (((r * r) * mu) * mu) >= c;
+        _671 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _667 = _655;
+        _671 = _659;
     }
-    return _667;
+    return _671;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _436;
+    float _440;
     if (r_mu > 0.0f)
     {
-        _436 = c / (r_mu + s);
+        _440 = c / (r_mu + s);
     }
     else
     {
-        _436 = s - r_mu;
+        _440 = s - r_mu;
     }
-    float param_1 = _436;
+    float param_1 = _440;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _885;
+    float _889;
     if (d_max > d_min)
     {
-        _885 = (d - d_min) / (d_max - d_min);
+        _889 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _885 = 0.0f;
+        _889 = 0.0f;
     }
-    float x_mu = _885;
+    float x_mu = _889;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1145;
+        float _1149;
         if (d_max == d_min)
         {
-            _1145 = 0.0f;
+            _1149 = 0.0f;
         }
         else
         {
-            _1145 = (d - d_min) / (d_max - d_min);
+            _1149 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1145;
+        x_mu = _1149;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1189;
+        float _1193;
         if (d_max_1 > d_min_1)
         {
-            _1189 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1193 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1189 = 0.0f;
+            _1193 = 0.0f;
         }
-        x_mu = _1189;
+        x_mu = _1193;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1564;
+    float _1568;
     if (low_sun)
     {
-        _1564 = min(t, 1.0f);
+        _1568 = min(t, 1.0f);
     }
     else
     {
-        _1564 = clamp(t, 0.0f, 1.0f);
+        _1568 = clamp(t, 0.0f, 1.0f);
     }
-    return _1564;
+    return _1568;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -394,16 +394,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1587;
+    float4 _1591;
     if (t < 0.0f)
     {
-        _1587 = min(blend, a);
+        _1591 = min(blend, a);
     }
     else
     {
-        _1587 = blend;
+        _1591 = blend;
     }
-    return _1587;
+    return _1591;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -464,16 +464,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _1907;
+        float3 _1911;
         if (scattering.x > 0.0f)
         {
-            _1907 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _1911 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _1907 = 0.0f.xxx;
+            _1911 = 0.0f.xxx;
         }
-        single_mie_scattering = _1907;
+        single_mie_scattering = _1911;
     }
     else
     {
@@ -545,13 +545,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _1975 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _1979 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_1975)
+    if (!_1979)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -560,19 +560,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _1995;
+    float3 _1999;
     if (ray_r_mu_intersects_ground)
     {
-        _1995 = 0.0f.xxx;
+        _1999 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _1995 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _1999 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _1995;
+    transmittance = _1999;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -580,9 +580,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2022 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2026 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2022;
+    float3 scattering = _2026;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -630,16 +630,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2116;
+    float _2120;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2116 = a * exp(f * log(b / a));
+        _2120 = a * exp(f * log(b / a));
     }
     else
     {
-        _2116 = lerp(a, b, f);
+        _2120 = lerp(a, b, f);
     }
-    return _2116;
+    return _2120;
 }
 #endif
 
@@ -712,16 +712,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2368;
+    float _2372;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2368 = 1.0f - (0.5f * depth);
+        _2372 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2368 = (1.0f - exp(-depth)) / depth;
+        _2372 = (1.0f - exp(-depth)) / depth;
     }
-    return _2368;
+    return _2372;
 }
 #endif
 
@@ -757,10 +757,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2448 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2452 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2448;
+        float3 extinction = _2452;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -818,10 +818,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2313 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2317 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2313;
+        float3 extinction = _2317;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -894,14 +894,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _2338;
+    float3 _2342;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2338 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2342 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -910,31 +910,31 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2338 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _2342 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _2338;
+    return _2342;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _671;
+    float _675;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _671 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _675 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _671 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _675 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _671;
+    return _675;
 }
 #endif
 
@@ -947,16 +947,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2078;
+    float _2082;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2078 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2082 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2078 = up;
+        _2082 = up;
     }
-    return _2078;
+    return _2082;
 }
 #endif
 
@@ -979,13 +979,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _2594 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2598 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2594)
+    if (!_2598)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1025,11 +1025,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2689 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _2693 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2689;
+        lit_optical_depth = _2693;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1043,11 +1043,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2723 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _2727 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2723;
+        optical_depth += _2727;
     }
     if (direct < 1.0f)
     {
@@ -1066,9 +1066,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _2766 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _2770 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _2766;
+    float3 scattering = _2770;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1089,11 +1089,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _2814 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _2818 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _2814;
+        float3 far_optical_depth = _2818;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1113,9 +1113,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _2868 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _2872 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _2868);
+            scattering -= (exp(-far_optical_depth) * _2872);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1136,9 +1136,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _2933 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _2937 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _2933;
+    float3 scattering_p = _2937;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1158,25 +1158,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _2977 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _2981 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _2977;
+    return _2981;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1243;
+    float _1247;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1243 = 0.100000001490116119384765625f;
+        _1247 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1243 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1247 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1243;
+    return _1247;
 }
 #endif
 
@@ -1185,16 +1185,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1261;
+    float _1265;
     if (mu_s < knee)
     {
-        _1261 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1265 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1261 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1265 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1261;
+    return _1265;
 }
 #endif
 
@@ -1221,16 +1221,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1292;
+    float _1296;
     if (x < 0.5f)
     {
-        _1292 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1296 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1292 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1296 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1292;
+    return _1296;
 }
 #endif
 
@@ -1295,4 +1295,9 @@ float3 GetSunAndSkyIrradiance(AtmosphereParameters atmosphere, Texture2D<float4>
 float3 GetSolarRadiance(AtmosphereParameters atmosphere)
 {
     return atmosphere.solar_irradiance / ((3.1415927410125732421875f * atmosphere.sun_angular_radius) * atmosphere.sun_angular_radius).xxx;
+}
+
+float3 XyzToLinearSrgb(float3 xyz)
+{
+    return float3(dot(float3(3.2409698963165283203125f, -1.53738319873809814453125f, -0.498610794544219970703125f), xyz), dot(float3(-0.969243586063385009765625f, 1.875967502593994140625f, 0.041555099189281463623046875f), xyz), dot(float3(0.0556300990283489227294921875f, -0.20397700369358062744140625f, 1.05697154998779296875f), xyz));
 }

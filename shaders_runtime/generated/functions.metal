@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _792 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _796 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_792)
+    if (!_796)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _655 = mu < 0.0;
-    bool _667;
-    if (_655)
+    bool _659 = mu < 0.0;
+    bool _671;
+    if (_659)
     {
-        _667 = (((r * r) * mu) * mu) >= c;
+        _671 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _667 = _655;
+        _671 = _659;
     }
-    return _667;
+    return _671;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _436;
+    float _440;
     if (r_mu > 0.0)
     {
-        _436 = c / (r_mu + s);
+        _440 = c / (r_mu + s);
     }
     else
     {
-        _436 = s - r_mu;
+        _440 = s - r_mu;
     }
-    float param_1 = _436;
+    float param_1 = _440;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _885;
+    float _889;
     if (d_max > d_min)
     {
-        _885 = (d - d_min) / (d_max - d_min);
+        _889 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _885 = 0.0;
+        _889 = 0.0;
     }
-    float x_mu = _885;
+    float x_mu = _889;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -323,16 +323,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1145;
+        float _1149;
         if (d_max == d_min)
         {
-            _1145 = 0.0;
+            _1149 = 0.0;
         }
         else
         {
-            _1145 = (d - d_min) / (d_max - d_min);
+            _1149 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1145;
+        x_mu = _1149;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +343,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1189;
+        float _1193;
         if (d_max_1 > d_min_1)
         {
-            _1189 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1193 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1189 = 0.0;
+            _1193 = 0.0;
         }
-        x_mu = _1189;
+        x_mu = _1193;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,16 +372,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1564;
+    float _1568;
     if (low_sun)
     {
-        _1564 = fast::min(t, 1.0);
+        _1568 = fast::min(t, 1.0);
     }
     else
     {
-        _1564 = fast::clamp(t, 0.0, 1.0);
+        _1568 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1564;
+    return _1568;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -421,16 +421,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1587;
+    float4 _1591;
     if (t < 0.0)
     {
-        _1587 = fast::min(blend, a);
+        _1591 = fast::min(blend, a);
     }
     else
     {
-        _1587 = blend;
+        _1591 = blend;
     }
-    return _1587;
+    return _1591;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -493,16 +493,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _1907;
+        float3 _1911;
         if (scattering.x > 0.0)
         {
-            _1907 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _1911 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _1907 = float3(0.0);
+            _1911 = float3(0.0);
         }
-        single_mie_scattering = _1907;
+        single_mie_scattering = _1911;
     }
     else
     {
@@ -579,13 +579,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _1975 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _1979 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_1975)
+    if (!_1979)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -594,19 +594,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _1995;
+    float3 _1999;
     if (ray_r_mu_intersects_ground)
     {
-        _1995 = float3(0.0);
+        _1999 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _1995 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _1999 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _1995;
+    transmittance = _1999;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -614,9 +614,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2022 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2026 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2022;
+    float3 scattering = _2026;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -670,16 +670,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2116;
+    float _2120;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2116 = a * exp(f * log(b / a));
+        _2120 = a * exp(f * log(b / a));
     }
     else
     {
-        _2116 = mix(a, b, f);
+        _2120 = mix(a, b, f);
     }
-    return _2116;
+    return _2120;
 }
 #endif
 
@@ -758,16 +758,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2368;
+    float _2372;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2368 = 1.0 - (0.5 * depth);
+        _2372 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2368 = (1.0 - exp(-depth)) / depth;
+        _2372 = (1.0 - exp(-depth)) / depth;
     }
-    return _2368;
+    return _2372;
 }
 #endif
 
@@ -804,10 +804,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2448 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2452 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2448;
+        float3 extinction = _2452;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -866,10 +866,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2313 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2317 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2313;
+        float3 extinction = _2317;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -944,14 +944,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _2338;
+    float3 _2342;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2338 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2342 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -960,9 +960,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2338 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _2342 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _2338;
+    return _2342;
 }
 #endif
 
@@ -970,22 +970,22 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _671;
+    float _675;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _671 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _675 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _671 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _675 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _671;
+    return _675;
 }
 #endif
 
@@ -999,16 +999,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2078;
+    float _2082;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2078 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2082 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2078 = up;
+        _2082 = up;
     }
-    return _2078;
+    return _2082;
 }
 #endif
 
@@ -1032,13 +1032,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _2594 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2598 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2594)
+    if (!_2598)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1078,11 +1078,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2689 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _2693 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2689;
+        lit_optical_depth = _2693;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1096,11 +1096,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2723 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _2727 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2723;
+        optical_depth += _2727;
     }
     if (direct < 1.0)
     {
@@ -1119,9 +1119,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _2766 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _2770 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _2766;
+    float3 scattering = _2770;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1142,11 +1142,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _2814 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _2818 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _2814;
+        float3 far_optical_depth = _2818;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1166,9 +1166,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _2868 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _2872 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _2868);
+            scattering -= (exp(-far_optical_depth) * _2872);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1189,9 +1189,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _2933 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _2937 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _2933;
+    float3 scattering_p = _2937;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1212,9 +1212,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _2977 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _2981 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _2977;
+    return _2981;
 }
 #endif
 
@@ -1222,16 +1222,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1243;
+    float _1247;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1243 = 0.100000001490116119384765625;
+        _1247 = 0.100000001490116119384765625;
     }
     else
     {
-        _1243 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1247 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1243;
+    return _1247;
 }
 #endif
 
@@ -1241,16 +1241,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1261;
+    float _1265;
     if (mu_s < knee)
     {
-        _1261 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1265 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1261 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1265 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1261;
+    return _1265;
 }
 #endif
 
@@ -1279,16 +1279,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1292;
+    float _1296;
     if (x < 0.5)
     {
-        _1292 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1296 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1292 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1296 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1292;
+    return _1296;
 }
 #endif
 
@@ -1357,4 +1357,10 @@ static inline __attribute__((always_inline))
 float3 GetSolarRadiance(thread const AtmosphereParameters& atmosphere)
 {
     return atmosphere.solar_irradiance / float3((3.1415927410125732421875 * atmosphere.sun_angular_radius) * atmosphere.sun_angular_radius);
+}
+
+static inline __attribute__((always_inline))
+float3 XyzToLinearSrgb(thread const float3& xyz)
+{
+    return float3(dot(float3(3.2409698963165283203125, -1.53738319873809814453125, -0.498610794544219970703125), xyz), dot(float3(-0.969243586063385009765625, 1.875967502593994140625, 0.041555099189281463623046875), xyz), dot(float3(0.0556300990283489227294921875, -0.20397700369358062744140625, 1.05697154998779296875), xyz));
 }

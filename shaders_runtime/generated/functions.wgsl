@@ -2405,3 +2405,13 @@ fn GetSolarRadiance(atmosphere_82: AtmosphereParameters) -> vec3<f32> {
     let _e16 = atmosphere_83;
     return (_e11.solar_irradiance / vec3(((PI * _e13.sun_angular_radius) * _e16.sun_angular_radius)));
 }
+
+fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
+    var xyz_1: vec3<f32>;
+
+    xyz_1 = xyz;
+    let _e17 = xyz_1;
+    let _e24 = xyz_1;
+    let _e31 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e17), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e24), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e31));
+}

@@ -30,5 +30,6 @@ void main() {
 #endif
   radiance += GetTransmittanceToSun(atmosphere, transmittance_texture, values[0].w, values[1].w);
   radiance += GetSolarRadiance(atmosphere);
+  radiance += XyzToLinearSrgb(values[5].xyz);
   values[4].xyz = radiance + transmittance + sky_irradiance;
 }
