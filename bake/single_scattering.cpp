@@ -245,10 +245,19 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
       for (auto& channel : kind) channel.assign(pair_count, 0.0f);
     }
     std::vector<double> t_start(pair_count), length(pair_count);
+    // The pairs come interval by interval: runs[i] to runs[i + 1] share one.
+    std::vector<int> runs;
     for (int l = 0; l < pair_count; ++l) {
       const int interval = pieces.interval[l];
       t_start[l] = ray.t[interval], length[l] = ray.t[interval + 1] - ray.t[interval];
       half_piece[l] = float(0.5 * length[l] / sub);
+      if (l == 0 || interval != pieces.interval[l - 1]) runs.push_back(l);
+    }
+    runs.push_back(pair_count);
+    // Per group, the phase ratio of each pair's direction, in pair order.
+    std::vector<std::vector<float>> pair_phase(groups, std::vector<float>(pair_count));
+    for (int g = 0; g < groups; ++g) {
+      for (int l = 0; l < pair_count; ++l) pair_phase[g][l] = phase_ratio[g][pieces.direction[l]];
     }
     const double r = ray.r, r_mu = ray.r * ray.mu;
     const SunAtPoints sun_at_points(params_, transmittance);
@@ -277,13 +286,16 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
       for (int g = 0; g < groups; ++g) {
         for (int c = 0; c < 3; ++c) {
           const float *sun_a = start.transmittance[c].data(), *sun_b = end.transmittance[c].data();
-          const float* phase = phase_ratio[g].data();
+          const float* phase = pair_phase[g].data();
           float* sum = piece_sums[g == mie ? 1 : 0][c].data();
-          const int stride = sub + 1;
+          for (std::size_t run = 0; run + 1 < runs.size(); ++run) {
+            const int interval = pieces.interval[runs[run]];
+            const float* ends = &piece_base[((std::size_t(interval) * groups + g) * 3 + c) * (sub + 1)];
+            const float base_a = ends[i - 1], base_b = ends[i];
 #pragma omp simd
-          for (int l = 0; l < pair_count; ++l) {
-            const float* ends = &piece_base[((std::size_t(pieces.interval[l]) * groups + g) * 3 + c) * stride];
-            sum[l] += half_piece[l] * (ends[i - 1] * sun_a[l] + ends[i] * sun_b[l]) * phase[pieces.direction[l]];
+            for (int l = runs[run]; l < runs[run + 1]; ++l) {
+              sum[l] += half_piece[l] * (base_a * sun_a[l] + base_b * sun_b[l]) * phase[l];
+            }
           }
         }
       }
