@@ -167,18 +167,23 @@ void ExpectGlMatchesTwin(GlContext* gl, const LutSet& luts, const std::string& s
                              gl->RunFragmentPass(source, testing::RuntimeQueryInputs(items), 4));
 }
 
+// The four tables of `luts` bound to the runtime's samplers.
+void SetTables(GlContext* gl, const LutSet& luts) {
+  auto set = [&](const char* sampler, const glsl::Texture& t) {
+    gl->SetTexture(sampler, t.width, t.height, t.depth, t.texels);
+  };
+  set("transmittance_texture", luts.transmittance);
+  set("scattering_texture", luts.scattering);
+  set("single_mie_scattering_texture", luts.single_mie_scattering);
+  set("irradiance_texture", luts.irradiance);
+}
+
 TEST_P(SnippetOnMesa, MatchesTheCppTwin) {
   std::string why_not;
   std::unique_ptr<GlContext> gl = GlContext::Create(GetParam(), &why_not);
   if (!gl) GTEST_SKIP() << why_not;
   static const LutSet luts = Bake(LoadAtmosphere("earth"), testing::RuntimeTestSettings(false));
-  auto upload = [&](const char* sampler, const glsl::Texture& t) {
-    gl->SetTexture(sampler, t.width, t.height, t.depth, t.texels);
-  };
-  upload("transmittance_texture", luts.transmittance);
-  upload("scattering_texture", luts.scattering);
-  upload("single_mie_scattering_texture", luts.single_mie_scattering);
-  upload("irradiance_texture", luts.irradiance);
+  SetTables(gl.get(), luts);
 
   std::vector<testing::RuntimeQuery> items = testing::MakeRuntimeQueries(luts.parameters.bottom_radius, luts.parameters.top_radius);
   ASSERT_GE(items.size(), 1000u);
@@ -249,13 +254,7 @@ TEST_P(SnippetOnMesa, SpectralSetMatchesTheCppTwin) {
   static const LutSet luts = BakeSpectral(ReadAtmosphereSource("earth"), MakeSpectralBatches(SpectralWavelengths(6)),
                                           testing::RuntimeTestSettings(false));
   ASSERT_EQ(luts.parameters.transmittance_is_colour, 1);
-  auto upload = [&](const char* sampler, const glsl::Texture& t) {
-    gl->SetTexture(sampler, t.width, t.height, t.depth, t.texels);
-  };
-  upload("transmittance_texture", luts.transmittance);
-  upload("scattering_texture", luts.scattering);
-  upload("single_mie_scattering_texture", luts.single_mie_scattering);
-  upload("irradiance_texture", luts.irradiance);
+  SetTables(gl.get(), luts);
   SnippetParts parts;
   parts.channels_are_xyz = true;
   ExpectGlMatchesTwin(gl.get(), luts, FragmentSource(luts, parts),
