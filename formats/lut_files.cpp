@@ -1,10 +1,10 @@
 #include "formats/lut_files.h"
 
 #include <algorithm>
+#include <atomic>
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include "core/errors.h"
 #include "core/file_io.h"
@@ -50,9 +50,11 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   InterruptScope interrupts;
   StagedFiles staged;
   // Each table file is encoded, hashed and written (under its temporary
-  // name) on its own thread, its bytes freed as soon as they are written
-  // (zip compression of the EXR files is most of the writing); the manifest
-  // lists them in a fixed order.
+  // name) by one worker, its bytes freed as soon as they are written; the
+  // manifest lists them in a fixed order. The workers take the files largest
+  // first, EXR (whose zip compression is most of the writing, spread over
+  // OpenEXR's threads) before KTX2, each taking the next file when done, so
+  // that the longest encodings start at once instead of after smaller ones.
   struct Encoded {
     const TableDescription* table;
     FileFormat format;
@@ -64,23 +66,30 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   for (const TableDescription& table : tables) {
     for (FileFormat format : options.formats) files.push_back({&table, format, {}, 0, {}});
   }
-  // One file per task (the default partitioner would hand both large EXR
-  // files, neighbours in the list, to the same thread).
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, files.size(), 1),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          Encoded& f = files[i];
-          f.image = MakeTableFileImage(luts, *f.table, f.format, options);
-          const std::vector<std::uint8_t> bytes = EncodeTableImage(f.image);
-          f.image.values = {};
-          f.bytes = bytes.size();
-          f.sha256 = Sha256Hex(bytes.data(), bytes.size());
-          staged.Write(dir / (f.table->name + FileExtension(f.format)),
-                       std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-        }
-      },
-      tbb::simple_partitioner());
+  std::vector<std::size_t> order(files.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto texels = [&](std::size_t i) {
+    const TableDescription& t = *files[i].table;
+    return std::size_t(t.width) * t.height * t.depth;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    if (texels(a) != texels(b)) return texels(a) > texels(b);
+    return files[a].format == FileFormat::kExr && files[b].format != FileFormat::kExr;
+  });
+  std::atomic<std::size_t> next{0};
+  const int workers = std::min<int>(int(files.size()), tbb::this_task_arena::max_concurrency());
+  tbb::parallel_for(0, workers, [&](int) {
+    for (std::size_t k = next++; k < order.size(); k = next++) {
+      Encoded& f = files[order[k]];
+      f.image = MakeTableFileImage(luts, *f.table, f.format, options);
+      const std::vector<std::uint8_t> bytes = EncodeTableImage(f.image);
+      f.image.values = {};
+      f.bytes = bytes.size();
+      f.sha256 = Sha256Hex(bytes.data(), bytes.size());
+      staged.Write(dir / (f.table->name + FileExtension(f.format)),
+                   std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    }
+  });
   for (const Encoded& f : files) {
     const std::string file = f.table->name + FileExtension(f.format);
     manifest.AddTableFile(*f.table, file, f.image, f.bytes, f.sha256);

@@ -1,5 +1,6 @@
 #include "formats/table_file.h"
 
+#include <OpenEXR/IlmThreadPool.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfCheckFile.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -15,6 +16,7 @@
 #include <set>
 
 #include <Imath/half.h>
+#include <tbb/info.h>
 
 #include "core/errors.h"
 #include "core/file_io.h"
@@ -149,7 +151,15 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   }
   MemoryOStream stream;
   try {
-    Imf::OutputFile file(stream, header);
+    // Zip compresses blocks of scanlines on OpenEXR's pool, one thread per
+    // core, sized once for the process (the blocks are written in order: the
+    // same bytes as with one thread).
+    static const int kZipThreads = [] {
+      const int threads = tbb::info::default_concurrency();
+      IlmThread::ThreadPool::globalThreadPool().setNumThreads(threads);
+      return threads;
+    }();
+    Imf::OutputFile file(stream, header, image.exr_compression == ExrCompression::kZip ? kZipThreads : 0);
     Imf::FrameBuffer frame;
     const std::size_t bytes_per_value = half ? 2 : 4;
     for (int c = 0; c < channels; ++c) {
