@@ -11,6 +11,7 @@
 
 #include "bake/grids.h"
 #include "bake/phase_weighted_radiance.h"
+#include "bake/sun_lookups.h"
 #include "core/constants.h"
 #include "core/quadrature.h"
 #include "shaders_runtime/runtime.h"
@@ -32,6 +33,32 @@ constexpr double kHorizonBand = 0.1;
 void AppendSkyRule(int n, double horizon, std::vector<double>& cosines, std::vector<double>& weights) {
   AppendGaussLegendre(std::max(1, n / 2), horizon, horizon + kHorizonBand, cosines, weights);
   AppendGaussLegendre(n, horizon + kHorizonBand, 1.0, cosines, weights);
+}
+
+// Per channel, values at evenly spaced columns read at t in [0, 1] between
+// columns k and k + 1 by the Catmull-Rom cubic through ln of columns k - 1
+// ... k + 2 (continued linearly in ln past the first and last column):
+// p(t) = (2 p1 + (p2 - p0) t + (2 p0 - 5 p1 + 4 p2 - p3) t^2
+//         + (3 p1 - p0 - 3 p2 + p3) t^3) / 2.
+// A channel with a value that is not positive among the four takes the
+// geometric blend of columns k and k + 1 (SunCosineMix, which falls to a
+// dark side).
+vec3 LogCubicAlongColumns(const std::vector<vec3>& values, int k, double t) {
+  const int last = static_cast<int>(values.size()) - 1;
+  vec3 result(0.0);
+  for (int c = 0; c < 3; ++c) {
+    const double v1 = values[k][c], v2 = values[k + 1][c];
+    const double v0 = k > 0 ? values[k - 1][c] : v1 * v1 / v2;
+    const double v3 = k + 2 <= last ? values[k + 2][c] : v2 * v2 / v1;
+    if (!(v0 > 0.0 && v1 > 0.0 && v2 > 0.0 && v3 > 0.0)) {
+      result[c] = glsl::SunCosineMix(vec4(v1), vec4(v2), t, true).x;
+      continue;
+    }
+    const double p0 = std::log(v0), p1 = std::log(v1), p2 = std::log(v2), p3 = std::log(v3);
+    result[c] = std::exp(0.5 * (2.0 * p1 + (p2 - p0) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t +
+                                (3.0 * p1 - p0 - 3.0 * p2 + p3) * t * t * t));
+  }
+  return result;
 }
 }  // namespace
 
@@ -201,22 +228,47 @@ void Baker::ComputeIndirectIrradiance(int order) {
   // the integral of L cos(theta) d cos(theta) d phi.
   std::vector<double> cosines, cosine_weights;
   AppendSkyRule(polar, 0.0, cosines, cosine_weights);
-  tbb::parallel_for(0, height, [&](int y) {
-    for (int x = 0; x < width; ++x) {
-      double r, mu_s;
-      glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu_s);
-      const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
-      vec3 result(0.0);
-      for (std::size_t l = 0; l < cosines.size(); ++l) {
-        const double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
-        const IncidentAlongNu incident_ring(*this, order, r, cos_theta, mu_s, false);
-        for (int m = 0; m < azimuths; ++m) {
-          double phi = (m + 0.5) * d_phi;
-          vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
-          double nu = glsl::ClampCosine(glm::dot(omega, sun));
-          result += incident_ring.At(nu) * (cos_theta * cosine_weights[l] * d_phi);
-        }
+  auto sky_irradiance = [&](double r, double mu_s) {
+    const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+    vec3 result(0.0);
+    for (std::size_t l = 0; l < cosines.size(); ++l) {
+      const double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+      const IncidentAlongNu incident_ring(*this, order, r, cos_theta, mu_s, false);
+      for (int m = 0; m < azimuths; ++m) {
+        double phi = (m + 0.5) * d_phi;
+        vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+        double nu = glsl::ClampCosine(glm::dot(omega, sun));
+        result += incident_ring.At(nu) * (cos_theta * cosine_weights[l] * d_phi);
       }
+    }
+    return result;
+  };
+  // Where the sun is low, the scattering table is blended geometrically
+  // between its mu_s columns, so an irradiance integrated from it at a sun
+  // between two columns follows the chord of ln E between them. After
+  // sunset ln E is concave in the sun's angle (its fall steepens as the sun
+  // sinks), and the chord reads up to 5-9 % low at mid-column (docs/accuracy.md).
+  // There the irradiance is integrated at the columns themselves, where the
+  // table needs no blend along mu_s, and read between them by a Catmull-Rom
+  // cubic in ln E over four columns (LogCubicAlongColumns).
+  const AtmosphereParameters& grid = order == 1 ? atmosphere_grid_ : orders_grid_;  // as IncidentAlongNu reads
+  const int mu_s_size = grid.scattering_mu_s_size;
+  const SunColumns columns(grid);
+  int low_sun_columns = 0;
+  while (low_sun_columns < mu_s_size && columns.mu_s[low_sun_columns] < glsl::LOW_SUN_MU_S) ++low_sun_columns;
+  const int integrated_columns = std::min(mu_s_size, low_sun_columns + 2);  // and two above, for the cubic
+  tbb::parallel_for(0, height, [&](int y) {
+    double r, mu_s;
+    glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2(0.5 / width, (y + 0.5) / height), r, mu_s);
+    std::vector<vec3> at_columns(integrated_columns);
+    for (int k = 0; k < integrated_columns; ++k) at_columns[k] = sky_irradiance(r, columns.mu_s[k]);
+    for (int x = 0; x < width; ++x) {
+      glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu_s);
+      const double position = glsl::GetScatteringTextureUMuS(grid, mu_s) * mu_s_size - 0.5;
+      const int column = std::clamp(static_cast<int>(std::floor(position)), 0, mu_s_size - 2);
+      const vec3 result = columns.mu_s[column] < glsl::LOW_SUN_MU_S
+                              ? LogCubicAlongColumns(at_columns, column, std::clamp(position - column, 0.0, 1.0))
+                              : sky_irradiance(r, mu_s);
       delta_irradiance_.Store(x, y, 0, vec4(result, 0.0));
       vec4 total = irradiance_.Fetch(x, y) + vec4(result, 0.0);
       irradiance_.Store(x, y, 0, total);
