@@ -399,9 +399,58 @@ void GetScatteringMuSColumns(IN(AtmosphereParameters) atmosphere, Number u_mu_s,
   mu_s_t = SunCosinePosition(mu_s_coord - mu_s_column, low_sun_below);
 }
 
-// 4D lookup: four fetches, at the two mu_s texel columns either side of
-// mu_s and the two nu slices either side of nu, each bilinear in (mu, r) by
-// the texture unit; then nu by SunCosineMix and mu_s by SunBelowTableMix.
+// The blend along mu_s of a low sun at t between texel columns b and c,
+// from the light at the four columns a, b, c, d around it: a cubic in ln L
+// (Hermite, each end's slope the harmonic mean of the secants beside it,
+// 0 where they differ in sign: Fritsch & Butland 1984). After sunset the
+// fall of ln L steepens as the sun sinks, and the geometric blend of b and
+// c (the chord of ln L) reads it low at mid-column; the cubic follows the
+// curve, and being monotone it stays within [b, c] where the light falls
+// off a cliff (next to a column whose ray lies in the Earth's shadow).
+// has_a, has_d: whether a and d exist; past the table's first or last
+// column ln L goes on linearly. Where one of the four is dark, the
+// geometric blend (SunCosineMix).
+vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d, Number t) {
+  vec4 dark = vec4(1e-30);
+  vec4 lb = log(max(b, dark));
+  vec4 lc = log(max(c, dark));
+  vec4 la = has_a ? log(max(a, dark)) : 2.0 * lb - lc;
+  vec4 ld = has_d ? log(max(d, dark)) : 2.0 * lc - lb;
+  vec4 secant_a = lb - la;
+  vec4 secant = lc - lb;
+  vec4 secant_d = ld - lc;
+  vec4 product_b = secant_a * secant;
+  vec4 product_c = secant * secant_d;
+  // 1 where the two secants beside an end agree in sign (the divisor is
+  // then not 0; elsewhere it is replaced by 1 and the slope is 0).
+  vec4 agree_b = vec4(1.0) - step(product_b, vec4(0.0));
+  vec4 agree_c = vec4(1.0) - step(product_c, vec4(0.0));
+  vec4 slope_b = agree_b * 2.0 * product_b / mix(vec4(1.0), secant_a + secant, agree_b);
+  vec4 slope_c = agree_c * 2.0 * product_c / mix(vec4(1.0), secant + secant_d, agree_c);
+  Number t2 = t * t;
+  Number t3 = t2 * t;
+  vec4 cubic = (2.0 * t3 - 3.0 * t2 + 1.0) * lb + (t3 - 2.0 * t2 + t) * slope_b + (3.0 * t2 - 2.0 * t3) * lc +
+               (t3 - t2) * slope_c;
+  vec4 lit = step(dark, min(min(a, b), min(c, d)));
+  return exp(mix(mix(lb, lc, t), cubic, lit)) * step(dark, max(b, c));
+}
+
+// The light at the mu_s texel column at texture coordinate x: the two nu
+// slices either side of nu, each bilinear in (mu, r) by the texture unit,
+// blended by SunCosineMix.
+vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                              IN(vec4) uvwz, Number x, Number nu_slice, Number nu_t, bool low_sun) {
+  Number nu_size = Number(atmosphere.scattering_nu_size);
+  return SunCosineMix(SampleTexture3D(scattering_texture, vec3((nu_slice + x) / nu_size, uvwz.z, uvwz.w)),
+                      SampleTexture3D(scattering_texture, vec3((nu_slice + 1.0 + x) / nu_size, uvwz.z, uvwz.w)),
+                      nu_t, low_sun);
+}
+
+// 4D lookup: the mu_s texel columns either side of mu_s
+// (GetScatteringAtMuSColumn, two fetches each), blended linearly in
+// daylight (four fetches); for a low sun between two columns by
+// LogMonotoneCubicMix of the four columns around it (eight fetches), and
+// below the table's lowest sun by SunBelowTableMix.
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
@@ -414,14 +463,20 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   Number mu_s_t;
   bool low_sun_below;
   GetScatteringMuSColumns(atmosphere, uvwz.y, x_below, x_above, mu_s_t, low_sun_below);
-  bool low_sun_above = x_above < GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
-  vec4 below = SunCosineMix(SampleTexture3D(scattering_texture, vec3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w)),
-                            SampleTexture3D(scattering_texture, vec3((nu_slice + 1.0 + x_below) / nu_size, uvwz.z, uvwz.w)),
-                            nu_t, low_sun_below);
-  vec4 above = SunCosineMix(SampleTexture3D(scattering_texture, vec3((nu_slice + x_above) / nu_size, uvwz.z, uvwz.w)),
-                            SampleTexture3D(scattering_texture, vec3((nu_slice + 1.0 + x_above) / nu_size, uvwz.z, uvwz.w)),
-                            nu_t, low_sun_above);
-  return SunBelowTableMix(below, above, mu_s_t, low_sun_below);
+  Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
+  vec4 below =
+      GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, low_sun_below);
+  vec4 above =
+      GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_above, nu_slice, nu_t, x_above < x_low_sun);
+  if (!low_sun_below || mu_s_t < 0.0) return SunBelowTableMix(below, above, mu_s_t, low_sun_below);
+  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  Number column = x_below * mu_s_size - 0.5;
+  Number x_first = (max(column - 1.0, 0.0) + 0.5) / mu_s_size;
+  Number x_last = (min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
+  vec4 first = GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_first, nu_slice, nu_t, true);
+  vec4 last =
+      GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_last, nu_slice, nu_t, x_last < x_low_sun);
+  return LogMonotoneCubicMix(first, below, above, last, column > 0.5, column + 2.0 < mu_s_size - 0.5, mu_s_t);
 }
 #endif
 

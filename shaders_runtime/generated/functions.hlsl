@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _796 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _816 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_796)
+    if (!_816)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _659 = mu < 0.0f;
-    bool _671;
-    if (_659)
+    bool _679 = mu < 0.0f;
+    bool _691;
+    if (_679)
     {
-        _671 = (((r * r) * mu) * mu) >= c;
+        _691 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _671 = _659;
+        _691 = _679;
     }
-    return _671;
+    return _691;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _440;
+    float _460;
     if (r_mu > 0.0f)
     {
-        _440 = c / (r_mu + s);
+        _460 = c / (r_mu + s);
     }
     else
     {
-        _440 = s - r_mu;
+        _460 = s - r_mu;
     }
-    float param_1 = _440;
+    float param_1 = _460;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _889;
+    float _909;
     if (d_max > d_min)
     {
-        _889 = (d - d_min) / (d_max - d_min);
+        _909 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _889 = 0.0f;
+        _909 = 0.0f;
     }
-    float x_mu = _889;
+    float x_mu = _909;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1149;
+        float _1169;
         if (d_max == d_min)
         {
-            _1149 = 0.0f;
+            _1169 = 0.0f;
         }
         else
         {
-            _1149 = (d - d_min) / (d_max - d_min);
+            _1169 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1149;
+        x_mu = _1169;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1193;
+        float _1213;
         if (d_max_1 > d_min_1)
         {
-            _1193 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1213 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1193 = 0.0f;
+            _1213 = 0.0f;
         }
-        x_mu = _1193;
+        x_mu = _1213;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1568;
+    float _1588;
     if (low_sun)
     {
-        _1568 = min(t, 1.0f);
+        _1588 = min(t, 1.0f);
     }
     else
     {
-        _1568 = clamp(t, 0.0f, 1.0f);
+        _1588 = clamp(t, 0.0f, 1.0f);
     }
-    return _1568;
+    return _1588;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -387,6 +387,18 @@ float4 SunCosineMix(float4 a, float4 b, float t, bool low_sun)
     return exp(lerp(log(max(a, dark)), log(max(b, dark)), t.xxxx)) * step(dark, max(a, b));
 }
 
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float4 GetScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float4 uvwz, float x, float nu_slice, float nu_t, bool low_sun)
+{
+    float nu_size = float(atmosphere.scattering_nu_size);
+    float4 param = scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3((nu_slice + x) / nu_size, uvwz.z, uvwz.w), 0.0f);
+    float4 param_1 = scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3(((nu_slice + 1.0f) + x) / nu_size, uvwz.z, uvwz.w), 0.0f);
+    float param_2 = nu_t;
+    bool param_3 = low_sun;
+    return SunCosineMix(param, param_1, param_2, param_3);
+}
+#endif
+
 float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
 {
     float4 param = a;
@@ -394,17 +406,60 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1591;
+    float4 _1611;
     if (t < 0.0f)
     {
-        _1591 = min(blend, a);
+        _1611 = min(blend, a);
     }
     else
     {
-        _1591 = blend;
+        _1611 = blend;
     }
-    return _1591;
+    return _1611;
 }
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, bool has_d, float t)
+{
+    float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
+    float4 lb = log(max(b, dark));
+    float4 lc = log(max(c, dark));
+    float4 _1672;
+    if (has_a)
+    {
+        _1672 = log(max(a, dark));
+    }
+    else
+    {
+        _1672 = (lb * 2.0f) - lc;
+    }
+    float4 la = _1672;
+    float4 _1687;
+    if (has_d)
+    {
+        _1687 = log(max(d, dark));
+    }
+    else
+    {
+        _1687 = (lc * 2.0f) - lb;
+    }
+    float4 ld = _1687;
+    float4 secant_a = lb - la;
+    float4 secant = lc - lb;
+    float4 secant_d = ld - lc;
+    float4 product_b = secant_a * secant;
+    float4 product_c = secant * secant_d;
+    float4 agree_b = 1.0f.xxxx - step(product_b, 0.0f.xxxx);
+    float4 agree_c = 1.0f.xxxx - step(product_c, 0.0f.xxxx);
+    float4 slope_b = ((agree_b * 2.0f) * product_b) / lerp(1.0f.xxxx, secant_a + secant, agree_b);
+    float4 slope_c = ((agree_c * 2.0f) * product_c) / lerp(1.0f.xxxx, secant + secant_d, agree_c);
+    float t2 = t * t;
+    float t3 = t2 * t;
+    float4 cubic = (((lb * (((2.0f * t3) - (3.0f * t2)) + 1.0f)) + (slope_b * ((t3 - (2.0f * t2)) + t))) + (lc * ((3.0f * t2) - (2.0f * t3)))) + (slope_c * (t3 - t2));
+    float4 lit = step(dark, min(min(a, b), min(c, d)));
+    return exp(lerp(lerp(lb, lc, t.xxxx), cubic, lit)) * step(dark, max(b, c));
+}
+#endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground)
@@ -433,22 +488,55 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     bool low_sun_below = param_11;
     AtmosphereParameters param_12 = atmosphere;
     float param_13 = 0.100000001490116119384765625f;
-    bool low_sun_above = x_above < GetScatteringTextureUMuS(param_12, param_13);
-    float4 param_14 = scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3((nu_slice + x_below) / nu_size, uvwz.z, uvwz.w), 0.0f);
-    float4 param_15 = scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3(((nu_slice + 1.0f) + x_below) / nu_size, uvwz.z, uvwz.w), 0.0f);
-    float param_16 = nu_t;
-    bool param_17 = low_sun_below;
-    float4 below = SunCosineMix(param_14, param_15, param_16, param_17);
-    float4 param_18 = scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3((nu_slice + x_above) / nu_size, uvwz.z, uvwz.w), 0.0f);
-    float4 param_19 = scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3(((nu_slice + 1.0f) + x_above) / nu_size, uvwz.z, uvwz.w), 0.0f);
-    float param_20 = nu_t;
-    bool param_21 = low_sun_above;
-    float4 above = SunCosineMix(param_18, param_19, param_20, param_21);
-    float4 param_22 = below;
-    float4 param_23 = above;
-    float param_24 = mu_s_t;
-    bool param_25 = low_sun_below;
-    return SunBelowTableMix(param_22, param_23, param_24, param_25);
+    float x_low_sun = GetScatteringTextureUMuS(param_12, param_13);
+    AtmosphereParameters param_14 = atmosphere;
+    float4 param_15 = uvwz;
+    float param_16 = x_below;
+    float param_17 = nu_slice;
+    float param_18 = nu_t;
+    bool param_19 = low_sun_below;
+    float4 below = GetScatteringAtMuSColumn(param_14, scattering_texture_1, _scattering_texture_1_sampler, param_15, param_16, param_17, param_18, param_19);
+    AtmosphereParameters param_20 = atmosphere;
+    float4 param_21 = uvwz;
+    float param_22 = x_above;
+    float param_23 = nu_slice;
+    float param_24 = nu_t;
+    bool param_25 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_20, scattering_texture_1, _scattering_texture_1_sampler, param_21, param_22, param_23, param_24, param_25);
+    if ((!low_sun_below) || (mu_s_t < 0.0f))
+    {
+        float4 param_26 = below;
+        float4 param_27 = above;
+        float param_28 = mu_s_t;
+        bool param_29 = low_sun_below;
+        return SunBelowTableMix(param_26, param_27, param_28, param_29);
+    }
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    float column = (x_below * mu_s_size) - 0.5f;
+    float x_first = (max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size;
+    float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
+    AtmosphereParameters param_30 = atmosphere;
+    float4 param_31 = uvwz;
+    float param_32 = x_first;
+    float param_33 = nu_slice;
+    float param_34 = nu_t;
+    bool param_35 = true;
+    float4 first = GetScatteringAtMuSColumn(param_30, scattering_texture_1, _scattering_texture_1_sampler, param_31, param_32, param_33, param_34, param_35);
+    AtmosphereParameters param_36 = atmosphere;
+    float4 param_37 = uvwz;
+    float param_38 = x_last;
+    float param_39 = nu_slice;
+    float param_40 = nu_t;
+    bool param_41 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_36, scattering_texture_1, _scattering_texture_1_sampler, param_37, param_38, param_39, param_40, param_41);
+    float4 param_42 = first;
+    float4 param_43 = below;
+    float4 param_44 = above;
+    float4 param_45 = last;
+    bool param_46 = column > 0.5f;
+    bool param_47 = (column + 2.0f) < (mu_s_size - 0.5f);
+    float param_48 = mu_s_t;
+    return LogMonotoneCubicMix(param_42, param_43, param_44, param_45, param_46, param_47, param_48);
 }
 #endif
 
@@ -464,16 +552,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _1911;
+        float3 _2174;
         if (scattering.x > 0.0f)
         {
-            _1911 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _2174 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _1911 = 0.0f.xxx;
+            _2174 = 0.0f.xxx;
         }
-        single_mie_scattering = _1911;
+        single_mie_scattering = _2174;
     }
     else
     {
@@ -545,13 +633,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _1979 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2242 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_1979)
+    if (!_2242)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -560,19 +648,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _1999;
+    float3 _2262;
     if (ray_r_mu_intersects_ground)
     {
-        _1999 = 0.0f.xxx;
+        _2262 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _1999 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _2262 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _1999;
+    transmittance = _2262;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -580,9 +668,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2026 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2289 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2026;
+    float3 scattering = _2289;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -630,16 +718,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2120;
+    float _2383;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2120 = a * exp(f * log(b / a));
+        _2383 = a * exp(f * log(b / a));
     }
     else
     {
-        _2120 = lerp(a, b, f);
+        _2383 = lerp(a, b, f);
     }
-    return _2120;
+    return _2383;
 }
 #endif
 
@@ -712,16 +800,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2372;
+    float _2635;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2372 = 1.0f - (0.5f * depth);
+        _2635 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2372 = (1.0f - exp(-depth)) / depth;
+        _2635 = (1.0f - exp(-depth)) / depth;
     }
-    return _2372;
+    return _2635;
 }
 #endif
 
@@ -757,10 +845,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2452 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2715 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2452;
+        float3 extinction = _2715;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -818,10 +906,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2317 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2580 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2317;
+        float3 extinction = _2580;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -894,14 +982,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _2342;
+    float3 _2605;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2342 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2605 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -910,31 +998,31 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2342 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _2605 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _2342;
+    return _2605;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _675;
+    float _695;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _675 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _695 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _675 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _695 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _675;
+    return _695;
 }
 #endif
 
@@ -947,16 +1035,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2082;
+    float _2345;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2082 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2345 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2082 = up;
+        _2345 = up;
     }
-    return _2082;
+    return _2345;
 }
 #endif
 
@@ -979,13 +1067,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _2598 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2861 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2598)
+    if (!_2861)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1025,11 +1113,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2693 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _2956 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2693;
+        lit_optical_depth = _2956;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1043,11 +1131,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2727 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _2990 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2727;
+        optical_depth += _2990;
     }
     if (direct < 1.0f)
     {
@@ -1066,9 +1154,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _2770 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3033 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _2770;
+    float3 scattering = _3033;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1089,11 +1177,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _2818 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3081 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _2818;
+        float3 far_optical_depth = _3081;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1113,9 +1201,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _2872 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3135 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _2872);
+            scattering -= (exp(-far_optical_depth) * _3135);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1136,9 +1224,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _2937 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3200 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _2937;
+    float3 scattering_p = _3200;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1158,25 +1246,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _2981 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _3244 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _2981;
+    return _3244;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1247;
+    float _1267;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1247 = 0.100000001490116119384765625f;
+        _1267 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1247 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1267 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1247;
+    return _1267;
 }
 #endif
 
@@ -1185,16 +1273,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1265;
+    float _1285;
     if (mu_s < knee)
     {
-        _1265 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1285 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1265 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1285 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1265;
+    return _1285;
 }
 #endif
 
@@ -1221,16 +1309,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1296;
+    float _1316;
     if (x < 0.5f)
     {
-        _1296 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1316 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1296 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1316 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1296;
+    return _1316;
 }
 #endif
 

@@ -1289,101 +1289,304 @@ fn GetScatteringMuSColumns(atmosphere_50: AtmosphereParameters, u_mu_s: f32, x_b
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_52: AtmosphereParameters, scattering_texture: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
+fn LogMonotoneCubicMix(a_9: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_15: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
+    var a_10: vec4<f32>;
+    var b_5: vec4<f32>;
+    var c_7: vec4<f32>;
+    var d_16: vec4<f32>;
+    var has_a_1: bool;
+    var has_d_1: bool;
+    var t_8: f32;
+    var dark_1: vec4<f32> = vec4(0.000000000000000000000000000001f);
+    var lb: vec4<f32>;
+    var lc: vec4<f32>;
+    var local_10: vec4<f32>;
+    var la: vec4<f32>;
+    var local_11: vec4<f32>;
+    var ld: vec4<f32>;
+    var secant_a: vec4<f32>;
+    var secant: vec4<f32>;
+    var secant_d: vec4<f32>;
+    var product_b: vec4<f32>;
+    var product_c: vec4<f32>;
+    var agree_b: vec4<f32>;
+    var agree_c: vec4<f32>;
+    var slope_b: vec4<f32>;
+    var slope_c: vec4<f32>;
+    var t2_: f32;
+    var t3_: f32;
+    var cubic: vec4<f32>;
+    var lit: vec4<f32>;
+
+    a_10 = a_9;
+    b_5 = b_4;
+    c_7 = c_6;
+    d_16 = d_15;
+    has_a_1 = has_a;
+    has_d_1 = has_d;
+    t_8 = t_7;
+    let _e24 = b_5;
+    let _e25 = dark_1;
+    lb = log(max(_e24, _e25));
+    let _e29 = c_7;
+    let _e30 = dark_1;
+    lc = log(max(_e29, _e30));
+    let _e34 = has_a_1;
+    if _e34 {
+        let _e35 = a_10;
+        let _e36 = dark_1;
+        local_10 = log(max(_e35, _e36));
+    } else {
+        let _e40 = lb;
+        let _e42 = lc;
+        local_10 = ((2f * _e40) - _e42);
+    }
+    let _e45 = local_10;
+    la = _e45;
+    let _e47 = has_d_1;
+    if _e47 {
+        let _e48 = d_16;
+        let _e49 = dark_1;
+        local_11 = log(max(_e48, _e49));
+    } else {
+        let _e53 = lc;
+        let _e55 = lb;
+        local_11 = ((2f * _e53) - _e55);
+    }
+    let _e58 = local_11;
+    ld = _e58;
+    let _e60 = lb;
+    let _e61 = la;
+    secant_a = (_e60 - _e61);
+    let _e64 = lc;
+    let _e65 = lb;
+    secant = (_e64 - _e65);
+    let _e68 = ld;
+    let _e69 = lc;
+    secant_d = (_e68 - _e69);
+    let _e72 = secant_a;
+    let _e73 = secant;
+    product_b = (_e72 * _e73);
+    let _e76 = secant;
+    let _e77 = secant_d;
+    product_c = (_e76 * _e77);
+    let _e82 = product_b;
+    agree_b = (vec4(1f) - step(_e82, vec4(0f)));
+    let _e90 = product_c;
+    agree_c = (vec4(1f) - step(_e90, vec4(0f)));
+    let _e96 = agree_b;
+    let _e99 = product_b;
+    let _e103 = secant_a;
+    let _e104 = secant;
+    let _e106 = agree_b;
+    slope_b = (((_e96 * 2f) * _e99) / mix(vec4(1f), (_e103 + _e104), _e106));
+    let _e110 = agree_c;
+    let _e113 = product_c;
+    let _e117 = secant;
+    let _e118 = secant_d;
+    let _e120 = agree_c;
+    slope_c = (((_e110 * 2f) * _e113) / mix(vec4(1f), (_e117 + _e118), _e120));
+    let _e124 = t_8;
+    let _e125 = t_8;
+    t2_ = (_e124 * _e125);
+    let _e128 = t2_;
+    let _e129 = t_8;
+    t3_ = (_e128 * _e129);
+    let _e133 = t3_;
+    let _e136 = t2_;
+    let _e141 = lb;
+    let _e143 = t3_;
+    let _e145 = t2_;
+    let _e148 = t_8;
+    let _e150 = slope_b;
+    let _e154 = t2_;
+    let _e157 = t3_;
+    let _e160 = lc;
+    let _e163 = t3_;
+    let _e164 = t2_;
+    let _e166 = slope_c;
+    cubic = (((((((2f * _e133) - (3f * _e136)) + 1f) * _e141) + (((_e143 - (2f * _e145)) + _e148) * _e150)) + (((3f * _e154) - (2f * _e157)) * _e160)) + ((_e163 - _e164) * _e166));
+    let _e170 = dark_1;
+    let _e171 = a_10;
+    let _e172 = b_5;
+    let _e174 = c_7;
+    let _e175 = d_16;
+    lit = step(_e170, min(min(_e171, _e172), min(_e174, _e175)));
+    let _e180 = lb;
+    let _e181 = lc;
+    let _e182 = t_8;
+    let _e185 = cubic;
+    let _e186 = lit;
+    let _e189 = dark_1;
+    let _e190 = b_5;
+    let _e191 = c_7;
+    return (exp(mix(mix(_e180, _e181, vec4(_e182)), _e185, _e186)) * step(_e189, max(_e190, _e191)));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringAtMuSColumn(atmosphere_52: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_5: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
     var atmosphere_53: AtmosphereParameters;
+    var uvwz_1: vec4<f32>;
+    var x_6: f32;
+    var nu_slice_1: f32;
+    var nu_t_1: f32;
+    var low_sun_7: bool;
+    var nu_size: f32;
+
+    atmosphere_53 = atmosphere_52;
+    uvwz_1 = uvwz;
+    x_6 = x_5;
+    nu_slice_1 = nu_slice;
+    nu_t_1 = nu_t;
+    low_sun_7 = low_sun_6;
+    let _e20 = atmosphere_53;
+    nu_size = f32(_e20.scattering_nu_size);
+    let _e24 = nu_slice_1;
+    let _e25 = x_6;
+    let _e27 = nu_size;
+    let _e29 = uvwz_1;
+    let _e31 = uvwz_1;
+    let _e34 = SampleTexture3D(scattering_texture, vec3<f32>(((_e24 + _e25) / _e27), _e29.z, _e31.w));
+    let _e35 = nu_slice_1;
+    let _e38 = x_6;
+    let _e40 = nu_size;
+    let _e42 = uvwz_1;
+    let _e44 = uvwz_1;
+    let _e47 = SampleTexture3D(scattering_texture, vec3<f32>((((_e35 + 1f) + _e38) / _e40), _e42.z, _e44.w));
+    let _e48 = nu_t_1;
+    let _e49 = low_sun_7;
+    let _e50 = SunCosineMix(_e34, _e47, _e48, _e49);
+    return _e50;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
+    var atmosphere_55: AtmosphereParameters;
     var r_43: f32;
     var mu_28: f32;
     var mu_s_18: f32;
     var nu_12: f32;
     var ray_r_mu_intersects_ground_11: bool;
-    var uvwz: vec4<f32>;
-    var nu_size: f32;
+    var uvwz_2: vec4<f32>;
+    var nu_size_1: f32;
     var nu_coord: f32;
-    var nu_slice: f32;
-    var nu_t: f32;
+    var nu_slice_2: f32;
+    var nu_t_2: f32;
     var x_below_1: f32;
     var x_above_1: f32;
     var mu_s_t_1: f32;
     var low_sun_below_1: bool;
-    var low_sun_above: bool;
+    var x_low_sun: f32;
     var below: vec4<f32>;
     var above: vec4<f32>;
+    var mu_s_size_1: f32;
+    var column: f32;
+    var x_first: f32;
+    var x_last: f32;
+    var first: vec4<f32>;
+    var last: vec4<f32>;
 
-    atmosphere_53 = atmosphere_52;
+    atmosphere_55 = atmosphere_54;
     r_43 = r_42;
     mu_28 = mu_27;
     mu_s_18 = mu_s_17;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e20 = atmosphere_53;
+    let _e20 = atmosphere_55;
     let _e21 = r_43;
     let _e22 = mu_28;
     let _e23 = mu_s_18;
     let _e24 = nu_12;
     let _e25 = ray_r_mu_intersects_ground_11;
     let _e26 = GetScatteringTextureUvwzFromRMuMuSNu(_e20, _e21, _e22, _e23, _e24, _e25);
-    uvwz = _e26;
-    let _e28 = atmosphere_53;
-    nu_size = f32(_e28.scattering_nu_size);
-    let _e32 = uvwz;
-    let _e34 = nu_size;
+    uvwz_2 = _e26;
+    let _e28 = atmosphere_55;
+    nu_size_1 = f32(_e28.scattering_nu_size);
+    let _e32 = uvwz_2;
+    let _e34 = nu_size_1;
     nu_coord = (_e32.x * (_e34 - 1f));
     let _e39 = nu_coord;
-    let _e41 = nu_size;
-    nu_slice = min(floor(_e39), (_e41 - 2f));
+    let _e41 = nu_size_1;
+    nu_slice_2 = min(floor(_e39), (_e41 - 2f));
     let _e46 = nu_coord;
-    let _e47 = nu_slice;
-    nu_t = (_e46 - _e47);
-    let _e54 = atmosphere_53;
-    let _e55 = uvwz;
+    let _e47 = nu_slice_2;
+    nu_t_2 = (_e46 - _e47);
+    let _e54 = atmosphere_55;
+    let _e55 = uvwz_2;
     GetScatteringMuSColumns(_e54, _e55.y, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e65 = x_above_1;
-    let _e66 = atmosphere_53;
-    let _e67 = GetScatteringTextureUMuS(_e66, LOW_SUN_MU_S);
-    low_sun_above = (_e65 < _e67);
-    let _e70 = nu_slice;
-    let _e71 = x_below_1;
-    let _e73 = nu_size;
-    let _e75 = uvwz;
-    let _e77 = uvwz;
-    let _e80 = SampleTexture3D(scattering_texture, vec3<f32>(((_e70 + _e71) / _e73), _e75.z, _e77.w));
-    let _e81 = nu_slice;
-    let _e84 = x_below_1;
-    let _e86 = nu_size;
-    let _e88 = uvwz;
-    let _e90 = uvwz;
-    let _e93 = SampleTexture3D(scattering_texture, vec3<f32>((((_e81 + 1f) + _e84) / _e86), _e88.z, _e90.w));
-    let _e94 = nu_t;
-    let _e95 = low_sun_below_1;
-    let _e96 = SunCosineMix(_e80, _e93, _e94, _e95);
-    below = _e96;
-    let _e98 = nu_slice;
-    let _e99 = x_above_1;
-    let _e101 = nu_size;
-    let _e103 = uvwz;
-    let _e105 = uvwz;
-    let _e108 = SampleTexture3D(scattering_texture, vec3<f32>(((_e98 + _e99) / _e101), _e103.z, _e105.w));
-    let _e109 = nu_slice;
-    let _e112 = x_above_1;
-    let _e114 = nu_size;
-    let _e116 = uvwz;
-    let _e118 = uvwz;
-    let _e121 = SampleTexture3D(scattering_texture, vec3<f32>((((_e109 + 1f) + _e112) / _e114), _e116.z, _e118.w));
-    let _e122 = nu_t;
-    let _e123 = low_sun_above;
-    let _e124 = SunCosineMix(_e108, _e121, _e122, _e123);
-    above = _e124;
-    let _e126 = below;
-    let _e127 = above;
-    let _e128 = mu_s_t_1;
-    let _e129 = low_sun_below_1;
-    let _e130 = SunBelowTableMix(_e126, _e127, _e128, _e129);
-    return _e130;
+    let _e65 = atmosphere_55;
+    let _e66 = GetScatteringTextureUMuS(_e65, LOW_SUN_MU_S);
+    x_low_sun = _e66;
+    let _e68 = atmosphere_55;
+    let _e69 = uvwz_2;
+    let _e70 = x_below_1;
+    let _e71 = nu_slice_2;
+    let _e72 = nu_t_2;
+    let _e73 = low_sun_below_1;
+    let _e74 = GetScatteringAtMuSColumn(_e68, scattering_texture_1, _e69, _e70, _e71, _e72, _e73);
+    below = _e74;
+    let _e76 = atmosphere_55;
+    let _e77 = uvwz_2;
+    let _e78 = x_above_1;
+    let _e79 = nu_slice_2;
+    let _e80 = nu_t_2;
+    let _e81 = x_above_1;
+    let _e82 = x_low_sun;
+    let _e84 = GetScatteringAtMuSColumn(_e76, scattering_texture_1, _e77, _e78, _e79, _e80, (_e81 < _e82));
+    above = _e84;
+    let _e86 = low_sun_below_1;
+    let _e88 = mu_s_t_1;
+    if (!(_e86) || (_e88 < 0f)) {
+        let _e92 = below;
+        let _e93 = above;
+        let _e94 = mu_s_t_1;
+        let _e95 = low_sun_below_1;
+        let _e96 = SunBelowTableMix(_e92, _e93, _e94, _e95);
+        return _e96;
+    }
+    let _e97 = atmosphere_55;
+    mu_s_size_1 = f32(_e97.scattering_mu_s_size);
+    let _e101 = x_below_1;
+    let _e102 = mu_s_size_1;
+    column = ((_e101 * _e102) - 0.5f);
+    let _e107 = column;
+    let _e114 = mu_s_size_1;
+    x_first = ((max((_e107 - 1f), 0f) + 0.5f) / _e114);
+    let _e117 = column;
+    let _e120 = mu_s_size_1;
+    let _e126 = mu_s_size_1;
+    x_last = ((min((_e117 + 2f), (_e120 - 1f)) + 0.5f) / _e126);
+    let _e129 = atmosphere_55;
+    let _e130 = uvwz_2;
+    let _e131 = x_first;
+    let _e132 = nu_slice_2;
+    let _e133 = nu_t_2;
+    let _e135 = GetScatteringAtMuSColumn(_e129, scattering_texture_1, _e130, _e131, _e132, _e133, true);
+    first = _e135;
+    let _e137 = atmosphere_55;
+    let _e138 = uvwz_2;
+    let _e139 = x_last;
+    let _e140 = nu_slice_2;
+    let _e141 = nu_t_2;
+    let _e142 = x_last;
+    let _e143 = x_low_sun;
+    let _e145 = GetScatteringAtMuSColumn(_e137, scattering_texture_1, _e138, _e139, _e140, _e141, (_e142 < _e143));
+    last = _e145;
+    let _e147 = first;
+    let _e148 = below;
+    let _e149 = above;
+    let _e150 = last;
+    let _e151 = column;
+    let _e154 = column;
+    let _e157 = mu_s_size_1;
+    let _e161 = mu_s_t_1;
+    let _e162 = LogMonotoneCubicMix(_e147, _e148, _e149, _e150, (_e151 > 0.5f), ((_e154 + 2f) < (_e157 - 0.5f)), _e161);
+    return _e162;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_54: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
-    var atmosphere_55: AtmosphereParameters;
+fn GetIrradiance(atmosphere_56: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
+    var atmosphere_57: AtmosphereParameters;
     var r_45: f32;
     var mu_s_20: f32;
     var uv_3: vec2<f32>;
@@ -1391,21 +1594,21 @@ fn GetIrradiance(atmosphere_54: AtmosphereParameters, irradiance_texture: textur
     var mu_s_coord_1: f32;
     var mu_s_column_1: f32;
     var mu_s_below: f32;
-    var low_sun_6: bool;
+    var low_sun_8: bool;
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_55 = atmosphere_54;
+    atmosphere_57 = atmosphere_56;
     r_45 = r_44;
     mu_s_20 = mu_s_19;
-    let _e14 = atmosphere_55;
+    let _e14 = atmosphere_57;
     let _e15 = r_45;
     let _e16 = mu_s_20;
     let _e17 = GetIrradianceTextureUvFromRMuS(_e14, _e15, _e16);
     uv_3 = _e17;
-    let _e19 = atmosphere_55;
+    let _e19 = atmosphere_57;
     width = f32(_e19.irradiance_width);
-    let _e23 = atmosphere_55;
+    let _e23 = atmosphere_57;
     let _e24 = mu_s_20;
     let _e25 = GetIrradianceUnitMuS(_e23, _e24);
     let _e26 = width;
@@ -1413,13 +1616,13 @@ fn GetIrradiance(atmosphere_54: AtmosphereParameters, irradiance_texture: textur
     let _e31 = mu_s_coord_1;
     let _e34 = width;
     mu_s_column_1 = clamp(floor(_e31), 0f, (_e34 - 2f));
-    let _e39 = atmosphere_55;
+    let _e39 = atmosphere_57;
     let _e40 = mu_s_column_1;
     let _e41 = width;
     let _e45 = GetIrradianceMuSFromUnit(_e39, (_e40 / (_e41 - 1f)));
     mu_s_below = _e45;
     let _e47 = mu_s_below;
-    low_sun_6 = (_e47 < LOW_SUN_MU_S);
+    low_sun_8 = (_e47 < LOW_SUN_MU_S);
     let _e50 = mu_s_column_1;
     let _e53 = width;
     let _e55 = uv_3;
@@ -1434,30 +1637,30 @@ fn GetIrradiance(atmosphere_54: AtmosphereParameters, irradiance_texture: textur
     let _e71 = above_1;
     let _e72 = mu_s_coord_1;
     let _e73 = mu_s_column_1;
-    let _e75 = low_sun_6;
+    let _e75 = low_sun_8;
     let _e76 = SunCosinePosition((_e72 - _e73), _e75);
-    let _e77 = low_sun_6;
+    let _e77 = low_sun_8;
     let _e78 = SunBelowTableMix(_e70, _e71, _e76, _e77);
     return vec3<f32>(_e78.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_56: AtmosphereParameters, nu_13: f32) -> f32 {
-    var atmosphere_57: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_58: AtmosphereParameters, nu_13: f32) -> f32 {
+    var atmosphere_59: AtmosphereParameters;
     var nu_14: f32;
 
-    atmosphere_57 = atmosphere_56;
+    atmosphere_59 = atmosphere_58;
     nu_14 = nu_13;
-    let _e11 = atmosphere_57;
+    let _e11 = atmosphere_59;
     if (_e11.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e14 = atmosphere_57;
+        let _e14 = atmosphere_59;
         let _e16 = nu_14;
         let _e17 = HenyeyGreensteinPhaseFunction(_e14.mie_g, _e16);
         return _e17;
     }
-    let _e18 = atmosphere_57;
+    let _e18 = atmosphere_59;
     if (_e18.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e21 = atmosphere_57;
+        let _e21 = atmosphere_59;
         let _e23 = nu_14;
         let _e24 = CornetteShanksPhaseFunction(_e21.mie_g, _e23);
         return _e24;
@@ -1466,31 +1669,31 @@ fn MiePhaseFunction(atmosphere_56: AtmosphereParameters, nu_13: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_58: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_59: AtmosphereParameters;
+fn GetCombinedScattering(atmosphere_60: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_61: AtmosphereParameters;
     var r_47: f32;
     var mu_30: f32;
     var mu_s_22: f32;
     var nu_16: f32;
     var ray_r_mu_intersects_ground_13: bool;
     var scattering: vec4<f32>;
-    var local_10: vec3<f32>;
+    var local_12: vec3<f32>;
 
-    atmosphere_59 = atmosphere_58;
+    atmosphere_61 = atmosphere_60;
     r_47 = r_46;
     mu_30 = mu_29;
     mu_s_22 = mu_s_21;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e22 = atmosphere_59;
+    let _e22 = atmosphere_61;
     let _e23 = r_47;
     let _e24 = mu_30;
     let _e25 = mu_s_22;
     let _e26 = nu_16;
     let _e27 = ray_r_mu_intersects_ground_13;
-    let _e28 = GetScattering(_e22, scattering_texture_1, _e23, _e24, _e25, _e26, _e27);
+    let _e28 = GetScattering(_e22, scattering_texture_2, _e23, _e24, _e25, _e26, _e27);
     scattering = _e28;
-    let _e30 = atmosphere_59;
+    let _e30 = atmosphere_61;
     if (_e30.single_mie_in_scattering_alpha == 1i) {
         {
             let _e34 = scattering;
@@ -1498,18 +1701,18 @@ fn GetCombinedScattering(atmosphere_58: AtmosphereParameters, scattering_texture
                 let _e38 = scattering;
                 let _e41 = scattering;
                 let _e44 = scattering;
-                let _e48 = atmosphere_59;
-                let _e50 = atmosphere_59;
-                local_10 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
+                let _e48 = atmosphere_61;
+                let _e50 = atmosphere_61;
+                local_12 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_10 = vec3(0f);
+                local_12 = vec3(0f);
             }
-            let _e59 = local_10;
+            let _e59 = local_12;
             (*single_mie_scattering) = _e59;
         }
     } else {
         {
-            let _e60 = atmosphere_59;
+            let _e60 = atmosphere_61;
             let _e61 = r_47;
             let _e62 = mu_30;
             let _e63 = mu_s_22;
@@ -1524,8 +1727,8 @@ fn GetCombinedScattering(atmosphere_58: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_60: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_61: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_62: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_63: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
@@ -1535,15 +1738,15 @@ fn GetSkyRadiance(atmosphere_60: AtmosphereParameters, transmittance_texture_5: 
     var mu_s_23: f32;
     var nu_17: f32;
     var ray_r_mu_intersects_ground_14: bool;
-    var local_11: vec3<f32>;
+    var local_13: vec3<f32>;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_63 = atmosphere_62;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e24 = atmosphere_61;
+    let _e24 = atmosphere_63;
     let _e25 = camera_5;
     let _e26 = view_ray_5;
     let _e27 = sun_direction_3;
@@ -1554,44 +1757,44 @@ fn GetSkyRadiance(atmosphere_60: AtmosphereParameters, transmittance_texture_5: 
             return vec3(0f);
         }
     }
-    let _e44 = atmosphere_61;
+    let _e44 = atmosphere_63;
     let _e45 = r_48;
     let _e46 = mu_31;
     let _e47 = RayIntersectsGround(_e44, _e45, _e46);
     ray_r_mu_intersects_ground_14 = _e47;
     let _e49 = ray_r_mu_intersects_ground_14;
     if _e49 {
-        local_11 = vec3(0f);
+        local_13 = vec3(0f);
     } else {
-        let _e52 = atmosphere_61;
+        let _e52 = atmosphere_63;
         let _e53 = r_48;
         let _e54 = mu_31;
         let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_5, _e53, _e54);
-        local_11 = _e55;
+        local_13 = _e55;
     }
-    let _e57 = local_11;
+    let _e57 = local_13;
     (*transmittance) = _e57;
-    let _e59 = atmosphere_61;
+    let _e59 = atmosphere_63;
     let _e60 = r_48;
     let _e61 = mu_31;
     let _e62 = mu_s_23;
     let _e63 = nu_17;
     let _e64 = ray_r_mu_intersects_ground_14;
-    let _e67 = GetCombinedScattering(_e59, scattering_texture_2, single_mie_scattering_texture_1, _e60, _e61, _e62, _e63, _e64, (&single_mie_scattering_1));
+    let _e67 = GetCombinedScattering(_e59, scattering_texture_3, single_mie_scattering_texture_1, _e60, _e61, _e62, _e63, _e64, (&single_mie_scattering_1));
     scattering_1 = _e67;
     let _e69 = scattering_1;
     let _e70 = nu_17;
     let _e71 = RayleighPhaseFunction(_e70);
     let _e73 = single_mie_scattering_1;
-    let _e74 = atmosphere_61;
+    let _e74 = atmosphere_63;
     let _e75 = nu_17;
     let _e76 = MiePhaseFunction(_e74, _e75);
     return ((_e69 * _e71) + (_e73 * _e76));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_62: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
-    var atmosphere_63: AtmosphereParameters;
+fn DistanceInsideScatteringRadii(atmosphere_64: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
+    var atmosphere_65: AtmosphereParameters;
     var r_50: f32;
     var mu_33: f32;
     var r_max: f32;
@@ -1599,14 +1802,14 @@ fn DistanceInsideScatteringRadii(atmosphere_62: AtmosphereParameters, r_49: f32,
     var across: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_12: f32;
+    var local_14: f32;
 
-    atmosphere_63 = atmosphere_62;
+    atmosphere_65 = atmosphere_64;
     r_50 = r_49;
     mu_33 = mu_32;
-    let _e14 = atmosphere_63;
+    let _e14 = atmosphere_65;
     r_max = _e14.scattering_r_max;
-    let _e17 = atmosphere_63;
+    let _e17 = atmosphere_65;
     r_min = _e17.scattering_r_min;
     let _e20 = r_50;
     let _e21 = r_50;
@@ -1631,155 +1834,155 @@ fn DistanceInsideScatteringRadii(atmosphere_62: AtmosphereParameters, r_49: f32,
         let _e56 = r_50;
         let _e58 = mu_33;
         let _e60 = down_discriminant;
-        local_12 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
+        local_14 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
     } else {
         let _e64 = up;
-        local_12 = _e64;
+        local_14 = _e64;
     }
-    let _e66 = local_12;
+    let _e66 = local_14;
     return _e66;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_64: AtmosphereParameters, i: i32) -> f32 {
-    var atmosphere_65: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_66: AtmosphereParameters, i: i32) -> f32 {
+    var atmosphere_67: AtmosphereParameters;
     var i_1: i32;
-    var x_5: f32;
+    var x_7: f32;
 
-    atmosphere_65 = atmosphere_64;
+    atmosphere_67 = atmosphere_66;
     i_1 = i;
     let _e13 = i_1;
-    x_5 = (f32(_e13) / 63f);
-    let _e21 = atmosphere_65;
-    let _e23 = atmosphere_65;
-    let _e26 = x_5;
-    let _e28 = x_5;
+    x_7 = (f32(_e13) / 63f);
+    let _e21 = atmosphere_67;
+    let _e23 = atmosphere_67;
+    let _e26 = x_7;
+    let _e28 = x_7;
     return (((_e21.top_radius - _e23.bottom_radius) * _e26) * _e28);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_9: f32, b_4: f32, f: f32) -> f32 {
-    var a_10: f32;
-    var b_5: f32;
+fn InterpolateCoefficient(a_11: f32, b_6: f32, f: f32) -> f32 {
+    var a_12: f32;
+    var b_7: f32;
     var f_1: f32;
-    var local_13: f32;
+    var local_15: f32;
 
-    a_10 = a_9;
-    b_5 = b_4;
+    a_12 = a_11;
+    b_7 = b_6;
     f_1 = f;
-    let _e15 = a_10;
-    let _e18 = b_5;
+    let _e15 = a_12;
+    let _e18 = b_7;
     if ((_e15 > 0f) && (_e18 > 0f)) {
-        let _e22 = a_10;
+        let _e22 = a_12;
         let _e23 = f_1;
-        let _e24 = b_5;
-        let _e25 = a_10;
-        local_13 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
+        let _e24 = b_7;
+        let _e25 = a_12;
+        local_15 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
     } else {
-        let _e31 = a_10;
-        let _e32 = b_5;
+        let _e31 = a_12;
+        let _e32 = b_7;
         let _e33 = f_1;
-        local_13 = mix(_e31, _e32, _e33);
+        local_15 = mix(_e31, _e32, _e33);
     }
-    let _e36 = local_13;
+    let _e36 = local_15;
     return _e36;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_11: vec3<f32>, b_6: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_12: vec3<f32>;
-    var b_7: vec3<f32>;
+fn InterpolateCoefficients(a_13: vec3<f32>, b_8: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_14: vec3<f32>;
+    var b_9: vec3<f32>;
     var f_3: f32;
 
-    a_12 = a_11;
-    b_7 = b_6;
+    a_14 = a_13;
+    b_9 = b_8;
     f_3 = f_2;
-    let _e15 = a_12;
-    let _e17 = b_7;
+    let _e15 = a_14;
+    let _e17 = b_9;
     let _e19 = f_3;
     let _e20 = InterpolateCoefficient(_e15.x, _e17.x, _e19);
-    let _e21 = a_12;
-    let _e23 = b_7;
+    let _e21 = a_14;
+    let _e23 = b_9;
     let _e25 = f_3;
     let _e26 = InterpolateCoefficient(_e21.y, _e23.y, _e25);
-    let _e27 = a_12;
-    let _e29 = b_7;
+    let _e27 = a_14;
+    let _e29 = b_9;
     let _e31 = f_3;
     let _e32 = InterpolateCoefficient(_e27.z, _e29.z, _e31);
     return vec3<f32>(_e20, _e26, _e32);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_66: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_67: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_68: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_69: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_6: f32;
+    var x_8: f32;
     var i_2: i32;
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_67 = atmosphere_66;
+    atmosphere_69 = atmosphere_68;
     altitude_1 = altitude;
-    let _e15 = atmosphere_67;
-    let _e17 = atmosphere_67;
+    let _e15 = atmosphere_69;
+    let _e17 = atmosphere_69;
     height = (_e15.top_radius - _e17.bottom_radius);
     let _e21 = altitude_1;
     let _e22 = height;
-    x_6 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
-    let _e34 = x_6;
+    x_8 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
+    let _e34 = x_8;
     i_2 = min(i32(_e34), 62i);
-    let _e41 = atmosphere_67;
+    let _e41 = atmosphere_69;
     let _e42 = i_2;
     let _e43 = ProfileSampleAltitude(_e41, _e42);
     h0_ = _e43;
     let _e45 = altitude_1;
     let _e46 = h0_;
-    let _e48 = atmosphere_67;
+    let _e48 = atmosphere_69;
     let _e49 = i_2;
     let _e52 = ProfileSampleAltitude(_e48, (_e49 + 1i));
     let _e53 = h0_;
     f_4 = clamp(((_e45 - _e46) / (_e52 - _e53)), 0f, 1f);
     let _e60 = i_2;
-    let _e63 = atmosphere_67.mie_scattering_profile[_e60];
+    let _e63 = atmosphere_69.mie_scattering_profile[_e60];
     let _e64 = i_2;
-    let _e69 = atmosphere_67.mie_scattering_profile[(_e64 + 1i)];
+    let _e69 = atmosphere_69.mie_scattering_profile[(_e64 + 1i)];
     let _e70 = f_4;
     let _e71 = InterpolateCoefficients(_e63, _e69, _e70);
     (*mie_scattering) = _e71;
     let _e72 = i_2;
-    let _e75 = atmosphere_67.rayleigh_scattering_profile[_e72];
+    let _e75 = atmosphere_69.rayleigh_scattering_profile[_e72];
     let _e76 = i_2;
-    let _e81 = atmosphere_67.rayleigh_scattering_profile[(_e76 + 1i)];
+    let _e81 = atmosphere_69.rayleigh_scattering_profile[(_e76 + 1i)];
     let _e82 = f_4;
     let _e83 = InterpolateCoefficients(_e75, _e81, _e82);
     (*rayleigh_scattering) = _e83;
     let _e84 = i_2;
-    let _e87 = atmosphere_67.extinction_profile[_e84];
+    let _e87 = atmosphere_69.extinction_profile[_e84];
     let _e88 = i_2;
-    let _e93 = atmosphere_67.extinction_profile[(_e88 + 1i)];
+    let _e93 = atmosphere_69.extinction_profile[(_e88 + 1i)];
     let _e94 = f_4;
     let _e95 = InterpolateCoefficients(_e87, _e93, _e94);
     return _e95;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_68: AtmosphereParameters, r_51: f32, mu_34: f32, t_7: f32, r_t: f32) -> f32 {
-    var atmosphere_69: AtmosphereParameters;
+fn AltitudeAtDistance(atmosphere_70: AtmosphereParameters, r_51: f32, mu_34: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_71: AtmosphereParameters;
     var r_52: f32;
     var mu_35: f32;
-    var t_8: f32;
+    var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_69 = atmosphere_68;
+    atmosphere_71 = atmosphere_70;
     r_52 = r_51;
     mu_35 = mu_34;
-    t_8 = t_7;
+    t_10 = t_9;
     r_t_1 = r_t;
     let _e19 = r_52;
-    let _e20 = atmosphere_69;
-    let _e23 = t_8;
-    let _e24 = t_8;
+    let _e20 = atmosphere_71;
+    let _e23 = t_10;
+    let _e24 = t_10;
     let _e26 = r_52;
     let _e28 = mu_35;
     let _e32 = r_t_1;
@@ -1788,26 +1991,26 @@ fn AltitudeAtDistance(atmosphere_68: AtmosphereParameters, r_51: f32, mu_34: f32
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_70: AtmosphereParameters, r_53: f32, mu_36: f32, d_15: f32) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
+fn IntegrateSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, r_53: f32, mu_36: f32, d_17: f32) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
     var r_54: f32;
     var mu_37: f32;
-    var d_16: f32;
+    var d_18: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
     var k_2: i32 = 0i;
-    var t_9: f32;
+    var t_11: f32;
     var r_t_2: f32;
     var mie_scattering_1: vec3<f32>;
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_71 = atmosphere_70;
+    atmosphere_73 = atmosphere_72;
     r_54 = r_53;
     mu_37 = mu_36;
-    d_16 = d_15;
-    let _e17 = d_16;
+    d_18 = d_17;
+    let _e17 = d_18;
     dt = (_e17 / 16f);
     loop {
         let _e30 = k_2;
@@ -1817,18 +2020,18 @@ fn IntegrateSegmentOpticalDepth(atmosphere_70: AtmosphereParameters, r_53: f32, 
         {
             let _e36 = dt;
             let _e37 = k_2;
-            t_9 = (_e36 * f32(_e37));
-            let _e41 = atmosphere_71;
+            t_11 = (_e36 * f32(_e37));
+            let _e41 = atmosphere_73;
             let _e42 = r_54;
             let _e43 = mu_37;
-            let _e44 = t_9;
+            let _e44 = t_11;
             let _e45 = RadiusAtDistance(_e41, _e42, _e43, _e44);
             r_t_2 = _e45;
-            let _e49 = atmosphere_71;
-            let _e50 = atmosphere_71;
+            let _e49 = atmosphere_73;
+            let _e50 = atmosphere_73;
             let _e51 = r_54;
             let _e52 = mu_37;
-            let _e53 = t_9;
+            let _e53 = t_11;
             let _e54 = r_t_2;
             let _e55 = AltitudeAtDistance(_e50, _e51, _e52, _e53, _e54);
             let _e60 = GetCoefficientsAtAltitude(_e49, _e55, (&mie_scattering_1), (&rayleigh_scattering_1));
@@ -1854,67 +2057,67 @@ fn IntegrateSegmentOpticalDepth(atmosphere_70: AtmosphereParameters, r_53: f32, 
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_17: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
+fn LongSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_19: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
+    var atmosphere_75: AtmosphereParameters;
     var r_56: f32;
     var mu_39: f32;
-    var d_18: f32;
+    var d_20: f32;
     var ray_r_mu_intersects_ground_16: bool;
-    var local_14: vec3<f32>;
+    var local_16: vec3<f32>;
 
-    atmosphere_73 = atmosphere_72;
+    atmosphere_75 = atmosphere_74;
     r_56 = r_55;
     mu_39 = mu_38;
-    d_18 = d_17;
+    d_20 = d_19;
     ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e20 = atmosphere_73;
+    let _e20 = atmosphere_75;
     if (_e20.transmittance_is_colour != 0i) {
-        let _e24 = atmosphere_73;
+        let _e24 = atmosphere_75;
         let _e25 = r_56;
         let _e26 = mu_39;
-        let _e27 = d_18;
+        let _e27 = d_20;
         let _e28 = IntegrateSegmentOpticalDepth(_e24, _e25, _e26, _e27);
-        local_14 = _e28;
+        local_16 = _e28;
     } else {
-        let _e29 = atmosphere_73;
+        let _e29 = atmosphere_75;
         let _e30 = r_56;
         let _e31 = mu_39;
-        let _e32 = d_18;
+        let _e32 = d_20;
         let _e33 = ray_r_mu_intersects_ground_16;
         let _e34 = GetOpticalDepth(_e29, transmittance_texture_6, _e30, _e31, _e32, _e33);
-        local_14 = _e34;
+        local_16 = _e34;
     }
-    let _e36 = local_14;
+    let _e36 = local_16;
     return _e36;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_15: f32;
+    var local_17: f32;
 
     depth_1 = depth;
     let _e11 = depth_1;
     if (_e11 < 0.0001f) {
         let _e16 = depth_1;
-        local_15 = (1f - (0.5f * _e16));
+        local_17 = (1f - (0.5f * _e16));
     } else {
         let _e20 = depth_1;
         let _e24 = depth_1;
-        local_15 = ((1f - exp(-(_e20))) / _e24);
+        local_17 = ((1f - exp(-(_e20))) / _e24);
     }
-    let _e27 = local_15;
+    let _e27 = local_17;
     return _e27;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_74: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_19: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_75: AtmosphereParameters;
+fn IntegrateSegment(atmosphere_76: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_21: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
     var r_58: f32;
     var mu_41: f32;
     var mu_s_25: f32;
     var nu_19: f32;
-    var d_20: f32;
+    var d_22: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
     var previous_extinction_1: vec3<f32> = vec3(0f);
@@ -1922,7 +2125,7 @@ fn IntegrateSegment(atmosphere_74: AtmosphereParameters, transmittance_texture_7
     var previous_mie: vec3<f32> = vec3(0f);
     var previous_scattering: vec3<f32> = vec3(0f);
     var k_3: i32 = 0i;
-    var t_10: f32;
+    var t_12: f32;
     var r_t_3: f32;
     var altitude_2: f32;
     var mu_s_t_2: f32;
@@ -1937,13 +2140,13 @@ fn IntegrateSegment(atmosphere_74: AtmosphereParameters, transmittance_texture_7
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_75 = atmosphere_74;
+    atmosphere_77 = atmosphere_76;
     r_58 = r_57;
     mu_41 = mu_40;
     mu_s_25 = mu_s_24;
     nu_19 = nu_18;
-    d_20 = d_19;
-    let _e25 = d_20;
+    d_22 = d_21;
+    let _e25 = d_22;
     dt_1 = (_e25 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
@@ -1956,36 +2159,36 @@ fn IntegrateSegment(atmosphere_74: AtmosphereParameters, transmittance_texture_7
         {
             let _e59 = dt_1;
             let _e60 = k_3;
-            t_10 = (_e59 * f32(_e60));
-            let _e64 = atmosphere_75;
+            t_12 = (_e59 * f32(_e60));
+            let _e64 = atmosphere_77;
             let _e65 = r_58;
             let _e66 = mu_41;
-            let _e67 = t_10;
+            let _e67 = t_12;
             let _e68 = RadiusAtDistance(_e64, _e65, _e66, _e67);
             r_t_3 = _e68;
-            let _e70 = atmosphere_75;
+            let _e70 = atmosphere_77;
             let _e71 = r_58;
             let _e72 = mu_41;
-            let _e73 = t_10;
+            let _e73 = t_12;
             let _e74 = r_t_3;
             let _e75 = AltitudeAtDistance(_e70, _e71, _e72, _e73, _e74);
             altitude_2 = _e75;
             let _e77 = r_58;
             let _e78 = mu_s_25;
-            let _e80 = t_10;
+            let _e80 = t_12;
             let _e81 = nu_19;
             let _e84 = r_t_3;
             let _e86 = ClampCosine((((_e77 * _e78) + (_e80 * _e81)) / _e84));
             mu_s_t_2 = _e86;
-            let _e90 = atmosphere_75;
+            let _e90 = atmosphere_77;
             let _e91 = altitude_2;
             let _e96 = GetCoefficientsAtAltitude(_e90, _e91, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e96;
-            let _e98 = atmosphere_75;
+            let _e98 = atmosphere_77;
             let _e99 = r_t_3;
             let _e100 = mu_s_t_2;
             let _e101 = GetOpticalDepthToTopAtmosphereBoundary(_e98, transmittance_texture_7, _e99, _e100);
-            let _e104 = atmosphere_75;
+            let _e104 = atmosphere_77;
             let _e105 = r_t_3;
             let _e106 = mu_s_t_2;
             let _e107 = SunVisibleFraction(_e104, _e105, _e106);
@@ -2054,18 +2257,18 @@ fn IntegrateSegment(atmosphere_74: AtmosphereParameters, transmittance_texture_7
         }
     }
     let _e190 = (*single_rayleigh);
-    let _e191 = atmosphere_75;
+    let _e191 = atmosphere_77;
     (*single_rayleigh) = (_e190 * _e191.solar_irradiance);
     let _e194 = (*single_mie);
-    let _e195 = atmosphere_75;
+    let _e195 = atmosphere_77;
     (*single_mie) = (_e194 * _e195.solar_irradiance);
     let _e198 = optical_depth_1;
     return _e198;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_79: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -2077,8 +2280,8 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     var mu_42: f32;
     var mu_s_26: f32;
     var nu_20: f32;
-    var d_21: f32;
-    var lit: f32;
+    var d_23: f32;
+    var lit_1: f32;
     var ray_r_mu_intersects_ground_17: bool;
     var r_p: f32;
     var mu_p: f32;
@@ -2108,7 +2311,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_77 = atmosphere_76;
+    atmosphere_79 = atmosphere_78;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -2126,7 +2329,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     }
     let _e36 = camera_to_point;
     view_ray_6 = normalize(_e36);
-    let _e44 = atmosphere_77;
+    let _e44 = atmosphere_79;
     let _e45 = camera_7;
     let _e46 = view_ray_6;
     let _e47 = sun_direction_5;
@@ -2139,47 +2342,47 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     }
     let _e64 = point_1;
     let _e65 = start_2;
-    d_21 = max(length((_e64 - _e65)), 0f);
-    let _e71 = d_21;
+    d_23 = max(length((_e64 - _e65)), 0f);
+    let _e71 = d_23;
     let _e72 = shadow_length_1;
-    lit = max((_e71 - max(_e72, 0f)), 0f);
-    let _e79 = atmosphere_77;
+    lit_1 = max((_e71 - max(_e72, 0f)), 0f);
+    let _e79 = atmosphere_79;
     let _e80 = r_59;
     let _e81 = mu_42;
     let _e82 = RayIntersectsGround(_e79, _e80, _e81);
     ray_r_mu_intersects_ground_17 = _e82;
-    let _e84 = atmosphere_77;
+    let _e84 = atmosphere_79;
     let _e85 = r_59;
     let _e86 = mu_42;
-    let _e87 = lit;
+    let _e87 = lit_1;
     let _e88 = RadiusAtDistance(_e84, _e85, _e86, _e87);
     r_p = _e88;
     let _e90 = r_59;
     let _e91 = mu_42;
-    let _e92 = lit;
+    let _e92 = lit_1;
     let _e93 = r_p;
     let _e94 = CosineAtDistance(_e90, _e91, _e92, _e93);
     mu_p = _e94;
     let _e96 = r_59;
     let _e97 = mu_s_26;
-    let _e99 = lit;
+    let _e99 = lit_1;
     let _e100 = nu_20;
     let _e103 = r_p;
     let _e105 = ClampCosine((((_e96 * _e97) + (_e99 * _e100)) / _e103));
     mu_s_p = _e105;
-    let _e111 = d_21;
+    let _e111 = d_23;
     direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e111));
-    let _e119 = lit;
+    let _e119 = lit_1;
     lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e119));
     let _e135 = lit_direct;
     if (_e135 > 0f) {
         {
-            let _e138 = atmosphere_77;
+            let _e138 = atmosphere_79;
             let _e139 = r_59;
             let _e140 = mu_42;
             let _e141 = mu_s_26;
             let _e142 = nu_20;
-            let _e143 = lit;
+            let _e143 = lit_1;
             let _e150 = IntegrateSegment(_e138, transmittance_texture_8, _e139, _e140, _e141, _e142, _e143, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
             lit_optical_depth = _e150;
         }
@@ -2187,18 +2390,18 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     let _e151 = lit_optical_depth;
     optical_depth_2 = _e151;
     let _e153 = direct;
-    let _e156 = lit;
-    let _e157 = d_21;
+    let _e156 = lit_1;
+    let _e157 = d_23;
     if ((_e153 > 0f) && (_e156 < _e157)) {
         {
             let _e163 = optical_depth_2;
-            let _e164 = atmosphere_77;
+            let _e164 = atmosphere_79;
             let _e165 = r_p;
             let _e166 = mu_p;
             let _e167 = mu_s_p;
             let _e168 = nu_20;
-            let _e169 = d_21;
-            let _e170 = lit;
+            let _e169 = d_23;
+            let _e170 = lit_1;
             let _e178 = IntegrateSegment(_e164, transmittance_texture_8, _e165, _e166, _e167, _e168, (_e169 - _e170), (&unused_rayleigh), (&unused_mie), (&unused_weight));
             optical_depth_2 = (_e163 + _e178);
         }
@@ -2206,10 +2409,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     let _e180 = direct;
     if (_e180 < 1f) {
         {
-            let _e183 = atmosphere_77;
+            let _e183 = atmosphere_79;
             let _e184 = r_59;
             let _e185 = mu_42;
-            let _e186 = d_21;
+            let _e186 = d_23;
             let _e187 = ray_r_mu_intersects_ground_17;
             let _e188 = LongSegmentOpticalDepth(_e183, transmittance_texture_8, _e184, _e185, _e186, _e187);
             let _e189 = optical_depth_2;
@@ -2219,31 +2422,31 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     }
     let _e193 = optical_depth_2;
     (*transmittance_1) = exp(-(_e193));
-    let _e197 = atmosphere_77;
+    let _e197 = atmosphere_79;
     let _e198 = r_59;
     let _e199 = mu_42;
     let _e200 = mu_s_26;
     let _e201 = nu_20;
     let _e202 = ray_r_mu_intersects_ground_17;
-    let _e205 = GetCombinedScattering(_e197, scattering_texture_3, single_mie_scattering_texture_2, _e198, _e199, _e200, _e201, _e202, (&single_mie_scattering_2));
+    let _e205 = GetCombinedScattering(_e197, scattering_texture_4, single_mie_scattering_texture_2, _e198, _e199, _e200, _e201, _e202, (&single_mie_scattering_2));
     scattering_3 = _e205;
-    let _e207 = lit;
+    let _e207 = lit_1;
     if (_e207 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e209 = atmosphere_77;
+            let _e209 = atmosphere_79;
             let _e210 = r_59;
             let _e211 = mu_42;
             let _e212 = ray_r_mu_intersects_ground_17;
             let _e213 = DistanceToNearestAtmosphereBoundary(_e209, _e210, _e211, _e212);
             boundary = _e213;
             let _e215 = boundary;
-            let _e217 = atmosphere_77;
+            let _e217 = atmosphere_79;
             let _e218 = r_59;
             let _e219 = mu_42;
             let _e220 = DistanceInsideScatteringRadii(_e217, _e218, _e219);
-            let _e222 = lit;
+            let _e222 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e215), _e220), _e222);
-            let _e228 = atmosphere_77;
+            let _e228 = atmosphere_79;
             let _e229 = r_59;
             let _e230 = mu_42;
             let _e231 = mu_s_26;
@@ -2255,7 +2458,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
             let _e243 = boundary;
             if (_e242 < _e243) {
                 {
-                    let _e245 = atmosphere_77;
+                    let _e245 = atmosphere_79;
                     let _e246 = r_59;
                     let _e247 = mu_42;
                     let _e248 = far;
@@ -2263,7 +2466,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
                     r_far = _e249;
                     let _e252 = scattering_3;
                     let _e253 = far_optical_depth;
-                    let _e256 = atmosphere_77;
+                    let _e256 = atmosphere_79;
                     let _e257 = r_far;
                     let _e258 = r_59;
                     let _e259 = mu_42;
@@ -2278,7 +2481,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
                     let _e272 = ClampCosine((((_e263 * _e264) + (_e266 * _e267)) / _e270));
                     let _e273 = nu_20;
                     let _e274 = ray_r_mu_intersects_ground_17;
-                    let _e277 = GetCombinedScattering(_e256, scattering_texture_3, single_mie_scattering_texture_2, _e257, _e262, _e272, _e273, _e274, (&unused_far_mie));
+                    let _e277 = GetCombinedScattering(_e256, scattering_texture_4, single_mie_scattering_texture_2, _e257, _e262, _e272, _e273, _e274, (&unused_far_mie));
                     scattering_3 = (_e252 - (exp(-(_e253)) * _e277));
                 }
             }
@@ -2292,28 +2495,28 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
             let _e297 = nu_20;
             let _e298 = RayleighPhaseFunction(_e297);
             let _e300 = single_mie_1;
-            let _e301 = atmosphere_77;
+            let _e301 = atmosphere_79;
             let _e302 = nu_20;
             let _e303 = MiePhaseFunction(_e301, _e302);
             return (((_e294 + _e295) * _e298) + (_e300 * _e303));
         }
     }
-    let _e306 = atmosphere_77;
+    let _e306 = atmosphere_79;
     let _e307 = r_59;
     let _e308 = mu_42;
-    let _e309 = lit;
+    let _e309 = lit_1;
     let _e310 = ray_r_mu_intersects_ground_17;
     let _e311 = LongSegmentOpticalDepth(_e306, transmittance_texture_8, _e307, _e308, _e309, _e310);
     let _e312 = lit_optical_depth;
     let _e313 = lit_direct;
     lit_transmittance = exp(-(mix(_e311, _e312, vec3(_e313))));
-    let _e320 = atmosphere_77;
+    let _e320 = atmosphere_79;
     let _e321 = r_p;
     let _e322 = mu_p;
     let _e323 = mu_s_p;
     let _e324 = nu_20;
     let _e325 = ray_r_mu_intersects_ground_17;
-    let _e328 = GetCombinedScattering(_e320, scattering_texture_3, single_mie_scattering_texture_2, _e321, _e322, _e323, _e324, _e325, (&single_mie_scattering_p));
+    let _e328 = GetCombinedScattering(_e320, scattering_texture_4, single_mie_scattering_texture_2, _e321, _e322, _e323, _e324, _e325, (&single_mie_scattering_p));
     scattering_p = _e328;
     let _e330 = scattering_3;
     let _e331 = lit_transmittance;
@@ -2331,45 +2534,45 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_76: AtmosphereParameters, transmit
     let _e352 = nu_20;
     let _e353 = RayleighPhaseFunction(_e352);
     let _e355 = single_mie_scattering_2;
-    let _e356 = atmosphere_77;
+    let _e356 = atmosphere_79;
     let _e357 = nu_20;
     let _e358 = MiePhaseFunction(_e356, _e357);
     return ((_e351 * _e353) + (_e355 * _e358));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_78: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_79: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_80: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_81 = atmosphere_80;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e21 = atmosphere_79;
+    let _e21 = atmosphere_81;
     let _e22 = camera_9;
     let _e23 = point_3;
     let _e25 = sun_direction_7;
-    let _e28 = GetSkyRadianceToPointWithShadow(_e21, transmittance_texture_9, scattering_texture_4, single_mie_scattering_texture_3, _e22, _e23, 0f, _e25, transmittance_2);
+    let _e28 = GetSkyRadianceToPointWithShadow(_e21, transmittance_texture_9, scattering_texture_5, single_mie_scattering_texture_3, _e22, _e23, 0f, _e25, transmittance_2);
     return _e28;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_80: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_82: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_83: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
     var r_60: f32;
     var mu_s_27: f32;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_83 = atmosphere_82;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e20 = atmosphere_81;
+    let _e20 = atmosphere_83;
     let _e21 = point_5;
     let _e23 = ClampRadius(_e20, length(_e21));
     r_60 = _e23;
@@ -2378,7 +2581,7 @@ fn GetSunAndSkyIrradiance(atmosphere_80: AtmosphereParameters, transmittance_tex
     let _e28 = point_5;
     let _e31 = ClampCosine((dot(_e25, _e26) / length(_e28)));
     mu_s_27 = _e31;
-    let _e33 = atmosphere_81;
+    let _e33 = atmosphere_83;
     let _e34 = r_60;
     let _e35 = mu_s_27;
     let _e36 = GetIrradiance(_e33, irradiance_texture_1, _e34, _e35);
@@ -2386,8 +2589,8 @@ fn GetSunAndSkyIrradiance(atmosphere_80: AtmosphereParameters, transmittance_tex
     let _e39 = point_5;
     let _e41 = point_5;
     (*sky_irradiance) = ((_e36 * (1f + (dot(_e38, _e39) / length(_e41)))) * 0.5f);
-    let _e48 = atmosphere_81;
-    let _e50 = atmosphere_81;
+    let _e48 = atmosphere_83;
+    let _e50 = atmosphere_83;
     let _e51 = r_60;
     let _e52 = mu_s_27;
     let _e53 = GetTransmittanceToSun(_e50, transmittance_texture_10, _e51, _e52);
@@ -2396,13 +2599,13 @@ fn GetSunAndSkyIrradiance(atmosphere_80: AtmosphereParameters, transmittance_tex
     return ((_e48.solar_irradiance * _e53) * max(dot(_e55, _e56), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_82: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_84: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_85: AtmosphereParameters;
 
-    atmosphere_83 = atmosphere_82;
-    let _e11 = atmosphere_83;
-    let _e13 = atmosphere_83;
-    let _e16 = atmosphere_83;
+    atmosphere_85 = atmosphere_84;
+    let _e11 = atmosphere_85;
+    let _e13 = atmosphere_85;
+    let _e16 = atmosphere_85;
     return (_e11.solar_irradiance / vec3(((PI * _e13.sun_angular_radius) * _e16.sun_angular_radius)));
 }
 
