@@ -13,6 +13,7 @@
 #include "bake/phase_weighted_radiance.h"
 #include "bake/sun_lookups.h"
 #include "core/constants.h"
+#include "core/errors.h"
 #include "core/quadrature.h"
 #include "shaders_runtime/runtime.h"
 
@@ -82,25 +83,21 @@ Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r,
   nu_size_ = grid.scattering_nu_size;
   // glsl::GetScattering's lookups of the nu slices 0 ... nu_size (the last
   // clamped to the edge, as the texture unit does), which nu only blends.
-  // Along mu_s, for a low sun between two texel columns, the two columns
-  // blended as the lookup blends them (geometrically, SunBelowTableMix);
-  // otherwise the texture unit's linear blend. (The density's rings sit on
-  // the columns themselves.)
+  // Along mu_s the texture unit's linear blend, which is the lookup's own
+  // in daylight; a low sun is read only at the grid's mu_s columns (the
+  // density's rings sit on them, and the irradiance of a low sun is
+  // integrated there), where no blend along mu_s enters.
   const vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(grid, r, mu, mu_s, 0.0, intersects_ground);
   double x_below, x_above, mu_s_t;
   bool low_sun;
   glsl::GetScatteringMuSColumns(grid, uvwz.y, x_below, x_above, mu_s_t, low_sun);
-  const bool between_columns = low_sun && std::abs(mu_s_t) > 1e-9 && std::abs(1.0 - mu_s_t) > 1e-9;
+  if (low_sun && std::abs(mu_s_t) > 1e-9 && std::abs(1.0 - mu_s_t) > 1e-9) {
+    throw InternalError("IncidentAlongNu: a low sun between two mu_s columns of the scattering grid");
+  }
   auto slices = [&](const Texture& table, std::vector<vec3>& out) {
     const glsl::sampler3D sampler{&table};
     for (int slice = 0; slice <= nu_size_; ++slice) {
-      if (between_columns) {
-        const vec4 below = glsl::texture(sampler, glsl::vec3((slice + x_below) / nu_size_, uvwz.z, uvwz.w));
-        const vec4 above = glsl::texture(sampler, glsl::vec3((slice + x_above) / nu_size_, uvwz.z, uvwz.w));
-        out.push_back(vec3(glsl::SunBelowTableMix(below, above, mu_s_t, true)));
-      } else {
-        out.push_back(vec3(glsl::texture(sampler, glsl::vec3((slice + uvwz.y) / nu_size_, uvwz.z, uvwz.w))));
-      }
+      out.push_back(vec3(glsl::texture(sampler, glsl::vec3((slice + uvwz.y) / nu_size_, uvwz.z, uvwz.w))));
     }
   };
   if (single_) {
