@@ -36,31 +36,6 @@ void AppendSkyRule(int n, double horizon, std::vector<double>& cosines, std::vec
   AppendGaussLegendre(n, horizon + kHorizonBand, 1.0, cosines, weights);
 }
 
-// Per channel, values at evenly spaced columns read at t in [0, 1] between
-// columns k and k + 1 by the Catmull-Rom cubic through ln of columns k - 1
-// ... k + 2 (continued linearly in ln past the first and last column):
-// p(t) = (2 p1 + (p2 - p0) t + (2 p0 - 5 p1 + 4 p2 - p3) t^2
-//         + (3 p1 - p0 - 3 p2 + p3) t^3) / 2.
-// A channel with a value that is not positive among the four takes the
-// geometric blend of columns k and k + 1 (SunCosineMix, which falls to a
-// dark side).
-vec3 LogCubicAlongColumns(const std::vector<vec3>& values, int k, double t) {
-  const int last = static_cast<int>(values.size()) - 1;
-  vec3 result(0.0);
-  for (int c = 0; c < 3; ++c) {
-    const double v1 = values[k][c], v2 = values[k + 1][c];
-    const double v0 = k > 0 ? values[k - 1][c] : v1 * v1 / v2;
-    const double v3 = k + 2 <= last ? values[k + 2][c] : v2 * v2 / v1;
-    if (!(v0 > 0.0 && v1 > 0.0 && v2 > 0.0 && v3 > 0.0)) {
-      result[c] = glsl::SunCosineMix(vec4(v1), vec4(v2), t, true).x;
-      continue;
-    }
-    const double p0 = std::log(v0), p1 = std::log(v1), p2 = std::log(v2), p3 = std::log(v3);
-    result[c] = std::exp(0.5 * (2.0 * p1 + (p2 - p0) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t +
-                                (3.0 * p1 - p0 - 3.0 * p2 + p3) * t * t * t));
-  }
-  return result;
-}
 }  // namespace
 
 vec3 Baker::DirectIrradiance(double r, double mu_s) const {
@@ -240,14 +215,15 @@ void Baker::ComputeIndirectIrradiance(int order) {
     }
     return result;
   };
-  // Where the sun is low, the scattering table is blended geometrically
-  // between its mu_s columns, so an irradiance integrated from it at a sun
-  // between two columns follows the chord of ln E between them. After
-  // sunset ln E is concave in the sun's angle (its fall steepens as the sun
-  // sinks), and the chord reads up to 5-9 % low at mid-column (docs/accuracy.md).
-  // There the irradiance is integrated at the columns themselves, where the
-  // table needs no blend along mu_s, and read between them by a Catmull-Rom
-  // cubic in ln E over four columns (LogCubicAlongColumns).
+  // Where the sun is low, an irradiance integrated from the scattering
+  // table at a sun between two of its mu_s columns would follow the table's
+  // blend between them, which is the lookup's and not the irradiance's own.
+  // After sunset ln E is concave in the sun's angle (its fall steepens as
+  // the sun sinks), and the geometric blend read up to 5-9 % low at
+  // mid-column (docs/accuracy.md). There the irradiance is integrated at
+  // the columns themselves, where the table needs no blend along mu_s, and
+  // read between them by the runtime's monotone cubic in ln over four
+  // columns (glsl::LogMonotoneCubicMix).
   const AtmosphereParameters& grid = order == 1 ? atmosphere_grid_ : orders_grid_;  // as IncidentAlongNu reads
   const int mu_s_size = grid.scattering_mu_s_size;
   const SunColumns columns(grid);
@@ -263,9 +239,15 @@ void Baker::ComputeIndirectIrradiance(int order) {
       glsl::GetRMuSFromIrradianceTextureUv(params_, glsl::vec2((x + 0.5) / width, (y + 0.5) / height), r, mu_s);
       const double position = glsl::GetScatteringTextureUMuS(grid, mu_s) * mu_s_size - 0.5;
       const int column = std::clamp(static_cast<int>(std::floor(position)), 0, mu_s_size - 2);
-      const vec3 result = columns.mu_s[column] < glsl::LOW_SUN_MU_S
-                              ? LogCubicAlongColumns(at_columns, column, std::clamp(position - column, 0.0, 1.0))
-                              : sky_irradiance(r, mu_s);
+      vec3 result;
+      if (columns.mu_s[column] < glsl::LOW_SUN_MU_S) {
+        auto at = [&](int k) { return vec4(at_columns[std::clamp(k, 0, integrated_columns - 1)], 0.0); };
+        result = vec3(glsl::LogMonotoneCubicMix(at(column - 1), at(column), at(column + 1), at(column + 2), column > 0,
+                                                column + 2 < integrated_columns,
+                                                std::clamp(position - column, 0.0, 1.0)));
+      } else {
+        result = sky_irradiance(r, mu_s);
+      }
       delta_irradiance_.Store(x, y, 0, vec4(result, 0.0));
       vec4 total = irradiance_.Fetch(x, y) + vec4(result, 0.0);
       irradiance_.Store(x, y, 0, total);

@@ -390,7 +390,7 @@ TEST(Twilight, ReportGroupWithinItsTargets) {
 // from the scattering table between its mu_s columns, the irradiance read
 // 1.76 % / 5.31 % in the report's cases (7.2 % at 440 nm) and 3.38 % /
 // 7.56 % in the twilight set's; integrated at the columns and read between
-// them by a cubic in ln E, 0.76 % / 2.03 % and 1.08 % / 1.75 %
+// them by a monotone cubic in ln E, 0.75 % / 2.00 % and 1.08 % / 1.79 %
 // (docs/accuracy.md).
 TEST(Twilight, SkyIrradianceWithinItsTargets) {
   for (const char* file : {"earth_reference.csv", "earth_twilight_reference.csv"}) {
