@@ -239,8 +239,9 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
 }
 #endif
 
-// Below this sun cosine (84 degrees) table lookups interpolate
-// geometrically along mu_s (SunCosineMix).
+// Below this sun cosine (84 degrees) table lookups interpolate along mu_s
+// in ln L: the irradiance geometrically (SunCosineMix), the scattering table
+// by a monotone cubic over four columns (LogMonotoneCubicMix).
 const Number LOW_SUN_MU_S = 0.1;
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
