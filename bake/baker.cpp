@@ -103,13 +103,16 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
       // The second order's J falls by orders of magnitude from one mu_s
       // column to the next after sunset, and along a ray into the Earth's
       // shadow the sun sinks by several columns: it is gathered following
-      // its own fall. The later orders are gathered linearly: weights that
-      // depend on each order's values would make the orders' operator
-      // nonlinear, and the extrapolated tail then misses by more than 1 %
-      // (Orders.AutoWithTail... on the stiff slab; docs/accuracy.md).
-      const MuSFall fall = order == 2 ? MuSFallOf(scattering_density_) : MuSFall();
-      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, atmosphere_grid_,
-                                        order == 2 ? &fall : nullptr);
+      // its own fall. The later orders are gathered linearly between the
+      // columns: weights that depend on each order's values would make the
+      // orders' operator nonlinear, and the extrapolated tail then misses by
+      // more than 1 % (Orders.AutoWithTail... on the stiff slab;
+      // docs/accuracy.md). Below the grid's lowest sun every order's J
+      // continues its own fall (held, it read the views from space into the
+      // Earth's shadow tens of times too bright); only deep-shadow samples
+      // read it, and the tail tests hold.
+      const MuSFall fall = MuSFallOf(scattering_density_, order == 2);
+      delta_multiple_ = GatherAlongRays(orders_grid_, scattering_density_, atmosphere_grid_, &fall);
       AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
     report_.orders_used = order;

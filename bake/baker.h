@@ -76,23 +76,29 @@ class Baker {
                                 Spectrum& rayleigh_sum, Spectrum& mie_sum) const;
   void ComputeScatteringDensity(int order);
   void ComputeIndirectIrradiance(int order);
-  // Per texel of a scattering grid whose sun is below the horizon (mu_s <
-  // 0), for the pair of it and its neighbour toward the higher sun: the ln
-  // of the ratio of their J summed over the channels (log_ratio > 0, as after
-  // sunset J rises with the sun) and 1 / (ratio - 1); 0 and 0 where J does
-  // not rise. Per (r, mu) row, nu slice, then column.
+  // How J falls along mu_s, read by GatherAlongRays. With
+  // `between_columns` (the second order), per texel of a scattering grid
+  // whose sun is below the horizon (mu_s < 0), for the pair of it and its
+  // neighbour toward the higher sun: the ln of the ratio of their J summed
+  // over the channels (log_ratio > 0, as after sunset J rises with the sun)
+  // and 1 / (ratio - 1); 0 and 0 where J does not rise; per (r, mu) row, nu
+  // slice, then column. Always, per row, nu slice and channel, the fall of
+  // J below the grid's lowest sun: LowestSunLogFall's slope and curvature
+  // of ln J in mu_s from the three lowest columns.
   struct MuSFall {
     std::vector<float> log_ratio, inverse_ratio_minus_one;
     int falling_columns = 0;  // the columns with mu_s < 0, lowest first (not the last)
+    std::vector<float> lowest_log_slope, lowest_log_curvature;
   };
-  MuSFall MuSFallOf(const Texture& density) const;
+  MuSFall MuSFallOf(const Texture& density, bool between_columns) const;
   // The light of the orders whose scattering density (per unit scattering
   // coefficient, on the grid of `density_grid`) is `density`, arriving at
   // every texel of a table on the grid `grid`: the density integrated along
   // each texel's ray. J is read linearly in r and mu; along mu_s linearly,
-  // or, given `fall`, with weights that follow it (exactly where J is
-  // exponential between two columns), continuing the fall below the grid's
-  // lowest sun instead of holding the lowest column.
+  // or where `fall` has falls between columns, with weights that follow
+  // them (exactly where J is exponential between two columns). Given
+  // `fall`, J below the grid's lowest sun continues the fall of the three
+  // lowest columns per channel instead of holding the lowest column.
   Texture GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
                           const AtmosphereParameters& density_grid, const MuSFall* fall = nullptr) const;
   // Whether the table covers less than the whole atmosphere (a scene's bake):

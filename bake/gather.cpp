@@ -21,32 +21,44 @@ namespace {
 // The largest ln of the ratio of J between neighbouring columns that
 // MuSFall keeps (a fall by 5e8).
 constexpr float kLargestLogRatio = 20.0f;
-// How far below the grid's lowest sun, in texels, the gather continues the
-// fall of the two lowest columns.
-constexpr float kLowestPosition = -8.0f;
-
-// The weight of the right column at position f (in texels from the left
-// one, below 0 under the lowest column) for a pair whose J falls by
-// exp(log_ratio) from right to left: (exp(f L) - 1) / (exp(L) - 1), which
-// reads J = a exp(f L) exactly when J is exponential between the columns
-// (b = a exp(L)) and is linear in a and b. Without a fall (inverse 0), f,
-// and the lowest column held below it.
+// The weight of the right column at position f in [0, 1] (in texels from
+// the left one) for a pair whose J falls by exp(log_ratio) from right to
+// left: (exp(f L) - 1) / (exp(L) - 1), which reads J = a exp(f L) exactly
+// when J is exponential between the columns (b = a exp(L)) and is linear in
+// a and b. Without a fall (inverse 0), f.
 inline float FallWeight(float f, float log_ratio, float inverse_ratio_minus_one) {
-  return inverse_ratio_minus_one == 0.0f ? (f > 0.0f ? f : 0.0f)
-                                         : (ExpFloat(f * log_ratio) - 1.0f) * inverse_ratio_minus_one;
+  return inverse_ratio_minus_one == 0.0f ? f : (ExpFloat(f * log_ratio) - 1.0f) * inverse_ratio_minus_one;
 }
 }  // namespace
 
-Baker::MuSFall Baker::MuSFallOf(const Texture& density) const {
+Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) const {
   const SunColumns columns(atmosphere_grid_);
   const int mu_s_size = atmosphere_grid_.scattering_mu_s_size, nu_size = atmosphere_grid_.scattering_nu_size;
   MuSFall fall;
-  while (fall.falling_columns < mu_s_size - 1 && columns.mu_s[fall.falling_columns] < 0.0) ++fall.falling_columns;
+  while (between_columns && fall.falling_columns < mu_s_size - 1 && columns.mu_s[fall.falling_columns] < 0.0) {
+    ++fall.falling_columns;
+  }
   const int columns_per_row = nu_size * fall.falling_columns;
   fall.log_ratio.assign(std::size_t(density.height) * density.depth * columns_per_row, 0.0f);
   fall.inverse_ratio_minus_one.assign(fall.log_ratio.size(), 0.0f);
+  fall.lowest_log_slope.assign(std::size_t(density.height) * density.depth * nu_size * 3, 0.0f);
+  fall.lowest_log_curvature.assign(fall.lowest_log_slope.size(), 0.0f);
   ForEachRow(density, [&](int row, std::size_t first, std::size_t) {
     for (int nu = 0; nu < nu_size; ++nu) {
+      // Below the grid's lowest sun: the runtime's continuation of the three
+      // lowest columns (LowestSunLogFall), per channel.
+      const float* lowest = &density.texels[first + std::size_t(4) * nu * mu_s_size];
+      auto column_value = [&](int column) {
+        return glsl::vec4(lowest[4 * column], lowest[4 * column + 1], lowest[4 * column + 2], 0.0);
+      };
+      glsl::vec4 slope, curvature;
+      glsl::LowestSunLogFall(column_value(0), column_value(1), column_value(2), columns.mu_s[1] - columns.mu_s[0],
+                             columns.mu_s[2] - columns.mu_s[0], slope, curvature);
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t i = (std::size_t(row) * nu_size + nu) * 3 + c;
+        fall.lowest_log_slope[i] = float(slope[c]);
+        fall.lowest_log_curvature[i] = float(curvature[c]);
+      }
       for (int column = 0; column < fall.falling_columns; ++column) {
         // J summed over the channels: one fall for the three.
         const float* a = &density.texels[first + std::size_t(4) * (nu * mu_s_size + column)];
@@ -120,6 +132,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // grid: the texture's r and mu interpolation, done once per sample.
     std::vector<int> samples;  // those with a non-zero weight
     std::vector<std::size_t> fall_rows;  // per sample, MuSFall's row nearest it
+    std::vector<std::size_t> lowest_rows;  // and that row's offset in lowest_log_ratio
     std::vector<float> planes;
     planes.reserve(std::size_t(n + 1) * 4 * plane_width);
     for (int k = 0; k <= n; ++k) {
@@ -146,6 +159,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       if (fall) {
         const std::size_t row = std::size_t(fz < 0.5 ? z0 : z1) * density.height + (fy < 0.5 ? y0 : y1);
         fall_rows.push_back(row * density_nu_size * fall->falling_columns);
+        lowest_rows.push_back(row * density_nu_size * 3);
       }
     }
 
@@ -155,33 +169,60 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     const SunDirections directions = RaySunDirections(columns, ray.mu);
     const int count = static_cast<int>(directions.nu.size());
     std::vector<float> mu_s(directions.mu_s.begin(), directions.mu_s.end()), nu(directions.nu.begin(), directions.nu.end());
+    std::vector<int> nu_slice0(count), nu_slice1(count);
     std::vector<int> nu_row0(count), nu_row1(count);  // offsets of the nu rows in a plane
     std::vector<int> fall_row0(count), fall_row1(count);  // and in a row of MuSFall
     std::vector<float> nu_weight(count);
     for (int j = 0; j < count; ++j) {
       const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (density_nu_size - 1);
       const int nu0 = std::min(int(std::floor(nu_coord)), density_nu_size - 1), nu1 = std::min(nu0 + 1, density_nu_size - 1);
+      nu_slice0[j] = nu0, nu_slice1[j] = nu1;
       nu_row0[j] = 4 * nu0 * density_mu_s_size, nu_row1[j] = 4 * nu1 * density_mu_s_size;
       if (fall) fall_row0[j] = nu0 * fall->falling_columns, fall_row1[j] = nu1 * fall->falling_columns;
       nu_weight[j] = float(nu_coord - nu0);
     }
     const MuSCoordinate mu_s_coordinate(density_grid);
+    const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
     std::vector<Spectrum> directions_sum(count);
     std::vector<float> mu_s_k(count), mu_s_weight(count), values(count);
     std::vector<int> mu_s_left(count);
     std::vector<float> sums[3], source;  // source: J per sample, channel and direction, for thick intervals
     for (auto& sum : sums) sum.assign(count, 0.0f);
     if (!thick_intervals.empty()) source.assign(std::size_t(n + 1) * 3 * count, 0.0f);
-    const bool shaped = fall != nullptr;
+    const bool shaped = fall != nullptr && fall->falling_columns > 0;
     std::vector<float> fall_weight_a(shaped ? count : 0), fall_weight_b(shaped ? count : 0);
+    // Per channel and direction, the fall of J below the lowest column at
+    // the sample (1 where the sun is above it): exp(d (slope + d curvature))
+    // with d = mu_s - mu_s_min < 0, slope and curvature blended between the
+    // nu rows. The directions come in order of mu_s (RaySunDirections), and
+    // only the first `below_end` can have the sun below the lowest column.
+    std::vector<float> below_factor[3];
+    for (auto& factor : below_factor) factor.resize(fall ? count : 0);
+    int below_end = 0;
     for (std::size_t i = 0; i < samples.size(); ++i) {
       const int k = samples[i];
       const float* plane = &planes[i * std::size_t(4) * plane_width];
       const float from_mu_s = float(ray.r / ray.radius[k]), from_nu = float(ray.t[k] / ray.radius[k]);
 #pragma omp simd
       for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
-      mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data(),
-                           shaped ? kLowestPosition : 0.0f);
+      mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data());
+      // The sun's cosine at the sample is at least mu_s r / r_k - t / r_k.
+      below_end = fall ? static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(),
+                                                           (lowest_mu_s + from_nu) / from_mu_s) - mu_s.begin())
+                       : 0;
+      for (int c = 0; c < 3 && below_end > 0; ++c) {
+        const float* slope = &fall->lowest_log_slope[lowest_rows[i] + c];
+        const float* curvature = &fall->lowest_log_curvature[lowest_rows[i] + c];
+        float* factor = below_factor[c].data();
+#pragma omp simd
+        for (int j = 0; j < below_end; ++j) {
+          const int a = 3 * nu_slice0[j], b = 3 * nu_slice1[j];
+          const float t = nu_weight[j], d = std::min(mu_s_k[j] - lowest_mu_s, 0.0f);
+          const float slope_j = slope[a] + t * (slope[b] - slope[a]);
+          const float curvature_j = curvature[a] + t * (curvature[b] - curvature[a]);
+          factor[j] = ExpFloat(d * (slope_j + d * curvature_j));
+        }
+      }
       // The weights of the right columns of the two nu rows: mu_s_weight,
       // or with a fall, weights that follow it (the same for the three
       // channels).
@@ -211,10 +252,16 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
           const int a = nu_row0[j] + 4 * mu_s_left[j] + c, b = nu_row1[j] + 4 * mu_s_left[j] + c;
           const float along_a = plane[a] + weight_a[j] * (plane[a + 4] - plane[a]);
           const float along_b = plane[b] + weight_b[j] * (plane[b + 4] - plane[b]);
-          // Never negative below the lowest column, where the columns may
-          // rise faster than their fall says (without a fall, never below 0).
-          value[j] = std::max(along_a + nu_weight[j] * (along_b - along_a), 0.0f);
+          value[j] = along_a + nu_weight[j] * (along_b - along_a);
           sum[j] += w * value[j];
+        }
+        // Below the lowest column the loop above read the lowest column's J
+        // (its weight clamped to 0); it falls from there.
+        const float* factor = below_factor[c].data();
+#pragma omp simd
+        for (int j = 0; j < below_end; ++j) {
+          sum[j] += w * value[j] * (factor[j] - 1.0f);
+          value[j] *= factor[j];
         }
       }
     }

@@ -33,7 +33,8 @@ struct SunColumns {
 // The distinct sun directions of one ray (view cosine mu) of a scattering
 // grid: its (mu_s, nu) texels, nu clamped as GetScatteringTexel clamps it to
 // the range that mu and mu_s allow, with the slices that clamping gave the
-// same nu merged, as their integrals are the same.
+// same nu merged, as their integrals are the same; in order of mu_s (the
+// lowest sun first).
 struct SunDirections {
   std::vector<double> mu_s, nu;  // per direction
   std::vector<int> of_texel;     // texel x -> direction
@@ -206,10 +207,9 @@ class MuSCoordinate {
     scale_ = float((grid.scattering_mu_s_size - 1) / glsl::GetScatteringUnitMuS(grid, grid.scattering_mu_s_max));
   }
   // For `count` sun cosines: the position along the mu_s axis in texels
-  // (in [lowest, size - 1]) split into a left tap (whose right neighbour
-  // exists) and the weight of the right one, negative for a position below
-  // the lowest column (lowest < 0).
-  void Taps(const float* mu_s, int count, int* left, float* weight, float lowest = 0.0f) const {
+  // (in [0, size - 1]) split into a left tap (whose right neighbour exists)
+  // and the weight of the right one.
+  void Taps(const float* mu_s, int count, int* left, float* weight) const {
     const float bottom = bottom_, c = c_, d_min = d_min_, inverse_span = inverse_span_, inverse_a = inverse_a_;
     const float last = last_, scale = scale_;
     const int last_left = last_left_;
@@ -217,9 +217,8 @@ class MuSCoordinate {
     for (int j = 0; j < count; ++j) {
       const float d = glsl_float::DistanceToSphereFromInside(bottom * mu_s[j], c);
       const float a = (d - d_min) * inverse_span;
-      const float position =
-          ClampFloat(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale, lowest, last);
-      const int i = std::min(static_cast<int>(ClampFloat(position, 0.0f, last)), last_left);
+      const float position = ClampFloat(glsl_float::ScatteringUnitMuSFromDistance(a, inverse_a) * scale, 0.0f, last);
+      const int i = std::min(static_cast<int>(position), last_left);
       left[j] = i;
       weight[j] = position - float(i);
     }

@@ -173,6 +173,23 @@ Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
   return ScatteringUnitMuSFromDistance(a, 1.0 / A);
 }
 
+// The inverse of GetScatteringUnitMuS stretched to [0, 1]: the sun cosine
+// at x in [0, 1] along the table's mu_s axis (x = column / (size - 1) at a
+// texel column). From x = (1 - a / A) / (1 + a), a = (1 - x) / (x + 1 / A);
+// then d, and mu_s from top^2 = bottom^2 + 2 bottom mu_s d + d^2.
+Number GetScatteringMuSFromUnitRange(IN(AtmosphereParameters) atmosphere, Number x) {
+  Number x_mu_s = x * GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
+  Number bottom = atmosphere.bottom_radius;
+  Number H = HorizonDistanceAtTop(atmosphere);
+  Number d_min = atmosphere.top_radius - bottom;
+  Number d_max = H;
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.scattering_mu_s_min);
+  Number A = (D - d_min) / (d_max - d_min);
+  Number a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
+  Number d = d_min + min(a, A) * (d_max - d_min);
+  return d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * bottom * d));
+}
+
 Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
   Number x = GetScatteringUnitMuS(atmosphere, mu_s) /
              GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
@@ -436,6 +453,25 @@ vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d,
   return exp(mix(mix(lb, lc, t), cubic, lit)) * step(dark, max(b, c));
 }
 
+// Below the table's lowest sun, ln L continued from the three lowest mu_s
+// columns a, b, c (b and c at d_b and d_c above the lowest column's mu_s):
+// ln L = ln a + slope d + curvature d^2 at d = mu_s - mu_s_min < 0, the
+// parabola through the three where the fall steepens toward the lower sun
+// (curvature < 0: after sunset the Earth's shadow rises about as the square
+// of the sun's depression, and ln L falls with it), else the line through a
+// and b; where L does not rise from a to b (or a is dark), held at a. The
+// bake's gather continues J below its grid's lowest sun the same way.
+void LowestSunLogFall(IN(vec4) a, IN(vec4) b, IN(vec4) c, Number d_b, Number d_c, OUT(vec4) slope,
+                      OUT(vec4) curvature) {
+  vec4 dark = vec4(1e-30);
+  vec4 la = log(max(a, dark));
+  vec4 secant_b = (log(max(b, dark)) - la) / d_b;
+  vec4 secant_c = (log(max(c, dark)) - la) / d_c;
+  vec4 rises = step(dark, a) * (vec4(1.0) - step(b, a));
+  curvature = rises * step(dark, c) * min((secant_c - secant_b) / (d_c - d_b), vec4(0.0));
+  slope = rises * (secant_b - curvature * d_b);
+}
+
 // The light at the mu_s texel column at texture coordinate x: the two nu
 // slices either side of nu, each bilinear in (mu, r) by the texture unit,
 // blended by SunCosineMix.
@@ -451,7 +487,8 @@ vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(Scattering
 // (GetScatteringAtMuSColumn, two fetches each), blended linearly in
 // daylight (four fetches); for a low sun between two columns by
 // LogMonotoneCubicMix of the four columns around it (eight fetches), and
-// below the table's lowest sun by SunBelowTableMix.
+// below the table's lowest sun by LowestSunLogFall of the three lowest
+// columns (six fetches).
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
@@ -469,8 +506,19 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, low_sun_below);
   vec4 above =
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_above, nu_slice, nu_t, x_above < x_low_sun);
-  if (!low_sun_below || mu_s_t < 0.0) return SunBelowTableMix(below, above, mu_s_t, low_sun_below);
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  if (mu_s_t < 0.0) {
+    vec4 third = GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 2.5 / mu_s_size, nu_slice, nu_t,
+                                          2.5 / mu_s_size < x_low_sun);
+    Number mu_s_min = atmosphere.scattering_mu_s_min;
+    vec4 slope;
+    vec4 curvature;
+    LowestSunLogFall(below, above, third, GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)) - mu_s_min,
+                     GetScatteringMuSFromUnitRange(atmosphere, 2.0 / (mu_s_size - 1.0)) - mu_s_min, slope, curvature);
+    Number d = mu_s - mu_s_min;
+    return below * exp(d * (slope + d * curvature));
+  }
+  if (!low_sun_below) return mix(below, above, mu_s_t);
   Number column = x_below * mu_s_size - 0.5;
   Number x_first = (max(column - 1.0, 0.0) + 0.5) / mu_s_size;
   Number x_last = (min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;

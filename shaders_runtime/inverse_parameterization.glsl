@@ -46,15 +46,8 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
     ray_r_mu_intersects_ground = false;
   }
 
-  Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size) *
-                  GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
-  Number d_min = atmosphere.top_radius - bottom;
-  Number d_max = H;
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.scattering_mu_s_min);
-  Number A = (D - d_min) / (d_max - d_min);
-  Number a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
-  Number d = d_min + min(a, A) * (d_max - d_min);
-  mu_s = d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * bottom * d));
+  mu_s = GetScatteringMuSFromUnitRange(atmosphere,
+                                       GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size));
   nu = ClampCosine(uvwz.x * 2.0 - 1.0);
 }
 

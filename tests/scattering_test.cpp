@@ -174,6 +174,37 @@ TEST(Twilight, LowSunBlendAlongMuSIsAMonotoneCubicInLnL) {
             glsl::SunCosineMix(glsl::vec4(0.5), glsl::vec4(0.0), 0.5, true).x);
 }
 
+// Below the lowest mu_s column (LowestSunLogFall): exact for ln L a
+// parabola that steepens toward the lower sun, as after sunset; the line
+// through the two lowest columns where the fall flattens instead (a
+// parabola would turn and rise); held where L does not rise from the
+// lowest column to the next, or the lowest is dark; per channel.
+TEST(Twilight, BelowTheLowestSunLnLIsContinuedFromTheThreeLowestColumns) {
+  auto continued = [](glsl::vec4 a, glsl::vec4 b, glsl::vec4 c, double d_b, double d_c, double d) {
+    glsl::vec4 slope, curvature;
+    glsl::LowestSunLogFall(a, b, c, d_b, d_c, slope, curvature);
+    return a * glm::exp(d * (slope + d * curvature));
+  };
+  auto parabola = [](double d) { return std::exp(-2.0 + 30.0 * d - 200.0 * d * d); };  // steepens as d falls
+  const double d_b = 0.03, d_c = 0.055;
+  for (double d : {-0.01, -0.05, -0.2}) {
+    const glsl::vec4 value = continued(glsl::vec4(parabola(0.0)), glsl::vec4(parabola(d_b)),
+                                       glsl::vec4(parabola(d_c)), d_b, d_c, d);
+    EXPECT_NEAR(value.x / parabola(d), 1.0, 1e-9) << d;
+  }
+  // Flattening toward the lower sun: the line through the two lowest.
+  auto flattening = [](double d) { return std::exp(30.0 * d + 200.0 * d * d); };
+  const glsl::vec4 line = continued(glsl::vec4(1.0), glsl::vec4(flattening(d_b)), glsl::vec4(flattening(d_c)), d_b,
+                                    d_c, -0.1);
+  EXPECT_NEAR(line.x, std::exp(-0.1 * std::log(flattening(d_b)) / d_b), 1e-12);
+  // Not rising, or dark at the lowest column: held there. Channels apart.
+  const glsl::vec4 held = continued(glsl::vec4(2.0, 0.0, 1.0, 0.0), glsl::vec4(1.0, 1.0, std::exp(0.3), 0.0),
+                                    glsl::vec4(0.5, 2.0, std::exp(0.55), 0.0), d_b, d_c, -0.1);
+  EXPECT_EQ(held.x, 2.0);
+  EXPECT_EQ(held.y, 0.0);
+  EXPECT_NEAR(held.z, std::exp(-1.0), 1e-12);  // ln L linear: slope 10 per unit of mu_s
+}
+
 // Between mu_s texels, from low sun to deep twilight: the zenith view (where
 // nu plays no part) at every fifth r row, the sun halfway in texture
 // coordinate between each pair of mu_s columns below LOW_SUN_MU_S, looked up
@@ -254,9 +285,10 @@ const LutSet& DefaultEarth() {
   return luts;
 }
 
-// Below the table's lowest sun the lookups go on falling from the two lowest
-// mu_s texels instead of holding the lowest one, and never rise above it:
-// sky and irradiance for the sun down to 10 degrees below the lowest sun.
+// Below the table's lowest sun the lookups go on falling (the sky from the
+// three lowest mu_s columns, LowestSunLogFall; the irradiance from its two
+// lowest) instead of holding the lowest one, and never rise above it: sky
+// and irradiance for the sun down to 10 degrees below the lowest sun.
 TEST(Twilight, LookupsBelowTheLowestSunKeepFalling) {
   const LutSet& luts = DefaultEarth();
   const Twin twin(MakeTwinTables(luts));
@@ -341,15 +373,21 @@ std::vector<report::GroupErrors> DefaultEarthErrors(const std::string& file, dou
 
 // The default tables after sunset against the twilight case set's
 // reference (reference/cases/earth_twilight_reference.csv, standard errors
-// up to 1 % to sun 100 degrees): the RMS relative error over the cases and
-// the three channels per group. Gathering the second order linearly along mu_s
-// (holding the lowest column below the grid's lowest sun) read 18.3 % at
-// sun 91-96 degrees and 436 % at 97-100; following its fall, 10.5 % and
-// 94 % (docs/accuracy.md). The bounds sit between; the aim is 5 %.
+// up to 1 % to sun 100 degrees, 3 % at 101-102): the RMS relative error
+// over the cases and the three channels per group. Gathering the second
+// order linearly along mu_s (holding the lowest column below the grid's
+// lowest sun) read 18.3 % at sun 91-96 degrees and 436 % at 97-100;
+// following its fall, 10.5 % and 94 %, 615 % at 101-102, where the views
+// from space into the Earth's shadow read the later orders' J held at the
+// lowest column and one fall for the three channels; with every order's J
+// continued below the lowest sun per channel by LowestSunLogFall, and the
+// lookups below it the same way, 6.7 %, 7.8 % and 28 % (docs/accuracy.md).
+// The bounds sit between; the aim is 5 %.
 TEST(Twilight, SkyAfterSunsetAgainstTheReference) {
   const std::vector<report::GroupErrors> errors = DefaultEarthErrors("earth_twilight_reference.csv");
-  for (const auto& [group, bound] : {std::pair<const char*, double>{"twilight_sky_sun_91-96", 0.14},
-                                     std::pair<const char*, double>{"twilight_sky_sun_97-100", 1.5}}) {
+  for (const auto& [group, bound] : {std::pair<const char*, double>{"twilight_sky_sun_91-96", 0.072},
+                                     std::pair<const char*, double>{"twilight_sky_sun_97-100", 0.2},
+                                     std::pair<const char*, double>{"twilight_sky_sun_101-102", 1.0}}) {
     const report::GroupErrors& e = report::FindGroup(errors, group);
     double squares = 0.0;
     int count = 0;

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _816 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _830 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_816)
+    if (!_830)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _679 = mu < 0.0f;
-    bool _691;
-    if (_679)
+    bool _693 = mu < 0.0f;
+    bool _705;
+    if (_693)
     {
-        _691 = (((r * r) * mu) * mu) >= c;
+        _705 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _691 = _679;
+        _705 = _693;
     }
-    return _691;
+    return _705;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _460;
+    float _474;
     if (r_mu > 0.0f)
     {
-        _460 = c / (r_mu + s);
+        _474 = c / (r_mu + s);
     }
     else
     {
-        _460 = s - r_mu;
+        _474 = s - r_mu;
     }
-    float param_1 = _460;
+    float param_1 = _474;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _909;
+    float _923;
     if (d_max > d_min)
     {
-        _909 = (d - d_min) / (d_max - d_min);
+        _923 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _909 = 0.0f;
+        _923 = 0.0f;
     }
-    float x_mu = _909;
+    float x_mu = _923;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1169;
+        float _1267;
         if (d_max == d_min)
         {
-            _1169 = 0.0f;
+            _1267 = 0.0f;
         }
         else
         {
-            _1169 = (d - d_min) / (d_max - d_min);
+            _1267 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1169;
+        x_mu = _1267;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1213;
+        float _1311;
         if (d_max_1 > d_min_1)
         {
-            _1213 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1311 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1213 = 0.0f;
+            _1311 = 0.0f;
         }
-        x_mu = _1213;
+        x_mu = _1311;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1588;
+    float _1686;
     if (low_sun)
     {
-        _1588 = min(t, 1.0f);
+        _1686 = min(t, 1.0f);
     }
     else
     {
-        _1588 = clamp(t, 0.0f, 1.0f);
+        _1686 = clamp(t, 0.0f, 1.0f);
     }
-    return _1588;
+    return _1686;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -399,24 +399,50 @@ float4 GetScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<float
 }
 #endif
 
-float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
 {
-    float4 param = a;
-    float4 param_1 = b;
-    float param_2 = t;
-    bool param_3 = low_sun;
-    float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1611;
-    if (t < 0.0f)
+    AtmosphereParameters param = atmosphere;
+    float param_1 = atmosphere.scattering_mu_s_max;
+    float x_mu_s = x * GetScatteringUnitMuS(param, param_1);
+    float bottom = atmosphere.bottom_radius;
+    AtmosphereParameters param_2 = atmosphere;
+    float H = HorizonDistanceAtTop(param_2);
+    float d_min = atmosphere.top_radius - bottom;
+    float d_max = H;
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = bottom;
+    float param_5 = atmosphere.scattering_mu_s_min;
+    float D = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+    float A = (D - d_min) / (d_max - d_min);
+    float a = (A - (x_mu_s * A)) / (1.0f + (x_mu_s * A));
+    float d = d_min + (min(a, A) * (d_max - d_min));
+    float _1074;
+    if (d == 0.0f)
     {
-        _1611 = min(blend, a);
+        _1074 = 1.0f;
     }
     else
     {
-        _1611 = blend;
+        float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
+        _1074 = ClampCosine(param_6);
     }
-    return _1611;
+    return _1074;
 }
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+void LowestSunLogFall(float4 a, float4 b, float4 c, float d_b, float d_c, out float4 slope, inout float4 curvature)
+{
+    float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
+    float4 la = log(max(a, dark));
+    float4 secant_b = (log(max(b, dark)) - la) / d_b.xxxx;
+    float4 secant_c = (log(max(c, dark)) - la) / d_c.xxxx;
+    float4 rises = step(dark, a) * (1.0f.xxxx - step(b, a));
+    curvature = (rises * step(dark, c)) * min((secant_c - secant_b) / (d_c - d_b).xxxx, 0.0f.xxxx);
+    slope = rises * (secant_b - (curvature * d_b));
+}
+#endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, bool has_d, float t)
@@ -424,26 +450,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _1672;
+    float4 _1770;
     if (has_a)
     {
-        _1672 = log(max(a, dark));
+        _1770 = log(max(a, dark));
     }
     else
     {
-        _1672 = (lb * 2.0f) - lc;
+        _1770 = (lb * 2.0f) - lc;
     }
-    float4 la = _1672;
-    float4 _1687;
+    float4 la = _1770;
+    float4 _1785;
     if (has_d)
     {
-        _1687 = log(max(d, dark));
+        _1785 = log(max(d, dark));
     }
     else
     {
-        _1687 = (lc * 2.0f) - lb;
+        _1785 = (lc * 2.0f) - lb;
     }
-    float4 ld = _1687;
+    float4 ld = _1785;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -503,40 +529,63 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float param_24 = nu_t;
     bool param_25 = x_above < x_low_sun;
     float4 above = GetScatteringAtMuSColumn(param_20, scattering_texture_1, _scattering_texture_1_sampler, param_21, param_22, param_23, param_24, param_25);
-    if ((!low_sun_below) || (mu_s_t < 0.0f))
-    {
-        float4 param_26 = below;
-        float4 param_27 = above;
-        float param_28 = mu_s_t;
-        bool param_29 = low_sun_below;
-        return SunBelowTableMix(param_26, param_27, param_28, param_29);
-    }
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    if (mu_s_t < 0.0f)
+    {
+        AtmosphereParameters param_26 = atmosphere;
+        float4 param_27 = uvwz;
+        float param_28 = 2.5f / mu_s_size;
+        float param_29 = nu_slice;
+        float param_30 = nu_t;
+        bool param_31 = (2.5f / mu_s_size) < x_low_sun;
+        float4 third = GetScatteringAtMuSColumn(param_26, scattering_texture_1, _scattering_texture_1_sampler, param_27, param_28, param_29, param_30, param_31);
+        float mu_s_min = atmosphere.scattering_mu_s_min;
+        AtmosphereParameters param_32 = atmosphere;
+        float param_33 = 1.0f / (mu_s_size - 1.0f);
+        AtmosphereParameters param_34 = atmosphere;
+        float param_35 = 2.0f / (mu_s_size - 1.0f);
+        float4 param_36 = below;
+        float4 param_37 = above;
+        float4 param_38 = third;
+        float param_39 = GetScatteringMuSFromUnitRange(param_32, param_33) - mu_s_min;
+        float param_40 = GetScatteringMuSFromUnitRange(param_34, param_35) - mu_s_min;
+        float4 param_41;
+        float4 param_42;
+        LowestSunLogFall(param_36, param_37, param_38, param_39, param_40, param_41, param_42);
+        float4 slope = param_41;
+        float4 curvature = param_42;
+        float d = mu_s - mu_s_min;
+        return below * exp((slope + (curvature * d)) * d);
+    }
+    if (!low_sun_below)
+    {
+        return lerp(below, above, mu_s_t.xxxx);
+    }
     float column = (x_below * mu_s_size) - 0.5f;
     float x_first = (max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size;
     float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
-    AtmosphereParameters param_30 = atmosphere;
-    float4 param_31 = uvwz;
-    float param_32 = x_first;
-    float param_33 = nu_slice;
-    float param_34 = nu_t;
-    bool param_35 = true;
-    float4 first = GetScatteringAtMuSColumn(param_30, scattering_texture_1, _scattering_texture_1_sampler, param_31, param_32, param_33, param_34, param_35);
-    AtmosphereParameters param_36 = atmosphere;
-    float4 param_37 = uvwz;
-    float param_38 = x_last;
-    float param_39 = nu_slice;
-    float param_40 = nu_t;
-    bool param_41 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_36, scattering_texture_1, _scattering_texture_1_sampler, param_37, param_38, param_39, param_40, param_41);
-    float4 param_42 = first;
-    float4 param_43 = below;
-    float4 param_44 = above;
-    float4 param_45 = last;
-    bool param_46 = column > 0.5f;
-    bool param_47 = (column + 2.0f) < (mu_s_size - 0.5f);
-    float param_48 = mu_s_t;
-    return LogMonotoneCubicMix(param_42, param_43, param_44, param_45, param_46, param_47, param_48);
+    AtmosphereParameters param_43 = atmosphere;
+    float4 param_44 = uvwz;
+    float param_45 = x_first;
+    float param_46 = nu_slice;
+    float param_47 = nu_t;
+    bool param_48 = true;
+    float4 first = GetScatteringAtMuSColumn(param_43, scattering_texture_1, _scattering_texture_1_sampler, param_44, param_45, param_46, param_47, param_48);
+    AtmosphereParameters param_49 = atmosphere;
+    float4 param_50 = uvwz;
+    float param_51 = x_last;
+    float param_52 = nu_slice;
+    float param_53 = nu_t;
+    bool param_54 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_49, scattering_texture_1, _scattering_texture_1_sampler, param_50, param_51, param_52, param_53, param_54);
+    float4 param_55 = first;
+    float4 param_56 = below;
+    float4 param_57 = above;
+    float4 param_58 = last;
+    bool param_59 = column > 0.5f;
+    bool param_60 = (column + 2.0f) < (mu_s_size - 0.5f);
+    float param_61 = mu_s_t;
+    return LogMonotoneCubicMix(param_55, param_56, param_57, param_58, param_59, param_60, param_61);
 }
 #endif
 
@@ -552,16 +601,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2174;
+        float3 _2396;
         if (scattering.x > 0.0f)
         {
-            _2174 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _2396 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _2174 = 0.0f.xxx;
+            _2396 = 0.0f.xxx;
         }
-        single_mie_scattering = _2174;
+        single_mie_scattering = _2396;
     }
     else
     {
@@ -633,13 +682,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _2242 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2464 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2242)
+    if (!_2464)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -648,19 +697,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2262;
+    float3 _2484;
     if (ray_r_mu_intersects_ground)
     {
-        _2262 = 0.0f.xxx;
+        _2484 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2262 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _2484 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _2262;
+    transmittance = _2484;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -668,9 +717,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2289 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2511 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2289;
+    float3 scattering = _2511;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -718,16 +767,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2383;
+    float _2605;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2383 = a * exp(f * log(b / a));
+        _2605 = a * exp(f * log(b / a));
     }
     else
     {
-        _2383 = lerp(a, b, f);
+        _2605 = lerp(a, b, f);
     }
-    return _2383;
+    return _2605;
 }
 #endif
 
@@ -800,16 +849,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2635;
+    float _2857;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2635 = 1.0f - (0.5f * depth);
+        _2857 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2635 = (1.0f - exp(-depth)) / depth;
+        _2857 = (1.0f - exp(-depth)) / depth;
     }
-    return _2635;
+    return _2857;
 }
 #endif
 
@@ -845,10 +894,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2715 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2937 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2715;
+        float3 extinction = _2937;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -906,10 +955,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2580 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2802 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2580;
+        float3 extinction = _2802;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -982,14 +1031,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _2605;
+    float3 _2827;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2605 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2827 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -998,31 +1047,31 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2605 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _2827 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _2605;
+    return _2827;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _695;
+    float _709;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _695 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _709 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _695 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _709 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _695;
+    return _709;
 }
 #endif
 
@@ -1035,16 +1084,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2345;
+    float _2567;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2345 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2567 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2345 = up;
+        _2567 = up;
     }
-    return _2345;
+    return _2567;
 }
 #endif
 
@@ -1067,13 +1116,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _2861 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3083 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2861)
+    if (!_3083)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1113,11 +1162,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2956 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3178 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2956;
+        lit_optical_depth = _3178;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1131,11 +1180,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2990 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3212 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2990;
+        optical_depth += _3212;
     }
     if (direct < 1.0f)
     {
@@ -1154,9 +1203,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3033 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3255 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3033;
+    float3 scattering = _3255;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1177,11 +1226,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3081 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3303 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3081;
+        float3 far_optical_depth = _3303;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1201,9 +1250,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3135 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3357 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3135);
+            scattering -= (exp(-far_optical_depth) * _3357);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1224,9 +1273,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3200 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3422 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3200;
+    float3 scattering_p = _3422;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1246,25 +1295,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3244 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _3466 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3244;
+    return _3466;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1267;
+    float _1365;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1267 = 0.100000001490116119384765625f;
+        _1365 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1267 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1365 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1267;
+    return _1365;
 }
 #endif
 
@@ -1273,16 +1322,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1285;
+    float _1383;
     if (mu_s < knee)
     {
-        _1285 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1383 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1285 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1383 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1285;
+    return _1383;
 }
 #endif
 
@@ -1309,16 +1358,37 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1316;
+    float _1414;
     if (x < 0.5f)
     {
-        _1316 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1414 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1316 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1414 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1316;
+    return _1414;
+}
+#endif
+
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
+{
+    float4 param = a;
+    float4 param_1 = b;
+    float param_2 = t;
+    bool param_3 = low_sun;
+    float4 blend = SunCosineMix(param, param_1, param_2, param_3);
+    float4 _1709;
+    if (t < 0.0f)
+    {
+        _1709 = min(blend, a);
+    }
+    else
+    {
+        _1709 = blend;
+    }
+    return _1709;
 }
 #endif
 

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _816 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _830 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_816)
+    if (!_830)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _679 = mu < 0.0;
-    bool _691;
-    if (_679)
+    bool _693 = mu < 0.0;
+    bool _705;
+    if (_693)
     {
-        _691 = (((r * r) * mu) * mu) >= c;
+        _705 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _691 = _679;
+        _705 = _693;
     }
-    return _691;
+    return _705;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _460;
+    float _474;
     if (r_mu > 0.0)
     {
-        _460 = c / (r_mu + s);
+        _474 = c / (r_mu + s);
     }
     else
     {
-        _460 = s - r_mu;
+        _474 = s - r_mu;
     }
-    float param_1 = _460;
+    float param_1 = _474;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _909;
+    float _923;
     if (d_max > d_min)
     {
-        _909 = (d - d_min) / (d_max - d_min);
+        _923 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _909 = 0.0;
+        _923 = 0.0;
     }
-    float x_mu = _909;
+    float x_mu = _923;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -323,16 +323,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1169;
+        float _1267;
         if (d_max == d_min)
         {
-            _1169 = 0.0;
+            _1267 = 0.0;
         }
         else
         {
-            _1169 = (d - d_min) / (d_max - d_min);
+            _1267 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1169;
+        x_mu = _1267;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +343,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1213;
+        float _1311;
         if (d_max_1 > d_min_1)
         {
-            _1213 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1311 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1213 = 0.0;
+            _1311 = 0.0;
         }
-        x_mu = _1213;
+        x_mu = _1311;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,16 +372,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1588;
+    float _1686;
     if (low_sun)
     {
-        _1588 = fast::min(t, 1.0);
+        _1686 = fast::min(t, 1.0);
     }
     else
     {
-        _1588 = fast::clamp(t, 0.0, 1.0);
+        _1686 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1588;
+    return _1686;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -426,25 +426,52 @@ float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, t
 }
 #endif
 
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
+float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmosphere, thread const float& x)
 {
-    float4 param = a;
-    float4 param_1 = b;
-    float param_2 = t;
-    bool param_3 = low_sun;
-    float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1611;
-    if (t < 0.0)
+    AtmosphereParameters param = atmosphere;
+    float param_1 = atmosphere.scattering_mu_s_max;
+    float x_mu_s = x * GetScatteringUnitMuS(param, param_1);
+    float bottom = atmosphere.bottom_radius;
+    AtmosphereParameters param_2 = atmosphere;
+    float H = HorizonDistanceAtTop(param_2);
+    float d_min = atmosphere.top_radius - bottom;
+    float d_max = H;
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = bottom;
+    float param_5 = atmosphere.scattering_mu_s_min;
+    float D = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+    float A = (D - d_min) / (d_max - d_min);
+    float a = (A - (x_mu_s * A)) / (1.0 + (x_mu_s * A));
+    float d = d_min + (fast::min(a, A) * (d_max - d_min));
+    float _1074;
+    if (d == 0.0)
     {
-        _1611 = fast::min(blend, a);
+        _1074 = 1.0;
     }
     else
     {
-        _1611 = blend;
+        float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
+        _1074 = ClampCosine(param_6);
     }
-    return _1611;
+    return _1074;
 }
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+void LowestSunLogFall(thread const float4& a, thread const float4& b, thread const float4& c, thread const float& d_b, thread const float& d_c, thread float4& slope, thread float4& curvature)
+{
+    float4 dark = float4(1.0000000031710768509710513471353e-30);
+    float4 la = log(fast::max(a, dark));
+    float4 secant_b = (log(fast::max(b, dark)) - la) / float4(d_b);
+    float4 secant_c = (log(fast::max(c, dark)) - la) / float4(d_c);
+    float4 rises = step(dark, a) * (float4(1.0) - step(b, a));
+    curvature = (rises * step(dark, c)) * fast::min((secant_c - secant_b) / float4(d_c - d_b), float4(0.0));
+    slope = rises * (secant_b - (curvature * d_b));
+}
+#endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
@@ -453,26 +480,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _1672;
+    float4 _1770;
     if (has_a)
     {
-        _1672 = log(fast::max(a, dark));
+        _1770 = log(fast::max(a, dark));
     }
     else
     {
-        _1672 = (lb * 2.0) - lc;
+        _1770 = (lb * 2.0) - lc;
     }
-    float4 la = _1672;
-    float4 _1687;
+    float4 la = _1770;
+    float4 _1785;
     if (has_d)
     {
-        _1687 = log(fast::max(d, dark));
+        _1785 = log(fast::max(d, dark));
     }
     else
     {
-        _1687 = (lc * 2.0) - lb;
+        _1785 = (lc * 2.0) - lb;
     }
-    float4 ld = _1687;
+    float4 ld = _1785;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -533,40 +560,63 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float param_24 = nu_t;
     bool param_25 = x_above < x_low_sun;
     float4 above = GetScatteringAtMuSColumn(param_20, scattering_texture, scattering_textureSmplr, param_21, param_22, param_23, param_24, param_25);
-    if ((!low_sun_below) || (mu_s_t < 0.0))
-    {
-        float4 param_26 = below;
-        float4 param_27 = above;
-        float param_28 = mu_s_t;
-        bool param_29 = low_sun_below;
-        return SunBelowTableMix(param_26, param_27, param_28, param_29);
-    }
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    if (mu_s_t < 0.0)
+    {
+        AtmosphereParameters param_26 = atmosphere;
+        float4 param_27 = uvwz;
+        float param_28 = 2.5 / mu_s_size;
+        float param_29 = nu_slice;
+        float param_30 = nu_t;
+        bool param_31 = (2.5 / mu_s_size) < x_low_sun;
+        float4 third = GetScatteringAtMuSColumn(param_26, scattering_texture, scattering_textureSmplr, param_27, param_28, param_29, param_30, param_31);
+        float mu_s_min = atmosphere.scattering_mu_s_min;
+        AtmosphereParameters param_32 = atmosphere;
+        float param_33 = 1.0 / (mu_s_size - 1.0);
+        AtmosphereParameters param_34 = atmosphere;
+        float param_35 = 2.0 / (mu_s_size - 1.0);
+        float4 param_36 = below;
+        float4 param_37 = above;
+        float4 param_38 = third;
+        float param_39 = GetScatteringMuSFromUnitRange(param_32, param_33) - mu_s_min;
+        float param_40 = GetScatteringMuSFromUnitRange(param_34, param_35) - mu_s_min;
+        float4 param_41;
+        float4 param_42;
+        LowestSunLogFall(param_36, param_37, param_38, param_39, param_40, param_41, param_42);
+        float4 slope = param_41;
+        float4 curvature = param_42;
+        float d = mu_s - mu_s_min;
+        return below * exp((slope + (curvature * d)) * d);
+    }
+    if (!low_sun_below)
+    {
+        return mix(below, above, float4(mu_s_t));
+    }
     float column = (x_below * mu_s_size) - 0.5;
     float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
     float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_30 = atmosphere;
-    float4 param_31 = uvwz;
-    float param_32 = x_first;
-    float param_33 = nu_slice;
-    float param_34 = nu_t;
-    bool param_35 = true;
-    float4 first = GetScatteringAtMuSColumn(param_30, scattering_texture, scattering_textureSmplr, param_31, param_32, param_33, param_34, param_35);
-    AtmosphereParameters param_36 = atmosphere;
-    float4 param_37 = uvwz;
-    float param_38 = x_last;
-    float param_39 = nu_slice;
-    float param_40 = nu_t;
-    bool param_41 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_36, scattering_texture, scattering_textureSmplr, param_37, param_38, param_39, param_40, param_41);
-    float4 param_42 = first;
-    float4 param_43 = below;
-    float4 param_44 = above;
-    float4 param_45 = last;
-    bool param_46 = column > 0.5;
-    bool param_47 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_48 = mu_s_t;
-    return LogMonotoneCubicMix(param_42, param_43, param_44, param_45, param_46, param_47, param_48);
+    AtmosphereParameters param_43 = atmosphere;
+    float4 param_44 = uvwz;
+    float param_45 = x_first;
+    float param_46 = nu_slice;
+    float param_47 = nu_t;
+    bool param_48 = true;
+    float4 first = GetScatteringAtMuSColumn(param_43, scattering_texture, scattering_textureSmplr, param_44, param_45, param_46, param_47, param_48);
+    AtmosphereParameters param_49 = atmosphere;
+    float4 param_50 = uvwz;
+    float param_51 = x_last;
+    float param_52 = nu_slice;
+    float param_53 = nu_t;
+    bool param_54 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_49, scattering_texture, scattering_textureSmplr, param_50, param_51, param_52, param_53, param_54);
+    float4 param_55 = first;
+    float4 param_56 = below;
+    float4 param_57 = above;
+    float4 param_58 = last;
+    bool param_59 = column > 0.5;
+    bool param_60 = (column + 2.0) < (mu_s_size - 0.5);
+    float param_61 = mu_s_t;
+    return LogMonotoneCubicMix(param_55, param_56, param_57, param_58, param_59, param_60, param_61);
 }
 #endif
 
@@ -583,16 +633,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2174;
+        float3 _2396;
         if (scattering.x > 0.0)
         {
-            _2174 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _2396 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _2174 = float3(0.0);
+            _2396 = float3(0.0);
         }
-        single_mie_scattering = _2174;
+        single_mie_scattering = _2396;
     }
     else
     {
@@ -669,13 +719,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _2242 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2464 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2242)
+    if (!_2464)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -684,19 +734,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2262;
+    float3 _2484;
     if (ray_r_mu_intersects_ground)
     {
-        _2262 = float3(0.0);
+        _2484 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2262 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _2484 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _2262;
+    transmittance = _2484;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -704,9 +754,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2289 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2511 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2289;
+    float3 scattering = _2511;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -760,16 +810,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2383;
+    float _2605;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2383 = a * exp(f * log(b / a));
+        _2605 = a * exp(f * log(b / a));
     }
     else
     {
-        _2383 = mix(a, b, f);
+        _2605 = mix(a, b, f);
     }
-    return _2383;
+    return _2605;
 }
 #endif
 
@@ -848,16 +898,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2635;
+    float _2857;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2635 = 1.0 - (0.5 * depth);
+        _2857 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2635 = (1.0 - exp(-depth)) / depth;
+        _2857 = (1.0 - exp(-depth)) / depth;
     }
-    return _2635;
+    return _2857;
 }
 #endif
 
@@ -894,10 +944,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2715 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2937 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2715;
+        float3 extinction = _2937;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -956,10 +1006,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2580 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2802 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2580;
+        float3 extinction = _2802;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1034,14 +1084,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _2605;
+    float3 _2827;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2605 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2827 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1050,9 +1100,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2605 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _2827 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _2605;
+    return _2827;
 }
 #endif
 
@@ -1060,22 +1110,22 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _695;
+    float _709;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _695 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _709 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _695 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _709 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _695;
+    return _709;
 }
 #endif
 
@@ -1089,16 +1139,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2345;
+    float _2567;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2345 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2567 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2345 = up;
+        _2567 = up;
     }
-    return _2345;
+    return _2567;
 }
 #endif
 
@@ -1122,13 +1172,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _2861 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3083 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2861)
+    if (!_3083)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1168,11 +1218,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _2956 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3178 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _2956;
+        lit_optical_depth = _3178;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1186,11 +1236,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _2990 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3212 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _2990;
+        optical_depth += _3212;
     }
     if (direct < 1.0)
     {
@@ -1209,9 +1259,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3033 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3255 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3033;
+    float3 scattering = _3255;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1232,11 +1282,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3081 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3303 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3081;
+        float3 far_optical_depth = _3303;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1256,9 +1306,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3135 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3357 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3135);
+            scattering -= (exp(-far_optical_depth) * _3357);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1279,9 +1329,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3200 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3422 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3200;
+    float3 scattering_p = _3422;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1302,9 +1352,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3244 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _3466 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3244;
+    return _3466;
 }
 #endif
 
@@ -1312,16 +1362,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1267;
+    float _1365;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1267 = 0.100000001490116119384765625;
+        _1365 = 0.100000001490116119384765625;
     }
     else
     {
-        _1267 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1365 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1267;
+    return _1365;
 }
 #endif
 
@@ -1331,16 +1381,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1285;
+    float _1383;
     if (mu_s < knee)
     {
-        _1285 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1383 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1285 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1383 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1285;
+    return _1383;
 }
 #endif
 
@@ -1369,16 +1419,38 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1316;
+    float _1414;
     if (x < 0.5)
     {
-        _1316 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1414 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1316 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1414 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1316;
+    return _1414;
+}
+#endif
+
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+static inline __attribute__((always_inline))
+float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
+{
+    float4 param = a;
+    float4 param_1 = b;
+    float param_2 = t;
+    bool param_3 = low_sun;
+    float4 blend = SunCosineMix(param, param_1, param_2, param_3);
+    float4 _1709;
+    if (t < 0.0)
+    {
+        _1709 = fast::min(blend, a);
+    }
+    else
+    {
+        _1709 = blend;
+    }
+    return _1709;
 }
 #endif
 

@@ -652,29 +652,100 @@ fn GetScatteringUnitMuS(atmosphere_22: AtmosphereParameters, mu_s_3: f32) -> f32
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUMuS(atmosphere_24: AtmosphereParameters, mu_s_5: f32) -> f32 {
+fn GetScatteringMuSFromUnitRange(atmosphere_24: AtmosphereParameters, x_2: f32) -> f32 {
     var atmosphere_25: AtmosphereParameters;
-    var mu_s_6: f32;
-    var x_2: f32;
+    var x_3: f32;
+    var x_mu_s: f32;
+    var bottom: f32;
+    var H_1: f32;
+    var d_min_2: f32;
+    var d_max_2: f32;
+    var D_1: f32;
+    var A_1: f32;
+    var a_5: f32;
+    var d_8: f32;
+    var local_3: f32;
 
     atmosphere_25 = atmosphere_24;
+    x_3 = x_2;
+    let _e10 = x_3;
+    let _e11 = atmosphere_25;
+    let _e12 = atmosphere_25;
+    let _e14 = GetScatteringUnitMuS(_e11, _e12.scattering_mu_s_max);
+    x_mu_s = (_e10 * _e14);
+    let _e17 = atmosphere_25;
+    bottom = _e17.bottom_radius;
+    let _e20 = atmosphere_25;
+    let _e21 = HorizonDistanceAtTop(_e20);
+    H_1 = _e21;
+    let _e23 = atmosphere_25;
+    let _e25 = bottom;
+    d_min_2 = (_e23.top_radius - _e25);
+    let _e28 = H_1;
+    d_max_2 = _e28;
+    let _e30 = atmosphere_25;
+    let _e31 = bottom;
+    let _e32 = atmosphere_25;
+    let _e34 = DistanceToTopAtmosphereBoundary(_e30, _e31, _e32.scattering_mu_s_min);
+    D_1 = _e34;
+    let _e36 = D_1;
+    let _e37 = d_min_2;
+    let _e39 = d_max_2;
+    let _e40 = d_min_2;
+    A_1 = ((_e36 - _e37) / (_e39 - _e40));
+    let _e44 = A_1;
+    let _e45 = x_mu_s;
+    let _e46 = A_1;
+    let _e50 = x_mu_s;
+    let _e51 = A_1;
+    a_5 = ((_e44 - (_e45 * _e46)) / (1f + (_e50 * _e51)));
+    let _e56 = d_min_2;
+    let _e57 = a_5;
+    let _e58 = A_1;
+    let _e60 = d_max_2;
+    let _e61 = d_min_2;
+    d_8 = (_e56 + (min(_e57, _e58) * (_e60 - _e61)));
+    let _e66 = d_8;
+    if (_e66 == 0f) {
+        local_3 = 1f;
+    } else {
+        let _e70 = H_1;
+        let _e71 = H_1;
+        let _e73 = d_8;
+        let _e74 = d_8;
+        let _e78 = bottom;
+        let _e80 = d_8;
+        let _e83 = ClampCosine((((_e70 * _e71) - (_e73 * _e74)) / ((2f * _e78) * _e80)));
+        local_3 = _e83;
+    }
+    let _e85 = local_3;
+    return _e85;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringTextureUMuS(atmosphere_26: AtmosphereParameters, mu_s_5: f32) -> f32 {
+    var atmosphere_27: AtmosphereParameters;
+    var mu_s_6: f32;
+    var x_4: f32;
+
+    atmosphere_27 = atmosphere_26;
     mu_s_6 = mu_s_5;
-    let _e10 = atmosphere_25;
+    let _e10 = atmosphere_27;
     let _e11 = mu_s_6;
     let _e12 = GetScatteringUnitMuS(_e10, _e11);
-    let _e13 = atmosphere_25;
-    let _e14 = atmosphere_25;
+    let _e13 = atmosphere_27;
+    let _e14 = atmosphere_27;
     let _e16 = GetScatteringUnitMuS(_e13, _e14.scattering_mu_s_max);
-    x_2 = (_e12 / _e16);
-    let _e19 = x_2;
-    let _e22 = atmosphere_25;
+    x_4 = (_e12 / _e16);
+    let _e19 = x_4;
+    let _e22 = atmosphere_27;
     let _e24 = GetTextureCoordFromUnitRange(min(_e19, 1f), _e22.scattering_mu_s_size);
     return _e24;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_26: AtmosphereParameters, r_24: f32, rho_3: f32, ray_r_mu_intersects_ground_2: bool, x_mu_1: f32) -> f32 {
-    var atmosphere_27: AtmosphereParameters;
+fn GetScatteringTextureUR(atmosphere_28: AtmosphereParameters, r_24: f32, rho_3: f32, ray_r_mu_intersects_ground_2: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_29: AtmosphereParameters;
     var r_25: f32;
     var rho_4: f32;
     var ray_r_mu_intersects_ground_3: bool;
@@ -686,26 +757,26 @@ fn GetScatteringTextureUR(atmosphere_26: AtmosphereParameters, r_24: f32, rho_3:
     var row: f32;
     var rho_below: f32;
     var rho_above: f32;
-    var bottom: f32;
+    var bottom_1: f32;
     var d_below: f32;
     var d_above: f32;
-    var d_8: f32;
+    var d_9: f32;
     var t: f32;
 
-    atmosphere_27 = atmosphere_26;
+    atmosphere_29 = atmosphere_28;
     r_25 = r_24;
     rho_4 = rho_3;
     ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
     x_mu_2 = x_mu_1;
-    let _e16 = atmosphere_27;
-    let _e17 = atmosphere_27;
+    let _e16 = atmosphere_29;
+    let _e17 = atmosphere_29;
     let _e19 = HorizonDistance(_e16, _e17.scattering_r_min);
     rho_min = _e19;
-    let _e21 = atmosphere_27;
-    let _e22 = atmosphere_27;
+    let _e21 = atmosphere_29;
+    let _e22 = atmosphere_29;
     let _e24 = HorizonDistance(_e21, _e22.scattering_r_max);
     rho_max = _e24;
-    let _e26 = atmosphere_27;
+    let _e26 = atmosphere_29;
     last_row = f32((_e26.scattering_r_size - 1i));
     let _e32 = rho_4;
     let _e33 = rho_min;
@@ -732,26 +803,26 @@ fn GetScatteringTextureUR(atmosphere_26: AtmosphereParameters, r_24: f32, rho_3:
     let _e70 = row;
     let _e73 = last_row;
     rho_above = mix(_e68, _e69, ((_e70 + 1f) / _e73));
-    let _e77 = atmosphere_27;
-    bottom = _e77.bottom_radius;
-    let _e80 = bottom;
+    let _e77 = atmosphere_29;
+    bottom_1 = _e77.bottom_radius;
+    let _e80 = bottom_1;
     let _e81 = rho_below;
     let _e82 = HeightFromHorizonDistance(_e80, _e81);
     let _e83 = rho_below;
     let _e84 = x_mu_2;
     d_below = mix(_e82, _e83, _e84);
-    let _e87 = bottom;
+    let _e87 = bottom_1;
     let _e88 = rho_above;
     let _e89 = HeightFromHorizonDistance(_e87, _e88);
     let _e90 = rho_above;
     let _e91 = x_mu_2;
     d_above = mix(_e89, _e90, _e91);
     let _e94 = r_25;
-    let _e95 = bottom;
+    let _e95 = bottom_1;
     let _e97 = rho_4;
     let _e98 = x_mu_2;
-    d_8 = mix((_e94 - _e95), _e97, _e98);
-    let _e101 = d_8;
+    d_9 = mix((_e94 - _e95), _e97, _e98);
+    let _e101 = d_9;
     let _e102 = d_below;
     let _e104 = d_above;
     let _e105 = d_below;
@@ -763,69 +834,69 @@ fn GetScatteringTextureUR(atmosphere_26: AtmosphereParameters, r_24: f32, rho_3:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_26: f32, mu_17: f32, mu_s_7: f32, nu_9: f32, ray_r_mu_intersects_ground_4: bool) -> vec4<f32> {
-    var atmosphere_29: AtmosphereParameters;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_26: f32, mu_17: f32, mu_s_7: f32, nu_9: f32, ray_r_mu_intersects_ground_4: bool) -> vec4<f32> {
+    var atmosphere_31: AtmosphereParameters;
     var r_27: f32;
     var mu_18: f32;
     var mu_s_8: f32;
     var nu_10: f32;
     var ray_r_mu_intersects_ground_5: bool;
-    var H_1: f32;
+    var H_2: f32;
     var rho_5: f32;
     var half_mu_size: f32;
     var u_mu: f32;
     var x_mu_3: f32;
-    var d_9: f32;
-    var d_min_2: f32;
-    var d_max_2: f32;
-    var local_3: f32;
     var d_10: f32;
     var d_min_3: f32;
     var d_max_3: f32;
     var local_4: f32;
+    var d_11: f32;
+    var d_min_4: f32;
+    var d_max_4: f32;
+    var local_5: f32;
     var u_r: f32;
     var u_nu: f32;
 
-    atmosphere_29 = atmosphere_28;
+    atmosphere_31 = atmosphere_30;
     r_27 = r_26;
     mu_18 = mu_17;
     mu_s_8 = mu_s_7;
     nu_10 = nu_9;
     ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
-    let _e18 = atmosphere_29;
+    let _e18 = atmosphere_31;
     let _e19 = HorizonDistanceAtTop(_e18);
-    H_1 = _e19;
-    let _e21 = atmosphere_29;
+    H_2 = _e19;
+    let _e21 = atmosphere_31;
     let _e22 = r_27;
     let _e23 = HorizonDistance(_e21, _e22);
     rho_5 = _e23;
-    let _e25 = atmosphere_29;
+    let _e25 = atmosphere_31;
     half_mu_size = f32((_e25.scattering_mu_size / 2i));
     let _e33 = ray_r_mu_intersects_ground_5;
     if _e33 {
         {
-            let _e34 = atmosphere_29;
+            let _e34 = atmosphere_31;
             let _e35 = r_27;
             let _e36 = mu_18;
             let _e37 = DistanceToBottomAtmosphereBoundary(_e34, _e35, _e36);
-            d_9 = _e37;
+            d_10 = _e37;
             let _e39 = r_27;
-            let _e40 = atmosphere_29;
-            d_min_2 = (_e39 - _e40.bottom_radius);
+            let _e40 = atmosphere_31;
+            d_min_3 = (_e39 - _e40.bottom_radius);
             let _e44 = rho_5;
-            d_max_2 = _e44;
-            let _e46 = d_max_2;
-            let _e47 = d_min_2;
+            d_max_3 = _e44;
+            let _e46 = d_max_3;
+            let _e47 = d_min_3;
             if (_e46 == _e47) {
-                local_3 = 0f;
+                local_4 = 0f;
             } else {
-                let _e50 = d_9;
-                let _e51 = d_min_2;
-                let _e53 = d_max_2;
-                let _e54 = d_min_2;
-                local_3 = ((_e50 - _e51) / (_e53 - _e54));
+                let _e50 = d_10;
+                let _e51 = d_min_3;
+                let _e53 = d_max_3;
+                let _e54 = d_min_3;
+                local_4 = ((_e50 - _e51) / (_e53 - _e54));
             }
-            let _e58 = local_3;
+            let _e58 = local_4;
             x_mu_3 = _e58;
             let _e62 = half_mu_size;
             let _e64 = x_mu_3;
@@ -834,29 +905,29 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_2
         }
     } else {
         {
-            let _e74 = atmosphere_29;
+            let _e74 = atmosphere_31;
             let _e75 = r_27;
             let _e76 = mu_18;
             let _e77 = DistanceToTopAtmosphereBoundary(_e74, _e75, _e76);
-            d_10 = _e77;
-            let _e79 = atmosphere_29;
+            d_11 = _e77;
+            let _e79 = atmosphere_31;
             let _e81 = r_27;
-            d_min_3 = (_e79.top_radius - _e81);
+            d_min_4 = (_e79.top_radius - _e81);
             let _e84 = rho_5;
-            let _e85 = H_1;
-            d_max_3 = (_e84 + _e85);
-            let _e88 = d_max_3;
-            let _e89 = d_min_3;
+            let _e85 = H_2;
+            d_max_4 = (_e84 + _e85);
+            let _e88 = d_max_4;
+            let _e89 = d_min_4;
             if (_e88 > _e89) {
-                let _e91 = d_10;
-                let _e92 = d_min_3;
-                let _e94 = d_max_3;
-                let _e95 = d_min_3;
-                local_4 = ((_e91 - _e92) / (_e94 - _e95));
+                let _e91 = d_11;
+                let _e92 = d_min_4;
+                let _e94 = d_max_4;
+                let _e95 = d_min_4;
+                local_5 = ((_e91 - _e92) / (_e94 - _e95));
             } else {
-                local_4 = 0f;
+                local_5 = 0f;
             }
-            let _e100 = local_4;
+            let _e100 = local_5;
             x_mu_3 = _e100;
             let _e104 = half_mu_size;
             let _e106 = x_mu_3;
@@ -864,7 +935,7 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_2
             u_mu = (0.5f + (0.5f * ((0.5f / _e104) + (_e106 * (1f - (1f / _e109))))));
         }
     }
-    let _e116 = atmosphere_29;
+    let _e116 = atmosphere_31;
     let _e117 = r_27;
     let _e118 = rho_5;
     let _e119 = ray_r_mu_intersects_ground_5;
@@ -875,7 +946,7 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_2
     let _e124 = ScatteringUnitNu(_e123);
     u_nu = _e124;
     let _e126 = u_nu;
-    let _e127 = atmosphere_29;
+    let _e127 = atmosphere_31;
     let _e128 = mu_s_8;
     let _e129 = GetScatteringTextureUMuS(_e127, _e128);
     let _e130 = u_mu;
@@ -884,121 +955,121 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_28: AtmosphereParameters, r_2
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_30: AtmosphereParameters) -> f32 {
-    var atmosphere_31: AtmosphereParameters;
-    var local_5: f32;
+fn IrradianceKneeMuS(atmosphere_32: AtmosphereParameters) -> f32 {
+    var atmosphere_33: AtmosphereParameters;
+    var local_6: f32;
 
-    atmosphere_31 = atmosphere_30;
-    let _e9 = atmosphere_31;
+    atmosphere_33 = atmosphere_32;
+    let _e9 = atmosphere_33;
     if (_e9.mu_s_min < LOW_SUN_MU_S) {
-        local_5 = LOW_SUN_MU_S;
+        local_6 = LOW_SUN_MU_S;
     } else {
-        let _e13 = atmosphere_31;
-        local_5 = (0.5f * (_e13.mu_s_min + 1f));
+        let _e13 = atmosphere_33;
+        local_6 = (0.5f * (_e13.mu_s_min + 1f));
     }
-    let _e19 = local_5;
+    let _e19 = local_6;
     return _e19;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_32: AtmosphereParameters, mu_s_9: f32) -> f32 {
-    var atmosphere_33: AtmosphereParameters;
+fn GetIrradianceUnitMuS(atmosphere_34: AtmosphereParameters, mu_s_9: f32) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
     var mu_s_10: f32;
     var knee: f32;
-    var local_6: f32;
+    var local_7: f32;
 
-    atmosphere_33 = atmosphere_32;
+    atmosphere_35 = atmosphere_34;
     mu_s_10 = mu_s_9;
-    let _e11 = atmosphere_33;
+    let _e11 = atmosphere_35;
     let _e12 = IrradianceKneeMuS(_e11);
     knee = _e12;
     let _e14 = mu_s_10;
     let _e15 = knee;
     if (_e14 < _e15) {
         let _e18 = mu_s_10;
-        let _e19 = atmosphere_33;
+        let _e19 = atmosphere_35;
         let _e23 = knee;
-        let _e24 = atmosphere_33;
-        local_6 = ((0.5f * (_e18 - _e19.mu_s_min)) / (_e23 - _e24.mu_s_min));
+        let _e24 = atmosphere_35;
+        local_7 = ((0.5f * (_e18 - _e19.mu_s_min)) / (_e23 - _e24.mu_s_min));
     } else {
         let _e30 = mu_s_10;
         let _e31 = knee;
         let _e35 = knee;
-        local_6 = (0.5f + ((0.5f * (_e30 - _e31)) / (1f - _e35)));
-    }
-    let _e40 = local_6;
-    return _e40;
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_34: AtmosphereParameters, x_3: f32) -> f32 {
-    var atmosphere_35: AtmosphereParameters;
-    var x_4: f32;
-    var knee_1: f32;
-    var local_7: f32;
-
-    atmosphere_35 = atmosphere_34;
-    x_4 = x_3;
-    let _e11 = atmosphere_35;
-    let _e12 = IrradianceKneeMuS(_e11);
-    knee_1 = _e12;
-    let _e14 = x_4;
-    if (_e14 < 0.5f) {
-        let _e17 = atmosphere_35;
-        let _e20 = x_4;
-        let _e22 = knee_1;
-        let _e23 = atmosphere_35;
-        local_7 = (_e17.mu_s_min + ((2f * _e20) * (_e22 - _e23.mu_s_min)));
-    } else {
-        let _e28 = knee_1;
-        let _e30 = x_4;
-        let _e35 = knee_1;
-        local_7 = (_e28 + (((2f * _e30) - 1f) * (1f - _e35)));
+        local_7 = (0.5f + ((0.5f * (_e30 - _e31)) / (1f - _e35)));
     }
     let _e40 = local_7;
     return _e40;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_36: AtmosphereParameters, r_28: f32, mu_s_11: f32) -> vec2<f32> {
+fn GetIrradianceMuSFromUnit(atmosphere_36: AtmosphereParameters, x_5: f32) -> f32 {
     var atmosphere_37: AtmosphereParameters;
+    var x_6: f32;
+    var knee_1: f32;
+    var local_8: f32;
+
+    atmosphere_37 = atmosphere_36;
+    x_6 = x_5;
+    let _e11 = atmosphere_37;
+    let _e12 = IrradianceKneeMuS(_e11);
+    knee_1 = _e12;
+    let _e14 = x_6;
+    if (_e14 < 0.5f) {
+        let _e17 = atmosphere_37;
+        let _e20 = x_6;
+        let _e22 = knee_1;
+        let _e23 = atmosphere_37;
+        local_8 = (_e17.mu_s_min + ((2f * _e20) * (_e22 - _e23.mu_s_min)));
+    } else {
+        let _e28 = knee_1;
+        let _e30 = x_6;
+        let _e35 = knee_1;
+        local_8 = (_e28 + (((2f * _e30) - 1f) * (1f - _e35)));
+    }
+    let _e40 = local_8;
+    return _e40;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceTextureUvFromRMuS(atmosphere_38: AtmosphereParameters, r_28: f32, mu_s_11: f32) -> vec2<f32> {
+    var atmosphere_39: AtmosphereParameters;
     var r_29: f32;
     var mu_s_12: f32;
     var x_r_1: f32;
-    var x_mu_s: f32;
+    var x_mu_s_1: f32;
 
-    atmosphere_37 = atmosphere_36;
+    atmosphere_39 = atmosphere_38;
     r_29 = r_28;
     mu_s_12 = mu_s_11;
-    let _e13 = atmosphere_37;
+    let _e13 = atmosphere_39;
     let _e14 = r_29;
     let _e15 = HorizonDistance(_e13, _e14);
-    let _e16 = atmosphere_37;
+    let _e16 = atmosphere_39;
     let _e17 = HorizonDistanceAtTop(_e16);
     x_r_1 = (_e15 / _e17);
-    let _e20 = atmosphere_37;
+    let _e20 = atmosphere_39;
     let _e21 = mu_s_12;
     let _e22 = GetIrradianceUnitMuS(_e20, _e21);
-    x_mu_s = clamp(_e22, 0f, 1f);
-    let _e27 = x_mu_s;
-    let _e28 = atmosphere_37;
+    x_mu_s_1 = clamp(_e22, 0f, 1f);
+    let _e27 = x_mu_s_1;
+    let _e28 = atmosphere_39;
     let _e30 = GetTextureCoordFromUnitRange(_e27, _e28.irradiance_width);
     let _e31 = x_r_1;
-    let _e32 = atmosphere_37;
+    let _e32 = atmosphere_39;
     let _e34 = GetTextureCoordFromUnitRange(_e31, _e32.irradiance_height);
     return vec2<f32>(_e30, _e34);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_38: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
-    var atmosphere_39: AtmosphereParameters;
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
+    var atmosphere_41: AtmosphereParameters;
     var r_31: f32;
     var mu_20: f32;
     var uv_2: vec2<f32>;
 
-    atmosphere_39 = atmosphere_38;
+    atmosphere_41 = atmosphere_40;
     r_31 = r_30;
     mu_20 = mu_19;
-    let _e14 = atmosphere_39;
+    let _e14 = atmosphere_41;
     let _e15 = r_31;
     let _e16 = mu_20;
     let _e17 = GetTransmittanceTextureUvFromRMu(_e14, _e15, _e16);
@@ -1008,26 +1079,26 @@ fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_38: AtmosphereParameters, t
     return vec3<f32>(_e20.xyz);
 }
 
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
-    var atmosphere_41: AtmosphereParameters;
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_42: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
+    var atmosphere_43: AtmosphereParameters;
     var r_33: f32;
     var mu_22: f32;
 
-    atmosphere_41 = atmosphere_40;
+    atmosphere_43 = atmosphere_42;
     r_33 = r_32;
     mu_22 = mu_21;
-    let _e14 = atmosphere_41;
+    let _e14 = atmosphere_43;
     let _e15 = r_33;
     let _e16 = mu_22;
     let _e17 = GetOpticalDepthToTopAtmosphereBoundary(_e14, transmittance_texture_1, _e15, _e16);
     return exp(-(_e17));
 }
 
-fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_11: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
-    var atmosphere_43: AtmosphereParameters;
+fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_12: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
+    var atmosphere_45: AtmosphereParameters;
     var r_35: f32;
     var mu_24: f32;
-    var d_12: f32;
+    var d_13: f32;
     var ray_r_mu_intersects_ground_7: bool;
     var r_d_2: f32;
     var mu_d: f32;
@@ -1035,20 +1106,20 @@ fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2:
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_45 = atmosphere_44;
     r_35 = r_34;
     mu_24 = mu_23;
-    d_12 = d_11;
+    d_13 = d_12;
     ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
-    let _e18 = atmosphere_43;
+    let _e18 = atmosphere_45;
     let _e19 = r_35;
     let _e20 = mu_24;
-    let _e21 = d_12;
+    let _e21 = d_13;
     let _e22 = RadiusAtDistance(_e18, _e19, _e20, _e21);
     r_d_2 = _e22;
     let _e24 = r_35;
     let _e25 = mu_24;
-    let _e26 = d_12;
+    let _e26 = d_13;
     let _e27 = r_d_2;
     let _e28 = CosineAtDistance(_e24, _e25, _e26, _e27);
     mu_d = _e28;
@@ -1056,11 +1127,11 @@ fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2:
     let _e32 = mu_d;
     if (_e31 || (_e32 < 0f)) {
         {
-            let _e36 = atmosphere_43;
+            let _e36 = atmosphere_45;
             let _e37 = r_d_2;
             let _e38 = mu_d;
             let _e40 = GetOpticalDepthToTopAtmosphereBoundary(_e36, transmittance_texture_2, _e37, -(_e38));
-            let _e41 = atmosphere_43;
+            let _e41 = atmosphere_45;
             let _e42 = r_35;
             let _e43 = mu_24;
             let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
@@ -1070,11 +1141,11 @@ fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2:
         let _e47 = mu_24;
         if (_e47 >= 0f) {
             {
-                let _e50 = atmosphere_43;
+                let _e50 = atmosphere_45;
                 let _e51 = r_35;
                 let _e52 = mu_24;
                 let _e53 = GetOpticalDepthToTopAtmosphereBoundary(_e50, transmittance_texture_2, _e51, _e52);
-                let _e54 = atmosphere_43;
+                let _e54 = atmosphere_45;
                 let _e55 = r_d_2;
                 let _e56 = mu_d;
                 let _e57 = GetOpticalDepthToTopAtmosphereBoundary(_e54, transmittance_texture_2, _e55, _e56);
@@ -1082,24 +1153,24 @@ fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2:
             }
         } else {
             {
-                let _e59 = atmosphere_43;
+                let _e59 = atmosphere_45;
                 let _e60 = r_35;
                 let _e62 = mu_24;
                 let _e63 = mu_24;
                 let _e66 = SafeSqrt((1f - (_e62 * _e63)));
                 let _e68 = ClampRadius(_e59, (_e60 * _e66));
                 r_low = _e68;
-                let _e70 = atmosphere_43;
+                let _e70 = atmosphere_45;
                 let _e71 = r_low;
                 let _e73 = GetOpticalDepthToTopAtmosphereBoundary(_e70, transmittance_texture_2, _e71, 0f);
                 tau_low = _e73;
                 let _e75 = tau_low;
-                let _e76 = atmosphere_43;
+                let _e76 = atmosphere_45;
                 let _e77 = r_35;
                 let _e78 = mu_24;
                 let _e80 = GetOpticalDepthToTopAtmosphereBoundary(_e76, transmittance_texture_2, _e77, -(_e78));
                 let _e85 = tau_low;
-                let _e86 = atmosphere_43;
+                let _e86 = atmosphere_45;
                 let _e87 = r_d_2;
                 let _e88 = mu_d;
                 let _e89 = GetOpticalDepthToTopAtmosphereBoundary(_e86, transmittance_texture_2, _e87, _e88);
@@ -1111,93 +1182,93 @@ fn GetOpticalDepth(atmosphere_42: AtmosphereParameters, transmittance_texture_2:
     return max(_e95, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_44: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_13: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
-    var atmosphere_45: AtmosphereParameters;
+fn GetTransmittance(atmosphere_46: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
+    var atmosphere_47: AtmosphereParameters;
     var r_37: f32;
     var mu_26: f32;
-    var d_14: f32;
+    var d_15: f32;
     var ray_r_mu_intersects_ground_9: bool;
 
-    atmosphere_45 = atmosphere_44;
+    atmosphere_47 = atmosphere_46;
     r_37 = r_36;
     mu_26 = mu_25;
-    d_14 = d_13;
+    d_15 = d_14;
     ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e18 = atmosphere_45;
+    let _e18 = atmosphere_47;
     let _e19 = r_37;
     let _e20 = mu_26;
-    let _e21 = d_14;
+    let _e21 = d_15;
     let _e22 = ray_r_mu_intersects_ground_9;
     let _e23 = GetOpticalDepth(_e18, transmittance_texture_3, _e19, _e20, _e21, _e22);
     return exp(-(_e23));
 }
 
-fn SunVisibleFraction(atmosphere_46: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
-    var atmosphere_47: AtmosphereParameters;
+fn SunVisibleFraction(atmosphere_48: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
+    var atmosphere_49: AtmosphereParameters;
     var r_39: f32;
     var mu_s_14: f32;
     var sin_theta_h: f32;
 
-    atmosphere_47 = atmosphere_46;
+    atmosphere_49 = atmosphere_48;
     r_39 = r_38;
     mu_s_14 = mu_s_13;
-    let _e13 = atmosphere_47;
+    let _e13 = atmosphere_49;
     let _e15 = r_39;
     sin_theta_h = (_e13.bottom_radius / _e15);
     let _e18 = mu_s_14;
-    let _e19 = atmosphere_47;
+    let _e19 = atmosphere_49;
     let _e21 = r_39;
     let _e22 = HorizonZenithCosine(_e19.bottom_radius, _e21);
     let _e23 = sin_theta_h;
-    let _e24 = atmosphere_47;
+    let _e24 = atmosphere_49;
     let _e27 = SunVisibleFractionAboveHorizon(_e18, _e22, (_e23 * _e24.sun_angular_radius));
     return _e27;
 }
 
-fn GetTransmittanceToSun(atmosphere_48: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
-    var atmosphere_49: AtmosphereParameters;
+fn GetTransmittanceToSun(atmosphere_50: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
+    var atmosphere_51: AtmosphereParameters;
     var r_41: f32;
     var mu_s_16: f32;
 
-    atmosphere_49 = atmosphere_48;
+    atmosphere_51 = atmosphere_50;
     r_41 = r_40;
     mu_s_16 = mu_s_15;
-    let _e14 = atmosphere_49;
+    let _e14 = atmosphere_51;
     let _e15 = r_41;
     let _e16 = mu_s_16;
     let _e17 = GetTransmittanceToTopAtmosphereBoundary(_e14, transmittance_texture_4, _e15, _e16);
-    let _e18 = atmosphere_49;
+    let _e18 = atmosphere_51;
     let _e19 = r_41;
     let _e20 = mu_s_16;
     let _e21 = SunVisibleFraction(_e18, _e19, _e20);
     return (_e17 * _e21);
 }
 
-fn SunCosineMix(a_5: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
-    var a_6: vec4<f32>;
+fn SunCosineMix(a_6: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
+    var a_7: vec4<f32>;
     var b_1: vec4<f32>;
     var t_2: f32;
     var low_sun_1: bool;
     var dark: vec4<f32> = vec4(0.000000000000000000000000000001f);
 
-    a_6 = a_5;
+    a_7 = a_6;
     b_1 = b;
     t_2 = t_1;
     low_sun_1 = low_sun;
     let _e15 = low_sun_1;
     if !(_e15) {
-        let _e17 = a_6;
+        let _e17 = a_7;
         let _e18 = b_1;
         let _e19 = t_2;
         return mix(_e17, _e18, vec4(_e19));
     }
-    let _e25 = a_6;
+    let _e25 = a_7;
     let _e26 = dark;
     let _e29 = b_1;
     let _e30 = dark;
     let _e33 = t_2;
     let _e37 = dark;
-    let _e38 = a_6;
+    let _e38 = a_7;
     let _e39 = b_1;
     return (exp(mix(log(max(_e25, _e26)), log(max(_e29, _e30)), vec4(_e33))) * step(_e37, max(_e38, _e39)));
 }
@@ -1205,35 +1276,35 @@ fn SunCosineMix(a_5: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
     var t_4: f32;
     var low_sun_3: bool;
-    var local_8: f32;
+    var local_9: f32;
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
     let _e11 = low_sun_3;
     if _e11 {
         let _e12 = t_4;
-        local_8 = min(_e12, 1f);
+        local_9 = min(_e12, 1f);
     } else {
         let _e15 = t_4;
-        local_8 = clamp(_e15, 0f, 1f);
+        local_9 = clamp(_e15, 0f, 1f);
     }
-    let _e20 = local_8;
+    let _e20 = local_9;
     return _e20;
 }
 
-fn SunBelowTableMix(a_7: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
-    var a_8: vec4<f32>;
+fn SunBelowTableMix(a_8: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
+    var a_9: vec4<f32>;
     var b_3: vec4<f32>;
     var t_6: f32;
     var low_sun_5: bool;
     var blend: vec4<f32>;
-    var local_9: vec4<f32>;
+    var local_10: vec4<f32>;
 
-    a_8 = a_7;
+    a_9 = a_8;
     b_3 = b_2;
     t_6 = t_5;
     low_sun_5 = low_sun_4;
-    let _e15 = a_8;
+    let _e15 = a_9;
     let _e16 = b_3;
     let _e17 = t_6;
     let _e18 = low_sun_5;
@@ -1242,27 +1313,27 @@ fn SunBelowTableMix(a_7: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
     let _e21 = t_6;
     if (_e21 < 0f) {
         let _e24 = blend;
-        let _e25 = a_8;
-        local_9 = min(_e24, _e25);
+        let _e25 = a_9;
+        local_10 = min(_e24, _e25);
     } else {
         let _e27 = blend;
-        local_9 = _e27;
+        local_10 = _e27;
     }
-    let _e29 = local_9;
+    let _e29 = local_10;
     return _e29;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_50: AtmosphereParameters, u_mu_s: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_51: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_52: AtmosphereParameters, u_mu_s: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_53: AtmosphereParameters;
     var u_mu_s_1: f32;
     var mu_s_size: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_51 = atmosphere_50;
+    atmosphere_53 = atmosphere_52;
     u_mu_s_1 = u_mu_s;
-    let _e15 = atmosphere_51;
+    let _e15 = atmosphere_53;
     mu_s_size = f32(_e15.scattering_mu_s_size);
     let _e19 = u_mu_s_1;
     let _e20 = mu_s_size;
@@ -1277,7 +1348,7 @@ fn GetScatteringMuSColumns(atmosphere_50: AtmosphereParameters, u_mu_s: f32, x_b
     let _e41 = mu_s_size;
     (*x_above) = ((_e38 + 1.5f) / _e41);
     let _e43 = (*x_below);
-    let _e44 = atmosphere_51;
+    let _e44 = atmosphere_53;
     let _e45 = GetScatteringTextureUMuS(_e44, LOW_SUN_MU_S);
     (*low_sun_below) = (_e43 < _e45);
     let _e47 = mu_s_coord;
@@ -1289,20 +1360,20 @@ fn GetScatteringMuSColumns(atmosphere_50: AtmosphereParameters, u_mu_s: f32, x_b
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LogMonotoneCubicMix(a_9: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_15: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
-    var a_10: vec4<f32>;
+fn LogMonotoneCubicMix(a_10: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_16: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
+    var a_11: vec4<f32>;
     var b_5: vec4<f32>;
     var c_7: vec4<f32>;
-    var d_16: vec4<f32>;
+    var d_17: vec4<f32>;
     var has_a_1: bool;
     var has_d_1: bool;
     var t_8: f32;
     var dark_1: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var lb: vec4<f32>;
     var lc: vec4<f32>;
-    var local_10: vec4<f32>;
-    var la: vec4<f32>;
     var local_11: vec4<f32>;
+    var la: vec4<f32>;
+    var local_12: vec4<f32>;
     var ld: vec4<f32>;
     var secant_a: vec4<f32>;
     var secant: vec4<f32>;
@@ -1318,10 +1389,10 @@ fn LogMonotoneCubicMix(a_9: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_15: vec
     var cubic: vec4<f32>;
     var lit: vec4<f32>;
 
-    a_10 = a_9;
+    a_11 = a_10;
     b_5 = b_4;
     c_7 = c_6;
-    d_16 = d_15;
+    d_17 = d_16;
     has_a_1 = has_a;
     has_d_1 = has_d;
     t_8 = t_7;
@@ -1333,27 +1404,27 @@ fn LogMonotoneCubicMix(a_9: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_15: vec
     lc = log(max(_e29, _e30));
     let _e34 = has_a_1;
     if _e34 {
-        let _e35 = a_10;
+        let _e35 = a_11;
         let _e36 = dark_1;
-        local_10 = log(max(_e35, _e36));
+        local_11 = log(max(_e35, _e36));
     } else {
         let _e40 = lb;
         let _e42 = lc;
-        local_10 = ((2f * _e40) - _e42);
+        local_11 = ((2f * _e40) - _e42);
     }
-    let _e45 = local_10;
+    let _e45 = local_11;
     la = _e45;
     let _e47 = has_d_1;
     if _e47 {
-        let _e48 = d_16;
+        let _e48 = d_17;
         let _e49 = dark_1;
-        local_11 = log(max(_e48, _e49));
+        local_12 = log(max(_e48, _e49));
     } else {
         let _e53 = lc;
         let _e55 = lb;
-        local_11 = ((2f * _e53) - _e55);
+        local_12 = ((2f * _e53) - _e55);
     }
-    let _e58 = local_11;
+    let _e58 = local_12;
     ld = _e58;
     let _e60 = lb;
     let _e61 = la;
@@ -1407,10 +1478,10 @@ fn LogMonotoneCubicMix(a_9: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_15: vec
     let _e166 = slope_c;
     cubic = (((((((2f * _e133) - (3f * _e136)) + 1f) * _e141) + (((_e143 - (2f * _e145)) + _e148) * _e150)) + (((3f * _e154) - (2f * _e157)) * _e160)) + ((_e163 - _e164) * _e166));
     let _e170 = dark_1;
-    let _e171 = a_10;
+    let _e171 = a_11;
     let _e172 = b_5;
     let _e174 = c_7;
-    let _e175 = d_16;
+    let _e175 = d_17;
     lit = step(_e170, min(min(_e171, _e172), min(_e174, _e175)));
     let _e180 = lb;
     let _e181 = lc;
@@ -1424,31 +1495,83 @@ fn LogMonotoneCubicMix(a_9: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_15: vec
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_52: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_5: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_53: AtmosphereParameters;
+fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, c_8: vec4<f32>, d_b: f32, d_c: f32, slope: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
+    var a_13: vec4<f32>;
+    var b_7: vec4<f32>;
+    var c_9: vec4<f32>;
+    var d_b_1: f32;
+    var d_c_1: f32;
+    var dark_2: vec4<f32> = vec4(0.000000000000000000000000000001f);
+    var la_1: vec4<f32>;
+    var secant_b: vec4<f32>;
+    var secant_c: vec4<f32>;
+    var rises: vec4<f32>;
+
+    a_13 = a_12;
+    b_7 = b_6;
+    c_9 = c_8;
+    d_b_1 = d_b;
+    d_c_1 = d_c;
+    let _e22 = a_13;
+    let _e23 = dark_2;
+    la_1 = log(max(_e22, _e23));
+    let _e27 = b_7;
+    let _e28 = dark_2;
+    let _e31 = la_1;
+    let _e33 = d_b_1;
+    secant_b = ((log(max(_e27, _e28)) - _e31) / vec4(_e33));
+    let _e37 = c_9;
+    let _e38 = dark_2;
+    let _e41 = la_1;
+    let _e43 = d_c_1;
+    secant_c = ((log(max(_e37, _e38)) - _e41) / vec4(_e43));
+    let _e47 = dark_2;
+    let _e48 = a_13;
+    let _e52 = b_7;
+    let _e53 = a_13;
+    rises = (step(_e47, _e48) * (vec4(1f) - step(_e52, _e53)));
+    let _e58 = rises;
+    let _e59 = dark_2;
+    let _e60 = c_9;
+    let _e63 = secant_c;
+    let _e64 = secant_b;
+    let _e66 = d_c_1;
+    let _e67 = d_b_1;
+    (*curvature) = ((_e58 * step(_e59, _e60)) * min(((_e63 - _e64) / vec4((_e66 - _e67))), vec4(0f)));
+    let _e75 = rises;
+    let _e76 = secant_b;
+    let _e77 = (*curvature);
+    let _e78 = d_b_1;
+    (*slope) = (_e75 * (_e76 - (_e77 * _e78)));
+    return;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_7: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_55: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
-    var x_6: f32;
+    var x_8: f32;
     var nu_slice_1: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
     var nu_size: f32;
 
-    atmosphere_53 = atmosphere_52;
+    atmosphere_55 = atmosphere_54;
     uvwz_1 = uvwz;
-    x_6 = x_5;
+    x_8 = x_7;
     nu_slice_1 = nu_slice;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e20 = atmosphere_53;
+    let _e20 = atmosphere_55;
     nu_size = f32(_e20.scattering_nu_size);
     let _e24 = nu_slice_1;
-    let _e25 = x_6;
+    let _e25 = x_8;
     let _e27 = nu_size;
     let _e29 = uvwz_1;
     let _e31 = uvwz_1;
     let _e34 = SampleTexture3D(scattering_texture, vec3<f32>(((_e24 + _e25) / _e27), _e29.z, _e31.w));
     let _e35 = nu_slice_1;
-    let _e38 = x_6;
+    let _e38 = x_8;
     let _e40 = nu_size;
     let _e42 = uvwz_1;
     let _e44 = uvwz_1;
@@ -1460,8 +1583,8 @@ fn GetScatteringAtMuSColumn(atmosphere_52: AtmosphereParameters, scattering_text
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
-    var atmosphere_55: AtmosphereParameters;
+fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
+    var atmosphere_57: AtmosphereParameters;
     var r_43: f32;
     var mu_28: f32;
     var mu_s_18: f32;
@@ -1480,19 +1603,24 @@ fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: text
     var below: vec4<f32>;
     var above: vec4<f32>;
     var mu_s_size_1: f32;
+    var third: vec4<f32>;
+    var mu_s_min: f32;
+    var slope_1: vec4<f32>;
+    var curvature_1: vec4<f32>;
+    var d_18: f32;
     var column: f32;
     var x_first: f32;
     var x_last: f32;
     var first: vec4<f32>;
     var last: vec4<f32>;
 
-    atmosphere_55 = atmosphere_54;
+    atmosphere_57 = atmosphere_56;
     r_43 = r_42;
     mu_28 = mu_27;
     mu_s_18 = mu_s_17;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e20 = atmosphere_55;
+    let _e20 = atmosphere_57;
     let _e21 = r_43;
     let _e22 = mu_28;
     let _e23 = mu_s_18;
@@ -1500,7 +1628,7 @@ fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: text
     let _e25 = ray_r_mu_intersects_ground_11;
     let _e26 = GetScatteringTextureUvwzFromRMuMuSNu(_e20, _e21, _e22, _e23, _e24, _e25);
     uvwz_2 = _e26;
-    let _e28 = atmosphere_55;
+    let _e28 = atmosphere_57;
     nu_size_1 = f32(_e28.scattering_nu_size);
     let _e32 = uvwz_2;
     let _e34 = nu_size_1;
@@ -1511,13 +1639,13 @@ fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: text
     let _e46 = nu_coord;
     let _e47 = nu_slice_2;
     nu_t_2 = (_e46 - _e47);
-    let _e54 = atmosphere_55;
+    let _e54 = atmosphere_57;
     let _e55 = uvwz_2;
     GetScatteringMuSColumns(_e54, _e55.y, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e65 = atmosphere_55;
+    let _e65 = atmosphere_57;
     let _e66 = GetScatteringTextureUMuS(_e65, LOW_SUN_MU_S);
     x_low_sun = _e66;
-    let _e68 = atmosphere_55;
+    let _e68 = atmosphere_57;
     let _e69 = uvwz_2;
     let _e70 = x_below_1;
     let _e71 = nu_slice_2;
@@ -1525,7 +1653,7 @@ fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: text
     let _e73 = low_sun_below_1;
     let _e74 = GetScatteringAtMuSColumn(_e68, scattering_texture_1, _e69, _e70, _e71, _e72, _e73);
     below = _e74;
-    let _e76 = atmosphere_55;
+    let _e76 = atmosphere_57;
     let _e77 = uvwz_2;
     let _e78 = x_above_1;
     let _e79 = nu_slice_2;
@@ -1534,59 +1662,93 @@ fn GetScattering(atmosphere_54: AtmosphereParameters, scattering_texture_1: text
     let _e82 = x_low_sun;
     let _e84 = GetScatteringAtMuSColumn(_e76, scattering_texture_1, _e77, _e78, _e79, _e80, (_e81 < _e82));
     above = _e84;
-    let _e86 = low_sun_below_1;
-    let _e88 = mu_s_t_1;
-    if (!(_e86) || (_e88 < 0f)) {
-        let _e92 = below;
-        let _e93 = above;
-        let _e94 = mu_s_t_1;
-        let _e95 = low_sun_below_1;
-        let _e96 = SunBelowTableMix(_e92, _e93, _e94, _e95);
-        return _e96;
+    let _e86 = atmosphere_57;
+    mu_s_size_1 = f32(_e86.scattering_mu_s_size);
+    let _e90 = mu_s_t_1;
+    if (_e90 < 0f) {
+        {
+            let _e93 = atmosphere_57;
+            let _e94 = uvwz_2;
+            let _e96 = mu_s_size_1;
+            let _e98 = nu_slice_2;
+            let _e99 = nu_t_2;
+            let _e101 = mu_s_size_1;
+            let _e103 = x_low_sun;
+            let _e105 = GetScatteringAtMuSColumn(_e93, scattering_texture_1, _e94, (2.5f / _e96), _e98, _e99, ((2.5f / _e101) < _e103));
+            third = _e105;
+            let _e107 = atmosphere_57;
+            mu_s_min = _e107.scattering_mu_s_min;
+            let _e112 = below;
+            let _e113 = above;
+            let _e114 = third;
+            let _e115 = atmosphere_57;
+            let _e117 = mu_s_size_1;
+            let _e121 = GetScatteringMuSFromUnitRange(_e115, (1f / (_e117 - 1f)));
+            let _e122 = mu_s_min;
+            let _e124 = atmosphere_57;
+            let _e126 = mu_s_size_1;
+            let _e130 = GetScatteringMuSFromUnitRange(_e124, (2f / (_e126 - 1f)));
+            let _e131 = mu_s_min;
+            LowestSunLogFall(_e112, _e113, _e114, (_e121 - _e122), (_e130 - _e131), (&slope_1), (&curvature_1));
+            let _e137 = mu_s_18;
+            let _e138 = mu_s_min;
+            d_18 = (_e137 - _e138);
+            let _e141 = below;
+            let _e142 = d_18;
+            let _e143 = slope_1;
+            let _e144 = d_18;
+            let _e145 = curvature_1;
+            return (_e141 * exp((_e142 * (_e143 + (_e144 * _e145)))));
+        }
     }
-    let _e97 = atmosphere_55;
-    mu_s_size_1 = f32(_e97.scattering_mu_s_size);
-    let _e101 = x_below_1;
-    let _e102 = mu_s_size_1;
-    column = ((_e101 * _e102) - 0.5f);
-    let _e107 = column;
-    let _e114 = mu_s_size_1;
-    x_first = ((max((_e107 - 1f), 0f) + 0.5f) / _e114);
-    let _e117 = column;
-    let _e120 = mu_s_size_1;
-    let _e126 = mu_s_size_1;
-    x_last = ((min((_e117 + 2f), (_e120 - 1f)) + 0.5f) / _e126);
-    let _e129 = atmosphere_55;
-    let _e130 = uvwz_2;
-    let _e131 = x_first;
-    let _e132 = nu_slice_2;
-    let _e133 = nu_t_2;
-    let _e135 = GetScatteringAtMuSColumn(_e129, scattering_texture_1, _e130, _e131, _e132, _e133, true);
-    first = _e135;
-    let _e137 = atmosphere_55;
-    let _e138 = uvwz_2;
-    let _e139 = x_last;
-    let _e140 = nu_slice_2;
-    let _e141 = nu_t_2;
-    let _e142 = x_last;
-    let _e143 = x_low_sun;
-    let _e145 = GetScatteringAtMuSColumn(_e137, scattering_texture_1, _e138, _e139, _e140, _e141, (_e142 < _e143));
-    last = _e145;
-    let _e147 = first;
-    let _e148 = below;
-    let _e149 = above;
-    let _e150 = last;
-    let _e151 = column;
-    let _e154 = column;
-    let _e157 = mu_s_size_1;
-    let _e161 = mu_s_t_1;
-    let _e162 = LogMonotoneCubicMix(_e147, _e148, _e149, _e150, (_e151 > 0.5f), ((_e154 + 2f) < (_e157 - 0.5f)), _e161);
-    return _e162;
+    let _e151 = low_sun_below_1;
+    if !(_e151) {
+        let _e153 = below;
+        let _e154 = above;
+        let _e155 = mu_s_t_1;
+        return mix(_e153, _e154, vec4(_e155));
+    }
+    let _e158 = x_below_1;
+    let _e159 = mu_s_size_1;
+    column = ((_e158 * _e159) - 0.5f);
+    let _e164 = column;
+    let _e171 = mu_s_size_1;
+    x_first = ((max((_e164 - 1f), 0f) + 0.5f) / _e171);
+    let _e174 = column;
+    let _e177 = mu_s_size_1;
+    let _e183 = mu_s_size_1;
+    x_last = ((min((_e174 + 2f), (_e177 - 1f)) + 0.5f) / _e183);
+    let _e186 = atmosphere_57;
+    let _e187 = uvwz_2;
+    let _e188 = x_first;
+    let _e189 = nu_slice_2;
+    let _e190 = nu_t_2;
+    let _e192 = GetScatteringAtMuSColumn(_e186, scattering_texture_1, _e187, _e188, _e189, _e190, true);
+    first = _e192;
+    let _e194 = atmosphere_57;
+    let _e195 = uvwz_2;
+    let _e196 = x_last;
+    let _e197 = nu_slice_2;
+    let _e198 = nu_t_2;
+    let _e199 = x_last;
+    let _e200 = x_low_sun;
+    let _e202 = GetScatteringAtMuSColumn(_e194, scattering_texture_1, _e195, _e196, _e197, _e198, (_e199 < _e200));
+    last = _e202;
+    let _e204 = first;
+    let _e205 = below;
+    let _e206 = above;
+    let _e207 = last;
+    let _e208 = column;
+    let _e211 = column;
+    let _e214 = mu_s_size_1;
+    let _e218 = mu_s_t_1;
+    let _e219 = LogMonotoneCubicMix(_e204, _e205, _e206, _e207, (_e208 > 0.5f), ((_e211 + 2f) < (_e214 - 0.5f)), _e218);
+    return _e219;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_56: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
-    var atmosphere_57: AtmosphereParameters;
+fn GetIrradiance(atmosphere_58: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
+    var atmosphere_59: AtmosphereParameters;
     var r_45: f32;
     var mu_s_20: f32;
     var uv_3: vec2<f32>;
@@ -1598,17 +1760,17 @@ fn GetIrradiance(atmosphere_56: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_57 = atmosphere_56;
+    atmosphere_59 = atmosphere_58;
     r_45 = r_44;
     mu_s_20 = mu_s_19;
-    let _e14 = atmosphere_57;
+    let _e14 = atmosphere_59;
     let _e15 = r_45;
     let _e16 = mu_s_20;
     let _e17 = GetIrradianceTextureUvFromRMuS(_e14, _e15, _e16);
     uv_3 = _e17;
-    let _e19 = atmosphere_57;
+    let _e19 = atmosphere_59;
     width = f32(_e19.irradiance_width);
-    let _e23 = atmosphere_57;
+    let _e23 = atmosphere_59;
     let _e24 = mu_s_20;
     let _e25 = GetIrradianceUnitMuS(_e23, _e24);
     let _e26 = width;
@@ -1616,7 +1778,7 @@ fn GetIrradiance(atmosphere_56: AtmosphereParameters, irradiance_texture: textur
     let _e31 = mu_s_coord_1;
     let _e34 = width;
     mu_s_column_1 = clamp(floor(_e31), 0f, (_e34 - 2f));
-    let _e39 = atmosphere_57;
+    let _e39 = atmosphere_59;
     let _e40 = mu_s_column_1;
     let _e41 = width;
     let _e45 = GetIrradianceMuSFromUnit(_e39, (_e40 / (_e41 - 1f)));
@@ -1645,22 +1807,22 @@ fn GetIrradiance(atmosphere_56: AtmosphereParameters, irradiance_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_58: AtmosphereParameters, nu_13: f32) -> f32 {
-    var atmosphere_59: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_60: AtmosphereParameters, nu_13: f32) -> f32 {
+    var atmosphere_61: AtmosphereParameters;
     var nu_14: f32;
 
-    atmosphere_59 = atmosphere_58;
+    atmosphere_61 = atmosphere_60;
     nu_14 = nu_13;
-    let _e11 = atmosphere_59;
+    let _e11 = atmosphere_61;
     if (_e11.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e14 = atmosphere_59;
+        let _e14 = atmosphere_61;
         let _e16 = nu_14;
         let _e17 = HenyeyGreensteinPhaseFunction(_e14.mie_g, _e16);
         return _e17;
     }
-    let _e18 = atmosphere_59;
+    let _e18 = atmosphere_61;
     if (_e18.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e21 = atmosphere_59;
+        let _e21 = atmosphere_61;
         let _e23 = nu_14;
         let _e24 = CornetteShanksPhaseFunction(_e21.mie_g, _e23);
         return _e24;
@@ -1669,23 +1831,23 @@ fn MiePhaseFunction(atmosphere_58: AtmosphereParameters, nu_13: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_60: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_61: AtmosphereParameters;
+fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_63: AtmosphereParameters;
     var r_47: f32;
     var mu_30: f32;
     var mu_s_22: f32;
     var nu_16: f32;
     var ray_r_mu_intersects_ground_13: bool;
     var scattering: vec4<f32>;
-    var local_12: vec3<f32>;
+    var local_13: vec3<f32>;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_63 = atmosphere_62;
     r_47 = r_46;
     mu_30 = mu_29;
     mu_s_22 = mu_s_21;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e22 = atmosphere_61;
+    let _e22 = atmosphere_63;
     let _e23 = r_47;
     let _e24 = mu_30;
     let _e25 = mu_s_22;
@@ -1693,7 +1855,7 @@ fn GetCombinedScattering(atmosphere_60: AtmosphereParameters, scattering_texture
     let _e27 = ray_r_mu_intersects_ground_13;
     let _e28 = GetScattering(_e22, scattering_texture_2, _e23, _e24, _e25, _e26, _e27);
     scattering = _e28;
-    let _e30 = atmosphere_61;
+    let _e30 = atmosphere_63;
     if (_e30.single_mie_in_scattering_alpha == 1i) {
         {
             let _e34 = scattering;
@@ -1701,18 +1863,18 @@ fn GetCombinedScattering(atmosphere_60: AtmosphereParameters, scattering_texture
                 let _e38 = scattering;
                 let _e41 = scattering;
                 let _e44 = scattering;
-                let _e48 = atmosphere_61;
-                let _e50 = atmosphere_61;
-                local_12 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
+                let _e48 = atmosphere_63;
+                let _e50 = atmosphere_63;
+                local_13 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_12 = vec3(0f);
+                local_13 = vec3(0f);
             }
-            let _e59 = local_12;
+            let _e59 = local_13;
             (*single_mie_scattering) = _e59;
         }
     } else {
         {
-            let _e60 = atmosphere_61;
+            let _e60 = atmosphere_63;
             let _e61 = r_47;
             let _e62 = mu_30;
             let _e63 = mu_s_22;
@@ -1727,8 +1889,8 @@ fn GetCombinedScattering(atmosphere_60: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_62: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_63: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_65: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
@@ -1738,15 +1900,15 @@ fn GetSkyRadiance(atmosphere_62: AtmosphereParameters, transmittance_texture_5: 
     var mu_s_23: f32;
     var nu_17: f32;
     var ray_r_mu_intersects_ground_14: bool;
-    var local_13: vec3<f32>;
+    var local_14: vec3<f32>;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_63 = atmosphere_62;
+    atmosphere_65 = atmosphere_64;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e24 = atmosphere_63;
+    let _e24 = atmosphere_65;
     let _e25 = camera_5;
     let _e26 = view_ray_5;
     let _e27 = sun_direction_3;
@@ -1757,24 +1919,24 @@ fn GetSkyRadiance(atmosphere_62: AtmosphereParameters, transmittance_texture_5: 
             return vec3(0f);
         }
     }
-    let _e44 = atmosphere_63;
+    let _e44 = atmosphere_65;
     let _e45 = r_48;
     let _e46 = mu_31;
     let _e47 = RayIntersectsGround(_e44, _e45, _e46);
     ray_r_mu_intersects_ground_14 = _e47;
     let _e49 = ray_r_mu_intersects_ground_14;
     if _e49 {
-        local_13 = vec3(0f);
+        local_14 = vec3(0f);
     } else {
-        let _e52 = atmosphere_63;
+        let _e52 = atmosphere_65;
         let _e53 = r_48;
         let _e54 = mu_31;
         let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_5, _e53, _e54);
-        local_13 = _e55;
+        local_14 = _e55;
     }
-    let _e57 = local_13;
+    let _e57 = local_14;
     (*transmittance) = _e57;
-    let _e59 = atmosphere_63;
+    let _e59 = atmosphere_65;
     let _e60 = r_48;
     let _e61 = mu_31;
     let _e62 = mu_s_23;
@@ -1786,15 +1948,15 @@ fn GetSkyRadiance(atmosphere_62: AtmosphereParameters, transmittance_texture_5: 
     let _e70 = nu_17;
     let _e71 = RayleighPhaseFunction(_e70);
     let _e73 = single_mie_scattering_1;
-    let _e74 = atmosphere_63;
+    let _e74 = atmosphere_65;
     let _e75 = nu_17;
     let _e76 = MiePhaseFunction(_e74, _e75);
     return ((_e69 * _e71) + (_e73 * _e76));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_64: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
-    var atmosphere_65: AtmosphereParameters;
+fn DistanceInsideScatteringRadii(atmosphere_66: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
+    var atmosphere_67: AtmosphereParameters;
     var r_50: f32;
     var mu_33: f32;
     var r_max: f32;
@@ -1802,14 +1964,14 @@ fn DistanceInsideScatteringRadii(atmosphere_64: AtmosphereParameters, r_49: f32,
     var across: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_14: f32;
+    var local_15: f32;
 
-    atmosphere_65 = atmosphere_64;
+    atmosphere_67 = atmosphere_66;
     r_50 = r_49;
     mu_33 = mu_32;
-    let _e14 = atmosphere_65;
+    let _e14 = atmosphere_67;
     r_max = _e14.scattering_r_max;
-    let _e17 = atmosphere_65;
+    let _e17 = atmosphere_67;
     r_min = _e17.scattering_r_min;
     let _e20 = r_50;
     let _e21 = r_50;
@@ -1834,153 +1996,153 @@ fn DistanceInsideScatteringRadii(atmosphere_64: AtmosphereParameters, r_49: f32,
         let _e56 = r_50;
         let _e58 = mu_33;
         let _e60 = down_discriminant;
-        local_14 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
+        local_15 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
     } else {
         let _e64 = up;
-        local_14 = _e64;
+        local_15 = _e64;
     }
-    let _e66 = local_14;
+    let _e66 = local_15;
     return _e66;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_66: AtmosphereParameters, i: i32) -> f32 {
-    var atmosphere_67: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_68: AtmosphereParameters, i: i32) -> f32 {
+    var atmosphere_69: AtmosphereParameters;
     var i_1: i32;
-    var x_7: f32;
+    var x_9: f32;
 
-    atmosphere_67 = atmosphere_66;
+    atmosphere_69 = atmosphere_68;
     i_1 = i;
     let _e13 = i_1;
-    x_7 = (f32(_e13) / 63f);
-    let _e21 = atmosphere_67;
-    let _e23 = atmosphere_67;
-    let _e26 = x_7;
-    let _e28 = x_7;
+    x_9 = (f32(_e13) / 63f);
+    let _e21 = atmosphere_69;
+    let _e23 = atmosphere_69;
+    let _e26 = x_9;
+    let _e28 = x_9;
     return (((_e21.top_radius - _e23.bottom_radius) * _e26) * _e28);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_11: f32, b_6: f32, f: f32) -> f32 {
-    var a_12: f32;
-    var b_7: f32;
+fn InterpolateCoefficient(a_14: f32, b_8: f32, f: f32) -> f32 {
+    var a_15: f32;
+    var b_9: f32;
     var f_1: f32;
-    var local_15: f32;
+    var local_16: f32;
 
-    a_12 = a_11;
-    b_7 = b_6;
+    a_15 = a_14;
+    b_9 = b_8;
     f_1 = f;
-    let _e15 = a_12;
-    let _e18 = b_7;
+    let _e15 = a_15;
+    let _e18 = b_9;
     if ((_e15 > 0f) && (_e18 > 0f)) {
-        let _e22 = a_12;
+        let _e22 = a_15;
         let _e23 = f_1;
-        let _e24 = b_7;
-        let _e25 = a_12;
-        local_15 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
+        let _e24 = b_9;
+        let _e25 = a_15;
+        local_16 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
     } else {
-        let _e31 = a_12;
-        let _e32 = b_7;
+        let _e31 = a_15;
+        let _e32 = b_9;
         let _e33 = f_1;
-        local_15 = mix(_e31, _e32, _e33);
+        local_16 = mix(_e31, _e32, _e33);
     }
-    let _e36 = local_15;
+    let _e36 = local_16;
     return _e36;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_13: vec3<f32>, b_8: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_14: vec3<f32>;
-    var b_9: vec3<f32>;
+fn InterpolateCoefficients(a_16: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_17: vec3<f32>;
+    var b_11: vec3<f32>;
     var f_3: f32;
 
-    a_14 = a_13;
-    b_9 = b_8;
+    a_17 = a_16;
+    b_11 = b_10;
     f_3 = f_2;
-    let _e15 = a_14;
-    let _e17 = b_9;
+    let _e15 = a_17;
+    let _e17 = b_11;
     let _e19 = f_3;
     let _e20 = InterpolateCoefficient(_e15.x, _e17.x, _e19);
-    let _e21 = a_14;
-    let _e23 = b_9;
+    let _e21 = a_17;
+    let _e23 = b_11;
     let _e25 = f_3;
     let _e26 = InterpolateCoefficient(_e21.y, _e23.y, _e25);
-    let _e27 = a_14;
-    let _e29 = b_9;
+    let _e27 = a_17;
+    let _e29 = b_11;
     let _e31 = f_3;
     let _e32 = InterpolateCoefficient(_e27.z, _e29.z, _e31);
     return vec3<f32>(_e20, _e26, _e32);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_68: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_69: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_70: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_71: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_8: f32;
+    var x_10: f32;
     var i_2: i32;
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_69 = atmosphere_68;
+    atmosphere_71 = atmosphere_70;
     altitude_1 = altitude;
-    let _e15 = atmosphere_69;
-    let _e17 = atmosphere_69;
+    let _e15 = atmosphere_71;
+    let _e17 = atmosphere_71;
     height = (_e15.top_radius - _e17.bottom_radius);
     let _e21 = altitude_1;
     let _e22 = height;
-    x_8 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
-    let _e34 = x_8;
+    x_10 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
+    let _e34 = x_10;
     i_2 = min(i32(_e34), 62i);
-    let _e41 = atmosphere_69;
+    let _e41 = atmosphere_71;
     let _e42 = i_2;
     let _e43 = ProfileSampleAltitude(_e41, _e42);
     h0_ = _e43;
     let _e45 = altitude_1;
     let _e46 = h0_;
-    let _e48 = atmosphere_69;
+    let _e48 = atmosphere_71;
     let _e49 = i_2;
     let _e52 = ProfileSampleAltitude(_e48, (_e49 + 1i));
     let _e53 = h0_;
     f_4 = clamp(((_e45 - _e46) / (_e52 - _e53)), 0f, 1f);
     let _e60 = i_2;
-    let _e63 = atmosphere_69.mie_scattering_profile[_e60];
+    let _e63 = atmosphere_71.mie_scattering_profile[_e60];
     let _e64 = i_2;
-    let _e69 = atmosphere_69.mie_scattering_profile[(_e64 + 1i)];
+    let _e69 = atmosphere_71.mie_scattering_profile[(_e64 + 1i)];
     let _e70 = f_4;
     let _e71 = InterpolateCoefficients(_e63, _e69, _e70);
     (*mie_scattering) = _e71;
     let _e72 = i_2;
-    let _e75 = atmosphere_69.rayleigh_scattering_profile[_e72];
+    let _e75 = atmosphere_71.rayleigh_scattering_profile[_e72];
     let _e76 = i_2;
-    let _e81 = atmosphere_69.rayleigh_scattering_profile[(_e76 + 1i)];
+    let _e81 = atmosphere_71.rayleigh_scattering_profile[(_e76 + 1i)];
     let _e82 = f_4;
     let _e83 = InterpolateCoefficients(_e75, _e81, _e82);
     (*rayleigh_scattering) = _e83;
     let _e84 = i_2;
-    let _e87 = atmosphere_69.extinction_profile[_e84];
+    let _e87 = atmosphere_71.extinction_profile[_e84];
     let _e88 = i_2;
-    let _e93 = atmosphere_69.extinction_profile[(_e88 + 1i)];
+    let _e93 = atmosphere_71.extinction_profile[(_e88 + 1i)];
     let _e94 = f_4;
     let _e95 = InterpolateCoefficients(_e87, _e93, _e94);
     return _e95;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_70: AtmosphereParameters, r_51: f32, mu_34: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_71: AtmosphereParameters;
+fn AltitudeAtDistance(atmosphere_72: AtmosphereParameters, r_51: f32, mu_34: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_73: AtmosphereParameters;
     var r_52: f32;
     var mu_35: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_71 = atmosphere_70;
+    atmosphere_73 = atmosphere_72;
     r_52 = r_51;
     mu_35 = mu_34;
     t_10 = t_9;
     r_t_1 = r_t;
     let _e19 = r_52;
-    let _e20 = atmosphere_71;
+    let _e20 = atmosphere_73;
     let _e23 = t_10;
     let _e24 = t_10;
     let _e26 = r_52;
@@ -1991,11 +2153,11 @@ fn AltitudeAtDistance(atmosphere_70: AtmosphereParameters, r_51: f32, mu_34: f32
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, r_53: f32, mu_36: f32, d_17: f32) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
+fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, mu_36: f32, d_19: f32) -> vec3<f32> {
+    var atmosphere_75: AtmosphereParameters;
     var r_54: f32;
     var mu_37: f32;
-    var d_18: f32;
+    var d_20: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
@@ -2006,11 +2168,11 @@ fn IntegrateSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, r_53: f32, 
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_73 = atmosphere_72;
+    atmosphere_75 = atmosphere_74;
     r_54 = r_53;
     mu_37 = mu_36;
-    d_18 = d_17;
-    let _e17 = d_18;
+    d_20 = d_19;
+    let _e17 = d_20;
     dt = (_e17 / 16f);
     loop {
         let _e30 = k_2;
@@ -2021,14 +2183,14 @@ fn IntegrateSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, r_53: f32, 
             let _e36 = dt;
             let _e37 = k_2;
             t_11 = (_e36 * f32(_e37));
-            let _e41 = atmosphere_73;
+            let _e41 = atmosphere_75;
             let _e42 = r_54;
             let _e43 = mu_37;
             let _e44 = t_11;
             let _e45 = RadiusAtDistance(_e41, _e42, _e43, _e44);
             r_t_2 = _e45;
-            let _e49 = atmosphere_73;
-            let _e50 = atmosphere_73;
+            let _e49 = atmosphere_75;
+            let _e50 = atmosphere_75;
             let _e51 = r_54;
             let _e52 = mu_37;
             let _e53 = t_11;
@@ -2057,67 +2219,67 @@ fn IntegrateSegmentOpticalDepth(atmosphere_72: AtmosphereParameters, r_53: f32, 
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_19: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
-    var atmosphere_75: AtmosphereParameters;
+fn LongSegmentOpticalDepth(atmosphere_76: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_21: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
     var r_56: f32;
     var mu_39: f32;
-    var d_20: f32;
+    var d_22: f32;
     var ray_r_mu_intersects_ground_16: bool;
-    var local_16: vec3<f32>;
+    var local_17: vec3<f32>;
 
-    atmosphere_75 = atmosphere_74;
+    atmosphere_77 = atmosphere_76;
     r_56 = r_55;
     mu_39 = mu_38;
-    d_20 = d_19;
+    d_22 = d_21;
     ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e20 = atmosphere_75;
+    let _e20 = atmosphere_77;
     if (_e20.transmittance_is_colour != 0i) {
-        let _e24 = atmosphere_75;
+        let _e24 = atmosphere_77;
         let _e25 = r_56;
         let _e26 = mu_39;
-        let _e27 = d_20;
+        let _e27 = d_22;
         let _e28 = IntegrateSegmentOpticalDepth(_e24, _e25, _e26, _e27);
-        local_16 = _e28;
+        local_17 = _e28;
     } else {
-        let _e29 = atmosphere_75;
+        let _e29 = atmosphere_77;
         let _e30 = r_56;
         let _e31 = mu_39;
-        let _e32 = d_20;
+        let _e32 = d_22;
         let _e33 = ray_r_mu_intersects_ground_16;
         let _e34 = GetOpticalDepth(_e29, transmittance_texture_6, _e30, _e31, _e32, _e33);
-        local_16 = _e34;
+        local_17 = _e34;
     }
-    let _e36 = local_16;
+    let _e36 = local_17;
     return _e36;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_17: f32;
+    var local_18: f32;
 
     depth_1 = depth;
     let _e11 = depth_1;
     if (_e11 < 0.0001f) {
         let _e16 = depth_1;
-        local_17 = (1f - (0.5f * _e16));
+        local_18 = (1f - (0.5f * _e16));
     } else {
         let _e20 = depth_1;
         let _e24 = depth_1;
-        local_17 = ((1f - exp(-(_e20))) / _e24);
+        local_18 = ((1f - exp(-(_e20))) / _e24);
     }
-    let _e27 = local_17;
+    let _e27 = local_18;
     return _e27;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_76: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_21: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
+fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_23: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_79: AtmosphereParameters;
     var r_58: f32;
     var mu_41: f32;
     var mu_s_25: f32;
     var nu_19: f32;
-    var d_22: f32;
+    var d_24: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
     var previous_extinction_1: vec3<f32> = vec3(0f);
@@ -2140,13 +2302,13 @@ fn IntegrateSegment(atmosphere_76: AtmosphereParameters, transmittance_texture_7
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_77 = atmosphere_76;
+    atmosphere_79 = atmosphere_78;
     r_58 = r_57;
     mu_41 = mu_40;
     mu_s_25 = mu_s_24;
     nu_19 = nu_18;
-    d_22 = d_21;
-    let _e25 = d_22;
+    d_24 = d_23;
+    let _e25 = d_24;
     dt_1 = (_e25 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
@@ -2160,13 +2322,13 @@ fn IntegrateSegment(atmosphere_76: AtmosphereParameters, transmittance_texture_7
             let _e59 = dt_1;
             let _e60 = k_3;
             t_12 = (_e59 * f32(_e60));
-            let _e64 = atmosphere_77;
+            let _e64 = atmosphere_79;
             let _e65 = r_58;
             let _e66 = mu_41;
             let _e67 = t_12;
             let _e68 = RadiusAtDistance(_e64, _e65, _e66, _e67);
             r_t_3 = _e68;
-            let _e70 = atmosphere_77;
+            let _e70 = atmosphere_79;
             let _e71 = r_58;
             let _e72 = mu_41;
             let _e73 = t_12;
@@ -2180,15 +2342,15 @@ fn IntegrateSegment(atmosphere_76: AtmosphereParameters, transmittance_texture_7
             let _e84 = r_t_3;
             let _e86 = ClampCosine((((_e77 * _e78) + (_e80 * _e81)) / _e84));
             mu_s_t_2 = _e86;
-            let _e90 = atmosphere_77;
+            let _e90 = atmosphere_79;
             let _e91 = altitude_2;
             let _e96 = GetCoefficientsAtAltitude(_e90, _e91, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e96;
-            let _e98 = atmosphere_77;
+            let _e98 = atmosphere_79;
             let _e99 = r_t_3;
             let _e100 = mu_s_t_2;
             let _e101 = GetOpticalDepthToTopAtmosphereBoundary(_e98, transmittance_texture_7, _e99, _e100);
-            let _e104 = atmosphere_77;
+            let _e104 = atmosphere_79;
             let _e105 = r_t_3;
             let _e106 = mu_s_t_2;
             let _e107 = SunVisibleFraction(_e104, _e105, _e106);
@@ -2257,18 +2419,18 @@ fn IntegrateSegment(atmosphere_76: AtmosphereParameters, transmittance_texture_7
         }
     }
     let _e190 = (*single_rayleigh);
-    let _e191 = atmosphere_77;
+    let _e191 = atmosphere_79;
     (*single_rayleigh) = (_e190 * _e191.solar_irradiance);
     let _e194 = (*single_mie);
-    let _e195 = atmosphere_77;
+    let _e195 = atmosphere_79;
     (*single_mie) = (_e194 * _e195.solar_irradiance);
     let _e198 = optical_depth_1;
     return _e198;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_79: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -2280,7 +2442,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     var mu_42: f32;
     var mu_s_26: f32;
     var nu_20: f32;
-    var d_23: f32;
+    var d_25: f32;
     var lit_1: f32;
     var ray_r_mu_intersects_ground_17: bool;
     var r_p: f32;
@@ -2311,7 +2473,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_81 = atmosphere_80;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -2329,7 +2491,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     }
     let _e36 = camera_to_point;
     view_ray_6 = normalize(_e36);
-    let _e44 = atmosphere_79;
+    let _e44 = atmosphere_81;
     let _e45 = camera_7;
     let _e46 = view_ray_6;
     let _e47 = sun_direction_5;
@@ -2342,16 +2504,16 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     }
     let _e64 = point_1;
     let _e65 = start_2;
-    d_23 = max(length((_e64 - _e65)), 0f);
-    let _e71 = d_23;
+    d_25 = max(length((_e64 - _e65)), 0f);
+    let _e71 = d_25;
     let _e72 = shadow_length_1;
     lit_1 = max((_e71 - max(_e72, 0f)), 0f);
-    let _e79 = atmosphere_79;
+    let _e79 = atmosphere_81;
     let _e80 = r_59;
     let _e81 = mu_42;
     let _e82 = RayIntersectsGround(_e79, _e80, _e81);
     ray_r_mu_intersects_ground_17 = _e82;
-    let _e84 = atmosphere_79;
+    let _e84 = atmosphere_81;
     let _e85 = r_59;
     let _e86 = mu_42;
     let _e87 = lit_1;
@@ -2370,14 +2532,14 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     let _e103 = r_p;
     let _e105 = ClampCosine((((_e96 * _e97) + (_e99 * _e100)) / _e103));
     mu_s_p = _e105;
-    let _e111 = d_23;
+    let _e111 = d_25;
     direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e111));
     let _e119 = lit_1;
     lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e119));
     let _e135 = lit_direct;
     if (_e135 > 0f) {
         {
-            let _e138 = atmosphere_79;
+            let _e138 = atmosphere_81;
             let _e139 = r_59;
             let _e140 = mu_42;
             let _e141 = mu_s_26;
@@ -2391,16 +2553,16 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     optical_depth_2 = _e151;
     let _e153 = direct;
     let _e156 = lit_1;
-    let _e157 = d_23;
+    let _e157 = d_25;
     if ((_e153 > 0f) && (_e156 < _e157)) {
         {
             let _e163 = optical_depth_2;
-            let _e164 = atmosphere_79;
+            let _e164 = atmosphere_81;
             let _e165 = r_p;
             let _e166 = mu_p;
             let _e167 = mu_s_p;
             let _e168 = nu_20;
-            let _e169 = d_23;
+            let _e169 = d_25;
             let _e170 = lit_1;
             let _e178 = IntegrateSegment(_e164, transmittance_texture_8, _e165, _e166, _e167, _e168, (_e169 - _e170), (&unused_rayleigh), (&unused_mie), (&unused_weight));
             optical_depth_2 = (_e163 + _e178);
@@ -2409,10 +2571,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     let _e180 = direct;
     if (_e180 < 1f) {
         {
-            let _e183 = atmosphere_79;
+            let _e183 = atmosphere_81;
             let _e184 = r_59;
             let _e185 = mu_42;
-            let _e186 = d_23;
+            let _e186 = d_25;
             let _e187 = ray_r_mu_intersects_ground_17;
             let _e188 = LongSegmentOpticalDepth(_e183, transmittance_texture_8, _e184, _e185, _e186, _e187);
             let _e189 = optical_depth_2;
@@ -2422,7 +2584,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     }
     let _e193 = optical_depth_2;
     (*transmittance_1) = exp(-(_e193));
-    let _e197 = atmosphere_79;
+    let _e197 = atmosphere_81;
     let _e198 = r_59;
     let _e199 = mu_42;
     let _e200 = mu_s_26;
@@ -2433,20 +2595,20 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     let _e207 = lit_1;
     if (_e207 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e209 = atmosphere_79;
+            let _e209 = atmosphere_81;
             let _e210 = r_59;
             let _e211 = mu_42;
             let _e212 = ray_r_mu_intersects_ground_17;
             let _e213 = DistanceToNearestAtmosphereBoundary(_e209, _e210, _e211, _e212);
             boundary = _e213;
             let _e215 = boundary;
-            let _e217 = atmosphere_79;
+            let _e217 = atmosphere_81;
             let _e218 = r_59;
             let _e219 = mu_42;
             let _e220 = DistanceInsideScatteringRadii(_e217, _e218, _e219);
             let _e222 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e215), _e220), _e222);
-            let _e228 = atmosphere_79;
+            let _e228 = atmosphere_81;
             let _e229 = r_59;
             let _e230 = mu_42;
             let _e231 = mu_s_26;
@@ -2458,7 +2620,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
             let _e243 = boundary;
             if (_e242 < _e243) {
                 {
-                    let _e245 = atmosphere_79;
+                    let _e245 = atmosphere_81;
                     let _e246 = r_59;
                     let _e247 = mu_42;
                     let _e248 = far;
@@ -2466,7 +2628,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
                     r_far = _e249;
                     let _e252 = scattering_3;
                     let _e253 = far_optical_depth;
-                    let _e256 = atmosphere_79;
+                    let _e256 = atmosphere_81;
                     let _e257 = r_far;
                     let _e258 = r_59;
                     let _e259 = mu_42;
@@ -2495,13 +2657,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
             let _e297 = nu_20;
             let _e298 = RayleighPhaseFunction(_e297);
             let _e300 = single_mie_1;
-            let _e301 = atmosphere_79;
+            let _e301 = atmosphere_81;
             let _e302 = nu_20;
             let _e303 = MiePhaseFunction(_e301, _e302);
             return (((_e294 + _e295) * _e298) + (_e300 * _e303));
         }
     }
-    let _e306 = atmosphere_79;
+    let _e306 = atmosphere_81;
     let _e307 = r_59;
     let _e308 = mu_42;
     let _e309 = lit_1;
@@ -2510,7 +2672,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     let _e312 = lit_optical_depth;
     let _e313 = lit_direct;
     lit_transmittance = exp(-(mix(_e311, _e312, vec3(_e313))));
-    let _e320 = atmosphere_79;
+    let _e320 = atmosphere_81;
     let _e321 = r_p;
     let _e322 = mu_p;
     let _e323 = mu_s_p;
@@ -2534,24 +2696,24 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_78: AtmosphereParameters, transmit
     let _e352 = nu_20;
     let _e353 = RayleighPhaseFunction(_e352);
     let _e355 = single_mie_scattering_2;
-    let _e356 = atmosphere_79;
+    let _e356 = atmosphere_81;
     let _e357 = nu_20;
     let _e358 = MiePhaseFunction(_e356, _e357);
     return ((_e351 * _e353) + (_e355 * _e358));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_80: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_82: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_83: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_83 = atmosphere_82;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e21 = atmosphere_81;
+    let _e21 = atmosphere_83;
     let _e22 = camera_9;
     let _e23 = point_3;
     let _e25 = sun_direction_7;
@@ -2560,19 +2722,19 @@ fn GetSkyRadianceToPoint(atmosphere_80: AtmosphereParameters, transmittance_text
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_82: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_84: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_85: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
     var r_60: f32;
     var mu_s_27: f32;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_85 = atmosphere_84;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e20 = atmosphere_83;
+    let _e20 = atmosphere_85;
     let _e21 = point_5;
     let _e23 = ClampRadius(_e20, length(_e21));
     r_60 = _e23;
@@ -2581,7 +2743,7 @@ fn GetSunAndSkyIrradiance(atmosphere_82: AtmosphereParameters, transmittance_tex
     let _e28 = point_5;
     let _e31 = ClampCosine((dot(_e25, _e26) / length(_e28)));
     mu_s_27 = _e31;
-    let _e33 = atmosphere_83;
+    let _e33 = atmosphere_85;
     let _e34 = r_60;
     let _e35 = mu_s_27;
     let _e36 = GetIrradiance(_e33, irradiance_texture_1, _e34, _e35);
@@ -2589,8 +2751,8 @@ fn GetSunAndSkyIrradiance(atmosphere_82: AtmosphereParameters, transmittance_tex
     let _e39 = point_5;
     let _e41 = point_5;
     (*sky_irradiance) = ((_e36 * (1f + (dot(_e38, _e39) / length(_e41)))) * 0.5f);
-    let _e48 = atmosphere_83;
-    let _e50 = atmosphere_83;
+    let _e48 = atmosphere_85;
+    let _e50 = atmosphere_85;
     let _e51 = r_60;
     let _e52 = mu_s_27;
     let _e53 = GetTransmittanceToSun(_e50, transmittance_texture_10, _e51, _e52);
@@ -2599,13 +2761,13 @@ fn GetSunAndSkyIrradiance(atmosphere_82: AtmosphereParameters, transmittance_tex
     return ((_e48.solar_irradiance * _e53) * max(dot(_e55, _e56), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_84: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_85: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_86: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_87: AtmosphereParameters;
 
-    atmosphere_85 = atmosphere_84;
-    let _e11 = atmosphere_85;
-    let _e13 = atmosphere_85;
-    let _e16 = atmosphere_85;
+    atmosphere_87 = atmosphere_86;
+    let _e11 = atmosphere_87;
+    let _e13 = atmosphere_87;
+    let _e16 = atmosphere_87;
     return (_e11.solar_irradiance / vec3(((PI * _e13.sun_angular_radius) * _e16.sun_angular_radius)));
 }
 
