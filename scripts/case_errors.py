@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Relative error of a baked set against the committed Monte Carlo reference.
 
-Answers reference/cases/earth.csv, earth_aerial_horizon.csv and
-earth_twilight.csv with `skybake eval` from LUT_DIR and prints, per case
+Answers reference/cases/earth.csv, earth_aerial_horizon.csv,
+earth_twilight.csv and earth_twilight_between.csv with `skybake eval` from LUT_DIR and prints, per case
 group and quantity, the RMS and largest relative error over the cases and
 the three wavelengths, and the reference's largest relative standard error
 there (an error below about twice it is noise):
@@ -54,7 +54,8 @@ def main():
     skybake, lut_dir = sys.argv[1], sys.argv[2]
     for cases, quantities in [("earth", ["radiance", "sky_irradiance"]),
                               ("earth_aerial_horizon", ["radiance", "transmittance"]),
-                              ("earth_twilight", ["radiance", "sky_irradiance"])]:
+                              ("earth_twilight", ["radiance", "sky_irradiance"]),
+                              ("earth_twilight_between", ["radiance"])]:
         with open(CASES / f"{cases}_reference.csv") as f:
             reference = list(csv.DictReader(f))
         report(evaluate(skybake, lut_dir, f"{cases}.csv"), reference, quantities)

@@ -1,16 +1,20 @@
 #!/usr/bin/env python3
-"""Writes the report's fixed case set (docs/report.md), or the dense twilight set
-(docs/accuracy.md, "Twilight case set"), to stdout.
+"""Writes the report's fixed case set (docs/report.md), the dense twilight set
+(docs/accuracy.md, "Twilight case set"), or the twilight set between whole
+degrees (docs/accuracy.md, "Twilight: more mu_s texels after sunset") to stdout.
 
 Each case set is a grid per group, so it is regenerated exactly by
     /usr/bin/python3 scripts/make_cases.py > reference/cases/earth.csv
     /usr/bin/python3 scripts/make_cases.py twilight > reference/cases/earth_twilight.csv
+    /usr/bin/python3 scripts/make_cases.py twilight-between > reference/cases/earth_twilight_between.csv
 
-The twilight set's reference values, with their standard errors, are computed with
+The twilight sets' reference values, with their standard errors, are computed with
     /usr/bin/python3 scripts/make_cases.py twilight-reference build/cli/skybake \
         > reference/cases/earth_twilight_reference.csv
-which runs `skybake reference` once per sun range with the paths that range
-needs (TWILIGHT_PATHS) and writes the rows in the case set's order.
+    /usr/bin/python3 scripts/make_cases.py twilight-between-reference build/cli/skybake \
+        > reference/cases/earth_twilight_between_reference.csv
+which run `skybake reference` once per sun range with the paths that range
+needs (TWILIGHT_PATHS) and write the rows in the case set's order.
 Columns are those of `skybake eval` plus `group`; empty distance_m means the
 whole ray (sky radiance), empty normal_zenith_deg means no irradiance.
 """
@@ -92,6 +96,17 @@ def twilight_rows():
         yield "low_sun_aerial_perspective_sun_84-90", 100, view, sun, azimuth, distance, ""
 
 
+def twilight_between_rows():
+    """The sky with the sun between whole degrees, 1.2 degrees apart, so that
+    its suns fall at every place between the scattering table's mu_s columns
+    rather than where whole degrees happen to fall."""
+    for sun in [90.5, 91.7, 92.9, 94.1, 95.3, 96.5, 97.7, 98.9]:
+        group = "twilight_between_sun_" + ("90-93" if sun < 93.5 else "94-96" if sun < 97 else "97-99")
+        for altitude in [0, 10000]:
+            for view, azimuth in [(0, 0), (85, 0), (85, 180), (60, 90)]:
+                yield group, altitude, view, sun, azimuth, "", ""
+
+
 # Paths per wavelength by the sun's zenith angle (up to the first bound), so
 # that the reference's standard error stays within about 1 % to sun 100
 # degrees and 3 % beyond (docs/accuracy.md, "Twilight case set"): deep
@@ -103,9 +118,8 @@ def twilight_paths(sun):
     return next(paths for bound, paths in TWILIGHT_PATHS if sun <= bound)
 
 
-def twilight_reference(skybake):
-    """The twilight set's reference: one `skybake reference` run per path count."""
-    cases = list(twilight_rows())
+def twilight_reference(skybake, cases):
+    """A twilight set's reference: one `skybake reference` run per path count."""
     results = [None] * len(cases)
     header = None
     with tempfile.TemporaryDirectory() as directory:
@@ -130,12 +144,13 @@ def twilight_reference(skybake):
 
 
 def main():
-    if sys.argv[1:2] == ["twilight-reference"] and len(sys.argv) == 3:
-        twilight_reference(sys.argv[2])
+    sets = {"twilight": twilight_rows, "twilight-between": twilight_between_rows}
+    if len(sys.argv) == 3 and sys.argv[1].endswith("-reference") and sys.argv[1][:-len("-reference")] in sets:
+        twilight_reference(sys.argv[2], list(sets[sys.argv[1][:-len("-reference")]]()))
         return
     out = sys.stdout
     out.write(",".join(COLUMNS) + "\n")
-    for row in twilight_rows() if sys.argv[1:] == ["twilight"] else rows():
+    for row in sets[sys.argv[1]]() if sys.argv[1:2] and sys.argv[1] in sets else rows():
         out.write(",".join(str(v) for v in row) + "\n")
 
 

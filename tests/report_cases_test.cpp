@@ -110,30 +110,21 @@ TEST(ReportCases, ReferenceCoversTheCasesWithSmallDaylightNoise) {
   EXPECT_LE(worst_daylight, 0.003);
 }
 
-// The dense twilight set (scripts/make_cases.py twilight, docs/accuracy.md):
-// its reference has every case, and standard errors no larger than those it
-// was committed with, per sun range, for the sky radiance and the sky
-// irradiance (the largest relative standard error of any channel).
-TEST(ReportCases, TwilightReferenceCoversItsCasesWithItsStatedNoise) {
-  const std::string cases_path = std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/earth_twilight.csv";
-  const std::string reference_path = std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/earth_twilight_reference.csv";
-  QueryTable cases = ParseQueryCsv(testing::ReadText(cases_path), "earth_twilight.csv");
-  QueryTable ref = ParseQueryCsv(testing::ReadText(reference_path), "earth_twilight_reference.csv",
+// A twilight case set (reference/cases/NAME.csv) and its reference
+// (NAME_reference.csv): the reference has every case, and standard errors
+// no larger than those it was committed with, per group, for the quantity
+// `stated` names (the largest relative standard error of any channel).
+void ExpectReferenceCoversItsCasesWithItsStatedNoise(
+    const std::string& name, const std::map<std::string, std::pair<std::string, double>>& stated) {
+  const std::string cases_path = std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/" + name + ".csv";
+  const std::string reference_path = std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/" + name + "_reference.csv";
+  QueryTable cases = ParseQueryCsv(testing::ReadText(cases_path), name + ".csv");
+  QueryTable ref = ParseQueryCsv(testing::ReadText(reference_path), name + "_reference.csv",
                                  ExtraColumns::kKeepAsResults);
   ASSERT_EQ(ref.fields.size(), cases.fields.size());
   for (size_t i = 0; i < cases.fields.size(); ++i) {
     for (size_t c = 0; c < cases.header.size(); ++c) EXPECT_EQ(ref.fields[i][c], cases.fields[i][c]) << "row " << i;
   }
-  // Per group: the quantity measured and the largest relative standard error
-  // allowed: 1 % to sun 100 degrees and 3 % beyond, what the case set is
-  // computed for (scripts/make_cases.py, docs/accuracy.md).
-  const std::map<std::string, std::pair<std::string, double>> stated = {
-      {"twilight_sky_sun_88-90", {"radiance", 0.01}},
-      {"twilight_sky_sun_91-96", {"radiance", 0.01}},
-      {"twilight_sky_sun_97-100", {"radiance", 0.01}},
-      {"twilight_sky_sun_101-102", {"radiance", 0.03}},
-      {"twilight_irradiance_sun_88-100", {"sky_irradiance", 0.01}},
-      {"low_sun_aerial_perspective_sun_84-90", {"radiance", 0.01}}};
   std::map<std::string, double> worst;
   for (size_t i = 0; i < ref.queries.size(); ++i) {
     const auto bound = stated.find(ref.groups[i]);
@@ -154,6 +145,27 @@ TEST(ReportCases, TwilightReferenceCoversItsCasesWithItsStatedNoise) {
     std::printf("%s: largest relative standard error %.3g\n", group.c_str(), worst[group]);
     EXPECT_LE(worst[group], bound.second) << group;
   }
+}
+
+// The dense twilight set (scripts/make_cases.py twilight, docs/accuracy.md):
+// 1 % to sun 100 degrees and 3 % beyond, what it is computed for.
+TEST(ReportCases, TwilightReferenceCoversItsCasesWithItsStatedNoise) {
+  ExpectReferenceCoversItsCasesWithItsStatedNoise("earth_twilight",
+                                                  {{"twilight_sky_sun_88-90", {"radiance", 0.01}},
+                                                   {"twilight_sky_sun_91-96", {"radiance", 0.01}},
+                                                   {"twilight_sky_sun_97-100", {"radiance", 0.01}},
+                                                   {"twilight_sky_sun_101-102", {"radiance", 0.03}},
+                                                   {"twilight_irradiance_sun_88-100", {"sky_irradiance", 0.01}},
+                                                   {"low_sun_aerial_perspective_sun_84-90", {"radiance", 0.01}}});
+}
+
+// The twilight set between whole degrees (scripts/make_cases.py
+// twilight-between): 1 %, with the same paths per sun as the dense set.
+TEST(ReportCases, TwilightBetweenDegreesReferenceCoversItsCasesWithItsStatedNoise) {
+  ExpectReferenceCoversItsCasesWithItsStatedNoise("earth_twilight_between",
+                                                  {{"twilight_between_sun_90-93", {"radiance", 0.01}},
+                                                   {"twilight_between_sun_94-96", {"radiance", 0.01}},
+                                                   {"twilight_between_sun_97-99", {"radiance", 0.01}}});
 }
 
 }  // namespace
