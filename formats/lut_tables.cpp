@@ -152,7 +152,7 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
       {"x", "mu_s", p.scattering_mu_s_size, p.scattering_mu_s_min, p.scattering_mu_s_max, "1",
        "a = (d - d_min) / (d_max - d_min) with d = distance from the ground to the top boundary along mu_s, "
        "d_min = top_radius - bottom_radius, d_max = H; A = a at scattering_mu_s_min; f = max(1 - a / A, 0) / (1 + "
-       "a); x = f / f(scattering_mu_s_max)" +
+       "a / 2); x = f / f(scattering_mu_s_max)" +
            std::string(kTexelCentres)},
       {"y", "mu", p.scattering_mu_size, -1.0, 1.0, "1",
        "two halves of n / 2 texels, discontinuous at the horizon: rays that hit the ground in the lower half, "

@@ -175,8 +175,8 @@ Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
 
 // The inverse of GetScatteringUnitMuS stretched to [0, 1]: the sun cosine
 // at x in [0, 1] along the table's mu_s axis (x = column / (size - 1) at a
-// texel column). From x = (1 - a / A) / (1 + a), a = (1 - x) / (x + 1 / A);
-// then d, and mu_s from top^2 = bottom^2 + 2 bottom mu_s d + d^2.
+// texel column): a by ScatteringDistanceFromUnitMuS, then d, and mu_s from
+// top^2 = bottom^2 + 2 bottom mu_s d + d^2.
 Number GetScatteringMuSFromUnitRange(IN(AtmosphereParameters) atmosphere, Number x) {
   Number x_mu_s = x * GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
   Number bottom = atmosphere.bottom_radius;
@@ -185,7 +185,7 @@ Number GetScatteringMuSFromUnitRange(IN(AtmosphereParameters) atmosphere, Number
   Number d_max = H;
   Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.scattering_mu_s_min);
   Number A = (D - d_min) / (d_max - d_min);
-  Number a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
+  Number a = ScatteringDistanceFromUnitMuS(x_mu_s, 1.0 / A);
   Number d = d_min + min(a, A) * (d_max - d_min);
   return d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * bottom * d));
 }

@@ -71,11 +71,24 @@ Number SunVisibleFractionAboveHorizon(Number mu_s, Number horizon_cosine, Number
 // The scattering table's unit mu_s before its stretch to scattering_mu_s_max,
 // from a = (d - d_min) / (d_max - d_min), the sun ray's distance d to the top
 // from the ground over its range, and inverse_A = 1 / A, A the same for
-// scattering_mu_s_min: (1 - a / A) / (1 + a), which gives low suns (a near
-// A) more texels, and is negative below scattering_mu_s_min, where the
-// lookups extrapolate. (1 / A is a constant of the table, computed once.)
+// scattering_mu_s_min: (1 - a / A) / (1 + k a), k =
+// SCATTERING_MU_S_HIGH_SUN_SHARE, which gives low suns (a near A) more
+// texels, and is negative below scattering_mu_s_min, where the lookups
+// extrapolate. (1 / A is a constant of the table, computed once.) The
+// smaller k, the more of the texels go to the low sun: on Earth (sun down
+// to 102 degrees, 32 texels) k = 1 (Bruneton's mapping) puts 11.1 of the 31
+// intervals below the horizon, k = 1/2 14.7 (and the sun from the zenith to
+// 51 degrees in the last one, where the sky changes slowly with it; see
+// docs/accuracy.md, "Twilight: more mu_s texels after sunset").
+const Number SCATTERING_MU_S_HIGH_SUN_SHARE = 0.5;
+
 Number ScatteringUnitMuSFromDistance(Number a, Number inverse_A) {
-  return (Number(1.0) - a * inverse_A) / (Number(1.0) + a);
+  return (Number(1.0) - a * inverse_A) / (Number(1.0) + SCATTERING_MU_S_HIGH_SUN_SHARE * a);
+}
+
+// Its inverse: a from the unit mu_s x, a = (1 - x) / (k x + 1 / A).
+Number ScatteringDistanceFromUnitMuS(Number x, Number inverse_A) {
+  return (Number(1.0) - x) / (SCATTERING_MU_S_HIGH_SUN_SHARE * x + inverse_A);
 }
 
 // The scattering table's unit nu: (nu + 1) / 2 over the slices.

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _830 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_830)
+    if (!_845)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _693 = mu < 0.0f;
-    bool _705;
-    if (_693)
+    bool _708 = mu < 0.0f;
+    bool _720;
+    if (_708)
     {
-        _705 = (((r * r) * mu) * mu) >= c;
+        _720 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _705 = _693;
+        _720 = _708;
     }
-    return _705;
+    return _720;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _474;
+    float _478;
     if (r_mu > 0.0f)
     {
-        _474 = c / (r_mu + s);
+        _478 = c / (r_mu + s);
     }
     else
     {
-        _474 = s - r_mu;
+        _478 = s - r_mu;
     }
-    float param_1 = _474;
+    float param_1 = _478;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _923;
+    float _937;
     if (d_max > d_min)
     {
-        _923 = (d - d_min) / (d_max - d_min);
+        _937 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _923 = 0.0f;
+        _937 = 0.0f;
     }
-    float x_mu = _923;
+    float x_mu = _937;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -241,7 +241,7 @@ float ScatteringUnitNu(float nu)
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float ScatteringUnitMuSFromDistance(float a, float inverse_A)
 {
-    return (1.0f - (a * inverse_A)) / (1.0f + a);
+    return (1.0f - (a * inverse_A)) / (1.0f + (0.5f * a));
 }
 #endif
 
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1267;
+        float _1277;
         if (d_max == d_min)
         {
-            _1267 = 0.0f;
+            _1277 = 0.0f;
         }
         else
         {
-            _1267 = (d - d_min) / (d_max - d_min);
+            _1277 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1267;
+        x_mu = _1277;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1311;
+        float _1321;
         if (d_max_1 > d_min_1)
         {
-            _1311 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1311 = 0.0f;
+            _1321 = 0.0f;
         }
-        x_mu = _1311;
+        x_mu = _1321;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1686;
+    float _1696;
     if (low_sun)
     {
-        _1686 = min(t, 1.0f);
+        _1696 = min(t, 1.0f);
     }
     else
     {
-        _1686 = clamp(t, 0.0f, 1.0f);
+        _1696 = clamp(t, 0.0f, 1.0f);
     }
-    return _1686;
+    return _1696;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -400,6 +400,13 @@ float4 GetScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<float
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+float ScatteringDistanceFromUnitMuS(float x, float inverse_A)
+{
+    return (1.0f - x) / ((0.5f * x) + inverse_A);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
@@ -415,19 +422,21 @@ float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
     float param_5 = atmosphere.scattering_mu_s_min;
     float D = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float A = (D - d_min) / (d_max - d_min);
-    float a = (A - (x_mu_s * A)) / (1.0f + (x_mu_s * A));
+    float param_6 = x_mu_s;
+    float param_7 = 1.0f / A;
+    float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
     float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1074;
+    float _1084;
     if (d == 0.0f)
     {
-        _1074 = 1.0f;
+        _1084 = 1.0f;
     }
     else
     {
-        float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1074 = ClampCosine(param_6);
+        float param_8 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
+        _1084 = ClampCosine(param_8);
     }
-    return _1074;
+    return _1084;
 }
 #endif
 
@@ -450,26 +459,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _1770;
+    float4 _1780;
     if (has_a)
     {
-        _1770 = log(max(a, dark));
+        _1780 = log(max(a, dark));
     }
     else
     {
-        _1770 = (lb * 2.0f) - lc;
+        _1780 = (lb * 2.0f) - lc;
     }
-    float4 la = _1770;
-    float4 _1785;
+    float4 la = _1780;
+    float4 _1795;
     if (has_d)
     {
-        _1785 = log(max(d, dark));
+        _1795 = log(max(d, dark));
     }
     else
     {
-        _1785 = (lc * 2.0f) - lb;
+        _1795 = (lc * 2.0f) - lb;
     }
-    float4 ld = _1785;
+    float4 ld = _1795;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -601,16 +610,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2396;
+        float3 _2406;
         if (scattering.x > 0.0f)
         {
-            _2396 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _2406 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _2396 = 0.0f.xxx;
+            _2406 = 0.0f.xxx;
         }
-        single_mie_scattering = _2396;
+        single_mie_scattering = _2406;
     }
     else
     {
@@ -682,13 +691,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _2464 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2474 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2464)
+    if (!_2474)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -697,19 +706,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2484;
+    float3 _2494;
     if (ray_r_mu_intersects_ground)
     {
-        _2484 = 0.0f.xxx;
+        _2494 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2484 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _2494 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _2484;
+    transmittance = _2494;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -717,9 +726,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2511 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2521 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2511;
+    float3 scattering = _2521;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -767,16 +776,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2605;
+    float _2615;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2605 = a * exp(f * log(b / a));
+        _2615 = a * exp(f * log(b / a));
     }
     else
     {
-        _2605 = lerp(a, b, f);
+        _2615 = lerp(a, b, f);
     }
-    return _2605;
+    return _2615;
 }
 #endif
 
@@ -849,16 +858,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2857;
+    float _2867;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2857 = 1.0f - (0.5f * depth);
+        _2867 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2857 = (1.0f - exp(-depth)) / depth;
+        _2867 = (1.0f - exp(-depth)) / depth;
     }
-    return _2857;
+    return _2867;
 }
 #endif
 
@@ -894,10 +903,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2937 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2947 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2937;
+        float3 extinction = _2947;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -955,10 +964,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2802 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2812 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2802;
+        float3 extinction = _2812;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1031,14 +1040,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _2827;
+    float3 _2837;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2827 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2837 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1047,31 +1056,31 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2827 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _2837 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _2827;
+    return _2837;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _709;
+    float _724;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _709 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _709 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _709;
+    return _724;
 }
 #endif
 
@@ -1084,16 +1093,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2567;
+    float _2577;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2567 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2577 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2567 = up;
+        _2577 = up;
     }
-    return _2567;
+    return _2577;
 }
 #endif
 
@@ -1116,13 +1125,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _3083 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3093 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3083)
+    if (!_3093)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1162,11 +1171,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3178 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3188 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3178;
+        lit_optical_depth = _3188;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1180,11 +1189,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3212 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3222 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3212;
+        optical_depth += _3222;
     }
     if (direct < 1.0f)
     {
@@ -1203,9 +1212,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3255 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3265 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3255;
+    float3 scattering = _3265;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1226,11 +1235,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3303 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3313 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3303;
+        float3 far_optical_depth = _3313;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1250,9 +1259,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3357 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3367 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3357);
+            scattering -= (exp(-far_optical_depth) * _3367);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1273,9 +1282,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3422 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3432 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3422;
+    float3 scattering_p = _3432;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1295,25 +1304,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3466 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _3476 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3466;
+    return _3476;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1365;
+    float _1375;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1365 = 0.100000001490116119384765625f;
+        _1375 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1365 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1375 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1365;
+    return _1375;
 }
 #endif
 
@@ -1322,16 +1331,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1383;
+    float _1393;
     if (mu_s < knee)
     {
-        _1383 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1393 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1383 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1393 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1383;
+    return _1393;
 }
 #endif
 
@@ -1358,16 +1367,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1414;
+    float _1424;
     if (x < 0.5f)
     {
-        _1414 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1424 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1414 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1424 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1414;
+    return _1424;
 }
 #endif
 
@@ -1379,16 +1388,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1709;
+    float4 _1719;
     if (t < 0.0f)
     {
-        _1709 = min(blend, a);
+        _1719 = min(blend, a);
     }
     else
     {
-        _1709 = blend;
+        _1719 = blend;
     }
-    return _1709;
+    return _1719;
 }
 #endif
 

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _830 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_830)
+    if (!_845)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _693 = mu < 0.0;
-    bool _705;
-    if (_693)
+    bool _708 = mu < 0.0;
+    bool _720;
+    if (_708)
     {
-        _705 = (((r * r) * mu) * mu) >= c;
+        _720 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _705 = _693;
+        _720 = _708;
     }
-    return _705;
+    return _720;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _474;
+    float _478;
     if (r_mu > 0.0)
     {
-        _474 = c / (r_mu + s);
+        _478 = c / (r_mu + s);
     }
     else
     {
-        _474 = s - r_mu;
+        _478 = s - r_mu;
     }
-    float param_1 = _474;
+    float param_1 = _478;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _923;
+    float _937;
     if (d_max > d_min)
     {
-        _923 = (d - d_min) / (d_max - d_min);
+        _937 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _923 = 0.0;
+        _937 = 0.0;
     }
-    float x_mu = _923;
+    float x_mu = _937;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -261,7 +261,7 @@ float ScatteringUnitNu(thread const float& nu)
 static inline __attribute__((always_inline))
 float ScatteringUnitMuSFromDistance(thread const float& a, thread const float& inverse_A)
 {
-    return (1.0 - (a * inverse_A)) / (1.0 + a);
+    return (1.0 - (a * inverse_A)) / (1.0 + (0.5 * a));
 }
 #endif
 
@@ -323,16 +323,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1267;
+        float _1277;
         if (d_max == d_min)
         {
-            _1267 = 0.0;
+            _1277 = 0.0;
         }
         else
         {
-            _1267 = (d - d_min) / (d_max - d_min);
+            _1277 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1267;
+        x_mu = _1277;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +343,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1311;
+        float _1321;
         if (d_max_1 > d_min_1)
         {
-            _1311 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1311 = 0.0;
+            _1321 = 0.0;
         }
-        x_mu = _1311;
+        x_mu = _1321;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,16 +372,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1686;
+    float _1696;
     if (low_sun)
     {
-        _1686 = fast::min(t, 1.0);
+        _1696 = fast::min(t, 1.0);
     }
     else
     {
-        _1686 = fast::clamp(t, 0.0, 1.0);
+        _1696 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1686;
+    return _1696;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -428,6 +428,14 @@ float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, t
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
+float ScatteringDistanceFromUnitMuS(thread const float& x, thread const float& inverse_A)
+{
+    return (1.0 - x) / ((0.5 * x) + inverse_A);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
 float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmosphere, thread const float& x)
 {
     AtmosphereParameters param = atmosphere;
@@ -443,19 +451,21 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_5 = atmosphere.scattering_mu_s_min;
     float D = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float A = (D - d_min) / (d_max - d_min);
-    float a = (A - (x_mu_s * A)) / (1.0 + (x_mu_s * A));
+    float param_6 = x_mu_s;
+    float param_7 = 1.0 / A;
+    float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1074;
+    float _1084;
     if (d == 0.0)
     {
-        _1074 = 1.0;
+        _1084 = 1.0;
     }
     else
     {
-        float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1074 = ClampCosine(param_6);
+        float param_8 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
+        _1084 = ClampCosine(param_8);
     }
-    return _1074;
+    return _1084;
 }
 #endif
 
@@ -480,26 +490,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _1770;
+    float4 _1780;
     if (has_a)
     {
-        _1770 = log(fast::max(a, dark));
+        _1780 = log(fast::max(a, dark));
     }
     else
     {
-        _1770 = (lb * 2.0) - lc;
+        _1780 = (lb * 2.0) - lc;
     }
-    float4 la = _1770;
-    float4 _1785;
+    float4 la = _1780;
+    float4 _1795;
     if (has_d)
     {
-        _1785 = log(fast::max(d, dark));
+        _1795 = log(fast::max(d, dark));
     }
     else
     {
-        _1785 = (lc * 2.0) - lb;
+        _1795 = (lc * 2.0) - lb;
     }
-    float4 ld = _1785;
+    float4 ld = _1795;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -633,16 +643,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2396;
+        float3 _2406;
         if (scattering.x > 0.0)
         {
-            _2396 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _2406 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _2396 = float3(0.0);
+            _2406 = float3(0.0);
         }
-        single_mie_scattering = _2396;
+        single_mie_scattering = _2406;
     }
     else
     {
@@ -719,13 +729,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _2464 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2474 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2464)
+    if (!_2474)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -734,19 +744,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2484;
+    float3 _2494;
     if (ray_r_mu_intersects_ground)
     {
-        _2484 = float3(0.0);
+        _2494 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2484 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _2494 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _2484;
+    transmittance = _2494;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -754,9 +764,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2511 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2521 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2511;
+    float3 scattering = _2521;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -810,16 +820,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2605;
+    float _2615;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2605 = a * exp(f * log(b / a));
+        _2615 = a * exp(f * log(b / a));
     }
     else
     {
-        _2605 = mix(a, b, f);
+        _2615 = mix(a, b, f);
     }
-    return _2605;
+    return _2615;
 }
 #endif
 
@@ -898,16 +908,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2857;
+    float _2867;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2857 = 1.0 - (0.5 * depth);
+        _2867 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2857 = (1.0 - exp(-depth)) / depth;
+        _2867 = (1.0 - exp(-depth)) / depth;
     }
-    return _2857;
+    return _2867;
 }
 #endif
 
@@ -944,10 +954,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2937 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2947 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2937;
+        float3 extinction = _2947;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1006,10 +1016,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2802 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2812 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2802;
+        float3 extinction = _2812;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1084,14 +1094,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _2827;
+    float3 _2837;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2827 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2837 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1100,9 +1110,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2827 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _2837 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _2827;
+    return _2837;
 }
 #endif
 
@@ -1110,22 +1120,22 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _709;
+    float _724;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _709 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _709 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _709;
+    return _724;
 }
 #endif
 
@@ -1139,16 +1149,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2567;
+    float _2577;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2567 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2577 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2567 = up;
+        _2577 = up;
     }
-    return _2567;
+    return _2577;
 }
 #endif
 
@@ -1172,13 +1182,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _3083 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3093 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3083)
+    if (!_3093)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1218,11 +1228,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3178 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3188 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3178;
+        lit_optical_depth = _3188;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1236,11 +1246,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3212 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3222 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3212;
+        optical_depth += _3222;
     }
     if (direct < 1.0)
     {
@@ -1259,9 +1269,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3255 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3265 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3255;
+    float3 scattering = _3265;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1282,11 +1292,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3303 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3313 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3303;
+        float3 far_optical_depth = _3313;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1306,9 +1316,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3357 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3367 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3357);
+            scattering -= (exp(-far_optical_depth) * _3367);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1329,9 +1339,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3422 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3432 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3422;
+    float3 scattering_p = _3432;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1352,9 +1362,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3466 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _3476 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3466;
+    return _3476;
 }
 #endif
 
@@ -1362,16 +1372,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1365;
+    float _1375;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1365 = 0.100000001490116119384765625;
+        _1375 = 0.100000001490116119384765625;
     }
     else
     {
-        _1365 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1375 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1365;
+    return _1375;
 }
 #endif
 
@@ -1381,16 +1391,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1383;
+    float _1393;
     if (mu_s < knee)
     {
-        _1383 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1393 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1383 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1393 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1383;
+    return _1393;
 }
 #endif
 
@@ -1419,16 +1429,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1414;
+    float _1424;
     if (x < 0.5)
     {
-        _1414 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1424 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1414 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1424 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1414;
+    return _1424;
 }
 #endif
 
@@ -1441,16 +1451,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1709;
+    float4 _1719;
     if (t < 0.0)
     {
-        _1709 = fast::min(blend, a);
+        _1719 = fast::min(blend, a);
     }
     else
     {
-        _1709 = blend;
+        _1719 = blend;
     }
-    return _1709;
+    return _1719;
 }
 #endif
 

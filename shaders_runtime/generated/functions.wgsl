@@ -40,6 +40,8 @@ const PHASE_CORNETTE_SHANKS: i32 = 2i;
 
 const ALTITUDE_PROFILE_SIZE: i32 = 64i;
 
+const SCATTERING_MU_S_HIGH_SUN_SHARE: f32 = 0.5f;
+
 const LOW_SUN_MU_S: f32 = 0.1f;
 
 const DIRECT_SEGMENT_LENGTH: f32 = 10000f;
@@ -181,18 +183,30 @@ fn ScatteringUnitMuSFromDistance(a_2: f32, inverse_A: f32) -> f32 {
 
     a_3 = a_2;
     inverse_A_1 = inverse_A;
-    let _e12 = a_3;
-    let _e13 = inverse_A_1;
-    let _e18 = a_3;
-    return ((1f - (_e12 * _e13)) / (1f + _e18));
+    let _e13 = a_3;
+    let _e14 = inverse_A_1;
+    let _e19 = a_3;
+    return ((1f - (_e13 * _e14)) / (1f + (SCATTERING_MU_S_HIGH_SUN_SHARE * _e19)));
+}
+
+fn ScatteringDistanceFromUnitMuS(x: f32, inverse_A_2: f32) -> f32 {
+    var x_1: f32;
+    var inverse_A_3: f32;
+
+    x_1 = x;
+    inverse_A_3 = inverse_A_2;
+    let _e13 = x_1;
+    let _e15 = x_1;
+    let _e17 = inverse_A_3;
+    return ((1f - _e13) / ((SCATTERING_MU_S_HIGH_SUN_SHARE * _e15) + _e17));
 }
 
 fn ScatteringUnitNu(nu: f32) -> f32 {
     var nu_1: f32;
 
     nu_1 = nu;
-    let _e8 = nu_1;
-    return ((_e8 + 1f) / 2f);
+    let _e9 = nu_1;
+    return ((_e9 + 1f) / 2f);
 }
 
 fn IsotropicPhaseFunction() -> f32 {
@@ -204,10 +218,10 @@ fn RayleighPhaseFunction(nu_2: f32) -> f32 {
     var k: f32 = 0.059683103f;
 
     nu_3 = nu_2;
-    let _e16 = k;
-    let _e19 = nu_3;
+    let _e17 = k;
     let _e20 = nu_3;
-    return (_e16 * (1f + (_e19 * _e20)));
+    let _e21 = nu_3;
+    return (_e17 * (1f + (_e20 * _e21)));
 }
 
 fn HenyeyGreensteinPhaseFunction(g: f32, nu_4: f32) -> f32 {
@@ -217,16 +231,16 @@ fn HenyeyGreensteinPhaseFunction(g: f32, nu_4: f32) -> f32 {
 
     g_1 = g;
     nu_5 = nu_4;
-    let _e12 = g_1;
     let _e13 = g_1;
-    let _e18 = g_1;
-    let _e20 = nu_5;
-    denom = ((1f + (_e12 * _e13)) - ((2f * _e18) * _e20));
-    let _e26 = g_1;
+    let _e14 = g_1;
+    let _e19 = g_1;
+    let _e21 = nu_5;
+    denom = ((1f + (_e13 * _e14)) - ((2f * _e19) * _e21));
     let _e27 = g_1;
-    let _e34 = denom;
-    let _e36 = denom;
-    return ((1f - (_e26 * _e27)) / ((12.566371f * _e34) * sqrt(_e36)));
+    let _e28 = g_1;
+    let _e35 = denom;
+    let _e37 = denom;
+    return ((1f - (_e27 * _e28)) / ((12.566371f * _e35) * sqrt(_e37)));
 }
 
 fn CornetteShanksPhaseFunction(g_2: f32, nu_6: f32) -> f32 {
@@ -237,22 +251,22 @@ fn CornetteShanksPhaseFunction(g_2: f32, nu_6: f32) -> f32 {
 
     g_3 = g_2;
     nu_7 = nu_6;
-    let _e12 = g_3;
     let _e13 = g_3;
-    let _e18 = g_3;
-    let _e20 = nu_7;
-    denom_1 = ((1f + (_e12 * _e13)) - ((2f * _e18) * _e20));
-    let _e33 = g_3;
+    let _e14 = g_3;
+    let _e19 = g_3;
+    let _e21 = nu_7;
+    denom_1 = ((1f + (_e13 * _e14)) - ((2f * _e19) * _e21));
     let _e34 = g_3;
-    let _e40 = g_3;
+    let _e35 = g_3;
     let _e41 = g_3;
-    k_1 = ((0.119366206f * (1f - (_e33 * _e34))) / (2f + (_e40 * _e41)));
-    let _e46 = k_1;
-    let _e49 = nu_7;
+    let _e42 = g_3;
+    k_1 = ((0.119366206f * (1f - (_e34 * _e35))) / (2f + (_e41 * _e42)));
+    let _e47 = k_1;
     let _e50 = nu_7;
-    let _e54 = denom_1;
+    let _e51 = nu_7;
     let _e55 = denom_1;
-    return ((_e46 * (1f + (_e49 * _e50))) / (_e54 * sqrt(_e55)));
+    let _e56 = denom_1;
+    return ((_e47 * (1f + (_e50 * _e51))) / (_e55 * sqrt(_e56)));
 }
 
 fn ClampRadius(atmosphere: AtmosphereParameters, r_4: f32) -> f32 {
@@ -261,10 +275,10 @@ fn ClampRadius(atmosphere: AtmosphereParameters, r_4: f32) -> f32 {
 
     atmosphere_1 = atmosphere;
     r_5 = r_4;
-    let _e10 = r_5;
-    let _e11 = atmosphere_1;
-    let _e13 = atmosphere_1;
-    return clamp(_e10, _e11.bottom_radius, _e13.top_radius);
+    let _e11 = r_5;
+    let _e12 = atmosphere_1;
+    let _e14 = atmosphere_1;
+    return clamp(_e11, _e12.bottom_radius, _e14.top_radius);
 }
 
 fn DistanceToTopAtmosphereBoundary(atmosphere_2: AtmosphereParameters, r_6: f32, mu_2: f32) -> f32 {
@@ -276,16 +290,16 @@ fn DistanceToTopAtmosphereBoundary(atmosphere_2: AtmosphereParameters, r_6: f32,
     atmosphere_3 = atmosphere_2;
     r_7 = r_6;
     mu_3 = mu_2;
-    let _e12 = atmosphere_3;
-    let _e14 = r_7;
-    let _e16 = atmosphere_3;
-    let _e18 = r_7;
-    c_2 = ((_e12.top_radius - _e14) * (_e16.top_radius + _e18));
-    let _e22 = r_7;
-    let _e23 = mu_3;
-    let _e25 = c_2;
-    let _e26 = DistanceToSphereFromInside((_e22 * _e23), _e25);
-    return _e26;
+    let _e13 = atmosphere_3;
+    let _e15 = r_7;
+    let _e17 = atmosphere_3;
+    let _e19 = r_7;
+    c_2 = ((_e13.top_radius - _e15) * (_e17.top_radius + _e19));
+    let _e23 = r_7;
+    let _e24 = mu_3;
+    let _e26 = c_2;
+    let _e27 = DistanceToSphereFromInside((_e23 * _e24), _e26);
+    return _e27;
 }
 
 fn DistanceToBottomAtmosphereBoundary(atmosphere_4: AtmosphereParameters, r_8: f32, mu_4: f32) -> f32 {
@@ -299,24 +313,24 @@ fn DistanceToBottomAtmosphereBoundary(atmosphere_4: AtmosphereParameters, r_8: f
     atmosphere_5 = atmosphere_4;
     r_9 = r_8;
     mu_5 = mu_4;
-    let _e12 = r_9;
-    let _e13 = mu_5;
-    r_mu_2 = (_e12 * _e13);
-    let _e16 = r_9;
-    let _e17 = atmosphere_5;
-    let _e20 = r_9;
-    let _e21 = atmosphere_5;
-    c_3 = ((_e16 - _e17.bottom_radius) * (_e20 + _e21.bottom_radius));
-    let _e26 = r_mu_2;
+    let _e13 = r_9;
+    let _e14 = mu_5;
+    r_mu_2 = (_e13 * _e14);
+    let _e17 = r_9;
+    let _e18 = atmosphere_5;
+    let _e21 = r_9;
+    let _e22 = atmosphere_5;
+    c_3 = ((_e17 - _e18.bottom_radius) * (_e21 + _e22.bottom_radius));
     let _e27 = r_mu_2;
-    let _e29 = c_3;
-    let _e31 = SafeSqrt(((_e26 * _e27) - _e29));
-    s_1 = _e31;
-    let _e33 = c_3;
-    let _e34 = s_1;
-    let _e35 = r_mu_2;
-    let _e40 = ClampDistance((_e33 / max((_e34 - _e35), 0.000000000000000000000000000001f)));
-    return _e40;
+    let _e28 = r_mu_2;
+    let _e30 = c_3;
+    let _e32 = SafeSqrt(((_e27 * _e28) - _e30));
+    s_1 = _e32;
+    let _e34 = c_3;
+    let _e35 = s_1;
+    let _e36 = r_mu_2;
+    let _e41 = ClampDistance((_e34 / max((_e35 - _e36), 0.000000000000000000000000000001f)));
+    return _e41;
 }
 
 fn RayIntersectsGround(atmosphere_6: AtmosphereParameters, r_10: f32, mu_6: f32) -> bool {
@@ -328,18 +342,18 @@ fn RayIntersectsGround(atmosphere_6: AtmosphereParameters, r_10: f32, mu_6: f32)
     atmosphere_7 = atmosphere_6;
     r_11 = r_10;
     mu_7 = mu_6;
-    let _e12 = r_11;
-    let _e13 = atmosphere_7;
-    let _e16 = r_11;
-    let _e17 = atmosphere_7;
-    c_4 = ((_e12 - _e13.bottom_radius) * (_e16 + _e17.bottom_radius));
-    let _e22 = mu_7;
-    let _e25 = r_11;
+    let _e13 = r_11;
+    let _e14 = atmosphere_7;
+    let _e17 = r_11;
+    let _e18 = atmosphere_7;
+    c_4 = ((_e13 - _e14.bottom_radius) * (_e17 + _e18.bottom_radius));
+    let _e23 = mu_7;
     let _e26 = r_11;
-    let _e28 = mu_7;
-    let _e30 = mu_7;
-    let _e32 = c_4;
-    return ((_e22 < 0f) && ((((_e25 * _e26) * _e28) * _e30) >= _e32));
+    let _e27 = r_11;
+    let _e29 = mu_7;
+    let _e31 = mu_7;
+    let _e33 = c_4;
+    return ((_e23 < 0f) && ((((_e26 * _e27) * _e29) * _e31) >= _e33));
 }
 
 fn DistanceToNearestAtmosphereBoundary(atmosphere_8: AtmosphereParameters, r_12: f32, mu_8: f32, ray_r_mu_intersects_ground: bool) -> f32 {
@@ -353,22 +367,22 @@ fn DistanceToNearestAtmosphereBoundary(atmosphere_8: AtmosphereParameters, r_12:
     r_13 = r_12;
     mu_9 = mu_8;
     ray_r_mu_intersects_ground_1 = ray_r_mu_intersects_ground;
-    let _e14 = ray_r_mu_intersects_ground_1;
-    if _e14 {
-        let _e15 = atmosphere_9;
-        let _e16 = r_13;
-        let _e17 = mu_9;
-        let _e18 = DistanceToBottomAtmosphereBoundary(_e15, _e16, _e17);
-        local_1 = _e18;
+    let _e15 = ray_r_mu_intersects_ground_1;
+    if _e15 {
+        let _e16 = atmosphere_9;
+        let _e17 = r_13;
+        let _e18 = mu_9;
+        let _e19 = DistanceToBottomAtmosphereBoundary(_e16, _e17, _e18);
+        local_1 = _e19;
     } else {
-        let _e19 = atmosphere_9;
-        let _e20 = r_13;
-        let _e21 = mu_9;
-        let _e22 = DistanceToTopAtmosphereBoundary(_e19, _e20, _e21);
-        local_1 = _e22;
+        let _e20 = atmosphere_9;
+        let _e21 = r_13;
+        let _e22 = mu_9;
+        let _e23 = DistanceToTopAtmosphereBoundary(_e20, _e21, _e22);
+        local_1 = _e23;
     }
-    let _e24 = local_1;
-    return _e24;
+    let _e25 = local_1;
+    return _e25;
 }
 
 fn RadiusAtDistance(atmosphere_10: AtmosphereParameters, r_14: f32, mu_10: f32, d_2: f32) -> f32 {
@@ -381,16 +395,16 @@ fn RadiusAtDistance(atmosphere_10: AtmosphereParameters, r_14: f32, mu_10: f32, 
     r_15 = r_14;
     mu_11 = mu_10;
     d_3 = d_2;
-    let _e14 = atmosphere_11;
-    let _e15 = d_3;
+    let _e15 = atmosphere_11;
     let _e16 = d_3;
-    let _e19 = r_15;
-    let _e21 = mu_11;
-    let _e23 = d_3;
-    let _e26 = r_15;
+    let _e17 = d_3;
+    let _e20 = r_15;
+    let _e22 = mu_11;
+    let _e24 = d_3;
     let _e27 = r_15;
-    let _e31 = ClampRadius(_e14, sqrt((((_e15 * _e16) + (((2f * _e19) * _e21) * _e23)) + (_e26 * _e27))));
-    return _e31;
+    let _e28 = r_15;
+    let _e32 = ClampRadius(_e15, sqrt((((_e16 * _e17) + (((2f * _e20) * _e22) * _e24)) + (_e27 * _e28))));
+    return _e32;
 }
 
 fn CosineAtDistance(r_16: f32, mu_12: f32, d_4: f32, r_d: f32) -> f32 {
@@ -403,12 +417,12 @@ fn CosineAtDistance(r_16: f32, mu_12: f32, d_4: f32, r_d: f32) -> f32 {
     mu_13 = mu_12;
     d_5 = d_4;
     r_d_1 = r_d;
-    let _e14 = r_17;
-    let _e15 = mu_13;
-    let _e17 = d_5;
-    let _e19 = r_d_1;
-    let _e21 = ClampCosine((((_e14 * _e15) + _e17) / _e19));
-    return _e21;
+    let _e15 = r_17;
+    let _e16 = mu_13;
+    let _e18 = d_5;
+    let _e20 = r_d_1;
+    let _e22 = ClampCosine((((_e15 * _e16) + _e18) / _e20));
+    return _e22;
 }
 
 fn EnterAtmosphere(atmosphere_12: AtmosphereParameters, camera: vec3<f32>, view_ray: vec3<f32>, entry: ptr<function, vec3<f32>>, r_18: ptr<function, f32>, r_mu_3: ptr<function, f32>) -> bool {
@@ -422,45 +436,45 @@ fn EnterAtmosphere(atmosphere_12: AtmosphereParameters, camera: vec3<f32>, view_
     atmosphere_13 = atmosphere_12;
     camera_1 = camera;
     view_ray_1 = view_ray;
-    let _e15 = camera_1;
-    (*entry) = _e15;
     let _e16 = camera_1;
-    (*r_18) = length(_e16);
-    let _e18 = camera_1;
-    let _e19 = view_ray_1;
-    (*r_mu_3) = dot(_e18, _e19);
-    let _e21 = (*r_18);
-    let _e22 = atmosphere_13;
-    if (_e21 > _e22.top_radius) {
+    (*entry) = _e16;
+    let _e17 = camera_1;
+    (*r_18) = length(_e17);
+    let _e19 = camera_1;
+    let _e20 = view_ray_1;
+    (*r_mu_3) = dot(_e19, _e20);
+    let _e22 = (*r_18);
+    let _e23 = atmosphere_13;
+    if (_e22 > _e23.top_radius) {
         {
-            let _e25 = (*r_18);
-            let _e26 = atmosphere_13;
-            let _e29 = (*r_18);
-            let _e30 = atmosphere_13;
-            c_5 = ((_e25 - _e26.top_radius) * (_e29 + _e30.top_radius));
-            let _e35 = (*r_mu_3);
+            let _e26 = (*r_18);
+            let _e27 = atmosphere_13;
+            let _e30 = (*r_18);
+            let _e31 = atmosphere_13;
+            c_5 = ((_e26 - _e27.top_radius) * (_e30 + _e31.top_radius));
             let _e36 = (*r_mu_3);
-            let _e38 = c_5;
-            disc = ((_e35 * _e36) - _e38);
-            let _e41 = (*r_mu_3);
-            let _e44 = disc;
-            if ((_e41 >= 0f) || (_e44 < 0f)) {
+            let _e37 = (*r_mu_3);
+            let _e39 = c_5;
+            disc = ((_e36 * _e37) - _e39);
+            let _e42 = (*r_mu_3);
+            let _e45 = disc;
+            if ((_e42 >= 0f) || (_e45 < 0f)) {
                 return false;
             }
-            let _e49 = c_5;
-            let _e50 = disc;
-            let _e51 = SafeSqrt(_e50);
-            let _e52 = (*r_mu_3);
-            distance_to_top = (_e49 / (_e51 - _e52));
-            let _e56 = camera_1;
-            let _e57 = view_ray_1;
-            let _e58 = distance_to_top;
-            (*entry) = (_e56 + (_e57 * _e58));
-            let _e61 = atmosphere_13;
-            (*r_18) = _e61.top_radius;
-            let _e63 = (*r_mu_3);
-            let _e64 = distance_to_top;
-            (*r_mu_3) = (_e63 + _e64);
+            let _e50 = c_5;
+            let _e51 = disc;
+            let _e52 = SafeSqrt(_e51);
+            let _e53 = (*r_mu_3);
+            distance_to_top = (_e50 / (_e52 - _e53));
+            let _e57 = camera_1;
+            let _e58 = view_ray_1;
+            let _e59 = distance_to_top;
+            (*entry) = (_e57 + (_e58 * _e59));
+            let _e62 = atmosphere_13;
+            (*r_18) = _e62.top_radius;
+            let _e64 = (*r_mu_3);
+            let _e65 = distance_to_top;
+            (*r_mu_3) = (_e64 + _e65);
         }
     }
     return true;
@@ -477,39 +491,39 @@ fn GetViewRayStart(atmosphere_14: AtmosphereParameters, camera_2: vec3<f32>, vie
     camera_3 = camera_2;
     view_ray_3 = view_ray_2;
     sun_direction_1 = sun_direction;
-    let _e20 = atmosphere_15;
-    let _e21 = camera_3;
-    let _e22 = view_ray_3;
-    let _e29 = EnterAtmosphere(_e20, _e21, _e22, start, r_19, (&r_mu_4));
-    if !(_e29) {
+    let _e21 = atmosphere_15;
+    let _e22 = camera_3;
+    let _e23 = view_ray_3;
+    let _e30 = EnterAtmosphere(_e21, _e22, _e23, start, r_19, (&r_mu_4));
+    if !(_e30) {
         return false;
     }
-    let _e32 = r_mu_4;
-    let _e33 = (*r_19);
-    let _e35 = ClampCosine((_e32 / _e33));
-    (*mu_14) = _e35;
-    let _e36 = (*start);
-    let _e37 = sun_direction_1;
-    let _e39 = (*r_19);
-    let _e41 = ClampCosine((dot(_e36, _e37) / _e39));
-    (*mu_s_2) = _e41;
-    let _e42 = view_ray_3;
-    let _e43 = sun_direction_1;
-    let _e45 = ClampCosine(dot(_e42, _e43));
-    (*nu_8) = _e45;
+    let _e33 = r_mu_4;
+    let _e34 = (*r_19);
+    let _e36 = ClampCosine((_e33 / _e34));
+    (*mu_14) = _e36;
+    let _e37 = (*start);
+    let _e38 = sun_direction_1;
+    let _e40 = (*r_19);
+    let _e42 = ClampCosine((dot(_e37, _e38) / _e40));
+    (*mu_s_2) = _e42;
+    let _e43 = view_ray_3;
+    let _e44 = sun_direction_1;
+    let _e46 = ClampCosine(dot(_e43, _e44));
+    (*nu_8) = _e46;
     return true;
 }
 
-fn GetTextureCoordFromUnitRange(x: f32, texture_size: i32) -> f32 {
-    var x_1: f32;
+fn GetTextureCoordFromUnitRange(x_2: f32, texture_size: i32) -> f32 {
+    var x_3: f32;
     var texture_size_1: i32;
 
-    x_1 = x;
+    x_3 = x_2;
     texture_size_1 = texture_size;
-    let _e11 = texture_size_1;
-    let _e14 = x_1;
-    let _e17 = texture_size_1;
-    return ((0.5f / f32(_e11)) + (_e14 * (1f - (1f / f32(_e17)))));
+    let _e12 = texture_size_1;
+    let _e15 = x_3;
+    let _e18 = texture_size_1;
+    return ((0.5f / f32(_e12)) + (_e15 * (1f - (1f / f32(_e18)))));
 }
 
 fn GetUnitRangeFromTextureCoord(u: f32, texture_size_2: i32) -> f32 {
@@ -518,21 +532,21 @@ fn GetUnitRangeFromTextureCoord(u: f32, texture_size_2: i32) -> f32 {
 
     u_1 = u;
     texture_size_3 = texture_size_2;
-    let _e10 = u_1;
-    let _e12 = texture_size_3;
-    let _e18 = texture_size_3;
-    return ((_e10 - (0.5f / f32(_e12))) / (1f - (1f / f32(_e18))));
+    let _e11 = u_1;
+    let _e13 = texture_size_3;
+    let _e19 = texture_size_3;
+    return ((_e11 - (0.5f / f32(_e13))) / (1f - (1f / f32(_e19))));
 }
 
 fn HorizonDistanceAtTop(atmosphere_16: AtmosphereParameters) -> f32 {
     var atmosphere_17: AtmosphereParameters;
 
     atmosphere_17 = atmosphere_16;
-    let _e8 = atmosphere_17;
-    let _e10 = atmosphere_17;
-    let _e13 = atmosphere_17;
-    let _e15 = atmosphere_17;
-    return sqrt(((_e8.top_radius - _e10.bottom_radius) * (_e13.top_radius + _e15.bottom_radius)));
+    let _e9 = atmosphere_17;
+    let _e11 = atmosphere_17;
+    let _e14 = atmosphere_17;
+    let _e16 = atmosphere_17;
+    return sqrt(((_e9.top_radius - _e11.bottom_radius) * (_e14.top_radius + _e16.bottom_radius)));
 }
 
 fn HorizonDistance(atmosphere_18: AtmosphereParameters, r_20: f32) -> f32 {
@@ -541,10 +555,10 @@ fn HorizonDistance(atmosphere_18: AtmosphereParameters, r_20: f32) -> f32 {
 
     atmosphere_19 = atmosphere_18;
     r_21 = r_20;
-    let _e10 = atmosphere_19;
-    let _e12 = r_21;
-    let _e13 = DistanceToHorizon(_e10.bottom_radius, _e12);
-    return _e13;
+    let _e11 = atmosphere_19;
+    let _e13 = r_21;
+    let _e14 = DistanceToHorizon(_e11.bottom_radius, _e13);
+    return _e14;
 }
 
 fn GetTransmittanceTextureUvFromRMu(atmosphere_20: AtmosphereParameters, r_22: f32, mu_15: f32) -> vec2<f32> {
@@ -563,47 +577,47 @@ fn GetTransmittanceTextureUvFromRMu(atmosphere_20: AtmosphereParameters, r_22: f
     atmosphere_21 = atmosphere_20;
     r_23 = r_22;
     mu_16 = mu_15;
-    let _e12 = atmosphere_21;
-    let _e13 = HorizonDistanceAtTop(_e12);
-    H = _e13;
-    let _e15 = atmosphere_21;
-    let _e16 = r_23;
-    let _e17 = HorizonDistance(_e15, _e16);
-    rho_2 = _e17;
-    let _e19 = atmosphere_21;
-    let _e20 = r_23;
-    let _e21 = mu_16;
-    let _e22 = DistanceToTopAtmosphereBoundary(_e19, _e20, _e21);
-    d_6 = _e22;
-    let _e24 = atmosphere_21;
-    let _e26 = r_23;
-    d_min = (_e24.top_radius - _e26);
-    let _e29 = rho_2;
-    let _e30 = H;
-    d_max = (_e29 + _e30);
-    let _e33 = d_max;
-    let _e34 = d_min;
-    if (_e33 > _e34) {
-        let _e36 = d_6;
-        let _e37 = d_min;
-        let _e39 = d_max;
-        let _e40 = d_min;
-        local_2 = ((_e36 - _e37) / (_e39 - _e40));
+    let _e13 = atmosphere_21;
+    let _e14 = HorizonDistanceAtTop(_e13);
+    H = _e14;
+    let _e16 = atmosphere_21;
+    let _e17 = r_23;
+    let _e18 = HorizonDistance(_e16, _e17);
+    rho_2 = _e18;
+    let _e20 = atmosphere_21;
+    let _e21 = r_23;
+    let _e22 = mu_16;
+    let _e23 = DistanceToTopAtmosphereBoundary(_e20, _e21, _e22);
+    d_6 = _e23;
+    let _e25 = atmosphere_21;
+    let _e27 = r_23;
+    d_min = (_e25.top_radius - _e27);
+    let _e30 = rho_2;
+    let _e31 = H;
+    d_max = (_e30 + _e31);
+    let _e34 = d_max;
+    let _e35 = d_min;
+    if (_e34 > _e35) {
+        let _e37 = d_6;
+        let _e38 = d_min;
+        let _e40 = d_max;
+        let _e41 = d_min;
+        local_2 = ((_e37 - _e38) / (_e40 - _e41));
     } else {
         local_2 = 0f;
     }
-    let _e45 = local_2;
-    x_mu = _e45;
-    let _e47 = rho_2;
-    let _e48 = H;
-    x_r = (_e47 / _e48);
-    let _e51 = x_mu;
-    let _e52 = atmosphere_21;
-    let _e54 = GetTextureCoordFromUnitRange(_e51, _e52.transmittance_width);
-    let _e55 = x_r;
-    let _e56 = atmosphere_21;
-    let _e58 = GetTextureCoordFromUnitRange(_e55, _e56.transmittance_height);
-    return vec2<f32>(_e54, _e58);
+    let _e46 = local_2;
+    x_mu = _e46;
+    let _e48 = rho_2;
+    let _e49 = H;
+    x_r = (_e48 / _e49);
+    let _e52 = x_mu;
+    let _e53 = atmosphere_21;
+    let _e55 = GetTextureCoordFromUnitRange(_e52, _e53.transmittance_width);
+    let _e56 = x_r;
+    let _e57 = atmosphere_21;
+    let _e59 = GetTextureCoordFromUnitRange(_e56, _e57.transmittance_height);
+    return vec2<f32>(_e55, _e59);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -619,42 +633,42 @@ fn GetScatteringUnitMuS(atmosphere_22: AtmosphereParameters, mu_s_3: f32) -> f32
 
     atmosphere_23 = atmosphere_22;
     mu_s_4 = mu_s_3;
-    let _e10 = atmosphere_23;
     let _e11 = atmosphere_23;
-    let _e13 = mu_s_4;
-    let _e14 = DistanceToTopAtmosphereBoundary(_e10, _e11.bottom_radius, _e13);
-    d_7 = _e14;
-    let _e16 = atmosphere_23;
-    let _e18 = atmosphere_23;
-    d_min_1 = (_e16.top_radius - _e18.bottom_radius);
-    let _e22 = atmosphere_23;
-    let _e23 = HorizonDistanceAtTop(_e22);
-    d_max_1 = _e23;
-    let _e25 = d_7;
-    let _e26 = d_min_1;
-    let _e28 = d_max_1;
-    let _e29 = d_min_1;
-    a_4 = ((_e25 - _e26) / (_e28 - _e29));
-    let _e33 = atmosphere_23;
+    let _e12 = atmosphere_23;
+    let _e14 = mu_s_4;
+    let _e15 = DistanceToTopAtmosphereBoundary(_e11, _e12.bottom_radius, _e14);
+    d_7 = _e15;
+    let _e17 = atmosphere_23;
+    let _e19 = atmosphere_23;
+    d_min_1 = (_e17.top_radius - _e19.bottom_radius);
+    let _e23 = atmosphere_23;
+    let _e24 = HorizonDistanceAtTop(_e23);
+    d_max_1 = _e24;
+    let _e26 = d_7;
+    let _e27 = d_min_1;
+    let _e29 = d_max_1;
+    let _e30 = d_min_1;
+    a_4 = ((_e26 - _e27) / (_e29 - _e30));
     let _e34 = atmosphere_23;
-    let _e36 = atmosphere_23;
-    let _e38 = DistanceToTopAtmosphereBoundary(_e33, _e34.bottom_radius, _e36.scattering_mu_s_min);
-    D = _e38;
-    let _e40 = D;
-    let _e41 = d_min_1;
-    let _e43 = d_max_1;
-    let _e44 = d_min_1;
-    A = ((_e40 - _e41) / (_e43 - _e44));
-    let _e48 = a_4;
-    let _e50 = A;
-    let _e52 = ScatteringUnitMuSFromDistance(_e48, (1f / _e50));
-    return _e52;
+    let _e35 = atmosphere_23;
+    let _e37 = atmosphere_23;
+    let _e39 = DistanceToTopAtmosphereBoundary(_e34, _e35.bottom_radius, _e37.scattering_mu_s_min);
+    D = _e39;
+    let _e41 = D;
+    let _e42 = d_min_1;
+    let _e44 = d_max_1;
+    let _e45 = d_min_1;
+    A = ((_e41 - _e42) / (_e44 - _e45));
+    let _e49 = a_4;
+    let _e51 = A;
+    let _e53 = ScatteringUnitMuSFromDistance(_e49, (1f / _e51));
+    return _e53;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSFromUnitRange(atmosphere_24: AtmosphereParameters, x_2: f32) -> f32 {
+fn GetScatteringMuSFromUnitRange(atmosphere_24: AtmosphereParameters, x_4: f32) -> f32 {
     var atmosphere_25: AtmosphereParameters;
-    var x_3: f32;
+    var x_5: f32;
     var x_mu_s: f32;
     var bottom: f32;
     var H_1: f32;
@@ -667,80 +681,78 @@ fn GetScatteringMuSFromUnitRange(atmosphere_24: AtmosphereParameters, x_2: f32) 
     var local_3: f32;
 
     atmosphere_25 = atmosphere_24;
-    x_3 = x_2;
-    let _e10 = x_3;
-    let _e11 = atmosphere_25;
+    x_5 = x_4;
+    let _e11 = x_5;
     let _e12 = atmosphere_25;
-    let _e14 = GetScatteringUnitMuS(_e11, _e12.scattering_mu_s_max);
-    x_mu_s = (_e10 * _e14);
-    let _e17 = atmosphere_25;
-    bottom = _e17.bottom_radius;
-    let _e20 = atmosphere_25;
-    let _e21 = HorizonDistanceAtTop(_e20);
-    H_1 = _e21;
-    let _e23 = atmosphere_25;
-    let _e25 = bottom;
-    d_min_2 = (_e23.top_radius - _e25);
-    let _e28 = H_1;
-    d_max_2 = _e28;
-    let _e30 = atmosphere_25;
-    let _e31 = bottom;
-    let _e32 = atmosphere_25;
-    let _e34 = DistanceToTopAtmosphereBoundary(_e30, _e31, _e32.scattering_mu_s_min);
-    D_1 = _e34;
-    let _e36 = D_1;
-    let _e37 = d_min_2;
-    let _e39 = d_max_2;
-    let _e40 = d_min_2;
-    A_1 = ((_e36 - _e37) / (_e39 - _e40));
-    let _e44 = A_1;
+    let _e13 = atmosphere_25;
+    let _e15 = GetScatteringUnitMuS(_e12, _e13.scattering_mu_s_max);
+    x_mu_s = (_e11 * _e15);
+    let _e18 = atmosphere_25;
+    bottom = _e18.bottom_radius;
+    let _e21 = atmosphere_25;
+    let _e22 = HorizonDistanceAtTop(_e21);
+    H_1 = _e22;
+    let _e24 = atmosphere_25;
+    let _e26 = bottom;
+    d_min_2 = (_e24.top_radius - _e26);
+    let _e29 = H_1;
+    d_max_2 = _e29;
+    let _e31 = atmosphere_25;
+    let _e32 = bottom;
+    let _e33 = atmosphere_25;
+    let _e35 = DistanceToTopAtmosphereBoundary(_e31, _e32, _e33.scattering_mu_s_min);
+    D_1 = _e35;
+    let _e37 = D_1;
+    let _e38 = d_min_2;
+    let _e40 = d_max_2;
+    let _e41 = d_min_2;
+    A_1 = ((_e37 - _e38) / (_e40 - _e41));
     let _e45 = x_mu_s;
-    let _e46 = A_1;
-    let _e50 = x_mu_s;
-    let _e51 = A_1;
-    a_5 = ((_e44 - (_e45 * _e46)) / (1f + (_e50 * _e51)));
+    let _e47 = A_1;
+    let _e49 = ScatteringDistanceFromUnitMuS(_e45, (1f / _e47));
+    a_5 = _e49;
+    let _e51 = d_min_2;
+    let _e52 = a_5;
+    let _e53 = A_1;
+    let _e55 = d_max_2;
     let _e56 = d_min_2;
-    let _e57 = a_5;
-    let _e58 = A_1;
-    let _e60 = d_max_2;
-    let _e61 = d_min_2;
-    d_8 = (_e56 + (min(_e57, _e58) * (_e60 - _e61)));
-    let _e66 = d_8;
-    if (_e66 == 0f) {
+    d_8 = (_e51 + (min(_e52, _e53) * (_e55 - _e56)));
+    let _e61 = d_8;
+    if (_e61 == 0f) {
         local_3 = 1f;
     } else {
-        let _e70 = H_1;
-        let _e71 = H_1;
-        let _e73 = d_8;
-        let _e74 = d_8;
-        let _e78 = bottom;
-        let _e80 = d_8;
-        let _e83 = ClampCosine((((_e70 * _e71) - (_e73 * _e74)) / ((2f * _e78) * _e80)));
-        local_3 = _e83;
+        let _e65 = H_1;
+        let _e66 = H_1;
+        let _e68 = d_8;
+        let _e69 = d_8;
+        let _e73 = bottom;
+        let _e75 = d_8;
+        let _e78 = ClampCosine((((_e65 * _e66) - (_e68 * _e69)) / ((2f * _e73) * _e75)));
+        local_3 = _e78;
     }
-    let _e85 = local_3;
-    return _e85;
+    let _e80 = local_3;
+    return _e80;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringTextureUMuS(atmosphere_26: AtmosphereParameters, mu_s_5: f32) -> f32 {
     var atmosphere_27: AtmosphereParameters;
     var mu_s_6: f32;
-    var x_4: f32;
+    var x_6: f32;
 
     atmosphere_27 = atmosphere_26;
     mu_s_6 = mu_s_5;
-    let _e10 = atmosphere_27;
-    let _e11 = mu_s_6;
-    let _e12 = GetScatteringUnitMuS(_e10, _e11);
-    let _e13 = atmosphere_27;
+    let _e11 = atmosphere_27;
+    let _e12 = mu_s_6;
+    let _e13 = GetScatteringUnitMuS(_e11, _e12);
     let _e14 = atmosphere_27;
-    let _e16 = GetScatteringUnitMuS(_e13, _e14.scattering_mu_s_max);
-    x_4 = (_e12 / _e16);
-    let _e19 = x_4;
-    let _e22 = atmosphere_27;
-    let _e24 = GetTextureCoordFromUnitRange(min(_e19, 1f), _e22.scattering_mu_s_size);
-    return _e24;
+    let _e15 = atmosphere_27;
+    let _e17 = GetScatteringUnitMuS(_e14, _e15.scattering_mu_s_max);
+    x_6 = (_e13 / _e17);
+    let _e20 = x_6;
+    let _e23 = atmosphere_27;
+    let _e25 = GetTextureCoordFromUnitRange(min(_e20, 1f), _e23.scattering_mu_s_size);
+    return _e25;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -768,69 +780,69 @@ fn GetScatteringTextureUR(atmosphere_28: AtmosphereParameters, r_24: f32, rho_3:
     rho_4 = rho_3;
     ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
     x_mu_2 = x_mu_1;
-    let _e16 = atmosphere_29;
     let _e17 = atmosphere_29;
-    let _e19 = HorizonDistance(_e16, _e17.scattering_r_min);
-    rho_min = _e19;
-    let _e21 = atmosphere_29;
+    let _e18 = atmosphere_29;
+    let _e20 = HorizonDistance(_e17, _e18.scattering_r_min);
+    rho_min = _e20;
     let _e22 = atmosphere_29;
-    let _e24 = HorizonDistance(_e21, _e22.scattering_r_max);
-    rho_max = _e24;
-    let _e26 = atmosphere_29;
-    last_row = f32((_e26.scattering_r_size - 1i));
-    let _e32 = rho_4;
-    let _e33 = rho_min;
-    let _e35 = rho_max;
-    let _e36 = rho_min;
-    let _e42 = last_row;
-    position = (clamp(((_e32 - _e33) / (_e35 - _e36)), 0f, 1f) * _e42);
-    let _e45 = ray_r_mu_intersects_ground_3;
-    if !(_e45) {
-        let _e47 = position;
-        let _e50 = last_row;
-        return ((_e47 + 0.5f) / (_e50 + 1f));
+    let _e23 = atmosphere_29;
+    let _e25 = HorizonDistance(_e22, _e23.scattering_r_max);
+    rho_max = _e25;
+    let _e27 = atmosphere_29;
+    last_row = f32((_e27.scattering_r_size - 1i));
+    let _e33 = rho_4;
+    let _e34 = rho_min;
+    let _e36 = rho_max;
+    let _e37 = rho_min;
+    let _e43 = last_row;
+    position = (clamp(((_e33 - _e34) / (_e36 - _e37)), 0f, 1f) * _e43);
+    let _e46 = ray_r_mu_intersects_ground_3;
+    if !(_e46) {
+        let _e48 = position;
+        let _e51 = last_row;
+        return ((_e48 + 0.5f) / (_e51 + 1f));
     }
-    let _e54 = position;
-    let _e56 = last_row;
-    row = min(floor(_e54), (_e56 - 1f));
-    let _e61 = rho_min;
-    let _e62 = rho_max;
-    let _e63 = row;
-    let _e64 = last_row;
-    rho_below = mix(_e61, _e62, (_e63 / _e64));
-    let _e68 = rho_min;
-    let _e69 = rho_max;
-    let _e70 = row;
-    let _e73 = last_row;
-    rho_above = mix(_e68, _e69, ((_e70 + 1f) / _e73));
-    let _e77 = atmosphere_29;
-    bottom_1 = _e77.bottom_radius;
-    let _e80 = bottom_1;
-    let _e81 = rho_below;
-    let _e82 = HeightFromHorizonDistance(_e80, _e81);
-    let _e83 = rho_below;
-    let _e84 = x_mu_2;
-    d_below = mix(_e82, _e83, _e84);
-    let _e87 = bottom_1;
-    let _e88 = rho_above;
-    let _e89 = HeightFromHorizonDistance(_e87, _e88);
-    let _e90 = rho_above;
-    let _e91 = x_mu_2;
-    d_above = mix(_e89, _e90, _e91);
-    let _e94 = r_25;
-    let _e95 = bottom_1;
-    let _e97 = rho_4;
-    let _e98 = x_mu_2;
-    d_9 = mix((_e94 - _e95), _e97, _e98);
-    let _e101 = d_9;
-    let _e102 = d_below;
-    let _e104 = d_above;
-    let _e105 = d_below;
-    t = clamp(((_e101 - _e102) / (_e104 - _e105)), 0f, 1f);
-    let _e112 = row;
-    let _e113 = t;
-    let _e117 = last_row;
-    return (((_e112 + _e113) + 0.5f) / (_e117 + 1f));
+    let _e55 = position;
+    let _e57 = last_row;
+    row = min(floor(_e55), (_e57 - 1f));
+    let _e62 = rho_min;
+    let _e63 = rho_max;
+    let _e64 = row;
+    let _e65 = last_row;
+    rho_below = mix(_e62, _e63, (_e64 / _e65));
+    let _e69 = rho_min;
+    let _e70 = rho_max;
+    let _e71 = row;
+    let _e74 = last_row;
+    rho_above = mix(_e69, _e70, ((_e71 + 1f) / _e74));
+    let _e78 = atmosphere_29;
+    bottom_1 = _e78.bottom_radius;
+    let _e81 = bottom_1;
+    let _e82 = rho_below;
+    let _e83 = HeightFromHorizonDistance(_e81, _e82);
+    let _e84 = rho_below;
+    let _e85 = x_mu_2;
+    d_below = mix(_e83, _e84, _e85);
+    let _e88 = bottom_1;
+    let _e89 = rho_above;
+    let _e90 = HeightFromHorizonDistance(_e88, _e89);
+    let _e91 = rho_above;
+    let _e92 = x_mu_2;
+    d_above = mix(_e90, _e91, _e92);
+    let _e95 = r_25;
+    let _e96 = bottom_1;
+    let _e98 = rho_4;
+    let _e99 = x_mu_2;
+    d_9 = mix((_e95 - _e96), _e98, _e99);
+    let _e102 = d_9;
+    let _e103 = d_below;
+    let _e105 = d_above;
+    let _e106 = d_below;
+    t = clamp(((_e102 - _e103) / (_e105 - _e106)), 0f, 1f);
+    let _e113 = row;
+    let _e114 = t;
+    let _e118 = last_row;
+    return (((_e113 + _e114) + 0.5f) / (_e118 + 1f));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -863,95 +875,95 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_2
     mu_s_8 = mu_s_7;
     nu_10 = nu_9;
     ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
-    let _e18 = atmosphere_31;
-    let _e19 = HorizonDistanceAtTop(_e18);
-    H_2 = _e19;
-    let _e21 = atmosphere_31;
-    let _e22 = r_27;
-    let _e23 = HorizonDistance(_e21, _e22);
-    rho_5 = _e23;
-    let _e25 = atmosphere_31;
-    half_mu_size = f32((_e25.scattering_mu_size / 2i));
-    let _e33 = ray_r_mu_intersects_ground_5;
-    if _e33 {
+    let _e19 = atmosphere_31;
+    let _e20 = HorizonDistanceAtTop(_e19);
+    H_2 = _e20;
+    let _e22 = atmosphere_31;
+    let _e23 = r_27;
+    let _e24 = HorizonDistance(_e22, _e23);
+    rho_5 = _e24;
+    let _e26 = atmosphere_31;
+    half_mu_size = f32((_e26.scattering_mu_size / 2i));
+    let _e34 = ray_r_mu_intersects_ground_5;
+    if _e34 {
         {
-            let _e34 = atmosphere_31;
-            let _e35 = r_27;
-            let _e36 = mu_18;
-            let _e37 = DistanceToBottomAtmosphereBoundary(_e34, _e35, _e36);
-            d_10 = _e37;
-            let _e39 = r_27;
-            let _e40 = atmosphere_31;
-            d_min_3 = (_e39 - _e40.bottom_radius);
-            let _e44 = rho_5;
-            d_max_3 = _e44;
-            let _e46 = d_max_3;
-            let _e47 = d_min_3;
-            if (_e46 == _e47) {
+            let _e35 = atmosphere_31;
+            let _e36 = r_27;
+            let _e37 = mu_18;
+            let _e38 = DistanceToBottomAtmosphereBoundary(_e35, _e36, _e37);
+            d_10 = _e38;
+            let _e40 = r_27;
+            let _e41 = atmosphere_31;
+            d_min_3 = (_e40 - _e41.bottom_radius);
+            let _e45 = rho_5;
+            d_max_3 = _e45;
+            let _e47 = d_max_3;
+            let _e48 = d_min_3;
+            if (_e47 == _e48) {
                 local_4 = 0f;
             } else {
-                let _e50 = d_10;
-                let _e51 = d_min_3;
-                let _e53 = d_max_3;
-                let _e54 = d_min_3;
-                local_4 = ((_e50 - _e51) / (_e53 - _e54));
+                let _e51 = d_10;
+                let _e52 = d_min_3;
+                let _e54 = d_max_3;
+                let _e55 = d_min_3;
+                local_4 = ((_e51 - _e52) / (_e54 - _e55));
             }
-            let _e58 = local_4;
-            x_mu_3 = _e58;
-            let _e62 = half_mu_size;
-            let _e64 = x_mu_3;
-            let _e67 = half_mu_size;
-            u_mu = (0.5f - (0.5f * ((0.5f / _e62) + (_e64 * (1f - (1f / _e67))))));
+            let _e59 = local_4;
+            x_mu_3 = _e59;
+            let _e63 = half_mu_size;
+            let _e65 = x_mu_3;
+            let _e68 = half_mu_size;
+            u_mu = (0.5f - (0.5f * ((0.5f / _e63) + (_e65 * (1f - (1f / _e68))))));
         }
     } else {
         {
-            let _e74 = atmosphere_31;
-            let _e75 = r_27;
-            let _e76 = mu_18;
-            let _e77 = DistanceToTopAtmosphereBoundary(_e74, _e75, _e76);
-            d_11 = _e77;
-            let _e79 = atmosphere_31;
-            let _e81 = r_27;
-            d_min_4 = (_e79.top_radius - _e81);
-            let _e84 = rho_5;
-            let _e85 = H_2;
-            d_max_4 = (_e84 + _e85);
-            let _e88 = d_max_4;
-            let _e89 = d_min_4;
-            if (_e88 > _e89) {
-                let _e91 = d_11;
-                let _e92 = d_min_4;
-                let _e94 = d_max_4;
-                let _e95 = d_min_4;
-                local_5 = ((_e91 - _e92) / (_e94 - _e95));
+            let _e75 = atmosphere_31;
+            let _e76 = r_27;
+            let _e77 = mu_18;
+            let _e78 = DistanceToTopAtmosphereBoundary(_e75, _e76, _e77);
+            d_11 = _e78;
+            let _e80 = atmosphere_31;
+            let _e82 = r_27;
+            d_min_4 = (_e80.top_radius - _e82);
+            let _e85 = rho_5;
+            let _e86 = H_2;
+            d_max_4 = (_e85 + _e86);
+            let _e89 = d_max_4;
+            let _e90 = d_min_4;
+            if (_e89 > _e90) {
+                let _e92 = d_11;
+                let _e93 = d_min_4;
+                let _e95 = d_max_4;
+                let _e96 = d_min_4;
+                local_5 = ((_e92 - _e93) / (_e95 - _e96));
             } else {
                 local_5 = 0f;
             }
-            let _e100 = local_5;
-            x_mu_3 = _e100;
-            let _e104 = half_mu_size;
-            let _e106 = x_mu_3;
-            let _e109 = half_mu_size;
-            u_mu = (0.5f + (0.5f * ((0.5f / _e104) + (_e106 * (1f - (1f / _e109))))));
+            let _e101 = local_5;
+            x_mu_3 = _e101;
+            let _e105 = half_mu_size;
+            let _e107 = x_mu_3;
+            let _e110 = half_mu_size;
+            u_mu = (0.5f + (0.5f * ((0.5f / _e105) + (_e107 * (1f - (1f / _e110))))));
         }
     }
-    let _e116 = atmosphere_31;
-    let _e117 = r_27;
-    let _e118 = rho_5;
-    let _e119 = ray_r_mu_intersects_ground_5;
-    let _e120 = x_mu_3;
-    let _e121 = GetScatteringTextureUR(_e116, _e117, _e118, _e119, _e120);
-    u_r = _e121;
-    let _e123 = nu_10;
-    let _e124 = ScatteringUnitNu(_e123);
-    u_nu = _e124;
-    let _e126 = u_nu;
-    let _e127 = atmosphere_31;
-    let _e128 = mu_s_8;
-    let _e129 = GetScatteringTextureUMuS(_e127, _e128);
-    let _e130 = u_mu;
-    let _e131 = u_r;
-    return vec4<f32>(_e126, _e129, _e130, _e131);
+    let _e117 = atmosphere_31;
+    let _e118 = r_27;
+    let _e119 = rho_5;
+    let _e120 = ray_r_mu_intersects_ground_5;
+    let _e121 = x_mu_3;
+    let _e122 = GetScatteringTextureUR(_e117, _e118, _e119, _e120, _e121);
+    u_r = _e122;
+    let _e124 = nu_10;
+    let _e125 = ScatteringUnitNu(_e124);
+    u_nu = _e125;
+    let _e127 = u_nu;
+    let _e128 = atmosphere_31;
+    let _e129 = mu_s_8;
+    let _e130 = GetScatteringTextureUMuS(_e128, _e129);
+    let _e131 = u_mu;
+    let _e132 = u_r;
+    return vec4<f32>(_e127, _e130, _e131, _e132);
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -960,15 +972,15 @@ fn IrradianceKneeMuS(atmosphere_32: AtmosphereParameters) -> f32 {
     var local_6: f32;
 
     atmosphere_33 = atmosphere_32;
-    let _e9 = atmosphere_33;
-    if (_e9.mu_s_min < LOW_SUN_MU_S) {
+    let _e10 = atmosphere_33;
+    if (_e10.mu_s_min < LOW_SUN_MU_S) {
         local_6 = LOW_SUN_MU_S;
     } else {
-        let _e13 = atmosphere_33;
-        local_6 = (0.5f * (_e13.mu_s_min + 1f));
+        let _e14 = atmosphere_33;
+        local_6 = (0.5f * (_e14.mu_s_min + 1f));
     }
-    let _e19 = local_6;
-    return _e19;
+    let _e20 = local_6;
+    return _e20;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -980,54 +992,54 @@ fn GetIrradianceUnitMuS(atmosphere_34: AtmosphereParameters, mu_s_9: f32) -> f32
 
     atmosphere_35 = atmosphere_34;
     mu_s_10 = mu_s_9;
-    let _e11 = atmosphere_35;
-    let _e12 = IrradianceKneeMuS(_e11);
-    knee = _e12;
-    let _e14 = mu_s_10;
-    let _e15 = knee;
-    if (_e14 < _e15) {
-        let _e18 = mu_s_10;
-        let _e19 = atmosphere_35;
-        let _e23 = knee;
-        let _e24 = atmosphere_35;
-        local_7 = ((0.5f * (_e18 - _e19.mu_s_min)) / (_e23 - _e24.mu_s_min));
+    let _e12 = atmosphere_35;
+    let _e13 = IrradianceKneeMuS(_e12);
+    knee = _e13;
+    let _e15 = mu_s_10;
+    let _e16 = knee;
+    if (_e15 < _e16) {
+        let _e19 = mu_s_10;
+        let _e20 = atmosphere_35;
+        let _e24 = knee;
+        let _e25 = atmosphere_35;
+        local_7 = ((0.5f * (_e19 - _e20.mu_s_min)) / (_e24 - _e25.mu_s_min));
     } else {
-        let _e30 = mu_s_10;
-        let _e31 = knee;
-        let _e35 = knee;
-        local_7 = (0.5f + ((0.5f * (_e30 - _e31)) / (1f - _e35)));
+        let _e31 = mu_s_10;
+        let _e32 = knee;
+        let _e36 = knee;
+        local_7 = (0.5f + ((0.5f * (_e31 - _e32)) / (1f - _e36)));
     }
-    let _e40 = local_7;
-    return _e40;
+    let _e41 = local_7;
+    return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_36: AtmosphereParameters, x_5: f32) -> f32 {
+fn GetIrradianceMuSFromUnit(atmosphere_36: AtmosphereParameters, x_7: f32) -> f32 {
     var atmosphere_37: AtmosphereParameters;
-    var x_6: f32;
+    var x_8: f32;
     var knee_1: f32;
     var local_8: f32;
 
     atmosphere_37 = atmosphere_36;
-    x_6 = x_5;
-    let _e11 = atmosphere_37;
-    let _e12 = IrradianceKneeMuS(_e11);
-    knee_1 = _e12;
-    let _e14 = x_6;
-    if (_e14 < 0.5f) {
-        let _e17 = atmosphere_37;
-        let _e20 = x_6;
-        let _e22 = knee_1;
-        let _e23 = atmosphere_37;
-        local_8 = (_e17.mu_s_min + ((2f * _e20) * (_e22 - _e23.mu_s_min)));
+    x_8 = x_7;
+    let _e12 = atmosphere_37;
+    let _e13 = IrradianceKneeMuS(_e12);
+    knee_1 = _e13;
+    let _e15 = x_8;
+    if (_e15 < 0.5f) {
+        let _e18 = atmosphere_37;
+        let _e21 = x_8;
+        let _e23 = knee_1;
+        let _e24 = atmosphere_37;
+        local_8 = (_e18.mu_s_min + ((2f * _e21) * (_e23 - _e24.mu_s_min)));
     } else {
-        let _e28 = knee_1;
-        let _e30 = x_6;
-        let _e35 = knee_1;
-        local_8 = (_e28 + (((2f * _e30) - 1f) * (1f - _e35)));
+        let _e29 = knee_1;
+        let _e31 = x_8;
+        let _e36 = knee_1;
+        local_8 = (_e29 + (((2f * _e31) - 1f) * (1f - _e36)));
     }
-    let _e40 = local_8;
-    return _e40;
+    let _e41 = local_8;
+    return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -1041,23 +1053,23 @@ fn GetIrradianceTextureUvFromRMuS(atmosphere_38: AtmosphereParameters, r_28: f32
     atmosphere_39 = atmosphere_38;
     r_29 = r_28;
     mu_s_12 = mu_s_11;
-    let _e13 = atmosphere_39;
-    let _e14 = r_29;
-    let _e15 = HorizonDistance(_e13, _e14);
-    let _e16 = atmosphere_39;
-    let _e17 = HorizonDistanceAtTop(_e16);
-    x_r_1 = (_e15 / _e17);
-    let _e20 = atmosphere_39;
-    let _e21 = mu_s_12;
-    let _e22 = GetIrradianceUnitMuS(_e20, _e21);
-    x_mu_s_1 = clamp(_e22, 0f, 1f);
-    let _e27 = x_mu_s_1;
-    let _e28 = atmosphere_39;
-    let _e30 = GetTextureCoordFromUnitRange(_e27, _e28.irradiance_width);
-    let _e31 = x_r_1;
-    let _e32 = atmosphere_39;
-    let _e34 = GetTextureCoordFromUnitRange(_e31, _e32.irradiance_height);
-    return vec2<f32>(_e30, _e34);
+    let _e14 = atmosphere_39;
+    let _e15 = r_29;
+    let _e16 = HorizonDistance(_e14, _e15);
+    let _e17 = atmosphere_39;
+    let _e18 = HorizonDistanceAtTop(_e17);
+    x_r_1 = (_e16 / _e18);
+    let _e21 = atmosphere_39;
+    let _e22 = mu_s_12;
+    let _e23 = GetIrradianceUnitMuS(_e21, _e22);
+    x_mu_s_1 = clamp(_e23, 0f, 1f);
+    let _e28 = x_mu_s_1;
+    let _e29 = atmosphere_39;
+    let _e31 = GetTextureCoordFromUnitRange(_e28, _e29.irradiance_width);
+    let _e32 = x_r_1;
+    let _e33 = atmosphere_39;
+    let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_height);
+    return vec2<f32>(_e31, _e35);
 }
 
 fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
@@ -1069,14 +1081,14 @@ fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, t
     atmosphere_41 = atmosphere_40;
     r_31 = r_30;
     mu_20 = mu_19;
-    let _e14 = atmosphere_41;
-    let _e15 = r_31;
-    let _e16 = mu_20;
-    let _e17 = GetTransmittanceTextureUvFromRMu(_e14, _e15, _e16);
-    uv_2 = _e17;
-    let _e19 = uv_2;
-    let _e20 = SampleTexture2D(transmittance_texture, _e19);
-    return vec3<f32>(_e20.xyz);
+    let _e15 = atmosphere_41;
+    let _e16 = r_31;
+    let _e17 = mu_20;
+    let _e18 = GetTransmittanceTextureUvFromRMu(_e15, _e16, _e17);
+    uv_2 = _e18;
+    let _e20 = uv_2;
+    let _e21 = SampleTexture2D(transmittance_texture, _e20);
+    return vec3<f32>(_e21.xyz);
 }
 
 fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_42: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
@@ -1087,11 +1099,11 @@ fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_42: AtmosphereParameters, 
     atmosphere_43 = atmosphere_42;
     r_33 = r_32;
     mu_22 = mu_21;
-    let _e14 = atmosphere_43;
-    let _e15 = r_33;
-    let _e16 = mu_22;
-    let _e17 = GetOpticalDepthToTopAtmosphereBoundary(_e14, transmittance_texture_1, _e15, _e16);
-    return exp(-(_e17));
+    let _e15 = atmosphere_43;
+    let _e16 = r_33;
+    let _e17 = mu_22;
+    let _e18 = GetOpticalDepthToTopAtmosphereBoundary(_e15, transmittance_texture_1, _e16, _e17);
+    return exp(-(_e18));
 }
 
 fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_12: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
@@ -1111,75 +1123,75 @@ fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2:
     mu_24 = mu_23;
     d_13 = d_12;
     ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
-    let _e18 = atmosphere_45;
-    let _e19 = r_35;
-    let _e20 = mu_24;
-    let _e21 = d_13;
-    let _e22 = RadiusAtDistance(_e18, _e19, _e20, _e21);
-    r_d_2 = _e22;
-    let _e24 = r_35;
-    let _e25 = mu_24;
-    let _e26 = d_13;
-    let _e27 = r_d_2;
-    let _e28 = CosineAtDistance(_e24, _e25, _e26, _e27);
-    mu_d = _e28;
-    let _e31 = ray_r_mu_intersects_ground_7;
-    let _e32 = mu_d;
-    if (_e31 || (_e32 < 0f)) {
+    let _e19 = atmosphere_45;
+    let _e20 = r_35;
+    let _e21 = mu_24;
+    let _e22 = d_13;
+    let _e23 = RadiusAtDistance(_e19, _e20, _e21, _e22);
+    r_d_2 = _e23;
+    let _e25 = r_35;
+    let _e26 = mu_24;
+    let _e27 = d_13;
+    let _e28 = r_d_2;
+    let _e29 = CosineAtDistance(_e25, _e26, _e27, _e28);
+    mu_d = _e29;
+    let _e32 = ray_r_mu_intersects_ground_7;
+    let _e33 = mu_d;
+    if (_e32 || (_e33 < 0f)) {
         {
-            let _e36 = atmosphere_45;
-            let _e37 = r_d_2;
-            let _e38 = mu_d;
-            let _e40 = GetOpticalDepthToTopAtmosphereBoundary(_e36, transmittance_texture_2, _e37, -(_e38));
-            let _e41 = atmosphere_45;
-            let _e42 = r_35;
-            let _e43 = mu_24;
-            let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
-            tau = (_e40 - _e45);
+            let _e37 = atmosphere_45;
+            let _e38 = r_d_2;
+            let _e39 = mu_d;
+            let _e41 = GetOpticalDepthToTopAtmosphereBoundary(_e37, transmittance_texture_2, _e38, -(_e39));
+            let _e42 = atmosphere_45;
+            let _e43 = r_35;
+            let _e44 = mu_24;
+            let _e46 = GetOpticalDepthToTopAtmosphereBoundary(_e42, transmittance_texture_2, _e43, -(_e44));
+            tau = (_e41 - _e46);
         }
     } else {
-        let _e47 = mu_24;
-        if (_e47 >= 0f) {
+        let _e48 = mu_24;
+        if (_e48 >= 0f) {
             {
-                let _e50 = atmosphere_45;
-                let _e51 = r_35;
-                let _e52 = mu_24;
-                let _e53 = GetOpticalDepthToTopAtmosphereBoundary(_e50, transmittance_texture_2, _e51, _e52);
-                let _e54 = atmosphere_45;
-                let _e55 = r_d_2;
-                let _e56 = mu_d;
-                let _e57 = GetOpticalDepthToTopAtmosphereBoundary(_e54, transmittance_texture_2, _e55, _e56);
-                tau = (_e53 - _e57);
+                let _e51 = atmosphere_45;
+                let _e52 = r_35;
+                let _e53 = mu_24;
+                let _e54 = GetOpticalDepthToTopAtmosphereBoundary(_e51, transmittance_texture_2, _e52, _e53);
+                let _e55 = atmosphere_45;
+                let _e56 = r_d_2;
+                let _e57 = mu_d;
+                let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
+                tau = (_e54 - _e58);
             }
         } else {
             {
-                let _e59 = atmosphere_45;
-                let _e60 = r_35;
-                let _e62 = mu_24;
+                let _e60 = atmosphere_45;
+                let _e61 = r_35;
                 let _e63 = mu_24;
-                let _e66 = SafeSqrt((1f - (_e62 * _e63)));
-                let _e68 = ClampRadius(_e59, (_e60 * _e66));
-                r_low = _e68;
-                let _e70 = atmosphere_45;
-                let _e71 = r_low;
-                let _e73 = GetOpticalDepthToTopAtmosphereBoundary(_e70, transmittance_texture_2, _e71, 0f);
-                tau_low = _e73;
-                let _e75 = tau_low;
-                let _e76 = atmosphere_45;
-                let _e77 = r_35;
-                let _e78 = mu_24;
-                let _e80 = GetOpticalDepthToTopAtmosphereBoundary(_e76, transmittance_texture_2, _e77, -(_e78));
-                let _e85 = tau_low;
-                let _e86 = atmosphere_45;
-                let _e87 = r_d_2;
-                let _e88 = mu_d;
-                let _e89 = GetOpticalDepthToTopAtmosphereBoundary(_e86, transmittance_texture_2, _e87, _e88);
-                tau = (max((_e75 - _e80), vec3(0f)) + max((_e85 - _e89), vec3(0f)));
+                let _e64 = mu_24;
+                let _e67 = SafeSqrt((1f - (_e63 * _e64)));
+                let _e69 = ClampRadius(_e60, (_e61 * _e67));
+                r_low = _e69;
+                let _e71 = atmosphere_45;
+                let _e72 = r_low;
+                let _e74 = GetOpticalDepthToTopAtmosphereBoundary(_e71, transmittance_texture_2, _e72, 0f);
+                tau_low = _e74;
+                let _e76 = tau_low;
+                let _e77 = atmosphere_45;
+                let _e78 = r_35;
+                let _e79 = mu_24;
+                let _e81 = GetOpticalDepthToTopAtmosphereBoundary(_e77, transmittance_texture_2, _e78, -(_e79));
+                let _e86 = tau_low;
+                let _e87 = atmosphere_45;
+                let _e88 = r_d_2;
+                let _e89 = mu_d;
+                let _e90 = GetOpticalDepthToTopAtmosphereBoundary(_e87, transmittance_texture_2, _e88, _e89);
+                tau = (max((_e76 - _e81), vec3(0f)) + max((_e86 - _e90), vec3(0f)));
             }
         }
     }
-    let _e95 = tau;
-    return max(_e95, vec3(0f));
+    let _e96 = tau;
+    return max(_e96, vec3(0f));
 }
 
 fn GetTransmittance(atmosphere_46: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
@@ -1194,13 +1206,13 @@ fn GetTransmittance(atmosphere_46: AtmosphereParameters, transmittance_texture_3
     mu_26 = mu_25;
     d_15 = d_14;
     ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e18 = atmosphere_47;
-    let _e19 = r_37;
-    let _e20 = mu_26;
-    let _e21 = d_15;
-    let _e22 = ray_r_mu_intersects_ground_9;
-    let _e23 = GetOpticalDepth(_e18, transmittance_texture_3, _e19, _e20, _e21, _e22);
-    return exp(-(_e23));
+    let _e19 = atmosphere_47;
+    let _e20 = r_37;
+    let _e21 = mu_26;
+    let _e22 = d_15;
+    let _e23 = ray_r_mu_intersects_ground_9;
+    let _e24 = GetOpticalDepth(_e19, transmittance_texture_3, _e20, _e21, _e22, _e23);
+    return exp(-(_e24));
 }
 
 fn SunVisibleFraction(atmosphere_48: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
@@ -1212,17 +1224,17 @@ fn SunVisibleFraction(atmosphere_48: AtmosphereParameters, r_38: f32, mu_s_13: f
     atmosphere_49 = atmosphere_48;
     r_39 = r_38;
     mu_s_14 = mu_s_13;
-    let _e13 = atmosphere_49;
-    let _e15 = r_39;
-    sin_theta_h = (_e13.bottom_radius / _e15);
-    let _e18 = mu_s_14;
-    let _e19 = atmosphere_49;
-    let _e21 = r_39;
-    let _e22 = HorizonZenithCosine(_e19.bottom_radius, _e21);
-    let _e23 = sin_theta_h;
-    let _e24 = atmosphere_49;
-    let _e27 = SunVisibleFractionAboveHorizon(_e18, _e22, (_e23 * _e24.sun_angular_radius));
-    return _e27;
+    let _e14 = atmosphere_49;
+    let _e16 = r_39;
+    sin_theta_h = (_e14.bottom_radius / _e16);
+    let _e19 = mu_s_14;
+    let _e20 = atmosphere_49;
+    let _e22 = r_39;
+    let _e23 = HorizonZenithCosine(_e20.bottom_radius, _e22);
+    let _e24 = sin_theta_h;
+    let _e25 = atmosphere_49;
+    let _e28 = SunVisibleFractionAboveHorizon(_e19, _e23, (_e24 * _e25.sun_angular_radius));
+    return _e28;
 }
 
 fn GetTransmittanceToSun(atmosphere_50: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
@@ -1233,15 +1245,15 @@ fn GetTransmittanceToSun(atmosphere_50: AtmosphereParameters, transmittance_text
     atmosphere_51 = atmosphere_50;
     r_41 = r_40;
     mu_s_16 = mu_s_15;
-    let _e14 = atmosphere_51;
-    let _e15 = r_41;
-    let _e16 = mu_s_16;
-    let _e17 = GetTransmittanceToTopAtmosphereBoundary(_e14, transmittance_texture_4, _e15, _e16);
-    let _e18 = atmosphere_51;
-    let _e19 = r_41;
-    let _e20 = mu_s_16;
-    let _e21 = SunVisibleFraction(_e18, _e19, _e20);
-    return (_e17 * _e21);
+    let _e15 = atmosphere_51;
+    let _e16 = r_41;
+    let _e17 = mu_s_16;
+    let _e18 = GetTransmittanceToTopAtmosphereBoundary(_e15, transmittance_texture_4, _e16, _e17);
+    let _e19 = atmosphere_51;
+    let _e20 = r_41;
+    let _e21 = mu_s_16;
+    let _e22 = SunVisibleFraction(_e19, _e20, _e21);
+    return (_e18 * _e22);
 }
 
 fn SunCosineMix(a_6: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
@@ -1255,22 +1267,22 @@ fn SunCosineMix(a_6: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f
     b_1 = b;
     t_2 = t_1;
     low_sun_1 = low_sun;
-    let _e15 = low_sun_1;
-    if !(_e15) {
-        let _e17 = a_7;
-        let _e18 = b_1;
-        let _e19 = t_2;
-        return mix(_e17, _e18, vec4(_e19));
+    let _e16 = low_sun_1;
+    if !(_e16) {
+        let _e18 = a_7;
+        let _e19 = b_1;
+        let _e20 = t_2;
+        return mix(_e18, _e19, vec4(_e20));
     }
-    let _e25 = a_7;
-    let _e26 = dark;
-    let _e29 = b_1;
-    let _e30 = dark;
-    let _e33 = t_2;
-    let _e37 = dark;
-    let _e38 = a_7;
-    let _e39 = b_1;
-    return (exp(mix(log(max(_e25, _e26)), log(max(_e29, _e30)), vec4(_e33))) * step(_e37, max(_e38, _e39)));
+    let _e26 = a_7;
+    let _e27 = dark;
+    let _e30 = b_1;
+    let _e31 = dark;
+    let _e34 = t_2;
+    let _e38 = dark;
+    let _e39 = a_7;
+    let _e40 = b_1;
+    return (exp(mix(log(max(_e26, _e27)), log(max(_e30, _e31)), vec4(_e34))) * step(_e38, max(_e39, _e40)));
 }
 
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
@@ -1280,16 +1292,16 @@ fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
-    let _e11 = low_sun_3;
-    if _e11 {
-        let _e12 = t_4;
-        local_9 = min(_e12, 1f);
+    let _e12 = low_sun_3;
+    if _e12 {
+        let _e13 = t_4;
+        local_9 = min(_e13, 1f);
     } else {
-        let _e15 = t_4;
-        local_9 = clamp(_e15, 0f, 1f);
+        let _e16 = t_4;
+        local_9 = clamp(_e16, 0f, 1f);
     }
-    let _e20 = local_9;
-    return _e20;
+    let _e21 = local_9;
+    return _e21;
 }
 
 fn SunBelowTableMix(a_8: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
@@ -1304,23 +1316,23 @@ fn SunBelowTableMix(a_8: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
     b_3 = b_2;
     t_6 = t_5;
     low_sun_5 = low_sun_4;
-    let _e15 = a_9;
-    let _e16 = b_3;
-    let _e17 = t_6;
-    let _e18 = low_sun_5;
-    let _e19 = SunCosineMix(_e15, _e16, _e17, _e18);
-    blend = _e19;
-    let _e21 = t_6;
-    if (_e21 < 0f) {
-        let _e24 = blend;
-        let _e25 = a_9;
-        local_10 = min(_e24, _e25);
+    let _e16 = a_9;
+    let _e17 = b_3;
+    let _e18 = t_6;
+    let _e19 = low_sun_5;
+    let _e20 = SunCosineMix(_e16, _e17, _e18, _e19);
+    blend = _e20;
+    let _e22 = t_6;
+    if (_e22 < 0f) {
+        let _e25 = blend;
+        let _e26 = a_9;
+        local_10 = min(_e25, _e26);
     } else {
-        let _e27 = blend;
-        local_10 = _e27;
+        let _e28 = blend;
+        local_10 = _e28;
     }
-    let _e29 = local_10;
-    return _e29;
+    let _e30 = local_10;
+    return _e30;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1333,29 +1345,29 @@ fn GetScatteringMuSColumns(atmosphere_52: AtmosphereParameters, u_mu_s: f32, x_b
 
     atmosphere_53 = atmosphere_52;
     u_mu_s_1 = u_mu_s;
-    let _e15 = atmosphere_53;
-    mu_s_size = f32(_e15.scattering_mu_s_size);
-    let _e19 = u_mu_s_1;
-    let _e20 = mu_s_size;
-    mu_s_coord = ((_e19 * _e20) - 0.5f);
-    let _e25 = mu_s_coord;
-    let _e28 = mu_s_size;
-    mu_s_column = clamp(floor(_e25), 0f, (_e28 - 2f));
-    let _e33 = mu_s_column;
-    let _e36 = mu_s_size;
-    (*x_below) = ((_e33 + 0.5f) / _e36);
-    let _e38 = mu_s_column;
-    let _e41 = mu_s_size;
-    (*x_above) = ((_e38 + 1.5f) / _e41);
-    let _e43 = (*x_below);
-    let _e44 = atmosphere_53;
-    let _e45 = GetScatteringTextureUMuS(_e44, LOW_SUN_MU_S);
-    (*low_sun_below) = (_e43 < _e45);
-    let _e47 = mu_s_coord;
-    let _e48 = mu_s_column;
-    let _e50 = (*low_sun_below);
-    let _e51 = SunCosinePosition((_e47 - _e48), _e50);
-    (*mu_s_t) = _e51;
+    let _e16 = atmosphere_53;
+    mu_s_size = f32(_e16.scattering_mu_s_size);
+    let _e20 = u_mu_s_1;
+    let _e21 = mu_s_size;
+    mu_s_coord = ((_e20 * _e21) - 0.5f);
+    let _e26 = mu_s_coord;
+    let _e29 = mu_s_size;
+    mu_s_column = clamp(floor(_e26), 0f, (_e29 - 2f));
+    let _e34 = mu_s_column;
+    let _e37 = mu_s_size;
+    (*x_below) = ((_e34 + 0.5f) / _e37);
+    let _e39 = mu_s_column;
+    let _e42 = mu_s_size;
+    (*x_above) = ((_e39 + 1.5f) / _e42);
+    let _e44 = (*x_below);
+    let _e45 = atmosphere_53;
+    let _e46 = GetScatteringTextureUMuS(_e45, LOW_SUN_MU_S);
+    (*low_sun_below) = (_e44 < _e46);
+    let _e48 = mu_s_coord;
+    let _e49 = mu_s_column;
+    let _e51 = (*low_sun_below);
+    let _e52 = SunCosinePosition((_e48 - _e49), _e51);
+    (*mu_s_t) = _e52;
     return;
 }
 
@@ -1396,102 +1408,102 @@ fn LogMonotoneCubicMix(a_10: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_16: ve
     has_a_1 = has_a;
     has_d_1 = has_d;
     t_8 = t_7;
-    let _e24 = b_5;
-    let _e25 = dark_1;
-    lb = log(max(_e24, _e25));
-    let _e29 = c_7;
-    let _e30 = dark_1;
-    lc = log(max(_e29, _e30));
-    let _e34 = has_a_1;
-    if _e34 {
-        let _e35 = a_11;
-        let _e36 = dark_1;
-        local_11 = log(max(_e35, _e36));
+    let _e25 = b_5;
+    let _e26 = dark_1;
+    lb = log(max(_e25, _e26));
+    let _e30 = c_7;
+    let _e31 = dark_1;
+    lc = log(max(_e30, _e31));
+    let _e35 = has_a_1;
+    if _e35 {
+        let _e36 = a_11;
+        let _e37 = dark_1;
+        local_11 = log(max(_e36, _e37));
     } else {
-        let _e40 = lb;
-        let _e42 = lc;
-        local_11 = ((2f * _e40) - _e42);
+        let _e41 = lb;
+        let _e43 = lc;
+        local_11 = ((2f * _e41) - _e43);
     }
-    let _e45 = local_11;
-    la = _e45;
-    let _e47 = has_d_1;
-    if _e47 {
-        let _e48 = d_17;
-        let _e49 = dark_1;
-        local_12 = log(max(_e48, _e49));
+    let _e46 = local_11;
+    la = _e46;
+    let _e48 = has_d_1;
+    if _e48 {
+        let _e49 = d_17;
+        let _e50 = dark_1;
+        local_12 = log(max(_e49, _e50));
     } else {
-        let _e53 = lc;
-        let _e55 = lb;
-        local_12 = ((2f * _e53) - _e55);
+        let _e54 = lc;
+        let _e56 = lb;
+        local_12 = ((2f * _e54) - _e56);
     }
-    let _e58 = local_12;
-    ld = _e58;
-    let _e60 = lb;
-    let _e61 = la;
-    secant_a = (_e60 - _e61);
-    let _e64 = lc;
-    let _e65 = lb;
-    secant = (_e64 - _e65);
-    let _e68 = ld;
-    let _e69 = lc;
-    secant_d = (_e68 - _e69);
-    let _e72 = secant_a;
-    let _e73 = secant;
-    product_b = (_e72 * _e73);
-    let _e76 = secant;
-    let _e77 = secant_d;
-    product_c = (_e76 * _e77);
-    let _e82 = product_b;
-    agree_b = (vec4(1f) - step(_e82, vec4(0f)));
-    let _e90 = product_c;
-    agree_c = (vec4(1f) - step(_e90, vec4(0f)));
-    let _e96 = agree_b;
-    let _e99 = product_b;
-    let _e103 = secant_a;
-    let _e104 = secant;
-    let _e106 = agree_b;
-    slope_b = (((_e96 * 2f) * _e99) / mix(vec4(1f), (_e103 + _e104), _e106));
-    let _e110 = agree_c;
-    let _e113 = product_c;
-    let _e117 = secant;
-    let _e118 = secant_d;
-    let _e120 = agree_c;
-    slope_c = (((_e110 * 2f) * _e113) / mix(vec4(1f), (_e117 + _e118), _e120));
-    let _e124 = t_8;
+    let _e59 = local_12;
+    ld = _e59;
+    let _e61 = lb;
+    let _e62 = la;
+    secant_a = (_e61 - _e62);
+    let _e65 = lc;
+    let _e66 = lb;
+    secant = (_e65 - _e66);
+    let _e69 = ld;
+    let _e70 = lc;
+    secant_d = (_e69 - _e70);
+    let _e73 = secant_a;
+    let _e74 = secant;
+    product_b = (_e73 * _e74);
+    let _e77 = secant;
+    let _e78 = secant_d;
+    product_c = (_e77 * _e78);
+    let _e83 = product_b;
+    agree_b = (vec4(1f) - step(_e83, vec4(0f)));
+    let _e91 = product_c;
+    agree_c = (vec4(1f) - step(_e91, vec4(0f)));
+    let _e97 = agree_b;
+    let _e100 = product_b;
+    let _e104 = secant_a;
+    let _e105 = secant;
+    let _e107 = agree_b;
+    slope_b = (((_e97 * 2f) * _e100) / mix(vec4(1f), (_e104 + _e105), _e107));
+    let _e111 = agree_c;
+    let _e114 = product_c;
+    let _e118 = secant;
+    let _e119 = secant_d;
+    let _e121 = agree_c;
+    slope_c = (((_e111 * 2f) * _e114) / mix(vec4(1f), (_e118 + _e119), _e121));
     let _e125 = t_8;
-    t2_ = (_e124 * _e125);
-    let _e128 = t2_;
-    let _e129 = t_8;
-    t3_ = (_e128 * _e129);
-    let _e133 = t3_;
-    let _e136 = t2_;
-    let _e141 = lb;
-    let _e143 = t3_;
-    let _e145 = t2_;
-    let _e148 = t_8;
-    let _e150 = slope_b;
-    let _e154 = t2_;
-    let _e157 = t3_;
-    let _e160 = lc;
-    let _e163 = t3_;
-    let _e164 = t2_;
-    let _e166 = slope_c;
-    cubic = (((((((2f * _e133) - (3f * _e136)) + 1f) * _e141) + (((_e143 - (2f * _e145)) + _e148) * _e150)) + (((3f * _e154) - (2f * _e157)) * _e160)) + ((_e163 - _e164) * _e166));
-    let _e170 = dark_1;
-    let _e171 = a_11;
-    let _e172 = b_5;
-    let _e174 = c_7;
-    let _e175 = d_17;
-    lit = step(_e170, min(min(_e171, _e172), min(_e174, _e175)));
-    let _e180 = lb;
-    let _e181 = lc;
-    let _e182 = t_8;
-    let _e185 = cubic;
-    let _e186 = lit;
-    let _e189 = dark_1;
-    let _e190 = b_5;
-    let _e191 = c_7;
-    return (exp(mix(mix(_e180, _e181, vec4(_e182)), _e185, _e186)) * step(_e189, max(_e190, _e191)));
+    let _e126 = t_8;
+    t2_ = (_e125 * _e126);
+    let _e129 = t2_;
+    let _e130 = t_8;
+    t3_ = (_e129 * _e130);
+    let _e134 = t3_;
+    let _e137 = t2_;
+    let _e142 = lb;
+    let _e144 = t3_;
+    let _e146 = t2_;
+    let _e149 = t_8;
+    let _e151 = slope_b;
+    let _e155 = t2_;
+    let _e158 = t3_;
+    let _e161 = lc;
+    let _e164 = t3_;
+    let _e165 = t2_;
+    let _e167 = slope_c;
+    cubic = (((((((2f * _e134) - (3f * _e137)) + 1f) * _e142) + (((_e144 - (2f * _e146)) + _e149) * _e151)) + (((3f * _e155) - (2f * _e158)) * _e161)) + ((_e164 - _e165) * _e167));
+    let _e171 = dark_1;
+    let _e172 = a_11;
+    let _e173 = b_5;
+    let _e175 = c_7;
+    let _e176 = d_17;
+    lit = step(_e171, min(min(_e172, _e173), min(_e175, _e176)));
+    let _e181 = lb;
+    let _e182 = lc;
+    let _e183 = t_8;
+    let _e186 = cubic;
+    let _e187 = lit;
+    let _e190 = dark_1;
+    let _e191 = b_5;
+    let _e192 = c_7;
+    return (exp(mix(mix(_e181, _e182, vec4(_e183)), _e186, _e187)) * step(_e190, max(_e191, _e192)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1512,45 +1524,45 @@ fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, c_8: vec4<f32>, d_b: f32, d
     c_9 = c_8;
     d_b_1 = d_b;
     d_c_1 = d_c;
-    let _e22 = a_13;
-    let _e23 = dark_2;
-    la_1 = log(max(_e22, _e23));
-    let _e27 = b_7;
-    let _e28 = dark_2;
-    let _e31 = la_1;
-    let _e33 = d_b_1;
-    secant_b = ((log(max(_e27, _e28)) - _e31) / vec4(_e33));
-    let _e37 = c_9;
-    let _e38 = dark_2;
-    let _e41 = la_1;
-    let _e43 = d_c_1;
-    secant_c = ((log(max(_e37, _e38)) - _e41) / vec4(_e43));
-    let _e47 = dark_2;
-    let _e48 = a_13;
-    let _e52 = b_7;
-    let _e53 = a_13;
-    rises = (step(_e47, _e48) * (vec4(1f) - step(_e52, _e53)));
-    let _e58 = rises;
-    let _e59 = dark_2;
-    let _e60 = c_9;
-    let _e63 = secant_c;
-    let _e64 = secant_b;
-    let _e66 = d_c_1;
-    let _e67 = d_b_1;
-    (*curvature) = ((_e58 * step(_e59, _e60)) * min(((_e63 - _e64) / vec4((_e66 - _e67))), vec4(0f)));
-    let _e75 = rises;
-    let _e76 = secant_b;
-    let _e77 = (*curvature);
-    let _e78 = d_b_1;
-    (*slope) = (_e75 * (_e76 - (_e77 * _e78)));
+    let _e23 = a_13;
+    let _e24 = dark_2;
+    la_1 = log(max(_e23, _e24));
+    let _e28 = b_7;
+    let _e29 = dark_2;
+    let _e32 = la_1;
+    let _e34 = d_b_1;
+    secant_b = ((log(max(_e28, _e29)) - _e32) / vec4(_e34));
+    let _e38 = c_9;
+    let _e39 = dark_2;
+    let _e42 = la_1;
+    let _e44 = d_c_1;
+    secant_c = ((log(max(_e38, _e39)) - _e42) / vec4(_e44));
+    let _e48 = dark_2;
+    let _e49 = a_13;
+    let _e53 = b_7;
+    let _e54 = a_13;
+    rises = (step(_e48, _e49) * (vec4(1f) - step(_e53, _e54)));
+    let _e59 = rises;
+    let _e60 = dark_2;
+    let _e61 = c_9;
+    let _e64 = secant_c;
+    let _e65 = secant_b;
+    let _e67 = d_c_1;
+    let _e68 = d_b_1;
+    (*curvature) = ((_e59 * step(_e60, _e61)) * min(((_e64 - _e65) / vec4((_e67 - _e68))), vec4(0f)));
+    let _e76 = rises;
+    let _e77 = secant_b;
+    let _e78 = (*curvature);
+    let _e79 = d_b_1;
+    (*slope) = (_e76 * (_e77 - (_e78 * _e79)));
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_7: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_9: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
     var atmosphere_55: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
-    var x_8: f32;
+    var x_10: f32;
     var nu_slice_1: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
@@ -1558,28 +1570,28 @@ fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_text
 
     atmosphere_55 = atmosphere_54;
     uvwz_1 = uvwz;
-    x_8 = x_7;
+    x_10 = x_9;
     nu_slice_1 = nu_slice;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e20 = atmosphere_55;
-    nu_size = f32(_e20.scattering_nu_size);
-    let _e24 = nu_slice_1;
-    let _e25 = x_8;
-    let _e27 = nu_size;
-    let _e29 = uvwz_1;
-    let _e31 = uvwz_1;
-    let _e34 = SampleTexture3D(scattering_texture, vec3<f32>(((_e24 + _e25) / _e27), _e29.z, _e31.w));
-    let _e35 = nu_slice_1;
-    let _e38 = x_8;
-    let _e40 = nu_size;
-    let _e42 = uvwz_1;
-    let _e44 = uvwz_1;
-    let _e47 = SampleTexture3D(scattering_texture, vec3<f32>((((_e35 + 1f) + _e38) / _e40), _e42.z, _e44.w));
-    let _e48 = nu_t_1;
-    let _e49 = low_sun_7;
-    let _e50 = SunCosineMix(_e34, _e47, _e48, _e49);
-    return _e50;
+    let _e21 = atmosphere_55;
+    nu_size = f32(_e21.scattering_nu_size);
+    let _e25 = nu_slice_1;
+    let _e26 = x_10;
+    let _e28 = nu_size;
+    let _e30 = uvwz_1;
+    let _e32 = uvwz_1;
+    let _e35 = SampleTexture3D(scattering_texture, vec3<f32>(((_e25 + _e26) / _e28), _e30.z, _e32.w));
+    let _e36 = nu_slice_1;
+    let _e39 = x_10;
+    let _e41 = nu_size;
+    let _e43 = uvwz_1;
+    let _e45 = uvwz_1;
+    let _e48 = SampleTexture3D(scattering_texture, vec3<f32>((((_e36 + 1f) + _e39) / _e41), _e43.z, _e45.w));
+    let _e49 = nu_t_1;
+    let _e50 = low_sun_7;
+    let _e51 = SunCosineMix(_e35, _e48, _e49, _e50);
+    return _e51;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1620,130 +1632,130 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     mu_s_18 = mu_s_17;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e20 = atmosphere_57;
-    let _e21 = r_43;
-    let _e22 = mu_28;
-    let _e23 = mu_s_18;
-    let _e24 = nu_12;
-    let _e25 = ray_r_mu_intersects_ground_11;
-    let _e26 = GetScatteringTextureUvwzFromRMuMuSNu(_e20, _e21, _e22, _e23, _e24, _e25);
-    uvwz_2 = _e26;
-    let _e28 = atmosphere_57;
-    nu_size_1 = f32(_e28.scattering_nu_size);
-    let _e32 = uvwz_2;
-    let _e34 = nu_size_1;
-    nu_coord = (_e32.x * (_e34 - 1f));
-    let _e39 = nu_coord;
-    let _e41 = nu_size_1;
-    nu_slice_2 = min(floor(_e39), (_e41 - 2f));
-    let _e46 = nu_coord;
-    let _e47 = nu_slice_2;
-    nu_t_2 = (_e46 - _e47);
-    let _e54 = atmosphere_57;
-    let _e55 = uvwz_2;
-    GetScatteringMuSColumns(_e54, _e55.y, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e65 = atmosphere_57;
-    let _e66 = GetScatteringTextureUMuS(_e65, LOW_SUN_MU_S);
-    x_low_sun = _e66;
-    let _e68 = atmosphere_57;
-    let _e69 = uvwz_2;
-    let _e70 = x_below_1;
-    let _e71 = nu_slice_2;
-    let _e72 = nu_t_2;
-    let _e73 = low_sun_below_1;
-    let _e74 = GetScatteringAtMuSColumn(_e68, scattering_texture_1, _e69, _e70, _e71, _e72, _e73);
-    below = _e74;
-    let _e76 = atmosphere_57;
-    let _e77 = uvwz_2;
-    let _e78 = x_above_1;
-    let _e79 = nu_slice_2;
-    let _e80 = nu_t_2;
-    let _e81 = x_above_1;
-    let _e82 = x_low_sun;
-    let _e84 = GetScatteringAtMuSColumn(_e76, scattering_texture_1, _e77, _e78, _e79, _e80, (_e81 < _e82));
-    above = _e84;
-    let _e86 = atmosphere_57;
-    mu_s_size_1 = f32(_e86.scattering_mu_s_size);
-    let _e90 = mu_s_t_1;
-    if (_e90 < 0f) {
+    let _e21 = atmosphere_57;
+    let _e22 = r_43;
+    let _e23 = mu_28;
+    let _e24 = mu_s_18;
+    let _e25 = nu_12;
+    let _e26 = ray_r_mu_intersects_ground_11;
+    let _e27 = GetScatteringTextureUvwzFromRMuMuSNu(_e21, _e22, _e23, _e24, _e25, _e26);
+    uvwz_2 = _e27;
+    let _e29 = atmosphere_57;
+    nu_size_1 = f32(_e29.scattering_nu_size);
+    let _e33 = uvwz_2;
+    let _e35 = nu_size_1;
+    nu_coord = (_e33.x * (_e35 - 1f));
+    let _e40 = nu_coord;
+    let _e42 = nu_size_1;
+    nu_slice_2 = min(floor(_e40), (_e42 - 2f));
+    let _e47 = nu_coord;
+    let _e48 = nu_slice_2;
+    nu_t_2 = (_e47 - _e48);
+    let _e55 = atmosphere_57;
+    let _e56 = uvwz_2;
+    GetScatteringMuSColumns(_e55, _e56.y, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
+    let _e66 = atmosphere_57;
+    let _e67 = GetScatteringTextureUMuS(_e66, LOW_SUN_MU_S);
+    x_low_sun = _e67;
+    let _e69 = atmosphere_57;
+    let _e70 = uvwz_2;
+    let _e71 = x_below_1;
+    let _e72 = nu_slice_2;
+    let _e73 = nu_t_2;
+    let _e74 = low_sun_below_1;
+    let _e75 = GetScatteringAtMuSColumn(_e69, scattering_texture_1, _e70, _e71, _e72, _e73, _e74);
+    below = _e75;
+    let _e77 = atmosphere_57;
+    let _e78 = uvwz_2;
+    let _e79 = x_above_1;
+    let _e80 = nu_slice_2;
+    let _e81 = nu_t_2;
+    let _e82 = x_above_1;
+    let _e83 = x_low_sun;
+    let _e85 = GetScatteringAtMuSColumn(_e77, scattering_texture_1, _e78, _e79, _e80, _e81, (_e82 < _e83));
+    above = _e85;
+    let _e87 = atmosphere_57;
+    mu_s_size_1 = f32(_e87.scattering_mu_s_size);
+    let _e91 = mu_s_t_1;
+    if (_e91 < 0f) {
         {
-            let _e93 = atmosphere_57;
-            let _e94 = uvwz_2;
-            let _e96 = mu_s_size_1;
-            let _e98 = nu_slice_2;
-            let _e99 = nu_t_2;
-            let _e101 = mu_s_size_1;
-            let _e103 = x_low_sun;
-            let _e105 = GetScatteringAtMuSColumn(_e93, scattering_texture_1, _e94, (2.5f / _e96), _e98, _e99, ((2.5f / _e101) < _e103));
-            third = _e105;
-            let _e107 = atmosphere_57;
-            mu_s_min = _e107.scattering_mu_s_min;
-            let _e112 = below;
-            let _e113 = above;
-            let _e114 = third;
-            let _e115 = atmosphere_57;
-            let _e117 = mu_s_size_1;
-            let _e121 = GetScatteringMuSFromUnitRange(_e115, (1f / (_e117 - 1f)));
-            let _e122 = mu_s_min;
-            let _e124 = atmosphere_57;
-            let _e126 = mu_s_size_1;
-            let _e130 = GetScatteringMuSFromUnitRange(_e124, (2f / (_e126 - 1f)));
-            let _e131 = mu_s_min;
-            LowestSunLogFall(_e112, _e113, _e114, (_e121 - _e122), (_e130 - _e131), (&slope_1), (&curvature_1));
-            let _e137 = mu_s_18;
-            let _e138 = mu_s_min;
-            d_18 = (_e137 - _e138);
-            let _e141 = below;
-            let _e142 = d_18;
-            let _e143 = slope_1;
-            let _e144 = d_18;
-            let _e145 = curvature_1;
-            return (_e141 * exp((_e142 * (_e143 + (_e144 * _e145)))));
+            let _e94 = atmosphere_57;
+            let _e95 = uvwz_2;
+            let _e97 = mu_s_size_1;
+            let _e99 = nu_slice_2;
+            let _e100 = nu_t_2;
+            let _e102 = mu_s_size_1;
+            let _e104 = x_low_sun;
+            let _e106 = GetScatteringAtMuSColumn(_e94, scattering_texture_1, _e95, (2.5f / _e97), _e99, _e100, ((2.5f / _e102) < _e104));
+            third = _e106;
+            let _e108 = atmosphere_57;
+            mu_s_min = _e108.scattering_mu_s_min;
+            let _e113 = below;
+            let _e114 = above;
+            let _e115 = third;
+            let _e116 = atmosphere_57;
+            let _e118 = mu_s_size_1;
+            let _e122 = GetScatteringMuSFromUnitRange(_e116, (1f / (_e118 - 1f)));
+            let _e123 = mu_s_min;
+            let _e125 = atmosphere_57;
+            let _e127 = mu_s_size_1;
+            let _e131 = GetScatteringMuSFromUnitRange(_e125, (2f / (_e127 - 1f)));
+            let _e132 = mu_s_min;
+            LowestSunLogFall(_e113, _e114, _e115, (_e122 - _e123), (_e131 - _e132), (&slope_1), (&curvature_1));
+            let _e138 = mu_s_18;
+            let _e139 = mu_s_min;
+            d_18 = (_e138 - _e139);
+            let _e142 = below;
+            let _e143 = d_18;
+            let _e144 = slope_1;
+            let _e145 = d_18;
+            let _e146 = curvature_1;
+            return (_e142 * exp((_e143 * (_e144 + (_e145 * _e146)))));
         }
     }
-    let _e151 = low_sun_below_1;
-    if !(_e151) {
-        let _e153 = below;
-        let _e154 = above;
-        let _e155 = mu_s_t_1;
-        return mix(_e153, _e154, vec4(_e155));
+    let _e152 = low_sun_below_1;
+    if !(_e152) {
+        let _e154 = below;
+        let _e155 = above;
+        let _e156 = mu_s_t_1;
+        return mix(_e154, _e155, vec4(_e156));
     }
-    let _e158 = x_below_1;
-    let _e159 = mu_s_size_1;
-    column = ((_e158 * _e159) - 0.5f);
-    let _e164 = column;
-    let _e171 = mu_s_size_1;
-    x_first = ((max((_e164 - 1f), 0f) + 0.5f) / _e171);
-    let _e174 = column;
-    let _e177 = mu_s_size_1;
-    let _e183 = mu_s_size_1;
-    x_last = ((min((_e174 + 2f), (_e177 - 1f)) + 0.5f) / _e183);
-    let _e186 = atmosphere_57;
-    let _e187 = uvwz_2;
-    let _e188 = x_first;
-    let _e189 = nu_slice_2;
-    let _e190 = nu_t_2;
-    let _e192 = GetScatteringAtMuSColumn(_e186, scattering_texture_1, _e187, _e188, _e189, _e190, true);
-    first = _e192;
-    let _e194 = atmosphere_57;
-    let _e195 = uvwz_2;
-    let _e196 = x_last;
-    let _e197 = nu_slice_2;
-    let _e198 = nu_t_2;
-    let _e199 = x_last;
-    let _e200 = x_low_sun;
-    let _e202 = GetScatteringAtMuSColumn(_e194, scattering_texture_1, _e195, _e196, _e197, _e198, (_e199 < _e200));
-    last = _e202;
-    let _e204 = first;
-    let _e205 = below;
-    let _e206 = above;
-    let _e207 = last;
-    let _e208 = column;
-    let _e211 = column;
-    let _e214 = mu_s_size_1;
-    let _e218 = mu_s_t_1;
-    let _e219 = LogMonotoneCubicMix(_e204, _e205, _e206, _e207, (_e208 > 0.5f), ((_e211 + 2f) < (_e214 - 0.5f)), _e218);
-    return _e219;
+    let _e159 = x_below_1;
+    let _e160 = mu_s_size_1;
+    column = ((_e159 * _e160) - 0.5f);
+    let _e165 = column;
+    let _e172 = mu_s_size_1;
+    x_first = ((max((_e165 - 1f), 0f) + 0.5f) / _e172);
+    let _e175 = column;
+    let _e178 = mu_s_size_1;
+    let _e184 = mu_s_size_1;
+    x_last = ((min((_e175 + 2f), (_e178 - 1f)) + 0.5f) / _e184);
+    let _e187 = atmosphere_57;
+    let _e188 = uvwz_2;
+    let _e189 = x_first;
+    let _e190 = nu_slice_2;
+    let _e191 = nu_t_2;
+    let _e193 = GetScatteringAtMuSColumn(_e187, scattering_texture_1, _e188, _e189, _e190, _e191, true);
+    first = _e193;
+    let _e195 = atmosphere_57;
+    let _e196 = uvwz_2;
+    let _e197 = x_last;
+    let _e198 = nu_slice_2;
+    let _e199 = nu_t_2;
+    let _e200 = x_last;
+    let _e201 = x_low_sun;
+    let _e203 = GetScatteringAtMuSColumn(_e195, scattering_texture_1, _e196, _e197, _e198, _e199, (_e200 < _e201));
+    last = _e203;
+    let _e205 = first;
+    let _e206 = below;
+    let _e207 = above;
+    let _e208 = last;
+    let _e209 = column;
+    let _e212 = column;
+    let _e215 = mu_s_size_1;
+    let _e219 = mu_s_t_1;
+    let _e220 = LogMonotoneCubicMix(_e205, _e206, _e207, _e208, (_e209 > 0.5f), ((_e212 + 2f) < (_e215 - 0.5f)), _e219);
+    return _e220;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -1763,47 +1775,47 @@ fn GetIrradiance(atmosphere_58: AtmosphereParameters, irradiance_texture: textur
     atmosphere_59 = atmosphere_58;
     r_45 = r_44;
     mu_s_20 = mu_s_19;
-    let _e14 = atmosphere_59;
-    let _e15 = r_45;
-    let _e16 = mu_s_20;
-    let _e17 = GetIrradianceTextureUvFromRMuS(_e14, _e15, _e16);
-    uv_3 = _e17;
-    let _e19 = atmosphere_59;
-    width = f32(_e19.irradiance_width);
-    let _e23 = atmosphere_59;
-    let _e24 = mu_s_20;
-    let _e25 = GetIrradianceUnitMuS(_e23, _e24);
-    let _e26 = width;
-    mu_s_coord_1 = (_e25 * (_e26 - 1f));
-    let _e31 = mu_s_coord_1;
-    let _e34 = width;
-    mu_s_column_1 = clamp(floor(_e31), 0f, (_e34 - 2f));
-    let _e39 = atmosphere_59;
-    let _e40 = mu_s_column_1;
-    let _e41 = width;
-    let _e45 = GetIrradianceMuSFromUnit(_e39, (_e40 / (_e41 - 1f)));
-    mu_s_below = _e45;
-    let _e47 = mu_s_below;
-    low_sun_8 = (_e47 < LOW_SUN_MU_S);
-    let _e50 = mu_s_column_1;
-    let _e53 = width;
-    let _e55 = uv_3;
-    let _e58 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e50 + 0.5f) / _e53), _e55.y));
-    below_1 = _e58;
-    let _e60 = mu_s_column_1;
-    let _e63 = width;
-    let _e65 = uv_3;
-    let _e68 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e60 + 1.5f) / _e63), _e65.y));
-    above_1 = _e68;
-    let _e70 = below_1;
-    let _e71 = above_1;
-    let _e72 = mu_s_coord_1;
-    let _e73 = mu_s_column_1;
-    let _e75 = low_sun_8;
-    let _e76 = SunCosinePosition((_e72 - _e73), _e75);
-    let _e77 = low_sun_8;
-    let _e78 = SunBelowTableMix(_e70, _e71, _e76, _e77);
-    return vec3<f32>(_e78.xyz);
+    let _e15 = atmosphere_59;
+    let _e16 = r_45;
+    let _e17 = mu_s_20;
+    let _e18 = GetIrradianceTextureUvFromRMuS(_e15, _e16, _e17);
+    uv_3 = _e18;
+    let _e20 = atmosphere_59;
+    width = f32(_e20.irradiance_width);
+    let _e24 = atmosphere_59;
+    let _e25 = mu_s_20;
+    let _e26 = GetIrradianceUnitMuS(_e24, _e25);
+    let _e27 = width;
+    mu_s_coord_1 = (_e26 * (_e27 - 1f));
+    let _e32 = mu_s_coord_1;
+    let _e35 = width;
+    mu_s_column_1 = clamp(floor(_e32), 0f, (_e35 - 2f));
+    let _e40 = atmosphere_59;
+    let _e41 = mu_s_column_1;
+    let _e42 = width;
+    let _e46 = GetIrradianceMuSFromUnit(_e40, (_e41 / (_e42 - 1f)));
+    mu_s_below = _e46;
+    let _e48 = mu_s_below;
+    low_sun_8 = (_e48 < LOW_SUN_MU_S);
+    let _e51 = mu_s_column_1;
+    let _e54 = width;
+    let _e56 = uv_3;
+    let _e59 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e51 + 0.5f) / _e54), _e56.y));
+    below_1 = _e59;
+    let _e61 = mu_s_column_1;
+    let _e64 = width;
+    let _e66 = uv_3;
+    let _e69 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e61 + 1.5f) / _e64), _e66.y));
+    above_1 = _e69;
+    let _e71 = below_1;
+    let _e72 = above_1;
+    let _e73 = mu_s_coord_1;
+    let _e74 = mu_s_column_1;
+    let _e76 = low_sun_8;
+    let _e77 = SunCosinePosition((_e73 - _e74), _e76);
+    let _e78 = low_sun_8;
+    let _e79 = SunBelowTableMix(_e71, _e72, _e77, _e78);
+    return vec3<f32>(_e79.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1813,19 +1825,19 @@ fn MiePhaseFunction(atmosphere_60: AtmosphereParameters, nu_13: f32) -> f32 {
 
     atmosphere_61 = atmosphere_60;
     nu_14 = nu_13;
-    let _e11 = atmosphere_61;
-    if (_e11.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e14 = atmosphere_61;
-        let _e16 = nu_14;
-        let _e17 = HenyeyGreensteinPhaseFunction(_e14.mie_g, _e16);
-        return _e17;
+    let _e12 = atmosphere_61;
+    if (_e12.mie_phase == PHASE_HENYEY_GREENSTEIN) {
+        let _e15 = atmosphere_61;
+        let _e17 = nu_14;
+        let _e18 = HenyeyGreensteinPhaseFunction(_e15.mie_g, _e17);
+        return _e18;
     }
-    let _e18 = atmosphere_61;
-    if (_e18.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e21 = atmosphere_61;
-        let _e23 = nu_14;
-        let _e24 = CornetteShanksPhaseFunction(_e21.mie_g, _e23);
-        return _e24;
+    let _e19 = atmosphere_61;
+    if (_e19.mie_phase == PHASE_CORNETTE_SHANKS) {
+        let _e22 = atmosphere_61;
+        let _e24 = nu_14;
+        let _e25 = CornetteShanksPhaseFunction(_e22.mie_g, _e24);
+        return _e25;
     }
     return 0f;
 }
@@ -1847,45 +1859,45 @@ fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture
     mu_s_22 = mu_s_21;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e22 = atmosphere_63;
-    let _e23 = r_47;
-    let _e24 = mu_30;
-    let _e25 = mu_s_22;
-    let _e26 = nu_16;
-    let _e27 = ray_r_mu_intersects_ground_13;
-    let _e28 = GetScattering(_e22, scattering_texture_2, _e23, _e24, _e25, _e26, _e27);
-    scattering = _e28;
-    let _e30 = atmosphere_63;
-    if (_e30.single_mie_in_scattering_alpha == 1i) {
+    let _e23 = atmosphere_63;
+    let _e24 = r_47;
+    let _e25 = mu_30;
+    let _e26 = mu_s_22;
+    let _e27 = nu_16;
+    let _e28 = ray_r_mu_intersects_ground_13;
+    let _e29 = GetScattering(_e23, scattering_texture_2, _e24, _e25, _e26, _e27, _e28);
+    scattering = _e29;
+    let _e31 = atmosphere_63;
+    if (_e31.single_mie_in_scattering_alpha == 1i) {
         {
-            let _e34 = scattering;
-            if (_e34.x > 0f) {
-                let _e38 = scattering;
-                let _e41 = scattering;
-                let _e44 = scattering;
-                let _e48 = atmosphere_63;
-                let _e50 = atmosphere_63;
-                local_13 = (((vec3<f32>(_e38.xyz) * _e41.w) / vec3(_e44.x)) * (_e48.mie_to_rayleigh_scattering_ratio / vec3(_e50.mie_to_rayleigh_scattering_ratio.x)));
+            let _e35 = scattering;
+            if (_e35.x > 0f) {
+                let _e39 = scattering;
+                let _e42 = scattering;
+                let _e45 = scattering;
+                let _e49 = atmosphere_63;
+                let _e51 = atmosphere_63;
+                local_13 = (((vec3<f32>(_e39.xyz) * _e42.w) / vec3(_e45.x)) * (_e49.mie_to_rayleigh_scattering_ratio / vec3(_e51.mie_to_rayleigh_scattering_ratio.x)));
             } else {
                 local_13 = vec3(0f);
             }
-            let _e59 = local_13;
-            (*single_mie_scattering) = _e59;
+            let _e60 = local_13;
+            (*single_mie_scattering) = _e60;
         }
     } else {
         {
-            let _e60 = atmosphere_63;
-            let _e61 = r_47;
-            let _e62 = mu_30;
-            let _e63 = mu_s_22;
-            let _e64 = nu_16;
-            let _e65 = ray_r_mu_intersects_ground_13;
-            let _e66 = GetScattering(_e60, single_mie_scattering_texture, _e61, _e62, _e63, _e64, _e65);
-            (*single_mie_scattering) = vec3<f32>(_e66.xyz);
+            let _e61 = atmosphere_63;
+            let _e62 = r_47;
+            let _e63 = mu_30;
+            let _e64 = mu_s_22;
+            let _e65 = nu_16;
+            let _e66 = ray_r_mu_intersects_ground_13;
+            let _e67 = GetScattering(_e61, single_mie_scattering_texture, _e62, _e63, _e64, _e65, _e66);
+            (*single_mie_scattering) = vec3<f32>(_e67.xyz);
         }
     }
-    let _e69 = scattering;
-    return vec3<f32>(_e69.xyz);
+    let _e70 = scattering;
+    return vec3<f32>(_e70.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1908,50 +1920,50 @@ fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: 
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e24 = atmosphere_65;
-    let _e25 = camera_5;
-    let _e26 = view_ray_5;
-    let _e27 = sun_direction_3;
-    let _e38 = GetViewRayStart(_e24, _e25, _e26, _e27, (&start_1), (&r_48), (&mu_31), (&mu_s_23), (&nu_17));
-    if !(_e38) {
+    let _e25 = atmosphere_65;
+    let _e26 = camera_5;
+    let _e27 = view_ray_5;
+    let _e28 = sun_direction_3;
+    let _e39 = GetViewRayStart(_e25, _e26, _e27, _e28, (&start_1), (&r_48), (&mu_31), (&mu_s_23), (&nu_17));
+    if !(_e39) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e44 = atmosphere_65;
-    let _e45 = r_48;
-    let _e46 = mu_31;
-    let _e47 = RayIntersectsGround(_e44, _e45, _e46);
-    ray_r_mu_intersects_ground_14 = _e47;
-    let _e49 = ray_r_mu_intersects_ground_14;
-    if _e49 {
+    let _e45 = atmosphere_65;
+    let _e46 = r_48;
+    let _e47 = mu_31;
+    let _e48 = RayIntersectsGround(_e45, _e46, _e47);
+    ray_r_mu_intersects_ground_14 = _e48;
+    let _e50 = ray_r_mu_intersects_ground_14;
+    if _e50 {
         local_14 = vec3(0f);
     } else {
-        let _e52 = atmosphere_65;
-        let _e53 = r_48;
-        let _e54 = mu_31;
-        let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_5, _e53, _e54);
-        local_14 = _e55;
+        let _e53 = atmosphere_65;
+        let _e54 = r_48;
+        let _e55 = mu_31;
+        let _e56 = GetTransmittanceToTopAtmosphereBoundary(_e53, transmittance_texture_5, _e54, _e55);
+        local_14 = _e56;
     }
-    let _e57 = local_14;
-    (*transmittance) = _e57;
-    let _e59 = atmosphere_65;
-    let _e60 = r_48;
-    let _e61 = mu_31;
-    let _e62 = mu_s_23;
-    let _e63 = nu_17;
-    let _e64 = ray_r_mu_intersects_ground_14;
-    let _e67 = GetCombinedScattering(_e59, scattering_texture_3, single_mie_scattering_texture_1, _e60, _e61, _e62, _e63, _e64, (&single_mie_scattering_1));
-    scattering_1 = _e67;
-    let _e69 = scattering_1;
-    let _e70 = nu_17;
-    let _e71 = RayleighPhaseFunction(_e70);
-    let _e73 = single_mie_scattering_1;
-    let _e74 = atmosphere_65;
-    let _e75 = nu_17;
-    let _e76 = MiePhaseFunction(_e74, _e75);
-    return ((_e69 * _e71) + (_e73 * _e76));
+    let _e58 = local_14;
+    (*transmittance) = _e58;
+    let _e60 = atmosphere_65;
+    let _e61 = r_48;
+    let _e62 = mu_31;
+    let _e63 = mu_s_23;
+    let _e64 = nu_17;
+    let _e65 = ray_r_mu_intersects_ground_14;
+    let _e68 = GetCombinedScattering(_e60, scattering_texture_3, single_mie_scattering_texture_1, _e61, _e62, _e63, _e64, _e65, (&single_mie_scattering_1));
+    scattering_1 = _e68;
+    let _e70 = scattering_1;
+    let _e71 = nu_17;
+    let _e72 = RayleighPhaseFunction(_e71);
+    let _e74 = single_mie_scattering_1;
+    let _e75 = atmosphere_65;
+    let _e76 = nu_17;
+    let _e77 = MiePhaseFunction(_e75, _e76);
+    return ((_e70 * _e72) + (_e74 * _e77));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -1969,57 +1981,57 @@ fn DistanceInsideScatteringRadii(atmosphere_66: AtmosphereParameters, r_49: f32,
     atmosphere_67 = atmosphere_66;
     r_50 = r_49;
     mu_33 = mu_32;
-    let _e14 = atmosphere_67;
-    r_max = _e14.scattering_r_max;
-    let _e17 = atmosphere_67;
-    r_min = _e17.scattering_r_min;
-    let _e20 = r_50;
+    let _e15 = atmosphere_67;
+    r_max = _e15.scattering_r_max;
+    let _e18 = atmosphere_67;
+    r_min = _e18.scattering_r_min;
     let _e21 = r_50;
-    let _e23 = mu_33;
+    let _e22 = r_50;
     let _e24 = mu_33;
-    across = ((_e20 * _e21) * ((_e23 * _e24) - 1f));
-    let _e30 = r_50;
-    let _e32 = mu_33;
-    let _e34 = across;
-    let _e35 = r_max;
+    let _e25 = mu_33;
+    across = ((_e21 * _e22) * ((_e24 * _e25) - 1f));
+    let _e31 = r_50;
+    let _e33 = mu_33;
+    let _e35 = across;
     let _e36 = r_max;
-    let _e39 = SafeSqrt((_e34 + (_e35 * _e36)));
-    up = ((-(_e30) * _e32) + _e39);
-    let _e42 = across;
-    let _e43 = r_min;
+    let _e37 = r_max;
+    let _e40 = SafeSqrt((_e35 + (_e36 * _e37)));
+    up = ((-(_e31) * _e33) + _e40);
+    let _e43 = across;
     let _e44 = r_min;
-    down_discriminant = (_e42 + (_e43 * _e44));
-    let _e48 = mu_33;
-    let _e51 = down_discriminant;
-    if ((_e48 < 0f) && (_e51 >= 0f)) {
-        let _e55 = up;
-        let _e56 = r_50;
-        let _e58 = mu_33;
-        let _e60 = down_discriminant;
-        local_15 = min(_e55, ((-(_e56) * _e58) - sqrt(_e60)));
+    let _e45 = r_min;
+    down_discriminant = (_e43 + (_e44 * _e45));
+    let _e49 = mu_33;
+    let _e52 = down_discriminant;
+    if ((_e49 < 0f) && (_e52 >= 0f)) {
+        let _e56 = up;
+        let _e57 = r_50;
+        let _e59 = mu_33;
+        let _e61 = down_discriminant;
+        local_15 = min(_e56, ((-(_e57) * _e59) - sqrt(_e61)));
     } else {
-        let _e64 = up;
-        local_15 = _e64;
+        let _e65 = up;
+        local_15 = _e65;
     }
-    let _e66 = local_15;
-    return _e66;
+    let _e67 = local_15;
+    return _e67;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn ProfileSampleAltitude(atmosphere_68: AtmosphereParameters, i: i32) -> f32 {
     var atmosphere_69: AtmosphereParameters;
     var i_1: i32;
-    var x_9: f32;
+    var x_11: f32;
 
     atmosphere_69 = atmosphere_68;
     i_1 = i;
-    let _e13 = i_1;
-    x_9 = (f32(_e13) / 63f);
-    let _e21 = atmosphere_69;
-    let _e23 = atmosphere_69;
-    let _e26 = x_9;
-    let _e28 = x_9;
-    return (((_e21.top_radius - _e23.bottom_radius) * _e26) * _e28);
+    let _e14 = i_1;
+    x_11 = (f32(_e14) / 63f);
+    let _e22 = atmosphere_69;
+    let _e24 = atmosphere_69;
+    let _e27 = x_11;
+    let _e29 = x_11;
+    return (((_e22.top_radius - _e24.bottom_radius) * _e27) * _e29);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2032,22 +2044,22 @@ fn InterpolateCoefficient(a_14: f32, b_8: f32, f: f32) -> f32 {
     a_15 = a_14;
     b_9 = b_8;
     f_1 = f;
-    let _e15 = a_15;
-    let _e18 = b_9;
-    if ((_e15 > 0f) && (_e18 > 0f)) {
-        let _e22 = a_15;
-        let _e23 = f_1;
-        let _e24 = b_9;
-        let _e25 = a_15;
-        local_16 = (_e22 * exp((_e23 * log((_e24 / _e25)))));
+    let _e16 = a_15;
+    let _e19 = b_9;
+    if ((_e16 > 0f) && (_e19 > 0f)) {
+        let _e23 = a_15;
+        let _e24 = f_1;
+        let _e25 = b_9;
+        let _e26 = a_15;
+        local_16 = (_e23 * exp((_e24 * log((_e25 / _e26)))));
     } else {
-        let _e31 = a_15;
-        let _e32 = b_9;
-        let _e33 = f_1;
-        local_16 = mix(_e31, _e32, _e33);
+        let _e32 = a_15;
+        let _e33 = b_9;
+        let _e34 = f_1;
+        local_16 = mix(_e32, _e33, _e34);
     }
-    let _e36 = local_16;
-    return _e36;
+    let _e37 = local_16;
+    return _e37;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2059,19 +2071,19 @@ fn InterpolateCoefficients(a_16: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f
     a_17 = a_16;
     b_11 = b_10;
     f_3 = f_2;
-    let _e15 = a_17;
-    let _e17 = b_11;
-    let _e19 = f_3;
-    let _e20 = InterpolateCoefficient(_e15.x, _e17.x, _e19);
-    let _e21 = a_17;
-    let _e23 = b_11;
-    let _e25 = f_3;
-    let _e26 = InterpolateCoefficient(_e21.y, _e23.y, _e25);
-    let _e27 = a_17;
-    let _e29 = b_11;
-    let _e31 = f_3;
-    let _e32 = InterpolateCoefficient(_e27.z, _e29.z, _e31);
-    return vec3<f32>(_e20, _e26, _e32);
+    let _e16 = a_17;
+    let _e18 = b_11;
+    let _e20 = f_3;
+    let _e21 = InterpolateCoefficient(_e16.x, _e18.x, _e20);
+    let _e22 = a_17;
+    let _e24 = b_11;
+    let _e26 = f_3;
+    let _e27 = InterpolateCoefficient(_e22.y, _e24.y, _e26);
+    let _e28 = a_17;
+    let _e30 = b_11;
+    let _e32 = f_3;
+    let _e33 = InterpolateCoefficient(_e28.z, _e30.z, _e32);
+    return vec3<f32>(_e21, _e27, _e33);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2079,53 +2091,53 @@ fn GetCoefficientsAtAltitude(atmosphere_70: AtmosphereParameters, altitude: f32,
     var atmosphere_71: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_10: f32;
+    var x_12: f32;
     var i_2: i32;
     var h0_: f32;
     var f_4: f32;
 
     atmosphere_71 = atmosphere_70;
     altitude_1 = altitude;
-    let _e15 = atmosphere_71;
-    let _e17 = atmosphere_71;
-    height = (_e15.top_radius - _e17.bottom_radius);
-    let _e21 = altitude_1;
-    let _e22 = height;
-    x_10 = (sqrt(clamp((_e21 / _e22), 0f, 1f)) * 63f);
-    let _e34 = x_10;
-    i_2 = min(i32(_e34), 62i);
-    let _e41 = atmosphere_71;
-    let _e42 = i_2;
-    let _e43 = ProfileSampleAltitude(_e41, _e42);
-    h0_ = _e43;
-    let _e45 = altitude_1;
-    let _e46 = h0_;
-    let _e48 = atmosphere_71;
-    let _e49 = i_2;
-    let _e52 = ProfileSampleAltitude(_e48, (_e49 + 1i));
-    let _e53 = h0_;
-    f_4 = clamp(((_e45 - _e46) / (_e52 - _e53)), 0f, 1f);
-    let _e60 = i_2;
-    let _e63 = atmosphere_71.mie_scattering_profile[_e60];
-    let _e64 = i_2;
-    let _e69 = atmosphere_71.mie_scattering_profile[(_e64 + 1i)];
-    let _e70 = f_4;
-    let _e71 = InterpolateCoefficients(_e63, _e69, _e70);
-    (*mie_scattering) = _e71;
-    let _e72 = i_2;
-    let _e75 = atmosphere_71.rayleigh_scattering_profile[_e72];
-    let _e76 = i_2;
-    let _e81 = atmosphere_71.rayleigh_scattering_profile[(_e76 + 1i)];
-    let _e82 = f_4;
-    let _e83 = InterpolateCoefficients(_e75, _e81, _e82);
-    (*rayleigh_scattering) = _e83;
-    let _e84 = i_2;
-    let _e87 = atmosphere_71.extinction_profile[_e84];
-    let _e88 = i_2;
-    let _e93 = atmosphere_71.extinction_profile[(_e88 + 1i)];
-    let _e94 = f_4;
-    let _e95 = InterpolateCoefficients(_e87, _e93, _e94);
-    return _e95;
+    let _e16 = atmosphere_71;
+    let _e18 = atmosphere_71;
+    height = (_e16.top_radius - _e18.bottom_radius);
+    let _e22 = altitude_1;
+    let _e23 = height;
+    x_12 = (sqrt(clamp((_e22 / _e23), 0f, 1f)) * 63f);
+    let _e35 = x_12;
+    i_2 = min(i32(_e35), 62i);
+    let _e42 = atmosphere_71;
+    let _e43 = i_2;
+    let _e44 = ProfileSampleAltitude(_e42, _e43);
+    h0_ = _e44;
+    let _e46 = altitude_1;
+    let _e47 = h0_;
+    let _e49 = atmosphere_71;
+    let _e50 = i_2;
+    let _e53 = ProfileSampleAltitude(_e49, (_e50 + 1i));
+    let _e54 = h0_;
+    f_4 = clamp(((_e46 - _e47) / (_e53 - _e54)), 0f, 1f);
+    let _e61 = i_2;
+    let _e64 = atmosphere_71.mie_scattering_profile[_e61];
+    let _e65 = i_2;
+    let _e70 = atmosphere_71.mie_scattering_profile[(_e65 + 1i)];
+    let _e71 = f_4;
+    let _e72 = InterpolateCoefficients(_e64, _e70, _e71);
+    (*mie_scattering) = _e72;
+    let _e73 = i_2;
+    let _e76 = atmosphere_71.rayleigh_scattering_profile[_e73];
+    let _e77 = i_2;
+    let _e82 = atmosphere_71.rayleigh_scattering_profile[(_e77 + 1i)];
+    let _e83 = f_4;
+    let _e84 = InterpolateCoefficients(_e76, _e82, _e83);
+    (*rayleigh_scattering) = _e84;
+    let _e85 = i_2;
+    let _e88 = atmosphere_71.extinction_profile[_e85];
+    let _e89 = i_2;
+    let _e94 = atmosphere_71.extinction_profile[(_e89 + 1i)];
+    let _e95 = f_4;
+    let _e96 = InterpolateCoefficients(_e88, _e94, _e95);
+    return _e96;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2141,15 +2153,15 @@ fn AltitudeAtDistance(atmosphere_72: AtmosphereParameters, r_51: f32, mu_34: f32
     mu_35 = mu_34;
     t_10 = t_9;
     r_t_1 = r_t;
-    let _e19 = r_52;
-    let _e20 = atmosphere_73;
-    let _e23 = t_10;
+    let _e20 = r_52;
+    let _e21 = atmosphere_73;
     let _e24 = t_10;
-    let _e26 = r_52;
-    let _e28 = mu_35;
-    let _e32 = r_t_1;
-    let _e33 = r_52;
-    return ((_e19 - _e20.bottom_radius) + ((_e23 * (_e24 + ((2f * _e26) * _e28))) / (_e32 + _e33)));
+    let _e25 = t_10;
+    let _e27 = r_52;
+    let _e29 = mu_35;
+    let _e33 = r_t_1;
+    let _e34 = r_52;
+    return ((_e20 - _e21.bottom_radius) + ((_e24 * (_e25 + ((2f * _e27) * _e29))) / (_e33 + _e34)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2172,50 +2184,50 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
     r_54 = r_53;
     mu_37 = mu_36;
     d_20 = d_19;
-    let _e17 = d_20;
-    dt = (_e17 / 16f);
+    let _e18 = d_20;
+    dt = (_e18 / 16f);
     loop {
-        let _e30 = k_2;
-        if !((_e30 <= SEGMENT_INTERVALS)) {
+        let _e31 = k_2;
+        if !((_e31 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e36 = dt;
-            let _e37 = k_2;
-            t_11 = (_e36 * f32(_e37));
-            let _e41 = atmosphere_75;
-            let _e42 = r_54;
-            let _e43 = mu_37;
-            let _e44 = t_11;
-            let _e45 = RadiusAtDistance(_e41, _e42, _e43, _e44);
-            r_t_2 = _e45;
-            let _e49 = atmosphere_75;
+            let _e37 = dt;
+            let _e38 = k_2;
+            t_11 = (_e37 * f32(_e38));
+            let _e42 = atmosphere_75;
+            let _e43 = r_54;
+            let _e44 = mu_37;
+            let _e45 = t_11;
+            let _e46 = RadiusAtDistance(_e42, _e43, _e44, _e45);
+            r_t_2 = _e46;
             let _e50 = atmosphere_75;
-            let _e51 = r_54;
-            let _e52 = mu_37;
-            let _e53 = t_11;
-            let _e54 = r_t_2;
-            let _e55 = AltitudeAtDistance(_e50, _e51, _e52, _e53, _e54);
-            let _e60 = GetCoefficientsAtAltitude(_e49, _e55, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e60;
-            let _e62 = k_2;
-            if (_e62 > 0i) {
-                let _e65 = optical_depth;
-                let _e66 = previous_extinction;
-                let _e67 = extinction;
-                let _e70 = dt;
-                optical_depth = (_e65 + ((_e66 + _e67) * (0.5f * _e70)));
+            let _e51 = atmosphere_75;
+            let _e52 = r_54;
+            let _e53 = mu_37;
+            let _e54 = t_11;
+            let _e55 = r_t_2;
+            let _e56 = AltitudeAtDistance(_e51, _e52, _e53, _e54, _e55);
+            let _e61 = GetCoefficientsAtAltitude(_e50, _e56, (&mie_scattering_1), (&rayleigh_scattering_1));
+            extinction = _e61;
+            let _e63 = k_2;
+            if (_e63 > 0i) {
+                let _e66 = optical_depth;
+                let _e67 = previous_extinction;
+                let _e68 = extinction;
+                let _e71 = dt;
+                optical_depth = (_e66 + ((_e67 + _e68) * (0.5f * _e71)));
             }
-            let _e74 = extinction;
-            previous_extinction = _e74;
+            let _e75 = extinction;
+            previous_extinction = _e75;
         }
         continuing {
-            let _e33 = k_2;
-            k_2 = (_e33 + 1i);
+            let _e34 = k_2;
+            k_2 = (_e34 + 1i);
         }
     }
-    let _e75 = optical_depth;
-    return _e75;
+    let _e76 = optical_depth;
+    return _e76;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2232,25 +2244,25 @@ fn LongSegmentOpticalDepth(atmosphere_76: AtmosphereParameters, transmittance_te
     mu_39 = mu_38;
     d_22 = d_21;
     ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e20 = atmosphere_77;
-    if (_e20.transmittance_is_colour != 0i) {
-        let _e24 = atmosphere_77;
-        let _e25 = r_56;
-        let _e26 = mu_39;
-        let _e27 = d_22;
-        let _e28 = IntegrateSegmentOpticalDepth(_e24, _e25, _e26, _e27);
-        local_17 = _e28;
+    let _e21 = atmosphere_77;
+    if (_e21.transmittance_is_colour != 0i) {
+        let _e25 = atmosphere_77;
+        let _e26 = r_56;
+        let _e27 = mu_39;
+        let _e28 = d_22;
+        let _e29 = IntegrateSegmentOpticalDepth(_e25, _e26, _e27, _e28);
+        local_17 = _e29;
     } else {
-        let _e29 = atmosphere_77;
-        let _e30 = r_56;
-        let _e31 = mu_39;
-        let _e32 = d_22;
-        let _e33 = ray_r_mu_intersects_ground_16;
-        let _e34 = GetOpticalDepth(_e29, transmittance_texture_6, _e30, _e31, _e32, _e33);
-        local_17 = _e34;
+        let _e30 = atmosphere_77;
+        let _e31 = r_56;
+        let _e32 = mu_39;
+        let _e33 = d_22;
+        let _e34 = ray_r_mu_intersects_ground_16;
+        let _e35 = GetOpticalDepth(_e30, transmittance_texture_6, _e31, _e32, _e33, _e34);
+        local_17 = _e35;
     }
-    let _e36 = local_17;
-    return _e36;
+    let _e37 = local_17;
+    return _e37;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2259,17 +2271,17 @@ fn MeanAttenuation(depth: f32) -> f32 {
     var local_18: f32;
 
     depth_1 = depth;
-    let _e11 = depth_1;
-    if (_e11 < 0.0001f) {
-        let _e16 = depth_1;
-        local_18 = (1f - (0.5f * _e16));
+    let _e12 = depth_1;
+    if (_e12 < 0.0001f) {
+        let _e17 = depth_1;
+        local_18 = (1f - (0.5f * _e17));
     } else {
-        let _e20 = depth_1;
-        let _e24 = depth_1;
-        local_18 = ((1f - exp(-(_e20))) / _e24);
+        let _e21 = depth_1;
+        let _e25 = depth_1;
+        local_18 = ((1f - exp(-(_e21))) / _e25);
     }
-    let _e27 = local_18;
-    return _e27;
+    let _e28 = local_18;
+    return _e28;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2308,124 +2320,124 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
     mu_s_25 = mu_s_24;
     nu_19 = nu_18;
     d_24 = d_23;
-    let _e25 = d_24;
-    dt_1 = (_e25 / 16f);
+    let _e26 = d_24;
+    dt_1 = (_e26 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
     (*scattering_weight) = vec3(0f);
     loop {
-        let _e53 = k_3;
-        if !((_e53 <= SEGMENT_INTERVALS)) {
+        let _e54 = k_3;
+        if !((_e54 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e59 = dt_1;
-            let _e60 = k_3;
-            t_12 = (_e59 * f32(_e60));
-            let _e64 = atmosphere_79;
-            let _e65 = r_58;
-            let _e66 = mu_41;
-            let _e67 = t_12;
-            let _e68 = RadiusAtDistance(_e64, _e65, _e66, _e67);
-            r_t_3 = _e68;
-            let _e70 = atmosphere_79;
-            let _e71 = r_58;
-            let _e72 = mu_41;
-            let _e73 = t_12;
-            let _e74 = r_t_3;
-            let _e75 = AltitudeAtDistance(_e70, _e71, _e72, _e73, _e74);
-            altitude_2 = _e75;
-            let _e77 = r_58;
-            let _e78 = mu_s_25;
-            let _e80 = t_12;
-            let _e81 = nu_19;
-            let _e84 = r_t_3;
-            let _e86 = ClampCosine((((_e77 * _e78) + (_e80 * _e81)) / _e84));
-            mu_s_t_2 = _e86;
-            let _e90 = atmosphere_79;
-            let _e91 = altitude_2;
-            let _e96 = GetCoefficientsAtAltitude(_e90, _e91, (&mie_scattering_2), (&rayleigh_scattering_2));
-            extinction_1 = _e96;
-            let _e98 = atmosphere_79;
-            let _e99 = r_t_3;
-            let _e100 = mu_s_t_2;
-            let _e101 = GetOpticalDepthToTopAtmosphereBoundary(_e98, transmittance_texture_7, _e99, _e100);
-            let _e104 = atmosphere_79;
-            let _e105 = r_t_3;
-            let _e106 = mu_s_t_2;
-            let _e107 = SunVisibleFraction(_e104, _e105, _e106);
-            sunlight = (exp(-(_e101)) * _e107);
-            let _e110 = rayleigh_scattering_2;
-            let _e111 = sunlight;
-            rayleigh = (_e110 * _e111);
-            let _e114 = mie_scattering_2;
-            let _e115 = sunlight;
-            mie = (_e114 * _e115);
-            let _e118 = rayleigh_scattering_2;
-            let _e119 = mie_scattering_2;
-            scattering_2 = (_e118 + _e119);
-            let _e122 = k_3;
-            if (_e122 > 0i) {
+            let _e60 = dt_1;
+            let _e61 = k_3;
+            t_12 = (_e60 * f32(_e61));
+            let _e65 = atmosphere_79;
+            let _e66 = r_58;
+            let _e67 = mu_41;
+            let _e68 = t_12;
+            let _e69 = RadiusAtDistance(_e65, _e66, _e67, _e68);
+            r_t_3 = _e69;
+            let _e71 = atmosphere_79;
+            let _e72 = r_58;
+            let _e73 = mu_41;
+            let _e74 = t_12;
+            let _e75 = r_t_3;
+            let _e76 = AltitudeAtDistance(_e71, _e72, _e73, _e74, _e75);
+            altitude_2 = _e76;
+            let _e78 = r_58;
+            let _e79 = mu_s_25;
+            let _e81 = t_12;
+            let _e82 = nu_19;
+            let _e85 = r_t_3;
+            let _e87 = ClampCosine((((_e78 * _e79) + (_e81 * _e82)) / _e85));
+            mu_s_t_2 = _e87;
+            let _e91 = atmosphere_79;
+            let _e92 = altitude_2;
+            let _e97 = GetCoefficientsAtAltitude(_e91, _e92, (&mie_scattering_2), (&rayleigh_scattering_2));
+            extinction_1 = _e97;
+            let _e99 = atmosphere_79;
+            let _e100 = r_t_3;
+            let _e101 = mu_s_t_2;
+            let _e102 = GetOpticalDepthToTopAtmosphereBoundary(_e99, transmittance_texture_7, _e100, _e101);
+            let _e105 = atmosphere_79;
+            let _e106 = r_t_3;
+            let _e107 = mu_s_t_2;
+            let _e108 = SunVisibleFraction(_e105, _e106, _e107);
+            sunlight = (exp(-(_e102)) * _e108);
+            let _e111 = rayleigh_scattering_2;
+            let _e112 = sunlight;
+            rayleigh = (_e111 * _e112);
+            let _e115 = mie_scattering_2;
+            let _e116 = sunlight;
+            mie = (_e115 * _e116);
+            let _e119 = rayleigh_scattering_2;
+            let _e120 = mie_scattering_2;
+            scattering_2 = (_e119 + _e120);
+            let _e123 = k_3;
+            if (_e123 > 0i) {
                 {
-                    let _e125 = previous_extinction_1;
-                    let _e126 = extinction_1;
-                    let _e129 = dt_1;
-                    interval_depth = ((_e125 + _e126) * (0.5f * _e129));
-                    let _e133 = optical_depth_1;
-                    start_transmittance = exp(-(_e133));
-                    let _e137 = start_transmittance;
-                    let _e138 = interval_depth;
-                    let _e140 = MeanAttenuation(_e138.x);
-                    let _e141 = interval_depth;
-                    let _e143 = MeanAttenuation(_e141.y);
-                    let _e144 = interval_depth;
-                    let _e146 = MeanAttenuation(_e144.z);
-                    mean_transmittance = (_e137 * vec3<f32>(_e140, _e143, _e146));
-                    let _e150 = (*single_rayleigh);
-                    let _e151 = previous_rayleigh;
-                    let _e152 = rayleigh;
-                    let _e155 = dt_1;
-                    let _e158 = mean_transmittance;
-                    (*single_rayleigh) = (_e150 + (((_e151 + _e152) * (0.5f * _e155)) * _e158));
-                    let _e161 = (*single_mie);
-                    let _e162 = previous_mie;
-                    let _e163 = mie;
-                    let _e166 = dt_1;
-                    let _e169 = mean_transmittance;
-                    (*single_mie) = (_e161 + (((_e162 + _e163) * (0.5f * _e166)) * _e169));
-                    let _e172 = (*scattering_weight);
-                    let _e173 = previous_scattering;
-                    let _e174 = scattering_2;
-                    let _e177 = dt_1;
-                    let _e180 = mean_transmittance;
-                    (*scattering_weight) = (_e172 + (((_e173 + _e174) * (0.5f * _e177)) * _e180));
-                    let _e183 = optical_depth_1;
-                    let _e184 = interval_depth;
-                    optical_depth_1 = (_e183 + _e184);
+                    let _e126 = previous_extinction_1;
+                    let _e127 = extinction_1;
+                    let _e130 = dt_1;
+                    interval_depth = ((_e126 + _e127) * (0.5f * _e130));
+                    let _e134 = optical_depth_1;
+                    start_transmittance = exp(-(_e134));
+                    let _e138 = start_transmittance;
+                    let _e139 = interval_depth;
+                    let _e141 = MeanAttenuation(_e139.x);
+                    let _e142 = interval_depth;
+                    let _e144 = MeanAttenuation(_e142.y);
+                    let _e145 = interval_depth;
+                    let _e147 = MeanAttenuation(_e145.z);
+                    mean_transmittance = (_e138 * vec3<f32>(_e141, _e144, _e147));
+                    let _e151 = (*single_rayleigh);
+                    let _e152 = previous_rayleigh;
+                    let _e153 = rayleigh;
+                    let _e156 = dt_1;
+                    let _e159 = mean_transmittance;
+                    (*single_rayleigh) = (_e151 + (((_e152 + _e153) * (0.5f * _e156)) * _e159));
+                    let _e162 = (*single_mie);
+                    let _e163 = previous_mie;
+                    let _e164 = mie;
+                    let _e167 = dt_1;
+                    let _e170 = mean_transmittance;
+                    (*single_mie) = (_e162 + (((_e163 + _e164) * (0.5f * _e167)) * _e170));
+                    let _e173 = (*scattering_weight);
+                    let _e174 = previous_scattering;
+                    let _e175 = scattering_2;
+                    let _e178 = dt_1;
+                    let _e181 = mean_transmittance;
+                    (*scattering_weight) = (_e173 + (((_e174 + _e175) * (0.5f * _e178)) * _e181));
+                    let _e184 = optical_depth_1;
+                    let _e185 = interval_depth;
+                    optical_depth_1 = (_e184 + _e185);
                 }
             }
-            let _e186 = extinction_1;
-            previous_extinction_1 = _e186;
-            let _e187 = rayleigh;
-            previous_rayleigh = _e187;
-            let _e188 = mie;
-            previous_mie = _e188;
-            let _e189 = scattering_2;
-            previous_scattering = _e189;
+            let _e187 = extinction_1;
+            previous_extinction_1 = _e187;
+            let _e188 = rayleigh;
+            previous_rayleigh = _e188;
+            let _e189 = mie;
+            previous_mie = _e189;
+            let _e190 = scattering_2;
+            previous_scattering = _e190;
         }
         continuing {
-            let _e56 = k_3;
-            k_3 = (_e56 + 1i);
+            let _e57 = k_3;
+            k_3 = (_e57 + 1i);
         }
     }
-    let _e190 = (*single_rayleigh);
-    let _e191 = atmosphere_79;
-    (*single_rayleigh) = (_e190 * _e191.solar_irradiance);
-    let _e194 = (*single_mie);
-    let _e195 = atmosphere_79;
-    (*single_mie) = (_e194 * _e195.solar_irradiance);
-    let _e198 = optical_depth_1;
-    return _e198;
+    let _e191 = (*single_rayleigh);
+    let _e192 = atmosphere_79;
+    (*single_rayleigh) = (_e191 * _e192.solar_irradiance);
+    let _e195 = (*single_mie);
+    let _e196 = atmosphere_79;
+    (*single_mie) = (_e195 * _e196.solar_irradiance);
+    let _e199 = optical_depth_1;
+    return _e199;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2478,228 +2490,228 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     point_1 = point;
     shadow_length_1 = shadow_length;
     sun_direction_5 = sun_direction_4;
-    let _e23 = point_1;
-    let _e24 = camera_7;
-    camera_to_point = (_e23 - _e24);
-    let _e27 = camera_to_point;
+    let _e24 = point_1;
+    let _e25 = camera_7;
+    camera_to_point = (_e24 - _e25);
     let _e28 = camera_to_point;
-    if (dot(_e27, _e28) == 0f) {
+    let _e29 = camera_to_point;
+    if (dot(_e28, _e29) == 0f) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e36 = camera_to_point;
-    view_ray_6 = normalize(_e36);
-    let _e44 = atmosphere_81;
-    let _e45 = camera_7;
-    let _e46 = view_ray_6;
-    let _e47 = sun_direction_5;
-    let _e58 = GetViewRayStart(_e44, _e45, _e46, _e47, (&start_2), (&r_59), (&mu_42), (&mu_s_26), (&nu_20));
-    if !(_e58) {
+    let _e37 = camera_to_point;
+    view_ray_6 = normalize(_e37);
+    let _e45 = atmosphere_81;
+    let _e46 = camera_7;
+    let _e47 = view_ray_6;
+    let _e48 = sun_direction_5;
+    let _e59 = GetViewRayStart(_e45, _e46, _e47, _e48, (&start_2), (&r_59), (&mu_42), (&mu_s_26), (&nu_20));
+    if !(_e59) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e64 = point_1;
-    let _e65 = start_2;
-    d_25 = max(length((_e64 - _e65)), 0f);
-    let _e71 = d_25;
-    let _e72 = shadow_length_1;
-    lit_1 = max((_e71 - max(_e72, 0f)), 0f);
-    let _e79 = atmosphere_81;
-    let _e80 = r_59;
-    let _e81 = mu_42;
-    let _e82 = RayIntersectsGround(_e79, _e80, _e81);
-    ray_r_mu_intersects_ground_17 = _e82;
-    let _e84 = atmosphere_81;
-    let _e85 = r_59;
-    let _e86 = mu_42;
-    let _e87 = lit_1;
-    let _e88 = RadiusAtDistance(_e84, _e85, _e86, _e87);
-    r_p = _e88;
-    let _e90 = r_59;
-    let _e91 = mu_42;
-    let _e92 = lit_1;
-    let _e93 = r_p;
-    let _e94 = CosineAtDistance(_e90, _e91, _e92, _e93);
-    mu_p = _e94;
-    let _e96 = r_59;
-    let _e97 = mu_s_26;
-    let _e99 = lit_1;
-    let _e100 = nu_20;
-    let _e103 = r_p;
-    let _e105 = ClampCosine((((_e96 * _e97) + (_e99 * _e100)) / _e103));
-    mu_s_p = _e105;
-    let _e111 = d_25;
-    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e111));
-    let _e119 = lit_1;
-    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e119));
-    let _e135 = lit_direct;
-    if (_e135 > 0f) {
+    let _e65 = point_1;
+    let _e66 = start_2;
+    d_25 = max(length((_e65 - _e66)), 0f);
+    let _e72 = d_25;
+    let _e73 = shadow_length_1;
+    lit_1 = max((_e72 - max(_e73, 0f)), 0f);
+    let _e80 = atmosphere_81;
+    let _e81 = r_59;
+    let _e82 = mu_42;
+    let _e83 = RayIntersectsGround(_e80, _e81, _e82);
+    ray_r_mu_intersects_ground_17 = _e83;
+    let _e85 = atmosphere_81;
+    let _e86 = r_59;
+    let _e87 = mu_42;
+    let _e88 = lit_1;
+    let _e89 = RadiusAtDistance(_e85, _e86, _e87, _e88);
+    r_p = _e89;
+    let _e91 = r_59;
+    let _e92 = mu_42;
+    let _e93 = lit_1;
+    let _e94 = r_p;
+    let _e95 = CosineAtDistance(_e91, _e92, _e93, _e94);
+    mu_p = _e95;
+    let _e97 = r_59;
+    let _e98 = mu_s_26;
+    let _e100 = lit_1;
+    let _e101 = nu_20;
+    let _e104 = r_p;
+    let _e106 = ClampCosine((((_e97 * _e98) + (_e100 * _e101)) / _e104));
+    mu_s_p = _e106;
+    let _e112 = d_25;
+    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e112));
+    let _e120 = lit_1;
+    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e120));
+    let _e136 = lit_direct;
+    if (_e136 > 0f) {
         {
-            let _e138 = atmosphere_81;
-            let _e139 = r_59;
-            let _e140 = mu_42;
-            let _e141 = mu_s_26;
-            let _e142 = nu_20;
-            let _e143 = lit_1;
-            let _e150 = IntegrateSegment(_e138, transmittance_texture_8, _e139, _e140, _e141, _e142, _e143, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
-            lit_optical_depth = _e150;
+            let _e139 = atmosphere_81;
+            let _e140 = r_59;
+            let _e141 = mu_42;
+            let _e142 = mu_s_26;
+            let _e143 = nu_20;
+            let _e144 = lit_1;
+            let _e151 = IntegrateSegment(_e139, transmittance_texture_8, _e140, _e141, _e142, _e143, _e144, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
+            lit_optical_depth = _e151;
         }
     }
-    let _e151 = lit_optical_depth;
-    optical_depth_2 = _e151;
-    let _e153 = direct;
-    let _e156 = lit_1;
-    let _e157 = d_25;
-    if ((_e153 > 0f) && (_e156 < _e157)) {
+    let _e152 = lit_optical_depth;
+    optical_depth_2 = _e152;
+    let _e154 = direct;
+    let _e157 = lit_1;
+    let _e158 = d_25;
+    if ((_e154 > 0f) && (_e157 < _e158)) {
         {
-            let _e163 = optical_depth_2;
-            let _e164 = atmosphere_81;
-            let _e165 = r_p;
-            let _e166 = mu_p;
-            let _e167 = mu_s_p;
-            let _e168 = nu_20;
-            let _e169 = d_25;
-            let _e170 = lit_1;
-            let _e178 = IntegrateSegment(_e164, transmittance_texture_8, _e165, _e166, _e167, _e168, (_e169 - _e170), (&unused_rayleigh), (&unused_mie), (&unused_weight));
-            optical_depth_2 = (_e163 + _e178);
+            let _e164 = optical_depth_2;
+            let _e165 = atmosphere_81;
+            let _e166 = r_p;
+            let _e167 = mu_p;
+            let _e168 = mu_s_p;
+            let _e169 = nu_20;
+            let _e170 = d_25;
+            let _e171 = lit_1;
+            let _e179 = IntegrateSegment(_e165, transmittance_texture_8, _e166, _e167, _e168, _e169, (_e170 - _e171), (&unused_rayleigh), (&unused_mie), (&unused_weight));
+            optical_depth_2 = (_e164 + _e179);
         }
     }
-    let _e180 = direct;
-    if (_e180 < 1f) {
+    let _e181 = direct;
+    if (_e181 < 1f) {
         {
-            let _e183 = atmosphere_81;
-            let _e184 = r_59;
-            let _e185 = mu_42;
-            let _e186 = d_25;
-            let _e187 = ray_r_mu_intersects_ground_17;
-            let _e188 = LongSegmentOpticalDepth(_e183, transmittance_texture_8, _e184, _e185, _e186, _e187);
-            let _e189 = optical_depth_2;
-            let _e190 = direct;
-            optical_depth_2 = mix(_e188, _e189, vec3(_e190));
+            let _e184 = atmosphere_81;
+            let _e185 = r_59;
+            let _e186 = mu_42;
+            let _e187 = d_25;
+            let _e188 = ray_r_mu_intersects_ground_17;
+            let _e189 = LongSegmentOpticalDepth(_e184, transmittance_texture_8, _e185, _e186, _e187, _e188);
+            let _e190 = optical_depth_2;
+            let _e191 = direct;
+            optical_depth_2 = mix(_e189, _e190, vec3(_e191));
         }
     }
-    let _e193 = optical_depth_2;
-    (*transmittance_1) = exp(-(_e193));
-    let _e197 = atmosphere_81;
-    let _e198 = r_59;
-    let _e199 = mu_42;
-    let _e200 = mu_s_26;
-    let _e201 = nu_20;
-    let _e202 = ray_r_mu_intersects_ground_17;
-    let _e205 = GetCombinedScattering(_e197, scattering_texture_4, single_mie_scattering_texture_2, _e198, _e199, _e200, _e201, _e202, (&single_mie_scattering_2));
-    scattering_3 = _e205;
-    let _e207 = lit_1;
-    if (_e207 < DIRECT_SEGMENT_LENGTH) {
+    let _e194 = optical_depth_2;
+    (*transmittance_1) = exp(-(_e194));
+    let _e198 = atmosphere_81;
+    let _e199 = r_59;
+    let _e200 = mu_42;
+    let _e201 = mu_s_26;
+    let _e202 = nu_20;
+    let _e203 = ray_r_mu_intersects_ground_17;
+    let _e206 = GetCombinedScattering(_e198, scattering_texture_4, single_mie_scattering_texture_2, _e199, _e200, _e201, _e202, _e203, (&single_mie_scattering_2));
+    scattering_3 = _e206;
+    let _e208 = lit_1;
+    if (_e208 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e209 = atmosphere_81;
-            let _e210 = r_59;
-            let _e211 = mu_42;
-            let _e212 = ray_r_mu_intersects_ground_17;
-            let _e213 = DistanceToNearestAtmosphereBoundary(_e209, _e210, _e211, _e212);
-            boundary = _e213;
-            let _e215 = boundary;
-            let _e217 = atmosphere_81;
-            let _e218 = r_59;
-            let _e219 = mu_42;
-            let _e220 = DistanceInsideScatteringRadii(_e217, _e218, _e219);
-            let _e222 = lit_1;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e215), _e220), _e222);
-            let _e228 = atmosphere_81;
-            let _e229 = r_59;
-            let _e230 = mu_42;
-            let _e231 = mu_s_26;
-            let _e232 = nu_20;
-            let _e233 = far;
-            let _e240 = IntegrateSegment(_e228, transmittance_texture_8, _e229, _e230, _e231, _e232, _e233, (&far_rayleigh), (&far_mie), (&far_weight));
-            far_optical_depth = _e240;
-            let _e242 = far;
-            let _e243 = boundary;
-            if (_e242 < _e243) {
+            let _e210 = atmosphere_81;
+            let _e211 = r_59;
+            let _e212 = mu_42;
+            let _e213 = ray_r_mu_intersects_ground_17;
+            let _e214 = DistanceToNearestAtmosphereBoundary(_e210, _e211, _e212, _e213);
+            boundary = _e214;
+            let _e216 = boundary;
+            let _e218 = atmosphere_81;
+            let _e219 = r_59;
+            let _e220 = mu_42;
+            let _e221 = DistanceInsideScatteringRadii(_e218, _e219, _e220);
+            let _e223 = lit_1;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e216), _e221), _e223);
+            let _e229 = atmosphere_81;
+            let _e230 = r_59;
+            let _e231 = mu_42;
+            let _e232 = mu_s_26;
+            let _e233 = nu_20;
+            let _e234 = far;
+            let _e241 = IntegrateSegment(_e229, transmittance_texture_8, _e230, _e231, _e232, _e233, _e234, (&far_rayleigh), (&far_mie), (&far_weight));
+            far_optical_depth = _e241;
+            let _e243 = far;
+            let _e244 = boundary;
+            if (_e243 < _e244) {
                 {
-                    let _e245 = atmosphere_81;
-                    let _e246 = r_59;
-                    let _e247 = mu_42;
-                    let _e248 = far;
-                    let _e249 = RadiusAtDistance(_e245, _e246, _e247, _e248);
-                    r_far = _e249;
-                    let _e252 = scattering_3;
-                    let _e253 = far_optical_depth;
-                    let _e256 = atmosphere_81;
-                    let _e257 = r_far;
-                    let _e258 = r_59;
-                    let _e259 = mu_42;
-                    let _e260 = far;
-                    let _e261 = r_far;
-                    let _e262 = CosineAtDistance(_e258, _e259, _e260, _e261);
-                    let _e263 = r_59;
-                    let _e264 = mu_s_26;
-                    let _e266 = far;
-                    let _e267 = nu_20;
-                    let _e270 = r_far;
-                    let _e272 = ClampCosine((((_e263 * _e264) + (_e266 * _e267)) / _e270));
-                    let _e273 = nu_20;
-                    let _e274 = ray_r_mu_intersects_ground_17;
-                    let _e277 = GetCombinedScattering(_e256, scattering_texture_4, single_mie_scattering_texture_2, _e257, _e262, _e272, _e273, _e274, (&unused_far_mie));
-                    scattering_3 = (_e252 - (exp(-(_e253)) * _e277));
+                    let _e246 = atmosphere_81;
+                    let _e247 = r_59;
+                    let _e248 = mu_42;
+                    let _e249 = far;
+                    let _e250 = RadiusAtDistance(_e246, _e247, _e248, _e249);
+                    r_far = _e250;
+                    let _e253 = scattering_3;
+                    let _e254 = far_optical_depth;
+                    let _e257 = atmosphere_81;
+                    let _e258 = r_far;
+                    let _e259 = r_59;
+                    let _e260 = mu_42;
+                    let _e261 = far;
+                    let _e262 = r_far;
+                    let _e263 = CosineAtDistance(_e259, _e260, _e261, _e262);
+                    let _e264 = r_59;
+                    let _e265 = mu_s_26;
+                    let _e267 = far;
+                    let _e268 = nu_20;
+                    let _e271 = r_far;
+                    let _e273 = ClampCosine((((_e264 * _e265) + (_e267 * _e268)) / _e271));
+                    let _e274 = nu_20;
+                    let _e275 = ray_r_mu_intersects_ground_17;
+                    let _e278 = GetCombinedScattering(_e257, scattering_texture_4, single_mie_scattering_texture_2, _e258, _e263, _e273, _e274, _e275, (&unused_far_mie));
+                    scattering_3 = (_e253 - (exp(-(_e254)) * _e278));
                 }
             }
-            let _e280 = scattering_3;
-            let _e281 = far_rayleigh;
-            let _e286 = lit_weight;
-            let _e288 = far_weight;
-            multiple = ((max((_e280 - _e281), vec3(0f)) * _e286) / max(_e288, vec3(0.000000000000000000000000000001f)));
-            let _e294 = single_rayleigh_1;
-            let _e295 = multiple;
-            let _e297 = nu_20;
-            let _e298 = RayleighPhaseFunction(_e297);
-            let _e300 = single_mie_1;
-            let _e301 = atmosphere_81;
-            let _e302 = nu_20;
-            let _e303 = MiePhaseFunction(_e301, _e302);
-            return (((_e294 + _e295) * _e298) + (_e300 * _e303));
+            let _e281 = scattering_3;
+            let _e282 = far_rayleigh;
+            let _e287 = lit_weight;
+            let _e289 = far_weight;
+            multiple = ((max((_e281 - _e282), vec3(0f)) * _e287) / max(_e289, vec3(0.000000000000000000000000000001f)));
+            let _e295 = single_rayleigh_1;
+            let _e296 = multiple;
+            let _e298 = nu_20;
+            let _e299 = RayleighPhaseFunction(_e298);
+            let _e301 = single_mie_1;
+            let _e302 = atmosphere_81;
+            let _e303 = nu_20;
+            let _e304 = MiePhaseFunction(_e302, _e303);
+            return (((_e295 + _e296) * _e299) + (_e301 * _e304));
         }
     }
-    let _e306 = atmosphere_81;
-    let _e307 = r_59;
-    let _e308 = mu_42;
-    let _e309 = lit_1;
-    let _e310 = ray_r_mu_intersects_ground_17;
-    let _e311 = LongSegmentOpticalDepth(_e306, transmittance_texture_8, _e307, _e308, _e309, _e310);
-    let _e312 = lit_optical_depth;
-    let _e313 = lit_direct;
-    lit_transmittance = exp(-(mix(_e311, _e312, vec3(_e313))));
-    let _e320 = atmosphere_81;
-    let _e321 = r_p;
-    let _e322 = mu_p;
-    let _e323 = mu_s_p;
-    let _e324 = nu_20;
-    let _e325 = ray_r_mu_intersects_ground_17;
-    let _e328 = GetCombinedScattering(_e320, scattering_texture_4, single_mie_scattering_texture_2, _e321, _e322, _e323, _e324, _e325, (&single_mie_scattering_p));
-    scattering_p = _e328;
-    let _e330 = scattering_3;
-    let _e331 = lit_transmittance;
-    let _e332 = scattering_p;
-    scattering_3 = max((_e330 - (_e331 * _e332)), vec3(0f));
-    let _e338 = single_mie_scattering_2;
-    let _e339 = lit_transmittance;
-    let _e340 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e338 - (_e339 * _e340)), vec3(0f));
-    let _e346 = single_mie_scattering_2;
-    let _e347 = single_mie_1;
-    let _e348 = lit_direct;
-    single_mie_scattering_2 = mix(_e346, _e347, vec3(_e348));
-    let _e351 = scattering_3;
-    let _e352 = nu_20;
-    let _e353 = RayleighPhaseFunction(_e352);
-    let _e355 = single_mie_scattering_2;
-    let _e356 = atmosphere_81;
-    let _e357 = nu_20;
-    let _e358 = MiePhaseFunction(_e356, _e357);
-    return ((_e351 * _e353) + (_e355 * _e358));
+    let _e307 = atmosphere_81;
+    let _e308 = r_59;
+    let _e309 = mu_42;
+    let _e310 = lit_1;
+    let _e311 = ray_r_mu_intersects_ground_17;
+    let _e312 = LongSegmentOpticalDepth(_e307, transmittance_texture_8, _e308, _e309, _e310, _e311);
+    let _e313 = lit_optical_depth;
+    let _e314 = lit_direct;
+    lit_transmittance = exp(-(mix(_e312, _e313, vec3(_e314))));
+    let _e321 = atmosphere_81;
+    let _e322 = r_p;
+    let _e323 = mu_p;
+    let _e324 = mu_s_p;
+    let _e325 = nu_20;
+    let _e326 = ray_r_mu_intersects_ground_17;
+    let _e329 = GetCombinedScattering(_e321, scattering_texture_4, single_mie_scattering_texture_2, _e322, _e323, _e324, _e325, _e326, (&single_mie_scattering_p));
+    scattering_p = _e329;
+    let _e331 = scattering_3;
+    let _e332 = lit_transmittance;
+    let _e333 = scattering_p;
+    scattering_3 = max((_e331 - (_e332 * _e333)), vec3(0f));
+    let _e339 = single_mie_scattering_2;
+    let _e340 = lit_transmittance;
+    let _e341 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e339 - (_e340 * _e341)), vec3(0f));
+    let _e347 = single_mie_scattering_2;
+    let _e348 = single_mie_1;
+    let _e349 = lit_direct;
+    single_mie_scattering_2 = mix(_e347, _e348, vec3(_e349));
+    let _e352 = scattering_3;
+    let _e353 = nu_20;
+    let _e354 = RayleighPhaseFunction(_e353);
+    let _e356 = single_mie_scattering_2;
+    let _e357 = atmosphere_81;
+    let _e358 = nu_20;
+    let _e359 = MiePhaseFunction(_e357, _e358);
+    return ((_e352 * _e354) + (_e356 * _e359));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -2713,12 +2725,12 @@ fn GetSkyRadianceToPoint(atmosphere_82: AtmosphereParameters, transmittance_text
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e21 = atmosphere_83;
-    let _e22 = camera_9;
-    let _e23 = point_3;
-    let _e25 = sun_direction_7;
-    let _e28 = GetSkyRadianceToPointWithShadow(_e21, transmittance_texture_9, scattering_texture_5, single_mie_scattering_texture_3, _e22, _e23, 0f, _e25, transmittance_2);
-    return _e28;
+    let _e22 = atmosphere_83;
+    let _e23 = camera_9;
+    let _e24 = point_3;
+    let _e26 = sun_direction_7;
+    let _e29 = GetSkyRadianceToPointWithShadow(_e22, transmittance_texture_9, scattering_texture_5, single_mie_scattering_texture_3, _e23, _e24, 0f, _e26, transmittance_2);
+    return _e29;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -2734,49 +2746,49 @@ fn GetSunAndSkyIrradiance(atmosphere_84: AtmosphereParameters, transmittance_tex
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e20 = atmosphere_85;
-    let _e21 = point_5;
-    let _e23 = ClampRadius(_e20, length(_e21));
-    r_60 = _e23;
-    let _e25 = point_5;
-    let _e26 = sun_direction_9;
-    let _e28 = point_5;
-    let _e31 = ClampCosine((dot(_e25, _e26) / length(_e28)));
-    mu_s_27 = _e31;
-    let _e33 = atmosphere_85;
-    let _e34 = r_60;
-    let _e35 = mu_s_27;
-    let _e36 = GetIrradiance(_e33, irradiance_texture_1, _e34, _e35);
-    let _e38 = normal_1;
-    let _e39 = point_5;
-    let _e41 = point_5;
-    (*sky_irradiance) = ((_e36 * (1f + (dot(_e38, _e39) / length(_e41)))) * 0.5f);
-    let _e48 = atmosphere_85;
-    let _e50 = atmosphere_85;
-    let _e51 = r_60;
-    let _e52 = mu_s_27;
-    let _e53 = GetTransmittanceToSun(_e50, transmittance_texture_10, _e51, _e52);
-    let _e55 = normal_1;
-    let _e56 = sun_direction_9;
-    return ((_e48.solar_irradiance * _e53) * max(dot(_e55, _e56), 0f));
+    let _e21 = atmosphere_85;
+    let _e22 = point_5;
+    let _e24 = ClampRadius(_e21, length(_e22));
+    r_60 = _e24;
+    let _e26 = point_5;
+    let _e27 = sun_direction_9;
+    let _e29 = point_5;
+    let _e32 = ClampCosine((dot(_e26, _e27) / length(_e29)));
+    mu_s_27 = _e32;
+    let _e34 = atmosphere_85;
+    let _e35 = r_60;
+    let _e36 = mu_s_27;
+    let _e37 = GetIrradiance(_e34, irradiance_texture_1, _e35, _e36);
+    let _e39 = normal_1;
+    let _e40 = point_5;
+    let _e42 = point_5;
+    (*sky_irradiance) = ((_e37 * (1f + (dot(_e39, _e40) / length(_e42)))) * 0.5f);
+    let _e49 = atmosphere_85;
+    let _e51 = atmosphere_85;
+    let _e52 = r_60;
+    let _e53 = mu_s_27;
+    let _e54 = GetTransmittanceToSun(_e51, transmittance_texture_10, _e52, _e53);
+    let _e56 = normal_1;
+    let _e57 = sun_direction_9;
+    return ((_e49.solar_irradiance * _e54) * max(dot(_e56, _e57), 0f));
 }
 
 fn GetSolarRadiance(atmosphere_86: AtmosphereParameters) -> vec3<f32> {
     var atmosphere_87: AtmosphereParameters;
 
     atmosphere_87 = atmosphere_86;
-    let _e11 = atmosphere_87;
-    let _e13 = atmosphere_87;
-    let _e16 = atmosphere_87;
-    return (_e11.solar_irradiance / vec3(((PI * _e13.sun_angular_radius) * _e16.sun_angular_radius)));
+    let _e12 = atmosphere_87;
+    let _e14 = atmosphere_87;
+    let _e17 = atmosphere_87;
+    return (_e12.solar_irradiance / vec3(((PI * _e14.sun_angular_radius) * _e17.sun_angular_radius)));
 }
 
 fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     var xyz_1: vec3<f32>;
 
     xyz_1 = xyz;
-    let _e17 = xyz_1;
-    let _e24 = xyz_1;
-    let _e31 = xyz_1;
-    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e17), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e24), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e31));
+    let _e18 = xyz_1;
+    let _e25 = xyz_1;
+    let _e32 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e18), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e25), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e32));
 }
