@@ -210,6 +210,11 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       below_end = fall ? static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(),
                                                            (lowest_mu_s + from_nu) / from_mu_s) - mu_s.begin())
                        : 0;
+      int below_count = 0;
+#pragma omp simd reduction(+ : below_count)
+      for (int j = 0; j < below_end; ++j) below_count += mu_s_k[j] < lowest_mu_s ? 1 : 0;
+      if (below_count == 0) below_end = 0;
+      while (below_end > 0 && !(mu_s_k[below_end - 1] < lowest_mu_s)) --below_end;
       for (int c = 0; c < 3 && below_end > 0; ++c) {
         const float* slope = &fall->lowest_log_slope[lowest_rows[i] + c];
         const float* curvature = &fall->lowest_log_curvature[lowest_rows[i] + c];
