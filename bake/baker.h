@@ -84,7 +84,7 @@ class Baker {
   // and 1 / (ratio - 1); 0 and 0 where J does not rise; per (r, mu) row, nu
   // slice, then column. Always, per row, nu slice and channel, the fall of
   // J below the grid's lowest sun: LowestSunLogFall's slope and curvature
-  // of ln J in mu_s from the three lowest columns.
+  // of ln J in mu_s from the two lowest columns.
   struct MuSFall {
     std::vector<float> log_ratio, inverse_ratio_minus_one;
     int falling_columns = 0;  // the columns with mu_s < 0, lowest first (not the last)
@@ -97,7 +97,7 @@ class Baker {
   // each texel's ray. J is read linearly in r and mu; along mu_s linearly,
   // or where `fall` has falls between columns, with weights that follow
   // them (exactly where J is exponential between two columns). Given
-  // `fall`, J below the grid's lowest sun continues the fall of the three
+  // `fall`, J below the grid's lowest sun continues the fall of the two
   // lowest columns per channel instead of holding the lowest column.
   Texture GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
                           const AtmosphereParameters& density_grid, const MuSFall* fall = nullptr) const;

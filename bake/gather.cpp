@@ -45,15 +45,14 @@ Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) co
   fall.lowest_log_curvature.assign(fall.lowest_log_slope.size(), 0.0f);
   ForEachRow(density, [&](int row, std::size_t first, std::size_t) {
     for (int nu = 0; nu < nu_size; ++nu) {
-      // Below the grid's lowest sun: the runtime's continuation of the three
+      // Below the grid's lowest sun: the runtime's continuation of the two
       // lowest columns (LowestSunLogFall), per channel.
       const float* lowest = &density.texels[first + std::size_t(4) * nu * mu_s_size];
       auto column_value = [&](int column) {
         return glsl::vec4(lowest[4 * column], lowest[4 * column + 1], lowest[4 * column + 2], 0.0);
       };
       glsl::vec4 slope, curvature;
-      glsl::LowestSunLogFall(column_value(0), column_value(1), column_value(2), columns.mu_s[1] - columns.mu_s[0],
-                             columns.mu_s[2] - columns.mu_s[0], slope, curvature);
+      glsl::LowestSunLogFall(column_value(0), column_value(1), columns.mu_s[0], columns.mu_s[1], slope, curvature);
       for (int c = 0; c < 3; ++c) {
         const std::size_t i = (std::size_t(row) * nu_size + nu) * 3 + c;
         fall.lowest_log_slope[i] = float(slope[c]);

@@ -453,23 +453,28 @@ vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d,
   return exp(mix(mix(lb, lc, t), cubic, lit)) * step(dark, max(b, c));
 }
 
-// Below the table's lowest sun, ln L continued from the three lowest mu_s
-// columns a, b, c (b and c at d_b and d_c above the lowest column's mu_s):
-// ln L = ln a + slope d + curvature d^2 at d = mu_s - mu_s_min < 0, the
-// parabola through the three where the fall steepens toward the lower sun
-// (curvature < 0: after sunset the Earth's shadow rises about as the square
-// of the sun's depression, and ln L falls with it), else the line through a
-// and b; where L does not rise from a to b (or a is dark), held at a. The
-// bake's gather continues J below its grid's lowest sun the same way.
-void LowestSunLogFall(IN(vec4) a, IN(vec4) b, IN(vec4) c, Number d_b, Number d_c, OUT(vec4) slope,
+// Below the table's lowest sun, ln L continued from the two lowest mu_s
+// columns a and b (at sun cosines mu_s_a < mu_s_b): ln L = ln a + slope d +
+// curvature d^2 at d = mu_s - mu_s_a < 0. Where both are below the horizon,
+// the parabola in mu_s through them with its vertex at the horizon, ln L =
+// ln a - k (mu_s^2 - mu_s_a^2): after sunset the light comes from above the
+// Earth's shadow, whose height grows as the square of the sun's depression
+// delta (h = R delta^2 / 2 about, and -mu_s = sin delta), and falls about as
+// exp(-h / H). Else the line through a and b. Where L does not rise from a
+// to b (or a is dark), held at a. The bake's gather continues J below its
+// grid's lowest sun the same way.
+void LowestSunLogFall(IN(vec4) a, IN(vec4) b, Number mu_s_a, Number mu_s_b, OUT(vec4) slope,
                       OUT(vec4) curvature) {
   vec4 dark = vec4(1e-30);
-  vec4 la = log(max(a, dark));
-  vec4 secant_b = (log(max(b, dark)) - la) / d_b;
-  vec4 secant_c = (log(max(c, dark)) - la) / d_c;
-  vec4 rises = step(dark, a) * (vec4(1.0) - step(b, a));
-  curvature = rises * step(dark, c) * min((secant_c - secant_b) / (d_c - d_b), vec4(0.0));
-  slope = rises * (secant_b - curvature * d_b);
+  vec4 rise = (log(max(b, dark)) - log(max(a, dark))) * step(dark, a) * (vec4(1.0) - step(b, a));
+  if (mu_s_b < 0.0) {
+    vec4 k = rise / (mu_s_a * mu_s_a - mu_s_b * mu_s_b);
+    slope = -2.0 * mu_s_a * k;
+    curvature = -k;
+  } else {
+    slope = rise / (mu_s_b - mu_s_a);
+    curvature = vec4(0.0);
+  }
 }
 
 // The light at the mu_s texel column at texture coordinate x: the two nu
@@ -487,8 +492,8 @@ vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(Scattering
 // (GetScatteringAtMuSColumn, two fetches each), blended linearly in
 // daylight (four fetches); for a low sun between two columns by
 // LogMonotoneCubicMix of the four columns around it (eight fetches), and
-// below the table's lowest sun by LowestSunLogFall of the three lowest
-// columns (six fetches).
+// below the table's lowest sun by LowestSunLogFall of the two lowest
+// columns (four fetches).
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
@@ -508,13 +513,11 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_above, nu_slice, nu_t, x_above < x_low_sun);
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
   if (mu_s_t < 0.0) {
-    vec4 third = GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 2.5 / mu_s_size, nu_slice, nu_t,
-                                          2.5 / mu_s_size < x_low_sun);
     Number mu_s_min = atmosphere.scattering_mu_s_min;
     vec4 slope;
     vec4 curvature;
-    LowestSunLogFall(below, above, third, GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)) - mu_s_min,
-                     GetScatteringMuSFromUnitRange(atmosphere, 2.0 / (mu_s_size - 1.0)) - mu_s_min, slope, curvature);
+    LowestSunLogFall(below, above, mu_s_min, GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)), slope,
+                     curvature);
     Number d = mu_s - mu_s_min;
     return below * exp(d * (slope + d * curvature));
   }

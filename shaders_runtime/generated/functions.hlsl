@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _844 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_845)
+    if (!_844)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _708 = mu < 0.0f;
-    bool _720;
-    if (_708)
+    bool _707 = mu < 0.0f;
+    bool _719;
+    if (_707)
     {
-        _720 = (((r * r) * mu) * mu) >= c;
+        _719 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _720 = _708;
+        _719 = _707;
     }
-    return _720;
+    return _719;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _478;
+    float _477;
     if (r_mu > 0.0f)
     {
-        _478 = c / (r_mu + s);
+        _477 = c / (r_mu + s);
     }
     else
     {
-        _478 = s - r_mu;
+        _477 = s - r_mu;
     }
-    float param_1 = _478;
+    float param_1 = _477;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _937;
+    float _936;
     if (d_max > d_min)
     {
-        _937 = (d - d_min) / (d_max - d_min);
+        _936 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _937 = 0.0f;
+        _936 = 0.0f;
     }
-    float x_mu = _937;
+    float x_mu = _936;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -300,16 +300,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1277;
+        float _1276;
         if (d_max == d_min)
         {
-            _1277 = 0.0f;
+            _1276 = 0.0f;
         }
         else
         {
-            _1277 = (d - d_min) / (d_max - d_min);
+            _1276 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1277;
+        x_mu = _1276;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +320,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1321;
+        float _1320;
         if (d_max_1 > d_min_1)
         {
-            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1320 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1321 = 0.0f;
+            _1320 = 0.0f;
         }
-        x_mu = _1321;
+        x_mu = _1320;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +348,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1696;
+    float _1695;
     if (low_sun)
     {
-        _1696 = min(t, 1.0f);
+        _1695 = min(t, 1.0f);
     }
     else
     {
-        _1696 = clamp(t, 0.0f, 1.0f);
+        _1695 = clamp(t, 0.0f, 1.0f);
     }
-    return _1696;
+    return _1695;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -426,30 +426,36 @@ float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
     float param_7 = 1.0f / A;
     float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
     float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1084;
+    float _1083;
     if (d == 0.0f)
     {
-        _1084 = 1.0f;
+        _1083 = 1.0f;
     }
     else
     {
         float param_8 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1084 = ClampCosine(param_8);
+        _1083 = ClampCosine(param_8);
     }
-    return _1084;
+    return _1083;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-void LowestSunLogFall(float4 a, float4 b, float4 c, float d_b, float d_c, out float4 slope, inout float4 curvature)
+void LowestSunLogFall(float4 a, float4 b, float mu_s_a, float mu_s_b, out float4 slope, out float4 curvature)
 {
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
-    float4 la = log(max(a, dark));
-    float4 secant_b = (log(max(b, dark)) - la) / d_b.xxxx;
-    float4 secant_c = (log(max(c, dark)) - la) / d_c.xxxx;
-    float4 rises = step(dark, a) * (1.0f.xxxx - step(b, a));
-    curvature = (rises * step(dark, c)) * min((secant_c - secant_b) / (d_c - d_b).xxxx, 0.0f.xxxx);
-    slope = rises * (secant_b - (curvature * d_b));
+    float4 rise = ((log(max(b, dark)) - log(max(a, dark))) * step(dark, a)) * (1.0f.xxxx - step(b, a));
+    if (mu_s_b < 0.0f)
+    {
+        float4 k = rise / ((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b)).xxxx;
+        slope = k * ((-2.0f) * mu_s_a);
+        curvature = -k;
+    }
+    else
+    {
+        slope = rise / (mu_s_b - mu_s_a).xxxx;
+        curvature = 0.0f.xxxx;
+    }
 }
 #endif
 
@@ -459,26 +465,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _1780;
+    float4 _1779;
     if (has_a)
     {
-        _1780 = log(max(a, dark));
+        _1779 = log(max(a, dark));
     }
     else
     {
-        _1780 = (lb * 2.0f) - lc;
+        _1779 = (lb * 2.0f) - lc;
     }
-    float4 la = _1780;
-    float4 _1795;
+    float4 la = _1779;
+    float4 _1794;
     if (has_d)
     {
-        _1795 = log(max(d, dark));
+        _1794 = log(max(d, dark));
     }
     else
     {
-        _1795 = (lc * 2.0f) - lb;
+        _1794 = (lc * 2.0f) - lb;
     }
-    float4 ld = _1795;
+    float4 ld = _1794;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -541,28 +547,18 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     if (mu_s_t < 0.0f)
     {
-        AtmosphereParameters param_26 = atmosphere;
-        float4 param_27 = uvwz;
-        float param_28 = 2.5f / mu_s_size;
-        float param_29 = nu_slice;
-        float param_30 = nu_t;
-        bool param_31 = (2.5f / mu_s_size) < x_low_sun;
-        float4 third = GetScatteringAtMuSColumn(param_26, scattering_texture_1, _scattering_texture_1_sampler, param_27, param_28, param_29, param_30, param_31);
         float mu_s_min = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_32 = atmosphere;
-        float param_33 = 1.0f / (mu_s_size - 1.0f);
-        AtmosphereParameters param_34 = atmosphere;
-        float param_35 = 2.0f / (mu_s_size - 1.0f);
-        float4 param_36 = below;
-        float4 param_37 = above;
-        float4 param_38 = third;
-        float param_39 = GetScatteringMuSFromUnitRange(param_32, param_33) - mu_s_min;
-        float param_40 = GetScatteringMuSFromUnitRange(param_34, param_35) - mu_s_min;
-        float4 param_41;
-        float4 param_42;
-        LowestSunLogFall(param_36, param_37, param_38, param_39, param_40, param_41, param_42);
-        float4 slope = param_41;
-        float4 curvature = param_42;
+        AtmosphereParameters param_26 = atmosphere;
+        float param_27 = 1.0f / (mu_s_size - 1.0f);
+        float4 param_28 = below;
+        float4 param_29 = above;
+        float param_30 = mu_s_min;
+        float param_31 = GetScatteringMuSFromUnitRange(param_26, param_27);
+        float4 param_32;
+        float4 param_33;
+        LowestSunLogFall(param_28, param_29, param_30, param_31, param_32, param_33);
+        float4 slope = param_32;
+        float4 curvature = param_33;
         float d = mu_s - mu_s_min;
         return below * exp((slope + (curvature * d)) * d);
     }
@@ -573,28 +569,28 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float column = (x_below * mu_s_size) - 0.5f;
     float x_first = (max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size;
     float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
-    AtmosphereParameters param_43 = atmosphere;
-    float4 param_44 = uvwz;
-    float param_45 = x_first;
-    float param_46 = nu_slice;
-    float param_47 = nu_t;
-    bool param_48 = true;
-    float4 first = GetScatteringAtMuSColumn(param_43, scattering_texture_1, _scattering_texture_1_sampler, param_44, param_45, param_46, param_47, param_48);
-    AtmosphereParameters param_49 = atmosphere;
-    float4 param_50 = uvwz;
-    float param_51 = x_last;
-    float param_52 = nu_slice;
-    float param_53 = nu_t;
-    bool param_54 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_49, scattering_texture_1, _scattering_texture_1_sampler, param_50, param_51, param_52, param_53, param_54);
-    float4 param_55 = first;
-    float4 param_56 = below;
-    float4 param_57 = above;
-    float4 param_58 = last;
-    bool param_59 = column > 0.5f;
-    bool param_60 = (column + 2.0f) < (mu_s_size - 0.5f);
-    float param_61 = mu_s_t;
-    return LogMonotoneCubicMix(param_55, param_56, param_57, param_58, param_59, param_60, param_61);
+    AtmosphereParameters param_34 = atmosphere;
+    float4 param_35 = uvwz;
+    float param_36 = x_first;
+    float param_37 = nu_slice;
+    float param_38 = nu_t;
+    bool param_39 = true;
+    float4 first = GetScatteringAtMuSColumn(param_34, scattering_texture_1, _scattering_texture_1_sampler, param_35, param_36, param_37, param_38, param_39);
+    AtmosphereParameters param_40 = atmosphere;
+    float4 param_41 = uvwz;
+    float param_42 = x_last;
+    float param_43 = nu_slice;
+    float param_44 = nu_t;
+    bool param_45 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_40, scattering_texture_1, _scattering_texture_1_sampler, param_41, param_42, param_43, param_44, param_45);
+    float4 param_46 = first;
+    float4 param_47 = below;
+    float4 param_48 = above;
+    float4 param_49 = last;
+    bool param_50 = column > 0.5f;
+    bool param_51 = (column + 2.0f) < (mu_s_size - 0.5f);
+    float param_52 = mu_s_t;
+    return LogMonotoneCubicMix(param_46, param_47, param_48, param_49, param_50, param_51, param_52);
 }
 #endif
 
@@ -610,16 +606,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2406;
+        float3 _2366;
         if (scattering.x > 0.0f)
         {
-            _2406 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _2366 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _2406 = 0.0f.xxx;
+            _2366 = 0.0f.xxx;
         }
-        single_mie_scattering = _2406;
+        single_mie_scattering = _2366;
     }
     else
     {
@@ -691,13 +687,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _2474 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2434 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2474)
+    if (!_2434)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -706,19 +702,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2494;
+    float3 _2454;
     if (ray_r_mu_intersects_ground)
     {
-        _2494 = 0.0f.xxx;
+        _2454 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2494 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _2454 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _2494;
+    transmittance = _2454;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -726,9 +722,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2521 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2481 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2521;
+    float3 scattering = _2481;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -776,16 +772,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2615;
+    float _2575;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2615 = a * exp(f * log(b / a));
+        _2575 = a * exp(f * log(b / a));
     }
     else
     {
-        _2615 = lerp(a, b, f);
+        _2575 = lerp(a, b, f);
     }
-    return _2615;
+    return _2575;
 }
 #endif
 
@@ -858,16 +854,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2867;
+    float _2827;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2867 = 1.0f - (0.5f * depth);
+        _2827 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2867 = (1.0f - exp(-depth)) / depth;
+        _2827 = (1.0f - exp(-depth)) / depth;
     }
-    return _2867;
+    return _2827;
 }
 #endif
 
@@ -903,10 +899,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2947 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2907 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2947;
+        float3 extinction = _2907;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -964,10 +960,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2812 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2772 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2812;
+        float3 extinction = _2772;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1040,14 +1036,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _2837;
+    float3 _2797;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2837 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2797 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1056,31 +1052,31 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2837 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _2797 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _2837;
+    return _2797;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _724;
+    float _723;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _723 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _723 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _724;
+    return _723;
 }
 #endif
 
@@ -1093,16 +1089,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2577;
+    float _2537;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2577 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2537 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2577 = up;
+        _2537 = up;
     }
-    return _2577;
+    return _2537;
 }
 #endif
 
@@ -1125,13 +1121,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _3093 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3053 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3093)
+    if (!_3053)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1171,11 +1167,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3188 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3148 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3188;
+        lit_optical_depth = _3148;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1189,11 +1185,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3222 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3182 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3222;
+        optical_depth += _3182;
     }
     if (direct < 1.0f)
     {
@@ -1212,9 +1208,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3265 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3225 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3265;
+    float3 scattering = _3225;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1235,11 +1231,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3313 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3273 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3313;
+        float3 far_optical_depth = _3273;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1259,9 +1255,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3367 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3327 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3367);
+            scattering -= (exp(-far_optical_depth) * _3327);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1282,9 +1278,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3432 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3392 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3432;
+    float3 scattering_p = _3392;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1304,25 +1300,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3476 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _3436 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3476;
+    return _3436;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1375;
+    float _1374;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1375 = 0.100000001490116119384765625f;
+        _1374 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1375 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1374 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1375;
+    return _1374;
 }
 #endif
 
@@ -1331,16 +1327,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1393;
+    float _1392;
     if (mu_s < knee)
     {
-        _1393 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1392 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1393 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1392 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1393;
+    return _1392;
 }
 #endif
 
@@ -1367,16 +1363,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1424;
+    float _1423;
     if (x < 0.5f)
     {
-        _1424 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1423 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1424 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1423 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1424;
+    return _1423;
 }
 #endif
 
@@ -1388,16 +1384,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1719;
+    float4 _1718;
     if (t < 0.0f)
     {
-        _1719 = min(blend, a);
+        _1718 = min(blend, a);
     }
     else
     {
-        _1719 = blend;
+        _1718 = blend;
     }
-    return _1719;
+    return _1718;
 }
 #endif
 

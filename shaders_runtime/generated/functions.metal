@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _844 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_845)
+    if (!_844)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _708 = mu < 0.0;
-    bool _720;
-    if (_708)
+    bool _707 = mu < 0.0;
+    bool _719;
+    if (_707)
     {
-        _720 = (((r * r) * mu) * mu) >= c;
+        _719 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _720 = _708;
+        _719 = _707;
     }
-    return _720;
+    return _719;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _478;
+    float _477;
     if (r_mu > 0.0)
     {
-        _478 = c / (r_mu + s);
+        _477 = c / (r_mu + s);
     }
     else
     {
-        _478 = s - r_mu;
+        _477 = s - r_mu;
     }
-    float param_1 = _478;
+    float param_1 = _477;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _937;
+    float _936;
     if (d_max > d_min)
     {
-        _937 = (d - d_min) / (d_max - d_min);
+        _936 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _937 = 0.0;
+        _936 = 0.0;
     }
-    float x_mu = _937;
+    float x_mu = _936;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -323,16 +323,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1277;
+        float _1276;
         if (d_max == d_min)
         {
-            _1277 = 0.0;
+            _1276 = 0.0;
         }
         else
         {
-            _1277 = (d - d_min) / (d_max - d_min);
+            _1276 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1277;
+        x_mu = _1276;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +343,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1321;
+        float _1320;
         if (d_max_1 > d_min_1)
         {
-            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1320 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1321 = 0.0;
+            _1320 = 0.0;
         }
-        x_mu = _1321;
+        x_mu = _1320;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,16 +372,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1696;
+    float _1695;
     if (low_sun)
     {
-        _1696 = fast::min(t, 1.0);
+        _1695 = fast::min(t, 1.0);
     }
     else
     {
-        _1696 = fast::clamp(t, 0.0, 1.0);
+        _1695 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1696;
+    return _1695;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -455,31 +455,37 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_7 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1084;
+    float _1083;
     if (d == 0.0)
     {
-        _1084 = 1.0;
+        _1083 = 1.0;
     }
     else
     {
         float param_8 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1084 = ClampCosine(param_8);
+        _1083 = ClampCosine(param_8);
     }
-    return _1084;
+    return _1083;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-void LowestSunLogFall(thread const float4& a, thread const float4& b, thread const float4& c, thread const float& d_b, thread const float& d_c, thread float4& slope, thread float4& curvature)
+void LowestSunLogFall(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread float4& slope, thread float4& curvature)
 {
     float4 dark = float4(1.0000000031710768509710513471353e-30);
-    float4 la = log(fast::max(a, dark));
-    float4 secant_b = (log(fast::max(b, dark)) - la) / float4(d_b);
-    float4 secant_c = (log(fast::max(c, dark)) - la) / float4(d_c);
-    float4 rises = step(dark, a) * (float4(1.0) - step(b, a));
-    curvature = (rises * step(dark, c)) * fast::min((secant_c - secant_b) / float4(d_c - d_b), float4(0.0));
-    slope = rises * (secant_b - (curvature * d_b));
+    float4 rise = ((log(fast::max(b, dark)) - log(fast::max(a, dark))) * step(dark, a)) * (float4(1.0) - step(b, a));
+    if (mu_s_b < 0.0)
+    {
+        float4 k = rise / float4((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b));
+        slope = k * ((-2.0) * mu_s_a);
+        curvature = -k;
+    }
+    else
+    {
+        slope = rise / float4(mu_s_b - mu_s_a);
+        curvature = float4(0.0);
+    }
 }
 #endif
 
@@ -490,26 +496,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _1780;
+    float4 _1779;
     if (has_a)
     {
-        _1780 = log(fast::max(a, dark));
+        _1779 = log(fast::max(a, dark));
     }
     else
     {
-        _1780 = (lb * 2.0) - lc;
+        _1779 = (lb * 2.0) - lc;
     }
-    float4 la = _1780;
-    float4 _1795;
+    float4 la = _1779;
+    float4 _1794;
     if (has_d)
     {
-        _1795 = log(fast::max(d, dark));
+        _1794 = log(fast::max(d, dark));
     }
     else
     {
-        _1795 = (lc * 2.0) - lb;
+        _1794 = (lc * 2.0) - lb;
     }
-    float4 ld = _1795;
+    float4 ld = _1794;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -573,28 +579,18 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     if (mu_s_t < 0.0)
     {
-        AtmosphereParameters param_26 = atmosphere;
-        float4 param_27 = uvwz;
-        float param_28 = 2.5 / mu_s_size;
-        float param_29 = nu_slice;
-        float param_30 = nu_t;
-        bool param_31 = (2.5 / mu_s_size) < x_low_sun;
-        float4 third = GetScatteringAtMuSColumn(param_26, scattering_texture, scattering_textureSmplr, param_27, param_28, param_29, param_30, param_31);
         float mu_s_min = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_32 = atmosphere;
-        float param_33 = 1.0 / (mu_s_size - 1.0);
-        AtmosphereParameters param_34 = atmosphere;
-        float param_35 = 2.0 / (mu_s_size - 1.0);
-        float4 param_36 = below;
-        float4 param_37 = above;
-        float4 param_38 = third;
-        float param_39 = GetScatteringMuSFromUnitRange(param_32, param_33) - mu_s_min;
-        float param_40 = GetScatteringMuSFromUnitRange(param_34, param_35) - mu_s_min;
-        float4 param_41;
-        float4 param_42;
-        LowestSunLogFall(param_36, param_37, param_38, param_39, param_40, param_41, param_42);
-        float4 slope = param_41;
-        float4 curvature = param_42;
+        AtmosphereParameters param_26 = atmosphere;
+        float param_27 = 1.0 / (mu_s_size - 1.0);
+        float4 param_28 = below;
+        float4 param_29 = above;
+        float param_30 = mu_s_min;
+        float param_31 = GetScatteringMuSFromUnitRange(param_26, param_27);
+        float4 param_32;
+        float4 param_33;
+        LowestSunLogFall(param_28, param_29, param_30, param_31, param_32, param_33);
+        float4 slope = param_32;
+        float4 curvature = param_33;
         float d = mu_s - mu_s_min;
         return below * exp((slope + (curvature * d)) * d);
     }
@@ -605,28 +601,28 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float column = (x_below * mu_s_size) - 0.5;
     float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
     float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_43 = atmosphere;
-    float4 param_44 = uvwz;
-    float param_45 = x_first;
-    float param_46 = nu_slice;
-    float param_47 = nu_t;
-    bool param_48 = true;
-    float4 first = GetScatteringAtMuSColumn(param_43, scattering_texture, scattering_textureSmplr, param_44, param_45, param_46, param_47, param_48);
-    AtmosphereParameters param_49 = atmosphere;
-    float4 param_50 = uvwz;
-    float param_51 = x_last;
-    float param_52 = nu_slice;
-    float param_53 = nu_t;
-    bool param_54 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_49, scattering_texture, scattering_textureSmplr, param_50, param_51, param_52, param_53, param_54);
-    float4 param_55 = first;
-    float4 param_56 = below;
-    float4 param_57 = above;
-    float4 param_58 = last;
-    bool param_59 = column > 0.5;
-    bool param_60 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_61 = mu_s_t;
-    return LogMonotoneCubicMix(param_55, param_56, param_57, param_58, param_59, param_60, param_61);
+    AtmosphereParameters param_34 = atmosphere;
+    float4 param_35 = uvwz;
+    float param_36 = x_first;
+    float param_37 = nu_slice;
+    float param_38 = nu_t;
+    bool param_39 = true;
+    float4 first = GetScatteringAtMuSColumn(param_34, scattering_texture, scattering_textureSmplr, param_35, param_36, param_37, param_38, param_39);
+    AtmosphereParameters param_40 = atmosphere;
+    float4 param_41 = uvwz;
+    float param_42 = x_last;
+    float param_43 = nu_slice;
+    float param_44 = nu_t;
+    bool param_45 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_40, scattering_texture, scattering_textureSmplr, param_41, param_42, param_43, param_44, param_45);
+    float4 param_46 = first;
+    float4 param_47 = below;
+    float4 param_48 = above;
+    float4 param_49 = last;
+    bool param_50 = column > 0.5;
+    bool param_51 = (column + 2.0) < (mu_s_size - 0.5);
+    float param_52 = mu_s_t;
+    return LogMonotoneCubicMix(param_46, param_47, param_48, param_49, param_50, param_51, param_52);
 }
 #endif
 
@@ -643,16 +639,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2406;
+        float3 _2366;
         if (scattering.x > 0.0)
         {
-            _2406 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _2366 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _2406 = float3(0.0);
+            _2366 = float3(0.0);
         }
-        single_mie_scattering = _2406;
+        single_mie_scattering = _2366;
     }
     else
     {
@@ -729,13 +725,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _2474 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2434 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2474)
+    if (!_2434)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -744,19 +740,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2494;
+    float3 _2454;
     if (ray_r_mu_intersects_ground)
     {
-        _2494 = float3(0.0);
+        _2454 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2494 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _2454 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _2494;
+    transmittance = _2454;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -764,9 +760,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2521 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2481 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2521;
+    float3 scattering = _2481;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -820,16 +816,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2615;
+    float _2575;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2615 = a * exp(f * log(b / a));
+        _2575 = a * exp(f * log(b / a));
     }
     else
     {
-        _2615 = mix(a, b, f);
+        _2575 = mix(a, b, f);
     }
-    return _2615;
+    return _2575;
 }
 #endif
 
@@ -908,16 +904,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2867;
+    float _2827;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2867 = 1.0 - (0.5 * depth);
+        _2827 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2867 = (1.0 - exp(-depth)) / depth;
+        _2827 = (1.0 - exp(-depth)) / depth;
     }
-    return _2867;
+    return _2827;
 }
 #endif
 
@@ -954,10 +950,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2947 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2907 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2947;
+        float3 extinction = _2907;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1016,10 +1012,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2812 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2772 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2812;
+        float3 extinction = _2772;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1094,14 +1090,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _2837;
+    float3 _2797;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2837 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2797 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1110,9 +1106,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2837 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _2797 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _2837;
+    return _2797;
 }
 #endif
 
@@ -1120,22 +1116,22 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _724;
+    float _723;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _723 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _723 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _724;
+    return _723;
 }
 #endif
 
@@ -1149,16 +1145,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2577;
+    float _2537;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2577 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2537 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2577 = up;
+        _2537 = up;
     }
-    return _2577;
+    return _2537;
 }
 #endif
 
@@ -1182,13 +1178,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _3093 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3053 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3093)
+    if (!_3053)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1228,11 +1224,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3188 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3148 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3188;
+        lit_optical_depth = _3148;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1246,11 +1242,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3222 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3182 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3222;
+        optical_depth += _3182;
     }
     if (direct < 1.0)
     {
@@ -1269,9 +1265,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3265 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3225 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3265;
+    float3 scattering = _3225;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1292,11 +1288,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3313 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3273 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3313;
+        float3 far_optical_depth = _3273;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1316,9 +1312,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3367 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3327 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3367);
+            scattering -= (exp(-far_optical_depth) * _3327);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1339,9 +1335,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3432 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3392 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3432;
+    float3 scattering_p = _3392;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1362,9 +1358,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3476 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _3436 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3476;
+    return _3436;
 }
 #endif
 
@@ -1372,16 +1368,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1375;
+    float _1374;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1375 = 0.100000001490116119384765625;
+        _1374 = 0.100000001490116119384765625;
     }
     else
     {
-        _1375 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1374 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1375;
+    return _1374;
 }
 #endif
 
@@ -1391,16 +1387,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1393;
+    float _1392;
     if (mu_s < knee)
     {
-        _1393 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1392 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1393 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1392 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1393;
+    return _1392;
 }
 #endif
 
@@ -1429,16 +1425,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1424;
+    float _1423;
     if (x < 0.5)
     {
-        _1424 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1423 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1424 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1423 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1424;
+    return _1423;
 }
 #endif
 
@@ -1451,16 +1447,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1719;
+    float4 _1718;
     if (t < 0.0)
     {
-        _1719 = fast::min(blend, a);
+        _1718 = fast::min(blend, a);
     }
     else
     {
-        _1719 = blend;
+        _1718 = blend;
     }
-    return _1719;
+    return _1718;
 }
 #endif
 

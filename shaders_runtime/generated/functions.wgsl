@@ -1507,55 +1507,54 @@ fn LogMonotoneCubicMix(a_10: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_16: ve
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, c_8: vec4<f32>, d_b: f32, d_c: f32, slope: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
+fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
     var a_13: vec4<f32>;
     var b_7: vec4<f32>;
-    var c_9: vec4<f32>;
-    var d_b_1: f32;
-    var d_c_1: f32;
+    var mu_s_a_1: f32;
+    var mu_s_b_1: f32;
     var dark_2: vec4<f32> = vec4(0.000000000000000000000000000001f);
-    var la_1: vec4<f32>;
-    var secant_b: vec4<f32>;
-    var secant_c: vec4<f32>;
-    var rises: vec4<f32>;
+    var rise: vec4<f32>;
+    var k_2: vec4<f32>;
 
     a_13 = a_12;
     b_7 = b_6;
-    c_9 = c_8;
-    d_b_1 = d_b;
-    d_c_1 = d_c;
-    let _e23 = a_13;
-    let _e24 = dark_2;
-    la_1 = log(max(_e23, _e24));
-    let _e28 = b_7;
-    let _e29 = dark_2;
-    let _e32 = la_1;
-    let _e34 = d_b_1;
-    secant_b = ((log(max(_e28, _e29)) - _e32) / vec4(_e34));
-    let _e38 = c_9;
-    let _e39 = dark_2;
-    let _e42 = la_1;
-    let _e44 = d_c_1;
-    secant_c = ((log(max(_e38, _e39)) - _e42) / vec4(_e44));
-    let _e48 = dark_2;
-    let _e49 = a_13;
-    let _e53 = b_7;
-    let _e54 = a_13;
-    rises = (step(_e48, _e49) * (vec4(1f) - step(_e53, _e54)));
-    let _e59 = rises;
-    let _e60 = dark_2;
-    let _e61 = c_9;
-    let _e64 = secant_c;
-    let _e65 = secant_b;
-    let _e67 = d_c_1;
-    let _e68 = d_b_1;
-    (*curvature) = ((_e59 * step(_e60, _e61)) * min(((_e64 - _e65) / vec4((_e67 - _e68))), vec4(0f)));
-    let _e76 = rises;
-    let _e77 = secant_b;
-    let _e78 = (*curvature);
-    let _e79 = d_b_1;
-    (*slope) = (_e76 * (_e77 - (_e78 * _e79)));
-    return;
+    mu_s_a_1 = mu_s_a;
+    mu_s_b_1 = mu_s_b;
+    let _e21 = b_7;
+    let _e22 = dark_2;
+    let _e25 = a_13;
+    let _e26 = dark_2;
+    let _e30 = dark_2;
+    let _e31 = a_13;
+    let _e36 = b_7;
+    let _e37 = a_13;
+    rise = (((log(max(_e21, _e22)) - log(max(_e25, _e26))) * step(_e30, _e31)) * (vec4(1f) - step(_e36, _e37)));
+    let _e42 = mu_s_b_1;
+    if (_e42 < 0f) {
+        {
+            let _e45 = rise;
+            let _e46 = mu_s_a_1;
+            let _e47 = mu_s_a_1;
+            let _e49 = mu_s_b_1;
+            let _e50 = mu_s_b_1;
+            k_2 = (_e45 / vec4(((_e46 * _e47) - (_e49 * _e50))));
+            let _e58 = mu_s_a_1;
+            let _e60 = k_2;
+            (*slope) = ((-2f * _e58) * _e60);
+            let _e62 = k_2;
+            (*curvature) = -(_e62);
+            return;
+        }
+    } else {
+        {
+            let _e64 = rise;
+            let _e65 = mu_s_b_1;
+            let _e66 = mu_s_a_1;
+            (*slope) = (_e64 / vec4((_e65 - _e66)));
+            (*curvature) = vec4(0f);
+            return;
+        }
+    }
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1615,7 +1614,6 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     var below: vec4<f32>;
     var above: vec4<f32>;
     var mu_s_size_1: f32;
-    var third: vec4<f32>;
     var mu_s_min: f32;
     var slope_1: vec4<f32>;
     var curvature_1: vec4<f32>;
@@ -1680,82 +1678,68 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     if (_e91 < 0f) {
         {
             let _e94 = atmosphere_57;
-            let _e95 = uvwz_2;
-            let _e97 = mu_s_size_1;
-            let _e99 = nu_slice_2;
-            let _e100 = nu_t_2;
-            let _e102 = mu_s_size_1;
-            let _e104 = x_low_sun;
-            let _e106 = GetScatteringAtMuSColumn(_e94, scattering_texture_1, _e95, (2.5f / _e97), _e99, _e100, ((2.5f / _e102) < _e104));
-            third = _e106;
-            let _e108 = atmosphere_57;
-            mu_s_min = _e108.scattering_mu_s_min;
-            let _e113 = below;
-            let _e114 = above;
-            let _e115 = third;
-            let _e116 = atmosphere_57;
-            let _e118 = mu_s_size_1;
-            let _e122 = GetScatteringMuSFromUnitRange(_e116, (1f / (_e118 - 1f)));
-            let _e123 = mu_s_min;
-            let _e125 = atmosphere_57;
-            let _e127 = mu_s_size_1;
-            let _e131 = GetScatteringMuSFromUnitRange(_e125, (2f / (_e127 - 1f)));
-            let _e132 = mu_s_min;
-            LowestSunLogFall(_e113, _e114, _e115, (_e122 - _e123), (_e131 - _e132), (&slope_1), (&curvature_1));
-            let _e138 = mu_s_18;
-            let _e139 = mu_s_min;
-            d_18 = (_e138 - _e139);
-            let _e142 = below;
-            let _e143 = d_18;
-            let _e144 = slope_1;
-            let _e145 = d_18;
-            let _e146 = curvature_1;
-            return (_e142 * exp((_e143 * (_e144 + (_e145 * _e146)))));
+            mu_s_min = _e94.scattering_mu_s_min;
+            let _e99 = below;
+            let _e100 = above;
+            let _e101 = mu_s_min;
+            let _e102 = atmosphere_57;
+            let _e104 = mu_s_size_1;
+            let _e108 = GetScatteringMuSFromUnitRange(_e102, (1f / (_e104 - 1f)));
+            LowestSunLogFall(_e99, _e100, _e101, _e108, (&slope_1), (&curvature_1));
+            let _e113 = mu_s_18;
+            let _e114 = mu_s_min;
+            d_18 = (_e113 - _e114);
+            let _e117 = below;
+            let _e118 = d_18;
+            let _e119 = slope_1;
+            let _e120 = d_18;
+            let _e121 = curvature_1;
+            return (_e117 * exp((_e118 * (_e119 + (_e120 * _e121)))));
         }
     }
-    let _e152 = low_sun_below_1;
-    if !(_e152) {
-        let _e154 = below;
-        let _e155 = above;
-        let _e156 = mu_s_t_1;
-        return mix(_e154, _e155, vec4(_e156));
+    let _e127 = low_sun_below_1;
+    if !(_e127) {
+        let _e129 = below;
+        let _e130 = above;
+        let _e131 = mu_s_t_1;
+        return mix(_e129, _e130, vec4(_e131));
     }
-    let _e159 = x_below_1;
-    let _e160 = mu_s_size_1;
-    column = ((_e159 * _e160) - 0.5f);
-    let _e165 = column;
-    let _e172 = mu_s_size_1;
-    x_first = ((max((_e165 - 1f), 0f) + 0.5f) / _e172);
-    let _e175 = column;
-    let _e178 = mu_s_size_1;
-    let _e184 = mu_s_size_1;
-    x_last = ((min((_e175 + 2f), (_e178 - 1f)) + 0.5f) / _e184);
-    let _e187 = atmosphere_57;
-    let _e188 = uvwz_2;
-    let _e189 = x_first;
-    let _e190 = nu_slice_2;
-    let _e191 = nu_t_2;
-    let _e193 = GetScatteringAtMuSColumn(_e187, scattering_texture_1, _e188, _e189, _e190, _e191, true);
-    first = _e193;
-    let _e195 = atmosphere_57;
-    let _e196 = uvwz_2;
-    let _e197 = x_last;
-    let _e198 = nu_slice_2;
-    let _e199 = nu_t_2;
-    let _e200 = x_last;
-    let _e201 = x_low_sun;
-    let _e203 = GetScatteringAtMuSColumn(_e195, scattering_texture_1, _e196, _e197, _e198, _e199, (_e200 < _e201));
-    last = _e203;
-    let _e205 = first;
-    let _e206 = below;
-    let _e207 = above;
-    let _e208 = last;
-    let _e209 = column;
-    let _e212 = column;
-    let _e215 = mu_s_size_1;
-    let _e219 = mu_s_t_1;
-    let _e220 = LogMonotoneCubicMix(_e205, _e206, _e207, _e208, (_e209 > 0.5f), ((_e212 + 2f) < (_e215 - 0.5f)), _e219);
-    return _e220;
+    let _e134 = x_below_1;
+    let _e135 = mu_s_size_1;
+    column = ((_e134 * _e135) - 0.5f);
+    let _e140 = column;
+    let _e147 = mu_s_size_1;
+    x_first = ((max((_e140 - 1f), 0f) + 0.5f) / _e147);
+    let _e150 = column;
+    let _e153 = mu_s_size_1;
+    let _e159 = mu_s_size_1;
+    x_last = ((min((_e150 + 2f), (_e153 - 1f)) + 0.5f) / _e159);
+    let _e162 = atmosphere_57;
+    let _e163 = uvwz_2;
+    let _e164 = x_first;
+    let _e165 = nu_slice_2;
+    let _e166 = nu_t_2;
+    let _e168 = GetScatteringAtMuSColumn(_e162, scattering_texture_1, _e163, _e164, _e165, _e166, true);
+    first = _e168;
+    let _e170 = atmosphere_57;
+    let _e171 = uvwz_2;
+    let _e172 = x_last;
+    let _e173 = nu_slice_2;
+    let _e174 = nu_t_2;
+    let _e175 = x_last;
+    let _e176 = x_low_sun;
+    let _e178 = GetScatteringAtMuSColumn(_e170, scattering_texture_1, _e171, _e172, _e173, _e174, (_e175 < _e176));
+    last = _e178;
+    let _e180 = first;
+    let _e181 = below;
+    let _e182 = above;
+    let _e183 = last;
+    let _e184 = column;
+    let _e187 = column;
+    let _e190 = mu_s_size_1;
+    let _e194 = mu_s_t_1;
+    let _e195 = LogMonotoneCubicMix(_e180, _e181, _e182, _e183, (_e184 > 0.5f), ((_e187 + 2f) < (_e190 - 0.5f)), _e194);
+    return _e195;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -2173,7 +2157,7 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
-    var k_2: i32 = 0i;
+    var k_3: i32 = 0i;
     var t_11: f32;
     var r_t_2: f32;
     var mie_scattering_1: vec3<f32>;
@@ -2187,13 +2171,13 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
     let _e18 = d_20;
     dt = (_e18 / 16f);
     loop {
-        let _e31 = k_2;
+        let _e31 = k_3;
         if !((_e31 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
             let _e37 = dt;
-            let _e38 = k_2;
+            let _e38 = k_3;
             t_11 = (_e37 * f32(_e38));
             let _e42 = atmosphere_75;
             let _e43 = r_54;
@@ -2210,7 +2194,7 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
             let _e56 = AltitudeAtDistance(_e51, _e52, _e53, _e54, _e55);
             let _e61 = GetCoefficientsAtAltitude(_e50, _e56, (&mie_scattering_1), (&rayleigh_scattering_1));
             extinction = _e61;
-            let _e63 = k_2;
+            let _e63 = k_3;
             if (_e63 > 0i) {
                 let _e66 = optical_depth;
                 let _e67 = previous_extinction;
@@ -2222,8 +2206,8 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
             previous_extinction = _e75;
         }
         continuing {
-            let _e34 = k_2;
-            k_2 = (_e34 + 1i);
+            let _e34 = k_3;
+            k_3 = (_e34 + 1i);
         }
     }
     let _e76 = optical_depth;
@@ -2298,7 +2282,7 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
     var previous_rayleigh: vec3<f32> = vec3(0f);
     var previous_mie: vec3<f32> = vec3(0f);
     var previous_scattering: vec3<f32> = vec3(0f);
-    var k_3: i32 = 0i;
+    var k_4: i32 = 0i;
     var t_12: f32;
     var r_t_3: f32;
     var altitude_2: f32;
@@ -2326,13 +2310,13 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
     (*single_mie) = vec3(0f);
     (*scattering_weight) = vec3(0f);
     loop {
-        let _e54 = k_3;
+        let _e54 = k_4;
         if !((_e54 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
             let _e60 = dt_1;
-            let _e61 = k_3;
+            let _e61 = k_4;
             t_12 = (_e60 * f32(_e61));
             let _e65 = atmosphere_79;
             let _e66 = r_58;
@@ -2376,7 +2360,7 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
             let _e119 = rayleigh_scattering_2;
             let _e120 = mie_scattering_2;
             scattering_2 = (_e119 + _e120);
-            let _e123 = k_3;
+            let _e123 = k_4;
             if (_e123 > 0i) {
                 {
                     let _e126 = previous_extinction_1;
@@ -2426,8 +2410,8 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
             previous_scattering = _e190;
         }
         continuing {
-            let _e57 = k_3;
-            k_3 = (_e57 + 1i);
+            let _e57 = k_4;
+            k_4 = (_e57 + 1i);
         }
     }
     let _e191 = (*single_rayleigh);
