@@ -131,7 +131,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // grid: the texture's r and mu interpolation, done once per sample.
     std::vector<int> samples;  // those with a non-zero weight
     std::vector<std::size_t> fall_rows;  // per sample, MuSFall's row nearest it
-    std::vector<std::size_t> lowest_rows;  // and that row's offset in lowest_log_ratio
+    std::vector<std::size_t> lowest_rows;  // and that row's offset in lowest_log_slope and _curvature
     std::vector<float> planes;
     planes.reserve(std::size_t(n + 1) * 4 * plane_width);
     for (int k = 0; k <= n; ++k) {

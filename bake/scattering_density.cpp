@@ -65,7 +65,8 @@ Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r,
   const vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(grid, r, mu, mu_s, 0.0, intersects_ground);
   double x_below, x_above, mu_s_t;
   bool low_sun;
-  glsl::GetScatteringMuSColumns(grid, uvwz.y, x_below, x_above, mu_s_t, low_sun);
+  glsl::GetScatteringMuSColumns(grid, uvwz.y, glsl::GetScatteringTextureUMuS(grid, glsl::LOW_SUN_MU_S), x_below,
+                                x_above, mu_s_t, low_sun);
   if (low_sun && std::abs(mu_s_t) > 1e-9 && std::abs(1.0 - mu_s_t) > 1e-9) {
     throw InternalError("IncidentAlongNu: a low sun between two mu_s columns of the scattering grid");
   }

@@ -405,15 +405,18 @@ vec4 SunBelowTableMix(vec4 a, vec4 b, Number t, bool low_sun) {
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 // The two scattering-table mu_s texel columns a lookup at unit mu_s u_mu_s
 // blends: their x coordinates within a nu slice, the position between them
-// (SunCosinePosition) and whether the lower one is a low sun.
-void GetScatteringMuSColumns(IN(AtmosphereParameters) atmosphere, Number u_mu_s, OUT(Number) x_below,
-                             OUT(Number) x_above, OUT(Number) mu_s_t, OUT(bool) low_sun_below) {
+// (SunCosinePosition) and whether the lower one is a low sun, that is below
+// x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S), which the
+// caller computes once.
+void GetScatteringMuSColumns(IN(AtmosphereParameters) atmosphere, Number u_mu_s, Number x_low_sun,
+                             OUT(Number) x_below, OUT(Number) x_above, OUT(Number) mu_s_t,
+                             OUT(bool) low_sun_below) {
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
   Number mu_s_coord = u_mu_s * mu_s_size - 0.5;
   Number mu_s_column = clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
   x_below = (mu_s_column + 0.5) / mu_s_size;
   x_above = (mu_s_column + 1.5) / mu_s_size;
-  low_sun_below = x_below < GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
+  low_sun_below = x_below < x_low_sun;
   mu_s_t = SunCosinePosition(mu_s_coord - mu_s_column, low_sun_below);
 }
 
@@ -505,8 +508,8 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   Number x_above;
   Number mu_s_t;
   bool low_sun_below;
-  GetScatteringMuSColumns(atmosphere, uvwz.y, x_below, x_above, mu_s_t, low_sun_below);
   Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
+  GetScatteringMuSColumns(atmosphere, uvwz.y, x_low_sun, x_below, x_above, mu_s_t, low_sun_below);
   vec4 below =
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, low_sun_below);
   vec4 above =

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _844 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_844)
+    if (!_845)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _707 = mu < 0.0;
-    bool _719;
-    if (_707)
+    bool _708 = mu < 0.0;
+    bool _720;
+    if (_708)
     {
-        _719 = (((r * r) * mu) * mu) >= c;
+        _720 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _719 = _707;
+        _720 = _708;
     }
-    return _719;
+    return _720;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _477;
+    float _478;
     if (r_mu > 0.0)
     {
-        _477 = c / (r_mu + s);
+        _478 = c / (r_mu + s);
     }
     else
     {
-        _477 = s - r_mu;
+        _478 = s - r_mu;
     }
-    float param_1 = _477;
+    float param_1 = _478;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _936;
+    float _937;
     if (d_max > d_min)
     {
-        _936 = (d - d_min) / (d_max - d_min);
+        _937 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _936 = 0.0;
+        _937 = 0.0;
     }
-    float x_mu = _936;
+    float x_mu = _937;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -323,16 +323,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1276;
+        float _1277;
         if (d_max == d_min)
         {
-            _1276 = 0.0;
+            _1277 = 0.0;
         }
         else
         {
-            _1276 = (d - d_min) / (d_max - d_min);
+            _1277 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1276;
+        x_mu = _1277;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +343,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1320;
+        float _1321;
         if (d_max_1 > d_min_1)
         {
-            _1320 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1320 = 0.0;
+            _1321 = 0.0;
         }
-        x_mu = _1320;
+        x_mu = _1321;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,33 +372,31 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1695;
+    float _1696;
     if (low_sun)
     {
-        _1695 = fast::min(t, 1.0);
+        _1696 = fast::min(t, 1.0);
     }
     else
     {
-        _1695 = fast::clamp(t, 0.0, 1.0);
+        _1696 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1695;
+    return _1696;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thread const float& u_mu_s, thread float& x_below, thread float& x_above, thread float& mu_s_t, thread bool& low_sun_below)
+void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thread const float& u_mu_s, thread const float& x_low_sun, thread float& x_below, thread float& x_above, thread float& mu_s_t, thread bool& low_sun_below)
 {
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float mu_s_coord = (u_mu_s * mu_s_size) - 0.5;
     float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
     x_below = (mu_s_column + 0.5) / mu_s_size;
     x_above = (mu_s_column + 1.5) / mu_s_size;
-    AtmosphereParameters param = atmosphere;
-    float param_1 = 0.100000001490116119384765625;
-    low_sun_below = x_below < GetScatteringTextureUMuS(param, param_1);
-    float param_2 = mu_s_coord - mu_s_column;
-    bool param_3 = low_sun_below;
-    mu_s_t = SunCosinePosition(param_2, param_3);
+    low_sun_below = x_below < x_low_sun;
+    float param = mu_s_coord - mu_s_column;
+    bool param_1 = low_sun_below;
+    mu_s_t = SunCosinePosition(param, param_1);
 }
 #endif
 
@@ -455,17 +453,17 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_7 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1083;
+    float _1084;
     if (d == 0.0)
     {
-        _1083 = 1.0;
+        _1084 = 1.0;
     }
     else
     {
         float param_8 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1083 = ClampCosine(param_8);
+        _1084 = ClampCosine(param_8);
     }
-    return _1083;
+    return _1084;
 }
 #endif
 
@@ -496,26 +494,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _1779;
+    float4 _1777;
     if (has_a)
     {
-        _1779 = log(fast::max(a, dark));
+        _1777 = log(fast::max(a, dark));
     }
     else
     {
-        _1779 = (lb * 2.0) - lc;
+        _1777 = (lb * 2.0) - lc;
     }
-    float4 la = _1779;
-    float4 _1794;
+    float4 la = _1777;
+    float4 _1792;
     if (has_d)
     {
-        _1794 = log(fast::max(d, dark));
+        _1792 = log(fast::max(d, dark));
     }
     else
     {
-        _1794 = (lc * 2.0) - lb;
+        _1792 = (lc * 2.0) - lb;
     }
-    float4 ld = _1794;
+    float4 ld = _1792;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -549,48 +547,49 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
     float nu_t = nu_coord - nu_slice;
     AtmosphereParameters param_6 = atmosphere;
-    float param_7 = uvwz.y;
-    float param_8;
-    float param_9;
-    float param_10;
-    bool param_11;
-    GetScatteringMuSColumns(param_6, param_7, param_8, param_9, param_10, param_11);
-    float x_below = param_8;
-    float x_above = param_9;
-    float mu_s_t = param_10;
-    bool low_sun_below = param_11;
-    AtmosphereParameters param_12 = atmosphere;
-    float param_13 = 0.100000001490116119384765625;
-    float x_low_sun = GetScatteringTextureUMuS(param_12, param_13);
-    AtmosphereParameters param_14 = atmosphere;
-    float4 param_15 = uvwz;
-    float param_16 = x_below;
-    float param_17 = nu_slice;
-    float param_18 = nu_t;
-    bool param_19 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_14, scattering_texture, scattering_textureSmplr, param_15, param_16, param_17, param_18, param_19);
-    AtmosphereParameters param_20 = atmosphere;
-    float4 param_21 = uvwz;
-    float param_22 = x_above;
-    float param_23 = nu_slice;
-    float param_24 = nu_t;
-    bool param_25 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_20, scattering_texture, scattering_textureSmplr, param_21, param_22, param_23, param_24, param_25);
+    float param_7 = 0.100000001490116119384765625;
+    float x_low_sun = GetScatteringTextureUMuS(param_6, param_7);
+    AtmosphereParameters param_8 = atmosphere;
+    float param_9 = uvwz.y;
+    float param_10 = x_low_sun;
+    float param_11;
+    float param_12;
+    float param_13;
+    bool param_14;
+    GetScatteringMuSColumns(param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+    float x_below = param_11;
+    float x_above = param_12;
+    float mu_s_t = param_13;
+    bool low_sun_below = param_14;
+    AtmosphereParameters param_15 = atmosphere;
+    float4 param_16 = uvwz;
+    float param_17 = x_below;
+    float param_18 = nu_slice;
+    float param_19 = nu_t;
+    bool param_20 = low_sun_below;
+    float4 below = GetScatteringAtMuSColumn(param_15, scattering_texture, scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20);
+    AtmosphereParameters param_21 = atmosphere;
+    float4 param_22 = uvwz;
+    float param_23 = x_above;
+    float param_24 = nu_slice;
+    float param_25 = nu_t;
+    bool param_26 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_21, scattering_texture, scattering_textureSmplr, param_22, param_23, param_24, param_25, param_26);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     if (mu_s_t < 0.0)
     {
         float mu_s_min = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_26 = atmosphere;
-        float param_27 = 1.0 / (mu_s_size - 1.0);
-        float4 param_28 = below;
-        float4 param_29 = above;
-        float param_30 = mu_s_min;
-        float param_31 = GetScatteringMuSFromUnitRange(param_26, param_27);
-        float4 param_32;
+        AtmosphereParameters param_27 = atmosphere;
+        float param_28 = 1.0 / (mu_s_size - 1.0);
+        float4 param_29 = below;
+        float4 param_30 = above;
+        float param_31 = mu_s_min;
+        float param_32 = GetScatteringMuSFromUnitRange(param_27, param_28);
         float4 param_33;
-        LowestSunLogFall(param_28, param_29, param_30, param_31, param_32, param_33);
-        float4 slope = param_32;
-        float4 curvature = param_33;
+        float4 param_34;
+        LowestSunLogFall(param_29, param_30, param_31, param_32, param_33, param_34);
+        float4 slope = param_33;
+        float4 curvature = param_34;
         float d = mu_s - mu_s_min;
         return below * exp((slope + (curvature * d)) * d);
     }
@@ -601,28 +600,28 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float column = (x_below * mu_s_size) - 0.5;
     float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
     float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_34 = atmosphere;
-    float4 param_35 = uvwz;
-    float param_36 = x_first;
-    float param_37 = nu_slice;
-    float param_38 = nu_t;
-    bool param_39 = true;
-    float4 first = GetScatteringAtMuSColumn(param_34, scattering_texture, scattering_textureSmplr, param_35, param_36, param_37, param_38, param_39);
-    AtmosphereParameters param_40 = atmosphere;
-    float4 param_41 = uvwz;
-    float param_42 = x_last;
-    float param_43 = nu_slice;
-    float param_44 = nu_t;
-    bool param_45 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_40, scattering_texture, scattering_textureSmplr, param_41, param_42, param_43, param_44, param_45);
-    float4 param_46 = first;
-    float4 param_47 = below;
-    float4 param_48 = above;
-    float4 param_49 = last;
-    bool param_50 = column > 0.5;
-    bool param_51 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_52 = mu_s_t;
-    return LogMonotoneCubicMix(param_46, param_47, param_48, param_49, param_50, param_51, param_52);
+    AtmosphereParameters param_35 = atmosphere;
+    float4 param_36 = uvwz;
+    float param_37 = x_first;
+    float param_38 = nu_slice;
+    float param_39 = nu_t;
+    bool param_40 = true;
+    float4 first = GetScatteringAtMuSColumn(param_35, scattering_texture, scattering_textureSmplr, param_36, param_37, param_38, param_39, param_40);
+    AtmosphereParameters param_41 = atmosphere;
+    float4 param_42 = uvwz;
+    float param_43 = x_last;
+    float param_44 = nu_slice;
+    float param_45 = nu_t;
+    bool param_46 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_41, scattering_texture, scattering_textureSmplr, param_42, param_43, param_44, param_45, param_46);
+    float4 param_47 = first;
+    float4 param_48 = below;
+    float4 param_49 = above;
+    float4 param_50 = last;
+    bool param_51 = column > 0.5;
+    bool param_52 = (column + 2.0) < (mu_s_size - 0.5);
+    float param_53 = mu_s_t;
+    return LogMonotoneCubicMix(param_47, param_48, param_49, param_50, param_51, param_52, param_53);
 }
 #endif
 
@@ -1116,22 +1115,22 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _723;
+    float _724;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _723 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _723 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _723;
+    return _724;
 }
 #endif
 
@@ -1368,16 +1367,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1374;
+    float _1375;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1374 = 0.100000001490116119384765625;
+        _1375 = 0.100000001490116119384765625;
     }
     else
     {
-        _1374 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1375 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1374;
+    return _1375;
 }
 #endif
 
@@ -1387,16 +1386,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1392;
+    float _1393;
     if (mu_s < knee)
     {
-        _1392 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1393 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1392 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1393 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1392;
+    return _1393;
 }
 #endif
 
@@ -1425,16 +1424,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1423;
+    float _1424;
     if (x < 0.5)
     {
-        _1423 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1424 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1423 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1424 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1423;
+    return _1424;
 }
 #endif
 
@@ -1447,16 +1446,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1718;
+    float4 _1719;
     if (t < 0.0)
     {
-        _1718 = fast::min(blend, a);
+        _1719 = fast::min(blend, a);
     }
     else
     {
-        _1718 = blend;
+        _1719 = blend;
     }
-    return _1718;
+    return _1719;
 }
 #endif
 
