@@ -371,6 +371,45 @@ std::vector<report::GroupErrors> DefaultEarthErrors(const std::string& file, dou
                                [&](const report::ReferenceCase& c) { return report::EvaluateTwin(twin, c); });
 }
 
+// Deep in the Earth's shadow a point's light comes from within a few
+// degrees above its horizon toward the sun, where it peaks steeply; the
+// scattering density's sphere rule resolves that band with its own nodes
+// (AppendSkyRule in bake/scattering_density.cpp). The second order, seen
+// from 100 km through the limb away from the sun at sun 98-100 degrees
+// (rays that run to where the sun is 15 degrees lower), with the default
+// rule against four times its polar and azimuthal nodes: with a quarter of
+// the polar nodes in the band the default read 440 nm 16 % high and 550 nm
+// 10 % low there, with half of them within 1.3 % (docs/accuracy.md,
+// "Twilight: the horizon band of the sphere's rule"). Bound: 3 %.
+TEST(Twilight, SecondOrderDeepInTheShadowConvergedInTheSphereRule) {
+  auto second_order = [](int sphere_samples) {
+    BakeSettings s;
+    s.orders = 2;
+    s.extrapolate_tail = false;
+    s.sphere_samples = sphere_samples;
+    return Bake(testing::Earth(), s);
+  };
+  const LutSet default_rule = second_order(BakeSettings{}.sphere_samples);
+  const LutSet fine_rule = second_order(4 * BakeSettings{}.sphere_samples);
+  const Twin default_twin(MakeTwinTables(default_rule)), fine_twin(MakeTwinTables(fine_rule));
+  for (double view_zenith : {99.0, 102.0}) {
+    for (double sun_zenith : {98.0, 100.0}) {
+      report::ReferenceCase c;
+      c.query.altitude_m = 100000.0, c.query.view_zenith_deg = view_zenith;
+      c.query.sun_zenith_deg = sun_zenith, c.query.view_sun_azimuth_deg = 180.0;
+      const glm::dvec3 coarse = report::EvaluateTwin(default_twin, c).radiance;
+      const glm::dvec3 fine = report::EvaluateTwin(fine_twin, c).radiance;
+      for (int channel = 0; channel < 3; ++channel) {
+        ASSERT_GT(fine[channel], 0.0);
+        const double difference = coarse[channel] / fine[channel] - 1.0;
+        std::printf("view %g, sun %g, channel %d: default rule %+.2f %% from four times its nodes\n", view_zenith,
+                    sun_zenith, channel, 100.0 * difference);
+        EXPECT_LT(std::abs(difference), 0.03) << "view " << view_zenith << " sun " << sun_zenith << " channel " << channel;
+      }
+    }
+  }
+}
+
 // The default tables after sunset against the twilight case sets'
 // references (reference/cases/earth_twilight_reference.csv, whole degrees,
 // standard errors up to 1 % to sun 100 degrees, 3 % at 101-102; and
@@ -386,9 +425,11 @@ std::vector<report::GroupErrors> DefaultEarthErrors(const std::string& file, dou
 // the horizon (SCATTERING_MU_S_HIGH_SUN_SHARE 1/2 instead of 1), 2.15 %,
 // 6.88 % and 22.6 %, and 1.08 %, 2.29 % and 1.99 %; with J and the sky
 // below the lowest sun continued by the Earth's shadow's parabola from two
-// columns instead of a parabola through three, 2.14 %, 5.51 % and 12.6 %
-// (docs/accuracy.md). The bounds sit between the last two for the groups
-// that changed, else between the two before; the aim is 5 %.
+// columns instead of a parabola through three, 2.14 %, 5.51 % and 12.6 %;
+// with half instead of a quarter of the scattering density's polar nodes
+// in its horizon band, 2.05 %, 4.27 % and 9.62 %, and 1.08 %, 2.26 % and
+// 2.22 % (docs/accuracy.md). The bounds sit between the last two for the
+// groups that changed, else between the two before; the aim is 5 %.
 TEST(Twilight, SkyAfterSunsetAgainstTheReference) {
   struct Bound {
     const char* file;
@@ -396,8 +437,8 @@ TEST(Twilight, SkyAfterSunsetAgainstTheReference) {
     double rms;
   };
   for (const Bound& bound : {Bound{"earth_twilight_reference.csv", "twilight_sky_sun_91-96", 0.05},
-                             Bound{"earth_twilight_reference.csv", "twilight_sky_sun_97-100", 0.062},
-                             Bound{"earth_twilight_reference.csv", "twilight_sky_sun_101-102", 0.18},
+                             Bound{"earth_twilight_reference.csv", "twilight_sky_sun_97-100", 0.05},
+                             Bound{"earth_twilight_reference.csv", "twilight_sky_sun_101-102", 0.11},
                              Bound{"earth_twilight_between_reference.csv", "twilight_between_sun_90-93", 0.013},
                              Bound{"earth_twilight_between_reference.csv", "twilight_between_sun_94-96", 0.027},
                              Bound{"earth_twilight_between_reference.csv", "twilight_between_sun_97-99", 0.045}}) {
@@ -412,6 +453,47 @@ TEST(Twilight, SkyAfterSunsetAgainstTheReference) {
     std::printf("%s: RMS relative error %.3g over %d values\n", bound.group, rms, count);
     EXPECT_LT(rms, bound.rms) << bound.group;
   }
+}
+
+// The twilight case set's sky after sunset (reference/cases/
+// earth_twilight_reference.csv, groups sun 88-90, 91-96 and 97-100
+// degrees) against the targets of the twilight work: luminance RMS 3 % and
+// max 10 %, every channel RMS 5 %. Before the scattering density's horizon
+// band had half of its polar nodes, 440 nm read 5.08 % RMS there; after,
+// luminance 2.39 % / 15.9 %, channels 2.60 / 2.63 / 3.02 % (docs/accuracy.md).
+// The max is not met: the camera at 100 km looking through the limb away
+// from the sun at sun 100 degrees reads +9.5 / +14.4 / +23.9 %, its second
+// order with the sphere rule converged +8 / +19 / +30 %, and with eight
+// times the scattering texels (mu doubled, mu_s quadrupled, nu
+// doubled) -1 / +6 / +13 %: the table's resolution. Its bound holds
+// today's figure.
+TEST(Twilight, TwilightSetWithinItsTargets) {
+  const std::vector<report::GroupErrors> errors = DefaultEarthErrors("earth_twilight_reference.csv", 100.0);
+  report::ErrorStats luminance;
+  report::ErrorStats channels[3];
+  // Pooled over the groups: counts add, squares of the RMS weighted by count.
+  auto pool = [](report::ErrorStats& total, const report::ErrorStats& group) {
+    const int count = total.count + group.count;
+    if (count == 0) return;
+    total.rms_relative = std::sqrt((total.count * total.rms_relative * total.rms_relative +
+                                    group.count * group.rms_relative * group.rms_relative) /
+                                   count);
+    total.max_relative = std::max(total.max_relative, group.max_relative);
+    total.count = count;
+  };
+  for (const char* group : {"twilight_sky_sun_88-90", "twilight_sky_sun_91-96", "twilight_sky_sun_97-100"}) {
+    const report::GroupErrors& e = report::FindGroup(errors, group);
+    pool(luminance, e.luminance);
+    for (int c = 0; c < 3; ++c) pool(channels[c], e.channel[c]);
+  }
+  std::printf("twilight set, sky to sun 100 deg: luminance RMS %.3g max %.3g over %d cases; channels RMS %.3g %.3g "
+              "%.3g\n",
+              luminance.rms_relative, luminance.max_relative, luminance.count, channels[0].rms_relative,
+              channels[1].rms_relative, channels[2].rms_relative);
+  EXPECT_GT(luminance.count, 150);
+  EXPECT_LT(luminance.rms_relative, 0.03);
+  EXPECT_LT(luminance.max_relative, 0.18);
+  for (const report::ErrorStats& channel : channels) EXPECT_LT(channel.rms_relative, 0.05);
 }
 
 // The report's twilight group (reference/cases/earth_reference.csv, sun 84
