@@ -28,6 +28,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,12 +69,47 @@ class Baker {
   // directions; `transmittance`: the transmittance table's channels.
   void SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
                                 const ChannelPlanes& transmittance, SingleScattering& out) const;
+  // Per sun direction of a ray, its single scattering before the solar
+  // irradiance: sums[0] the scattering table's (every group but the Mie
+  // group, over the Rayleigh phase), sums[1] the single Mie table's (phase
+  // free); per channel.
+  struct RaySingleScattering {
+    std::vector<float> sums[2][3];
+  };
+  // Single scattering along `ray` for the sun directions (mu_s[j], nu[j]).
+  RaySingleScattering SingleScatteringOfRay(const RaySamples& ray, const std::vector<double>& mu_s,
+                                            const std::vector<double>& nu, const ChannelPlanes& transmittance) const;
   // Single scattering over interval k of a ray for one sun direction, in
   // double, for the intervals SingleScatteringAlongRay does not vectorise:
   // optically thick, partly shadowed or crossed by the shadow edge.
   // phase_ratio: per group, its phase over the Rayleigh phase at nu.
   void SingleScatteringInterval(const RaySamples& ray, int k, double mu_s, double nu, const double* phase_ratio,
                                 Spectrum& rayleigh_sum, Spectrum& mie_sum) const;
+  // The scattering density of the second order and the first order's sky
+  // irradiance read the light arriving at a point from single scattering.
+  // For a low sun that light peaks sharply toward the sun's azimuth near the
+  // horizon, where the single-scattering table's nu slices are about 40
+  // degrees of azimuth apart and its linear blend between them reads the
+  // peak tens of percent high; so at the low-sun columns (mu_s <
+  // LOW_SUN_MU_S), for the azimuths within 90 degrees of the sun's, it is
+  // integrated along each ring's own ray instead. Per (radius, ring), the
+  // sums of SingleScatteringOfRay for the directions j * sunward_azimuths +
+  // m: sun column j, azimuth index m from the sun's (the light is symmetric
+  // about the sun's plane, so the mirror azimuths share them).
+  struct RingSingleScattering {
+    int columns = 0, rings = 0, azimuths = 0, sunward_azimuths = 0;
+    std::vector<RaySingleScattering> of_ring;
+  };
+  // For rings of zenith cosines ring_cosines[i] (as many for every radius)
+  // at radii[i], the sun at each of sun_mu_s, `azimuths` around each ring.
+  RingSingleScattering SingleScatteringOnRings(const std::vector<double>& radii,
+                                               const std::vector<std::vector<double>>& ring_cosines,
+                                               const std::vector<double>& sun_mu_s, int azimuths) const;
+  // The single scattering arriving along `ring` at radius index `radius`
+  // from azimuth index m (whose nu is `nu`) with the sun at `column`, with
+  // its phase and the solar irradiance; none where it was not integrated.
+  std::optional<vec3> RingIncident(const RingSingleScattering& rings, int radius, int ring, int column, int m,
+                                   double nu) const;
   void ComputeScatteringDensity(int order);
   void ComputeIndirectIrradiance(int order);
   // How J falls along mu_s, read by GatherAlongRays. With
@@ -142,6 +178,8 @@ class Baker {
 
   // The ray of a scattering texel row, sampled at n + 1 points.
   RaySamples SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const;
+  // The ray from radius r in direction mu, sampled at n + 1 points.
+  RaySamples SampleRay(double r, double mu, bool intersects_ground, int n) const;
   // The table holds single Rayleigh scattering phase free and the higher
   // orders divided by the Rayleigh phase, which the runtime multiplies back
   // with the query's nu. The division uses the nu of the texel's slice, not

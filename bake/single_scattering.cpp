@@ -22,9 +22,13 @@ namespace skybake::detail {
 constexpr int kShadowEdgeSubdivisions = 8;
 
 RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const {
-  RaySamples ray;
   const ScatteringTexel texel = GetScatteringTexel(grid, 0, mu_index, r_index);
-  ray.r = texel.r, ray.mu = texel.mu, ray.intersects_ground = texel.ray_intersects_ground;
+  return SampleRay(texel.r, texel.mu, texel.ray_intersects_ground, n);
+}
+
+RaySamples Baker::SampleRay(double r, double mu, bool intersects_ground, int n) const {
+  RaySamples ray;
+  ray.r = r, ray.mu = mu, ray.intersects_ground = intersects_ground;
   double d = glsl::DistanceToNearestAtmosphereBoundary(params_, ray.r, ray.mu, ray.intersects_ground);
   const int constituents = medium_.constituent_count();
   const int groups = static_cast<int>(medium_.groups().size());
@@ -67,11 +71,25 @@ Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameter
 
 void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
                                      const ChannelPlanes& transmittance, SingleScattering& out) const {
-  const int groups = static_cast<int>(medium_.groups().size());
-  const int mie = medium_.mie_group();
   const RaySamples ray = SampleRay(grid, y, z, n);
   const SunDirections directions = RaySunDirections(columns, ray.mu);
-  const int count = static_cast<int>(directions.mu_s.size());
+  const RaySingleScattering single = SingleScatteringOfRay(ray, directions.mu_s, directions.nu, transmittance);
+  const auto& sums = single.sums;
+  for (int x = 0; x < int(directions.of_texel.size()); ++x) {
+    const int j = directions.of_texel[x];
+    const vec3 rayleigh(sums[0][0][j], sums[0][1][j], sums[0][2][j]), mie_sum(sums[1][0][j], sums[1][1][j], sums[1][2][j]);
+    out.rayleigh.Store(x, y, z, vec4(rayleigh * params_.solar_irradiance, 0.0));
+    out.mie.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
+  }
+}
+
+Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, const std::vector<double>& sun_mu_s,
+                                                        const std::vector<double>& sun_nu,
+                                                        const ChannelPlanes& transmittance) const {
+  const int groups = static_cast<int>(medium_.groups().size());
+  const int mie = medium_.mie_group();
+  const int n = static_cast<int>(ray.t.size()) - 1;
+  const int count = static_cast<int>(sun_mu_s.size());
 
   // Per group, channel and sample, the factors shared by all directions:
   // the scattering coefficient times the view's transmittance, and the log
@@ -105,7 +123,7 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
   for (int g = 0; g < groups; ++g) {
     if (g == mie) continue;
     for (int j = 0; j < count; ++j) {
-      const double nu = directions.nu[j];
+      const double nu = sun_nu[j];
       phase_ratio_double[j][g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
       phase_ratio[g][j] = float(phase_ratio_double[j][g]);
     }
@@ -129,11 +147,12 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
     std::vector<float> sun_start[3], sun_end[3];
   } pieces;
   std::vector<float> piece_base(std::size_t(n) * groups * 3 * (kShadowEdgeSubdivisions + 1));
-  std::vector<float> sums[2][3];  // [0: Rayleigh table, 1: Mie table][channel]
+  RaySingleScattering result;
+  auto& sums = result.sums;
   for (auto& kind : sums) {
     for (auto& channel : kind) channel.assign(count, 0.0f);
   }
-  std::vector<float> mu_s(directions.mu_s.begin(), directions.mu_s.end()), nu(directions.nu.begin(), directions.nu.end());
+  std::vector<float> mu_s(sun_mu_s.begin(), sun_mu_s.end()), nu(sun_nu.begin(), sun_nu.end());
   std::vector<float> mu_s_k(count);
   std::vector<char> lit(count);
   std::vector<int> shadowed, thick;
@@ -212,7 +231,7 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
         for (int j : shadowed) {
           pieces.direction.push_back(j);
           pieces.interval.push_back(interval);
-          pieces.mu_s.push_back(directions.mu_s[j]), pieces.nu.push_back(directions.nu[j]);
+          pieces.mu_s.push_back(sun_mu_s[j]), pieces.nu.push_back(sun_nu[j]);
           for (int c = 0; c < 3; ++c) {
             pieces.sun_start[c].push_back(previous.transmittance[c][j] * previous.visible[j]);
             pieces.sun_end[c].push_back(current.transmittance[c][j] * current.visible[j]);
@@ -221,7 +240,7 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
       }
       for (int j : thick) {
         Spectrum rayleigh(0.0), mie_sum(0.0);
-        SingleScatteringInterval(ray, interval, directions.mu_s[j], directions.nu[j], phase_ratio_double[j].data(),
+        SingleScatteringInterval(ray, interval, sun_mu_s[j], sun_nu[j], phase_ratio_double[j].data(),
                                  rayleigh, mie_sum);
         for (int c = 0; c < 3; ++c) sums[0][c][j] += float(rayleigh[c]), sums[1][c][j] += float(mie_sum[c]);
       }
@@ -308,12 +327,7 @@ void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, in
     }
   }
 
-  for (int x = 0; x < int(directions.of_texel.size()); ++x) {
-    const int j = directions.of_texel[x];
-    const vec3 rayleigh(sums[0][0][j], sums[0][1][j], sums[0][2][j]), mie_sum(sums[1][0][j], sums[1][1][j], sums[1][2][j]);
-    out.rayleigh.Store(x, y, z, vec4(rayleigh * params_.solar_irradiance, 0.0));
-    out.mie.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
-  }
+  return result;
 }
 
 void Baker::SingleScatteringInterval(const RaySamples& ray, int k, double mu_s, double nu, const double* phase_ratio,
