@@ -1,5 +1,7 @@
-// Single scattering: per ray of the table's grid, the light of the sun
-// scattered once toward the camera, for all of the ray's sun directions.
+// Single scattering: along a ray, the light of the sun scattered once toward
+// its start, for many sun directions at once: per ray of the table's grid
+// for all of its texels' suns, and along the rings of the sphere rules that
+// read a low sun's light (Baker::SingleScatteringOnRings).
 #include "bake/baker.h"
 
 #include <algorithm>
