@@ -13,7 +13,8 @@
 #   scripts/figures.sh report     # docs/accuracy.md, docs/images/report/ and the colour error in
 #                                 # docs/colour.md and README.md (skybake report, a few minutes)
 #   scripts/figures.sh images     # the gallery and the engine example's images (scripts/gallery.sh,
-#                                 # scripts/engine_example_images.sh)
+#                                 # scripts/engine_example_images.sh) and the sky through sunset
+#                                 # (docs/images/twilight/lut_sunset.png, skybake info --plot)
 #   scripts/figures.sh all        # everything above (about 12 minutes)
 #
 # bench and report time the machine: run them with nothing else running.
@@ -44,4 +45,7 @@ fi
 if ((images)); then
   scripts/gallery.sh
   scripts/engine_example_images.sh
+  "$SKYBAKE" bake earth -o build/figures/sunset/earth -q
+  "$SKYBAKE" info build/figures/sunset/earth --plot build/figures/sunset/plots >/dev/null
+  cp build/figures/sunset/plots/lut_sunset.png docs/images/twilight/
 fi
