@@ -159,6 +159,16 @@ vec2 GetTransmittanceTextureUvFromRMu(IN(AtmosphereParameters) atmosphere, Numbe
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+// A of ScatteringUnitMuSFromDistance: the distance to the top boundary from
+// the ground for the sun at scattering_mu_s_min, over its range from d_min =
+// top - bottom (the sun at the zenith) to d_max = HorizonDistanceAtTop.
+Number GetScatteringLowestSunDistance(IN(AtmosphereParameters) atmosphere) {
+  Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+  Number d_max = HorizonDistanceAtTop(atmosphere);
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.scattering_mu_s_min);
+  return (D - d_min) / (d_max - d_min);
+}
+
 // mu_s through the distance to the top boundary from the ground, rescaled so
 // that scattering_mu_s_min maps to 0 and more texels go to low suns, then
 // stretched so that scattering_mu_s_max maps to 1. (Independent of r: the
@@ -168,9 +178,7 @@ Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
   Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
   Number d_max = HorizonDistanceAtTop(atmosphere);
   Number a = (d - d_min) / (d_max - d_min);
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.scattering_mu_s_min);
-  Number A = (D - d_min) / (d_max - d_min);
-  return ScatteringUnitMuSFromDistance(a, 1.0 / A);
+  return ScatteringUnitMuSFromDistance(a, 1.0 / GetScatteringLowestSunDistance(atmosphere));
 }
 
 // The inverse of GetScatteringUnitMuS stretched to [0, 1]: the sun cosine
@@ -183,8 +191,7 @@ Number GetScatteringMuSFromUnitRange(IN(AtmosphereParameters) atmosphere, Number
   Number H = HorizonDistanceAtTop(atmosphere);
   Number d_min = atmosphere.top_radius - bottom;
   Number d_max = H;
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, bottom, atmosphere.scattering_mu_s_min);
-  Number A = (D - d_min) / (d_max - d_min);
+  Number A = GetScatteringLowestSunDistance(atmosphere);
   Number a = ScatteringDistanceFromUnitMuS(x_mu_s, 1.0 / A);
   Number d = d_min + min(a, A) * (d_max - d_min);
   return d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * bottom * d));

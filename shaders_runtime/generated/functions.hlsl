@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _848 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_845)
+    if (!_848)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _708 = mu < 0.0f;
-    bool _720;
-    if (_708)
+    bool _711 = mu < 0.0f;
+    bool _723;
+    if (_711)
     {
-        _720 = (((r * r) * mu) * mu) >= c;
+        _723 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _720 = _708;
+        _723 = _711;
     }
-    return _720;
+    return _723;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _478;
+    float _481;
     if (r_mu > 0.0f)
     {
-        _478 = c / (r_mu + s);
+        _481 = c / (r_mu + s);
     }
     else
     {
-        _478 = s - r_mu;
+        _481 = s - r_mu;
     }
-    float param_1 = _478;
+    float param_1 = _481;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _937;
+    float _940;
     if (d_max > d_min)
     {
-        _937 = (d - d_min) / (d_max - d_min);
+        _940 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _937 = 0.0f;
+        _940 = 0.0f;
     }
-    float x_mu = _937;
+    float x_mu = _940;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -239,6 +239,20 @@ float ScatteringUnitNu(float nu)
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetScatteringLowestSunDistance(AtmosphereParameters atmosphere)
+{
+    float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+    AtmosphereParameters param = atmosphere;
+    float d_max = HorizonDistanceAtTop(param);
+    AtmosphereParameters param_1 = atmosphere;
+    float param_2 = atmosphere.bottom_radius;
+    float param_3 = atmosphere.scattering_mu_s_min;
+    float D = DistanceToTopAtmosphereBoundary(param_1, param_2, param_3);
+    return (D - d_min) / (d_max - d_min);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 float ScatteringUnitMuSFromDistance(float a, float inverse_A)
 {
     return (1.0f - (a * inverse_A)) / (1.0f + (0.5f * a));
@@ -257,13 +271,9 @@ float GetScatteringUnitMuS(AtmosphereParameters atmosphere, float mu_s)
     float d_max = HorizonDistanceAtTop(param_3);
     float a = (d - d_min) / (d_max - d_min);
     AtmosphereParameters param_4 = atmosphere;
-    float param_5 = atmosphere.bottom_radius;
-    float param_6 = atmosphere.scattering_mu_s_min;
-    float D = DistanceToTopAtmosphereBoundary(param_4, param_5, param_6);
-    float A = (D - d_min) / (d_max - d_min);
-    float param_7 = a;
-    float param_8 = 1.0f / A;
-    return ScatteringUnitMuSFromDistance(param_7, param_8);
+    float param_5 = a;
+    float param_6 = 1.0f / GetScatteringLowestSunDistance(param_4);
+    return ScatteringUnitMuSFromDistance(param_5, param_6);
 }
 #endif
 
@@ -300,16 +310,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1277;
+        float _1280;
         if (d_max == d_min)
         {
-            _1277 = 0.0f;
+            _1280 = 0.0f;
         }
         else
         {
-            _1277 = (d - d_min) / (d_max - d_min);
+            _1280 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1277;
+        x_mu = _1280;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -320,16 +330,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1321;
+        float _1324;
         if (d_max_1 > d_min_1)
         {
-            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1324 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1321 = 0.0f;
+            _1324 = 0.0f;
         }
-        x_mu = _1321;
+        x_mu = _1324;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -348,16 +358,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _1696;
+    float _1699;
     if (low_sun)
     {
-        _1696 = min(t, 1.0f);
+        _1699 = min(t, 1.0f);
     }
     else
     {
-        _1696 = clamp(t, 0.0f, 1.0f);
+        _1699 = clamp(t, 0.0f, 1.0f);
     }
-    return _1696;
+    return _1699;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -416,25 +426,22 @@ float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
     float d_min = atmosphere.top_radius - bottom;
     float d_max = H;
     AtmosphereParameters param_3 = atmosphere;
-    float param_4 = bottom;
-    float param_5 = atmosphere.scattering_mu_s_min;
-    float D = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
-    float A = (D - d_min) / (d_max - d_min);
-    float param_6 = x_mu_s;
-    float param_7 = 1.0f / A;
-    float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
+    float A = GetScatteringLowestSunDistance(param_3);
+    float param_4 = x_mu_s;
+    float param_5 = 1.0f / A;
+    float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1084;
+    float _1087;
     if (d == 0.0f)
     {
-        _1084 = 1.0f;
+        _1087 = 1.0f;
     }
     else
     {
-        float param_8 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1084 = ClampCosine(param_8);
+        float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
+        _1087 = ClampCosine(param_6);
     }
-    return _1084;
+    return _1087;
 }
 #endif
 
@@ -463,26 +470,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _1777;
+    float4 _1780;
     if (has_a)
     {
-        _1777 = log(max(a, dark));
+        _1780 = log(max(a, dark));
     }
     else
     {
-        _1777 = (lb * 2.0f) - lc;
+        _1780 = (lb * 2.0f) - lc;
     }
-    float4 la = _1777;
-    float4 _1792;
+    float4 la = _1780;
+    float4 _1795;
     if (has_d)
     {
-        _1792 = log(max(d, dark));
+        _1795 = log(max(d, dark));
     }
     else
     {
-        _1792 = (lc * 2.0f) - lb;
+        _1795 = (lc * 2.0f) - lb;
     }
-    float4 ld = _1792;
+    float4 ld = _1795;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -605,16 +612,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2366;
+        float3 _2369;
         if (scattering.x > 0.0f)
         {
-            _2366 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _2369 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _2366 = 0.0f.xxx;
+            _2369 = 0.0f.xxx;
         }
-        single_mie_scattering = _2366;
+        single_mie_scattering = _2369;
     }
     else
     {
@@ -686,13 +693,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _2434 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2437 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2434)
+    if (!_2437)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -701,19 +708,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2454;
+    float3 _2457;
     if (ray_r_mu_intersects_ground)
     {
-        _2454 = 0.0f.xxx;
+        _2457 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2454 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _2457 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _2454;
+    transmittance = _2457;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -721,9 +728,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2481 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2484 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2481;
+    float3 scattering = _2484;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -771,16 +778,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _2575;
+    float _2578;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _2575 = a * exp(f * log(b / a));
+        _2578 = a * exp(f * log(b / a));
     }
     else
     {
-        _2575 = lerp(a, b, f);
+        _2578 = lerp(a, b, f);
     }
-    return _2575;
+    return _2578;
 }
 #endif
 
@@ -853,16 +860,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _2827;
+    float _2830;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _2827 = 1.0f - (0.5f * depth);
+        _2830 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _2827 = (1.0f - exp(-depth)) / depth;
+        _2830 = (1.0f - exp(-depth)) / depth;
     }
-    return _2827;
+    return _2830;
 }
 #endif
 
@@ -898,10 +905,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2907 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2910 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2907;
+        float3 extinction = _2910;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -959,10 +966,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2772 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2775 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2772;
+        float3 extinction = _2775;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1035,14 +1042,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _2797;
+    float3 _2800;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2797 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2800 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1051,31 +1058,31 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2797 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _2800 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _2797;
+    return _2800;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _724;
+    float _727;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _727 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _727 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _724;
+    return _727;
 }
 #endif
 
@@ -1088,16 +1095,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2537;
+    float _2540;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _2537 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2540 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2537 = up;
+        _2540 = up;
     }
-    return _2537;
+    return _2540;
 }
 #endif
 
@@ -1120,13 +1127,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _3053 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3056 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3053)
+    if (!_3056)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1166,11 +1173,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3148 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3151 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3148;
+        lit_optical_depth = _3151;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1184,11 +1191,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3182 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3185 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3182;
+        optical_depth += _3185;
     }
     if (direct < 1.0f)
     {
@@ -1207,9 +1214,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3225 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3228 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3225;
+    float3 scattering = _3228;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1230,11 +1237,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3273 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3276 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3273;
+        float3 far_optical_depth = _3276;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1254,9 +1261,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3327 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3330 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3327);
+            scattering -= (exp(-far_optical_depth) * _3330);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1277,9 +1284,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3392 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3395 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3392;
+    float3 scattering_p = _3395;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1299,25 +1306,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3436 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _3439 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3436;
+    return _3439;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1375;
+    float _1378;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1375 = 0.100000001490116119384765625f;
+        _1378 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1375 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1378 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1375;
+    return _1378;
 }
 #endif
 
@@ -1326,16 +1333,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1393;
+    float _1396;
     if (mu_s < knee)
     {
-        _1393 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1396 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1393 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1396 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1393;
+    return _1396;
 }
 #endif
 
@@ -1362,16 +1369,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1424;
+    float _1427;
     if (x < 0.5f)
     {
-        _1424 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1427 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1424 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1427 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1424;
+    return _1427;
 }
 #endif
 
@@ -1383,16 +1390,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1719;
+    float4 _1722;
     if (t < 0.0f)
     {
-        _1719 = min(blend, a);
+        _1722 = min(blend, a);
     }
     else
     {
-        _1719 = blend;
+        _1722 = blend;
     }
-    return _1719;
+    return _1722;
 }
 #endif
 

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _845 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _848 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_845)
+    if (!_848)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _708 = mu < 0.0;
-    bool _720;
-    if (_708)
+    bool _711 = mu < 0.0;
+    bool _723;
+    if (_711)
     {
-        _720 = (((r * r) * mu) * mu) >= c;
+        _723 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _720 = _708;
+        _723 = _711;
     }
-    return _720;
+    return _723;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _478;
+    float _481;
     if (r_mu > 0.0)
     {
-        _478 = c / (r_mu + s);
+        _481 = c / (r_mu + s);
     }
     else
     {
-        _478 = s - r_mu;
+        _481 = s - r_mu;
     }
-    float param_1 = _478;
+    float param_1 = _481;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _937;
+    float _940;
     if (d_max > d_min)
     {
-        _937 = (d - d_min) / (d_max - d_min);
+        _940 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _937 = 0.0;
+        _940 = 0.0;
     }
-    float x_mu = _937;
+    float x_mu = _940;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -259,6 +259,21 @@ float ScatteringUnitNu(thread const float& nu)
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
+float GetScatteringLowestSunDistance(thread const AtmosphereParameters& atmosphere)
+{
+    float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+    AtmosphereParameters param = atmosphere;
+    float d_max = HorizonDistanceAtTop(param);
+    AtmosphereParameters param_1 = atmosphere;
+    float param_2 = atmosphere.bottom_radius;
+    float param_3 = atmosphere.scattering_mu_s_min;
+    float D = DistanceToTopAtmosphereBoundary(param_1, param_2, param_3);
+    return (D - d_min) / (d_max - d_min);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
 float ScatteringUnitMuSFromDistance(thread const float& a, thread const float& inverse_A)
 {
     return (1.0 - (a * inverse_A)) / (1.0 + (0.5 * a));
@@ -278,13 +293,9 @@ float GetScatteringUnitMuS(thread const AtmosphereParameters& atmosphere, thread
     float d_max = HorizonDistanceAtTop(param_3);
     float a = (d - d_min) / (d_max - d_min);
     AtmosphereParameters param_4 = atmosphere;
-    float param_5 = atmosphere.bottom_radius;
-    float param_6 = atmosphere.scattering_mu_s_min;
-    float D = DistanceToTopAtmosphereBoundary(param_4, param_5, param_6);
-    float A = (D - d_min) / (d_max - d_min);
-    float param_7 = a;
-    float param_8 = 1.0 / A;
-    return ScatteringUnitMuSFromDistance(param_7, param_8);
+    float param_5 = a;
+    float param_6 = 1.0 / GetScatteringLowestSunDistance(param_4);
+    return ScatteringUnitMuSFromDistance(param_5, param_6);
 }
 #endif
 
@@ -323,16 +334,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1277;
+        float _1280;
         if (d_max == d_min)
         {
-            _1277 = 0.0;
+            _1280 = 0.0;
         }
         else
         {
-            _1277 = (d - d_min) / (d_max - d_min);
+            _1280 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1277;
+        x_mu = _1280;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -343,16 +354,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1321;
+        float _1324;
         if (d_max_1 > d_min_1)
         {
-            _1321 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1324 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1321 = 0.0;
+            _1324 = 0.0;
         }
-        x_mu = _1321;
+        x_mu = _1324;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -372,16 +383,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _1696;
+    float _1699;
     if (low_sun)
     {
-        _1696 = fast::min(t, 1.0);
+        _1699 = fast::min(t, 1.0);
     }
     else
     {
-        _1696 = fast::clamp(t, 0.0, 1.0);
+        _1699 = fast::clamp(t, 0.0, 1.0);
     }
-    return _1696;
+    return _1699;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -445,25 +456,22 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float d_min = atmosphere.top_radius - bottom;
     float d_max = H;
     AtmosphereParameters param_3 = atmosphere;
-    float param_4 = bottom;
-    float param_5 = atmosphere.scattering_mu_s_min;
-    float D = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
-    float A = (D - d_min) / (d_max - d_min);
-    float param_6 = x_mu_s;
-    float param_7 = 1.0 / A;
-    float a = ScatteringDistanceFromUnitMuS(param_6, param_7);
+    float A = GetScatteringLowestSunDistance(param_3);
+    float param_4 = x_mu_s;
+    float param_5 = 1.0 / A;
+    float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1084;
+    float _1087;
     if (d == 0.0)
     {
-        _1084 = 1.0;
+        _1087 = 1.0;
     }
     else
     {
-        float param_8 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1084 = ClampCosine(param_8);
+        float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
+        _1087 = ClampCosine(param_6);
     }
-    return _1084;
+    return _1087;
 }
 #endif
 
@@ -494,26 +502,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _1777;
+    float4 _1780;
     if (has_a)
     {
-        _1777 = log(fast::max(a, dark));
+        _1780 = log(fast::max(a, dark));
     }
     else
     {
-        _1777 = (lb * 2.0) - lc;
+        _1780 = (lb * 2.0) - lc;
     }
-    float4 la = _1777;
-    float4 _1792;
+    float4 la = _1780;
+    float4 _1795;
     if (has_d)
     {
-        _1792 = log(fast::max(d, dark));
+        _1795 = log(fast::max(d, dark));
     }
     else
     {
-        _1792 = (lc * 2.0) - lb;
+        _1795 = (lc * 2.0) - lb;
     }
-    float4 ld = _1792;
+    float4 ld = _1795;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -638,16 +646,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2366;
+        float3 _2369;
         if (scattering.x > 0.0)
         {
-            _2366 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _2369 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _2366 = float3(0.0);
+            _2369 = float3(0.0);
         }
-        single_mie_scattering = _2366;
+        single_mie_scattering = _2369;
     }
     else
     {
@@ -724,13 +732,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _2434 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _2437 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2434)
+    if (!_2437)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -739,19 +747,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2454;
+    float3 _2457;
     if (ray_r_mu_intersects_ground)
     {
-        _2454 = float3(0.0);
+        _2457 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2454 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _2457 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _2454;
+    transmittance = _2457;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -759,9 +767,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2481 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _2484 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2481;
+    float3 scattering = _2484;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -815,16 +823,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2575;
+    float _2578;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2575 = a * exp(f * log(b / a));
+        _2578 = a * exp(f * log(b / a));
     }
     else
     {
-        _2575 = mix(a, b, f);
+        _2578 = mix(a, b, f);
     }
-    return _2575;
+    return _2578;
 }
 #endif
 
@@ -903,16 +911,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2827;
+    float _2830;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2827 = 1.0 - (0.5 * depth);
+        _2830 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2827 = (1.0 - exp(-depth)) / depth;
+        _2830 = (1.0 - exp(-depth)) / depth;
     }
-    return _2827;
+    return _2830;
 }
 #endif
 
@@ -949,10 +957,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2907 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _2910 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2907;
+        float3 extinction = _2910;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1011,10 +1019,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2772 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _2775 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2772;
+        float3 extinction = _2775;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1089,14 +1097,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _2797;
+    float3 _2800;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2797 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _2800 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1105,9 +1113,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2797 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _2800 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _2797;
+    return _2800;
 }
 #endif
 
@@ -1115,22 +1123,22 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _724;
+    float _727;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _724 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _727 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _724 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _727 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _724;
+    return _727;
 }
 #endif
 
@@ -1144,16 +1152,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2537;
+    float _2540;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2537 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _2540 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2537 = up;
+        _2540 = up;
     }
-    return _2537;
+    return _2540;
 }
 #endif
 
@@ -1177,13 +1185,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _3053 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3056 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3053)
+    if (!_3056)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1223,11 +1231,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3148 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _3151 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3148;
+        lit_optical_depth = _3151;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1241,11 +1249,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3182 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _3185 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3182;
+        optical_depth += _3185;
     }
     if (direct < 1.0)
     {
@@ -1264,9 +1272,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3225 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _3228 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3225;
+    float3 scattering = _3228;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1287,11 +1295,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3273 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _3276 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3273;
+        float3 far_optical_depth = _3276;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1311,9 +1319,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3327 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _3330 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3327);
+            scattering -= (exp(-far_optical_depth) * _3330);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1334,9 +1342,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3392 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _3395 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3392;
+    float3 scattering_p = _3395;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1357,9 +1365,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3436 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _3439 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3436;
+    return _3439;
 }
 #endif
 
@@ -1367,16 +1375,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1375;
+    float _1378;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1375 = 0.100000001490116119384765625;
+        _1378 = 0.100000001490116119384765625;
     }
     else
     {
-        _1375 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1378 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1375;
+    return _1378;
 }
 #endif
 
@@ -1386,16 +1394,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1393;
+    float _1396;
     if (mu_s < knee)
     {
-        _1393 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1396 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1393 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1396 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1393;
+    return _1396;
 }
 #endif
 
@@ -1424,16 +1432,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1424;
+    float _1427;
     if (x < 0.5)
     {
-        _1424 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1427 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1424 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1427 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1424;
+    return _1427;
 }
 #endif
 
@@ -1446,16 +1454,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1719;
+    float4 _1722;
     if (t < 0.0)
     {
-        _1719 = fast::min(blend, a);
+        _1722 = fast::min(blend, a);
     }
     else
     {
-        _1719 = blend;
+        _1722 = blend;
     }
-    return _1719;
+    return _1722;
 }
 #endif
 

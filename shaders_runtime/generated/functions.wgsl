@@ -621,143 +621,150 @@ fn GetTransmittanceTextureUvFromRMu(atmosphere_20: AtmosphereParameters, r_22: f
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringUnitMuS(atmosphere_22: AtmosphereParameters, mu_s_3: f32) -> f32 {
+fn GetScatteringLowestSunDistance(atmosphere_22: AtmosphereParameters) -> f32 {
     var atmosphere_23: AtmosphereParameters;
-    var mu_s_4: f32;
-    var d_7: f32;
     var d_min_1: f32;
     var d_max_1: f32;
-    var a_4: f32;
     var D: f32;
-    var A: f32;
 
     atmosphere_23 = atmosphere_22;
-    mu_s_4 = mu_s_3;
+    let _e9 = atmosphere_23;
     let _e11 = atmosphere_23;
-    let _e12 = atmosphere_23;
-    let _e14 = mu_s_4;
-    let _e15 = DistanceToTopAtmosphereBoundary(_e11, _e12.bottom_radius, _e14);
-    d_7 = _e15;
-    let _e17 = atmosphere_23;
+    d_min_1 = (_e9.top_radius - _e11.bottom_radius);
+    let _e15 = atmosphere_23;
+    let _e16 = HorizonDistanceAtTop(_e15);
+    d_max_1 = _e16;
+    let _e18 = atmosphere_23;
     let _e19 = atmosphere_23;
-    d_min_1 = (_e17.top_radius - _e19.bottom_radius);
-    let _e23 = atmosphere_23;
-    let _e24 = HorizonDistanceAtTop(_e23);
-    d_max_1 = _e24;
-    let _e26 = d_7;
-    let _e27 = d_min_1;
-    let _e29 = d_max_1;
-    let _e30 = d_min_1;
-    a_4 = ((_e26 - _e27) / (_e29 - _e30));
-    let _e34 = atmosphere_23;
-    let _e35 = atmosphere_23;
-    let _e37 = atmosphere_23;
-    let _e39 = DistanceToTopAtmosphereBoundary(_e34, _e35.bottom_radius, _e37.scattering_mu_s_min);
-    D = _e39;
-    let _e41 = D;
-    let _e42 = d_min_1;
-    let _e44 = d_max_1;
-    let _e45 = d_min_1;
-    A = ((_e41 - _e42) / (_e44 - _e45));
-    let _e49 = a_4;
-    let _e51 = A;
-    let _e53 = ScatteringUnitMuSFromDistance(_e49, (1f / _e51));
-    return _e53;
+    let _e21 = atmosphere_23;
+    let _e23 = DistanceToTopAtmosphereBoundary(_e18, _e19.bottom_radius, _e21.scattering_mu_s_min);
+    D = _e23;
+    let _e25 = D;
+    let _e26 = d_min_1;
+    let _e28 = d_max_1;
+    let _e29 = d_min_1;
+    return ((_e25 - _e26) / (_e28 - _e29));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSFromUnitRange(atmosphere_24: AtmosphereParameters, x_4: f32) -> f32 {
+fn GetScatteringUnitMuS(atmosphere_24: AtmosphereParameters, mu_s_3: f32) -> f32 {
     var atmosphere_25: AtmosphereParameters;
+    var mu_s_4: f32;
+    var d_7: f32;
+    var d_min_2: f32;
+    var d_max_2: f32;
+    var a_4: f32;
+
+    atmosphere_25 = atmosphere_24;
+    mu_s_4 = mu_s_3;
+    let _e11 = atmosphere_25;
+    let _e12 = atmosphere_25;
+    let _e14 = mu_s_4;
+    let _e15 = DistanceToTopAtmosphereBoundary(_e11, _e12.bottom_radius, _e14);
+    d_7 = _e15;
+    let _e17 = atmosphere_25;
+    let _e19 = atmosphere_25;
+    d_min_2 = (_e17.top_radius - _e19.bottom_radius);
+    let _e23 = atmosphere_25;
+    let _e24 = HorizonDistanceAtTop(_e23);
+    d_max_2 = _e24;
+    let _e26 = d_7;
+    let _e27 = d_min_2;
+    let _e29 = d_max_2;
+    let _e30 = d_min_2;
+    a_4 = ((_e26 - _e27) / (_e29 - _e30));
+    let _e34 = a_4;
+    let _e36 = atmosphere_25;
+    let _e37 = GetScatteringLowestSunDistance(_e36);
+    let _e39 = ScatteringUnitMuSFromDistance(_e34, (1f / _e37));
+    return _e39;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringMuSFromUnitRange(atmosphere_26: AtmosphereParameters, x_4: f32) -> f32 {
+    var atmosphere_27: AtmosphereParameters;
     var x_5: f32;
     var x_mu_s: f32;
     var bottom: f32;
     var H_1: f32;
-    var d_min_2: f32;
-    var d_max_2: f32;
-    var D_1: f32;
-    var A_1: f32;
+    var d_min_3: f32;
+    var d_max_3: f32;
+    var A: f32;
     var a_5: f32;
     var d_8: f32;
     var local_3: f32;
 
-    atmosphere_25 = atmosphere_24;
+    atmosphere_27 = atmosphere_26;
     x_5 = x_4;
     let _e11 = x_5;
-    let _e12 = atmosphere_25;
-    let _e13 = atmosphere_25;
+    let _e12 = atmosphere_27;
+    let _e13 = atmosphere_27;
     let _e15 = GetScatteringUnitMuS(_e12, _e13.scattering_mu_s_max);
     x_mu_s = (_e11 * _e15);
-    let _e18 = atmosphere_25;
+    let _e18 = atmosphere_27;
     bottom = _e18.bottom_radius;
-    let _e21 = atmosphere_25;
+    let _e21 = atmosphere_27;
     let _e22 = HorizonDistanceAtTop(_e21);
     H_1 = _e22;
-    let _e24 = atmosphere_25;
+    let _e24 = atmosphere_27;
     let _e26 = bottom;
-    d_min_2 = (_e24.top_radius - _e26);
+    d_min_3 = (_e24.top_radius - _e26);
     let _e29 = H_1;
-    d_max_2 = _e29;
-    let _e31 = atmosphere_25;
-    let _e32 = bottom;
-    let _e33 = atmosphere_25;
-    let _e35 = DistanceToTopAtmosphereBoundary(_e31, _e32, _e33.scattering_mu_s_min);
-    D_1 = _e35;
-    let _e37 = D_1;
-    let _e38 = d_min_2;
-    let _e40 = d_max_2;
-    let _e41 = d_min_2;
-    A_1 = ((_e37 - _e38) / (_e40 - _e41));
-    let _e45 = x_mu_s;
-    let _e47 = A_1;
-    let _e49 = ScatteringDistanceFromUnitMuS(_e45, (1f / _e47));
-    a_5 = _e49;
-    let _e51 = d_min_2;
-    let _e52 = a_5;
-    let _e53 = A_1;
-    let _e55 = d_max_2;
-    let _e56 = d_min_2;
-    d_8 = (_e51 + (min(_e52, _e53) * (_e55 - _e56)));
-    let _e61 = d_8;
-    if (_e61 == 0f) {
+    d_max_3 = _e29;
+    let _e31 = atmosphere_27;
+    let _e32 = GetScatteringLowestSunDistance(_e31);
+    A = _e32;
+    let _e34 = x_mu_s;
+    let _e36 = A;
+    let _e38 = ScatteringDistanceFromUnitMuS(_e34, (1f / _e36));
+    a_5 = _e38;
+    let _e40 = d_min_3;
+    let _e41 = a_5;
+    let _e42 = A;
+    let _e44 = d_max_3;
+    let _e45 = d_min_3;
+    d_8 = (_e40 + (min(_e41, _e42) * (_e44 - _e45)));
+    let _e50 = d_8;
+    if (_e50 == 0f) {
         local_3 = 1f;
     } else {
-        let _e65 = H_1;
-        let _e66 = H_1;
-        let _e68 = d_8;
-        let _e69 = d_8;
-        let _e73 = bottom;
-        let _e75 = d_8;
-        let _e78 = ClampCosine((((_e65 * _e66) - (_e68 * _e69)) / ((2f * _e73) * _e75)));
-        local_3 = _e78;
+        let _e54 = H_1;
+        let _e55 = H_1;
+        let _e57 = d_8;
+        let _e58 = d_8;
+        let _e62 = bottom;
+        let _e64 = d_8;
+        let _e67 = ClampCosine((((_e54 * _e55) - (_e57 * _e58)) / ((2f * _e62) * _e64)));
+        local_3 = _e67;
     }
-    let _e80 = local_3;
-    return _e80;
+    let _e69 = local_3;
+    return _e69;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUMuS(atmosphere_26: AtmosphereParameters, mu_s_5: f32) -> f32 {
-    var atmosphere_27: AtmosphereParameters;
+fn GetScatteringTextureUMuS(atmosphere_28: AtmosphereParameters, mu_s_5: f32) -> f32 {
+    var atmosphere_29: AtmosphereParameters;
     var mu_s_6: f32;
     var x_6: f32;
 
-    atmosphere_27 = atmosphere_26;
+    atmosphere_29 = atmosphere_28;
     mu_s_6 = mu_s_5;
-    let _e11 = atmosphere_27;
+    let _e11 = atmosphere_29;
     let _e12 = mu_s_6;
     let _e13 = GetScatteringUnitMuS(_e11, _e12);
-    let _e14 = atmosphere_27;
-    let _e15 = atmosphere_27;
+    let _e14 = atmosphere_29;
+    let _e15 = atmosphere_29;
     let _e17 = GetScatteringUnitMuS(_e14, _e15.scattering_mu_s_max);
     x_6 = (_e13 / _e17);
     let _e20 = x_6;
-    let _e23 = atmosphere_27;
+    let _e23 = atmosphere_29;
     let _e25 = GetTextureCoordFromUnitRange(min(_e20, 1f), _e23.scattering_mu_s_size);
     return _e25;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_28: AtmosphereParameters, r_24: f32, rho_3: f32, ray_r_mu_intersects_ground_2: bool, x_mu_1: f32) -> f32 {
-    var atmosphere_29: AtmosphereParameters;
+fn GetScatteringTextureUR(atmosphere_30: AtmosphereParameters, r_24: f32, rho_3: f32, ray_r_mu_intersects_ground_2: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_31: AtmosphereParameters;
     var r_25: f32;
     var rho_4: f32;
     var ray_r_mu_intersects_ground_3: bool;
@@ -775,20 +782,20 @@ fn GetScatteringTextureUR(atmosphere_28: AtmosphereParameters, r_24: f32, rho_3:
     var d_9: f32;
     var t: f32;
 
-    atmosphere_29 = atmosphere_28;
+    atmosphere_31 = atmosphere_30;
     r_25 = r_24;
     rho_4 = rho_3;
     ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
     x_mu_2 = x_mu_1;
-    let _e17 = atmosphere_29;
-    let _e18 = atmosphere_29;
+    let _e17 = atmosphere_31;
+    let _e18 = atmosphere_31;
     let _e20 = HorizonDistance(_e17, _e18.scattering_r_min);
     rho_min = _e20;
-    let _e22 = atmosphere_29;
-    let _e23 = atmosphere_29;
+    let _e22 = atmosphere_31;
+    let _e23 = atmosphere_31;
     let _e25 = HorizonDistance(_e22, _e23.scattering_r_max);
     rho_max = _e25;
-    let _e27 = atmosphere_29;
+    let _e27 = atmosphere_31;
     last_row = f32((_e27.scattering_r_size - 1i));
     let _e33 = rho_4;
     let _e34 = rho_min;
@@ -815,7 +822,7 @@ fn GetScatteringTextureUR(atmosphere_28: AtmosphereParameters, r_24: f32, rho_3:
     let _e71 = row;
     let _e74 = last_row;
     rho_above = mix(_e69, _e70, ((_e71 + 1f) / _e74));
-    let _e78 = atmosphere_29;
+    let _e78 = atmosphere_31;
     bottom_1 = _e78.bottom_radius;
     let _e81 = bottom_1;
     let _e82 = rho_below;
@@ -846,8 +853,8 @@ fn GetScatteringTextureUR(atmosphere_28: AtmosphereParameters, r_24: f32, rho_3:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_26: f32, mu_17: f32, mu_s_7: f32, nu_9: f32, ray_r_mu_intersects_ground_4: bool) -> vec4<f32> {
-    var atmosphere_31: AtmosphereParameters;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_32: AtmosphereParameters, r_26: f32, mu_17: f32, mu_s_7: f32, nu_9: f32, ray_r_mu_intersects_ground_4: bool) -> vec4<f32> {
+    var atmosphere_33: AtmosphereParameters;
     var r_27: f32;
     var mu_18: f32;
     var mu_s_8: f32;
@@ -859,53 +866,53 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_2
     var u_mu: f32;
     var x_mu_3: f32;
     var d_10: f32;
-    var d_min_3: f32;
-    var d_max_3: f32;
-    var local_4: f32;
-    var d_11: f32;
     var d_min_4: f32;
     var d_max_4: f32;
+    var local_4: f32;
+    var d_11: f32;
+    var d_min_5: f32;
+    var d_max_5: f32;
     var local_5: f32;
     var u_r: f32;
     var u_nu: f32;
 
-    atmosphere_31 = atmosphere_30;
+    atmosphere_33 = atmosphere_32;
     r_27 = r_26;
     mu_18 = mu_17;
     mu_s_8 = mu_s_7;
     nu_10 = nu_9;
     ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
-    let _e19 = atmosphere_31;
+    let _e19 = atmosphere_33;
     let _e20 = HorizonDistanceAtTop(_e19);
     H_2 = _e20;
-    let _e22 = atmosphere_31;
+    let _e22 = atmosphere_33;
     let _e23 = r_27;
     let _e24 = HorizonDistance(_e22, _e23);
     rho_5 = _e24;
-    let _e26 = atmosphere_31;
+    let _e26 = atmosphere_33;
     half_mu_size = f32((_e26.scattering_mu_size / 2i));
     let _e34 = ray_r_mu_intersects_ground_5;
     if _e34 {
         {
-            let _e35 = atmosphere_31;
+            let _e35 = atmosphere_33;
             let _e36 = r_27;
             let _e37 = mu_18;
             let _e38 = DistanceToBottomAtmosphereBoundary(_e35, _e36, _e37);
             d_10 = _e38;
             let _e40 = r_27;
-            let _e41 = atmosphere_31;
-            d_min_3 = (_e40 - _e41.bottom_radius);
+            let _e41 = atmosphere_33;
+            d_min_4 = (_e40 - _e41.bottom_radius);
             let _e45 = rho_5;
-            d_max_3 = _e45;
-            let _e47 = d_max_3;
-            let _e48 = d_min_3;
+            d_max_4 = _e45;
+            let _e47 = d_max_4;
+            let _e48 = d_min_4;
             if (_e47 == _e48) {
                 local_4 = 0f;
             } else {
                 let _e51 = d_10;
-                let _e52 = d_min_3;
-                let _e54 = d_max_3;
-                let _e55 = d_min_3;
+                let _e52 = d_min_4;
+                let _e54 = d_max_4;
+                let _e55 = d_min_4;
                 local_4 = ((_e51 - _e52) / (_e54 - _e55));
             }
             let _e59 = local_4;
@@ -917,24 +924,24 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_2
         }
     } else {
         {
-            let _e75 = atmosphere_31;
+            let _e75 = atmosphere_33;
             let _e76 = r_27;
             let _e77 = mu_18;
             let _e78 = DistanceToTopAtmosphereBoundary(_e75, _e76, _e77);
             d_11 = _e78;
-            let _e80 = atmosphere_31;
+            let _e80 = atmosphere_33;
             let _e82 = r_27;
-            d_min_4 = (_e80.top_radius - _e82);
+            d_min_5 = (_e80.top_radius - _e82);
             let _e85 = rho_5;
             let _e86 = H_2;
-            d_max_4 = (_e85 + _e86);
-            let _e89 = d_max_4;
-            let _e90 = d_min_4;
+            d_max_5 = (_e85 + _e86);
+            let _e89 = d_max_5;
+            let _e90 = d_min_5;
             if (_e89 > _e90) {
                 let _e92 = d_11;
-                let _e93 = d_min_4;
-                let _e95 = d_max_4;
-                let _e96 = d_min_4;
+                let _e93 = d_min_5;
+                let _e95 = d_max_5;
+                let _e96 = d_min_5;
                 local_5 = ((_e92 - _e93) / (_e95 - _e96));
             } else {
                 local_5 = 0f;
@@ -947,7 +954,7 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_2
             u_mu = (0.5f + (0.5f * ((0.5f / _e105) + (_e107 * (1f - (1f / _e110))))));
         }
     }
-    let _e117 = atmosphere_31;
+    let _e117 = atmosphere_33;
     let _e118 = r_27;
     let _e119 = rho_5;
     let _e120 = ray_r_mu_intersects_ground_5;
@@ -958,7 +965,7 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_2
     let _e125 = ScatteringUnitNu(_e124);
     u_nu = _e125;
     let _e127 = u_nu;
-    let _e128 = atmosphere_31;
+    let _e128 = atmosphere_33;
     let _e129 = mu_s_8;
     let _e130 = GetScatteringTextureUMuS(_e128, _e129);
     let _e131 = u_mu;
@@ -967,16 +974,16 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_30: AtmosphereParameters, r_2
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_32: AtmosphereParameters) -> f32 {
-    var atmosphere_33: AtmosphereParameters;
+fn IrradianceKneeMuS(atmosphere_34: AtmosphereParameters) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
     var local_6: f32;
 
-    atmosphere_33 = atmosphere_32;
-    let _e10 = atmosphere_33;
+    atmosphere_35 = atmosphere_34;
+    let _e10 = atmosphere_35;
     if (_e10.mu_s_min < LOW_SUN_MU_S) {
         local_6 = LOW_SUN_MU_S;
     } else {
-        let _e14 = atmosphere_33;
+        let _e14 = atmosphere_35;
         local_6 = (0.5f * (_e14.mu_s_min + 1f));
     }
     let _e20 = local_6;
@@ -984,24 +991,24 @@ fn IrradianceKneeMuS(atmosphere_32: AtmosphereParameters) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_34: AtmosphereParameters, mu_s_9: f32) -> f32 {
-    var atmosphere_35: AtmosphereParameters;
+fn GetIrradianceUnitMuS(atmosphere_36: AtmosphereParameters, mu_s_9: f32) -> f32 {
+    var atmosphere_37: AtmosphereParameters;
     var mu_s_10: f32;
     var knee: f32;
     var local_7: f32;
 
-    atmosphere_35 = atmosphere_34;
+    atmosphere_37 = atmosphere_36;
     mu_s_10 = mu_s_9;
-    let _e12 = atmosphere_35;
+    let _e12 = atmosphere_37;
     let _e13 = IrradianceKneeMuS(_e12);
     knee = _e13;
     let _e15 = mu_s_10;
     let _e16 = knee;
     if (_e15 < _e16) {
         let _e19 = mu_s_10;
-        let _e20 = atmosphere_35;
+        let _e20 = atmosphere_37;
         let _e24 = knee;
-        let _e25 = atmosphere_35;
+        let _e25 = atmosphere_37;
         local_7 = ((0.5f * (_e19 - _e20.mu_s_min)) / (_e24 - _e25.mu_s_min));
     } else {
         let _e31 = mu_s_10;
@@ -1014,23 +1021,23 @@ fn GetIrradianceUnitMuS(atmosphere_34: AtmosphereParameters, mu_s_9: f32) -> f32
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_36: AtmosphereParameters, x_7: f32) -> f32 {
-    var atmosphere_37: AtmosphereParameters;
+fn GetIrradianceMuSFromUnit(atmosphere_38: AtmosphereParameters, x_7: f32) -> f32 {
+    var atmosphere_39: AtmosphereParameters;
     var x_8: f32;
     var knee_1: f32;
     var local_8: f32;
 
-    atmosphere_37 = atmosphere_36;
+    atmosphere_39 = atmosphere_38;
     x_8 = x_7;
-    let _e12 = atmosphere_37;
+    let _e12 = atmosphere_39;
     let _e13 = IrradianceKneeMuS(_e12);
     knee_1 = _e13;
     let _e15 = x_8;
     if (_e15 < 0.5f) {
-        let _e18 = atmosphere_37;
+        let _e18 = atmosphere_39;
         let _e21 = x_8;
         let _e23 = knee_1;
-        let _e24 = atmosphere_37;
+        let _e24 = atmosphere_39;
         local_8 = (_e18.mu_s_min + ((2f * _e21) * (_e23 - _e24.mu_s_min)));
     } else {
         let _e29 = knee_1;
@@ -1043,45 +1050,45 @@ fn GetIrradianceMuSFromUnit(atmosphere_36: AtmosphereParameters, x_7: f32) -> f3
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_38: AtmosphereParameters, r_28: f32, mu_s_11: f32) -> vec2<f32> {
-    var atmosphere_39: AtmosphereParameters;
+fn GetIrradianceTextureUvFromRMuS(atmosphere_40: AtmosphereParameters, r_28: f32, mu_s_11: f32) -> vec2<f32> {
+    var atmosphere_41: AtmosphereParameters;
     var r_29: f32;
     var mu_s_12: f32;
     var x_r_1: f32;
     var x_mu_s_1: f32;
 
-    atmosphere_39 = atmosphere_38;
+    atmosphere_41 = atmosphere_40;
     r_29 = r_28;
     mu_s_12 = mu_s_11;
-    let _e14 = atmosphere_39;
+    let _e14 = atmosphere_41;
     let _e15 = r_29;
     let _e16 = HorizonDistance(_e14, _e15);
-    let _e17 = atmosphere_39;
+    let _e17 = atmosphere_41;
     let _e18 = HorizonDistanceAtTop(_e17);
     x_r_1 = (_e16 / _e18);
-    let _e21 = atmosphere_39;
+    let _e21 = atmosphere_41;
     let _e22 = mu_s_12;
     let _e23 = GetIrradianceUnitMuS(_e21, _e22);
     x_mu_s_1 = clamp(_e23, 0f, 1f);
     let _e28 = x_mu_s_1;
-    let _e29 = atmosphere_39;
+    let _e29 = atmosphere_41;
     let _e31 = GetTextureCoordFromUnitRange(_e28, _e29.irradiance_width);
     let _e32 = x_r_1;
-    let _e33 = atmosphere_39;
+    let _e33 = atmosphere_41;
     let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_height);
     return vec2<f32>(_e31, _e35);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
-    var atmosphere_41: AtmosphereParameters;
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_42: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
+    var atmosphere_43: AtmosphereParameters;
     var r_31: f32;
     var mu_20: f32;
     var uv_2: vec2<f32>;
 
-    atmosphere_41 = atmosphere_40;
+    atmosphere_43 = atmosphere_42;
     r_31 = r_30;
     mu_20 = mu_19;
-    let _e15 = atmosphere_41;
+    let _e15 = atmosphere_43;
     let _e16 = r_31;
     let _e17 = mu_20;
     let _e18 = GetTransmittanceTextureUvFromRMu(_e15, _e16, _e17);
@@ -1091,23 +1098,23 @@ fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_40: AtmosphereParameters, t
     return vec3<f32>(_e21.xyz);
 }
 
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_42: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
-    var atmosphere_43: AtmosphereParameters;
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_44: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
+    var atmosphere_45: AtmosphereParameters;
     var r_33: f32;
     var mu_22: f32;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_45 = atmosphere_44;
     r_33 = r_32;
     mu_22 = mu_21;
-    let _e15 = atmosphere_43;
+    let _e15 = atmosphere_45;
     let _e16 = r_33;
     let _e17 = mu_22;
     let _e18 = GetOpticalDepthToTopAtmosphereBoundary(_e15, transmittance_texture_1, _e16, _e17);
     return exp(-(_e18));
 }
 
-fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_12: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
-    var atmosphere_45: AtmosphereParameters;
+fn GetOpticalDepth(atmosphere_46: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_12: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
+    var atmosphere_47: AtmosphereParameters;
     var r_35: f32;
     var mu_24: f32;
     var d_13: f32;
@@ -1118,12 +1125,12 @@ fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2:
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_45 = atmosphere_44;
+    atmosphere_47 = atmosphere_46;
     r_35 = r_34;
     mu_24 = mu_23;
     d_13 = d_12;
     ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
-    let _e19 = atmosphere_45;
+    let _e19 = atmosphere_47;
     let _e20 = r_35;
     let _e21 = mu_24;
     let _e22 = d_13;
@@ -1139,11 +1146,11 @@ fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2:
     let _e33 = mu_d;
     if (_e32 || (_e33 < 0f)) {
         {
-            let _e37 = atmosphere_45;
+            let _e37 = atmosphere_47;
             let _e38 = r_d_2;
             let _e39 = mu_d;
             let _e41 = GetOpticalDepthToTopAtmosphereBoundary(_e37, transmittance_texture_2, _e38, -(_e39));
-            let _e42 = atmosphere_45;
+            let _e42 = atmosphere_47;
             let _e43 = r_35;
             let _e44 = mu_24;
             let _e46 = GetOpticalDepthToTopAtmosphereBoundary(_e42, transmittance_texture_2, _e43, -(_e44));
@@ -1153,11 +1160,11 @@ fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2:
         let _e48 = mu_24;
         if (_e48 >= 0f) {
             {
-                let _e51 = atmosphere_45;
+                let _e51 = atmosphere_47;
                 let _e52 = r_35;
                 let _e53 = mu_24;
                 let _e54 = GetOpticalDepthToTopAtmosphereBoundary(_e51, transmittance_texture_2, _e52, _e53);
-                let _e55 = atmosphere_45;
+                let _e55 = atmosphere_47;
                 let _e56 = r_d_2;
                 let _e57 = mu_d;
                 let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
@@ -1165,24 +1172,24 @@ fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2:
             }
         } else {
             {
-                let _e60 = atmosphere_45;
+                let _e60 = atmosphere_47;
                 let _e61 = r_35;
                 let _e63 = mu_24;
                 let _e64 = mu_24;
                 let _e67 = SafeSqrt((1f - (_e63 * _e64)));
                 let _e69 = ClampRadius(_e60, (_e61 * _e67));
                 r_low = _e69;
-                let _e71 = atmosphere_45;
+                let _e71 = atmosphere_47;
                 let _e72 = r_low;
                 let _e74 = GetOpticalDepthToTopAtmosphereBoundary(_e71, transmittance_texture_2, _e72, 0f);
                 tau_low = _e74;
                 let _e76 = tau_low;
-                let _e77 = atmosphere_45;
+                let _e77 = atmosphere_47;
                 let _e78 = r_35;
                 let _e79 = mu_24;
                 let _e81 = GetOpticalDepthToTopAtmosphereBoundary(_e77, transmittance_texture_2, _e78, -(_e79));
                 let _e86 = tau_low;
-                let _e87 = atmosphere_45;
+                let _e87 = atmosphere_47;
                 let _e88 = r_d_2;
                 let _e89 = mu_d;
                 let _e90 = GetOpticalDepthToTopAtmosphereBoundary(_e87, transmittance_texture_2, _e88, _e89);
@@ -1194,19 +1201,19 @@ fn GetOpticalDepth(atmosphere_44: AtmosphereParameters, transmittance_texture_2:
     return max(_e96, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_46: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
-    var atmosphere_47: AtmosphereParameters;
+fn GetTransmittance(atmosphere_48: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
+    var atmosphere_49: AtmosphereParameters;
     var r_37: f32;
     var mu_26: f32;
     var d_15: f32;
     var ray_r_mu_intersects_ground_9: bool;
 
-    atmosphere_47 = atmosphere_46;
+    atmosphere_49 = atmosphere_48;
     r_37 = r_36;
     mu_26 = mu_25;
     d_15 = d_14;
     ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e19 = atmosphere_47;
+    let _e19 = atmosphere_49;
     let _e20 = r_37;
     let _e21 = mu_26;
     let _e22 = d_15;
@@ -1215,41 +1222,41 @@ fn GetTransmittance(atmosphere_46: AtmosphereParameters, transmittance_texture_3
     return exp(-(_e24));
 }
 
-fn SunVisibleFraction(atmosphere_48: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
-    var atmosphere_49: AtmosphereParameters;
+fn SunVisibleFraction(atmosphere_50: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
+    var atmosphere_51: AtmosphereParameters;
     var r_39: f32;
     var mu_s_14: f32;
     var sin_theta_h: f32;
 
-    atmosphere_49 = atmosphere_48;
+    atmosphere_51 = atmosphere_50;
     r_39 = r_38;
     mu_s_14 = mu_s_13;
-    let _e14 = atmosphere_49;
+    let _e14 = atmosphere_51;
     let _e16 = r_39;
     sin_theta_h = (_e14.bottom_radius / _e16);
     let _e19 = mu_s_14;
-    let _e20 = atmosphere_49;
+    let _e20 = atmosphere_51;
     let _e22 = r_39;
     let _e23 = HorizonZenithCosine(_e20.bottom_radius, _e22);
     let _e24 = sin_theta_h;
-    let _e25 = atmosphere_49;
+    let _e25 = atmosphere_51;
     let _e28 = SunVisibleFractionAboveHorizon(_e19, _e23, (_e24 * _e25.sun_angular_radius));
     return _e28;
 }
 
-fn GetTransmittanceToSun(atmosphere_50: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
-    var atmosphere_51: AtmosphereParameters;
+fn GetTransmittanceToSun(atmosphere_52: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
+    var atmosphere_53: AtmosphereParameters;
     var r_41: f32;
     var mu_s_16: f32;
 
-    atmosphere_51 = atmosphere_50;
+    atmosphere_53 = atmosphere_52;
     r_41 = r_40;
     mu_s_16 = mu_s_15;
-    let _e15 = atmosphere_51;
+    let _e15 = atmosphere_53;
     let _e16 = r_41;
     let _e17 = mu_s_16;
     let _e18 = GetTransmittanceToTopAtmosphereBoundary(_e15, transmittance_texture_4, _e16, _e17);
-    let _e19 = atmosphere_51;
+    let _e19 = atmosphere_53;
     let _e20 = r_41;
     let _e21 = mu_s_16;
     let _e22 = SunVisibleFraction(_e19, _e20, _e21);
@@ -1336,18 +1343,18 @@ fn SunBelowTableMix(a_8: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_52: AtmosphereParameters, u_mu_s: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_53: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_54: AtmosphereParameters, u_mu_s: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_55: AtmosphereParameters;
     var u_mu_s_1: f32;
     var x_low_sun_1: f32;
     var mu_s_size: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_53 = atmosphere_52;
+    atmosphere_55 = atmosphere_54;
     u_mu_s_1 = u_mu_s;
     x_low_sun_1 = x_low_sun;
-    let _e18 = atmosphere_53;
+    let _e18 = atmosphere_55;
     mu_s_size = f32(_e18.scattering_mu_s_size);
     let _e22 = u_mu_s_1;
     let _e23 = mu_s_size;
@@ -1559,8 +1566,8 @@ fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_9: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_55: AtmosphereParameters;
+fn GetScatteringAtMuSColumn(atmosphere_56: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_9: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_57: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
     var x_10: f32;
     var nu_slice_1: f32;
@@ -1568,13 +1575,13 @@ fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_text
     var low_sun_7: bool;
     var nu_size: f32;
 
-    atmosphere_55 = atmosphere_54;
+    atmosphere_57 = atmosphere_56;
     uvwz_1 = uvwz;
     x_10 = x_9;
     nu_slice_1 = nu_slice;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e21 = atmosphere_55;
+    let _e21 = atmosphere_57;
     nu_size = f32(_e21.scattering_nu_size);
     let _e25 = nu_slice_1;
     let _e26 = x_10;
@@ -1595,8 +1602,8 @@ fn GetScatteringAtMuSColumn(atmosphere_54: AtmosphereParameters, scattering_text
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
-    var atmosphere_57: AtmosphereParameters;
+fn GetScattering(atmosphere_58: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
+    var atmosphere_59: AtmosphereParameters;
     var r_43: f32;
     var mu_28: f32;
     var mu_s_18: f32;
@@ -1625,13 +1632,13 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     var first: vec4<f32>;
     var last: vec4<f32>;
 
-    atmosphere_57 = atmosphere_56;
+    atmosphere_59 = atmosphere_58;
     r_43 = r_42;
     mu_28 = mu_27;
     mu_s_18 = mu_s_17;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e21 = atmosphere_57;
+    let _e21 = atmosphere_59;
     let _e22 = r_43;
     let _e23 = mu_28;
     let _e24 = mu_s_18;
@@ -1639,7 +1646,7 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     let _e26 = ray_r_mu_intersects_ground_11;
     let _e27 = GetScatteringTextureUvwzFromRMuMuSNu(_e21, _e22, _e23, _e24, _e25, _e26);
     uvwz_2 = _e27;
-    let _e29 = atmosphere_57;
+    let _e29 = atmosphere_59;
     nu_size_1 = f32(_e29.scattering_nu_size);
     let _e33 = uvwz_2;
     let _e35 = nu_size_1;
@@ -1650,14 +1657,14 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     let _e47 = nu_coord;
     let _e48 = nu_slice_2;
     nu_t_2 = (_e47 - _e48);
-    let _e55 = atmosphere_57;
+    let _e55 = atmosphere_59;
     let _e56 = GetScatteringTextureUMuS(_e55, LOW_SUN_MU_S);
     x_low_sun_2 = _e56;
-    let _e58 = atmosphere_57;
+    let _e58 = atmosphere_59;
     let _e59 = uvwz_2;
     let _e61 = x_low_sun_2;
     GetScatteringMuSColumns(_e58, _e59.y, _e61, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e70 = atmosphere_57;
+    let _e70 = atmosphere_59;
     let _e71 = uvwz_2;
     let _e72 = x_below_1;
     let _e73 = nu_slice_2;
@@ -1665,7 +1672,7 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     let _e75 = low_sun_below_1;
     let _e76 = GetScatteringAtMuSColumn(_e70, scattering_texture_1, _e71, _e72, _e73, _e74, _e75);
     below = _e76;
-    let _e78 = atmosphere_57;
+    let _e78 = atmosphere_59;
     let _e79 = uvwz_2;
     let _e80 = x_above_1;
     let _e81 = nu_slice_2;
@@ -1674,17 +1681,17 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     let _e84 = x_low_sun_2;
     let _e86 = GetScatteringAtMuSColumn(_e78, scattering_texture_1, _e79, _e80, _e81, _e82, (_e83 < _e84));
     above = _e86;
-    let _e88 = atmosphere_57;
+    let _e88 = atmosphere_59;
     mu_s_size_1 = f32(_e88.scattering_mu_s_size);
     let _e92 = mu_s_t_1;
     if (_e92 < 0f) {
         {
-            let _e95 = atmosphere_57;
+            let _e95 = atmosphere_59;
             mu_s_min = _e95.scattering_mu_s_min;
             let _e100 = below;
             let _e101 = above;
             let _e102 = mu_s_min;
-            let _e103 = atmosphere_57;
+            let _e103 = atmosphere_59;
             let _e105 = mu_s_size_1;
             let _e109 = GetScatteringMuSFromUnitRange(_e103, (1f / (_e105 - 1f)));
             LowestSunLogFall(_e100, _e101, _e102, _e109, (&slope_1), (&curvature_1));
@@ -1716,14 +1723,14 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
     let _e154 = mu_s_size_1;
     let _e160 = mu_s_size_1;
     x_last = ((min((_e151 + 2f), (_e154 - 1f)) + 0.5f) / _e160);
-    let _e163 = atmosphere_57;
+    let _e163 = atmosphere_59;
     let _e164 = uvwz_2;
     let _e165 = x_first;
     let _e166 = nu_slice_2;
     let _e167 = nu_t_2;
     let _e169 = GetScatteringAtMuSColumn(_e163, scattering_texture_1, _e164, _e165, _e166, _e167, true);
     first = _e169;
-    let _e171 = atmosphere_57;
+    let _e171 = atmosphere_59;
     let _e172 = uvwz_2;
     let _e173 = x_last;
     let _e174 = nu_slice_2;
@@ -1745,8 +1752,8 @@ fn GetScattering(atmosphere_56: AtmosphereParameters, scattering_texture_1: text
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_58: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
-    var atmosphere_59: AtmosphereParameters;
+fn GetIrradiance(atmosphere_60: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
+    var atmosphere_61: AtmosphereParameters;
     var r_45: f32;
     var mu_s_20: f32;
     var uv_3: vec2<f32>;
@@ -1758,17 +1765,17 @@ fn GetIrradiance(atmosphere_58: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_59 = atmosphere_58;
+    atmosphere_61 = atmosphere_60;
     r_45 = r_44;
     mu_s_20 = mu_s_19;
-    let _e15 = atmosphere_59;
+    let _e15 = atmosphere_61;
     let _e16 = r_45;
     let _e17 = mu_s_20;
     let _e18 = GetIrradianceTextureUvFromRMuS(_e15, _e16, _e17);
     uv_3 = _e18;
-    let _e20 = atmosphere_59;
+    let _e20 = atmosphere_61;
     width = f32(_e20.irradiance_width);
-    let _e24 = atmosphere_59;
+    let _e24 = atmosphere_61;
     let _e25 = mu_s_20;
     let _e26 = GetIrradianceUnitMuS(_e24, _e25);
     let _e27 = width;
@@ -1776,7 +1783,7 @@ fn GetIrradiance(atmosphere_58: AtmosphereParameters, irradiance_texture: textur
     let _e32 = mu_s_coord_1;
     let _e35 = width;
     mu_s_column_1 = clamp(floor(_e32), 0f, (_e35 - 2f));
-    let _e40 = atmosphere_59;
+    let _e40 = atmosphere_61;
     let _e41 = mu_s_column_1;
     let _e42 = width;
     let _e46 = GetIrradianceMuSFromUnit(_e40, (_e41 / (_e42 - 1f)));
@@ -1805,22 +1812,22 @@ fn GetIrradiance(atmosphere_58: AtmosphereParameters, irradiance_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_60: AtmosphereParameters, nu_13: f32) -> f32 {
-    var atmosphere_61: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_62: AtmosphereParameters, nu_13: f32) -> f32 {
+    var atmosphere_63: AtmosphereParameters;
     var nu_14: f32;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_63 = atmosphere_62;
     nu_14 = nu_13;
-    let _e12 = atmosphere_61;
+    let _e12 = atmosphere_63;
     if (_e12.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e15 = atmosphere_61;
+        let _e15 = atmosphere_63;
         let _e17 = nu_14;
         let _e18 = HenyeyGreensteinPhaseFunction(_e15.mie_g, _e17);
         return _e18;
     }
-    let _e19 = atmosphere_61;
+    let _e19 = atmosphere_63;
     if (_e19.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e22 = atmosphere_61;
+        let _e22 = atmosphere_63;
         let _e24 = nu_14;
         let _e25 = CornetteShanksPhaseFunction(_e22.mie_g, _e24);
         return _e25;
@@ -1829,8 +1836,8 @@ fn MiePhaseFunction(atmosphere_60: AtmosphereParameters, nu_13: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_63: AtmosphereParameters;
+fn GetCombinedScattering(atmosphere_64: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_65: AtmosphereParameters;
     var r_47: f32;
     var mu_30: f32;
     var mu_s_22: f32;
@@ -1839,13 +1846,13 @@ fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture
     var scattering: vec4<f32>;
     var local_13: vec3<f32>;
 
-    atmosphere_63 = atmosphere_62;
+    atmosphere_65 = atmosphere_64;
     r_47 = r_46;
     mu_30 = mu_29;
     mu_s_22 = mu_s_21;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e23 = atmosphere_63;
+    let _e23 = atmosphere_65;
     let _e24 = r_47;
     let _e25 = mu_30;
     let _e26 = mu_s_22;
@@ -1853,7 +1860,7 @@ fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture
     let _e28 = ray_r_mu_intersects_ground_13;
     let _e29 = GetScattering(_e23, scattering_texture_2, _e24, _e25, _e26, _e27, _e28);
     scattering = _e29;
-    let _e31 = atmosphere_63;
+    let _e31 = atmosphere_65;
     if (_e31.single_mie_in_scattering_alpha == 1i) {
         {
             let _e35 = scattering;
@@ -1861,8 +1868,8 @@ fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture
                 let _e39 = scattering;
                 let _e42 = scattering;
                 let _e45 = scattering;
-                let _e49 = atmosphere_63;
-                let _e51 = atmosphere_63;
+                let _e49 = atmosphere_65;
+                let _e51 = atmosphere_65;
                 local_13 = (((vec3<f32>(_e39.xyz) * _e42.w) / vec3(_e45.x)) * (_e49.mie_to_rayleigh_scattering_ratio / vec3(_e51.mie_to_rayleigh_scattering_ratio.x)));
             } else {
                 local_13 = vec3(0f);
@@ -1872,7 +1879,7 @@ fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture
         }
     } else {
         {
-            let _e61 = atmosphere_63;
+            let _e61 = atmosphere_65;
             let _e62 = r_47;
             let _e63 = mu_30;
             let _e64 = mu_s_22;
@@ -1887,8 +1894,8 @@ fn GetCombinedScattering(atmosphere_62: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_65: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_66: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_67: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
@@ -1902,11 +1909,11 @@ fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: 
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_65 = atmosphere_64;
+    atmosphere_67 = atmosphere_66;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e25 = atmosphere_65;
+    let _e25 = atmosphere_67;
     let _e26 = camera_5;
     let _e27 = view_ray_5;
     let _e28 = sun_direction_3;
@@ -1917,7 +1924,7 @@ fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: 
             return vec3(0f);
         }
     }
-    let _e45 = atmosphere_65;
+    let _e45 = atmosphere_67;
     let _e46 = r_48;
     let _e47 = mu_31;
     let _e48 = RayIntersectsGround(_e45, _e46, _e47);
@@ -1926,7 +1933,7 @@ fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: 
     if _e50 {
         local_14 = vec3(0f);
     } else {
-        let _e53 = atmosphere_65;
+        let _e53 = atmosphere_67;
         let _e54 = r_48;
         let _e55 = mu_31;
         let _e56 = GetTransmittanceToTopAtmosphereBoundary(_e53, transmittance_texture_5, _e54, _e55);
@@ -1934,7 +1941,7 @@ fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: 
     }
     let _e58 = local_14;
     (*transmittance) = _e58;
-    let _e60 = atmosphere_65;
+    let _e60 = atmosphere_67;
     let _e61 = r_48;
     let _e62 = mu_31;
     let _e63 = mu_s_23;
@@ -1946,15 +1953,15 @@ fn GetSkyRadiance(atmosphere_64: AtmosphereParameters, transmittance_texture_5: 
     let _e71 = nu_17;
     let _e72 = RayleighPhaseFunction(_e71);
     let _e74 = single_mie_scattering_1;
-    let _e75 = atmosphere_65;
+    let _e75 = atmosphere_67;
     let _e76 = nu_17;
     let _e77 = MiePhaseFunction(_e75, _e76);
     return ((_e70 * _e72) + (_e74 * _e77));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_66: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
-    var atmosphere_67: AtmosphereParameters;
+fn DistanceInsideScatteringRadii(atmosphere_68: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
+    var atmosphere_69: AtmosphereParameters;
     var r_50: f32;
     var mu_33: f32;
     var r_max: f32;
@@ -1964,12 +1971,12 @@ fn DistanceInsideScatteringRadii(atmosphere_66: AtmosphereParameters, r_49: f32,
     var down_discriminant: f32;
     var local_15: f32;
 
-    atmosphere_67 = atmosphere_66;
+    atmosphere_69 = atmosphere_68;
     r_50 = r_49;
     mu_33 = mu_32;
-    let _e15 = atmosphere_67;
+    let _e15 = atmosphere_69;
     r_max = _e15.scattering_r_max;
-    let _e18 = atmosphere_67;
+    let _e18 = atmosphere_69;
     r_min = _e18.scattering_r_min;
     let _e21 = r_50;
     let _e22 = r_50;
@@ -2004,17 +2011,17 @@ fn DistanceInsideScatteringRadii(atmosphere_66: AtmosphereParameters, r_49: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_68: AtmosphereParameters, i: i32) -> f32 {
-    var atmosphere_69: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_70: AtmosphereParameters, i: i32) -> f32 {
+    var atmosphere_71: AtmosphereParameters;
     var i_1: i32;
     var x_11: f32;
 
-    atmosphere_69 = atmosphere_68;
+    atmosphere_71 = atmosphere_70;
     i_1 = i;
     let _e14 = i_1;
     x_11 = (f32(_e14) / 63f);
-    let _e22 = atmosphere_69;
-    let _e24 = atmosphere_69;
+    let _e22 = atmosphere_71;
+    let _e24 = atmosphere_71;
     let _e27 = x_11;
     let _e29 = x_11;
     return (((_e22.top_radius - _e24.bottom_radius) * _e27) * _e29);
@@ -2073,8 +2080,8 @@ fn InterpolateCoefficients(a_16: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_70: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_72: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
     var x_12: f32;
@@ -2082,65 +2089,65 @@ fn GetCoefficientsAtAltitude(atmosphere_70: AtmosphereParameters, altitude: f32,
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_71 = atmosphere_70;
+    atmosphere_73 = atmosphere_72;
     altitude_1 = altitude;
-    let _e16 = atmosphere_71;
-    let _e18 = atmosphere_71;
+    let _e16 = atmosphere_73;
+    let _e18 = atmosphere_73;
     height = (_e16.top_radius - _e18.bottom_radius);
     let _e22 = altitude_1;
     let _e23 = height;
     x_12 = (sqrt(clamp((_e22 / _e23), 0f, 1f)) * 63f);
     let _e35 = x_12;
     i_2 = min(i32(_e35), 62i);
-    let _e42 = atmosphere_71;
+    let _e42 = atmosphere_73;
     let _e43 = i_2;
     let _e44 = ProfileSampleAltitude(_e42, _e43);
     h0_ = _e44;
     let _e46 = altitude_1;
     let _e47 = h0_;
-    let _e49 = atmosphere_71;
+    let _e49 = atmosphere_73;
     let _e50 = i_2;
     let _e53 = ProfileSampleAltitude(_e49, (_e50 + 1i));
     let _e54 = h0_;
     f_4 = clamp(((_e46 - _e47) / (_e53 - _e54)), 0f, 1f);
     let _e61 = i_2;
-    let _e64 = atmosphere_71.mie_scattering_profile[_e61];
+    let _e64 = atmosphere_73.mie_scattering_profile[_e61];
     let _e65 = i_2;
-    let _e70 = atmosphere_71.mie_scattering_profile[(_e65 + 1i)];
+    let _e70 = atmosphere_73.mie_scattering_profile[(_e65 + 1i)];
     let _e71 = f_4;
     let _e72 = InterpolateCoefficients(_e64, _e70, _e71);
     (*mie_scattering) = _e72;
     let _e73 = i_2;
-    let _e76 = atmosphere_71.rayleigh_scattering_profile[_e73];
+    let _e76 = atmosphere_73.rayleigh_scattering_profile[_e73];
     let _e77 = i_2;
-    let _e82 = atmosphere_71.rayleigh_scattering_profile[(_e77 + 1i)];
+    let _e82 = atmosphere_73.rayleigh_scattering_profile[(_e77 + 1i)];
     let _e83 = f_4;
     let _e84 = InterpolateCoefficients(_e76, _e82, _e83);
     (*rayleigh_scattering) = _e84;
     let _e85 = i_2;
-    let _e88 = atmosphere_71.extinction_profile[_e85];
+    let _e88 = atmosphere_73.extinction_profile[_e85];
     let _e89 = i_2;
-    let _e94 = atmosphere_71.extinction_profile[(_e89 + 1i)];
+    let _e94 = atmosphere_73.extinction_profile[(_e89 + 1i)];
     let _e95 = f_4;
     let _e96 = InterpolateCoefficients(_e88, _e94, _e95);
     return _e96;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_72: AtmosphereParameters, r_51: f32, mu_34: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_73: AtmosphereParameters;
+fn AltitudeAtDistance(atmosphere_74: AtmosphereParameters, r_51: f32, mu_34: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_75: AtmosphereParameters;
     var r_52: f32;
     var mu_35: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_73 = atmosphere_72;
+    atmosphere_75 = atmosphere_74;
     r_52 = r_51;
     mu_35 = mu_34;
     t_10 = t_9;
     r_t_1 = r_t;
     let _e20 = r_52;
-    let _e21 = atmosphere_73;
+    let _e21 = atmosphere_75;
     let _e24 = t_10;
     let _e25 = t_10;
     let _e27 = r_52;
@@ -2151,8 +2158,8 @@ fn AltitudeAtDistance(atmosphere_72: AtmosphereParameters, r_51: f32, mu_34: f32
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, mu_36: f32, d_19: f32) -> vec3<f32> {
-    var atmosphere_75: AtmosphereParameters;
+fn IntegrateSegmentOpticalDepth(atmosphere_76: AtmosphereParameters, r_53: f32, mu_36: f32, d_19: f32) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
     var r_54: f32;
     var mu_37: f32;
     var d_20: f32;
@@ -2166,7 +2173,7 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_75 = atmosphere_74;
+    atmosphere_77 = atmosphere_76;
     r_54 = r_53;
     mu_37 = mu_36;
     d_20 = d_19;
@@ -2181,14 +2188,14 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
             let _e37 = dt;
             let _e38 = k_3;
             t_11 = (_e37 * f32(_e38));
-            let _e42 = atmosphere_75;
+            let _e42 = atmosphere_77;
             let _e43 = r_54;
             let _e44 = mu_37;
             let _e45 = t_11;
             let _e46 = RadiusAtDistance(_e42, _e43, _e44, _e45);
             r_t_2 = _e46;
-            let _e50 = atmosphere_75;
-            let _e51 = atmosphere_75;
+            let _e50 = atmosphere_77;
+            let _e51 = atmosphere_77;
             let _e52 = r_54;
             let _e53 = mu_37;
             let _e54 = t_11;
@@ -2217,29 +2224,29 @@ fn IntegrateSegmentOpticalDepth(atmosphere_74: AtmosphereParameters, r_53: f32, 
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_76: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_21: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
+fn LongSegmentOpticalDepth(atmosphere_78: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_21: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
+    var atmosphere_79: AtmosphereParameters;
     var r_56: f32;
     var mu_39: f32;
     var d_22: f32;
     var ray_r_mu_intersects_ground_16: bool;
     var local_17: vec3<f32>;
 
-    atmosphere_77 = atmosphere_76;
+    atmosphere_79 = atmosphere_78;
     r_56 = r_55;
     mu_39 = mu_38;
     d_22 = d_21;
     ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e21 = atmosphere_77;
+    let _e21 = atmosphere_79;
     if (_e21.transmittance_is_colour != 0i) {
-        let _e25 = atmosphere_77;
+        let _e25 = atmosphere_79;
         let _e26 = r_56;
         let _e27 = mu_39;
         let _e28 = d_22;
         let _e29 = IntegrateSegmentOpticalDepth(_e25, _e26, _e27, _e28);
         local_17 = _e29;
     } else {
-        let _e30 = atmosphere_77;
+        let _e30 = atmosphere_79;
         let _e31 = r_56;
         let _e32 = mu_39;
         let _e33 = d_22;
@@ -2271,8 +2278,8 @@ fn MeanAttenuation(depth: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_23: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_79: AtmosphereParameters;
+fn IntegrateSegment(atmosphere_80: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_23: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var r_58: f32;
     var mu_41: f32;
     var mu_s_25: f32;
@@ -2300,7 +2307,7 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_81 = atmosphere_80;
     r_58 = r_57;
     mu_41 = mu_40;
     mu_s_25 = mu_s_24;
@@ -2320,13 +2327,13 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
             let _e60 = dt_1;
             let _e61 = k_4;
             t_12 = (_e60 * f32(_e61));
-            let _e65 = atmosphere_79;
+            let _e65 = atmosphere_81;
             let _e66 = r_58;
             let _e67 = mu_41;
             let _e68 = t_12;
             let _e69 = RadiusAtDistance(_e65, _e66, _e67, _e68);
             r_t_3 = _e69;
-            let _e71 = atmosphere_79;
+            let _e71 = atmosphere_81;
             let _e72 = r_58;
             let _e73 = mu_41;
             let _e74 = t_12;
@@ -2340,15 +2347,15 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
             let _e85 = r_t_3;
             let _e87 = ClampCosine((((_e78 * _e79) + (_e81 * _e82)) / _e85));
             mu_s_t_2 = _e87;
-            let _e91 = atmosphere_79;
+            let _e91 = atmosphere_81;
             let _e92 = altitude_2;
             let _e97 = GetCoefficientsAtAltitude(_e91, _e92, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e97;
-            let _e99 = atmosphere_79;
+            let _e99 = atmosphere_81;
             let _e100 = r_t_3;
             let _e101 = mu_s_t_2;
             let _e102 = GetOpticalDepthToTopAtmosphereBoundary(_e99, transmittance_texture_7, _e100, _e101);
-            let _e105 = atmosphere_79;
+            let _e105 = atmosphere_81;
             let _e106 = r_t_3;
             let _e107 = mu_s_t_2;
             let _e108 = SunVisibleFraction(_e105, _e106, _e107);
@@ -2417,18 +2424,18 @@ fn IntegrateSegment(atmosphere_78: AtmosphereParameters, transmittance_texture_7
         }
     }
     let _e191 = (*single_rayleigh);
-    let _e192 = atmosphere_79;
+    let _e192 = atmosphere_81;
     (*single_rayleigh) = (_e191 * _e192.solar_irradiance);
     let _e195 = (*single_mie);
-    let _e196 = atmosphere_79;
+    let _e196 = atmosphere_81;
     (*single_mie) = (_e195 * _e196.solar_irradiance);
     let _e199 = optical_depth_1;
     return _e199;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_82: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_83: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -2471,7 +2478,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_83 = atmosphere_82;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -2489,7 +2496,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     }
     let _e37 = camera_to_point;
     view_ray_6 = normalize(_e37);
-    let _e45 = atmosphere_81;
+    let _e45 = atmosphere_83;
     let _e46 = camera_7;
     let _e47 = view_ray_6;
     let _e48 = sun_direction_5;
@@ -2506,12 +2513,12 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     let _e72 = d_25;
     let _e73 = shadow_length_1;
     lit_1 = max((_e72 - max(_e73, 0f)), 0f);
-    let _e80 = atmosphere_81;
+    let _e80 = atmosphere_83;
     let _e81 = r_59;
     let _e82 = mu_42;
     let _e83 = RayIntersectsGround(_e80, _e81, _e82);
     ray_r_mu_intersects_ground_17 = _e83;
-    let _e85 = atmosphere_81;
+    let _e85 = atmosphere_83;
     let _e86 = r_59;
     let _e87 = mu_42;
     let _e88 = lit_1;
@@ -2537,7 +2544,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     let _e136 = lit_direct;
     if (_e136 > 0f) {
         {
-            let _e139 = atmosphere_81;
+            let _e139 = atmosphere_83;
             let _e140 = r_59;
             let _e141 = mu_42;
             let _e142 = mu_s_26;
@@ -2555,7 +2562,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     if ((_e154 > 0f) && (_e157 < _e158)) {
         {
             let _e164 = optical_depth_2;
-            let _e165 = atmosphere_81;
+            let _e165 = atmosphere_83;
             let _e166 = r_p;
             let _e167 = mu_p;
             let _e168 = mu_s_p;
@@ -2569,7 +2576,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     let _e181 = direct;
     if (_e181 < 1f) {
         {
-            let _e184 = atmosphere_81;
+            let _e184 = atmosphere_83;
             let _e185 = r_59;
             let _e186 = mu_42;
             let _e187 = d_25;
@@ -2582,7 +2589,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     }
     let _e194 = optical_depth_2;
     (*transmittance_1) = exp(-(_e194));
-    let _e198 = atmosphere_81;
+    let _e198 = atmosphere_83;
     let _e199 = r_59;
     let _e200 = mu_42;
     let _e201 = mu_s_26;
@@ -2593,20 +2600,20 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     let _e208 = lit_1;
     if (_e208 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e210 = atmosphere_81;
+            let _e210 = atmosphere_83;
             let _e211 = r_59;
             let _e212 = mu_42;
             let _e213 = ray_r_mu_intersects_ground_17;
             let _e214 = DistanceToNearestAtmosphereBoundary(_e210, _e211, _e212, _e213);
             boundary = _e214;
             let _e216 = boundary;
-            let _e218 = atmosphere_81;
+            let _e218 = atmosphere_83;
             let _e219 = r_59;
             let _e220 = mu_42;
             let _e221 = DistanceInsideScatteringRadii(_e218, _e219, _e220);
             let _e223 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e216), _e221), _e223);
-            let _e229 = atmosphere_81;
+            let _e229 = atmosphere_83;
             let _e230 = r_59;
             let _e231 = mu_42;
             let _e232 = mu_s_26;
@@ -2618,7 +2625,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
             let _e244 = boundary;
             if (_e243 < _e244) {
                 {
-                    let _e246 = atmosphere_81;
+                    let _e246 = atmosphere_83;
                     let _e247 = r_59;
                     let _e248 = mu_42;
                     let _e249 = far;
@@ -2626,7 +2633,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
                     r_far = _e250;
                     let _e253 = scattering_3;
                     let _e254 = far_optical_depth;
-                    let _e257 = atmosphere_81;
+                    let _e257 = atmosphere_83;
                     let _e258 = r_far;
                     let _e259 = r_59;
                     let _e260 = mu_42;
@@ -2655,13 +2662,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
             let _e298 = nu_20;
             let _e299 = RayleighPhaseFunction(_e298);
             let _e301 = single_mie_1;
-            let _e302 = atmosphere_81;
+            let _e302 = atmosphere_83;
             let _e303 = nu_20;
             let _e304 = MiePhaseFunction(_e302, _e303);
             return (((_e295 + _e296) * _e299) + (_e301 * _e304));
         }
     }
-    let _e307 = atmosphere_81;
+    let _e307 = atmosphere_83;
     let _e308 = r_59;
     let _e309 = mu_42;
     let _e310 = lit_1;
@@ -2670,7 +2677,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     let _e313 = lit_optical_depth;
     let _e314 = lit_direct;
     lit_transmittance = exp(-(mix(_e312, _e313, vec3(_e314))));
-    let _e321 = atmosphere_81;
+    let _e321 = atmosphere_83;
     let _e322 = r_p;
     let _e323 = mu_p;
     let _e324 = mu_s_p;
@@ -2694,24 +2701,24 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_80: AtmosphereParameters, transmit
     let _e353 = nu_20;
     let _e354 = RayleighPhaseFunction(_e353);
     let _e356 = single_mie_scattering_2;
-    let _e357 = atmosphere_81;
+    let _e357 = atmosphere_83;
     let _e358 = nu_20;
     let _e359 = MiePhaseFunction(_e357, _e358);
     return ((_e352 * _e354) + (_e356 * _e359));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_82: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_84: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_85: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_85 = atmosphere_84;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e22 = atmosphere_83;
+    let _e22 = atmosphere_85;
     let _e23 = camera_9;
     let _e24 = point_3;
     let _e26 = sun_direction_7;
@@ -2720,19 +2727,19 @@ fn GetSkyRadianceToPoint(atmosphere_82: AtmosphereParameters, transmittance_text
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_84: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_85: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_86: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_87: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
     var r_60: f32;
     var mu_s_27: f32;
 
-    atmosphere_85 = atmosphere_84;
+    atmosphere_87 = atmosphere_86;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e21 = atmosphere_85;
+    let _e21 = atmosphere_87;
     let _e22 = point_5;
     let _e24 = ClampRadius(_e21, length(_e22));
     r_60 = _e24;
@@ -2741,7 +2748,7 @@ fn GetSunAndSkyIrradiance(atmosphere_84: AtmosphereParameters, transmittance_tex
     let _e29 = point_5;
     let _e32 = ClampCosine((dot(_e26, _e27) / length(_e29)));
     mu_s_27 = _e32;
-    let _e34 = atmosphere_85;
+    let _e34 = atmosphere_87;
     let _e35 = r_60;
     let _e36 = mu_s_27;
     let _e37 = GetIrradiance(_e34, irradiance_texture_1, _e35, _e36);
@@ -2749,8 +2756,8 @@ fn GetSunAndSkyIrradiance(atmosphere_84: AtmosphereParameters, transmittance_tex
     let _e40 = point_5;
     let _e42 = point_5;
     (*sky_irradiance) = ((_e37 * (1f + (dot(_e39, _e40) / length(_e42)))) * 0.5f);
-    let _e49 = atmosphere_85;
-    let _e51 = atmosphere_85;
+    let _e49 = atmosphere_87;
+    let _e51 = atmosphere_87;
     let _e52 = r_60;
     let _e53 = mu_s_27;
     let _e54 = GetTransmittanceToSun(_e51, transmittance_texture_10, _e52, _e53);
@@ -2759,13 +2766,13 @@ fn GetSunAndSkyIrradiance(atmosphere_84: AtmosphereParameters, transmittance_tex
     return ((_e49.solar_irradiance * _e54) * max(dot(_e56, _e57), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_86: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_87: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_88: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_89: AtmosphereParameters;
 
-    atmosphere_87 = atmosphere_86;
-    let _e12 = atmosphere_87;
-    let _e14 = atmosphere_87;
-    let _e17 = atmosphere_87;
+    atmosphere_89 = atmosphere_88;
+    let _e12 = atmosphere_89;
+    let _e14 = atmosphere_89;
+    let _e17 = atmosphere_89;
     return (_e12.solar_irradiance / vec3(((PI * _e14.sun_angular_radius) * _e17.sun_angular_radius)));
 }
 
