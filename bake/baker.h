@@ -91,7 +91,8 @@ class Baker {
   // horizon, where the single-scattering table's nu slices are about 40
   // degrees of azimuth apart and its linear blend between them reads the
   // peak tens of percent high; so at the low-sun columns (mu_s <
-  // LOW_SUN_MU_S), for the azimuths within 90 degrees of the sun's, it is
+  // LOW_SUN_MU_S, and for the irradiance the two above, which its cubic
+  // reads), for the azimuths within 90 degrees of the sun's, it is
   // integrated along each ring's own ray instead. Per (radius, ring), the
   // sums of SingleScatteringOfRay for the directions j * sunward_azimuths +
   // m: sun column j, azimuth index m from the sun's (the light is symmetric

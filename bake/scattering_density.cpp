@@ -274,9 +274,10 @@ void Baker::ComputeIndirectIrradiance(int order) {
   // the integral of L cos(theta) d cos(theta) d phi.
   std::vector<double> cosines, cosine_weights;
   AppendSkyRule(polar, std::max(1, polar / 2), 0.0, cosines, cosine_weights);
-  // `ring_single`: the first order's light on the rings at the low-sun
-  // columns, where it was integrated along them (see RingSingleScattering);
-  // the irradiance at row y, column `column` reads it.
+  // `ring_single`: the first order's light on the rings at the columns
+  // where the irradiance is integrated (below), integrated along the rings
+  // (see RingSingleScattering); the irradiance at row y, column `column`
+  // reads it.
   RingSingleScattering ring_single;
   auto sky_irradiance = [&](double r, double mu_s, int y = -1, int column = -1) {
     const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
@@ -316,9 +317,9 @@ void Baker::ComputeIndirectIrradiance(int order) {
     return r;
   };
   if (order == 1) {
-    std::vector<double> radii, low_sun(columns.mu_s.begin(), columns.mu_s.begin() + integrated_columns);
+    std::vector<double> radii, integrated(columns.mu_s.begin(), columns.mu_s.begin() + integrated_columns);
     for (int y = 0; y < height; ++y) radii.push_back(row_radius(y));
-    ring_single = SingleScatteringOnRings(radii, std::vector<std::vector<double>>(height, cosines), low_sun, azimuths);
+    ring_single = SingleScatteringOnRings(radii, std::vector<std::vector<double>>(height, cosines), integrated, azimuths);
   }
   tbb::parallel_for(0, height, [&](int y) {
     double r = row_radius(y), mu_s;
