@@ -8,6 +8,11 @@
 
 namespace skybake {
 
+// Floats in the widest SIMD vector the bake's loops use (512 bits). A loop
+// that starts at a multiple of it puts each element in the lane it has when
+// the loop starts at 0, and so computes it the same way to the bit.
+constexpr int kVectorFloats = 16;
+
 // x clamped to [lo, hi], by value (std::clamp returns a reference, which
 // can keep a loop from vectorising).
 inline float ClampFloat(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }

@@ -156,22 +156,34 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
   }
   std::vector<float> mu_s(sun_mu_s.begin(), sun_mu_s.end()), nu(sun_nu.begin(), sun_nu.end());
   std::vector<float> mu_s_k(count);
-  std::vector<char> lit(count);
+  std::vector<char> lit(count), partly_lit(count);
   std::vector<int> shadowed, thick;
   SunAtRadius sun(params_, transmittance);
+  int previous_seen_from = 0;  // the previous sample's seen_from (below)
   for (int k = 0; k <= n; ++k) {
     // The sun's cosine at the sample: (r mu_s + t nu) / r_k.
     const float from_mu_s = float(ray.r / ray.radius[k]), from_nu = float(ray.t[k] / ray.radius[k]);
 #pragma omp simd
     for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
     sun.SetRadius(ray.radius[k]);
-    sun.Evaluate(mu_s_k.data(), count, current.tau, current.visible.data());
+    // Both callers pass the directions in order of mu_s, so those whose sun
+    // is below the horizon lead. A direction
+    // whose sun is wholly hidden at both ends of an interval adds nothing
+    // over it, and a hidden sun's transmittance is never used (the sums
+    // keep it only where the sun is visible at that end), so the loops
+    // start at the last whole vector before the first direction that sees
+    // the sun: every direction keeps its lane, and its value to the bit.
+    const int hidden = sun.Visible(mu_s_k.data(), count, current.visible.data());
+    const int seen_from = hidden / kVectorFloats * kVectorFloats;
+    const int begin = std::min(seen_from, previous_seen_from);
+    sun.OpticalDepth(mu_s_k.data(), seen_from, count, current.tau);
     for (int c = 0; c < 3; ++c) {
       const float* tau = current.tau[c].data();
       float* transmittance = current.transmittance[c].data();
 #pragma omp simd
-      for (int j = 0; j < count; ++j) transmittance[j] = ExpFloat(-tau[j]);
+      for (int j = seen_from; j < count; ++j) transmittance[j] = ExpFloat(-tau[j]);
     }
+    previous_seen_from = seen_from;
     if (k > 0) {
       // Fully lit, optically thin intervals: the exponential trapezoid of
       // each group's integrand, vectorised over the directions.
@@ -181,11 +193,17 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
       // The rest, where any of it is lit: optically thin but partly
       // shadowed (the shadow edge crosses the interval, or the sun's disc is
       // partly hidden), or thick.
-      shadowed.clear(), thick.clear();
-      for (int j = 0; j < count; ++j) {
+      int partly_lit_count = 0;
+#pragma omp simd reduction(+ : partly_lit_count)
+      for (int j = begin; j < count; ++j) {
         const bool fully_lit = previous.visible[j] == 1.0f && current.visible[j] == 1.0f;
         lit[j] = thin && fully_lit;
-        if (!lit[j] && (previous.visible[j] > 0.0f || current.visible[j] > 0.0f)) (thin ? shadowed : thick).push_back(j);
+        partly_lit[j] = !lit[j] && (previous.visible[j] > 0.0f || current.visible[j] > 0.0f);
+        partly_lit_count += partly_lit[j];
+      }
+      shadowed.clear(), thick.clear();
+      for (int j = begin; j < count && partly_lit_count > 0; ++j) {
+        if (partly_lit[j]) (thin ? shadowed : thick).push_back(j), --partly_lit_count;
       }
       for (int g = 0; g < groups; ++g) {
         for (int c = 0; c < 3; ++c) {
@@ -199,14 +217,14 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
           // (Two loops: a choice between them inside one keeps it from vectorising.)
           if (exponential) {
 #pragma omp simd
-            for (int j = 0; j < count; ++j) {
+            for (int j = begin; j < count; ++j) {
               const float fa = base_a * sun_a[j], fb = base_b * sun_b[j];
               const float integral = ExponentialTrapezoidFloat(fa, fb, ratio - (tau_b[j] - tau_a[j]), h);
               sum[j] += lit[j] ? integral * phase[j] : 0.0f;
             }
           } else {
 #pragma omp simd
-            for (int j = 0; j < count; ++j) {
+            for (int j = begin; j < count; ++j) {
               const float integral = 0.5f * h * (base_a * sun_a[j] + base_b * sun_b[j]);
               sum[j] += lit[j] ? integral * phase[j] : 0.0f;
             }

@@ -116,25 +116,41 @@ class SunAtRadius {
   // For `count` sun cosines: the optical depth per channel into tau[c][j]
   // and the visible fraction into visible[j].
   void Evaluate(const float* mu_s, int count, std::vector<float> (&tau)[3], float* visible) {
-    const float r = r_, c = c_, d_min = d_min_, scale = scale_;
+    Visible(mu_s, count, visible);
+    OpticalDepth(mu_s, 0, count, tau);
+  }
+
+  // The visible fraction of the sun's disc into visible[j], for `count` sun
+  // cosines; returns how many of the first ones see none of it.
+  int Visible(const float* mu_s, int count, float* visible) const {
     const float horizon = horizon_cosine_, half_disc = half_disc_;
+#pragma omp simd
+    for (int j = 0; j < count; ++j) visible[j] = glsl_float::SunVisibleFractionAboveHorizon(mu_s[j], horizon, half_disc);
+    int hidden = 0;
+    while (hidden < count && visible[hidden] == 0.0f) ++hidden;
+    return hidden;
+  }
+
+  // The optical depth per channel into tau[c][j], for the sun cosines j in
+  // [begin, count).
+  void OpticalDepth(const float* mu_s, int begin, int count, std::vector<float> (&tau)[3]) {
+    const float r = r_, c = c_, d_min = d_min_, scale = scale_;
     const float last = float(transmittance_.width - 1);
     const int last_left = transmittance_.width - 2;
     if (int(left_.size()) < count) left_.resize(count), weight_.resize(count);
     int* left = left_.data();
     float* weight = weight_.data();
 #pragma omp simd
-    for (int j = 0; j < count; ++j) {
+    for (int j = begin; j < count; ++j) {
       const float x = TransmittanceTableX(r, c, d_min, scale, mu_s[j], last);
       left[j] = std::min(static_cast<int>(x), last_left);
       weight[j] = x - float(left[j]);
-      visible[j] = glsl_float::SunVisibleFractionAboveHorizon(mu_s[j], horizon, half_disc);
     }
     for (int channel = 0; channel < 3; ++channel) {
       const float* row = row_[channel].data();
       float* out = tau[channel].data();
 #pragma omp simd
-      for (int j = 0; j < count; ++j) out[j] = row[left[j]] + weight[j] * (row[left[j] + 1] - row[left[j]]);
+      for (int j = begin; j < count; ++j) out[j] = row[left[j]] + weight[j] * (row[left[j] + 1] - row[left[j]]);
     }
   }
 
