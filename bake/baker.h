@@ -125,6 +125,7 @@ class Baker {
   struct MuSFall {
     std::vector<float> log_ratio, inverse_ratio_minus_one;
     int falling_columns = 0;  // the columns with mu_s < 0, lowest first (not the last)
+    float steady_mu_s = 0.0f;  // mu_s of the first column that does not fall
     std::vector<float> lowest_log_slope, lowest_log_curvature;
   };
   MuSFall MuSFallOf(const Texture& density, bool between_columns) const;

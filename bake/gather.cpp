@@ -21,6 +21,9 @@ namespace {
 // The largest ln of the ratio of J between neighbouring columns that
 // MuSFall keeps (a fall by 5e8).
 constexpr float kLargestLogRatio = 20.0f;
+// Margin in mu_s (about 0.005 texels of the columns around the horizon) by
+// which a sun is taken to be above the first column that does not fall.
+constexpr float kSteadyMargin = 1e-4f;
 // The weight of the right column at position f in [0, 1] (in texels from
 // the left one) for a pair whose J falls by exp(log_ratio) from right to
 // left: (exp(f L) - 1) / (exp(L) - 1), which reads J = a exp(f L) exactly
@@ -38,6 +41,7 @@ Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) co
   while (between_columns && fall.falling_columns < mu_s_size - 1 && columns.mu_s[fall.falling_columns] < 0.0) {
     ++fall.falling_columns;
   }
+  fall.steady_mu_s = float(columns.mu_s[fall.falling_columns]);
   const int columns_per_row = nu_size * fall.falling_columns;
   fall.log_ratio.assign(std::size_t(density.height) * density.depth * columns_per_row, 0.0f);
   fall.inverse_ratio_minus_one.assign(fall.log_ratio.size(), 0.0f);
@@ -236,8 +240,19 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         const float* log_ratio = &fall->log_ratio[fall_rows[i]];
         const float* inverse = &fall->inverse_ratio_minus_one[fall_rows[i]];
         const int falling = fall->falling_columns;
+        // The sun's cosine at the sample is at most mu_s r / r_k + t / r_k,
+        // so from `falling_end` on (rounded up to a whole vector, so that
+        // each direction keeps its lane) no direction's sun is below the
+        // first column that does not fall (less a margin far above the float
+        // position's rounding), and FallWeight would return mu_s_weight.
+        const float steady = fall->steady_mu_s + kSteadyMargin;
+        int falling_end = static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(), (steady + from_nu) / from_mu_s) -
+                                           mu_s.begin());
+        falling_end = std::min(count, (falling_end + kVectorFloats - 1) / kVectorFloats * kVectorFloats);
+        std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.end(), fall_weight_a.begin() + falling_end);
+        std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.end(), fall_weight_b.begin() + falling_end);
 #pragma omp simd
-        for (int j = 0; j < count; ++j) {
+        for (int j = 0; j < falling_end; ++j) {
           const int left = mu_s_left[j];
           const int column = left < falling ? left : falling - 1;  // any, when the pair does not fall
           const int a = fall_row0[j] + column, b = fall_row1[j] + column;
