@@ -123,8 +123,9 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   const int rows = image.height * image.depth;  // the atlas
   Imf::Header header(image.width, rows);
   if (image.exr_compression == ExrCompression::kOther) throw InternalError("EXR encode: no compression chosen");
-  header.compression() =
-      image.exr_compression == ExrCompression::kZip ? Imf::ZIP_COMPRESSION : Imf::NO_COMPRESSION;
+  header.compression() = image.exr_compression == ExrCompression::kZip   ? Imf::ZIP_COMPRESSION
+                         : image.exr_compression == ExrCompression::kRle ? Imf::RLE_COMPRESSION
+                                                                         : Imf::NO_COMPRESSION;
   const bool half = image.pixel_type == PixelType::kHalf;
   for (const std::string& name : image.channel_names) {
     header.channels().insert(name, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
@@ -151,15 +152,15 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   }
   MemoryOStream stream;
   try {
-    // Zip compresses blocks of scanlines on OpenEXR's pool, one thread per
-    // core, sized once for the process (the blocks are written in order: the
-    // same bytes as with one thread).
-    static const int kZipThreads = [] {
+    // A codec compresses blocks of scanlines on OpenEXR's pool, one thread
+    // per core, sized once for the process (the blocks are written in
+    // order: the same bytes as with one thread).
+    static const int kCodecThreads = [] {
       const int threads = tbb::info::default_concurrency();
       IlmThread::ThreadPool::globalThreadPool().setNumThreads(threads);
       return threads;
     }();
-    Imf::OutputFile file(stream, header, image.exr_compression == ExrCompression::kZip ? kZipThreads : 0);
+    Imf::OutputFile file(stream, header, image.exr_compression == ExrCompression::kNone ? 0 : kCodecThreads);
     Imf::FrameBuffer frame;
     const std::size_t bytes_per_value = half ? 2 : 4;
     for (int c = 0; c < channels; ++c) {
@@ -194,8 +195,9 @@ TableImage DecodeExr(const std::vector<std::uint8_t>& bytes, const std::string& 
     const long long rows = static_cast<long long>(window.max.y) - window.min.y + 1;
     if (width <= 0 || rows <= 0) throw IoError(source + ": corrupt EXR: empty data window");
     image.exr_compression = header.compression() == Imf::ZIP_COMPRESSION ? ExrCompression::kZip
-                            : header.compression() == Imf::NO_COMPRESSION ? ExrCompression::kNone
-                                                                          : ExrCompression::kOther;
+                            : header.compression() == Imf::RLE_COMPRESSION ? ExrCompression::kRle
+                            : header.compression() == Imf::NO_COMPRESSION  ? ExrCompression::kNone
+                                                                           : ExrCompression::kOther;
     for (auto it = header.begin(); it != header.end(); ++it) {
       if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
         if (std::strncmp(it.name(), "skybake.", 8) == 0) image.metadata[it.name()] = text->value();
@@ -352,6 +354,7 @@ std::string TableImage::StorageName() const {
            (ktx2_zstd_level != 0 ? ", zstd" : "");
   }
   const char* compression = exr_compression == ExrCompression::kZip    ? "ZIP"
+                            : exr_compression == ExrCompression::kRle  ? "RLE"
                             : exr_compression == ExrCompression::kNone ? "uncompressed"
                                                                        : "other compression";
   return std::string("EXR ") + ToString(pixel_type) + " " + compression;
@@ -377,9 +380,13 @@ void ChooseExrCompression(TableImage* image) {
   }
   sample.exr_compression = ExrCompression::kNone;
   const double stored = double(EncodeExr(sample).size());
-  sample.exr_compression = ExrCompression::kZip;
-  const double zipped = double(EncodeExr(sample).size());
-  image->exr_compression = zipped <= (1.0 - kExrZipMinimumSaving) * stored ? ExrCompression::kZip : ExrCompression::kNone;
+  auto pays = [&](ExrCompression codec) {
+    sample.exr_compression = codec;
+    return double(EncodeExr(sample).size()) <= (1.0 - kExrMinimumSaving) * stored;
+  };
+  image->exr_compression = pays(ExrCompression::kRle)   ? ExrCompression::kRle
+                           : pays(ExrCompression::kZip) ? ExrCompression::kZip
+                                                        : ExrCompression::kNone;
 }
 
 void ChooseFileStorage(TableImage* image, int ktx2_zstd_level) {

@@ -5,7 +5,7 @@
 // the file stores them, x fastest, then y, then z. Both formats carry the same
 // "skybake.*" metadata (EXR string attributes, KTX2 key/value data).
 //
-// OpenEXR: scanline, ZIP or uncompressed (ChooseExrCompression), one
+// OpenEXR: scanline, RLE, ZIP or uncompressed (ChooseExrCompression), one
 // channel per name, float32 or half.
 // A 3D table is a vertical atlas of its depth slices (image row = z * height
 // + y); the "skybake.size" attribute ("WxHxD") says how to unstack it.
@@ -56,7 +56,7 @@ inline constexpr const char kExrGeneratorKey[] = "skybake.generator";
 
 // How an OpenEXR file's pixels are stored (both lossless). kOther: read from
 // a file written with another of OpenEXR's codecs.
-enum class ExrCompression { kZip, kNone, kOther };
+enum class ExrCompression { kZip, kRle, kNone, kOther };
 
 struct TableImage {
   FileFormat format = FileFormat::kExr;
@@ -77,18 +77,21 @@ struct TableImage {
 
   std::size_t TexelCount() const { return std::size_t(width) * height * depth; }
   // "VK_FORMAT_R32G32B32A32_SFLOAT" (", zstd" appended when supercompressed)
-  // for KTX2; for OpenEXR "EXR float ZIP" or "EXR float uncompressed" (half
-  // likewise).
+  // for KTX2; for OpenEXR "EXR float RLE", "EXR float ZIP" or "EXR float
+  // uncompressed" (half likewise).
   std::string StorageName() const;
 };
 
-// ZIP where it pays: an OpenEXR image is stored ZIP-compressed if a sample
-// of its rows (up to 16 of OpenEXR's 16-row ZIP blocks, spread evenly)
-// shrinks by at least kExrZipMinimumSaving, else uncompressed. Tables whose
-// low mantissa bits are noise shrink by a few percent at a cost of about
-// 20 ns per byte (the default scattering table: 3 % for 0.25 s), where
-// smooth ones shrink by a fifth or more. No effect on KTX2 images.
-inline constexpr double kExrZipMinimumSaving = 0.10;
+// The fastest codec that pays: an OpenEXR image is stored with OpenEXR's
+// run-length coding (RLE, one pass over the byte-reordered differences of
+// neighbouring values) if a sample of its rows (up to 16 of OpenEXR's
+// 16-row ZIP blocks, spread evenly) shrinks by at least kExrMinimumSaving
+// with it, else ZIP-compressed if it shrinks by that much with ZIP, else
+// uncompressed. Tables whose low mantissa bits are noise shrink by a few
+// percent either way, at a cost of about 20 ns per byte for ZIP; smooth ones
+// shrink by a sixth or more with RLE at a fraction of ZIP's cost
+// (docs/benchmark.md). No effect on KTX2 images.
+inline constexpr double kExrMinimumSaving = 0.10;
 void ChooseExrCompression(TableImage* image);
 
 // The storage of a file about to be written: for OpenEXR the compression
