@@ -284,15 +284,14 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
       for (auto& channel : kind) channel.assign(pair_count, 0.0f);
     }
     std::vector<double> t_start(pair_count), length(pair_count);
-    // The pairs come interval by interval: runs[i] to runs[i + 1] share one.
-    std::vector<int> runs;
+    // Per pair, the offset of its interval's bases in piece_base.
+    std::vector<int> base_offset(pair_count);
     for (int l = 0; l < pair_count; ++l) {
       const int interval = pieces.interval[l];
       t_start[l] = ray.t[interval], length[l] = ray.t[interval + 1] - ray.t[interval];
       half_piece[l] = float(0.5 * length[l] / sub);
-      if (l == 0 || interval != pieces.interval[l - 1]) runs.push_back(l);
+      base_offset[l] = interval * groups * 3 * (sub + 1);
     }
-    runs.push_back(pair_count);
     // Per group, the phase ratio of each pair's direction, in pair order.
     std::vector<std::vector<float>> pair_phase(groups, std::vector<float>(pair_count));
     for (int g = 0; g < groups; ++g) {
@@ -327,14 +326,11 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
           const float *sun_a = start.transmittance[c].data(), *sun_b = end.transmittance[c].data();
           const float* phase = pair_phase[g].data();
           float* sum = piece_sums[g == mie ? 1 : 0][c].data();
-          for (std::size_t run = 0; run + 1 < runs.size(); ++run) {
-            const int interval = pieces.interval[runs[run]];
-            const float* ends = &piece_base[((std::size_t(interval) * groups + g) * 3 + c) * (sub + 1)];
-            const float base_a = ends[i - 1], base_b = ends[i];
+          const float* ends = &piece_base[(std::size_t(g) * 3 + c) * (sub + 1) + i];
 #pragma omp simd
-            for (int l = runs[run]; l < runs[run + 1]; ++l) {
-              sum[l] += half_piece[l] * (base_a * sun_a[l] + base_b * sun_b[l]) * phase[l];
-            }
+          for (int l = 0; l < pair_count; ++l) {
+            const float base_a = ends[base_offset[l] - 1], base_b = ends[base_offset[l]];
+            sum[l] += half_piece[l] * (base_a * sun_a[l] + base_b * sun_b[l]) * phase[l];
           }
         }
       }

@@ -55,6 +55,13 @@ inline SunDirections RaySunDirections(const SunColumns& columns, double mu) {
       directions.of_texel[x] = static_cast<int>(directions.nu.size()) - 1;
     }
   }
+  // Padded with copies of the last direction to whole vectors, so that the
+  // loops over the directions leave no scalar remainder (no texel reads the
+  // copies).
+  while (directions.mu_s.size() % kVectorFloats != 0) {
+    directions.mu_s.push_back(directions.mu_s.back());
+    directions.nu.push_back(directions.nu.back());
+  }
   return directions;
 }
 
