@@ -51,6 +51,19 @@ void AppendDensityRule(int polar, double horizon, std::vector<double>& cosines, 
   AppendSkyRule(polar - polar / 2, std::max(1, polar / 2), horizon, cosines, weights);
 }
 
+// The cosines and sines of a sphere rule's azimuths (m + 1/2) 2 pi / count,
+// m = 0 ... count - 1, the same on every ring: computed once per rule.
+struct RingAzimuths {
+  std::vector<double> cos, sin;
+  explicit RingAzimuths(int count) {
+    for (int m = 0; m < count; ++m) {
+      const double phi = (m + 0.5) * (2.0 * kPi / count);
+      cos.push_back(std::cos(phi));
+      sin.push_back(std::sin(phi));
+    }
+  }
+};
+
 }  // namespace
 
 vec3 Baker::DirectIrradiance(double r, double mu_s) const {
@@ -125,7 +138,7 @@ Baker::RingSingleScattering Baker::SingleScatteringOnRings(const std::vector<dou
   // by 0.2 %).
   const int ray_samples =
       std::max(8, (TableRestricted() ? settings_.scattering_range->atmosphere_ray_samples : settings_.ray_samples) / 2);
-  const double d_phi = 2.0 * kPi / azimuths;
+  const RingAzimuths azimuth(azimuths);
   const ChannelPlanes transmittance(transmittance_);
   result.of_ring.resize(radii.size() * result.rings);
   tbb::parallel_for(0, static_cast<int>(result.of_ring.size()), [&](int index) {
@@ -138,7 +151,7 @@ Baker::RingSingleScattering Baker::SingleScatteringOnRings(const std::vector<dou
       const double sun_sin = std::sqrt(std::max(0.0, 1.0 - column_mu_s * column_mu_s));
       for (int m = 0; m < result.sunward_azimuths; ++m) {
         mu_s.push_back(column_mu_s);
-        nu.push_back(glsl::ClampCosine(std::cos((m + 0.5) * d_phi) * sin_theta * sun_sin + cos_theta * column_mu_s));
+        nu.push_back(glsl::ClampCosine(azimuth.cos[m] * sin_theta * sun_sin + cos_theta * column_mu_s));
       }
     }
     const RaySamples ray = SampleRay(r, cos_theta, glsl::RayIntersectsGround(params_, r, cos_theta), ray_samples);
@@ -167,6 +180,7 @@ void Baker::ComputeScatteringDensity(int order) {
   const int nu_size = grid.scattering_nu_size, mu_size = grid.scattering_mu_size;
   const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
   const double d_phi = 2.0 * kPi / azimuths;
+  const RingAzimuths azimuth(azimuths);
   const int groups = static_cast<int>(medium_.groups().size());
   const vec3 albedo_over_pi = medium_.atmosphere().ground_albedo / kPi;
   const glsl::sampler2D transmittance{&transmittance_};
@@ -210,8 +224,7 @@ void Baker::ComputeScatteringDensity(int order) {
       }
       const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
       for (int m = 0; m < azimuths; ++m) {
-        double phi = (m + 0.5) * d_phi;
-        vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+        vec3 omega(azimuth.cos[m] * sin_theta, azimuth.sin[m] * sin_theta, cos_theta);
         double nu = glsl::ClampCosine(glm::dot(omega, sun));
         const std::optional<vec3> exact = RingIncident(ring_single, z, l, mu_s_index, m, nu);
         vec3 incident = exact ? *exact : incident_ring.At(nu);
@@ -270,6 +283,7 @@ void Baker::ComputeIndirectIrradiance(int order) {
   const int width = irradiance_.width, height = irradiance_.height;
   const int polar = settings_.sphere_samples, azimuths = 4 * settings_.sphere_samples;
   const double d_phi = 2.0 * kPi / azimuths;
+  const RingAzimuths azimuth(azimuths);
   // Polar nodes in cos(theta) over the upper hemisphere: the irradiance is
   // the integral of L cos(theta) d cos(theta) d phi.
   std::vector<double> cosines, cosine_weights;
@@ -286,8 +300,7 @@ void Baker::ComputeIndirectIrradiance(int order) {
       const double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
       const IncidentAlongNu incident_ring(*this, order, r, cos_theta, mu_s, false);
       for (int m = 0; m < azimuths; ++m) {
-        double phi = (m + 0.5) * d_phi;
-        vec3 omega(std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta);
+        vec3 omega(azimuth.cos[m] * sin_theta, azimuth.sin[m] * sin_theta, cos_theta);
         double nu = glsl::ClampCosine(glm::dot(omega, sun));
         const std::optional<vec3> exact =
             column >= 0 ? RingIncident(ring_single, y, static_cast<int>(l), column, m, nu) : std::nullopt;
