@@ -223,8 +223,17 @@ void Baker::ComputeScatteringDensity(int order) {
         ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
       }
       const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
+      const std::size_t ring_start = radiance.size();
       for (int m = 0; m < azimuths; ++m) {
         vec3 omega(azimuth.cos[m] * sin_theta, azimuth.sin[m] * sin_theta, cos_theta);
+        directions.push_back(omega);
+        solid_angles.push_back(cosine_weights[l] * d_phi);
+        // The light is symmetric about the sun's plane: the second half of
+        // the ring's azimuths (2 pi - phi) has the first half's.
+        if (m >= azimuths / 2) {
+          radiance.push_back(radiance[ring_start + azimuths - 1 - m]);
+          continue;
+        }
         double nu = glsl::ClampCosine(glm::dot(omega, sun));
         const std::optional<vec3> exact = RingIncident(ring_single, z, l, mu_s_index, m, nu);
         vec3 incident = exact ? *exact : incident_ring.At(nu);
@@ -233,9 +242,7 @@ void Baker::ComputeScatteringDensity(int order) {
           double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
           incident += ground_transmittance * albedo_over_pi * GroundIrradiance(order - 1, ground_mu_s);
         }
-        directions.push_back(omega);
         radiance.push_back(incident);
-        solid_angles.push_back(cosine_weights[l] * d_phi);
       }
     }
 
