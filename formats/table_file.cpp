@@ -378,15 +378,19 @@ void ChooseExrCompression(TableImage* image) {
     sample.values.insert(sample.values.end(), begin, begin + std::ptrdiff_t(count * row_values));
     sample.height += count;
   }
-  sample.exr_compression = ExrCompression::kNone;
-  const double stored = double(EncodeExr(sample).size());
-  auto pays = [&](ExrCompression codec) {
+  auto size = [&](ExrCompression codec) {
     sample.exr_compression = codec;
-    return double(EncodeExr(sample).size()) <= (1.0 - kExrMinimumSaving) * stored;
+    return double(EncodeExr(sample).size());
   };
-  image->exr_compression = pays(ExrCompression::kRle)   ? ExrCompression::kRle
-                           : pays(ExrCompression::kZip) ? ExrCompression::kZip
-                                                        : ExrCompression::kNone;
+  const double stored = size(ExrCompression::kNone);
+  const double rle_saving = 1.0 - size(ExrCompression::kRle) / stored;
+  const double zip_saving = 1.0 - size(ExrCompression::kZip) / stored;
+  const bool rle_pays = rle_saving >= kExrMinimumSaving;
+  if (zip_saving >= kExrMinimumSaving && (!rle_pays || zip_saving >= rle_saving + kExrMinimumSaving)) {
+    image->exr_compression = ExrCompression::kZip;
+  } else {
+    image->exr_compression = rle_pays ? ExrCompression::kRle : ExrCompression::kNone;
+  }
 }
 
 void ChooseFileStorage(TableImage* image, int ktx2_zstd_level) {

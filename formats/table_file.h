@@ -85,12 +85,13 @@ struct TableImage {
 // The fastest codec that pays: an OpenEXR image is stored with OpenEXR's
 // run-length coding (RLE, one pass over the byte-reordered differences of
 // neighbouring values) if a sample of its rows (up to 16 of OpenEXR's
-// 16-row ZIP blocks, spread evenly) shrinks by at least kExrMinimumSaving
-// with it, else ZIP-compressed if it shrinks by that much with ZIP, else
-// uncompressed. Tables whose low mantissa bits are noise shrink by a few
-// percent either way, at a cost of about 20 ns per byte for ZIP; smooth ones
-// shrink by a sixth or more with RLE at a fraction of ZIP's cost
-// (docs/benchmark.md). No effect on KTX2 images.
+// 16-row ZIP blocks, spread evenly) shrinks by at least kExrMinimumSaving of
+// its size with it, ZIP-compressed if ZIP shrinks it by that much and by
+// that much more than RLE, else uncompressed. Float tables whose low
+// mantissa bits are noise shrink by a few percent with either, at about 20
+// ns per byte for ZIP; RLE takes the runs of zero of dark texels at a
+// fraction of ZIP's cost, and ZIP what repeats beyond runs, as in half
+// tables (docs/benchmark.md). No effect on KTX2 images.
 inline constexpr double kExrMinimumSaving = 0.10;
 void ChooseExrCompression(TableImage* image);
 
