@@ -167,12 +167,12 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
     for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
     sun.SetRadius(ray.radius[k]);
     // Both callers pass the directions in order of mu_s, so those whose sun
-    // is below the horizon lead. A direction
-    // whose sun is wholly hidden at both ends of an interval adds nothing
-    // over it, and a hidden sun's transmittance is never used (the sums
-    // keep it only where the sun is visible at that end), so the loops
-    // start at the last whole vector before the first direction that sees
-    // the sun: every direction keeps its lane, and its value to the bit.
+    // is below the horizon lead. A direction whose sun is wholly hidden at
+    // both ends of an interval adds nothing over it, and a hidden sun's
+    // transmittance is never used (the sums keep it only where the sun is
+    // visible at that end), so the loops start at the last whole vector
+    // before the first direction that sees the sun: every direction keeps
+    // its lane, and its value to the bit.
     const int hidden = sun.Visible(mu_s_k.data(), count, current.visible.data());
     const int seen_from = hidden / kVectorFloats * kVectorFloats;
     const int begin = std::min(seen_from, previous_seen_from);

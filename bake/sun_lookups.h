@@ -34,7 +34,7 @@ struct SunColumns {
 // grid: its (mu_s, nu) texels, nu clamped as GetScatteringTexel clamps it to
 // the range that mu and mu_s allow, with the slices that clamping gave the
 // same nu merged, as their integrals are the same; in order of mu_s (the
-// lowest sun first).
+// lowest sun first), padded to whole vectors.
 struct SunDirections {
   std::vector<double> mu_s, nu;  // per direction
   std::vector<int> of_texel;     // texel x -> direction
