@@ -80,7 +80,7 @@ class Baker {
   RaySingleScattering SingleScatteringOfRay(const RaySamples& ray, const std::vector<double>& mu_s,
                                             const std::vector<double>& nu, const ChannelPlanes& transmittance) const;
   // Single scattering over interval k of a ray for one sun direction, in
-  // double, for the intervals SingleScatteringAlongRay does not vectorise:
+  // double, for the intervals SingleScatteringOfRay does not vectorise:
   // optically thick, partly shadowed or crossed by the shadow edge.
   // phase_ratio: per group, its phase over the Rayleigh phase at nu.
   void SingleScatteringInterval(const RaySamples& ray, int k, double mu_s, double nu, const double* phase_ratio,

@@ -209,10 +209,14 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
 #pragma omp simd
       for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
       mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data());
-      // The sun's cosine at the sample is at least mu_s r / r_k - t / r_k.
-      below_end = fall ? static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(),
-                                                           (lowest_mu_s + from_nu) / from_mu_s) - mu_s.begin())
-                       : 0;
+      // The sun's cosine at the sample, (mu_s r + nu t) / r_k, is at least
+      // mu_s r / r_k - t / r_k: from the first direction this returns on,
+      // every direction's sun at the sample is at or above `cosine`.
+      auto surely_at_or_above = [&](float cosine) {
+        return static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(), (cosine + from_nu) / from_mu_s) -
+                                mu_s.begin());
+      };
+      below_end = fall ? surely_at_or_above(lowest_mu_s) : 0;
       int below_count = 0;
 #pragma omp simd reduction(+ : below_count)
       for (int j = 0; j < below_end; ++j) below_count += mu_s_k[j] < lowest_mu_s ? 1 : 0;
@@ -240,14 +244,11 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         const float* log_ratio = &fall->log_ratio[fall_rows[i]];
         const float* inverse = &fall->inverse_ratio_minus_one[fall_rows[i]];
         const int falling = fall->falling_columns;
-        // The sun's cosine at the sample is at most mu_s r / r_k + t / r_k,
-        // so from `falling_end` on (rounded up to a whole vector, so that
-        // each direction keeps its lane) no direction's sun is below the
-        // first column that does not fall (less a margin far above the float
+        // From `falling_end` on (rounded up to a whole vector, so that each
+        // direction keeps its lane) no direction's sun is below the first
+        // column that does not fall (plus a margin far above the float
         // position's rounding), and FallWeight would return mu_s_weight.
-        const float steady = fall->steady_mu_s + kSteadyMargin;
-        int falling_end = static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(), (steady + from_nu) / from_mu_s) -
-                                           mu_s.begin());
+        int falling_end = surely_at_or_above(fall->steady_mu_s + kSteadyMargin);
         falling_end = std::min(count, (falling_end + kVectorFloats - 1) / kVectorFloats * kVectorFloats);
         std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.end(), fall_weight_a.begin() + falling_end);
         std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.end(), fall_weight_b.begin() + falling_end);

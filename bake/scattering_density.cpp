@@ -186,15 +186,17 @@ void Baker::ComputeScatteringDensity(int order) {
   const glsl::sampler2D transmittance{&transmittance_};
 
   const SunColumns columns(grid);
+  // Per r row, its radius and the polar nodes of its sphere rule.
+  std::vector<double> radii;
+  std::vector<std::vector<double>> ring_cosines(r_size), ring_weights(r_size);
+  for (int z = 0; z < r_size; ++z) {
+    radii.push_back(GetScatteringTexel(grid, 0, 0, z).r);
+    AppendDensityRule(polar, glsl::HorizonZenithCosine(params_.bottom_radius, radii.back()), ring_cosines[z],
+                      ring_weights[z]);
+  }
   RingSingleScattering ring_single;
   if (order == 2) {
-    std::vector<double> radii, low_sun;
-    std::vector<std::vector<double>> ring_cosines(r_size);
-    for (int z = 0; z < r_size; ++z) {
-      radii.push_back(GetScatteringTexel(grid, 0, 0, z).r);
-      std::vector<double> weights;
-      AppendDensityRule(polar, glsl::HorizonZenithCosine(params_.bottom_radius, radii.back()), ring_cosines[z], weights);
-    }
+    std::vector<double> low_sun;
     for (int j = 0; j < mu_s_size && columns.mu_s[j] < glsl::LOW_SUN_MU_S; ++j) low_sun.push_back(columns.mu_s[j]);
     ring_single = SingleScatteringOnRings(radii, ring_cosines, low_sun, azimuths);
   }
@@ -206,8 +208,8 @@ void Baker::ComputeScatteringDensity(int order) {
     const vec3 zenith(0.0, 0.0, 1.0);
     const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
 
-    std::vector<double> cosines, cosine_weights;
-    AppendDensityRule(polar, glsl::HorizonZenithCosine(params_.bottom_radius, r), cosines, cosine_weights);
+    const std::vector<double>& cosines = ring_cosines[z];
+    const std::vector<double>& cosine_weights = ring_weights[z];
 
     // Incoming radiance (of the previous order) from every direction.
     std::vector<vec3> directions, radiance;

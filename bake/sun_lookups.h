@@ -120,13 +120,6 @@ class SunAtRadius {
     half_disc_ = float(sin_horizon * p.sun_angular_radius);
   }
 
-  // For `count` sun cosines: the optical depth per channel into tau[c][j]
-  // and the visible fraction into visible[j].
-  void Evaluate(const float* mu_s, int count, std::vector<float> (&tau)[3], float* visible) {
-    Visible(mu_s, count, visible);
-    OpticalDepth(mu_s, 0, count, tau);
-  }
-
   // The visible fraction of the sun's disc into visible[j], for `count` sun
   // cosines; returns how many of the first ones see none of it.
   int Visible(const float* mu_s, int count, float* visible) const {
@@ -223,9 +216,8 @@ class MuSCoordinate {
   explicit MuSCoordinate(const AtmosphereParameters& grid) {
     const double top = grid.top_radius, bottom = grid.bottom_radius;
     const double d_min = top - bottom, d_max = glsl::HorizonDistanceAtTop(grid);
-    const double big_d = glsl::DistanceToTopAtmosphereBoundary(grid, bottom, grid.scattering_mu_s_min);
     bottom_ = float(bottom), c_ = float((top - bottom) * (top + bottom)), d_min_ = float(d_min);
-    inverse_span_ = float(1.0 / (d_max - d_min)), inverse_a_ = float((d_max - d_min) / (big_d - d_min));
+    inverse_span_ = float(1.0 / (d_max - d_min)), inverse_a_ = float(1.0 / glsl::GetScatteringLowestSunDistance(grid));
     last_ = float(grid.scattering_mu_s_size - 1), last_left_ = grid.scattering_mu_s_size - 2;
     scale_ = float((grid.scattering_mu_s_size - 1) / glsl::GetScatteringUnitMuS(grid, grid.scattering_mu_s_max));
   }

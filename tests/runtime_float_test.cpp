@@ -172,7 +172,8 @@ TEST(RuntimeFloat, HoistedSunLookupsReadWhereTheRuntimeReads) {
     for (int c = 0; c < 3; ++c) tau[c].resize(count), tau_points[c].resize(count);
     std::vector<float> visible(count), visible_points(count);
     at_radius.SetRadius(r);
-    at_radius.Evaluate(mu_s.data(), count, tau, visible.data());
+    at_radius.Visible(mu_s.data(), count, visible.data());
+    at_radius.OpticalDepth(mu_s.data(), 0, count, tau);
     at_points.Evaluate(radii.data(), mu_s.data(), count, tau_points, visible_points.data());
     for (int j = 0; j < count; ++j) {
       const glsl::vec3 exact =
