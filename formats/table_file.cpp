@@ -33,6 +33,24 @@ namespace {
 // otherwise ask for terabytes); skybake's largest default table has 4.2 million.
 constexpr std::size_t kMaxValues = std::size_t(1) << 28;
 
+// The OpenEXR codecs skybake writes and names, and OpenEXR's for each.
+struct ExrCodec {
+  ExrCompression compression;
+  Imf::Compression imf;
+  const char* name;
+};
+constexpr ExrCodec kExrCodecs[] = {{ExrCompression::kZip, Imf::ZIP_COMPRESSION, "ZIP"},
+                                   {ExrCompression::kRle, Imf::RLE_COMPRESSION, "RLE"},
+                                   {ExrCompression::kNone, Imf::NO_COMPRESSION, "uncompressed"}};
+
+// The entry of `compression`; nullptr for kOther.
+const ExrCodec* FindExrCodec(ExrCompression compression) {
+  for (const ExrCodec& codec : kExrCodecs) {
+    if (codec.compression == compression) return &codec;
+  }
+  return nullptr;
+}
+
 constexpr std::uint8_t kExrMagic[4] = {0x76, 0x2F, 0x31, 0x01};
 constexpr std::uint8_t kKtx2Magic[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
 
@@ -122,10 +140,9 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   const int channels = static_cast<int>(image.channel_names.size());
   const int rows = image.height * image.depth;  // the atlas
   Imf::Header header(image.width, rows);
-  if (image.exr_compression == ExrCompression::kOther) throw InternalError("EXR encode: no compression chosen");
-  header.compression() = image.exr_compression == ExrCompression::kZip   ? Imf::ZIP_COMPRESSION
-                         : image.exr_compression == ExrCompression::kRle ? Imf::RLE_COMPRESSION
-                                                                         : Imf::NO_COMPRESSION;
+  const ExrCodec* codec = FindExrCodec(image.exr_compression);
+  if (codec == nullptr) throw InternalError("EXR encode: no compression chosen");
+  header.compression() = codec->imf;
   const bool half = image.pixel_type == PixelType::kHalf;
   for (const std::string& name : image.channel_names) {
     header.channels().insert(name, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
@@ -194,10 +211,10 @@ TableImage DecodeExr(const std::vector<std::uint8_t>& bytes, const std::string& 
     const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
     const long long rows = static_cast<long long>(window.max.y) - window.min.y + 1;
     if (width <= 0 || rows <= 0) throw IoError(source + ": corrupt EXR: empty data window");
-    image.exr_compression = header.compression() == Imf::ZIP_COMPRESSION ? ExrCompression::kZip
-                            : header.compression() == Imf::RLE_COMPRESSION ? ExrCompression::kRle
-                            : header.compression() == Imf::NO_COMPRESSION  ? ExrCompression::kNone
-                                                                           : ExrCompression::kOther;
+    image.exr_compression = ExrCompression::kOther;
+    for (const ExrCodec& codec : kExrCodecs) {
+      if (codec.imf == header.compression()) image.exr_compression = codec.compression;
+    }
     for (auto it = header.begin(); it != header.end(); ++it) {
       if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
         if (std::strncmp(it.name(), "skybake.", 8) == 0) image.metadata[it.name()] = text->value();
@@ -353,11 +370,8 @@ std::string TableImage::StorageName() const {
                                                       : "VK_FORMAT_R32G32B32A32_SFLOAT") +
            (ktx2_zstd_level != 0 ? ", zstd" : "");
   }
-  const char* compression = exr_compression == ExrCompression::kZip    ? "ZIP"
-                            : exr_compression == ExrCompression::kRle  ? "RLE"
-                            : exr_compression == ExrCompression::kNone ? "uncompressed"
-                                                                       : "other compression";
-  return std::string("EXR ") + ToString(pixel_type) + " " + compression;
+  const ExrCodec* codec = FindExrCodec(exr_compression);
+  return std::string("EXR ") + ToString(pixel_type) + " " + (codec ? codec->name : "other compression");
 }
 
 void ChooseExrCompression(TableImage* image) {
