@@ -145,12 +145,13 @@ def twilight_reference(skybake, cases):
 
 def main():
     sets = {"twilight": twilight_rows, "twilight-between": twilight_between_rows}
-    if len(sys.argv) == 3 and sys.argv[1].endswith("-reference") and sys.argv[1][:-len("-reference")] in sets:
-        twilight_reference(sys.argv[2], list(sets[sys.argv[1][:-len("-reference")]]()))
+    name = sys.argv[1] if len(sys.argv) > 1 else ""
+    if len(sys.argv) == 3 and name.removesuffix("-reference") in sets and name.endswith("-reference"):
+        twilight_reference(sys.argv[2], list(sets[name.removesuffix("-reference")]()))
         return
     out = sys.stdout
     out.write(",".join(COLUMNS) + "\n")
-    for row in sets[sys.argv[1]]() if sys.argv[1:2] and sys.argv[1] in sets else rows():
+    for row in sets[name]() if name in sets else rows():
         out.write(",".join(str(v) for v in row) + "\n")
 
 
