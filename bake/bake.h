@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -83,6 +84,9 @@ struct BakeSettings {
   // Store single Mie's red channel in the scattering table's alpha instead of
   // a separate table (Bruneton 2017's approximation, halves the memory).
   bool pack_single_mie_in_alpha = false;
+  // With orders = 1: the irradiance table also holds single scattering's
+  // light on the ground (what the second order's indirect irradiance adds).
+  bool single_scattering_sky_irradiance = false;
   // Worker threads; 0 = all cores.
   int threads = 0;
 
@@ -144,14 +148,18 @@ struct BakeReport {
 // Called after each phase with its name and duration.
 using BakeProgress = std::function<void(const BakeTiming&)>;
 
-// Called once single scattering is done (order 1) and after each further
-// order with the tables a bake of exactly that many orders returns (before
-// any extrapolated tail) and the seconds the bake's phases took so far, so
-// that one bake yields every order up to `orders` (`skybake report`).
-using BakeOrderSnapshot = std::function<void(int order, const LutSet& tables, double bake_seconds)>;
+// `take` is called once single scattering is done (order 1) and after each
+// further order up to `last_order` with the tables a bake of exactly that
+// many orders returns (before any extrapolated tail) and the seconds the
+// bake's phases took so far, so that one bake yields every order up to
+// `orders` (`skybake report`). Each snapshot builds and copies every table.
+struct BakeOrderSnapshot {
+  std::function<void(int order, const LutSet& tables, double bake_seconds)> take;
+  int last_order = std::numeric_limits<int>::max();
+};
 
 LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report = nullptr,
-            const BakeProgress& progress = nullptr, const BakeOrderSnapshot& order_snapshot = nullptr);
+            const BakeProgress& progress = nullptr, const BakeOrderSnapshot& order_snapshot = {});
 
 // The physical coordinates a scattering texel stands for. Texel
 // (x = nu_index * mu_s_size + mu_s_index, y = mu_index, z = r_index) sits at

@@ -57,11 +57,11 @@ double Baker::PhaseSecondsSoFar() const {
 LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot) {
   progress_ = progress;
   auto snapshot = [&](int order) {
-    if (order_snapshot) {
+    if (order_snapshot.take && order <= order_snapshot.last_order) {
       LutSet tables = AssembleTables(transmittance_, irradiance_, ScatteringTable(), single_.mie);
       tables.settings.orders = order;  // exactly these orders, no tail
       tables.settings.extrapolate_tail = false;
-      order_snapshot(order, tables, PhaseSecondsSoFar());
+      order_snapshot.take(order, tables, PhaseSecondsSoFar());
     }
   };
   auto start = std::chrono::steady_clock::now();
@@ -76,6 +76,10 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     Phase("single scattering, whole atmosphere", [&] {
       grid_single_ = ComputeSingleScattering(atmosphere_grid_, s.scattering_range->atmosphere_ray_samples);
     });
+  }
+  if (s.orders == 1 && s.single_scattering_sky_irradiance) {
+    delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
+    Phase("sky irradiance of single scattering", [&] { ComputeIndirectIrradiance(1); });
   }
   if (s.orders != 1) {  // 0 = auto
     scattering_density_ = ScatteringGridTexture(atmosphere_grid_);

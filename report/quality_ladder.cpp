@@ -174,7 +174,7 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
   orders_settings.extrapolate_tail = false;
   say("bake " + DescribeSettings(plan.base, SettingsDetail::kSamples) + ", orders 1-" +
       std::to_string(plan.max_orders) + " without the tail");
-  Bake(atmosphere, orders_settings, nullptr, nullptr, [&](int order, const LutSet& tables, double seconds) {
+  Bake(atmosphere, orders_settings, nullptr, nullptr, {[&](int order, const LutSet& tables, double seconds) {
     LadderEntry e;
     e.step.knob = "orders";
     e.step.name = "orders " + std::to_string(order) + (order > 1 ? ", no tail" : "");
@@ -186,7 +186,7 @@ std::vector<LadderEntry> RunLadder(const Atmosphere& atmosphere, const LadderPla
     char line[64];
     std::snprintf(line, sizeof line, "order %d done after %.1f s", order, seconds);
     say(line);
-  });
+  }});
 
   for (const LadderStep& step : plan.variants) {
     LadderEntry e;

@@ -124,19 +124,26 @@ TEST(ReportCaseErrors, GroupsIrradianceTwiceAndLeavesUnansweredGroupsOut) {
 }
 
 // One bake yields every order: the snapshot after order N is the bake of N
-// orders, texel for texel, and the reported time grows with the orders.
+// orders, texel for texel, and the reported time grows with the orders;
+// with a last order, the orders after it are not taken and the tables are
+// the same.
 TEST(BakeOrderSnapshot, EachOrderEqualsABakeOfThatManyOrders) {
   BakeSettings settings = testing::SmallBakeSettings();
   settings.orders = 3;
   std::vector<LutSet> snapshots;
   std::vector<double> seconds;
-  LutSet final_tables = Bake(testing::Earth(), settings, nullptr, nullptr,
-                             [&](int order, const LutSet& tables, double bake_seconds) {
-                               EXPECT_EQ(order, static_cast<int>(snapshots.size()) + 1);
-                               snapshots.push_back(tables);
-                               seconds.push_back(bake_seconds);
-                             });
+  LutSet final_tables =
+      Bake(testing::Earth(), settings, nullptr, nullptr, {[&](int order, const LutSet& tables, double bake_seconds) {
+             EXPECT_EQ(order, static_cast<int>(snapshots.size()) + 1);
+             snapshots.push_back(tables);
+             seconds.push_back(bake_seconds);
+           }});
   ASSERT_EQ(snapshots.size(), 3u);
+  std::vector<int> taken;
+  const LutSet up_to_first = Bake(testing::Earth(), settings, nullptr, nullptr,
+                                  {[&](int order, const LutSet&, double) { taken.push_back(order); }, 1});
+  EXPECT_EQ(taken, std::vector<int>{1});
+  EXPECT_EQ(up_to_first.scattering.texels, final_tables.scattering.texels);
   EXPECT_LT(seconds[0], seconds[1]);
   EXPECT_LT(seconds[1], seconds[2]);
   for (int orders = 1; orders <= 2; ++orders) {
