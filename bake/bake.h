@@ -104,6 +104,9 @@ double EstimatedBakeBytes(const BakeSettings& settings);
 // spectrum sampled at these wavelengths instead of one wavelength per channel.
 struct SpectralColour {
   std::vector<double> wavelengths_nm;
+  // Those at which the scattering orders >= 2 were computed; at the others
+  // they are interpolated (bake/spectral.h).
+  std::vector<double> higher_order_wavelengths_nm;
 };
 
 // The baked tables and the constants the runtime needs to sample them.

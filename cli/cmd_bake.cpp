@@ -36,6 +36,7 @@ struct BakeOptions {
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
   int wavelengths = 0;
+  std::string spectral_higher_orders = ToString(kDefaultSpectralHigherOrders);
   std::string ktx2_supercompression = "none";
   std::vector<std::string> runtime = {"glsl", "hlsl", "msl", "wgsl"};
   bool json = false;
@@ -44,6 +45,7 @@ struct BakeOptions {
   bool compare_full = false;
   std::string reference;
   CLI::Option* format_option = nullptr;
+  CLI::Option* spectral_higher_orders_option = nullptr;
 };
 
 // The value of --runtime: shading languages by name, or "none".
@@ -65,6 +67,10 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   report::BakeJob job;
   job.spectral_source = ReadAtmosphereSource(atmosphere_arg);
   job.wavelengths = o.wavelengths;
+  job.spectral_higher_orders = ParseSpectralHigherOrders(o.spectral_higher_orders);
+  if (o.spectral_higher_orders_option->count() > 0 && o.wavelengths == 0) {
+    throw UsageError("--spectral-higher-orders: needs --wavelengths N (a spectral bake)");
+  }
   const Atmosphere atmosphere = ParseAtmosphere(job.spectral_source.text, job.spectral_source.name);
   job.settings = o.bake.Resolve();
   job.scene_file = o.scene;
@@ -196,6 +202,13 @@ void AddBakeCommand(CLI::App& app) {
                   "at a time, into tables in CIE 1931 XYZ, Y in cd m^-2 (docs/colour.md); 0 = the atmosphere's own "
                   "three wavelengths, one per channel")
       ->capture_default_str();
+  o->spectral_higher_orders_option =
+      cmd->add_option("--spectral-higher-orders", o->spectral_higher_orders,
+                      "With --wavelengths: interpolated = the scattering orders >= 2 computed at the three "
+                      "wavelengths nearest 460, 560 and 660 nm and interpolated at the others, about half the time; "
+                      "exact = at every wavelength (docs/colour.md)")
+          ->check(CLI::IsMember({"interpolated", "exact"}))
+          ->capture_default_str();
   cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
   cmd->add_option("--ktx2-supercompression", o->ktx2_supercompression, kKtx2SupercompressionHelp)
       ->capture_default_str();

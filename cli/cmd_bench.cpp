@@ -41,6 +41,7 @@ struct BenchOptions {
   std::string output_dir;  // empty: a temporary directory, removed afterwards
   BakeSettingsOptions bake;
   int wavelengths = 0;  // as `bake --wavelengths`: 0 is the atmosphere's own three
+  std::string spectral_higher_orders = ToString(kDefaultSpectralHigherOrders);
   int runs = 5;
   bool scaling = false;
   bool json = false;
@@ -85,11 +86,13 @@ struct Measurement {
   std::map<std::string, std::vector<double>> seconds;  // phase (and "total") -> one value per run
 };
 
-// What one configuration bakes: the settings and, as `bake --wavelengths`,
-// the number of wavelengths (0: the atmosphere's own three).
+// What one configuration bakes: the settings and, as `bake --wavelengths`
+// and `--spectral-higher-orders`, the number of wavelengths (0: the
+// atmosphere's own three) and how their higher orders are computed.
 struct BenchConfiguration {
   BakeSettings settings;
   int wavelengths = 0;
+  SpectralHigherOrders spectral_higher_orders = kDefaultSpectralHigherOrders;
 };
 
 Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere,
@@ -99,6 +102,7 @@ Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere
   report::BakeJob job;
   job.settings = configuration.settings;
   job.wavelengths = configuration.wavelengths;
+  job.spectral_higher_orders = configuration.spectral_higher_orders;
   job.spectral_source = source;
   job.runtime_languages.clear();
   job.command_line = CommandLine();
@@ -138,11 +142,17 @@ std::vector<Variant> ScalingVariants() {
     v.push_back({"orders " + std::to_string(orders), [orders](BenchConfiguration& c) { c.settings.orders = orders; }});
   }
   // Three wavelengths (the atmosphere's own, one per channel), and spectral
-  // bakes of 15 and 45 in batches of three (bake/spectral.h).
+  // bakes of 15 and 45 in batches of three (bake/spectral.h), their higher
+  // orders interpolated (the default) and computed at every wavelength.
   v.push_back({"wavelengths 3", [](BenchConfiguration& c) { c.wavelengths = 0; }});
   for (int wavelengths : {15, 45}) {
     v.push_back({"wavelengths " + std::to_string(wavelengths),
                  [wavelengths](BenchConfiguration& c) { c.wavelengths = wavelengths; }});
+    v.push_back(
+        {"wavelengths " + std::to_string(wavelengths) + ", exact higher orders", [wavelengths](BenchConfiguration& c) {
+           c.wavelengths = wavelengths;
+           c.spectral_higher_orders = SpectralHigherOrders::kExact;
+         }});
   }
   // 1, 2 and, where the machine has more, all its cores.
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -160,7 +170,8 @@ void RunBench(const BenchOptions& o) {
   if (o.runs < 1 || o.runs > 1000) throw UsageError("--runs = " + std::to_string(o.runs) + " must be in [1, 1000]");
   const AtmosphereSource source = ReadAtmosphereSource(o.atmosphere);
   const Atmosphere atmosphere = ParseAtmosphere(source.text, source.name);
-  const BenchConfiguration base_configuration{o.bake.Resolve(), o.wavelengths};
+  const BenchConfiguration base_configuration{o.bake.Resolve(), o.wavelengths,
+                                              ParseSpectralHigherOrders(o.spectral_higher_orders)};
   const BakeSettings& settings = base_configuration.settings;
 
   std::optional<ScratchDirectory> scratch;
@@ -242,8 +253,13 @@ void AddBenchCommand(CLI::App& app) {
   cmd->add_option("--wavelengths", o->wavelengths,
                   "Time a spectral bake of this many wavelengths, as bake --wavelengths; 0 = the atmosphere's own three")
       ->capture_default_str();
+  cmd->add_option("--spectral-higher-orders", o->spectral_higher_orders,
+                  "With --wavelengths: interpolated or exact, as bake --spectral-higher-orders")
+      ->check(CLI::IsMember({"interpolated", "exact"}))
+      ->capture_default_str();
   cmd->add_flag("--scaling", o->scaling,
-                "Also time each table axis doubled, orders 1 to 8, 3, 15 and 45 wavelengths, and 1, 2 and all threads "
+                "Also time each table axis doubled, orders 1 to 8, 3, 15 and 45 wavelengths (the last two also with "
+                "exact higher orders), and 1, 2 and all threads "
                 "(total time and peak memory)");
   cmd->add_option("-o,--output", o->output_dir,
                   "Directory the bakes write to (default: a temporary one, removed afterwards)");

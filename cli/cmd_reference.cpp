@@ -50,7 +50,8 @@ void RunReference(const ReferenceOptions& o) {
   std::vector<reference::Result> results;
   ChannelNames channels;
   if (o.wavelengths != 0) {
-    const SpectralBatches batches = MakeSpectralBatches(SpectralWavelengths(o.wavelengths));
+    const SpectralBatches batches =
+        MakeSpectralBatches(SpectralWavelengths(o.wavelengths), SpectralHigherOrders::kExact);
     ProgressBar bar("reference", table.queries.size() * batches.size(), o.quiet);
     results = reference::EvaluateSpectral(source, batches, table.queries, settings, [&] { bar.Advance(); });
     bar.Finish();

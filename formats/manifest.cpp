@@ -121,6 +121,7 @@ ordered_json ColourToJson(const LutSet& luts) {
           {"units", "photometric: Y is luminance in cd m^-2 (illuminance in lx for irradiance), X and Z alike"},
           {"luminous_efficacy_lm_per_w", kLuminousEfficacyLmPerW},
           {"wavelengths_nm", luts.colour->wavelengths_nm},
+          {"higher_order_wavelengths_nm", luts.colour->higher_order_wavelengths_nm},
           {"xyz_to_linear_srgb", to_srgb},
           {"transmittance", "of sunlight's colour: exp(-depth) is the sun's XYZ through the ray over its XYZ"},
           {"extinction_profile", profile(p.extinction_profile)},
@@ -231,7 +232,12 @@ Manifest ReadManifest(const fs::path& dir) {
       // The coefficient profiles are a function of the atmosphere, not stored twice.
       SetAltitudeProfiles(luts.atmosphere, &luts.parameters);
     } else {
-      luts.colour = SpectralColour{colour.at("wavelengths_nm").get<std::vector<double>>()};
+      const std::vector<double> wavelengths = colour.at("wavelengths_nm").get<std::vector<double>>();
+      // Sets written before the higher orders could be interpolated computed them everywhere.
+      luts.colour =
+          SpectralColour{wavelengths, colour.contains("higher_order_wavelengths_nm")
+                                          ? colour.at("higher_order_wavelengths_nm").get<std::vector<double>>()
+                                          : wavelengths};
       ColourProfilesFromJson(colour, where, &luts.parameters);
     }
     const json& bake = m.document.at("bake");

@@ -203,7 +203,8 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   }
   if (job.wavelengths != 0 && scene) throw UsageError("--wavelengths: a scene's bake has the atmosphere's three");
   std::optional<SpectralBatches> batches;
-  if (job.wavelengths != 0) batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths));
+  if (job.wavelengths != 0)
+    batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths), job.spectral_higher_orders);
   if (!job.reference_file.empty() && !job.compare_full) throw UsageError("--reference: needs --compare-full");
   // Read before baking, so that a bad file fails at once.
   std::optional<ReferenceSet> reference;

@@ -19,6 +19,7 @@
 #include "bake/bake.h"
 #include "bake/config.h"
 #include "bake/scene.h"
+#include "bake/spectral.h"
 #include "formats/lut_files.h"
 #include "report/scene_accuracy.h"
 #include "shaders_runtime/snippet.h"
@@ -42,6 +43,7 @@ struct BakeJob {
   // atmosphere's own three wavelengths (SpectralWavelengths refuses 1, 2 and
   // negative counts).
   int wavelengths = 0;
+  SpectralHigherOrders spectral_higher_orders = kDefaultSpectralHigherOrders;
   AtmosphereSource spectral_source;
   std::string command_line;    // recorded in the manifest
 };

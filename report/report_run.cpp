@@ -134,8 +134,9 @@ ReportDocument MeasureReport(const Atmosphere& atmosphere, const ReportRequest& 
   if (spectral_reference) {
     progress("colour: the base settings at " + std::to_string(request.wavelengths) + " wavelengths");
     BakeReport timing;
-    const LutSet spectral = BakeSpectral(request.source, MakeSpectralBatches(SpectralWavelengths(request.wavelengths)),
-                                         plan.base, &timing);
+    const LutSet spectral = BakeSpectral(
+        request.source, MakeSpectralBatches(SpectralWavelengths(request.wavelengths), kDefaultSpectralHigherOrders),
+        plan.base, &timing);
     document.colour = MeasureColourErrors(*spectral_reference, spectral, base_tables);
     document.colour->spectral_bake_seconds = timing.total_seconds;
     document.spectral_reference = spectral_reference->source_name;

@@ -93,6 +93,16 @@ TEST(CliBake, BakeErrors) {
     EXPECT_EQ(Lines(err).size(), 1u) << err;
     EXPECT_NE(err.find("--ktx2-supercompression"), std::string::npos) << err;
   }
+  // A spectral bake's higher orders are interpolated or exact, and only a
+  // spectral bake has them: usage errors naming the option.
+  for (const char* options : {" --wavelengths 6 --spectral-higher-orders fast", " --spectral-higher-orders exact"}) {
+    EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "y") + options + kSmallBake, dir,
+                         nullptr, &err),
+              1)
+        << options;
+    EXPECT_EQ(Lines(err).size(), 1u) << err;
+    EXPECT_NE(err.find("--spectral-higher-orders"), std::string::npos) << err;
+  }
   EXPECT_FALSE(fs::exists(dir.path() / "y"));
 }
 

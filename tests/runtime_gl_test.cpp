@@ -251,8 +251,10 @@ TEST_P(SnippetOnMesa, SpectralSetMatchesTheCppTwin) {
   std::string why_not;
   std::unique_ptr<GlContext> gl = GlContext::Create(GetParam(), &why_not);
   if (!gl) GTEST_SKIP() << why_not;
-  static const LutSet luts = BakeSpectral(ReadAtmosphereSource("earth"), MakeSpectralBatches(SpectralWavelengths(6)),
-                                          testing::RuntimeTestSettings(false));
+  static const LutSet luts =
+      BakeSpectral(ReadAtmosphereSource("earth"),
+                   MakeSpectralBatches(SpectralWavelengths(6), kDefaultSpectralHigherOrders),
+                   testing::RuntimeTestSettings(false));
   ASSERT_EQ(luts.parameters.transmittance_is_colour, 1);
   SetTables(gl.get(), luts);
   SnippetParts parts;
