@@ -128,7 +128,8 @@ def bake_defaults(help_text):
             lines.append(line)
     defaults = []
     for line in lines:
-        m = re.match(r"\s+(?:-\w,)?(--[\w-]+)(?: (\w+))?(?:=(\S+))?(?: x (\d))?(?:\s+(.*))?$", line)
+        # TYPE, TYPE:{choices}, =DEFAULT, x COUNT
+        m = re.match(r"\s+(?:-\w,)?(--[\w-]+)(?: (\w+)(?::\{[^}]*\})?)?(?:=(\S+))?(?: x (\d))?(?:\s+(.*))?$", line)
         if not m:
             continue
         option, value, description = m.group(1), m.group(3), m.group(5) or ""
