@@ -121,13 +121,14 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
   // The table divides out the Rayleigh phase; the other groups' phases
   // (all but the Mie group's, which has its own table) are applied here.
   std::vector<std::vector<float>> phase_ratio(groups, std::vector<float>(count, 1.0f));
-  std::vector<std::vector<double>> phase_ratio_double(count, std::vector<double>(groups, 1.0));
+  std::vector<double> phase_ratio_double(std::size_t(count) * groups, 1.0);  // [direction][group]
   for (int g = 0; g < groups; ++g) {
     if (g == mie) continue;
     for (int j = 0; j < count; ++j) {
       const double nu = sun_nu[j];
-      phase_ratio_double[j][g] = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
-      phase_ratio[g][j] = float(phase_ratio_double[j][g]);
+      double& ratio = phase_ratio_double[std::size_t(j) * groups + g];
+      ratio = medium_.groups()[g].phase.Evaluate(nu) / glsl::RayleighPhaseFunction(nu);
+      phase_ratio[g][j] = float(ratio);
     }
   }
 
@@ -260,8 +261,8 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
       }
       for (int j : thick) {
         Spectrum rayleigh(0.0), mie_sum(0.0);
-        SingleScatteringInterval(ray, interval, sun_mu_s[j], sun_nu[j], phase_ratio_double[j].data(),
-                                 rayleigh, mie_sum);
+        SingleScatteringInterval(ray, interval, sun_mu_s[j], sun_nu[j],
+                                 &phase_ratio_double[std::size_t(j) * groups], rayleigh, mie_sum);
         for (int c = 0; c < 3; ++c) sums[0][c][j] += float(rayleigh[c]), sums[1][c][j] += float(mie_sum[c]);
       }
     }
