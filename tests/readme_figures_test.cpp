@@ -226,8 +226,9 @@ TEST(NewcomerDefects, D10_PresetListMatches) {
 }
 
 // The (option, default) pairs `skybake bake --help` states: CLI11's
-// "--option TYPE=VALUE", or "(default VALUE)" in the description, which CLI11
-// moves to the next line when the option column is full.
+// "--option TYPE=VALUE" (or "TYPE:{CHOICES}=VALUE"), or "(default VALUE)" in
+// the description, which CLI11 moves to the next line when the option column
+// is full.
 std::map<std::string, std::string> HelpDefaults(const std::string& help) {
   std::vector<std::string> lines;
   for (const std::string& line : testing::Lines(help)) {
@@ -239,7 +240,7 @@ std::map<std::string, std::string> HelpDefaults(const std::string& help) {
     }
   }
   std::map<std::string, std::string> defaults;
-  const std::regex option(R"(\s+(?:-\w,)?(--[\w-]+)(?: (\w+))?(?:=(\S+))?(?: x (\d))?(?:\s+(.*))?)");
+  const std::regex option(R"(\s+(?:-\w,)?(--[\w-]+)(?: (\w+)(?::\{[^}]*\})?)?(?:=(\S+))?(?: x (\d))?(?:\s+(.*))?)");
   const std::regex stated(R"(\(default ([^;)]*))");
   for (const std::string& line : lines) {
     std::smatch m, d;
@@ -262,6 +263,7 @@ TEST(NewcomerDefects, D10_DocumentedDefaultsMatchHelp) {
   // The parser itself: the defaults every page relies on must be found.
   ASSERT_EQ(stated.count("--orders"), 1u) << help;
   ASSERT_EQ(stated.count("--scattering-size"), 1u) << help;
+  ASSERT_EQ(stated.count("--spectral-higher-orders"), 1u) << help;
 
   std::map<std::string, std::string> documented;
   for (const auto& row : TableRows(Block("docs/cli.md", "bake-defaults"))) {
