@@ -208,18 +208,16 @@ namespace {
 // The first batch's higher orders H_j (its table of all orders less its
 // first orders' part, per channel j) and, per key, the reference spectrum
 // N_j they are relative to (HigherOrderInterpolation). A texel's key is its
-// index for the irradiance table and its (r, mu_s) column for the scattering
-// table: (t / plane) * mu_s_size + (t % width) % mu_s_size.
+// index for the irradiance table and its mu_s column for the scattering
+// table: (t % width) % mu_s_size.
 struct HigherOrderSource {
   const glsl::Texture* all_orders = nullptr;
   const glsl::Texture* first_orders = nullptr;
   std::vector<glm::dvec3> reference;  // per key
   glm::dvec3 sun{0.0};                // E at its channels, the reference where a key has none
-  std::size_t width = 0, plane = 0, mu_s_size = 0;  // mu_s_size 0: the key is the texel's index
+  std::size_t width = 0, mu_s_size = 0;  // mu_s_size 0: the key is the texel's index
 
-  std::size_t Key(std::size_t t) const {
-    return mu_s_size == 0 ? t : (t / plane) * mu_s_size + (t % width) % mu_s_size;
-  }
+  std::size_t Key(std::size_t t) const { return mu_s_size == 0 ? t : (t % width) % mu_s_size; }
 };
 
 // The higher orders of one batch that does not compute them: per channel c,
@@ -310,26 +308,26 @@ std::vector<glm::dvec3> IrradianceReference(const glsl::Texture& sky_light) {
   return reference;
 }
 
-// For the scattering table, per (r, mu_s) column of `grid`: I1 where the
-// runtime's lookup reads it there, while the sun lights the air around the
-// point. Once it is more than kLitAirDepth below the point's horizon, I1
-// comes from a thin, high sunlit shell whose colour the next orders do not
-// share, and N turns to the sun's spectrum E, geometrically in between over
-// kReferenceBlend (both measured, docs/colour.md). 0 where I1 is not
-// positive (AddInterpolated then takes the sun's).
+// For the scattering table, per mu_s column of `grid`: I1 on the ground
+// under that sun (the runtime's lookup) at every altitude, as the higher
+// orders anywhere in a column of air come mostly from its dense lower part
+// (I1 aloft falls to 0 at the top, with no air above). That holds while the
+// sun lights the air over the ground: once it is more than kLitAirDepth
+// below the horizon, I1 comes from a thin, high sunlit shell whose colour
+// the next orders do not share, and N turns to the sun's spectrum E,
+// geometrically in between over kReferenceBlend (both measured,
+// docs/colour.md). 0 where I1 is not positive (AddInterpolated then takes
+// the sun's).
 std::vector<glm::dvec3> ScatteringReference(const glsl::AtmosphereParameters& grid, const glsl::Texture& sky_light,
                                             const glm::dvec3& sun) {
   constexpr double kLitAirDepth = 4.0 * kPi / 180.0, kReferenceBlend = 4.0 * kPi / 180.0;
   std::vector<glm::dvec3> reference;
-  for (int z = 0; z < grid.scattering_r_size; ++z) {
-    for (int x = 0; x < grid.scattering_mu_s_size; ++x) {
-      const ScatteringTexel texel = GetScatteringTexel(grid, x, 0, z);
-      const double depth = std::acos(texel.mu_s) - std::acos(glsl::HorizonZenithCosine(grid.bottom_radius, texel.r));
-      const double w = std::clamp((kLitAirDepth + kReferenceBlend - depth) / kReferenceBlend, 0.0, 1.0);
-      const glm::dvec3 light(glsl::GetIrradiance(grid, glsl::sampler2D{&sky_light}, texel.r, texel.mu_s));
-      reference.push_back(Positive(light) ? glm::exp(w * glm::log(light) + (1.0 - w) * glm::log(sun))
-                                          : glm::dvec3(0.0));
-    }
+  for (int x = 0; x < grid.scattering_mu_s_size; ++x) {
+    const double mu_s = GetScatteringTexel(grid, x, 0, 0).mu_s;
+    const double depth = std::acos(mu_s) - kPi / 2.0;
+    const double w = std::clamp((kLitAirDepth + kReferenceBlend - depth) / kReferenceBlend, 0.0, 1.0);
+    const glm::dvec3 light(glsl::GetIrradiance(grid, glsl::sampler2D{&sky_light}, grid.bottom_radius, mu_s));
+    reference.push_back(Positive(light) ? glm::exp(w * glm::log(light) + (1.0 - w) * glm::log(sun)) : glm::dvec3(0.0));
   }
   return reference;
 }
@@ -525,7 +523,6 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
           ScatteringReference(source_luts.parameters, source_sky_light, interpolation[0].sun);
       scattering_source.sun = interpolation[0].sun;
       scattering_source.width = std::size_t(table.width);
-      scattering_source.plane = std::size_t(table.width) * table.height;
       scattering_source.mu_s_size = std::size_t(source_luts.parameters.scattering_mu_s_size);
       irradiance_source = {&source_luts.irradiance, &source_sky_light, IrradianceReference(source_sky_light),
                            interpolation[0].sun};
