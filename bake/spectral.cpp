@@ -224,7 +224,9 @@ struct HigherOrderSource {
 // ln(H_c / N_c) = sum_j log_weight[c][j] ln(H_j / N_j) (or H_c / N_c =
 // sum_j linear_weight[c][j] H_j / N_j where some H_j is not positive), with
 // N the batch's reference per key and H_j, N_j the source's. Where either
-// batch's reference is not positive at a key, both take the sun's spectrum.
+// batch's reference is not positive at a key, both take the sun's spectrum,
+// and where the sun is dark at a wavelength of either, 1 (H itself is
+// interpolated, linearly where it is 0 at a computed wavelength).
 struct InterpolatedBatch {
   glm::dmat3 log_weight{0.0}, linear_weight{0.0};  // column c: channel c's weights over j
   glm::dvec3 sun{0.0};
@@ -253,11 +255,14 @@ class XyzSum {
     // An exponent at most this far above the source's largest keeps an
     // extrapolation to the ends of the spectrum finite.
     constexpr double kLargestLogRatio = 20.0;
+    const bool sunlit = Positive(source.sun) && Positive(batch.sun);
+    const glm::dvec3 source_fallback = sunlit ? source.sun : glm::dvec3(1.0);
+    const glm::dvec3 fallback = sunlit ? batch.sun : glm::dvec3(1.0);
     ForEachTexel([&](std::size_t t) {
       const std::size_t key = source.Key(t);
       const bool referenced = Positive(source.reference[key]) && Positive(batch_reference[key]);
-      const glm::dvec3& source_reference = referenced ? source.reference[key] : source.sun;
-      const glm::dvec3& reference = referenced ? batch_reference[key] : batch.sun;
+      const glm::dvec3& source_reference = referenced ? source.reference[key] : source_fallback;
+      const glm::dvec3& reference = referenced ? batch_reference[key] : fallback;
       const float* all = &source.all_orders->texels[4 * t];
       const float* first = &source.first_orders->texels[4 * t];
       const glm::dvec3 ratio =
@@ -327,7 +332,11 @@ std::vector<glm::dvec3> ScatteringReference(const glsl::AtmosphereParameters& gr
     const double depth = std::acos(mu_s) - kPi / 2.0;
     const double w = std::clamp((kLitAirDepth + kReferenceBlend - depth) / kReferenceBlend, 0.0, 1.0);
     const glm::dvec3 light(glsl::GetIrradiance(grid, glsl::sampler2D{&sky_light}, grid.bottom_radius, mu_s));
-    reference.push_back(Positive(light) ? glm::exp(w * glm::log(light) + (1.0 - w) * glm::log(sun)) : glm::dvec3(0.0));
+    if (!Positive(light) || (w < 1.0 && !Positive(sun))) {
+      reference.push_back(glm::dvec3(0.0));
+    } else {
+      reference.push_back(w < 1.0 ? glm::exp(w * glm::log(light) + (1.0 - w) * glm::log(sun)) : light);
+    }
   }
   return reference;
 }

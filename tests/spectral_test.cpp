@@ -466,6 +466,23 @@ TEST(SpectralBake, InterpolatedHigherOrdersAgainstEveryWavelength) {
   EXPECT_LT(LargestRelativeDifference(interpolated.irradiance, exact.irradiance), 1e-6);
 }
 
+// A dark sun (irradiance 0, which the file format allows): the interpolated
+// higher orders have no reference spectrum to divide by, and every table is
+// 0, not NaN.
+TEST(SpectralBake, DarkSunBakesToZeroNotNaN) {
+  AtmosphereSource dark = Preset("earth");
+  const std::string sun = "irradiance_w_m2_nm = \"astm-g173\"";
+  const std::size_t at = dark.text.find(sun);
+  ASSERT_NE(at, std::string::npos);
+  dark.text.replace(at, sun.size(), "irradiance_w_m2_nm = 0.0");
+  BakeSettings settings = testing::SmallBakeSettings();
+  const LutSet luts = BakeSpectral(dark, MakeSpectralBatches(SpectralWavelengths(6), SpectralHigherOrders::kInterpolated),
+                                   settings);
+  for (const glsl::Texture* table : {&luts.scattering, &luts.irradiance, &luts.single_mie_scattering}) {
+    for (float v : table->texels) EXPECT_EQ(v, 0.0f);
+  }
+}
+
 // A spectral set written and loaded back: the manifest says its channels
 // are XYZ and at which wavelengths, and the loader takes its altitude
 // profiles and sun from the manifest, not from the atmosphere at three
