@@ -120,6 +120,7 @@ ColourErrors MeasureColourErrors(const ReferenceSet& reference, const LutSet& sp
   if (three_wavelength.colour) throw InputError("colour errors: the three-wavelength set's tables are in XYZ");
   ColourErrors errors;
   errors.wavelengths = static_cast<int>(spectral.colour->wavelengths_nm.size());
+  errors.higher_order_wavelengths = static_cast<int>(spectral.colour->higher_order_wavelengths_nm.size());
   const std::vector<glm::dvec3> colour = AnswerInXyz(reference, spectral, glm::dmat3(1.0));
   const std::vector<glm::dvec3> as_srgb = AnswerInXyz(reference, three_wavelength, LinearSrgbToXyzMatrix());
 
@@ -154,12 +155,16 @@ std::string ColourMarkdown(const ColourErrors& e) {
          Percent(g.as_srgb.luminance_max) + " | " + Fixed4(g.as_srgb.delta_uv_rms) + " / " +
          Fixed4(g.as_srgb.delta_uv_max) + " |\n";
   }
-  char scale[160];
-  std::snprintf(scale, sizeof scale,
-                "\nThe three-wavelength set's luminance is scaled by %.4g (fitted on daylight); the spectral bake "
-                "took %.1f s.\n",
-                e.as_srgb_luminance_scale, e.spectral_bake_seconds);
-  return s + scale;
+  const std::string interpolated =
+      e.higher_order_wavelengths < e.wavelengths
+          ? " (its higher orders computed at " + std::to_string(e.higher_order_wavelengths) + " of the " +
+                std::to_string(e.wavelengths) + " wavelengths and interpolated at the others)"
+          : "";
+  char scale[32], seconds[32];
+  std::snprintf(scale, sizeof scale, "%.4g", e.as_srgb_luminance_scale);
+  std::snprintf(seconds, sizeof seconds, "%.1f", e.spectral_bake_seconds);
+  return s + "\nThe three-wavelength set's luminance is scaled by " + scale +
+         " (fitted on daylight); the spectral bake" + interpolated + " took " + seconds + " s.\n";
 }
 
 nlohmann::json ColourJson(const ColourErrors& e) {
@@ -168,6 +173,7 @@ nlohmann::json ColourJson(const ColourErrors& e) {
     groups.push_back({{"group", g.name}, {"spectral", StatsJson(g.spectral)}, {"as_srgb", StatsJson(g.as_srgb)}});
   }
   return {{"wavelengths", e.wavelengths},
+          {"higher_order_wavelengths", e.higher_order_wavelengths},
           {"spectral_bake_seconds", e.spectral_bake_seconds},
           {"as_srgb_luminance_scale", e.as_srgb_luminance_scale},
           {"groups", groups}};

@@ -32,6 +32,9 @@ struct ColourGroup {
 
 struct ColourErrors {
   int wavelengths = 0;  // of the spectral set
+  // Of those, how many computed the scattering orders >= 2 (the others'
+  // interpolated, bake/spectral.h).
+  int higher_order_wavelengths = 0;
   double spectral_bake_seconds = 0.0;
   // The three-wavelength set's values are in the atmosphere's solar units,
   // not cd m^-2: its luminance is compared after this one scale, fitted (least
