@@ -100,7 +100,6 @@ HigherOrderInterpolation MakeHigherOrderInterpolation(const std::vector<double>&
                                                       const std::vector<double>& absorption_depth) {
   const int n = static_cast<int>(wavelengths_nm.size()), k = static_cast<int>(computed.size());
   HigherOrderInterpolation result;
-  result.computed = computed;
   // Linear interpolation in wavelength between the computed wavelengths,
   // held beyond them: weights[i][j].
   std::vector<std::vector<double>> linear(n, std::vector<double>(k, 0.0));
@@ -407,7 +406,7 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
     // The interpolation's weights, from the atmosphere at each wavelength.
     const std::vector<int> computed = batches.HigherOrderWavelengths();
     const int n = static_cast<int>(batches.wavelengths_nm.size());
-    std::vector<double> sun(n), ground_scattering(n), absorption_depth(n);
+    std::vector<double> ground_scattering(n), absorption_depth(n);
     for (std::size_t b = 0; b < batches.size(); ++b) {
       const Atmosphere& atmosphere = atmospheres[b];
       // The vertical optical depth of the absorbers alone.
@@ -420,7 +419,6 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
       for (int c = 0; c < kWavelengthCount; ++c) {
         const int i = batches.wavelength_index[b][c];
         if (i < 0) continue;
-        sun[i] = atmosphere.solar_irradiance[c];
         ground_scattering[i] = scattering_at_ground[c];
         absorption_depth[i] = absorption[c];
       }

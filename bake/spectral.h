@@ -92,7 +92,6 @@ SpectralBatches MakeSpectralBatches(const std::vector<double>& wavelengths_nm, S
 // interpolation of H / N in wavelength stands in:
 //   H_i / N_i = sum_j linear_weight[i][j] H_j / N_j.
 struct HigherOrderInterpolation {
-  std::vector<int> computed;                                   // indices into the wavelengths, increasing
   std::vector<std::vector<double>> log_weight, linear_weight;  // [wavelength][computed]
 };
 HigherOrderInterpolation MakeHigherOrderInterpolation(const std::vector<double>& wavelengths_nm,
