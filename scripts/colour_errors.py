@@ -14,13 +14,10 @@ against reference/cases/earth_spectral_reference.csv:
 as sRGB beside it; this is the quick check for one bake.)
 """
 import csv
-import io
 import math
-import pathlib
-import subprocess
 import sys
 
-CASES = pathlib.Path(__file__).resolve().parent.parent / "reference" / "cases"
+from case_errors import CASES, evaluate
 
 
 def ucs(x, y, z):
@@ -39,9 +36,7 @@ def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     skybake, lut_dir = sys.argv[1], sys.argv[2]
-    out = subprocess.run([skybake, "eval", lut_dir, "--in", str(CASES / "earth.csv")], capture_output=True,
-                         text=True, check=True).stdout
-    baked = list(csv.DictReader(io.StringIO(out)))
+    baked = evaluate(skybake, lut_dir, "earth.csv")
     with open(CASES / "earth_spectral_reference.csv") as f:
         reference = list(csv.DictReader(f))
     groups = {}
