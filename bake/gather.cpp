@@ -9,6 +9,10 @@
 
 #include <tbb/parallel_for.h>
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 #include "bake/float_math.h"
 #include "bake/grids.h"
 #include "bake/sun_lookups.h"
@@ -32,6 +36,151 @@ constexpr float kSteadyMargin = 1e-4f;
 inline float FallWeight(float f, float log_ratio, float inverse_ratio_minus_one) {
   return inverse_ratio_minus_one == 0.0f ? f : (ExpFloat(f * log_ratio) - 1.0f) * inverse_ratio_minus_one;
 }
+
+// n rounded up to whole vectors of floats.
+inline int RoundUpToVector(int n) { return (n + kVectorFloats - 1) / kVectorFloats * kVectorFloats; }
+
+// A ray's sun directions (RaySunDirections) grouped by the nu slice of the
+// density grid below their nu: every direction of a group reads J's nu rows
+// `slice` and `next_slice`. Within a group in order of mu_s, each group
+// padded to whole vectors with copies of its last direction.
+struct DirectionsBySlice {
+  struct Group {
+    int slice, next_slice, begin, end;  // [begin, end): the group's positions
+  };
+  std::vector<Group> groups;
+  std::vector<int> position;  // per direction of SunDirections
+  // Per position:
+  std::vector<double> mu_s, nu;
+  std::vector<int> slice, next_slice;
+  std::vector<float> nu_weight;  // of next_slice
+
+  DirectionsBySlice(const SunDirections& directions, const AtmosphereParameters& grid) {
+    const int nu_size = grid.scattering_nu_size;
+    const int distinct = *std::max_element(directions.of_texel.begin(), directions.of_texel.end()) + 1;
+    std::vector<std::vector<int>> members(nu_size);
+    std::vector<float> weight(distinct);
+    for (int j = 0; j < distinct; ++j) {
+      const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (nu_size - 1);
+      const int nu0 = std::min(int(std::floor(nu_coord)), nu_size - 1);
+      members[nu0].push_back(j);
+      weight[j] = float(nu_coord - nu0);
+    }
+    position.resize(distinct);
+    for (int s = 0; s < nu_size; ++s) {
+      if (members[s].empty()) continue;
+      Group group{s, std::min(s + 1, nu_size - 1), count(), 0};
+      for (std::size_t m = 0; m < members[s].size() || count() % kVectorFloats != 0; ++m) {
+        const int j = members[s][std::min(m, members[s].size() - 1)];
+        if (m < members[s].size()) position[j] = count();
+        mu_s.push_back(directions.mu_s[j]), nu.push_back(directions.nu[j]);
+        slice.push_back(group.slice), next_slice.push_back(group.next_slice), nu_weight.push_back(weight[j]);
+      }
+      group.end = count();
+      groups.push_back(group);
+    }
+  }
+  int count() const { return static_cast<int>(mu_s.size()); }
+};
+
+// J per channel in rows along mu_s: of a density texture, per (r, mu) row
+// and channel, one row per nu slice padded to whole vectors (Rows); and of
+// a sample, those of its four (r, mu) rows blended, with the differences
+// between neighbouring columns, and the lookups of a group of directions in
+// two of its nu rows (Accumulate).
+class JRows {
+ public:
+  JRows(int mu_s_size, int nu_size)
+      : mu_s_size_(mu_s_size),
+        nu_size_(nu_size),
+        stride_(std::max(kRegisterRow, RoundUpToVector(mu_s_size))),
+        values_(PerTexelRow(), 0.0f),
+        differences_(values_.size(), 0.0f) {}
+
+  // Floats per (r, mu) row of a texture: 3 channels, nu_size rows of stride_.
+  std::size_t PerTexelRow() const { return std::size_t(3) * nu_size_ * stride_; }
+
+  // The texture's rgb in rows: per (r, mu) row, PerTexelRow() floats.
+  std::vector<float> Rows(const Texture& density) const {
+    std::vector<float> rows(std::size_t(density.height) * density.depth * PerTexelRow(), 0.0f);
+    ForEachRow(density, [&](int row, std::size_t first, std::size_t) {
+      float* out = &rows[row * PerTexelRow()];
+      for (int c = 0; c < 3; ++c) {
+        for (int s = 0; s < nu_size_; ++s) {
+          const float* texels = &density.texels[first + std::size_t(4) * s * mu_s_size_ + c];
+          float* row_out = out + (std::size_t(c) * nu_size_ + s) * stride_;
+          for (int i = 0; i < mu_s_size_; ++i) row_out[i] = texels[4 * i];
+        }
+      }
+    });
+    return rows;
+  }
+
+  // The sample's rows: the four (r, mu) rows' (of Rows) blended by their weights.
+  void Set(const float* t00, const float* t10, const float* t01, const float* t11, float w00, float w10, float w01,
+           float w11) {
+    const int size = static_cast<int>(values_.size());
+    float* values = values_.data();
+#pragma omp simd
+    for (int i = 0; i < size; ++i) values[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
+    float* differences = differences_.data();
+#pragma omp simd
+    for (int i = 0; i < size - 1; ++i) differences[i] = values[i + 1] - values[i];
+  }
+
+  // For the directions [begin, end) (whole vectors), channel c: J between
+  // the mu_s columns left[j] and left[j] + 1 at weight_a[j] in nu row
+  // `slice_a` and at weight_b[j] in row `slice_b`, blended between the rows
+  // by nu_weight[j], into value[j]; sum[j] += w value[j].
+  void Accumulate(int c, int slice_a, int slice_b, int begin, int end, const int* left, const float* weight_a,
+                  const float* weight_b, const float* nu_weight, float w, float* value, float* sum) const {
+    const float* row_a = Row(values_, c, slice_a);
+    const float* row_b = Row(values_, c, slice_b);
+    const float* difference_a = Row(differences_, c, slice_a);
+    const float* difference_b = Row(differences_, c, slice_b);
+#if defined(__AVX512F__)
+    if (stride_ == kRegisterRow) {
+      // Each row in two registers: a lookup is one permutation of them.
+      const __m512 a_low = _mm512_loadu_ps(row_a), a_high = _mm512_loadu_ps(row_a + 16);
+      const __m512 b_low = _mm512_loadu_ps(row_b), b_high = _mm512_loadu_ps(row_b + 16);
+      const __m512 da_low = _mm512_loadu_ps(difference_a), da_high = _mm512_loadu_ps(difference_a + 16);
+      const __m512 db_low = _mm512_loadu_ps(difference_b), db_high = _mm512_loadu_ps(difference_b + 16);
+      const __m512 weight = _mm512_set1_ps(w);
+      for (int j = begin; j < end; j += kVectorFloats) {
+        const __m512i column = _mm512_loadu_si512(left + j);
+        const __m512 along_a =
+            _mm512_fmadd_ps(_mm512_loadu_ps(weight_a + j), _mm512_permutex2var_ps(da_low, column, da_high),
+                            _mm512_permutex2var_ps(a_low, column, a_high));
+        const __m512 along_b =
+            _mm512_fmadd_ps(_mm512_loadu_ps(weight_b + j), _mm512_permutex2var_ps(db_low, column, db_high),
+                            _mm512_permutex2var_ps(b_low, column, b_high));
+        const __m512 blend = _mm512_fmadd_ps(_mm512_loadu_ps(nu_weight + j), _mm512_sub_ps(along_b, along_a), along_a);
+        _mm512_storeu_ps(value + j, blend);
+        _mm512_storeu_ps(sum + j, _mm512_fmadd_ps(weight, blend, _mm512_loadu_ps(sum + j)));
+      }
+      return;
+    }
+#endif
+#pragma omp simd
+    for (int j = begin; j < end; ++j) {
+      const int i = left[j];
+      const float along_a = row_a[i] + weight_a[j] * difference_a[i];
+      const float along_b = row_b[i] + weight_b[j] * difference_b[i];
+      value[j] = along_a + nu_weight[j] * (along_b - along_a);
+      sum[j] += w * value[j];
+    }
+  }
+
+ private:
+  // A row that fits two 512-bit registers.
+  static constexpr int kRegisterRow = 2 * kVectorFloats;
+  float* Row(std::vector<float>& rows, int c, int s) { return &rows[(std::size_t(c) * nu_size_ + s) * stride_]; }
+  const float* Row(const std::vector<float>& rows, int c, int s) const {
+    return &rows[(std::size_t(c) * nu_size_ + s) * stride_];
+  }
+  int mu_s_size_, nu_size_, stride_;
+  std::vector<float> values_, differences_;
+};
 }  // namespace
 
 Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) const {
@@ -83,8 +232,10 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
   Texture result = ScatteringGridTexture(grid);
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
-  const int plane_width = density.width;  // density nu * mu_s
   const SunColumns columns(grid);
+  // J in rows along mu_s per channel and nu slice (JRows).
+  const std::size_t per_row = JRows(density_mu_s_size, density_nu_size).PerTexelRow();
+  const std::vector<float> density_rows = JRows(density_mu_s_size, density_nu_size).Rows(density);
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
     const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
@@ -131,13 +282,16 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         weight[k + 1][c] += w.second;
       }
     }
-    // J at each sample's (r, mu) for every (nu, mu_s) texel of the density
-    // grid: the texture's r and mu interpolation, done once per sample.
-    std::vector<int> samples;  // those with a non-zero weight
-    std::vector<std::size_t> fall_rows;  // per sample, MuSFall's row nearest it
-    std::vector<std::size_t> lowest_rows;  // and that row's offset in lowest_log_slope and _curvature
-    std::vector<float> planes;
-    planes.reserve(std::size_t(n + 1) * 4 * plane_width);
+    // Per sample with a non-zero weight (or a thick interval's end): its
+    // taps in the density grid's r and mu rows, interpolated once for all of
+    // the ray's texels (the texture's r and mu interpolation).
+    struct SampleTaps {
+      int k;
+      const float *t00, *t10, *t01, *t11;
+      float w00, w10, w01, w11;
+      std::size_t fall_row, lowest_row;  // MuSFall's row nearest it, and its offset in lowest_log_*
+    };
+    std::vector<SampleTaps> samples;
     for (int k = 0; k <= n; ++k) {
       needed[k] = needed[k] || weight[k] != Spectrum(0.0);
       if (!needed[k]) continue;
@@ -148,41 +302,28 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       double fy, fz;
       glsl::detail::LinearTaps(uvwz.z, density.height, y0, y1, fy);
       glsl::detail::LinearTaps(uvwz.w, density.depth, z0, z1, fz);
-      const float* t00 = &density.texels[density.Index(0, y0, z0)];
-      const float* t10 = &density.texels[density.Index(0, y1, z0)];
-      const float* t01 = &density.texels[density.Index(0, y0, z1)];
-      const float* t11 = &density.texels[density.Index(0, y1, z1)];
-      const float w00 = float((1 - fy) * (1 - fz)), w10 = float(fy * (1 - fz)), w01 = float((1 - fy) * fz),
-                  w11 = float(fy * fz);
-      const std::size_t offset = planes.size();
-      planes.resize(offset + std::size_t(4) * plane_width);
-      float* plane = &planes[offset];
-      for (int i = 0; i < 4 * plane_width; ++i) plane[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
-      samples.push_back(k);
-      if (fall) {
-        const std::size_t row = std::size_t(fz < 0.5 ? z0 : z1) * density.height + (fy < 0.5 ? y0 : y1);
-        fall_rows.push_back(row * density_nu_size * fall->falling_columns);
-        lowest_rows.push_back(row * density_nu_size * 3);
-      }
+      const std::size_t row = std::size_t(fz < 0.5 ? z0 : z1) * density.height + (fy < 0.5 ? y0 : y1);
+      auto rows_at = [&](int y, int z) { return &density_rows[(std::size_t(z) * density.height + y) * per_row]; };
+      samples.push_back({k, rows_at(y0, z0), rows_at(y1, z0), rows_at(y0, z1), rows_at(y1, z1),
+                         float((1 - fy) * (1 - fz)), float(fy * (1 - fz)), float((1 - fy) * fz), float(fy * fz),
+                         fall ? row * density_nu_size * fall->falling_columns : 0,
+                         fall ? row * density_nu_size * 3 : 0});
     }
 
-    // Per distinct sun direction of the ray: its nu taps in the density
-    // grid (nu is the same all along the ray), then per sample its mu_s
-    // taps and J, vectorised over the directions.
+    // The ray's sun directions grouped by the nu slice below them, so that
+    // each vector of directions reads the same two nu rows of J: the lookups
+    // along mu_s are then permutations of rows held in registers (RowLookups)
+    // instead of gathers. Within a group, in order of mu_s.
     const SunDirections directions = RaySunDirections(columns, ray.mu);
-    const int count = static_cast<int>(directions.nu.size());
-    std::vector<float> mu_s(directions.mu_s.begin(), directions.mu_s.end()), nu(directions.nu.begin(), directions.nu.end());
-    std::vector<int> nu_slice0(count), nu_slice1(count);
-    std::vector<int> nu_row0(count), nu_row1(count);  // offsets of the nu rows in a plane
-    std::vector<int> fall_row0(count), fall_row1(count);  // and in a row of MuSFall
-    std::vector<float> nu_weight(count);
-    for (int j = 0; j < count; ++j) {
-      const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (density_nu_size - 1);
-      const int nu0 = std::min(int(std::floor(nu_coord)), density_nu_size - 1), nu1 = std::min(nu0 + 1, density_nu_size - 1);
-      nu_slice0[j] = nu0, nu_slice1[j] = nu1;
-      nu_row0[j] = 4 * nu0 * density_mu_s_size, nu_row1[j] = 4 * nu1 * density_mu_s_size;
-      if (fall) fall_row0[j] = nu0 * fall->falling_columns, fall_row1[j] = nu1 * fall->falling_columns;
-      nu_weight[j] = float(nu_coord - nu0);
+    const DirectionsBySlice by_slice(directions, density_grid);
+    const int count = by_slice.count();
+    const std::vector<float> mu_s(by_slice.mu_s.begin(), by_slice.mu_s.end());
+    const std::vector<float> nu(by_slice.nu.begin(), by_slice.nu.end());
+    const std::vector<float>& nu_weight = by_slice.nu_weight;
+    std::vector<int> fall_row0(count), fall_row1(count);  // offsets of the nu rows in a row of MuSFall
+    for (int j = 0; j < count && fall; ++j) {
+      fall_row0[j] = by_slice.slice[j] * fall->falling_columns;
+      fall_row1[j] = by_slice.next_slice[j] * fall->falling_columns;
     }
     const MuSCoordinate mu_s_coordinate(density_grid);
     const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
@@ -197,91 +338,101 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // Per channel and direction, the fall of J below the lowest column at
     // the sample (1 where the sun is above it): exp(d (slope + d curvature))
     // with d = mu_s - mu_s_min < 0, slope and curvature blended between the
-    // nu rows. The directions come in order of mu_s (RaySunDirections), and
-    // only the first `below_end` can have the sun below the lowest column.
+    // nu rows. Within a group only the first directions (to its entry in
+    // below_end) can have the sun below the lowest column.
     std::vector<float> below_factor[3];
     for (auto& factor : below_factor) factor.resize(fall ? count : 0);
-    int below_end = 0;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const int k = samples[i];
-      const float* plane = &planes[i * std::size_t(4) * plane_width];
+    std::vector<int> below_end(by_slice.groups.size());
+    JRows rows(density_mu_s_size, density_nu_size);
+    for (const SampleTaps& sample : samples) {
+      const int k = sample.k;
+      // J at the sample's (r, mu) for every (nu, mu_s) texel.
+      rows.Set(sample.t00, sample.t10, sample.t01, sample.t11, sample.w00, sample.w10, sample.w01, sample.w11);
       const float from_mu_s = float(ray.r / ray.radius[k]), from_nu = float(ray.t[k] / ray.radius[k]);
 #pragma omp simd
       for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
       mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data());
-      // The sun's cosine at the sample, (mu_s r + nu t) / r_k, is at least
-      // mu_s r / r_k - t / r_k: from the first direction this returns on,
-      // every direction's sun at the sample is at or above `cosine`.
-      auto surely_at_or_above = [&](float cosine) {
-        return static_cast<int>(std::lower_bound(mu_s.begin(), mu_s.end(), (cosine + from_nu) / from_mu_s) -
-                                mu_s.begin());
-      };
-      below_end = fall ? surely_at_or_above(lowest_mu_s) : 0;
-      int below_count = 0;
+      for (std::size_t g = 0; g < by_slice.groups.size(); ++g) {
+        const DirectionsBySlice::Group& group = by_slice.groups[g];
+        // The sun's cosine at the sample, (mu_s r + nu t) / r_k, is at least
+        // mu_s r / r_k - t / r_k: from the first direction of the group this
+        // returns on, every direction's sun at the sample is at or above
+        // `cosine`.
+        auto surely_at_or_above = [&](float cosine) {
+          return static_cast<int>(
+              std::lower_bound(mu_s.begin() + group.begin, mu_s.begin() + group.end, (cosine + from_nu) / from_mu_s) -
+              mu_s.begin());
+        };
+        int end = fall ? surely_at_or_above(lowest_mu_s) : group.begin;
+        int below_count = 0;
 #pragma omp simd reduction(+ : below_count)
-      for (int j = 0; j < below_end; ++j) below_count += mu_s_k[j] < lowest_mu_s ? 1 : 0;
-      if (below_count == 0) below_end = 0;
-      while (below_end > 0 && !(mu_s_k[below_end - 1] < lowest_mu_s)) --below_end;
-      for (int c = 0; c < 3 && below_end > 0; ++c) {
-        const float* slope = &fall->lowest_log_slope[lowest_rows[i] + c];
-        const float* curvature = &fall->lowest_log_curvature[lowest_rows[i] + c];
-        float* factor = below_factor[c].data();
+        for (int j = group.begin; j < end; ++j) below_count += mu_s_k[j] < lowest_mu_s ? 1 : 0;
+        if (below_count == 0) end = group.begin;
+        while (end > group.begin && !(mu_s_k[end - 1] < lowest_mu_s)) --end;
+        // Rounded up to a whole vector: past the last sun below the lowest
+        // column the factor is exp(0) = 1, which changes nothing.
+        if (end > group.begin) end = std::min(group.end, RoundUpToVector(end - group.begin) + group.begin);
+        below_end[g] = end;
+        const int a = 3 * group.slice, b = 3 * group.next_slice;
+        for (int c = 0; c < 3 && end > group.begin; ++c) {
+          const float* slope = &fall->lowest_log_slope[sample.lowest_row + c];
+          const float* curvature = &fall->lowest_log_curvature[sample.lowest_row + c];
+          float* factor = below_factor[c].data();
 #pragma omp simd
-        for (int j = 0; j < below_end; ++j) {
-          const int a = 3 * nu_slice0[j], b = 3 * nu_slice1[j];
-          const float t = nu_weight[j], d = std::min(mu_s_k[j] - lowest_mu_s, 0.0f);
-          const float slope_j = slope[a] + t * (slope[b] - slope[a]);
-          const float curvature_j = curvature[a] + t * (curvature[b] - curvature[a]);
-          factor[j] = ExpFloat(d * (slope_j + d * curvature_j));
+          for (int j = group.begin; j < end; ++j) {
+            const float t = nu_weight[j], d = std::min(mu_s_k[j] - lowest_mu_s, 0.0f);
+            const float slope_j = slope[a] + t * (slope[b] - slope[a]);
+            const float curvature_j = curvature[a] + t * (curvature[b] - curvature[a]);
+            factor[j] = ExpFloat(d * (slope_j + d * curvature_j));
+          }
+        }
+        if (shaped) {
+          // The weights of the right columns of the two nu rows, following
+          // the fall (the same for the three channels). From `falling_end`
+          // on (rounded up to a whole vector, so that each direction keeps
+          // its lane) no direction's sun is below the first column that
+          // does not fall (plus a margin far above the float position's
+          // rounding), and FallWeight would return mu_s_weight.
+          const float* log_ratio = &fall->log_ratio[sample.fall_row];
+          const float* inverse = &fall->inverse_ratio_minus_one[sample.fall_row];
+          const int falling = fall->falling_columns;
+          int falling_end = surely_at_or_above(fall->steady_mu_s + kSteadyMargin);
+          falling_end = std::min(group.end, group.begin + RoundUpToVector(falling_end - group.begin));
+          std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.begin() + group.end,
+                    fall_weight_a.begin() + falling_end);
+          std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.begin() + group.end,
+                    fall_weight_b.begin() + falling_end);
+#pragma omp simd
+          for (int j = group.begin; j < falling_end; ++j) {
+            const int left = mu_s_left[j];
+            const int column = left < falling ? left : falling - 1;  // any, when the pair does not fall
+            const int a = fall_row0[j] + column, b = fall_row1[j] + column;
+            const float inverse_a = left < falling ? inverse[a] : 0.0f, inverse_b = left < falling ? inverse[b] : 0.0f;
+            fall_weight_a[j] = FallWeight(mu_s_weight[j], log_ratio[a], inverse_a);
+            fall_weight_b[j] = FallWeight(mu_s_weight[j], log_ratio[b], inverse_b);
+          }
         }
       }
       // The weights of the right columns of the two nu rows: mu_s_weight,
-      // or with a fall, weights that follow it (the same for the three
-      // channels).
-      const float* weight_a = mu_s_weight.data();
-      const float* weight_b = mu_s_weight.data();
-      if (shaped) {
-        const float* log_ratio = &fall->log_ratio[fall_rows[i]];
-        const float* inverse = &fall->inverse_ratio_minus_one[fall_rows[i]];
-        const int falling = fall->falling_columns;
-        // From `falling_end` on (rounded up to a whole vector, so that each
-        // direction keeps its lane) no direction's sun is below the first
-        // column that does not fall (plus a margin far above the float
-        // position's rounding), and FallWeight would return mu_s_weight.
-        int falling_end = surely_at_or_above(fall->steady_mu_s + kSteadyMargin);
-        falling_end = std::min(count, (falling_end + kVectorFloats - 1) / kVectorFloats * kVectorFloats);
-        std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.end(), fall_weight_a.begin() + falling_end);
-        std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.end(), fall_weight_b.begin() + falling_end);
-#pragma omp simd
-        for (int j = 0; j < falling_end; ++j) {
-          const int left = mu_s_left[j];
-          const int column = left < falling ? left : falling - 1;  // any, when the pair does not fall
-          const int a = fall_row0[j] + column, b = fall_row1[j] + column;
-          const float inverse_a = left < falling ? inverse[a] : 0.0f, inverse_b = left < falling ? inverse[b] : 0.0f;
-          fall_weight_a[j] = FallWeight(mu_s_weight[j], log_ratio[a], inverse_a);
-          fall_weight_b[j] = FallWeight(mu_s_weight[j], log_ratio[b], inverse_b);
-        }
-        weight_a = fall_weight_a.data(), weight_b = fall_weight_b.data();
-      }
+      // or with a fall, those that follow it.
+      const float* weight_a = shaped ? fall_weight_a.data() : mu_s_weight.data();
+      const float* weight_b = shaped ? fall_weight_b.data() : mu_s_weight.data();
       for (int c = 0; c < 3; ++c) {
         const float w = float(weight[k][c]);
         float* sum = sums[c].data();
         float* value = source.empty() ? values.data() : &source[(std::size_t(k) * 3 + c) * count];
+        for (std::size_t g = 0; g < by_slice.groups.size(); ++g) {
+          const DirectionsBySlice::Group& group = by_slice.groups[g];
+          rows.Accumulate(c, group.slice, group.next_slice, group.begin, group.end, mu_s_left.data(), weight_a,
+                          weight_b, nu_weight.data(), w, value, sum);
+          // Below the lowest column the lookup read the lowest column's J
+          // (its weight clamped to 0); it falls from there.
+          const float* factor = below_factor[c].data();
 #pragma omp simd
-        for (int j = 0; j < count; ++j) {
-          const int a = nu_row0[j] + 4 * mu_s_left[j] + c, b = nu_row1[j] + 4 * mu_s_left[j] + c;
-          const float along_a = plane[a] + weight_a[j] * (plane[a + 4] - plane[a]);
-          const float along_b = plane[b] + weight_b[j] * (plane[b + 4] - plane[b]);
-          value[j] = along_a + nu_weight[j] * (along_b - along_a);
-          sum[j] += w * value[j];
-        }
-        // Below the lowest column the loop above read the lowest column's J
-        // (its weight clamped to 0); it falls from there.
-        const float* factor = below_factor[c].data();
-#pragma omp simd
-        for (int j = 0; j < below_end; ++j) {
-          sum[j] += w * value[j] * (factor[j] - 1.0f);
-          value[j] *= factor[j];
+          for (int j = group.begin; j < below_end[g]; ++j) {
+            sum[j] += w * value[j] * (factor[j] - 1.0f);
+            value[j] *= factor[j];
+          }
         }
       }
     }
@@ -297,7 +448,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       directions_sum[j] = sum;
     }
     for (int x = 0; x < int(directions.of_texel.size()); ++x) {
-      result.Store(x, y, z, vec4(directions_sum[directions.of_texel[x]], 0.0));
+      result.Store(x, y, z, vec4(directions_sum[by_slice.position[directions.of_texel[x]]], 0.0));
     }
   });
   return result;
