@@ -20,8 +20,9 @@ namespace skybake::detail {
 // crosses them, or the sun's disc is partly hidden) are integrated on this
 // many sub-intervals: the shadow edge moves the integrand from lit to dark
 // within one interval, which the two-point rules cannot follow. Tested
-// against brute force in SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent.
-constexpr int kShadowEdgeSubdivisions = 8;
+// against brute force in SingleScattering.MatchesBruteForceQuadratureWithinHalfPercent;
+// twice as many move no case group by more than 0.004 % (docs/benchmark.md).
+constexpr int kShadowEdgeSubdivisions = 4;
 
 RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const {
   const ScatteringTexel texel = GetScatteringTexel(grid, 0, mu_index, r_index);
