@@ -40,13 +40,16 @@ inline float FallWeight(float f, float log_ratio, float inverse_ratio_minus_one)
 // n rounded up to whole vectors of floats.
 inline int RoundUpToVector(int n) { return (n + kVectorFloats - 1) / kVectorFloats * kVectorFloats; }
 
-// A ray's sun directions (RaySunDirections) grouped by the nu slice of the
-// density grid below their nu: every direction of a group reads J's nu rows
-// `slice` and `next_slice`. Within a group in order of mu_s, each group
-// padded to whole vectors with copies of its last direction.
+// A ray's sun directions (RaySunDirections) with the nu slices of the
+// density grid around their nu. With `by_slice`, grouped by the slice below
+// their nu, so that every direction of a group reads J's nu rows `slice`
+// and `next_slice` (as JRows's permutations need): within a group in order
+// of mu_s, each group padded to whole vectors with copies of its last
+// direction. Else one group of them all in their order (of mu_s).
 struct DirectionsBySlice {
   struct Group {
-    int slice, next_slice, begin, end;  // [begin, end): the group's positions
+    int slice, next_slice;  // the group's, where grouped by slice (else -1)
+    int begin, end;         // [begin, end): its positions
   };
   std::vector<Group> groups;
   std::vector<int> position;  // per direction of SunDirections
@@ -55,26 +58,30 @@ struct DirectionsBySlice {
   std::vector<int> slice, next_slice;
   std::vector<float> nu_weight;  // of next_slice
 
-  DirectionsBySlice(const SunDirections& directions, const AtmosphereParameters& grid) {
+  DirectionsBySlice(const SunDirections& directions, const AtmosphereParameters& grid, bool by_slice) {
     const int nu_size = grid.scattering_nu_size;
-    const int distinct = *std::max_element(directions.of_texel.begin(), directions.of_texel.end()) + 1;
+    const int distinct = by_slice ? *std::max_element(directions.of_texel.begin(), directions.of_texel.end()) + 1
+                                  : static_cast<int>(directions.nu.size());
     std::vector<std::vector<int>> members(nu_size);
+    std::vector<int> slice_of(distinct);
     std::vector<float> weight(distinct);
     for (int j = 0; j < distinct; ++j) {
       const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (nu_size - 1);
-      const int nu0 = std::min(int(std::floor(nu_coord)), nu_size - 1);
-      members[nu0].push_back(j);
-      weight[j] = float(nu_coord - nu0);
+      slice_of[j] = std::min(int(std::floor(nu_coord)), nu_size - 1);
+      members[by_slice ? slice_of[j] : 0].push_back(j);
+      weight[j] = float(nu_coord - slice_of[j]);
     }
     position.resize(distinct);
-    for (int s = 0; s < nu_size; ++s) {
-      if (members[s].empty()) continue;
-      Group group{s, std::min(s + 1, nu_size - 1), count(), 0};
-      for (std::size_t m = 0; m < members[s].size() || count() % kVectorFloats != 0; ++m) {
-        const int j = members[s][std::min(m, members[s].size() - 1)];
-        if (m < members[s].size()) position[j] = count();
+    for (const std::vector<int>& group_members : members) {
+      if (group_members.empty()) continue;
+      const int group_slice = by_slice ? slice_of[group_members.front()] : -1;
+      Group group{group_slice, by_slice ? std::min(group_slice + 1, nu_size - 1) : -1, count(), 0};
+      for (std::size_t m = 0; m < group_members.size() || count() % kVectorFloats != 0; ++m) {
+        const int j = group_members[std::min(m, group_members.size() - 1)];
+        if (m < group_members.size()) position[j] = count();
         mu_s.push_back(directions.mu_s[j]), nu.push_back(directions.nu[j]);
-        slice.push_back(group.slice), next_slice.push_back(group.next_slice), nu_weight.push_back(weight[j]);
+        slice.push_back(slice_of[j]), next_slice.push_back(std::min(slice_of[j] + 1, nu_size - 1));
+        nu_weight.push_back(weight[j]);
       }
       group.end = count();
       groups.push_back(group);
@@ -85,9 +92,9 @@ struct DirectionsBySlice {
 
 // J per channel in rows along mu_s: of a density texture, per (r, mu) row
 // and channel, one row per nu slice padded to whole vectors (Rows); and of
-// a sample, those of its four (r, mu) rows blended, with the differences
-// between neighbouring columns, and the lookups of a group of directions in
-// two of its nu rows (Accumulate).
+// a sample, those of its four (r, mu) rows blended (with the differences
+// between neighbouring columns where the lookups permute them), and the
+// lookups of the ray's directions in them (Accumulate).
 class JRows {
  public:
   JRows(int mu_s_size, int nu_size)
@@ -96,6 +103,16 @@ class JRows {
         stride_(std::max(kRegisterRow, RoundUpToVector(mu_s_size))),
         values_(PerTexelRow(), 0.0f),
         differences_(values_.size(), 0.0f) {}
+
+  // Whether Accumulate's lookups are permutations of rows in registers,
+  // which needs the directions grouped by nu slice (DirectionsBySlice).
+  bool PermutesRows() const {
+#if defined(__AVX512F__)
+    return stride_ == kRegisterRow;
+#else
+    return false;
+#endif
+  }
 
   // Floats per (r, mu) row of a texture: 3 channels, nu_size rows of stride_.
   std::size_t PerTexelRow() const { return std::size_t(3) * nu_size_ * stride_; }
@@ -123,30 +140,32 @@ class JRows {
     float* values = values_.data();
 #pragma omp simd
     for (int i = 0; i < size; ++i) values[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
+    if (!PermutesRows()) return;
     float* differences = differences_.data();
 #pragma omp simd
     for (int i = 0; i < size - 1; ++i) differences[i] = values[i + 1] - values[i];
   }
 
-  // For the directions [begin, end) (whole vectors), channel c: J between
-  // the mu_s columns left[j] and left[j] + 1 at weight_a[j] in nu row
-  // `slice_a` and at weight_b[j] in row `slice_b`, blended between the rows
-  // by nu_weight[j], into value[j]; sum[j] += w value[j].
-  void Accumulate(int c, int slice_a, int slice_b, int begin, int end, const int* left, const float* weight_a,
-                  const float* weight_b, const float* nu_weight, float w, float* value, float* sum) const {
-    const float* row_a = Row(values_, c, slice_a);
-    const float* row_b = Row(values_, c, slice_b);
-    const float* difference_a = Row(differences_, c, slice_a);
-    const float* difference_b = Row(differences_, c, slice_b);
+  // For the directions j of a group of `directions`, channel c: J between
+  // the mu_s columns left[j] and left[j] + 1 at weight_a[j] in the nu row of
+  // j's slice and at weight_b[j] in the row of its next slice, blended
+  // between the rows by j's nu weight, into value[j]; sum[j] += w value[j].
+  void Accumulate(int c, const DirectionsBySlice& directions, const DirectionsBySlice::Group& group, const int* left,
+                  const float* weight_a, const float* weight_b, float w, float* value, float* sum) const {
+    const float* nu_weight = directions.nu_weight.data();
 #if defined(__AVX512F__)
-    if (stride_ == kRegisterRow) {
+    if (PermutesRows()) {
       // Each row in two registers: a lookup is one permutation of them.
+      const float* row_a = Row(values_, c, group.slice);
+      const float* row_b = Row(values_, c, group.next_slice);
+      const float* difference_a = Row(differences_, c, group.slice);
+      const float* difference_b = Row(differences_, c, group.next_slice);
       const __m512 a_low = _mm512_loadu_ps(row_a), a_high = _mm512_loadu_ps(row_a + 16);
       const __m512 b_low = _mm512_loadu_ps(row_b), b_high = _mm512_loadu_ps(row_b + 16);
       const __m512 da_low = _mm512_loadu_ps(difference_a), da_high = _mm512_loadu_ps(difference_a + 16);
       const __m512 db_low = _mm512_loadu_ps(difference_b), db_high = _mm512_loadu_ps(difference_b + 16);
       const __m512 weight = _mm512_set1_ps(w);
-      for (int j = begin; j < end; j += kVectorFloats) {
+      for (int j = group.begin; j < group.end; j += kVectorFloats) {
         const __m512i column = _mm512_loadu_si512(left + j);
         const __m512 along_a =
             _mm512_fmadd_ps(_mm512_loadu_ps(weight_a + j), _mm512_permutex2var_ps(da_low, column, da_high),
@@ -161,11 +180,15 @@ class JRows {
       return;
     }
 #endif
+    // Elsewhere each direction reads its rows by index (the same arithmetic).
+    const float* values = Row(values_, c, 0);
+    const int *slice = directions.slice.data(), *next_slice = directions.next_slice.data();
+    const int stride = stride_;
 #pragma omp simd
-    for (int j = begin; j < end; ++j) {
-      const int i = left[j];
-      const float along_a = row_a[i] + weight_a[j] * difference_a[i];
-      const float along_b = row_b[i] + weight_b[j] * difference_b[i];
+    for (int j = group.begin; j < group.end; ++j) {
+      const int a = slice[j] * stride + left[j], b = next_slice[j] * stride + left[j];
+      const float along_a = values[a] + weight_a[j] * (values[a + 1] - values[a]);
+      const float along_b = values[b] + weight_b[j] * (values[b + 1] - values[b]);
       value[j] = along_a + nu_weight[j] * (along_b - along_a);
       sum[j] += w * value[j];
     }
@@ -315,7 +338,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // along mu_s are then permutations of rows held in registers (RowLookups)
     // instead of gathers. Within a group, in order of mu_s.
     const SunDirections directions = RaySunDirections(columns, ray.mu);
-    const DirectionsBySlice by_slice(directions, density_grid);
+    JRows rows(density_mu_s_size, density_nu_size);
+    const DirectionsBySlice by_slice(directions, density_grid, rows.PermutesRows());
     const int count = by_slice.count();
     const std::vector<float> mu_s(by_slice.mu_s.begin(), by_slice.mu_s.end());
     const std::vector<float> nu(by_slice.nu.begin(), by_slice.nu.end());
@@ -343,7 +367,6 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     std::vector<float> below_factor[3];
     for (auto& factor : below_factor) factor.resize(fall ? count : 0);
     std::vector<int> below_end(by_slice.groups.size());
-    JRows rows(density_mu_s_size, density_nu_size);
     for (const SampleTaps& sample : samples) {
       const int k = sample.k;
       // J at the sample's (r, mu) for every (nu, mu_s) texel.
@@ -373,18 +396,28 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         // column the factor is exp(0) = 1, which changes nothing.
         if (end > group.begin) end = std::min(group.end, RoundUpToVector(end - group.begin) + group.begin);
         below_end[g] = end;
-        const int a = 3 * group.slice, b = 3 * group.next_slice;
-        for (int c = 0; c < 3 && end > group.begin; ++c) {
-          const float* slope = &fall->lowest_log_slope[sample.lowest_row + c];
-          const float* curvature = &fall->lowest_log_curvature[sample.lowest_row + c];
-          float* factor = below_factor[c].data();
+        // The slope and curvature blended between each direction's nu rows
+        // (for a group of one slice, the same two rows throughout).
+        auto below_factors = [&](auto slice_of, auto next_slice_of) {
+          for (int c = 0; c < 3 && end > group.begin; ++c) {
+            const float* slope = &fall->lowest_log_slope[sample.lowest_row + c];
+            const float* curvature = &fall->lowest_log_curvature[sample.lowest_row + c];
+            float* factor = below_factor[c].data();
 #pragma omp simd
-          for (int j = group.begin; j < end; ++j) {
-            const float t = nu_weight[j], d = std::min(mu_s_k[j] - lowest_mu_s, 0.0f);
-            const float slope_j = slope[a] + t * (slope[b] - slope[a]);
-            const float curvature_j = curvature[a] + t * (curvature[b] - curvature[a]);
-            factor[j] = ExpFloat(d * (slope_j + d * curvature_j));
+            for (int j = group.begin; j < end; ++j) {
+              const int a = 3 * slice_of(j), b = 3 * next_slice_of(j);
+              const float t = nu_weight[j], d = std::min(mu_s_k[j] - lowest_mu_s, 0.0f);
+              const float slope_j = slope[a] + t * (slope[b] - slope[a]);
+              const float curvature_j = curvature[a] + t * (curvature[b] - curvature[a]);
+              factor[j] = ExpFloat(d * (slope_j + d * curvature_j));
+            }
           }
+        };
+        if (group.slice >= 0) {
+          below_factors([&](int) { return group.slice; }, [&](int) { return group.next_slice; });
+        } else {
+          const int *slice = by_slice.slice.data(), *next_slice = by_slice.next_slice.data();
+          below_factors([&](int j) { return slice[j]; }, [&](int j) { return next_slice[j]; });
         }
         if (shaped) {
           // The weights of the right columns of the two nu rows, following
@@ -421,15 +454,13 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         const float w = float(weight[k][c]);
         float* sum = sums[c].data();
         float* value = source.empty() ? values.data() : &source[(std::size_t(k) * 3 + c) * count];
+        const float* factor = below_factor[c].data();
         for (std::size_t g = 0; g < by_slice.groups.size(); ++g) {
-          const DirectionsBySlice::Group& group = by_slice.groups[g];
-          rows.Accumulate(c, group.slice, group.next_slice, group.begin, group.end, mu_s_left.data(), weight_a,
-                          weight_b, nu_weight.data(), w, value, sum);
+          rows.Accumulate(c, by_slice, by_slice.groups[g], mu_s_left.data(), weight_a, weight_b, w, value, sum);
           // Below the lowest column the lookup read the lowest column's J
           // (its weight clamped to 0); it falls from there.
-          const float* factor = below_factor[c].data();
 #pragma omp simd
-          for (int j = group.begin; j < below_end[g]; ++j) {
+          for (int j = by_slice.groups[g].begin; j < below_end[g]; ++j) {
             sum[j] += w * value[j] * (factor[j] - 1.0f);
             value[j] *= factor[j];
           }
