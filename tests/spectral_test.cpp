@@ -417,11 +417,14 @@ double LargestRelativeDifference(const glsl::Texture& got, const glsl::Texture& 
 // 0.14 and 0.25 %. The bounds, about 1.5 times the larger, hold the
 // interpolation where it is (docs/colour.md has its error on the case set).
 // Single Mie and the transmittance have no higher orders and are the same
-// but for the rounding of summing the wavelengths in another order, and so
-// is a bake of single scattering alone. (At the stress set's 16 ray
-// intervals they would not be: an interval counts as optically thick when
-// any wavelength of its batch is, and the interpolated bake batches the
-// wavelengths differently.)
+// but for the rounding of summing the wavelengths in another order. So is a
+// bake of single scattering alone, but for a few texels: an interval counts
+// as optically thick when any wavelength of its batch is, a partly shadowed
+// thick interval is integrated by another rule (SingleScatteringInterval)
+// than a thin one, and the interpolated bake batches the wavelengths
+// differently; measured 2.1e-6 at most (4e-7 with twice the sub-intervals
+// of a partly shadowed interval), bound 1e-5. (At the stress set's 16
+// ray intervals the difference would be larger.)
 TEST(SpectralBake, InterpolatedHigherOrdersAgainstEveryWavelength) {
   BakeSettings settings = testing::SmallBakeSettings();
   settings.orders = 4;
@@ -462,8 +465,8 @@ TEST(SpectralBake, InterpolatedHigherOrdersAgainstEveryWavelength) {
   const LutSet exact = BakeSpectral(Preset("earth"), MakeSpectralBatches(nm, SpectralHigherOrders::kExact), settings);
   const LutSet interpolated =
       BakeSpectral(Preset("earth"), MakeSpectralBatches(nm, SpectralHigherOrders::kInterpolated), settings);
-  EXPECT_LT(LargestRelativeDifference(interpolated.scattering, exact.scattering), 1e-6);
-  EXPECT_LT(LargestRelativeDifference(interpolated.irradiance, exact.irradiance), 1e-6);
+  EXPECT_LT(LargestRelativeDifference(interpolated.scattering, exact.scattering), 1e-5);
+  EXPECT_LT(LargestRelativeDifference(interpolated.irradiance, exact.irradiance), 1e-5);
 }
 
 // A dark sun (irradiance 0, which the file format allows): the interpolated
