@@ -40,6 +40,28 @@ inline float FallWeight(float f, float log_ratio, float inverse_ratio_minus_one)
 // n rounded up to whole vectors of floats.
 inline int RoundUpToVector(int n) { return (n + kVectorFloats - 1) / kVectorFloats * kVectorFloats; }
 
+// out[j] = row[index[j]] for j in [begin, end) (whole vectors), from a row
+// of `size` floats; with AVX-512 and at most 32 of them, a permutation of
+// the row held in two registers.
+inline void LookUpInRow(const float* row, int size, const int* index, int begin, int end, float* out) {
+#if defined(__AVX512F__)
+  if (size <= 2 * kVectorFloats) {
+    const __mmask16 low_mask = size >= kVectorFloats ? __mmask16(0xffff) : __mmask16((1u << size) - 1u);
+    const __mmask16 high_mask = size <= kVectorFloats       ? __mmask16(0)
+                                : size >= 2 * kVectorFloats ? __mmask16(0xffff)
+                                                            : __mmask16((1u << (size - kVectorFloats)) - 1u);
+    const __m512 low = _mm512_maskz_loadu_ps(low_mask, row),
+                 high = _mm512_maskz_loadu_ps(high_mask, row + kVectorFloats);
+    for (int j = begin; j < end; j += kVectorFloats) {
+      _mm512_storeu_ps(out + j, _mm512_permutex2var_ps(low, _mm512_loadu_si512(index + j), high));
+    }
+    return;
+  }
+#endif
+#pragma omp simd
+  for (int j = begin; j < end; ++j) out[j] = row[index[j]];
+}
+
 // A ray's sun directions (RaySunDirections) with the nu slices of the
 // density grid around their nu. With `by_slice`, grouped by the slice below
 // their nu, so that every direction of a group reads J's nu rows `slice`
@@ -359,6 +381,9 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     if (!thick_intervals.empty()) source.assign(std::size_t(n + 1) * 3 * count, 0.0f);
     const bool shaped = fall != nullptr && fall->falling_columns > 0;
     std::vector<float> fall_weight_a(shaped ? count : 0), fall_weight_b(shaped ? count : 0);
+    std::vector<int> falling_column(shaped ? count : 0);
+    std::vector<float> ratio_a(shaped ? count : 0), ratio_b(shaped ? count : 0);
+    std::vector<float> inverse_a(shaped ? count : 0), inverse_b(shaped ? count : 0);
     // Per channel and direction, the fall of J below the lowest column at
     // the sample (1 where the sun is above it): exp(d (slope + d curvature))
     // with d = mu_s - mu_s_min < 0, slope and curvature blended between the
@@ -435,14 +460,32 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
                     fall_weight_a.begin() + falling_end);
           std::copy(mu_s_weight.begin() + falling_end, mu_s_weight.begin() + group.end,
                     fall_weight_b.begin() + falling_end);
+          // Per direction, the ln of the ratio and 1 / (ratio - 1) of the
+          // pair of columns it lies between in each of its nu rows.
 #pragma omp simd
           for (int j = group.begin; j < falling_end; ++j) {
-            const int left = mu_s_left[j];
-            const int column = left < falling ? left : falling - 1;  // any, when the pair does not fall
-            const int a = fall_row0[j] + column, b = fall_row1[j] + column;
-            const float inverse_a = left < falling ? inverse[a] : 0.0f, inverse_b = left < falling ? inverse[b] : 0.0f;
-            fall_weight_a[j] = FallWeight(mu_s_weight[j], log_ratio[a], inverse_a);
-            fall_weight_b[j] = FallWeight(mu_s_weight[j], log_ratio[b], inverse_b);
+            falling_column[j] = mu_s_left[j] < falling ? mu_s_left[j] : falling - 1;  // any, when it does not fall
+          }
+          if (group.slice >= 0) {
+            // One pair of rows for the whole group.
+            const int a = group.slice * falling, b = group.next_slice * falling;
+            LookUpInRow(log_ratio + a, falling, falling_column.data(), group.begin, falling_end, ratio_a.data());
+            LookUpInRow(log_ratio + b, falling, falling_column.data(), group.begin, falling_end, ratio_b.data());
+            LookUpInRow(inverse + a, falling, falling_column.data(), group.begin, falling_end, inverse_a.data());
+            LookUpInRow(inverse + b, falling, falling_column.data(), group.begin, falling_end, inverse_b.data());
+          } else {
+#pragma omp simd
+            for (int j = group.begin; j < falling_end; ++j) {
+              const int a = fall_row0[j] + falling_column[j], b = fall_row1[j] + falling_column[j];
+              ratio_a[j] = log_ratio[a], ratio_b[j] = log_ratio[b], inverse_a[j] = inverse[a],
+              inverse_b[j] = inverse[b];
+            }
+          }
+#pragma omp simd
+          for (int j = group.begin; j < falling_end; ++j) {
+            const bool falls = mu_s_left[j] < falling;
+            fall_weight_a[j] = FallWeight(mu_s_weight[j], ratio_a[j], falls ? inverse_a[j] : 0.0f);
+            fall_weight_b[j] = FallWeight(mu_s_weight[j], ratio_b[j], falls ? inverse_b[j] : 0.0f);
           }
         }
       }
