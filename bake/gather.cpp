@@ -279,8 +279,9 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
   const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
   const SunColumns columns(grid);
   // J in rows along mu_s per channel and nu slice (JRows).
-  const std::size_t per_row = JRows(density_mu_s_size, density_nu_size).PerTexelRow();
-  const std::vector<float> density_rows = JRows(density_mu_s_size, density_nu_size).Rows(density);
+  const JRows layout(density_mu_s_size, density_nu_size);
+  const std::size_t per_row = layout.PerTexelRow();
+  const std::vector<float> density_rows = layout.Rows(density);
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
     const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
