@@ -219,7 +219,6 @@ class JRows {
  private:
   // A row that fits two 512-bit registers.
   static constexpr int kRegisterRow = 2 * kVectorFloats;
-  float* Row(std::vector<float>& rows, int c, int s) { return &rows[(std::size_t(c) * nu_size_ + s) * stride_]; }
   const float* Row(const std::vector<float>& rows, int c, int s) const {
     return &rows[(std::size_t(c) * nu_size_ + s) * stride_];
   }
@@ -356,10 +355,10 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
                          fall ? row * density_nu_size * 3 : 0});
     }
 
-    // The ray's sun directions grouped by the nu slice below them, so that
-    // each vector of directions reads the same two nu rows of J: the lookups
-    // along mu_s are then permutations of rows held in registers (RowLookups)
-    // instead of gathers. Within a group, in order of mu_s.
+    // The ray's sun directions, grouped by the nu slice below them where
+    // JRows's lookups along mu_s are permutations of rows held in registers
+    // (each vector of directions then reads the same two nu rows of J);
+    // within a group in order of mu_s (DirectionsBySlice).
     const SunDirections directions = RaySunDirections(columns, ray.mu);
     JRows rows(density_mu_s_size, density_nu_size);
     const DirectionsBySlice by_slice(directions, density_grid, rows.PermutesRows());
@@ -367,11 +366,6 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     const std::vector<float> mu_s(by_slice.mu_s.begin(), by_slice.mu_s.end());
     const std::vector<float> nu(by_slice.nu.begin(), by_slice.nu.end());
     const std::vector<float>& nu_weight = by_slice.nu_weight;
-    std::vector<int> fall_row0(count), fall_row1(count);  // offsets of the nu rows in a row of MuSFall
-    for (int j = 0; j < count && fall; ++j) {
-      fall_row0[j] = by_slice.slice[j] * fall->falling_columns;
-      fall_row1[j] = by_slice.next_slice[j] * fall->falling_columns;
-    }
     const MuSCoordinate mu_s_coordinate(density_grid);
     const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
     std::vector<Spectrum> directions_sum(count);
@@ -475,9 +469,10 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
             LookUpInRow(inverse + a, falling, falling_column.data(), group.begin, falling_end, inverse_a.data());
             LookUpInRow(inverse + b, falling, falling_column.data(), group.begin, falling_end, inverse_b.data());
           } else {
+            const int *slice = by_slice.slice.data(), *next_slice = by_slice.next_slice.data();
 #pragma omp simd
             for (int j = group.begin; j < falling_end; ++j) {
-              const int a = fall_row0[j] + falling_column[j], b = fall_row1[j] + falling_column[j];
+              const int a = slice[j] * falling + falling_column[j], b = next_slice[j] * falling + falling_column[j];
               ratio_a[j] = log_ratio[a], ratio_b[j] = log_ratio[b], inverse_a[j] = inverse[a],
               inverse_b[j] = inverse[b];
             }
