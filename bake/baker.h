@@ -28,6 +28,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,6 +38,7 @@
 #include "bake/grids.h"
 #include "bake/medium.h"
 #include "bake/ray_integrals.h"
+#include "bake/ring_phase.h"
 #include "bake/sun_lookups.h"
 
 namespace skybake::detail {
@@ -234,6 +236,10 @@ class Baker {
   Texture delta_multiple_;        // radiance of the latest order >= 2, on orders_grid_
   // J of the current order per unit scattering coefficient, on atmosphere_grid_.
   Texture scattering_density_;
+  // Per r row of atmosphere_grid_, the phases' weights on the scattering
+  // density's sphere rule (computed with the first order's density, kept
+  // for the later ones).
+  std::vector<std::unique_ptr<RingPhaseMeans>> density_phase_;
   // Sum over the orders >= 2 so far, and their tail, of their radiance, or
   // of their J where GatherAtEnd(); on atmosphere_grid_.
   Texture higher_orders_;

@@ -5,13 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
 #include "bake/grids.h"
-#include "bake/phase_weighted_radiance.h"
+#include "bake/ring_phase.h"
 #include "bake/sun_lookups.h"
 #include "core/constants.h"
 #include "core/errors.h"
@@ -179,7 +180,6 @@ void Baker::ComputeScatteringDensity(int order) {
   const int mu_s_size = grid.scattering_mu_s_size, r_size = grid.scattering_r_size;
   const int nu_size = grid.scattering_nu_size, mu_size = grid.scattering_mu_size;
   const int polar = settings_.sphere_samples, azimuths = 2 * settings_.sphere_samples;
-  const double d_phi = 2.0 * kPi / azimuths;
   const RingAzimuths azimuth(azimuths);
   const int groups = static_cast<int>(medium_.groups().size());
   const vec3 albedo_over_pi = medium_.atmosphere().ground_albedo / kPi;
@@ -200,6 +200,40 @@ void Baker::ComputeScatteringDensity(int order) {
     for (int j = 0; j < mu_s_size && columns.mu_s[j] < glsl::LOW_SUN_MU_S; ++j) low_sun.push_back(columns.mu_s[j]);
     ring_single = SingleScatteringOnRings(radii, ring_cosines, low_sun, azimuths);
   }
+  // Per r row, the weights of the rings' series terms in the mean of each
+  // mu row's view (RingPhaseMeans), the same for every order.
+  const int terms = azimuths / 2;
+  // Each group's share of the scattering at radius r, per channel.
+  auto scattering_shares = [&](double r) {
+    std::vector<double> densities(medium_.constituent_count());
+    medium_.Densities(r - params_.bottom_radius, densities.data());
+    std::vector<Spectrum> shares(groups);
+    Spectrum total(0.0);
+    for (int g = 0; g < groups; ++g) total += shares[g] = medium_.GroupScattering(g, densities.data());
+    for (Spectrum& share : shares) {
+      for (int c = 0; c < 3; ++c) share[c] = total[c] > 0.0 ? share[c] / total[c] : 0.0;
+    }
+    return shares;
+  };
+  if (density_phase_.empty()) {
+    std::vector<PhaseAzimuthSeries> series;
+    for (int g = 0; g < groups; ++g) series.emplace_back(medium_.groups()[g].phase, terms);
+    density_phase_.resize(r_size);
+    tbb::parallel_for(0, r_size, [&](int z) {
+      std::vector<double> view_mu;
+      for (int y = 0; y < mu_size; ++y) view_mu.push_back(GetScatteringTexel(grid, 0, y, z).mu);
+      density_phase_[z] = std::make_unique<RingPhaseMeans>(series, scattering_shares(radii[z]), view_mu,
+                                                           ring_cosines[z], ring_weights[z], terms);
+    });
+  }
+  const AzimuthCosineSeries cosine_series(terms);
+  // Per (r, mu_s) slice, channel and ring, the cosine series of the
+  // incoming radiance (of the previous order) along the ring, at the
+  // weights' stride.
+  const int rings = static_cast<int>(ring_cosines.front().size());
+  const int stride = density_phase_.front()->Stride();
+  const std::size_t slice_terms = std::size_t(3) * rings * stride;
+  std::vector<float> ring_series(r_size * mu_s_size * slice_terms, 0.0f);
   tbb::parallel_for(0, r_size * mu_s_size, [&](int slice) {
     int z = slice / mu_s_size, mu_s_index = slice % mu_s_size;
     const ScatteringTexel slice_texel = GetScatteringTexel(grid, mu_s_index, 0, z);
@@ -209,13 +243,11 @@ void Baker::ComputeScatteringDensity(int order) {
     const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
 
     const std::vector<double>& cosines = ring_cosines[z];
-    const std::vector<double>& cosine_weights = ring_weights[z];
 
-    // Incoming radiance (of the previous order) from every direction.
-    std::vector<vec3> directions, radiance;
-    std::vector<double> solid_angles;
-    directions.reserve(cosines.size() * azimuths);
-    for (int l = 0; l < int(cosines.size()); ++l) {
+    // Incoming radiance on every ring, at the azimuths on the sun's side of
+    // its plane of symmetry (the light is symmetric about it), per channel.
+    std::vector<double> radiance(std::size_t(3) * rings * terms);
+    for (int l = 0; l < rings; ++l) {
       double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
       bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
       double ground_distance = 0.0;
@@ -225,17 +257,8 @@ void Baker::ComputeScatteringDensity(int order) {
         ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
       }
       const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
-      const std::size_t ring_start = radiance.size();
-      for (int m = 0; m < azimuths; ++m) {
+      for (int m = 0; m < terms; ++m) {
         vec3 omega(azimuth.cos[m] * sin_theta, azimuth.sin[m] * sin_theta, cos_theta);
-        directions.push_back(omega);
-        solid_angles.push_back(cosine_weights[l] * d_phi);
-        // The light is symmetric about the sun's plane: the second half of
-        // the ring's azimuths (2 pi - phi) has the first half's.
-        if (m >= azimuths / 2) {
-          radiance.push_back(radiance[ring_start + azimuths - 1 - m]);
-          continue;
-        }
         double nu = glsl::ClampCosine(glm::dot(omega, sun));
         const std::optional<vec3> exact = RingIncident(ring_single, z, l, mu_s_index, m, nu);
         vec3 incident = exact ? *exact : incident_ring.At(nu);
@@ -244,45 +267,54 @@ void Baker::ComputeScatteringDensity(int order) {
           double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
           incident += ground_transmittance * albedo_over_pi * GroundIrradiance(order - 1, ground_mu_s);
         }
-        radiance.push_back(incident);
+        for (int c = 0; c < 3; ++c) radiance[(std::size_t(c) * rings + l) * terms + m] = incident[c];
       }
     }
-
-    std::vector<double> densities(medium_.constituent_count());
-    medium_.Densities(r - params_.bottom_radius, densities.data());
-    std::vector<Spectrum> group_scattering(groups);
-    Spectrum total_scattering(0.0);
-    for (int g = 0; g < groups; ++g) {
-      group_scattering[g] = medium_.GroupScattering(g, densities.data());
-      total_scattering += group_scattering[g];
+    for (int ring = 0; ring < 3 * rings; ++ring) {
+      cosine_series.Coefficients(&radiance[std::size_t(ring) * terms], 1,
+                                 &ring_series[slice * slice_terms + std::size_t(ring) * stride]);
     }
+  });
 
-    const PhaseWeightedRadiance incoming(directions, radiance, solid_angles);
+  // Stored per unit scattering coefficient, i.e. as the phase-weighted
+  // mean incoming radiance, which varies slowly with altitude; the
+  // multiple-scattering integral multiplies the coefficient back at each
+  // sample. Interpolating J itself between r texels overestimates a thin
+  // exponential haze (linear interpolation of a convex profile), so that
+  // an order could carry more light than the previous one and the orders
+  // of a dense fog diverged. Per r row, the weights of each mu row's view
+  // are read once for all the row's suns.
+  tbb::parallel_for(0, r_size, [&](int z) {
+    const RingPhaseMeans& means = *density_phase_[z];
+    std::vector<float> view_terms(std::size_t(3) * stride);
+    std::vector<double> cos_phi(nu_size), multiples(std::size_t(terms) * nu_size);
+    std::vector<vec3> per_unit_scattering(nu_size);
     for (int y = 0; y < mu_size; ++y) {
-      const double mu = GetScatteringTexel(grid, mu_s_index, y, z).mu;
-      for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
-        int x = nu_index * mu_s_size + mu_s_index;
-        const double nu = ClampedNu(columns.grid_nu[x], mu, mu_s);
-        // View direction with zenith cosine mu and sun cosine nu.
-        double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-        double sin_mu_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
-        double cos_phi = sin_mu * sin_mu_s > 0.0 ? std::clamp((nu - mu * mu_s) / (sin_mu * sin_mu_s), -1.0, 1.0) : 1.0;
-        vec3 view(sin_mu * cos_phi, sin_mu * std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi)), mu);
-        vec3 density(0.0);
-        for (int g = 0; g < groups; ++g) {
-          if (group_scattering[g] == Spectrum(0.0)) continue;
-          density += group_scattering[g] * incoming.Mean(medium_.groups()[g].phase, view);
+      const double mu = GetScatteringTexel(grid, 0, y, z).mu;
+      const double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+      for (int mu_s_index = 0; mu_s_index < mu_s_size; ++mu_s_index) {
+        const double mu_s = columns.mu_s[mu_s_index];
+        const double sin_mu_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+        // The views' azimuths from the sun, for zenith cosine mu and sun cosine nu.
+        for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+          const double nu = ClampedNu(columns.grid_nu[nu_index * mu_s_size + mu_s_index], mu, mu_s);
+          cos_phi[nu_index] =
+              sin_mu * sin_mu_s > 0.0 ? std::clamp((nu - mu * mu_s) / (sin_mu * sin_mu_s), -1.0, 1.0) : 1.0;
         }
-        // Stored per unit scattering coefficient, i.e. as the phase-weighted
-        // mean incoming radiance, which varies slowly with altitude; the
-        // multiple-scattering integral multiplies the coefficient back at
-        // each sample. Interpolating J itself between r texels overestimates
-        // a thin exponential haze (linear interpolation of a convex profile),
-        // so that an order could carry more light than the previous one and
-        // the orders of a dense fog diverged.
-        vec3 per_unit_scattering(0.0);
-        for (int c = 0; c < 3; ++c) per_unit_scattering[c] = total_scattering[c] > 0.0 ? density[c] / total_scattering[c] : 0.0;
-        scattering_density_.Store(x, y, z, vec4(per_unit_scattering, 0.0));
+        CosineMultiples(cos_phi.data(), nu_size, terms, multiples.data());
+        means.Terms(y, &ring_series[(std::size_t(z) * mu_s_size + mu_s_index) * slice_terms], view_terms.data());
+        for (int c = 0; c < 3; ++c) {
+          for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+            double sum = 0.0;
+            for (int k = 0; k < terms; ++k) {
+              sum += view_terms[std::size_t(c) * stride + k] * multiples[std::size_t(k) * nu_size + nu_index];
+            }
+            per_unit_scattering[nu_index][c] = sum;
+          }
+        }
+        for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
+          scattering_density_.Store(nu_index * mu_s_size + mu_s_index, y, z, vec4(per_unit_scattering[nu_index], 0.0));
+        }
       }
     }
   });
