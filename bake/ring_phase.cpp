@@ -133,10 +133,8 @@ RingPhaseMeans::RingPhaseMeans(const std::vector<PhaseAzimuthSeries>& series, co
       for (int channel = 0; channel < 3; ++channel) {
         float* out = &weights_[(v * 3 + channel) * rings_ * stride_];
         for (int l = 0; l < rings_; ++l) {
-          for (int k = 0; k < terms; ++k) {
-            out[l * stride_ + k] +=
-                float(shares[g][channel] * ring_weights[l] * c[std::size_t(l) * terms + k] / weight);
-          }
+          const double factor = shares[g][channel] * ring_weights[l] / weight;
+          for (int k = 0; k < terms; ++k) out[l * stride_ + k] += float(factor * c[std::size_t(l) * terms + k]);
         }
       }
     }
