@@ -51,10 +51,10 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   StagedFiles staged;
   // Each table file is encoded, hashed and written (under its temporary
   // name) by one worker, its bytes freed as soon as they are written; the
-  // manifest lists them in a fixed order. The workers take the files largest
-  // first, EXR (whose zip compression is most of the writing, spread over
-  // OpenEXR's threads) before KTX2, each taking the next file when done, so
-  // that the longest encodings start at once instead of after smaller ones.
+  // manifest lists them in a fixed order. The workers, one per core, take
+  // the files largest first, EXR (whose encoding is most of the writing)
+  // before KTX2, each taking the next file when done, so that the longest
+  // encodings start at once instead of after smaller ones.
   struct Encoded {
     const TableDescription* table;
     FileFormat format;
