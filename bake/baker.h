@@ -238,7 +238,7 @@ class Baker {
   Texture scattering_density_;
   // Per r row of atmosphere_grid_, the phases' weights on the scattering
   // density's sphere rule (computed with the first order's density, kept
-  // for the later ones).
+  // for the later ones unless they are large: ComputeScatteringDensity).
   std::vector<std::unique_ptr<RingPhaseMeans>> density_phase_;
   // Sum over the orders >= 2 so far, and their tail, of their radiance, or
   // of their J where GatherAtEnd(); on atmosphere_grid_.

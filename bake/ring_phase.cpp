@@ -118,7 +118,7 @@ void PhaseAzimuthSeries::Coefficients(double view_mu, double ring_cos, double* c
 RingPhaseMeans::RingPhaseMeans(const std::vector<PhaseAzimuthSeries>& series, const std::vector<Spectrum>& shares,
                                const std::vector<double>& view_mu, const std::vector<double>& ring_cos,
                                const std::vector<double>& ring_weights, int terms)
-    : rings_(static_cast<int>(ring_cos.size())), stride_((terms + kTermBlock - 1) / kTermBlock * kTermBlock) {
+    : rings_(static_cast<int>(ring_cos.size())), stride_(StrideFor(terms)) {
   weights_.assign(view_mu.size() * 3 * rings_ * stride_, 0.0f);
   std::vector<double> c(std::size_t(rings_) * terms);
   for (std::size_t v = 0; v < view_mu.size(); ++v) {

@@ -71,6 +71,7 @@ class RingPhaseMeans {
   // of vectors (kTermBlock floats), the terms past `terms` zero.
   int Stride() const { return stride_; }
   static constexpr int kTermBlock = 16;
+  static int StrideFor(int terms) { return (terms + kTermBlock - 1) / kTermBlock * kTermBlock; }
 
   // The terms of the mean for a view of zenith cosine view_mu[view], per
   // channel c: out[c * Stride() + k] = sum_l weight_clk a[(c * Rings() + l)

@@ -201,96 +201,103 @@ void Baker::ComputeScatteringDensity(int order) {
     ring_single = SingleScatteringOnRings(radii, ring_cosines, low_sun, azimuths);
   }
   // Per r row, the weights of the rings' series terms in the mean of each
-  // mu row's view (RingPhaseMeans), the same for every order.
+  // mu row's view (RingPhaseMeans), the same for every order: kept for the
+  // later orders up to kKeptPhaseWeightBytes (the default rule's are 19
+  // MiB; they grow as the square of the sphere samples, to 302 MiB at 64),
+  // else computed again per order and view, where they are used.
+  constexpr std::size_t kKeptPhaseWeightBytes = std::size_t(128) << 20;
   const int terms = azimuths / 2;
-  // Each group's share of the scattering at radius r, per channel.
-  auto scattering_shares = [&](double r) {
+  const int rings = static_cast<int>(ring_cosines.front().size());
+  const int stride = RingPhaseMeans::StrideFor(terms);
+  const bool keep_weights = std::size_t(r_size) * mu_size * 3 * rings * stride * sizeof(float) <= kKeptPhaseWeightBytes;
+  std::vector<PhaseAzimuthSeries> series;
+  for (int g = 0; g < groups; ++g) series.emplace_back(medium_.groups()[g].phase, terms);
+  std::vector<double> view_mu(std::size_t(r_size) * mu_size);
+  for (int z = 0; z < r_size; ++z) {
+    for (int y = 0; y < mu_size; ++y) view_mu[std::size_t(z) * mu_size + y] = GetScatteringTexel(grid, 0, y, z).mu;
+  }
+  // The weights of row z for its views [first, end).
+  auto row_weights = [&](int z, int first, int end) {
+    // Each group's share of the scattering at the row's radius, per channel.
     std::vector<double> densities(medium_.constituent_count());
-    medium_.Densities(r - params_.bottom_radius, densities.data());
+    medium_.Densities(radii[z] - params_.bottom_radius, densities.data());
     std::vector<Spectrum> shares(groups);
     Spectrum total(0.0);
     for (int g = 0; g < groups; ++g) total += shares[g] = medium_.GroupScattering(g, densities.data());
     for (Spectrum& share : shares) {
       for (int c = 0; c < 3; ++c) share[c] = total[c] > 0.0 ? share[c] / total[c] : 0.0;
     }
-    return shares;
+    const auto row = view_mu.begin() + std::ptrdiff_t(z) * mu_size;
+    return std::make_unique<RingPhaseMeans>(series, shares, std::vector<double>(row + first, row + end),
+                                            ring_cosines[z], ring_weights[z], terms);
   };
-  if (density_phase_.empty()) {
-    std::vector<PhaseAzimuthSeries> series;
-    for (int g = 0; g < groups; ++g) series.emplace_back(medium_.groups()[g].phase, terms);
+  if (keep_weights && density_phase_.empty()) {
     density_phase_.resize(r_size);
-    tbb::parallel_for(0, r_size, [&](int z) {
-      std::vector<double> view_mu;
-      for (int y = 0; y < mu_size; ++y) view_mu.push_back(GetScatteringTexel(grid, 0, y, z).mu);
-      density_phase_[z] = std::make_unique<RingPhaseMeans>(series, scattering_shares(radii[z]), view_mu,
-                                                           ring_cosines[z], ring_weights[z], terms);
-    });
+    tbb::parallel_for(0, r_size, [&](int z) { density_phase_[z] = row_weights(z, 0, mu_size); });
   }
+
+  // Row by row: the incoming radiance's series on the rings per sun, then
+  // the texels' means, which read each view's weights once for all suns.
   const AzimuthCosineSeries cosine_series(terms);
-  // Per (r, mu_s) slice, channel and ring, the cosine series of the
-  // incoming radiance (of the previous order) along the ring, at the
-  // weights' stride.
-  const int rings = static_cast<int>(ring_cosines.front().size());
-  const int stride = density_phase_.front()->Stride();
   const std::size_t slice_terms = std::size_t(3) * rings * stride;
-  std::vector<float> ring_series(r_size * mu_s_size * slice_terms, 0.0f);
-  tbb::parallel_for(0, r_size * mu_s_size, [&](int slice) {
-    int z = slice / mu_s_size, mu_s_index = slice % mu_s_size;
-    const ScatteringTexel slice_texel = GetScatteringTexel(grid, mu_s_index, 0, z);
-    const double r = slice_texel.r, mu_s = slice_texel.mu_s;
-    // Local frame: zenith along z, sun in the x-z plane.
-    const vec3 zenith(0.0, 0.0, 1.0);
-    const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
-
+  std::vector<float> ring_series(mu_s_size * slice_terms, 0.0f);
+  for (int z = 0; z < r_size; ++z) {
+    const double r = radii[z];
     const std::vector<double>& cosines = ring_cosines[z];
-
-    // Incoming radiance on every ring, at the azimuths on the sun's side of
-    // its plane of symmetry (the light is symmetric about it), per channel.
-    std::vector<double> radiance(std::size_t(3) * rings * terms);
-    for (int l = 0; l < rings; ++l) {
-      double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
-      bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
-      double ground_distance = 0.0;
-      vec3 ground_transmittance(0.0);
-      if (intersects) {
-        ground_distance = glsl::DistanceToBottomAtmosphereBoundary(params_, r, cos_theta);
-        ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
-      }
-      const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
-      for (int m = 0; m < terms; ++m) {
-        vec3 omega(azimuth.cos[m] * sin_theta, azimuth.sin[m] * sin_theta, cos_theta);
-        double nu = glsl::ClampCosine(glm::dot(omega, sun));
-        const std::optional<vec3> exact = RingIncident(ring_single, z, l, mu_s_index, m, nu);
-        vec3 incident = exact ? *exact : incident_ring.At(nu);
+    tbb::parallel_for(0, mu_s_size, [&](int mu_s_index) {
+      const double mu_s = columns.mu_s[mu_s_index];
+      // Local frame: zenith along z, sun in the x-z plane.
+      const vec3 zenith(0.0, 0.0, 1.0);
+      const vec3 sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+      // Incoming radiance (of the previous order) on every ring, at the
+      // azimuths on the sun's side of its plane of symmetry (the light is
+      // symmetric about it), per channel; then its cosine series per ring.
+      std::vector<double> radiance(std::size_t(3) * rings * terms);
+      for (int l = 0; l < rings; ++l) {
+        double cos_theta = cosines[l], sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+        bool intersects = glsl::RayIntersectsGround(params_, r, cos_theta);
+        double ground_distance = 0.0;
+        vec3 ground_transmittance(0.0);
         if (intersects) {
-          vec3 ground_normal = glm::normalize(zenith * r + omega * ground_distance);
-          double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
-          incident += ground_transmittance * albedo_over_pi * GroundIrradiance(order - 1, ground_mu_s);
+          ground_distance = glsl::DistanceToBottomAtmosphereBoundary(params_, r, cos_theta);
+          ground_transmittance = glsl::GetTransmittance(params_, transmittance, r, cos_theta, ground_distance, true);
         }
-        for (int c = 0; c < 3; ++c) radiance[(std::size_t(c) * rings + l) * terms + m] = incident[c];
+        const IncidentAlongNu incident_ring(*this, order - 1, r, cos_theta, mu_s, intersects);
+        for (int m = 0; m < terms; ++m) {
+          vec3 omega(azimuth.cos[m] * sin_theta, azimuth.sin[m] * sin_theta, cos_theta);
+          double nu = glsl::ClampCosine(glm::dot(omega, sun));
+          const std::optional<vec3> exact = RingIncident(ring_single, z, l, mu_s_index, m, nu);
+          vec3 incident = exact ? *exact : incident_ring.At(nu);
+          if (intersects) {
+            vec3 ground_normal = glm::normalize(zenith * r + omega * ground_distance);
+            double ground_mu_s = glsl::ClampCosine(glm::dot(ground_normal, sun));
+            incident += ground_transmittance * albedo_over_pi * GroundIrradiance(order - 1, ground_mu_s);
+          }
+          for (int c = 0; c < 3; ++c) radiance[(std::size_t(c) * rings + l) * terms + m] = incident[c];
+        }
       }
-    }
-    for (int ring = 0; ring < 3 * rings; ++ring) {
-      cosine_series.Coefficients(&radiance[std::size_t(ring) * terms], 1,
-                                 &ring_series[slice * slice_terms + std::size_t(ring) * stride]);
-    }
-  });
+      for (int ring = 0; ring < 3 * rings; ++ring) {
+        cosine_series.Coefficients(&radiance[std::size_t(ring) * terms], 1,
+                                   &ring_series[mu_s_index * slice_terms + std::size_t(ring) * stride]);
+      }
+    });
 
-  // Stored per unit scattering coefficient, i.e. as the phase-weighted
-  // mean incoming radiance, which varies slowly with altitude; the
-  // multiple-scattering integral multiplies the coefficient back at each
-  // sample. Interpolating J itself between r texels overestimates a thin
-  // exponential haze (linear interpolation of a convex profile), so that
-  // an order could carry more light than the previous one and the orders
-  // of a dense fog diverged. Per r row, the weights of each mu row's view
-  // are read once for all the row's suns.
-  tbb::parallel_for(0, r_size, [&](int z) {
-    const RingPhaseMeans& means = *density_phase_[z];
-    std::vector<float> view_terms(std::size_t(3) * stride);
-    std::vector<double> cos_phi(nu_size), multiples(std::size_t(terms) * nu_size);
-    std::vector<vec3> per_unit_scattering(nu_size);
-    for (int y = 0; y < mu_size; ++y) {
-      const double mu = GetScatteringTexel(grid, 0, y, z).mu;
+    // Stored per unit scattering coefficient, i.e. as the phase-weighted
+    // mean incoming radiance, which varies slowly with altitude; the
+    // multiple-scattering integral multiplies the coefficient back at each
+    // sample. Interpolating J itself between r texels overestimates a thin
+    // exponential haze (linear interpolation of a convex profile), so that
+    // an order could carry more light than the previous one and the orders
+    // of a dense fog diverged.
+    tbb::parallel_for(0, mu_size, [&](int y) {
+      std::unique_ptr<RingPhaseMeans> computed;
+      if (!keep_weights) computed = row_weights(z, y, y + 1);
+      const RingPhaseMeans& means = keep_weights ? *density_phase_[z] : *computed;
+      const int view = keep_weights ? y : 0;
+      std::vector<float> view_terms(std::size_t(3) * stride);
+      std::vector<double> cos_phi(nu_size), multiples(std::size_t(terms) * nu_size);
+      std::vector<vec3> per_unit_scattering(nu_size);
+      const double mu = view_mu[std::size_t(z) * mu_size + y];
       const double sin_mu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
       for (int mu_s_index = 0; mu_s_index < mu_s_size; ++mu_s_index) {
         const double mu_s = columns.mu_s[mu_s_index];
@@ -302,7 +309,7 @@ void Baker::ComputeScatteringDensity(int order) {
               sin_mu * sin_mu_s > 0.0 ? std::clamp((nu - mu * mu_s) / (sin_mu * sin_mu_s), -1.0, 1.0) : 1.0;
         }
         CosineMultiples(cos_phi.data(), nu_size, terms, multiples.data());
-        means.Terms(y, &ring_series[(std::size_t(z) * mu_s_size + mu_s_index) * slice_terms], view_terms.data());
+        means.Terms(view, &ring_series[mu_s_index * slice_terms], view_terms.data());
         for (int c = 0; c < 3; ++c) {
           for (int nu_index = 0; nu_index < nu_size; ++nu_index) {
             double sum = 0.0;
@@ -316,8 +323,8 @@ void Baker::ComputeScatteringDensity(int order) {
           scattering_density_.Store(nu_index * mu_s_size + mu_s_index, y, z, vec4(per_unit_scattering[nu_index], 0.0));
         }
       }
-    }
-  });
+    });
+  }
 }
 
 void Baker::ComputeIndirectIrradiance(int order) {

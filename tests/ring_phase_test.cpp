@@ -170,5 +170,27 @@ TEST(RingPhase, GroupsWeighedByTheirSharesPerChannel) {
   }
 }
 
+// A view's weights do not depend on the other views they are computed with:
+// the scattering density computes them per view where it does not keep
+// them for a whole row.
+TEST(RingPhase, OneViewsWeightsAloneAsAmongOthers) {
+  const int terms = 16, stride = RingPhaseMeans::kTermBlock;
+  const std::vector<double> ring_cos = {-0.5, 0.0, 0.4, 0.95}, ring_weights = {0.4, 0.1, 0.3, 0.2};
+  const std::vector<PhaseAzimuthSeries> series = {PhaseAzimuthSeries({PhaseKind::kRayleigh, 0.0}, terms),
+                                                  PhaseAzimuthSeries({PhaseKind::kHenyeyGreenstein, 0.85}, terms)};
+  const std::vector<Spectrum> shares = {Spectrum(0.3, 0.5, 0.8), Spectrum(0.7, 0.5, 0.2)};
+  const std::vector<double> views = {-0.7, 0.05, 0.6};
+  const RingPhaseMeans all(series, shares, views, ring_cos, ring_weights, terms);
+  std::vector<float> a(3 * 4 * stride, 0.0f);
+  for (int i = 0; i < int(a.size()); ++i) a[i] = (i % stride) < terms ? float(std::cos(0.7 * i)) : 0.0f;
+  for (int view = 0; view < 3; ++view) {
+    const RingPhaseMeans alone(series, shares, {views[view]}, ring_cos, ring_weights, terms);
+    std::vector<float> among(3 * stride), single(3 * stride);
+    all.Terms(view, a.data(), among.data());
+    alone.Terms(0, a.data(), single.data());
+    EXPECT_EQ(among, single) << "view " << view;
+  }
+}
+
 }  // namespace
 }  // namespace skybake::detail
