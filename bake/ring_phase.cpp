@@ -11,15 +11,19 @@ namespace skybake::detail {
 namespace {
 // Midpoint nodes in s over [0, pi] (the integrand is even in psi). With
 // the map's lambda = sqrt(half width) the error in s decays as fast on the
-// lobe's side as on the far side, where cos(k psi) is squeezed; kNodesPerLambda
-// / lambda nodes (64 to kMostNodes, in powers of two) put every c_k within
-// 1e-9 of c_0 of the plain midpoint rule on 2^17 nodes for Henyey-Greenstein
-// lobes with g from 0.5 to 0.999 (64 for Earth's haze, g = 0.8; 512 for g =
-// 0.999; tests/ring_phase_test.cpp holds 1e-7). The smooth phases take enough
-// that the rule is exact for the integrand's cosine series (degree 2 + k <
-// 2 * nodes).
+// lobe's side as on the far side, where cos(k psi) is squeezed by 1 /
+// lambda. A lobe takes the larger of kNodesPerLambda / lambda and terms /
+// lambda nodes, from 64 up in powers of two: that puts every c_k within
+// 1e-9 of c_0 of the plain midpoint rule on 2^17 nodes for
+// Henyey-Greenstein lobes with g from 0.5 to 0.999 and 16 terms (64 nodes
+// for Earth's haze, g = 0.8, 512 for g = 0.999), and within 1e-7 for 64
+// terms (tests/ring_phase_test.cpp). The smooth phases take enough that the
+// rule is exact for the integrand's cosine series (degree 2 + k < 2 *
+// nodes).
 constexpr double kNodesPerLambda = 20.0;
-constexpr int kFewestLobeNodes = 64, kMostNodes = 1024;
+constexpr int kFewestLobeNodes = 64, kMostNodes = 1 << 16;
+// Nodes are summed in blocks of this many (their values on the stack).
+constexpr int kNodeBlock = 256;
 
 // Half width in t = tan(psi / 2) of a Henyey-Greenstein or Cornette-Shanks
 // lobe around psi = 0 (with cos gamma = a + b cos psi, b >= 0, g > 0):
@@ -31,37 +35,47 @@ double LobeHalfWidth(double g, double a, double b) {
   return std::sqrt(e / (4.0 * g * b));
 }
 
+// The map's lambda for a lobe (cos gamma = a + b cos psi, g > 0), and the
+// nodes a rule of `terms` terms needs with it.
+double LobeLambda(double g, double a, double b) { return std::clamp(std::sqrt(LobeHalfWidth(g, a, b)), 1e-3, 1.0); }
+double NodesNeeded(double lambda, int terms) { return std::max(kNodesPerLambda, double(terms)) / lambda; }
+
 // sum_q p(a + b cos psi_q) (d psi / d s)_q cos(k psi_q), k < terms, into c:
-// a loop over the nodes per k, which the compiler vectorises.
+// per block of nodes, a loop over them per k, which the compiler vectorises.
 template <typename Phase>
 void SumOverNodes(Phase phase, double a, double b, double lambda, const std::vector<double>& tan_half_s, int terms,
                   double* c) {
+  std::fill(c, c + terms, 0.0);
   const int n = static_cast<int>(tan_half_s.size());
-  double cos_psi[kMostNodes], value[kMostNodes], previous[kMostNodes], current[kMostNodes];
+  for (int first = 0; first < n; first += kNodeBlock) {
+    const int count = std::min(kNodeBlock, n - first);
+    const double* tan_half = tan_half_s.data() + first;
+    double cos_psi[kNodeBlock], value[kNodeBlock], previous[kNodeBlock], current[kNodeBlock];
 #pragma omp simd
-  for (int q = 0; q < n; ++q) {
-    const double t = lambda * tan_half_s[q];
-    cos_psi[q] = (1.0 - t * t) / (1.0 + t * t);
-    // d psi / d s, psi = 2 atan(lambda tan(s / 2)).
-    const double dpsi_ds = lambda * (1.0 + tan_half_s[q] * tan_half_s[q]) / (1.0 + t * t);
-    value[q] = phase(std::clamp(a + b * cos_psi[q], -1.0, 1.0)) * dpsi_ds;
-    previous[q] = 1.0, current[q] = cos_psi[q];
-  }
-  for (int k = 0; k < terms; ++k) {
-    double sum = 0.0;
-    if (k == 0) {
-#pragma omp simd reduction(+ : sum)
-      for (int q = 0; q < n; ++q) sum += value[q];
-    } else {
-      // cos(k psi) from the two before it.
-#pragma omp simd reduction(+ : sum)
-      for (int q = 0; q < n; ++q) {
-        sum += value[q] * current[q];
-        const double next = 2.0 * cos_psi[q] * current[q] - previous[q];
-        previous[q] = current[q], current[q] = next;
-      }
+    for (int q = 0; q < count; ++q) {
+      const double t = lambda * tan_half[q];
+      cos_psi[q] = (1.0 - t * t) / (1.0 + t * t);
+      // d psi / d s, psi = 2 atan(lambda tan(s / 2)).
+      const double dpsi_ds = lambda * (1.0 + tan_half[q] * tan_half[q]) / (1.0 + t * t);
+      value[q] = phase(std::clamp(a + b * cos_psi[q], -1.0, 1.0)) * dpsi_ds;
+      previous[q] = 1.0, current[q] = cos_psi[q];
     }
-    c[k] = sum;
+    for (int k = 0; k < terms; ++k) {
+      double sum = 0.0;
+      if (k == 0) {
+#pragma omp simd reduction(+ : sum)
+        for (int q = 0; q < count; ++q) sum += value[q];
+      } else {
+        // cos(k psi) from the two before it.
+#pragma omp simd reduction(+ : sum)
+        for (int q = 0; q < count; ++q) {
+          sum += value[q] * current[q];
+          const double next = 2.0 * cos_psi[q] * current[q] - previous[q];
+          previous[q] = current[q], current[q] = next;
+        }
+      }
+      c[k] += sum;
+    }
   }
 }
 }  // namespace
@@ -79,7 +93,13 @@ PhaseAzimuthSeries::PhaseAzimuthSeries(const PhaseFunction& phase, int terms)
     tan_half_s_.push_back(rule(terms / 2 + 2));
     return;
   }
-  for (int nodes = kFewestLobeNodes; nodes <= kMostNodes; nodes *= 2) tan_half_s_.push_back(rule(nodes));
+  // Up to the rule of the narrowest lobe: a ring through the view (a + b =
+  // 1, b = 1).
+  const double narrowest = NodesNeeded(LobeLambda(std::abs(phase.g), 0.0, 1.0), terms);
+  for (int nodes = kFewestLobeNodes; nodes <= kMostNodes; nodes *= 2) {
+    tan_half_s_.push_back(rule(nodes));
+    if (nodes >= narrowest) break;
+  }
 }
 
 void PhaseAzimuthSeries::Coefficients(double view_mu, double ring_cos, double* c) const {
@@ -89,9 +109,10 @@ void PhaseAzimuthSeries::Coefficients(double view_mu, double ring_cos, double* c
   // A lobe with g < 0 peaks at psi = pi: integrate over psi' = pi - psi,
   // where cos psi = -cos psi' and cos(k psi) = (-1)^k cos(k psi').
   const double side = lobe_ && phase_.g < 0.0 ? -1.0 : 1.0;
-  const double lambda = lobe_ ? std::clamp(std::sqrt(LobeHalfWidth(std::abs(phase_.g), side * a, b)), 1e-3, 1.0) : 1.0;
+  const double lambda = lobe_ ? LobeLambda(std::abs(phase_.g), side * a, b) : 1.0;
+  const double needed = NodesNeeded(lambda, terms_);
   std::size_t rule = 0;
-  while (rule + 1 < tan_half_s_.size() && double(tan_half_s_[rule].size()) * lambda < kNodesPerLambda) ++rule;
+  while (rule + 1 < tan_half_s_.size() && double(tan_half_s_[rule].size()) < needed) ++rule;
   const std::vector<double>& nodes = tan_half_s_[rule];
   const double g = phase_.g;
   switch (phase_.kind) {
