@@ -187,10 +187,10 @@ AzimuthCosineSeries::AzimuthCosineSeries(int samples) : samples_(samples), basis
   }
 }
 
-void AzimuthCosineSeries::Coefficients(const double* samples, int stride, float* a) const {
+void AzimuthCosineSeries::Coefficients(const double* samples, float* a) const {
   for (int k = 0; k < samples_; ++k) {
     double sum = 0.0;
-    for (int m = 0; m < samples_; ++m) sum += basis_[k * samples_ + m] * samples[m * stride];
+    for (int m = 0; m < samples_; ++m) sum += basis_[k * samples_ + m] * samples[m];
     a[k] = float(sum);
   }
 }

@@ -3,6 +3,7 @@
 // taken in Fourier terms.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include "bake/atmosphere.h"
@@ -22,7 +23,6 @@ namespace skybake::detail {
 class PhaseAzimuthSeries {
  public:
   PhaseAzimuthSeries(const PhaseFunction& phase, int terms);
-  int Terms() const { return terms_; }
   // c[k], k < Terms().
   void Coefficients(double view_mu, double ring_cos, double* c) const;
 
@@ -66,12 +66,15 @@ class RingPhaseMeans {
                  const std::vector<double>& view_mu, const std::vector<double>& ring_cos,
                  const std::vector<double>& ring_weights, int terms);
 
-  int Rings() const { return rings_; }
   // The terms of a ring's series are stored at this stride, a whole number
   // of vectors (kTermBlock floats), the terms past `terms` zero.
   int Stride() const { return stride_; }
   static constexpr int kTermBlock = 16;
   static int StrideFor(int terms) { return (terms + kTermBlock - 1) / kTermBlock * kTermBlock; }
+  // The bytes of the weights of `views` views.
+  static std::size_t WeightBytes(std::size_t views, int rings, int terms) {
+    return views * 3 * rings * StrideFor(terms) * sizeof(float);
+  }
 
   // The terms of the mean for a view of zenith cosine view_mu[view], per
   // channel c: out[c * Stride() + k] = sum_l weight_clk a[(c * Rings() + l)
@@ -93,9 +96,8 @@ void CosineMultiples(const double* cos_phi, int count, int terms, double* out);
 class AzimuthCosineSeries {
  public:
   explicit AzimuthCosineSeries(int samples);
-  int Terms() const { return samples_; }
-  // a[k] from samples[m * stride].
-  void Coefficients(const double* samples, int stride, float* a) const;
+  // a[k] from samples[m].
+  void Coefficients(const double* samples, float* a) const;
 
  private:
   int samples_;

@@ -209,7 +209,8 @@ void Baker::ComputeScatteringDensity(int order) {
   const int terms = azimuths / 2;
   const int rings = static_cast<int>(ring_cosines.front().size());
   const int stride = RingPhaseMeans::StrideFor(terms);
-  const bool keep_weights = std::size_t(r_size) * mu_size * 3 * rings * stride * sizeof(float) <= kKeptPhaseWeightBytes;
+  const bool keep_weights =
+      RingPhaseMeans::WeightBytes(std::size_t(r_size) * mu_size, rings, terms) <= kKeptPhaseWeightBytes;
   std::vector<PhaseAzimuthSeries> series;
   for (int g = 0; g < groups; ++g) series.emplace_back(medium_.groups()[g].phase, terms);
   std::vector<double> view_mu(std::size_t(r_size) * mu_size);
@@ -277,7 +278,7 @@ void Baker::ComputeScatteringDensity(int order) {
         }
       }
       for (int ring = 0; ring < 3 * rings; ++ring) {
-        cosine_series.Coefficients(&radiance[std::size_t(ring) * terms], 1,
+        cosine_series.Coefficients(&radiance[std::size_t(ring) * terms],
                                    &ring_series[mu_s_index * slice_terms + std::size_t(ring) * stride]);
       }
     });

@@ -76,7 +76,7 @@ TEST(RingPhase, CosineSeriesPassesThroughTheSamples) {
   std::vector<double> values(samples);
   for (int m = 0; m < samples; ++m) values[m] = std::exp(-3.0 * m / samples) + (m == 2 ? 5.0 : 0.0);
   std::vector<float> a(samples);
-  series.Coefficients(values.data(), 1, a.data());
+  series.Coefficients(values.data(), a.data());
   std::vector<double> cos_phi(samples), multiples(samples * samples);
   for (int m = 0; m < samples; ++m) cos_phi[m] = std::cos((m + 0.5) * kPi / samples);
   CosineMultiples(cos_phi.data(), samples, samples, multiples.data());
