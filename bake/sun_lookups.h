@@ -14,6 +14,10 @@
 #include "bake/float_math.h"
 #include "shaders_runtime/primitives.h"
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 namespace skybake::detail {
 
 // Per texel column x of a scattering grid, the sun's cosine mu_s and the
@@ -89,7 +93,9 @@ class SunAtRadius {
  public:
   SunAtRadius(const AtmosphereParameters& params, const ChannelPlanes& transmittance)
       : params_(params), transmittance_(transmittance) {
-    for (auto& row : row_) row.resize(transmittance.width);
+    // Padded so that a window that starts at any texel stays inside.
+    for (auto& row : row_) row.resize(transmittance.width + kWindow, 0.0f);
+    for (auto& row : difference_) row.resize(transmittance.width + kWindow, 0.0f);
   }
 
   void SetRadius(double r) {
@@ -114,6 +120,9 @@ class SunAtRadius {
       float* row = row_[channel].data();
 #pragma omp simd
       for (int x = 0; x < width; ++x) row[x] = a[x] + weight * (b[x] - a[x]);
+      float* difference = difference_[channel].data();
+#pragma omp simd
+      for (int x = 0; x < width - 1; ++x) difference[x] = row[x + 1] - row[x];
     }
     const double sin_horizon = p.bottom_radius / r;
     horizon_cosine_ = float(glsl::HorizonZenithCosine(p.bottom_radius, r));
@@ -132,7 +141,7 @@ class SunAtRadius {
   }
 
   // The optical depth per channel into tau[c][j], for the sun cosines j in
-  // [begin, count).
+  // [begin, count), begin a whole number of vectors.
   void OpticalDepth(const float* mu_s, int begin, int count, std::vector<float> (&tau)[3]) {
     const float r = r_, c = c_, d_min = d_min_, scale = scale_;
     const float last = float(transmittance_.width - 1);
@@ -146,20 +155,81 @@ class SunAtRadius {
       left[j] = std::min(static_cast<int>(x), last_left);
       weight[j] = x - float(left[j]);
     }
+    int j = begin;
+#if defined(__AVX512F__)
+    // Where a vector of directions' left taps lie within kWindow texels of
+    // the row, it reads them by permutations of that window held in
+    // registers (two per lookup, one where the taps lie within half of it)
+    // instead of a gather per channel and tap: the directions come in order
+    // of mu_s, and 70 % of the default bake's vectors fit. value + weight *
+    // difference, with the differences formed per radius, is the arithmetic
+    // of LookUp, to the bit. Wider vectors, and the rest, gather.
+    for (; j + kVectorFloats <= count; j += kVectorFloats) {
+      const __m512i taps = _mm512_loadu_si512(left + j);
+      const int lowest = LowestLane(taps), highest = -LowestLane(_mm512_sub_epi32(_mm512_setzero_si512(), taps));
+      if (highest - lowest >= kWindow) {
+        LookUp(j, j + kVectorFloats, tau);
+        continue;
+      }
+      const __m512i index = _mm512_sub_epi32(taps, _mm512_set1_epi32(lowest));
+      const bool half_window = highest - lowest < kWindow / 2;
+      const __mmask16 upper = _mm512_cmpge_epi32_mask(index, _mm512_set1_epi32(kWindow / 2));
+      auto look_up = [&](const float* window) {
+        const __m512 low =
+            _mm512_permutex2var_ps(_mm512_loadu_ps(window), index, _mm512_loadu_ps(window + kVectorFloats));
+        if (half_window) return low;
+        const __m512 high = _mm512_permutex2var_ps(_mm512_loadu_ps(window + 2 * kVectorFloats), index,
+                                                   _mm512_loadu_ps(window + 3 * kVectorFloats));
+        return _mm512_mask_blend_ps(upper, low, high);
+      };
+      const __m512 w = _mm512_loadu_ps(weight + j);
+      for (int channel = 0; channel < 3; ++channel) {
+        const __m512 value = look_up(row_[channel].data() + lowest);
+        const __m512 difference = look_up(difference_[channel].data() + lowest);
+        _mm512_storeu_ps(tau[channel].data() + j, _mm512_fmadd_ps(w, difference, value));
+      }
+    }
+#endif
+    LookUp(j, count, tau);
+  }
+
+ private:
+  // The texels of the row that OpticalDepth permutes: four 512-bit registers.
+  static constexpr int kWindow = 4 * kVectorFloats;
+
+#if defined(__AVX512F__)
+  // The least of a vector's 16 integers, by halving. (The masked forms,
+  // with every lane set, name a source for the lanes they keep; the plain
+  // ones' undefined source draws a false warning from GCC 12.)
+  static int LowestLane(__m512i v) {
+    const __mmask16 all = 0xffff;
+    v = _mm512_mask_min_epi32(v, all, v, _mm512_mask_shuffle_i32x4(v, all, v, v, _MM_SHUFFLE(1, 0, 3, 2)));
+    v = _mm512_mask_min_epi32(v, all, v, _mm512_mask_shuffle_i32x4(v, all, v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+    v = _mm512_mask_min_epi32(v, all, v, _mm512_mask_shuffle_epi32(v, all, v, _MM_PERM_BADC));
+    v = _mm512_mask_min_epi32(v, all, v, _mm512_mask_shuffle_epi32(v, all, v, _MM_PERM_CDAB));
+    return _mm512_cvtsi512_si32(v);
+  }
+#endif
+
+  // The optical depth per channel for the directions in [begin, end), from
+  // their taps in left_ and weight_.
+  void LookUp(int begin, int end, std::vector<float> (&tau)[3]) const {
+    const int* left = left_.data();
+    const float* weight = weight_.data();
     for (int channel = 0; channel < 3; ++channel) {
       const float* row = row_[channel].data();
       float* out = tau[channel].data();
 #pragma omp simd
-      for (int j = begin; j < count; ++j) out[j] = row[left[j]] + weight[j] * (row[left[j] + 1] - row[left[j]]);
+      for (int j = begin; j < end; ++j) out[j] = row[left[j]] + weight[j] * (row[left[j] + 1] - row[left[j]]);
     }
   }
 
- private:
   const AtmosphereParameters& params_;
   const ChannelPlanes& transmittance_;  // optical depth
   std::vector<int> left_;               // per direction: the left tap along x
   std::vector<float> weight_;           // and the right one's weight
   std::vector<float> row_[3];           // per channel, the table interpolated to the radius
+  std::vector<float> difference_[3];    // and row[x + 1] - row[x] (for OpticalDepth's permutations)
   float r_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, scale_ = 0.0f, horizon_cosine_ = 0.0f, half_disc_ = 0.0f;
 };
 
