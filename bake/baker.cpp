@@ -175,15 +175,14 @@ Texture Baker::ScatteringTable() const {
   });
   // At a slice's clamped nu the runtime multiplies the higher orders by the
   // Rayleigh phase there, not at the slice's own nu.
-  ExtendSlicesPastTheirRange(params_, table, [&](int x, int y, int z) {
-    const double nu = GetScatteringTexel(params_, x, y, z).nu;
+  ExtendSlicesPastTheirRange(params_, table, [&](int x, int y, int z, double nu) {
     return vec3(single_.rayleigh.Fetch(x, y, z)) + vec3(higher.Fetch(x, y, z)) / glsl::RayleighPhaseFunction(nu);
   });
   return table;
 }
 
 void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture& table,
-                                       const std::function<vec3(int x, int y, int z)>& edge_value) {
+                                       const std::function<vec3(int x, int y, int z, double nu)>& edge_value) {
   const int nu_size = grid.scattering_nu_size, mu_s_size = grid.scattering_mu_s_size;
   // Rows are independent, and within a row each slice past the range is
   // read (for its own edge value) and written once, by the interval whose
@@ -204,8 +203,11 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
         // Intervals wholly inside or outside the range, or with too little
         // of it inside to extend from, keep their slices.
         if (!(k_clamped || next_clamped) || end - start < kSmallestExtendedFraction * spacing) continue;
-        const vec3 at_start = k_clamped && edge_value ? edge_value(x0, y, z) : vec3(table.Fetch(x0, y, z));
-        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z) : vec3(table.Fetch(x1, y, z));
+        // (A texel's nu is its slice's clamped as GetScatteringTexel clamps it.)
+        const vec3 at_start =
+            k_clamped && edge_value ? edge_value(x0, y, z, ClampedNu(nu_k, mu, mu_s)) : vec3(table.Fetch(x0, y, z));
+        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z, ClampedNu(columns.grid_nu[x1], mu, mu_s))
+                                                       : vec3(table.Fetch(x1, y, z));
         const double t_start = (start - nu_k) / spacing, t_end = (end - nu_k) / spacing;
         vec4 value0 = table.Fetch(x0, y, z), value1 = table.Fetch(x1, y, z);
         for (int c = 0; c < 3; ++c) {

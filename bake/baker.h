@@ -160,10 +160,11 @@ class Baker {
   // the two ends of the allowed part of its interval extends (linear, or
   // geometric for a low sun as in SunCosineMix), so that the lookup returns
   // the light at the edge and follows its change toward it. `edge_value`:
-  // the light a clamped texel stands for, in the units the lookup blends
-  // (none: the texel's own value).
-  static void ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture& table,
-                                         const std::function<vec3(int x, int y, int z)>& edge_value = nullptr);
+  // the light a clamped texel (x, y, z) with clamped nu stands for, in the
+  // units the lookup blends (none: the texel's own value).
+  static void ExtendSlicesPastTheirRange(
+      const AtmosphereParameters& grid, Texture& table,
+      const std::function<vec3(int x, int y, int z, double nu)>& edge_value = nullptr);
   // Intervals with less than this fraction of them allowed keep their
   // slices; an extended slice holds at most kLargestExtension times the
   // light at the larger end of the allowed part (on Earth the cap holds
