@@ -131,16 +131,21 @@ class Baker {
     std::vector<float> lowest_log_slope, lowest_log_curvature;
   };
   MuSFall MuSFallOf(const Texture& density, bool between_columns) const;
+  // The rays of a table on the grid `grid`, prepared for gathering
+  // densities on the grid `density_grid`: what each gather needs of them
+  // whatever the density (gather.cpp), built once for all the orders.
+  struct GatherPlan;
+  std::shared_ptr<const GatherPlan> PlanGather(const AtmosphereParameters& grid,
+                                               const AtmosphereParameters& density_grid) const;
   // The light of the orders whose scattering density (per unit scattering
-  // coefficient, on the grid of `density_grid`) is `density`, arriving at
-  // every texel of a table on the grid `grid`: the density integrated along
+  // coefficient, on the plan's density grid) is `density`, arriving at
+  // every texel of a table on the plan's grid: the density integrated along
   // each texel's ray. J is read linearly in r and mu; along mu_s linearly,
   // or where `fall` has falls between columns, with weights that follow
   // them (exactly where J is exponential between two columns). Given
   // `fall`, J below the grid's lowest sun continues the fall of the two
   // lowest columns per channel instead of holding the lowest column.
-  Texture GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
-                          const AtmosphereParameters& density_grid, const MuSFall* fall = nullptr) const;
+  Texture GatherAlongRays(const GatherPlan& plan, const Texture& density, const MuSFall* fall = nullptr) const;
   // Whether the table covers less than the whole atmosphere (a scene's bake):
   // its grid is then not the one the orders are computed on.
   bool TableRestricted() const { return settings_.scattering_range.has_value(); }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -74,18 +75,19 @@ struct DirectionsBySlice {
     int begin, end;         // [begin, end): its positions
   };
   std::vector<Group> groups;
-  std::vector<int> position;  // per direction of SunDirections
+  std::vector<int> of_texel;  // per texel column x of the grid, its direction's position
   // Per position:
-  std::vector<double> mu_s, nu;
+  std::vector<float> mu_s, nu;
   std::vector<int> slice, next_slice;
   std::vector<float> nu_weight;  // of next_slice
 
+  DirectionsBySlice() = default;
   DirectionsBySlice(const SunDirections& directions, const AtmosphereParameters& grid, bool by_slice) {
     const int nu_size = grid.scattering_nu_size;
     const int distinct = by_slice ? *std::max_element(directions.of_texel.begin(), directions.of_texel.end()) + 1
                                   : static_cast<int>(directions.nu.size());
     std::vector<std::vector<int>> members(nu_size);
-    std::vector<int> slice_of(distinct);
+    std::vector<int> slice_of(distinct), position(distinct);
     std::vector<float> weight(distinct);
     for (int j = 0; j < distinct; ++j) {
       const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (nu_size - 1);
@@ -93,7 +95,6 @@ struct DirectionsBySlice {
       members[by_slice ? slice_of[j] : 0].push_back(j);
       weight[j] = float(nu_coord - slice_of[j]);
     }
-    position.resize(distinct);
     for (const std::vector<int>& group_members : members) {
       if (group_members.empty()) continue;
       const int group_slice = by_slice ? slice_of[group_members.front()] : -1;
@@ -101,13 +102,14 @@ struct DirectionsBySlice {
       for (std::size_t m = 0; m < group_members.size() || count() % kVectorFloats != 0; ++m) {
         const int j = group_members[std::min(m, group_members.size() - 1)];
         if (m < group_members.size()) position[j] = count();
-        mu_s.push_back(directions.mu_s[j]), nu.push_back(directions.nu[j]);
+        mu_s.push_back(float(directions.mu_s[j])), nu.push_back(float(directions.nu[j]));
         slice.push_back(slice_of[j]), next_slice.push_back(std::min(slice_of[j] + 1, nu_size - 1));
         nu_weight.push_back(weight[j]);
       }
       group.end = count();
       groups.push_back(group);
     }
+    for (int texel : directions.of_texel) of_texel.push_back(position[texel]);
   }
   int count() const { return static_cast<int>(mu_s.size()); }
 };
@@ -271,19 +273,53 @@ Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) co
   return fall;
 }
 
-Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& density,
-                               const AtmosphereParameters& density_grid, const MuSFall* fall) const {
-  Texture result = ScatteringGridTexture(grid);
+// What GatherAlongRays needs of each ray of a table's grid whatever the
+// density it gathers: the samples at which J is read, with their taps in
+// the density grid's (r, mu) rows, the weights of J there, the optically
+// thick intervals, and the ray's sun directions grouped by nu slice. Every
+// order gathers along the same rays, so it is built once (PlanGather).
+struct Baker::GatherPlan {
+  struct ThickInterval {
+    int k, c;
+    double albedo_a, albedo_b;
+  };
+  // A sample with a non-zero weight (or a thick interval's end): its taps
+  // in the density grid's r and mu rows, interpolated once for all of the
+  // ray's texels (the texture's r and mu interpolation), and the sun's
+  // cosine there for a direction (mu_s, nu): mu_s from_mu_s + nu from_nu.
+  struct Sample {
+    int k;
+    int row00, row10, row01, row11;
+    float w00, w10, w01, w11;
+    int nearest_row;  // the (r, mu) row nearest it (MuSFall's)
+    float from_mu_s, from_nu;
+  };
+  struct Ray {
+    std::vector<Sample> samples;
+    std::vector<glm::vec3> weight;  // per sample k and channel, of J
+    std::vector<ThickInterval> thick_intervals;
+    std::vector<Spectrum> optical_depth;  // the view's, per sample k (where there are thick intervals)
+    DirectionsBySlice directions;
+  };
+  AtmosphereParameters grid, density_grid;
+  int samples_per_ray = 0;  // intervals per ray
+  std::vector<Ray> rays;    // per ray index z * mu_size + y
+};
+
+std::shared_ptr<const Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters& grid,
+                                                           const AtmosphereParameters& density_grid) const {
+  auto plan = std::make_shared<GatherPlan>();
+  plan->grid = grid, plan->density_grid = density_grid;
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
-  const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
+  const int density_height = density_grid.scattering_mu_size, density_depth = density_grid.scattering_r_size;
+  const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
+  plan->samples_per_ray = n;
+  plan->rays.resize(std::size_t(r_size) * mu_size);
   const SunColumns columns(grid);
-  // J in rows along mu_s per channel and nu slice (JRows).
-  const JRows layout(density_mu_s_size, density_nu_size);
-  const std::size_t per_row = layout.PerTexelRow();
-  const std::vector<float> density_rows = layout.Rows(density);
+  const bool by_slice = JRows(density_grid.scattering_mu_s_size, density_grid.scattering_nu_size).PermutesRows();
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
-    const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
+    GatherPlan::Ray& out = plan->rays[ray_index];
     const RaySamples ray = SampleRay(grid, y, z, n);
     // The integrand is J times the scattering coefficient times the view's
     // transmittance. Over optically thin intervals J varies slowly and is
@@ -293,11 +329,6 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     // can fall by orders of magnitude (into a fog) and the integrand is
     // taken as exponential per unit of the view's optical depth, per texel
     // (IntegrateOverOpticalDepth).
-    struct ThickInterval {
-      int k, c;
-      double albedo_a, albedo_b;
-    };
-    std::vector<ThickInterval> thick_intervals;
     std::vector<Spectrum> weight(n + 1, Spectrum(0.0));
     std::vector<Spectrum> scattering(n + 1, Spectrum(0.0));
     std::vector<bool> needed(n + 1, false);  // J is looked up there
@@ -313,7 +344,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
           const double albedo_a =
               extinction_a > 0.0 ? scattering[k][c] / extinction_a : scattering[k + 1][c] / extinction_b;
           const double albedo_b = extinction_b > 0.0 ? scattering[k + 1][c] / extinction_b : albedo_a;
-          thick_intervals.push_back({k, c, albedo_a, albedo_b});
+          out.thick_intervals.push_back({k, c, albedo_a, albedo_b});
           needed[k] = needed[k + 1] = true;
           continue;
         }
@@ -327,16 +358,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         weight[k + 1][c] += w.second;
       }
     }
-    // Per sample with a non-zero weight (or a thick interval's end): its
-    // taps in the density grid's r and mu rows, interpolated once for all of
-    // the ray's texels (the texture's r and mu interpolation).
-    struct SampleTaps {
-      int k;
-      const float *t00, *t10, *t01, *t11;
-      float w00, w10, w01, w11;
-      std::size_t fall_row, lowest_row;  // MuSFall's row nearest it, and its offset in lowest_log_*
-    };
-    std::vector<SampleTaps> samples;
+    out.weight.assign(weight.begin(), weight.end());
+    if (!out.thick_intervals.empty()) out.optical_depth = ray.optical_depth;
     for (int k = 0; k <= n; ++k) {
       needed[k] = needed[k] || weight[k] != Spectrum(0.0);
       if (!needed[k]) continue;
@@ -345,35 +368,47 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
           glsl::GetScatteringTextureUvwzFromRMuMuSNu(density_grid, ray.radius[k], mu_k, 1.0, 1.0, ray.intersects_ground);
       int y0, y1, z0, z1;
       double fy, fz;
-      glsl::detail::LinearTaps(uvwz.z, density.height, y0, y1, fy);
-      glsl::detail::LinearTaps(uvwz.w, density.depth, z0, z1, fz);
-      const std::size_t row = std::size_t(fz < 0.5 ? z0 : z1) * density.height + (fy < 0.5 ? y0 : y1);
-      auto rows_at = [&](int y, int z) { return &density_rows[(std::size_t(z) * density.height + y) * per_row]; };
-      samples.push_back({k, rows_at(y0, z0), rows_at(y1, z0), rows_at(y0, z1), rows_at(y1, z1),
-                         float((1 - fy) * (1 - fz)), float(fy * (1 - fz)), float((1 - fy) * fz), float(fy * fz),
-                         fall ? row * density_nu_size * fall->falling_columns : 0,
-                         fall ? row * density_nu_size * 3 : 0});
+      glsl::detail::LinearTaps(uvwz.z, density_height, y0, y1, fy);
+      glsl::detail::LinearTaps(uvwz.w, density_depth, z0, z1, fz);
+      auto row = [&](int y, int z) { return z * density_height + y; };
+      out.samples.push_back({k, row(y0, z0), row(y1, z0), row(y0, z1), row(y1, z1), float((1 - fy) * (1 - fz)),
+                             float(fy * (1 - fz)), float((1 - fy) * fz), float(fy * fz),
+                             row(fy < 0.5 ? y0 : y1, fz < 0.5 ? z0 : z1), float(ray.r / ray.radius[k]),
+                             float(ray.t[k] / ray.radius[k])});
     }
-
     // The ray's sun directions, grouped by the nu slice below them where
     // JRows's lookups along mu_s are permutations of rows held in registers
     // (each vector of directions then reads the same two nu rows of J);
     // within a group in order of mu_s (DirectionsBySlice).
-    const SunDirections directions = RaySunDirections(columns, ray.mu);
+    out.directions = DirectionsBySlice(RaySunDirections(columns, ray.mu), density_grid, by_slice);
+  });
+  return plan;
+}
+
+Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, const MuSFall* fall) const {
+  const AtmosphereParameters &grid = plan.grid, &density_grid = plan.density_grid;
+  Texture result = ScatteringGridTexture(grid);
+  const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
+  const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
+  const int n = plan.samples_per_ray;
+  // J in rows along mu_s per channel and nu slice (JRows).
+  const JRows layout(density_mu_s_size, density_nu_size);
+  const std::size_t per_row = layout.PerTexelRow();
+  const std::vector<float> density_rows = layout.Rows(density);
+  const MuSCoordinate mu_s_coordinate(density_grid);
+  const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
+  tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
+    const int z = ray_index / mu_size, y = ray_index % mu_size;
+    const GatherPlan::Ray& ray = plan.rays[ray_index];
+    const DirectionsBySlice& by_slice = ray.directions;
     JRows rows(density_mu_s_size, density_nu_size);
-    const DirectionsBySlice by_slice(directions, density_grid, rows.PermutesRows());
     const int count = by_slice.count();
-    const std::vector<float> mu_s(by_slice.mu_s.begin(), by_slice.mu_s.end());
-    const std::vector<float> nu(by_slice.nu.begin(), by_slice.nu.end());
-    const std::vector<float>& nu_weight = by_slice.nu_weight;
-    const MuSCoordinate mu_s_coordinate(density_grid);
-    const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
-    std::vector<Spectrum> directions_sum(count);
+    const std::vector<float>&mu_s = by_slice.mu_s, &nu = by_slice.nu, &nu_weight = by_slice.nu_weight;
     std::vector<float> mu_s_k(count), mu_s_weight(count), values(count);
     std::vector<int> mu_s_left(count);
     std::vector<float> sums[3], source;  // source: J per sample, channel and direction, for thick intervals
     for (auto& sum : sums) sum.assign(count, 0.0f);
-    if (!thick_intervals.empty()) source.assign(std::size_t(n + 1) * 3 * count, 0.0f);
+    if (!ray.thick_intervals.empty()) source.assign(std::size_t(n + 1) * 3 * count, 0.0f);
     const bool shaped = fall != nullptr && fall->falling_columns > 0;
     std::vector<float> fall_weight_a(shaped ? count : 0), fall_weight_b(shaped ? count : 0);
     std::vector<int> falling_column(shaped ? count : 0);
@@ -387,11 +422,16 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
     std::vector<float> below_factor[3];
     for (auto& factor : below_factor) factor.resize(fall ? count : 0);
     std::vector<int> below_end(by_slice.groups.size());
-    for (const SampleTaps& sample : samples) {
+    for (const GatherPlan::Sample& sample : ray.samples) {
       const int k = sample.k;
       // J at the sample's (r, mu) for every (nu, mu_s) texel.
-      rows.Set(sample.t00, sample.t10, sample.t01, sample.t11, sample.w00, sample.w10, sample.w01, sample.w11);
-      const float from_mu_s = float(ray.r / ray.radius[k]), from_nu = float(ray.t[k] / ray.radius[k]);
+      auto rows_at = [&](int row) { return &density_rows[std::size_t(row) * per_row]; };
+      rows.Set(rows_at(sample.row00), rows_at(sample.row10), rows_at(sample.row01), rows_at(sample.row11), sample.w00,
+               sample.w10, sample.w01, sample.w11);
+      const float from_mu_s = sample.from_mu_s, from_nu = sample.from_nu;
+      // MuSFall's offsets of the row nearest the sample.
+      const std::size_t fall_row = fall ? std::size_t(sample.nearest_row) * density_nu_size * fall->falling_columns : 0;
+      const std::size_t lowest_row = std::size_t(sample.nearest_row) * density_nu_size * 3;
 #pragma omp simd
       for (int j = 0; j < count; ++j) mu_s_k[j] = ClampFloat(mu_s[j] * from_mu_s + nu[j] * from_nu, -1.0f, 1.0f);
       mu_s_coordinate.Taps(mu_s_k.data(), count, mu_s_left.data(), mu_s_weight.data());
@@ -420,8 +460,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         // (for a group of one slice, the same two rows throughout).
         auto below_factors = [&](auto slice_of, auto next_slice_of) {
           for (int c = 0; c < 3 && end > group.begin; ++c) {
-            const float* slope = &fall->lowest_log_slope[sample.lowest_row + c];
-            const float* curvature = &fall->lowest_log_curvature[sample.lowest_row + c];
+            const float* slope = &fall->lowest_log_slope[lowest_row + c];
+            const float* curvature = &fall->lowest_log_curvature[lowest_row + c];
             float* factor = below_factor[c].data();
 #pragma omp simd
             for (int j = group.begin; j < end; ++j) {
@@ -446,8 +486,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
           // its lane) no direction's sun is below the first column that
           // does not fall (plus a margin far above the float position's
           // rounding), and FallWeight would return mu_s_weight.
-          const float* log_ratio = &fall->log_ratio[sample.fall_row];
-          const float* inverse = &fall->inverse_ratio_minus_one[sample.fall_row];
+          const float* log_ratio = &fall->log_ratio[fall_row];
+          const float* inverse = &fall->inverse_ratio_minus_one[fall_row];
           const int falling = fall->falling_columns;
           int falling_end = surely_at_or_above(fall->steady_mu_s + kSteadyMargin);
           falling_end = std::min(group.end, group.begin + RoundUpToVector(falling_end - group.begin));
@@ -490,7 +530,7 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       const float* weight_a = shaped ? fall_weight_a.data() : mu_s_weight.data();
       const float* weight_b = shaped ? fall_weight_b.data() : mu_s_weight.data();
       for (int c = 0; c < 3; ++c) {
-        const float w = float(weight[k][c]);
+        const float w = ray.weight[k][c];
         float* sum = sums[c].data();
         float* value = source.empty() ? values.data() : &source[(std::size_t(k) * 3 + c) * count];
         const float* factor = below_factor[c].data();
@@ -506,9 +546,10 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
         }
       }
     }
+    std::vector<Spectrum> directions_sum(count);
     for (int j = 0; j < count; ++j) {
       Spectrum sum(sums[0][j], sums[1][j], sums[2][j]);
-      for (const ThickInterval& interval : thick_intervals) {
+      for (const GatherPlan::ThickInterval& interval : ray.thick_intervals) {
         const int k = interval.k, c = interval.c;
         const double value_a = source[(std::size_t(k) * 3 + c) * count + j] * interval.albedo_a;
         const double value_b = source[(std::size_t(k + 1) * 3 + c) * count + j] * interval.albedo_b;
@@ -517,8 +558,8 @@ Texture Baker::GatherAlongRays(const AtmosphereParameters& grid, const Texture& 
       }
       directions_sum[j] = sum;
     }
-    for (int x = 0; x < int(directions.of_texel.size()); ++x) {
-      result.Store(x, y, z, vec4(directions_sum[by_slice.position[directions.of_texel[x]]], 0.0));
+    for (int x = 0; x < int(by_slice.of_texel.size()); ++x) {
+      result.Store(x, y, z, vec4(directions_sum[by_slice.of_texel[x]], 0.0));
     }
   });
   return result;
