@@ -446,12 +446,13 @@ Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, c
               std::lower_bound(mu_s.begin() + group.begin, mu_s.begin() + group.end, (cosine + from_nu) / from_mu_s) -
               mu_s.begin());
         };
-        int end = fall ? surely_at_or_above(lowest_mu_s) : group.begin;
-        int below_count = 0;
-#pragma omp simd reduction(+ : below_count)
-        for (int j = group.begin; j < end; ++j) below_count += mu_s_k[j] < lowest_mu_s ? 1 : 0;
-        if (below_count == 0) end = group.begin;
-        while (end > group.begin && !(mu_s_k[end - 1] < lowest_mu_s)) --end;
+        // Just past the last direction whose sun at the sample is below the
+        // lowest column (none without `fall`).
+        int last_below = group.begin - 1;
+        const int bound = fall ? surely_at_or_above(lowest_mu_s) : group.begin;
+#pragma omp simd reduction(max : last_below)
+        for (int j = group.begin; j < bound; ++j) last_below = std::max(last_below, mu_s_k[j] < lowest_mu_s ? j : -1);
+        int end = last_below + 1;
         // Rounded up to a whole vector: past the last sun below the lowest
         // column the factor is exp(0) = 1, which changes nothing.
         if (end > group.begin) end = std::min(group.end, RoundUpToVector(end - group.begin) + group.begin);
