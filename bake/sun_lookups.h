@@ -95,7 +95,6 @@ class SunAtRadius {
       : params_(params), transmittance_(transmittance) {
     // Padded so that a window that starts at any texel stays inside.
     for (auto& row : row_) row.resize(transmittance.width + kWindow, 0.0f);
-    for (auto& row : difference_) row.resize(transmittance.width + kWindow, 0.0f);
   }
 
   void SetRadius(double r) {
@@ -120,9 +119,6 @@ class SunAtRadius {
       float* row = row_[channel].data();
 #pragma omp simd
       for (int x = 0; x < width; ++x) row[x] = a[x] + weight * (b[x] - a[x]);
-      float* difference = difference_[channel].data();
-#pragma omp simd
-      for (int x = 0; x < width - 1; ++x) difference[x] = row[x + 1] - row[x];
     }
     const double sin_horizon = p.bottom_radius / r;
     horizon_cosine_ = float(glsl::HorizonZenithCosine(p.bottom_radius, r));
@@ -157,36 +153,37 @@ class SunAtRadius {
     }
     int j = begin;
 #if defined(__AVX512F__)
-    // Where a vector of directions' left taps lie within kWindow texels of
-    // the row, it reads them by permutations of that window held in
-    // registers (two per lookup, one where the taps lie within half of it)
-    // instead of a gather per channel and tap: the directions come in order
-    // of mu_s, and 70 % of the default bake's vectors fit. value + weight *
-    // difference, with the differences formed per radius, is the arithmetic
-    // of LookUp, to the bit. Wider vectors, and the rest, gather.
+    // Where a vector of directions' taps (left and right) lie within
+    // kWindow texels of the row, it reads them by permutations of that
+    // window held in registers (two per tap, one where the taps lie within
+    // half of it) instead of a gather per channel and tap: the directions
+    // come in order of mu_s, and 70 % of the default bake's vectors fit.
+    // value + weight * (next - value) is the arithmetic of LookUp, to the
+    // bit. Wider vectors, and the rest, gather.
     for (; j + kVectorFloats <= count; j += kVectorFloats) {
       const __m512i taps = _mm512_loadu_si512(left + j);
       const int lowest = LowestLane(taps), highest = -LowestLane(_mm512_sub_epi32(_mm512_setzero_si512(), taps));
-      if (highest - lowest >= kWindow) {
+      if (highest + 1 - lowest >= kWindow) {
         LookUp(j, j + kVectorFloats, tau);
         continue;
       }
       const __m512i index = _mm512_sub_epi32(taps, _mm512_set1_epi32(lowest));
-      const bool half_window = highest - lowest < kWindow / 2;
+      const __m512i next_index = _mm512_add_epi32(index, _mm512_set1_epi32(1));
+      const bool half_window = highest + 1 - lowest < kWindow / 2;
       const __mmask16 upper = _mm512_cmpge_epi32_mask(index, _mm512_set1_epi32(kWindow / 2));
-      auto look_up = [&](const float* window) {
-        const __m512 low =
-            _mm512_permutex2var_ps(_mm512_loadu_ps(window), index, _mm512_loadu_ps(window + kVectorFloats));
-        if (half_window) return low;
-        const __m512 high = _mm512_permutex2var_ps(_mm512_loadu_ps(window + 2 * kVectorFloats), index,
-                                                   _mm512_loadu_ps(window + 3 * kVectorFloats));
-        return _mm512_mask_blend_ps(upper, low, high);
-      };
+      const __mmask16 next_upper = _mm512_cmpge_epi32_mask(next_index, _mm512_set1_epi32(kWindow / 2));
       const __m512 w = _mm512_loadu_ps(weight + j);
       for (int channel = 0; channel < 3; ++channel) {
-        const __m512 value = look_up(row_[channel].data() + lowest);
-        const __m512 difference = look_up(difference_[channel].data() + lowest);
-        _mm512_storeu_ps(tau[channel].data() + j, _mm512_fmadd_ps(w, difference, value));
+        const float* window = row_[channel].data() + lowest;
+        const __m512 r0 = _mm512_loadu_ps(window), r1 = _mm512_loadu_ps(window + kVectorFloats);
+        __m512 value = _mm512_permutex2var_ps(r0, index, r1), next = _mm512_permutex2var_ps(r0, next_index, r1);
+        if (!half_window) {
+          const __m512 r2 = _mm512_loadu_ps(window + 2 * kVectorFloats),
+                       r3 = _mm512_loadu_ps(window + 3 * kVectorFloats);
+          value = _mm512_mask_blend_ps(upper, value, _mm512_permutex2var_ps(r2, index, r3));
+          next = _mm512_mask_blend_ps(next_upper, next, _mm512_permutex2var_ps(r2, next_index, r3));
+        }
+        _mm512_storeu_ps(tau[channel].data() + j, _mm512_fmadd_ps(w, _mm512_sub_ps(next, value), value));
       }
     }
 #endif
@@ -229,7 +226,6 @@ class SunAtRadius {
   std::vector<int> left_;               // per direction: the left tap along x
   std::vector<float> weight_;           // and the right one's weight
   std::vector<float> row_[3];           // per channel, the table interpolated to the radius
-  std::vector<float> difference_[3];    // and row[x + 1] - row[x] (for OpticalDepth's permutations)
   float r_ = 0.0f, c_ = 0.0f, d_min_ = 0.0f, scale_ = 0.0f, horizon_cosine_ = 0.0f, half_disc_ = 0.0f;
 };
 
