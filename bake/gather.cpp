@@ -116,17 +116,15 @@ struct DirectionsBySlice {
 
 // J per channel in rows along mu_s: of a density texture, per (r, mu) row
 // and channel, one row per nu slice padded to whole vectors (Rows); and of
-// a sample, those of its four (r, mu) rows blended (with the differences
-// between neighbouring columns where the lookups permute them), and the
-// lookups of the ray's directions in them (Accumulate).
+// a sample, those of its four (r, mu) rows blended, and the lookups of the
+// ray's directions in them (Accumulate).
 class JRows {
  public:
   JRows(int mu_s_size, int nu_size)
       : mu_s_size_(mu_s_size),
         nu_size_(nu_size),
         stride_(std::max(kRegisterRow, RoundUpToVector(mu_s_size))),
-        values_(PerTexelRow(), 0.0f),
-        differences_(values_.size(), 0.0f) {}
+        values_(PerTexelRow(), 0.0f) {}
 
   // Whether Accumulate's lookups are permutations of rows in registers,
   // which needs the directions grouped by nu slice (DirectionsBySlice).
@@ -164,10 +162,6 @@ class JRows {
     float* values = values_.data();
 #pragma omp simd
     for (int i = 0; i < size; ++i) values[i] = w00 * t00[i] + w10 * t10[i] + w01 * t01[i] + w11 * t11[i];
-    if (!PermutesRows()) return;
-    float* differences = differences_.data();
-#pragma omp simd
-    for (int i = 0; i < size - 1; ++i) differences[i] = values[i + 1] - values[i];
   }
 
   // For the directions j of a group of `directions`, channel c: J between
@@ -179,24 +173,23 @@ class JRows {
     const float* nu_weight = directions.nu_weight.data();
 #if defined(__AVX512F__)
     if (PermutesRows()) {
-      // Each row in two registers: a lookup is one permutation of them.
+      // Each row in two registers: a tap is one permutation of them.
       const float* row_a = Row(values_, c, group.slice);
       const float* row_b = Row(values_, c, group.next_slice);
-      const float* difference_a = Row(differences_, c, group.slice);
-      const float* difference_b = Row(differences_, c, group.next_slice);
       const __m512 a_low = _mm512_loadu_ps(row_a), a_high = _mm512_loadu_ps(row_a + 16);
       const __m512 b_low = _mm512_loadu_ps(row_b), b_high = _mm512_loadu_ps(row_b + 16);
-      const __m512 da_low = _mm512_loadu_ps(difference_a), da_high = _mm512_loadu_ps(difference_a + 16);
-      const __m512 db_low = _mm512_loadu_ps(difference_b), db_high = _mm512_loadu_ps(difference_b + 16);
       const __m512 weight = _mm512_set1_ps(w);
+      const __m512i one = _mm512_set1_epi32(1);
       for (int j = group.begin; j < group.end; j += kVectorFloats) {
-        const __m512i column = _mm512_loadu_si512(left + j);
+        const __m512i column = _mm512_loadu_si512(left + j), next_column = _mm512_add_epi32(column, one);
+        const __m512 left_a = _mm512_permutex2var_ps(a_low, column, a_high);
+        const __m512 left_b = _mm512_permutex2var_ps(b_low, column, b_high);
         const __m512 along_a =
-            _mm512_fmadd_ps(_mm512_loadu_ps(weight_a + j), _mm512_permutex2var_ps(da_low, column, da_high),
-                            _mm512_permutex2var_ps(a_low, column, a_high));
+            _mm512_fmadd_ps(_mm512_loadu_ps(weight_a + j),
+                            _mm512_sub_ps(_mm512_permutex2var_ps(a_low, next_column, a_high), left_a), left_a);
         const __m512 along_b =
-            _mm512_fmadd_ps(_mm512_loadu_ps(weight_b + j), _mm512_permutex2var_ps(db_low, column, db_high),
-                            _mm512_permutex2var_ps(b_low, column, b_high));
+            _mm512_fmadd_ps(_mm512_loadu_ps(weight_b + j),
+                            _mm512_sub_ps(_mm512_permutex2var_ps(b_low, next_column, b_high), left_b), left_b);
         const __m512 blend = _mm512_fmadd_ps(_mm512_loadu_ps(nu_weight + j), _mm512_sub_ps(along_b, along_a), along_a);
         _mm512_storeu_ps(value + j, blend);
         _mm512_storeu_ps(sum + j, _mm512_fmadd_ps(weight, blend, _mm512_loadu_ps(sum + j)));
@@ -225,7 +218,7 @@ class JRows {
     return &rows[(std::size_t(c) * nu_size_ + s) * stride_];
   }
   int mu_s_size_, nu_size_, stride_;
-  std::vector<float> values_, differences_;
+  std::vector<float> values_;
 };
 }  // namespace
 
