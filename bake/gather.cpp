@@ -76,12 +76,12 @@ struct DirectionsBySlice {
   };
   std::vector<Group> groups;
   std::vector<int> of_texel;  // per texel column x of the grid, its direction's position
-  // Per position:
+  // Per position (slice and next_slice only where not grouped by slice:
+  // a group's directions share its own):
   std::vector<float> mu_s, nu;
   std::vector<int> slice, next_slice;
   std::vector<float> nu_weight;  // of next_slice
 
-  DirectionsBySlice() = default;
   DirectionsBySlice(const SunDirections& directions, const AtmosphereParameters& grid, bool by_slice) {
     const int nu_size = grid.scattering_nu_size;
     const int distinct = by_slice ? *std::max_element(directions.of_texel.begin(), directions.of_texel.end()) + 1
@@ -95,6 +95,9 @@ struct DirectionsBySlice {
       members[by_slice ? slice_of[j] : 0].push_back(j);
       weight[j] = float(nu_coord - slice_of[j]);
     }
+    // At most a vector's padding per group.
+    const std::size_t most = std::size_t(distinct) + std::size_t(nu_size) * (kVectorFloats - 1);
+    mu_s.reserve(most), nu.reserve(most), nu_weight.reserve(most);
     for (const std::vector<int>& group_members : members) {
       if (group_members.empty()) continue;
       const int group_slice = by_slice ? slice_of[group_members.front()] : -1;
@@ -103,7 +106,7 @@ struct DirectionsBySlice {
         const int j = group_members[std::min(m, group_members.size() - 1)];
         if (m < group_members.size()) position[j] = count();
         mu_s.push_back(float(directions.mu_s[j])), nu.push_back(float(directions.nu[j]));
-        slice.push_back(slice_of[j]), next_slice.push_back(std::min(slice_of[j] + 1, nu_size - 1));
+        if (!by_slice) slice.push_back(slice_of[j]), next_slice.push_back(std::min(slice_of[j] + 1, nu_size - 1));
         nu_weight.push_back(weight[j]);
       }
       group.end = count();
@@ -268,9 +271,9 @@ Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) co
 
 // What GatherAlongRays needs of each ray of a table's grid whatever the
 // density it gathers: the samples at which J is read, with their taps in
-// the density grid's (r, mu) rows, the weights of J there, the optically
-// thick intervals, and the ray's sun directions grouped by nu slice. Every
-// order gathers along the same rays, so it is built once (PlanGather).
+// the density grid's (r, mu) rows, the weights of J there and the
+// optically thick intervals. Every order gathers along the same rays, so it
+// is built once (PlanGather).
 struct Baker::GatherPlan {
   struct ThickInterval {
     int k, c;
@@ -292,7 +295,7 @@ struct Baker::GatherPlan {
     std::vector<glm::vec3> weight;  // per sample k and channel, of J
     std::vector<ThickInterval> thick_intervals;
     std::vector<Spectrum> optical_depth;  // the view's, per sample k (where there are thick intervals)
-    DirectionsBySlice directions;
+    double mu = 0.0;                      // the view's cosine, whose sun directions are the ray's (RaySunDirections)
   };
   AtmosphereParameters grid, density_grid;
   int samples_per_ray = 0;  // intervals per ray
@@ -308,8 +311,6 @@ std::shared_ptr<const Baker::GatherPlan> Baker::PlanGather(const AtmosphereParam
   const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
   plan->samples_per_ray = n;
   plan->rays.resize(std::size_t(r_size) * mu_size);
-  const SunColumns columns(grid);
-  const bool by_slice = JRows(density_grid.scattering_mu_s_size, density_grid.scattering_nu_size).PermutesRows();
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
     GatherPlan::Ray& out = plan->rays[ray_index];
@@ -352,6 +353,7 @@ std::shared_ptr<const Baker::GatherPlan> Baker::PlanGather(const AtmosphereParam
       }
     }
     out.weight.assign(weight.begin(), weight.end());
+    out.samples.reserve(n + 1);
     if (!out.thick_intervals.empty()) out.optical_depth = ray.optical_depth;
     for (int k = 0; k <= n; ++k) {
       needed[k] = needed[k] || weight[k] != Spectrum(0.0);
@@ -369,11 +371,7 @@ std::shared_ptr<const Baker::GatherPlan> Baker::PlanGather(const AtmosphereParam
                              row(fy < 0.5 ? y0 : y1, fz < 0.5 ? z0 : z1), float(ray.r / ray.radius[k]),
                              float(ray.t[k] / ray.radius[k])});
     }
-    // The ray's sun directions, grouped by the nu slice below them where
-    // JRows's lookups along mu_s are permutations of rows held in registers
-    // (each vector of directions then reads the same two nu rows of J);
-    // within a group in order of mu_s (DirectionsBySlice).
-    out.directions = DirectionsBySlice(RaySunDirections(columns, ray.mu), density_grid, by_slice);
+    out.mu = ray.mu;
   });
   return plan;
 }
@@ -388,13 +386,20 @@ Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, c
   const JRows layout(density_mu_s_size, density_nu_size);
   const std::size_t per_row = layout.PerTexelRow();
   const std::vector<float> density_rows = layout.Rows(density);
+  const SunColumns columns(grid);
   const MuSCoordinate mu_s_coordinate(density_grid);
   const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
     const GatherPlan::Ray& ray = plan.rays[ray_index];
-    const DirectionsBySlice& by_slice = ray.directions;
+    // The ray's sun directions, grouped by the nu slice below them where
+    // JRows's lookups along mu_s are permutations of rows held in registers
+    // (each vector of directions then reads the same two nu rows of J);
+    // within a group in order of mu_s (DirectionsBySlice). (Kept in the
+    // plan they took more memory than the rest of it, for 0.5 % of the
+    // bake's time.)
     JRows rows(density_mu_s_size, density_nu_size);
+    const DirectionsBySlice by_slice(RaySunDirections(columns, ray.mu), density_grid, rows.PermutesRows());
     const int count = by_slice.count();
     const std::vector<float>&mu_s = by_slice.mu_s, &nu = by_slice.nu, &nu_weight = by_slice.nu_weight;
     std::vector<float> mu_s_k(count), mu_s_weight(count), values(count);
