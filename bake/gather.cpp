@@ -395,9 +395,9 @@ Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, c
     // The ray's sun directions, grouped by the nu slice below them where
     // JRows's lookups along mu_s are permutations of rows held in registers
     // (each vector of directions then reads the same two nu rows of J);
-    // within a group in order of mu_s (DirectionsBySlice). (Kept in the
-    // plan they took more memory than the rest of it, for 0.5 % of the
-    // bake's time.)
+    // within a group in order of mu_s (DirectionsBySlice). Formed per
+    // order: kept in the plan they would take more memory than all the
+    // rest of it (docs/benchmark.md).
     JRows rows(density_mu_s_size, density_nu_size);
     const DirectionsBySlice by_slice(RaySunDirections(columns, ray.mu), density_grid, rows.PermutesRows());
     const int count = by_slice.count();
