@@ -44,7 +44,7 @@ inline int RoundUpToVector(int n) { return (n + kVectorFloats - 1) / kVectorFloa
 // out[j] = row[index[j]] for j in [begin, end) (whole vectors), from a row
 // of `size` floats; with AVX-512 and at most 32 of them, a permutation of
 // the row held in two registers.
-inline void LookUpInRow(const float* row, int size, const int* index, int begin, int end, float* out) {
+inline void LookUpInRow(const float* row, [[maybe_unused]] int size, const int* index, int begin, int end, float* out) {
 #if defined(__AVX512F__)
   if (size <= 2 * kVectorFloats) {
     const __mmask16 low_mask = size >= kVectorFloats ? __mmask16(0xffff) : __mmask16((1u << size) - 1u);
