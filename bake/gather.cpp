@@ -389,6 +389,7 @@ Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, c
   const SunColumns columns(grid);
   const MuSCoordinate mu_s_coordinate(density_grid);
   const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
+  auto rows_at = [&](int row) { return &density_rows[std::size_t(row) * per_row]; };
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
     const GatherPlan::Ray& ray = plan.rays[ray_index];
@@ -423,7 +424,6 @@ Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, c
     for (const GatherPlan::Sample& sample : ray.samples) {
       const int k = sample.k;
       // J at the sample's (r, mu) for every (nu, mu_s) texel.
-      auto rows_at = [&](int row) { return &density_rows[std::size_t(row) * per_row]; };
       rows.Set(rows_at(sample.row00), rows_at(sample.row10), rows_at(sample.row01), rows_at(sample.row11), sample.w00,
                sample.w10, sample.w01, sample.w11);
       const float from_mu_s = sample.from_mu_s, from_nu = sample.from_nu;

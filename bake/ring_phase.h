@@ -23,7 +23,7 @@ namespace skybake::detail {
 class PhaseAzimuthSeries {
  public:
   PhaseAzimuthSeries(const PhaseFunction& phase, int terms);
-  // c[k], k < Terms().
+  // c[k], k < the terms it was built for.
   void Coefficients(double view_mu, double ring_cos, double* c) const;
 
  private:
@@ -31,7 +31,8 @@ class PhaseAzimuthSeries {
   int terms_;
   bool lobe_;
   // tan(s_q / 2) at the midpoint nodes s_q over [0, pi], per rule (for a
-  // lobe, 64 to 1024 nodes in powers of two, the narrower the more).
+  // lobe, from 64 nodes up in powers of two, the narrower the lobe and the
+  // more terms the more: ring_phase.cpp).
   std::vector<std::vector<double>> tan_half_s_;
 };
 
@@ -77,7 +78,7 @@ class RingPhaseMeans {
   }
 
   // The terms of the mean for a view of zenith cosine view_mu[view], per
-  // channel c: out[c * Stride() + k] = sum_l weight_clk a[(c * Rings() + l)
+  // channel c: out[c * Stride() + k] = sum_l weight_clk a[(c * rings + l)
   // * Stride() + k].
   void Terms(int view, const float* a, float* out) const;
 

@@ -172,10 +172,8 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
     // in OpenEXR's global pool its writer hands each block to the pool as a
     // task, whatever the file's thread count, and waits for it; for the
     // one-scanline blocks of the uncompressed and RLE files the handoffs
-    // cost more than the encoding (a 12.6 MB float table uncompressed: 16-23
-    // ms on the calling thread, 60-140 ms through a pool of two; RLE 33 ms
-    // against 74 ms). The writer encodes one file per core instead
-    // (WriteStagedSet).
+    // cost more than the encoding (measured in docs/benchmark.md, seventh
+    // round). The writer encodes one file per core instead (WriteStagedSet).
     static const bool kEncodeOnCallingThread = [] {
       IlmThread::ThreadPool::globalThreadPool().setNumThreads(0);
       return true;
