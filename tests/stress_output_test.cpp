@@ -50,6 +50,26 @@ TEST(StagedFiles, CommitRenamesEveryFile) {
   EXPECT_EQ(Snapshot(dir.path()), (std::map<std::string, std::string>{{"a.txt", "new a"}, {"b.txt", "new b"}}));
 }
 
+TEST(StagedFiles, FailedRenameKeepsTheFileItWouldReplace) {
+  TempDir dir;
+  testing::WriteText(dir.path() / "a.txt", "old a");
+  testing::WriteText(dir.path() / "b.txt", "old b");
+  {
+    StagedFiles staged;
+    staged.Write(dir.path() / "a.txt", "new a");
+    staged.Write(dir.path() / "b.txt", "new b");
+    staged.Write(dir.path() / "manifest.json", "new manifest");
+    // b.txt's staged copy vanishes before Commit, so its rename fails after
+    // the file it replaces was moved aside.
+    for (const auto& entry : fs::directory_iterator(dir.path())) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("b.txt", 0) == 0 && IsTemporaryFileName(name)) fs::remove(entry.path());
+    }
+    EXPECT_THROW(staged.Commit(), IoError);
+  }
+  EXPECT_EQ(Snapshot(dir.path()), (std::map<std::string, std::string>{{"a.txt", "new a"}, {"b.txt", "old b"}}));
+}
+
 TEST(InterruptScope, RecordsSigintUntilTakenAndRestoresTheHandler) {
   static volatile std::sig_atomic_t received_signal = 0;
   auto previous = std::signal(SIGINT, [](int signal) { received_signal = signal; });
