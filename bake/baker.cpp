@@ -96,7 +96,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   sums.table = TableMean(GridSingle().rayleigh, atmosphere_grid_, {});
   const std::vector<double> orders_packing = PackingFactors(orders_grid_);
   const bool gather_at_end = GatherAtEnd();
-  std::shared_ptr<const GatherPlan> orders_plan;  // every order's gather is along the same rays
+  std::shared_ptr<GatherPlan> orders_plan;  // every order's gather is along the same rays
   for (int order = 2; order <= (auto_orders ? s.max_orders : s.orders); ++order) {
     std::string prefix = "order " + std::to_string(order) + ": ";
     Phase(prefix + "scattering density", [&] { ComputeScatteringDensity(order); });
@@ -118,7 +118,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
       // read it, and the tail tests hold.
       const MuSFall fall = MuSFallOf(scattering_density_, order == 2);
       if (!orders_plan) orders_plan = PlanGather(orders_grid_, atmosphere_grid_);
-      delta_multiple_ = GatherAlongRays(*orders_plan, scattering_density_, &fall);
+      GatherAlongRays(*orders_plan, scattering_density_, &fall, &delta_multiple_);
       AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
     report_.orders_used = order;
@@ -166,8 +166,9 @@ Texture Baker::ScatteringTable() const {
     ExtendSlicesPastTheirRange(params_, table);
     return table;
   }
-  const Texture higher =
-      GatherAtEnd() ? GatherAlongRays(*PlanGather(params_, atmosphere_grid_), higher_orders_) : higher_orders_;
+  Texture gathered;
+  if (GatherAtEnd()) GatherAlongRays(*PlanGather(params_, atmosphere_grid_), higher_orders_, nullptr, &gathered);
+  const Texture& higher = GatherAtEnd() ? gathered : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;
   const std::vector<double> packing = PackingFactors(params_);
   ForEachRow(table, [&](int, std::size_t first, std::size_t end) {

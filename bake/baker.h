@@ -135,8 +135,8 @@ class Baker {
   // densities on the grid `density_grid`: what each gather needs of them
   // whatever the density (gather.cpp), built once for all the orders.
   struct GatherPlan;
-  std::shared_ptr<const GatherPlan> PlanGather(const AtmosphereParameters& grid,
-                                               const AtmosphereParameters& density_grid) const;
+  std::shared_ptr<GatherPlan> PlanGather(const AtmosphereParameters& grid,
+                                         const AtmosphereParameters& density_grid) const;
   // The light of the orders whose scattering density (per unit scattering
   // coefficient, on the plan's density grid) is `density`, arriving at
   // every texel of a table on the plan's grid: the density integrated along
@@ -144,8 +144,9 @@ class Baker {
   // or where `fall` has falls between columns, with weights that follow
   // them (exactly where J is exponential between two columns). Given
   // `fall`, J below the grid's lowest sun continues the fall of the two
-  // lowest columns per channel instead of holding the lowest column.
-  Texture GatherAlongRays(const GatherPlan& plan, const Texture& density, const MuSFall* fall = nullptr) const;
+  // lowest columns per channel instead of holding the lowest column. Into
+  // `result`, reused if it has the grid's size.
+  void GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSFall* fall, Texture* result) const;
   // Whether the table covers less than the whole atmosphere (a scene's bake):
   // its grid is then not the one the orders are computed on.
   bool TableRestricted() const { return settings_.scattering_range.has_value(); }

@@ -142,9 +142,12 @@ class JRows {
   // Floats per (r, mu) row of a texture: 3 channels, nu_size rows of stride_.
   std::size_t PerTexelRow() const { return std::size_t(3) * nu_size_ * stride_; }
 
-  // The texture's rgb in rows: per (r, mu) row, PerTexelRow() floats.
-  std::vector<float> Rows(const Texture& density) const {
-    std::vector<float> rows(std::size_t(density.height) * density.depth * PerTexelRow(), 0.0f);
+  // The texture's rgb in rows: per (r, mu) row, PerTexelRow() floats, the
+  // padding zero. Into `rows_out`, which a gather of every order reuses: its
+  // padding stays zero and every other value is overwritten.
+  void Rows(const Texture& density, std::vector<float>* rows_out) const {
+    std::vector<float>& rows = *rows_out;
+    rows.resize(std::size_t(density.height) * density.depth * PerTexelRow(), 0.0f);
     ForEachRow(density, [&](int row, std::size_t first, std::size_t) {
       float* out = &rows[row * PerTexelRow()];
       for (int c = 0; c < 3; ++c) {
@@ -155,7 +158,6 @@ class JRows {
         }
       }
     });
-    return rows;
   }
 
   // The sample's rows: the four (r, mu) rows' (of Rows) blended by their weights.
@@ -300,10 +302,14 @@ struct Baker::GatherPlan {
   AtmosphereParameters grid, density_grid;
   int samples_per_ray = 0;  // intervals per ray
   std::vector<Ray> rays;    // per ray index z * mu_size + y
+  // The gathered order's J in JRows's layout (JRows::Rows): kept with the
+  // plan so that every order's gather writes into pages already touched,
+  // instead of faulting in a fresh buffer on the calling thread.
+  std::vector<float> density_rows;
 };
 
-std::shared_ptr<const Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters& grid,
-                                                           const AtmosphereParameters& density_grid) const {
+std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters& grid,
+                                                     const AtmosphereParameters& density_grid) const {
   auto plan = std::make_shared<GatherPlan>();
   plan->grid = grid, plan->density_grid = density_grid;
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
@@ -376,16 +382,22 @@ std::shared_ptr<const Baker::GatherPlan> Baker::PlanGather(const AtmosphereParam
   return plan;
 }
 
-Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, const MuSFall* fall) const {
+void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSFall* fall, Texture* result_out) const {
   const AtmosphereParameters &grid = plan.grid, &density_grid = plan.density_grid;
-  Texture result = ScatteringGridTexture(grid);
+  // Every texel is written below: a texture of the grid's size is reused as it is.
+  Texture& result = *result_out;
+  if (result.width != grid.scattering_nu_size * grid.scattering_mu_s_size || result.height != grid.scattering_mu_size ||
+      result.depth != grid.scattering_r_size) {
+    result = ScatteringGridTexture(grid);
+  }
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
   const int n = plan.samples_per_ray;
   // J in rows along mu_s per channel and nu slice (JRows).
   const JRows layout(density_mu_s_size, density_nu_size);
   const std::size_t per_row = layout.PerTexelRow();
-  const std::vector<float> density_rows = layout.Rows(density);
+  layout.Rows(density, &plan.density_rows);
+  const std::vector<float>& density_rows = plan.density_rows;
   const SunColumns columns(grid);
   const MuSCoordinate mu_s_coordinate(density_grid);
   const float lowest_mu_s = float(density_grid.scattering_mu_s_min);
@@ -561,7 +573,6 @@ Texture Baker::GatherAlongRays(const GatherPlan& plan, const Texture& density, c
       result.Store(x, y, z, vec4(directions_sum[by_slice.of_texel[x]], 0.0));
     }
   });
-  return result;
 }
 
 }  // namespace skybake::detail
