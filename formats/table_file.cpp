@@ -378,7 +378,10 @@ std::string TableImage::StorageName() const {
 
 void ChooseExrCompression(TableImage* image) {
   if (image->format != FileFormat::kExr) return;
-  constexpr int kBlockRows = 16, kSampleBlocks = 16;  // OpenEXR's ZIP block: 16 scanlines
+  // OpenEXR's ZIP block: 16 scanlines. Each sampled block lies in the
+  // middle of its share of the image: the first rows (the ground, and views
+  // into it) are the most compressible and would speak for too much.
+  constexpr int kBlockRows = 16, kSampleBlocks = 4;
   const int rows = image->height * image->depth;
   const int blocks = (rows + kBlockRows - 1) / kBlockRows;
   const int step = std::max(1, blocks / kSampleBlocks);
@@ -388,7 +391,7 @@ void ChooseExrCompression(TableImage* image) {
   sample.width = image->width;
   sample.channel_names = image->channel_names;
   const std::size_t row_values = std::size_t(image->width) * image->channel_names.size();
-  for (int block = 0; block < blocks; block += step) {
+  for (int block = step / 2; block < blocks; block += step) {
     const int first = block * kBlockRows, count = std::min(kBlockRows, rows - first);
     const auto begin = image->values.begin() + std::ptrdiff_t(first * row_values);
     sample.values.insert(sample.values.end(), begin, begin + std::ptrdiff_t(count * row_values));
