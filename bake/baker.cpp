@@ -149,11 +149,12 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
       break;
     }
   }
+  // The orders' density is no longer needed: its pages hold the table.
   Texture scattering;
   if (gather_at_end) {
-    Phase("gather higher orders", [&] { scattering = ScatteringTable(); });
+    Phase("gather higher orders", [&] { scattering = ScatteringTable(std::move(scattering_density_)); });
   } else {
-    scattering = ScatteringTable();
+    scattering = ScatteringTable(std::move(scattering_density_));
   }
 
   LutSet result = AssembleTables(std::move(transmittance_), std::move(irradiance_), std::move(scattering),
@@ -163,8 +164,9 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   return result;
 }
 
-Texture Baker::ScatteringTable() const {
-  Texture table = single_.rayleigh;
+Texture Baker::ScatteringTable(Texture storage) const {
+  Texture table = std::move(storage);
+  table = single_.rayleigh;  // into the storage's memory if it is large enough
   if (report_.orders_used < 2) {
     ExtendSlicesPastTheirRange(params_, table);
     return table;

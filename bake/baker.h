@@ -156,8 +156,10 @@ class Baker {
   bool GatherAtEnd() const { return settings_.higher_order_divisor > 1 || TableRestricted(); }
   // Single scattering on the atmosphere's grid, the light of order 1.
   const SingleScattering& GridSingle() const { return TableRestricted() ? grid_single_ : single_; }
-  // The scattering table: single Rayleigh plus the higher orders.
-  Texture ScatteringTable() const;
+  // The scattering table: single Rayleigh plus the higher orders, in the
+  // memory of `storage` (a texture no longer needed) where it is large
+  // enough.
+  Texture ScatteringTable(Texture storage = {}) const;
   // Where the range of nu that a texel's (mu, mu_s) allow ends inside a nu
   // slice interval, the slice past the range holds the light at the range's
   // edge (its clamped nu), and GetScattering, which blends two slices at
