@@ -167,6 +167,10 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
     }
   }
   MemoryOStream stream;
+  // Room for the file as stored uncompressed (header, and per block of
+  // scanlines its offset, row and size), so that the buffer is not copied as
+  // it grows; compressed files take less, or a few bytes more.
+  stream.bytes().reserve(texels * channels * (half ? 2 : 4) + std::size_t(rows) * 16 + (std::size_t(1) << 16));
   try {
     // Every block of scanlines encoded on the calling thread: with threads
     // in OpenEXR's global pool its writer hands each block to the pool as a
