@@ -108,10 +108,14 @@ Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, c
   std::vector<float> base(per_ray), log_ratio(per_ray);
   std::vector<char> has_ratio(per_ray);
   auto at = [&](int g, int c, int k) { return (std::size_t(g) * 3 + c) * (n + 1) + k; };
+  std::vector<double> view_transmittance(std::size_t(3) * (n + 1));  // per channel and sample, for every group
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k <= n; ++k) view_transmittance[std::size_t(c) * (n + 1) + k] = std::exp(-ray.optical_depth[k][c]);
+  }
   for (int g = 0; g < groups; ++g) {
     for (int c = 0; c < 3; ++c) {
       for (int k = 0; k <= n; ++k) {
-        base_double[at(g, c, k)] = ray.scattering[g][k][c] * std::exp(-ray.optical_depth[k][c]);
+        base_double[at(g, c, k)] = ray.scattering[g][k][c] * view_transmittance[std::size_t(c) * (n + 1) + k];
         base[at(g, c, k)] = float(base_double[at(g, c, k)]);
       }
       for (int k = 0; k < n; ++k) {
