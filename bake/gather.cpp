@@ -87,25 +87,34 @@ struct DirectionsBySlice {
     const int nu_size = grid.scattering_nu_size;
     const int distinct = by_slice ? *std::max_element(directions.of_texel.begin(), directions.of_texel.end()) + 1
                                   : static_cast<int>(directions.nu.size());
-    std::vector<std::vector<int>> members(nu_size);
+    const int group_count = by_slice ? nu_size : 1;
     std::vector<int> slice_of(distinct), position(distinct);
     std::vector<float> weight(distinct);
+    // The directions of each group in their order, members[group_start[g]]
+    // onward (a counting sort by group).
+    std::vector<int> group_start(group_count + 1, 0), members(distinct);
     for (int j = 0; j < distinct; ++j) {
       const double nu_coord = glsl::ScatteringUnitNu(directions.nu[j]) * (nu_size - 1);
       slice_of[j] = std::min(int(std::floor(nu_coord)), nu_size - 1);
-      members[by_slice ? slice_of[j] : 0].push_back(j);
+      ++group_start[(by_slice ? slice_of[j] : 0) + 1];
       weight[j] = float(nu_coord - slice_of[j]);
     }
+    for (int g = 0; g < group_count; ++g) group_start[g + 1] += group_start[g];
+    std::vector<int> next_member(group_start.begin(), group_start.end() - 1);
+    for (int j = 0; j < distinct; ++j) members[next_member[by_slice ? slice_of[j] : 0]++] = j;
     // At most a vector's padding per group.
     const std::size_t most = std::size_t(distinct) + std::size_t(nu_size) * (kVectorFloats - 1);
     mu_s.reserve(most), nu.reserve(most), nu_weight.reserve(most);
-    for (const std::vector<int>& group_members : members) {
-      if (group_members.empty()) continue;
-      const int group_slice = by_slice ? slice_of[group_members.front()] : -1;
+    if (!by_slice) slice.reserve(most), next_slice.reserve(most);
+    groups.reserve(group_count);
+    for (int g = 0; g < group_count; ++g) {
+      const int first = group_start[g], size = group_start[g + 1] - first;
+      if (size == 0) continue;
+      const int group_slice = by_slice ? slice_of[members[first]] : -1;
       Group group{group_slice, by_slice ? std::min(group_slice + 1, nu_size - 1) : -1, count(), 0};
-      for (std::size_t m = 0; m < group_members.size() || count() % kVectorFloats != 0; ++m) {
-        const int j = group_members[std::min(m, group_members.size() - 1)];
-        if (m < group_members.size()) position[j] = count();
+      for (int m = 0; m < size || count() % kVectorFloats != 0; ++m) {
+        const int j = members[first + std::min(m, size - 1)];
+        if (m < size) position[j] = count();
         mu_s.push_back(float(directions.mu_s[j])), nu.push_back(float(directions.nu[j]));
         if (!by_slice) slice.push_back(slice_of[j]), next_slice.push_back(std::min(slice_of[j] + 1, nu_size - 1));
         nu_weight.push_back(weight[j]);
@@ -113,6 +122,7 @@ struct DirectionsBySlice {
       group.end = count();
       groups.push_back(group);
     }
+    of_texel.reserve(directions.of_texel.size());
     for (int texel : directions.of_texel) of_texel.push_back(position[texel]);
   }
   int count() const { return static_cast<int>(mu_s.size()); }

@@ -101,6 +101,7 @@ Baker::IncidentAlongNu::IncidentAlongNu(const Baker& baker, int order, double r,
   }
   auto slices = [&](const Texture& table, std::vector<vec3>& out) {
     const glsl::sampler3D sampler{&table};
+    out.reserve(nu_size_ + 1);
     for (int slice = 0; slice <= nu_size_; ++slice) {
       out.push_back(vec3(glsl::texture(sampler, glsl::vec3((slice + uvwz.y) / nu_size_, uvwz.z, uvwz.w))));
     }
