@@ -13,7 +13,6 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include "bake/grids.h"
 #include "bake/order_convergence.h"
@@ -83,10 +82,8 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     Phase("sky irradiance of single scattering", [&] { ComputeIndirectIrradiance(1); });
   }
   if (s.orders != 1) {  // 0 = auto
-    // Zeroed side by side: a table's pages take milliseconds to fault in.
-    tbb::parallel_invoke([&] { scattering_density_ = ScatteringGridTexture(atmosphere_grid_); },
-                         [&] { higher_orders_ = ScatteringGridTexture(atmosphere_grid_); },
-                         [&] { delta_multiple_ = ScatteringGridTexture(orders_grid_); });
+    scattering_density_ = ScatteringGridTexture(atmosphere_grid_);
+    higher_orders_ = ScatteringGridTexture(atmosphere_grid_);
     delta_irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
   }
   report_.orders_used = 1;

@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #if defined(__AVX512F__)
 #include <immintrin.h>
@@ -314,7 +313,8 @@ struct Baker::GatherPlan {
   int samples_per_ray = 0;  // intervals per ray
   std::vector<Ray> rays;    // per ray index z * mu_size + y
   // The gathered order's J in JRows's layout (JRows::Rows): kept with the
-  // plan so that every order's gather writes into pages already touched.
+  // plan so that every order's gather writes into pages already touched,
+  // instead of faulting in a fresh buffer on the calling thread.
   std::vector<float> density_rows;
 };
 
@@ -327,7 +327,7 @@ std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters&
   const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
   plan->samples_per_ray = n;
   plan->rays.resize(std::size_t(r_size) * mu_size);
-  auto plan_ray = [&](int ray_index) {
+  tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
     GatherPlan::Ray& out = plan->rays[ray_index];
     const RaySamples ray = SampleRay(grid, y, z, n);
@@ -388,14 +388,7 @@ std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters&
                              float(ray.t[k] / ray.radius[k])});
     }
     out.mu = ray.mu;
-  };
-  // J's rows are zeroed (their pages faulted in) by one worker while the
-  // others plan the rays.
-  auto allocate_rows = [&] {
-    const JRows layout(density_grid.scattering_mu_s_size, density_grid.scattering_nu_size);
-    plan->density_rows.assign(std::size_t(density_height) * density_depth * layout.PerTexelRow(), 0.0f);
-  };
-  tbb::parallel_invoke(allocate_rows, [&] { tbb::parallel_for(0, r_size * mu_size, plan_ray); });
+  });
   return plan;
 }
 

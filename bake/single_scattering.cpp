@@ -10,7 +10,6 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include "bake/grids.h"
 #include "core/constants.h"
@@ -65,10 +64,7 @@ Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameter
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const ChannelPlanes transmittance(transmittance_);
   const SunColumns columns(grid);
-  SingleScattering result;
-  // Zeroed side by side: a table's pages take milliseconds to fault in.
-  tbb::parallel_invoke([&] { result.rayleigh = ScatteringGridTexture(grid); },
-                       [&] { result.mie = ScatteringGridTexture(grid); });
+  SingleScattering result{ScatteringGridTexture(grid), ScatteringGridTexture(grid)};
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     SingleScatteringAlongRay(grid, ray_samples, ray_index % mu_size, ray_index / mu_size, columns, transmittance,
                              result);
