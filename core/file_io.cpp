@@ -86,13 +86,10 @@ void StagedFiles::Commit() {
   for (const Staged& file : staged_) {
     if (fs::is_directory(file.path)) throw IoError(file.path.string() + ": cannot write: is a directory");
   }
-  // Every file but the last moves the one it replaces aside first and
-  // removes it once all are in place: renamed directly over an earlier file,
-  // ext4 starts writing the new one to disk within the rename (its
-  // auto_da_alloc), which for a table of megabytes costs more than the rest
-  // of the file's writing. The last file (the manifest, which readers open
-  // first) replaces its predecessor in one rename, so a reader always finds
-  // one.
+  // Renamed directly over an earlier file, ext4 starts writing the new one
+  // to disk within the rename (its auto_da_alloc), which for a table of
+  // megabytes costs more than the rest of the file's writing; so every file
+  // but the last (the header says why) moves its predecessor aside instead.
   std::vector<fs::path> replaced;
   auto remove_replaced = [&replaced] {
     for (const fs::path& old : replaced) {

@@ -25,8 +25,11 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view byt
 // write failed), it removes its temporary files and every earlier file of the
 // same names is left intact. Commit() refuses up front a final name it could
 // not replace (a directory), so that no rename of the set has happened yet.
-// A rename that fails part-way leaves the files renamed before it new and
-// the rest as they were.
+// Each file but the last written moves the file it replaces aside and
+// removes it once the set is in place; the last (a manifest, which readers
+// open first) replaces its predecessor in one rename, so that a reader
+// always finds one. A rename that fails part-way leaves the files renamed
+// before it new and the rest as they were.
 // Write() may run on several threads at once; the order written is then the
 // order the writes began.
 class StagedFiles {
