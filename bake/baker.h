@@ -145,7 +145,7 @@ class Baker {
   // them (exactly where J is exponential between two columns). Given
   // `fall`, J below the grid's lowest sun continues the fall of the two
   // lowest columns per channel instead of holding the lowest column. Into
-  // `result`, reused if it has the grid's size.
+  // `result`, in the memory it has.
   void GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSFall* fall, Texture* result) const;
   // Whether the table covers less than the whole atmosphere (a scene's bake):
   // its grid is then not the one the orders are computed on.

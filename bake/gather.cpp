@@ -394,12 +394,9 @@ std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters&
 
 void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSFall* fall, Texture* result_out) const {
   const AtmosphereParameters &grid = plan.grid, &density_grid = plan.density_grid;
-  // Every texel is written below: a texture of the grid's size is reused as it is.
+  // Every texel is written below, so the texture's memory is reused as it is.
   Texture& result = *result_out;
-  if (result.width != grid.scattering_nu_size * grid.scattering_mu_s_size || result.height != grid.scattering_mu_size ||
-      result.depth != grid.scattering_r_size) {
-    result = ScatteringGridTexture(grid);
-  }
+  SizeForScatteringGrid(grid, &result);
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const int density_mu_s_size = density_grid.scattering_mu_s_size, density_nu_size = density_grid.scattering_nu_size;
   const int n = plan.samples_per_ray;

@@ -42,7 +42,18 @@ inline void AddScaled(const Texture& source, const Spectrum& factor, Texture& ta
   });
 }
 
+// Gives `texture` the size of the grid's scattering textures, in the memory
+// it has where that is large enough; texels it did not have are zero.
+inline void SizeForScatteringGrid(const AtmosphereParameters& grid, Texture* texture) {
+  texture->width = grid.scattering_nu_size * grid.scattering_mu_s_size;
+  texture->height = grid.scattering_mu_size;
+  texture->depth = grid.scattering_r_size;
+  texture->texels.resize(std::size_t(4) * texture->width * texture->height * texture->depth, 0.0f);
+}
+
 inline Texture ScatteringGridTexture(const AtmosphereParameters& grid) {
-  return Texture(grid.scattering_nu_size * grid.scattering_mu_s_size, grid.scattering_mu_size, grid.scattering_r_size);
+  Texture texture;
+  SizeForScatteringGrid(grid, &texture);
+  return texture;
 }
 }  // namespace skybake::detail

@@ -88,11 +88,11 @@ struct TableImage {
 // 16-row ZIP blocks, each in the middle of its quarter of the image) shrinks
 // by at least kExrMinimumSaving of its size with it, ZIP-compressed if ZIP
 // shrinks it by that much and by that much more than RLE, else
-// uncompressed. Float tables whose low
-// mantissa bits are noise shrink by a few percent with either, at about 20
-// ns per byte for ZIP; RLE takes the runs of zero of dark texels at a
-// fraction of ZIP's cost, and ZIP what repeats beyond runs, as in half
-// tables (docs/benchmark.md). No effect on KTX2 images.
+// uncompressed. Float tables whose low mantissa bits are noise shrink by a
+// few percent with either, at about 20 ns per byte for ZIP; RLE takes the
+// runs of zero of dark texels at a fraction of ZIP's cost, and ZIP what
+// repeats beyond runs, as in half tables (docs/benchmark.md). No effect on
+// KTX2 images.
 inline constexpr double kExrMinimumSaving = 0.10;
 void ChooseExrCompression(TableImage* image);
 
