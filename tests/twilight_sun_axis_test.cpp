@@ -1,0 +1,542 @@
+// A design study for single scattering in twilight: a scattering table whose
+// sun axis is measured from each texel ray's shadow edge, against the
+// tables' own sun axis, both filled with exact texel values.
+//
+// After sunset a ray's single scattering falls off a cliff where its last
+// lit point sets (docs/accuracy.md, "Twilight: where single scattering alone
+// stays wrong"): the light falls by orders of magnitude between two of the
+// tables' mu_s columns, which lie at the same sun angles for every ray. Here
+// each ray (r, mu) and sun azimuth phi from the view has its own columns:
+// most of them at logarithmically closing distances to the sun zenith at
+// which the ray goes wholly dark, a few past it. The fourth axis is the
+// sun's azimuth. The texels are computed by one quadrature, the same as the
+// exact values they are compared with, so the figures measure where the
+// texels lie and how a lookup blends them, nothing else; the blends are the
+// runtime's own (LogMonotoneCubicMix along the sun, SunCosineMix across
+// azimuth slices, bilinear in r and mu as a texture fetch is).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "bake/bake.h"
+#include "bake/ray_integrals.h"
+#include "core/constants.h"
+#include "shaders_runtime/runtime.h"
+#include "shaders_runtime/twin.h"
+#include "test_atmospheres.h"
+
+namespace skybake {
+namespace {
+
+using glsl::vec4;
+constexpr double kDegree = kPi / 180.0;
+
+// nu: the cosine between the view (zenith cosine mu) and the sun at zenith
+// angle `sun` and azimuth phi from the view.
+double ViewSunCosine(double mu, double sun, double phi) {
+  return mu * std::cos(sun) + glsl::SafeSqrt(1.0 - mu * mu) * std::sin(sun) * std::cos(phi);
+}
+
+// Single scattering, phase free, times the solar irradiance.
+struct Light {
+  Spectrum rayleigh{0.0}, mie{0.0};
+};
+
+// Single scattering along the ray (r, mu) for the sun at (mu_s, nu): the
+// trapezoid rule on 2048 intervals, exponential between samples, each
+// interval the shadow edge crosses (or the sun's disc straddles the horizon
+// in) cut into 128. The sun's optical depth comes from the transmittance
+// table, as the bake reads it, so that texels and exact values carry the
+// same error of their own.
+Light SingleScatteringQuadrature(const LutSet& luts, double r, double mu, double mu_s, double nu) {
+  const Atmosphere& a = luts.atmosphere;
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  const glsl::sampler2D transmittance{&luts.transmittance};
+  const double d = glsl::DistanceToNearestAtmosphereBoundary(p, r, mu, glsl::RayIntersectsGround(p, r, mu));
+  struct Sample {
+    double radius;
+    std::vector<double> density;
+    Spectrum optical_depth{0.0};  // from the ray's start
+    Light light;
+    double visible = 0.0;
+  };
+  auto sample_at = [&](double t, const Sample* previous, double step) {
+    Sample s;
+    s.radius = std::sqrt(t * t + 2.0 * r * mu * t + r * r);
+    for (const Constituent& c : a.constituents) s.density.push_back(c.density.At(s.radius - p.bottom_radius));
+    if (previous) {
+      s.optical_depth = previous->optical_depth;
+      for (std::size_t c = 0; c < a.constituents.size(); ++c) {
+        s.optical_depth +=
+            a.constituents[c].Extinction() * detail::ExponentialTrapezoid(previous->density[c], s.density[c], step);
+      }
+    }
+    const double mu_s_t = glsl::ClampCosine((r * mu_s + t * nu) / s.radius);
+    s.visible = glsl::SunVisibleFraction(p, s.radius, mu_s_t);
+    if (s.visible > 0.0) {
+      const Spectrum attenuation = glm::exp(-(s.optical_depth + glsl::GetOpticalDepthToTopAtmosphereBoundary(
+                                                                    p, transmittance, s.radius, mu_s_t))) *
+                                   s.visible;
+      s.light = {a.constituents[0].scattering_per_m * s.density[0] * attenuation,
+                 a.constituents[1].scattering_per_m * s.density[1] * attenuation};
+    }
+    return s;
+  };
+  Light sum;
+  auto add = [&](const Sample& from, const Sample& to, double step) {
+    for (int c = 0; c < 3; ++c) {
+      sum.rayleigh[c] += detail::ExponentialTrapezoid(from.light.rayleigh[c], to.light.rayleigh[c], step);
+      sum.mie[c] += detail::ExponentialTrapezoid(from.light.mie[c], to.light.mie[c], step);
+    }
+  };
+  constexpr int kIntervals = 2048, kEdgePieces = 128;
+  const double step = d / kIntervals;
+  Sample start = sample_at(0.0, nullptr, 0.0);
+  for (int k = 1; k <= kIntervals; ++k) {
+    Sample end = sample_at(k * step, &start, step);
+    const bool edge = start.visible != end.visible || (start.visible > 0.0 && start.visible < 1.0);
+    if (edge) {
+      Sample piece_start = start;
+      for (int i = 1; i <= kEdgePieces; ++i) {
+        Sample piece_end = sample_at((k - 1) * step + i * step / kEdgePieces, &piece_start, step / kEdgePieces);
+        add(piece_start, piece_end, step / kEdgePieces);
+        piece_start = std::move(piece_end);
+      }
+    } else if (start.visible > 0.0 || end.visible > 0.0) {
+      add(start, end, step);
+    }
+    start = std::move(end);
+  }
+  return {sum.rayleigh * a.solar_irradiance, sum.mie * a.solar_irradiance};
+}
+
+// The sun zenith angle past which no point of the ray (r, mu) sees any of
+// the sun's disc, for the sun at azimuth phi from the view. The Earth's
+// shadow is a half cylinder behind the planet, so the last lit point of a
+// ray is one of its ends: the start, lit while the sun's centre is above
+// its horizon (mu_s > -sqrt(1 - (bottom / r)^2) = -c), or the far end, seen
+// from the start at angle alpha around the planet's centre, where the sun's
+// cosine is cos(theta) cos(alpha) + sin(theta) sin(alpha) cos(phi) =
+// rho cos(theta - beta), with rho cos(beta) = cos(alpha) and rho sin(beta) =
+// sin(alpha) cos(phi), above the far end's -c until theta = beta +
+// acos(-c / rho). Plus the disc's angular radius: the disc's top sets last.
+double ShadowEdgeSunZenith(const glsl::AtmosphereParameters& p, double r, double mu, double phi) {
+  auto horizon_sine = [&](double radius) {
+    return glsl::DistanceToHorizon(p.bottom_radius, radius) / radius;  // c = -HorizonZenithCosine
+  };
+  const double d = glsl::DistanceToNearestAtmosphereBoundary(p, r, mu, glsl::RayIntersectsGround(p, r, mu));
+  const double r_d = glsl::RadiusAtDistance(p, r, mu, d);
+  const double cos_alpha = glsl::ClampCosine((r + d * mu) / r_d);
+  const double sin_alpha = d * glsl::SafeSqrt(1.0 - mu * mu) / r_d;
+  const double rho = std::hypot(sin_alpha * std::cos(phi), cos_alpha);
+  const double beta = std::atan2(sin_alpha * std::cos(phi), cos_alpha);
+  const double c_far = horizon_sine(r_d);
+  const double far_end = c_far >= rho ? kPi : beta + std::acos(-c_far / rho);
+  const double start = std::acos(-horizon_sine(r));
+  return std::max(start, far_end) + p.sun_angular_radius;
+}
+
+// The position of the sun at zenith angle `sun` along the tables' mu_s
+// axis, in columns from the lowest sun (GetScatteringTextureUMuS), held at
+// the lowest column below it.
+double TablesColumnPosition(const glsl::AtmosphereParameters& p, double sun) {
+  const double mu_s = std::max(std::cos(sun), p.scattering_mu_s_min);
+  return std::max(glsl::GetScatteringTextureUMuS(p, mu_s) * p.scattering_mu_s_size - 0.5, 0.0);
+}
+
+// Where a table's sun axis puts the columns of a ray, and how a lookup
+// blends them for a query.
+class SunAxis {
+ public:
+  virtual ~SunAxis() = default;
+  // Sun zenith angle of column k of the ray (r, mu) at sun azimuth phi.
+  virtual double ColumnSunZenith(double r, double mu, double phi, int k) const = 0;
+  // The light for the sun at zenith angle `sun` from the values of the
+  // columns (in one azimuth slice, blended in r and mu).
+  virtual vec4 Blend(const std::function<vec4(int)>& column, double r, double mu, double phi, double sun) const = 0;
+};
+
+// The tables' axis (GetScatteringMuSFromUnitRange): the same columns for
+// every ray, blended as GetScattering blends them.
+class TableSunAxis : public SunAxis {
+ public:
+  explicit TableSunAxis(const glsl::AtmosphereParameters& p) : p_(p) {}
+  double ColumnSunZenith(double, double, double, int k) const override {
+    return std::acos(glsl::GetScatteringMuSFromUnitRange(p_, double(k) / (p_.scattering_mu_s_size - 1)));
+  }
+  vec4 Blend(const std::function<vec4(int)>& column, double, double, double, double sun) const override {
+    const int size = p_.scattering_mu_s_size;
+    const double x = TablesColumnPosition(p_, sun);
+    const int k = std::clamp(int(std::floor(x)), 0, size - 2);
+    if (std::cos(ColumnSunZenith(0, 0, 0, k)) >= glsl::LOW_SUN_MU_S) return glm::mix(column(k), column(k + 1), x - k);
+    const bool has_a = k >= 1, has_d = k + 2 < size;
+    return glsl::LogMonotoneCubicMix(has_a ? column(k - 1) : vec4(0.0), column(k), column(k + 1),
+                                     has_d ? column(k + 2) : vec4(0.0), has_a, has_d, x - k);
+  }
+
+ private:
+  const glsl::AtmosphereParameters& p_;
+};
+
+// The axis measured from the shadow edge E (ShadowEdgeSunZenith) of each
+// ray and azimuth. Of the columns, kPast lie at and past the edge, evenly
+// up to the tables' lowest sun (at least 2 degrees past E), where single
+// scattering is 0 and only the higher orders remain; the others on the lit
+// side, at even steps of
+//   x = w X(theta) + (1 - w) ln(D / D_min) / ln(E / D_min),  D = E - theta,
+// rescaled to [0, 1] from D = D_min to the zenith. X is the tables' own
+// unit mu_s (dense toward sunset at the camera, where light that grazes
+// the ground also changes fast); the logarithm closes in on the edge,
+// where near it the light falls as D^3 (the disc's smooth step times the
+// lit stretch) and farther out as the sunlight's grazing path thickens.
+// Between E and D_min, the light continues from the two nearest lit
+// columns as a power of D, above the edge column's value.
+class ShadowEdgeSunAxis : public SunAxis {
+ public:
+  static constexpr int kPast = 6;
+  static constexpr double kTablesWeight = 0.55, kClosestDistance = 0.1 * kDegree;
+
+  explicit ShadowEdgeSunAxis(const glsl::AtmosphereParameters& p) : p_(p) {}
+  double ColumnSunZenith(double r, double mu, double phi, int k) const override {
+    const double edge = ShadowEdgeSunZenith(p_, r, mu, phi);
+    if (k < kPast) return edge + (kPast - 1 - k) * PastStep(edge);
+    return LitSunZenith(double(k - kPast) / (LitColumns() - 1), edge);
+  }
+  vec4 Blend(const std::function<vec4(int)>& column, double r, double mu, double phi, double sun) const override {
+    const double edge = ShadowEdgeSunZenith(p_, r, mu, phi), distance = edge - sun;
+    const int lit = LitColumns();
+    if (distance > kClosestDistance) {
+      const double x = LitUnit(sun, edge) * (lit - 1);
+      const int k = std::min(int(std::floor(x)), lit - 2);
+      const bool has_a = k >= 1, has_d = k + 2 < lit;
+      return glsl::LogMonotoneCubicMix(has_a ? column(kPast + k - 1) : vec4(0.0), column(kPast + k),
+                                       column(kPast + k + 1), has_d ? column(kPast + k + 2) : vec4(0.0), has_a, has_d,
+                                       x - k);
+    }
+    if (distance > 0.0) {
+      const vec4 at_edge = column(kPast - 1), first = column(kPast), second = column(kPast + 1);
+      const double ln_distances = std::log((edge - LitSunZenith(1.0 / (lit - 1), edge)) / kClosestDistance);
+      vec4 result = at_edge;
+      for (int c = 0; c < 3; ++c) {
+        const double near = first[c] - at_edge[c], far = second[c] - at_edge[c];
+        const double power =
+            near > 0.0 && far > near ? std::clamp(std::log(far / near) / ln_distances, 1.0, 10.0) : 3.0;
+        result[c] += near * std::pow(distance / kClosestDistance, power);
+      }
+      return result;
+    }
+    const double x = -distance / PastStep(edge);
+    const int k = std::min(int(x), kPast - 2);
+    return glsl::SunCosineMix(column(kPast - 1 - k), column(kPast - 2 - k), x - k, true);
+  }
+
+ private:
+  int LitColumns() const { return p_.scattering_mu_s_size - kPast; }
+  double PastStep(double edge) const {
+    const double lowest = std::acos(p_.scattering_mu_s_min);
+    return std::max(lowest - edge, 2.0 * kDegree) / (kPast - 1);
+  }
+  double RawUnit(double sun, double edge) const {
+    const double distance = std::max(edge - sun, kClosestDistance);
+    const double tables = TablesColumnPosition(p_, sun) / (p_.scattering_mu_s_size - 1);
+    return kTablesWeight * tables +
+           (1.0 - kTablesWeight) * std::log(distance / kClosestDistance) / std::log(edge / kClosestDistance);
+  }
+  // In [0, 1] from D = D_min to the zenith.
+  double LitUnit(double sun, double edge) const {
+    const double low = RawUnit(edge - kClosestDistance, edge);
+    return (RawUnit(sun, edge) - low) / (1.0 - low);
+  }
+  // Its inverse, by bisection (LitUnit falls as the sun sinks).
+  double LitSunZenith(double x, double edge) const {
+    double high_sun = 0.0, low_sun = edge - kClosestDistance;
+    for (int i = 0; i < 60; ++i) {
+      const double middle = 0.5 * (high_sun + low_sun);
+      (LitUnit(middle, edge) > x ? high_sun : low_sun) = middle;
+    }
+    return 0.5 * (high_sun + low_sun);
+  }
+
+  const glsl::AtmosphereParameters& p_;
+};
+
+// A table on the tables' r and mu rows, with the columns of `axis` and
+// eight azimuth slices at phi = pi (l / 7)^2 (crowded toward the sun,
+// where the lit wedge narrows after sunset); its texels computed on first
+// use. `higher_orders`, if given, adds to each texel the light of the
+// higher orders over the Rayleigh phase, as the scattering table holds it.
+class StudyTable {
+ public:
+  using HigherOrders = std::function<Spectrum(double r, double mu, double mu_s, double nu)>;
+  static constexpr int kSlices = 8;
+
+  StudyTable(const LutSet& luts, const SunAxis& axis, HigherOrders higher_orders)
+      : luts_(luts), axis_(axis), higher_orders_(std::move(higher_orders)) {}
+
+  static double SliceAzimuth(int l) { return kPi * std::pow(double(l) / (kSlices - 1), 2.0); }
+  static double SlicePosition(double phi) { return (kSlices - 1) * std::sqrt(phi / kPi); }
+
+  // The light of the table toward (r, mu) for the sun at zenith angle `sun`
+  // and azimuth phi from the view, phase free.
+  Light Lookup(double r, double mu, double sun, double phi) const {
+    const glsl::AtmosphereParameters& p = luts_.parameters;
+    const vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(p, r, mu, 1.0, 0.0, false);
+    const double y = uvwz.z * p.scattering_mu_size - 0.5, z = uvwz.w * p.scattering_r_size - 0.5;
+    const int y0 = std::clamp(int(y), 0, p.scattering_mu_size - 2), z0 = std::clamp(int(z), 0, p.scattering_r_size - 2);
+    const double slice = SlicePosition(phi);
+    const int l0 = std::min(int(slice), kSlices - 2);
+    Light result;
+    for (int kind = 0; kind < 2; ++kind) {
+      vec4 slices[2];
+      for (int l = 0; l < 2; ++l) {
+        auto column = [&](int k) {
+          vec4 value(0.0);
+          for (int dy = 0; dy < 2; ++dy) {
+            for (int dz = 0; dz < 2; ++dz) {
+              const double weight = (dy ? y - y0 : 1.0 - (y - y0)) * (dz ? z - z0 : 1.0 - (z - z0));
+              if (weight == 0.0) continue;
+              const Light texel = Texel(y0 + dy, z0 + dz, k, l0 + l);
+              value += weight * vec4(kind ? texel.mie : texel.rayleigh, 0.0);
+            }
+          }
+          return value;
+        };
+        slices[l] = axis_.Blend(column, r, mu, phi, sun);
+      }
+      const vec4 blended = glsl::SunCosineMix(slices[0], slices[1], slice - l0, true);
+      (kind ? result.mie : result.rayleigh) = Spectrum(blended);
+    }
+    return result;
+  }
+
+ private:
+  Light Texel(int y, int z, int k, int l) const {
+    const auto key = std::make_tuple(y, z, k, l);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto found = texels_.find(key);
+      if (found != texels_.end()) return found->second;
+    }
+    const ScatteringTexel row = GetScatteringTexel(luts_.parameters, 0, y, z);
+    EXPECT_FALSE(row.ray_intersects_ground);
+    const double phi = SliceAzimuth(l), sun = axis_.ColumnSunZenith(row.r, row.mu, phi, k);
+    const double nu = ViewSunCosine(row.mu, sun, phi);
+    Light light = SingleScatteringQuadrature(luts_, row.r, row.mu, std::cos(sun), nu);
+    if (higher_orders_) light.rayleigh += higher_orders_(row.r, row.mu, std::cos(sun), nu);
+    std::lock_guard<std::mutex> lock(mutex_);
+    return texels_.emplace(key, light).first->second;
+  }
+
+  const LutSet& luts_;
+  const SunAxis& axis_;
+  HigherOrders higher_orders_;
+  mutable std::mutex mutex_;
+  mutable std::map<std::tuple<int, int, int, int>, Light> texels_;
+};
+
+// The views of scripts/twilight_single_scattering.py (zenith 0/45/80/85/88
+// degrees, azimuth 0/90/180 from the sun, camera at 0, 1 and 10 km) for
+// the sun at `suns`.
+struct View {
+  double altitude, view_zenith, sun_zenith, azimuth;  // m, degrees
+};
+std::vector<View> Views(const std::vector<double>& suns) {
+  std::vector<View> views;
+  for (double sun : suns) {
+    for (double view : {0.0, 45.0, 80.0, 85.0, 88.0}) {
+      for (double azimuth : {0.0, 90.0, 180.0}) {
+        for (double altitude : {0.0, 1000.0, 10000.0}) views.push_back({altitude, view, sun, azimuth});
+      }
+    }
+  }
+  return views;
+}
+
+// Relative errors of the table's radiance (with both phase functions) per
+// sun range, three channels each, over the values above 0; and the largest
+// value where the exact one is 0.
+struct RangeErrors {
+  RangeErrors(std::string range_name, double low_sun, double high_sun)
+      : name(std::move(range_name)), low(low_sun), high(high_sun) {}
+  std::string name;
+  double low, high;  // sun zenith, degrees
+  std::vector<double> errors;
+  double largest_where_dark = 0.0;
+  double Rms() const {
+    double sum = 0.0;
+    for (double e : errors) sum += e * e;
+    return std::sqrt(sum / errors.size());
+  }
+  double Quantile(double q) const {
+    std::vector<double> magnitudes;
+    for (double e : errors) magnitudes.push_back(std::abs(e));
+    std::sort(magnitudes.begin(), magnitudes.end());
+    return magnitudes[std::min(magnitudes.size() - 1, std::size_t(q * magnitudes.size()))];
+  }
+};
+
+std::vector<RangeErrors> Errors(const LutSet& luts, const StudyTable& table, const std::vector<View>& views,
+                                const StudyTable::HigherOrders& higher_orders, std::vector<RangeErrors> ranges) {
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  std::vector<std::array<double, 6>> values(views.size());  // exact, then the table's, per channel
+  tbb::parallel_for(std::size_t(0), views.size(), [&](std::size_t i) {
+    const View& v = views[i];
+    const double r = p.bottom_radius + v.altitude, mu = std::cos(v.view_zenith * kDegree);
+    const double sun = v.sun_zenith * kDegree, phi = v.azimuth * kDegree;
+    const double nu = ViewSunCosine(mu, sun, phi);
+    Light exact = SingleScatteringQuadrature(luts, r, mu, std::cos(sun), nu);
+    if (higher_orders) exact.rayleigh += higher_orders(r, mu, std::cos(sun), nu);
+    const Light looked_up = table.Lookup(r, mu, sun, phi);
+    const double rayleigh_phase = glsl::RayleighPhaseFunction(nu), mie_phase = glsl::MiePhaseFunction(p, nu);
+    for (int c = 0; c < 3; ++c) {
+      values[i][c] = exact.rayleigh[c] * rayleigh_phase + exact.mie[c] * mie_phase;
+      values[i][3 + c] = looked_up.rayleigh[c] * rayleigh_phase + looked_up.mie[c] * mie_phase;
+    }
+  });
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    for (RangeErrors& range : ranges) {
+      const double sun = views[i].sun_zenith;
+      if (sun < range.low || sun > range.high || (sun == range.low && range.low != ranges.front().low)) continue;
+      for (int c = 0; c < 3; ++c) {
+        if (values[i][c] > 0.0) {
+          range.errors.push_back((values[i][3 + c] - values[i][c]) / values[i][c]);
+        } else {
+          range.largest_where_dark = std::max(range.largest_where_dark, values[i][3 + c]);
+        }
+      }
+    }
+  }
+  return ranges;
+}
+
+void Print(const char* layout, const std::vector<RangeErrors>& ranges) {
+  for (const RangeErrors& r : ranges) {
+    std::printf(
+        "%-22s sun %-7s %5zu values: RMS %.3g%%, median %.3g%%, 90th pct %.3g%%, max %.3g%%; "
+        "largest where exactly dark %.2g\n",
+        layout, r.name.c_str(), r.errors.size(), 100 * r.Rms(), 100 * r.Quantile(0.5), 100 * r.Quantile(0.9),
+        100 * r.Quantile(1.0), r.largest_where_dark);
+  }
+}
+
+const LutSet& EarthSingleScatteringTables() {
+  static const LutSet luts = [] {
+    BakeSettings settings;
+    settings.orders = 1;
+    settings.extrapolate_tail = false;
+    return Bake(testing::Earth(), settings);
+  }();
+  return luts;
+}
+
+const std::vector<double> kTwilightSuns = {80, 84, 86, 88, 89, 90, 91, 92, 93, 94, 95, 96, 97, 98, 99, 100};
+// The issue's targets for single scattering alone, RMS per range.
+constexpr double kTargets[] = {0.02, 0.05, 0.10};
+std::vector<RangeErrors> TwilightRanges() { return {{"80-90", 80, 90}, {"90-96", 90, 96}, {"96-100", 96, 100}}; }
+
+// The issue's single-scattering targets (RMS 2 / 5 / 10 % at sun 80-90 /
+// 90-96 / 96-100 degrees, and never bright where the exact light is 0):
+// the tables' axis misses them with exact texels as the tables do
+// (docs/accuracy.md), the shadow-edge axis meets them at the same size.
+TEST(TwilightSunAxis, ShadowEdgeAxisMeetsTheSingleScatteringTargetsWithExactTexels) {
+  const LutSet& luts = EarthSingleScatteringTables();
+  const TableSunAxis tables(luts.parameters);
+  const ShadowEdgeSunAxis shadow_edge(luts.parameters);
+  const StudyTable on_tables(luts, tables, nullptr), on_shadow_edge(luts, shadow_edge, nullptr);
+  const std::vector<View> views = Views(kTwilightSuns);
+  const std::vector<RangeErrors> before = Errors(luts, on_tables, views, nullptr, TwilightRanges());
+  const std::vector<RangeErrors> after = Errors(luts, on_shadow_edge, views, nullptr, TwilightRanges());
+  Print("tables' sun axis", before);
+  Print("shadow-edge sun axis", after);
+  EXPECT_GT(before[2].Rms(), 0.3);  // the tables' axis fails deep twilight with exact texels too
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(after[i].Rms(), kTargets[i]) << after[i].name;
+    EXPECT_LT(after[i].largest_where_dark, 1e-15) << after[i].name;
+  }
+}
+
+// The same off the whole degrees the case set samples (offsets 0.25, 0.5
+// and 0.75 degrees), and in daylight, where the shadow-edge axis gives the
+// high sun fewer columns than the tables' axis: the cost there, measured.
+TEST(TwilightSunAxis, ShadowEdgeAxisBetweenWholeDegreesAndInDaylight) {
+  const LutSet& luts = EarthSingleScatteringTables();
+  const TableSunAxis tables(luts.parameters);
+  const ShadowEdgeSunAxis shadow_edge(luts.parameters);
+  const StudyTable on_tables(luts, tables, nullptr), on_shadow_edge(luts, shadow_edge, nullptr);
+  for (double offset : {0.25, 0.5, 0.75}) {
+    std::vector<double> suns;
+    for (double sun : kTwilightSuns) suns.push_back(sun + offset);
+    const std::vector<RangeErrors> after = Errors(luts, on_shadow_edge, Views(suns), nullptr, TwilightRanges());
+    std::printf("offset %.2f degrees:\n", offset);
+    Print("shadow-edge sun axis", after);
+    for (int i = 0; i < 3; ++i) EXPECT_LT(after[i].Rms(), kTargets[i]) << after[i].name << " offset " << offset;
+  }
+  std::vector<double> daylight_suns;
+  for (double sun = 10.25; sun < 80.0; sun += 2.5) daylight_suns.push_back(sun);
+  const std::vector<RangeErrors> daylight_ranges = {{"10-80", 10, 80}};
+  const std::vector<RangeErrors> before = Errors(luts, on_tables, Views(daylight_suns), nullptr, daylight_ranges);
+  const std::vector<RangeErrors> after = Errors(luts, on_shadow_edge, Views(daylight_suns), nullptr, daylight_ranges);
+  Print("tables' sun axis", before);
+  Print("shadow-edge sun axis", after);
+  // Daylight's error against the reference is 0.32 % RMS (docs/accuracy.md):
+  // the study's bound keeps the axis' own share of it small.
+  EXPECT_LT(after[0].Rms(), 0.005);
+  EXPECT_LT(after[0].Quantile(1.0), 0.02);
+}
+
+// With the higher orders in the texels (the scattering table holds them
+// over the Rayleigh phase), taken from a bake with four times the mu_s and
+// nu texels as a stand-in for exact values: the columns past the shadow
+// edge carry the light that remains there. Twilight only: along an azimuth
+// slice nu changes with the sun, so the higher orders over the texel's own
+// Rayleigh phase change along mu_s as well, which a linear blend across the
+// tables' last column interval (zenith to 51 degrees) reads up to 9 % off
+// in daylight on either axis (how an azimuth axis would pack the higher
+// orders is a question of its own). Bakes 16 times the default table (about
+// 30 s and 1.8 GiB), so it runs only with
+// SKYBAKE_TWILIGHT_AXIS_HIGHER_ORDERS=1.
+TEST(TwilightSunAxis, ShadowEdgeAxisWithTheHigherOrders) {
+  if (!std::getenv("SKYBAKE_TWILIGHT_AXIS_HIGHER_ORDERS")) {
+    GTEST_SKIP() << "set SKYBAKE_TWILIGHT_AXIS_HIGHER_ORDERS=1 to run (bakes a 16 times larger table)";
+  }
+  const LutSet& luts = EarthSingleScatteringTables();
+  BakeSettings large;
+  large.scattering_mu_s_size = 4 * large.scattering_mu_s_size;
+  large.scattering_nu_size = 4 * large.scattering_nu_size;
+  const LutSet all_orders = Bake(testing::Earth(), large);
+  large.orders = 1;
+  large.extrapolate_tail = false;
+  const LutSet single = Bake(testing::Earth(), large);
+  const Twin all_orders_twin(MakeTwinTables(all_orders)), single_twin(MakeTwinTables(single));
+  const StudyTable::HigherOrders higher_orders = [&](double r, double mu, double mu_s, double nu) {
+    return Spectrum(all_orders_twin.Scattering(r, mu, mu_s, nu, false) -
+                    single_twin.Scattering(r, mu, mu_s, nu, false));
+  };
+  const TableSunAxis tables(luts.parameters);
+  const ShadowEdgeSunAxis shadow_edge(luts.parameters);
+  const StudyTable on_tables(luts, tables, higher_orders), on_shadow_edge(luts, shadow_edge, higher_orders);
+  std::vector<double> suns;
+  for (double sun = 80.25; sun <= 100.0; sun += 0.5) suns.push_back(sun);
+  const std::vector<RangeErrors> ranges = TwilightRanges();
+  const std::vector<RangeErrors> before = Errors(luts, on_tables, Views(suns), higher_orders, ranges);
+  const std::vector<RangeErrors> after = Errors(luts, on_shadow_edge, Views(suns), higher_orders, ranges);
+  Print("tables' sun axis", before);
+  Print("shadow-edge sun axis", after);
+  for (std::size_t i = 0; i < ranges.size(); ++i) EXPECT_LT(after[i].Rms(), before[i].Rms() + 0.002) << ranges[i].name;
+}
+
+}  // namespace
+}  // namespace skybake
