@@ -215,18 +215,8 @@ TEST(Twilight, BelowTheLowestSunLnLIsContinuedFromTheTwoLowestColumns) {
 // night sky at 550 nm, about 2e-4 cd/m^2) are left out of the relative
 // errors; where the exact value is 0 (the ray wholly in the Earth's shadow)
 // the lookup must be below that too.
-const LutSet& DefaultSizeEarthSingleScattering() {
-  static const LutSet luts = [] {
-    BakeSettings settings;
-    settings.orders = 1;
-    settings.extrapolate_tail = false;
-    return Bake(testing::Earth(), settings);
-  }();
-  return luts;
-}
-
 TEST(SingleScattering, LowSunLookupsBetweenTexelsFollowTheFall) {
-  const LutSet& luts = DefaultSizeEarthSingleScattering();
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   const Twin twin(MakeTwinTables(luts));
   const glsl::AtmosphereParameters& p = luts.parameters;
   const int size = p.scattering_mu_s_size, zenith_row = p.scattering_mu_size / 2;
@@ -576,7 +566,7 @@ TEST(Twilight, SkyIrradianceWithinItsTargets) {
 // degrees (a position between the rows linear in rho instead read a camera
 // at 10 m 150 % high looking straight down).
 TEST(SingleScattering, DownwardViewsFromLowCamerasWithinOnePercent) {
-  const LutSet& luts = DefaultSizeEarthSingleScattering();
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   const Twin twin(MakeTwinTables(luts));
   const glsl::AtmosphereParameters& p = luts.parameters;
   double worst = 0.0;

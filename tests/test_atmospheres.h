@@ -56,4 +56,16 @@ inline BakeSettings SmallBakeSettings() {
   return s;
 }
 
+// Earth's single scattering at the default table sizes (one order, no
+// tail), baked once per test binary.
+inline const LutSet& DefaultSizeEarthSingleScattering() {
+  static const LutSet luts = [] {
+    BakeSettings settings;
+    settings.orders = 1;
+    settings.extrapolate_tail = false;
+    return Bake(Earth(), settings);
+  }();
+  return luts;
+}
+
 }  // namespace skybake::testing

@@ -432,16 +432,6 @@ void Print(const char* layout, const std::vector<RangeErrors>& ranges) {
   }
 }
 
-const LutSet& EarthSingleScatteringTables() {
-  static const LutSet luts = [] {
-    BakeSettings settings;
-    settings.orders = 1;
-    settings.extrapolate_tail = false;
-    return Bake(testing::Earth(), settings);
-  }();
-  return luts;
-}
-
 const std::vector<double> kTwilightSuns = {80, 84, 86, 88, 89, 90, 91, 92, 93, 94, 95, 96, 97, 98, 99, 100};
 // The targets for single scattering alone, RMS per range.
 constexpr double kTargets[] = {0.02, 0.05, 0.10};
@@ -453,7 +443,7 @@ std::vector<RangeErrors> TwilightRanges() { return {{"80-90", 80, 90}, {"90-96",
 // "Near E the light falls as D^3"): doubling D from 0.005 to 0.01 and
 // 0.01 to 0.02 degrees multiplies it by 8 within 10 %.
 TEST(TwilightSunAxis, ShadowEdgeIsWhereTheLastPointOfTheRaySeesTheSunSet) {
-  const LutSet& luts = EarthSingleScatteringTables();
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   const glsl::AtmosphereParameters& p = luts.parameters;
   int rays = 0;
   for (double altitude : {0.0, 1000.0, 10000.0, 40000.0}) {
@@ -498,7 +488,7 @@ TEST(TwilightSunAxis, ShadowEdgeIsWhereTheLastPointOfTheRaySeesTheSunSet) {
 // the tables' axis misses them with exact texels as the tables do
 // (docs/accuracy.md), the shadow-edge axis meets them at the same size.
 TEST(TwilightSunAxis, ShadowEdgeAxisMeetsTheSingleScatteringTargetsWithExactTexels) {
-  const LutSet& luts = EarthSingleScatteringTables();
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   const TableSunAxis tables(luts.parameters);
   const ShadowEdgeSunAxis shadow_edge(luts.parameters);
   const StudyTable on_tables(luts, tables, nullptr), on_shadow_edge(luts, shadow_edge, nullptr);
@@ -518,7 +508,7 @@ TEST(TwilightSunAxis, ShadowEdgeAxisMeetsTheSingleScatteringTargetsWithExactTexe
 // and 0.75 degrees), and in daylight, where the shadow-edge axis gives the
 // high sun fewer columns than the tables' axis: the cost there, measured.
 TEST(TwilightSunAxis, ShadowEdgeAxisBetweenWholeDegreesAndInDaylight) {
-  const LutSet& luts = EarthSingleScatteringTables();
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   const TableSunAxis tables(luts.parameters);
   const ShadowEdgeSunAxis shadow_edge(luts.parameters);
   const StudyTable on_tables(luts, tables, nullptr), on_shadow_edge(luts, shadow_edge, nullptr);
@@ -558,7 +548,7 @@ TEST(TwilightSunAxis, ShadowEdgeAxisWithTheHigherOrders) {
   if (!std::getenv("SKYBAKE_TWILIGHT_AXIS_HIGHER_ORDERS")) {
     GTEST_SKIP() << "set SKYBAKE_TWILIGHT_AXIS_HIGHER_ORDERS=1 to run (bakes a 16 times larger table)";
   }
-  const LutSet& luts = EarthSingleScatteringTables();
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   BakeSettings large;
   large.scattering_mu_s_size = 4 * large.scattering_mu_s_size;
   large.scattering_nu_size = 4 * large.scattering_nu_size;
