@@ -204,16 +204,17 @@ class TableSunAxis : public SunAxis {
 // falls as D^3 (the disc's smooth step times the lit stretch) and farther
 // out as the sunlight's grazing path thickens. Between E and D_min the
 // light continues from the two nearest lit columns as a power of D, above
-// the edge column's value.
+// the edge column's value. The shape's numbers were chosen on the suns of
+// ShadowEdgeAxisBetweenWholeDegreesAndInDaylight's finer set.
 struct ShadowEdgeShape {
   int past = 6;
   double tables_weight = 0.55;               // w
   double closest_distance = 0.05 * kDegree;  // D_min
-  double log_reach = 0.0;                    // D_reach, 0 for E (the logarithm reaches the zenith)
-  double high_sun_share = 0.0;               // k of X's mapping (primitives.glsl), 0 for the tables' own
+  double log_reach = 10.0 * kDegree;         // D_reach, 0 for E (the logarithm reaches the zenith)
+  double high_sun_share = 1.0;               // k of X's mapping (primitives.glsl), 0 for the tables' own 1/2
 };
-// The shape above meets the twilight targets; this one gives daylight
-// about the tables' columns, the logarithm only within 5 degrees of E.
+// Nearer the tables' columns in daylight: more weight on X and the
+// logarithm only within 5 degrees of E.
 ShadowEdgeShape DaylightShape() { return {6, 0.75, 0.05 * kDegree, 5.0 * kDegree, 1.0}; }
 
 class ShadowEdgeSunAxis : public SunAxis {
@@ -636,13 +637,13 @@ TEST(TwilightSunAxis, ShadowEdgeAxisWithTheHigherOrders) {
   const std::vector<RangeErrors> daylight_single_errors =
       Errors(luts, daylight_single, Views(every_tenth), nullptr, TwilightRanges());
   Print("daylight shape, single", daylight_single_errors);
-  // After sunset the shadow-edge axis reads the whole sky at least as well
-  // as the tables' axis, in daylight worse; DaylightShape keeps daylight
-  // within 0.05 points of the tables' axis but misses a single-scattering
-  // target; azimuth slices read the daylight sky worse than nu slices.
-  for (std::size_t i = 1; i < ranges.size(); ++i) {
-    EXPECT_LT(errors[1][i].Rms(), errors[0][i].Rms() + 0.002) << ranges[i].name;
-  }
+  // After sunset (90-100) the shadow-edge axis reads the whole sky better
+  // than the tables' axis, at low sun (80-90) within 0.2 points of it, in
+  // daylight worse; DaylightShape keeps daylight within 0.05 points of the
+  // tables' axis but misses a single-scattering target; azimuth slices read
+  // the daylight sky worse than nu slices.
+  EXPECT_LT(errors[1][1].Rms(), errors[0][1].Rms() + 0.002);
+  for (std::size_t i = 2; i < ranges.size(); ++i) EXPECT_LT(errors[1][i].Rms(), errors[0][i].Rms()) << ranges[i].name;
   EXPECT_GT(errors[1][0].Rms(), errors[0][0].Rms());
   EXPECT_LT(errors[2][0].Rms(), errors[0][0].Rms() + 0.0005);
   EXPECT_GT(daylight_single_errors[2].Rms(), kTargets[2]);
