@@ -9,7 +9,8 @@
 // each ray (r, mu) and sun azimuth phi from the view has its own columns:
 // most of them at logarithmically closing distances to the sun zenith at
 // which the ray goes wholly dark, a few past it. The r and mu rows and the
-// nu slices are the tables'. The texels are computed by one quadrature,
+// nu slices are the tables' (slices of the sun's azimuth are measured as
+// an alternative). The texels are computed by one quadrature,
 // the same as the exact values they are compared with, so the figures
 // measure where the texels lie and how a lookup blends them, nothing else;
 // the blends are the runtime's own (LogMonotoneCubicMix along the sun,
@@ -165,7 +166,7 @@ class SunAxis {
   // Sun zenith angle of column k of the ray (r, mu) at sun azimuth phi.
   virtual double ColumnSunZenith(double r, double mu, double phi, int k) const = 0;
   // The light for the sun at zenith angle `sun` from the values of the
-  // columns (in one azimuth slice, blended in r and mu).
+  // columns (in one slice, blended in r and mu).
   virtual vec4 Blend(const std::function<vec4(int)>& column, double r, double mu, double phi, double sun) const = 0;
 };
 
