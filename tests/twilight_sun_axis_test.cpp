@@ -135,9 +135,7 @@ Light SingleScatteringQuadrature(const LutSet& luts, double r, double mu, double
 // sin(alpha) cos(phi), above the far end's -c until theta = beta +
 // acos(-c / rho). Plus the disc's angular radius: the disc's top sets last.
 double ShadowEdgeSunZenith(const glsl::AtmosphereParameters& p, double r, double mu, double phi) {
-  auto horizon_sine = [&](double radius) {
-    return glsl::DistanceToHorizon(p.bottom_radius, radius) / radius;  // c = -HorizonZenithCosine
-  };
+  auto horizon_sine = [&](double radius) { return -glsl::HorizonZenithCosine(p.bottom_radius, radius); };
   const double d = glsl::DistanceToNearestAtmosphereBoundary(p, r, mu, glsl::RayIntersectsGround(p, r, mu));
   const double r_d = glsl::RadiusAtDistance(p, r, mu, d);
   const double cos_alpha = glsl::ClampCosine((r + d * mu) / r_d);
@@ -148,14 +146,6 @@ double ShadowEdgeSunZenith(const glsl::AtmosphereParameters& p, double r, double
   const double far_end = c_far >= rho ? kPi : beta + std::acos(-c_far / rho);
   const double start = std::acos(-horizon_sine(r));
   return std::max(start, far_end) + p.sun_angular_radius;
-}
-
-// The position of the sun at zenith angle `sun` along the tables' mu_s
-// axis, in columns from the lowest sun (GetScatteringTextureUMuS), held at
-// the lowest column below it.
-double TablesColumnPosition(const glsl::AtmosphereParameters& p, double sun) {
-  const double mu_s = std::max(std::cos(sun), p.scattering_mu_s_min);
-  return std::max(glsl::GetScatteringTextureUMuS(p, mu_s) * p.scattering_mu_s_size - 0.5, 0.0);
 }
 
 // Where a table's sun axis puts the columns of a ray, and how a lookup
@@ -180,12 +170,15 @@ class TableSunAxis : public SunAxis {
   }
   vec4 Blend(const std::function<vec4(int)>& column, double, double, double, double sun) const override {
     const int size = p_.scattering_mu_s_size;
-    const double x = TablesColumnPosition(p_, sun);
-    const int k = std::clamp(int(std::floor(x)), 0, size - 2);
-    if (std::cos(ColumnSunZenith(0, 0, 0, k)) >= glsl::LOW_SUN_MU_S) return glm::mix(column(k), column(k + 1), x - k);
+    double x_below, x_above, t;
+    bool low_sun;
+    glsl::GetScatteringMuSColumns(p_, glsl::GetScatteringTextureUMuS(p_, std::cos(sun)),
+                                  glsl::GetScatteringTextureUMuS(p_, glsl::LOW_SUN_MU_S), x_below, x_above, t, low_sun);
+    const int k = int(std::lround(x_below * size - 0.5));
+    if (!low_sun) return glm::mix(column(k), column(k + 1), t);
     const bool has_a = k >= 1, has_d = k + 2 < size;
     return glsl::LogMonotoneCubicMix(has_a ? column(k - 1) : vec4(0.0), column(k), column(k + 1),
-                                     has_d ? column(k + 2) : vec4(0.0), has_a, has_d, x - k);
+                                     has_d ? column(k + 2) : vec4(0.0), has_a, has_d, t);
   }
 
  private:
@@ -212,7 +205,7 @@ struct ShadowEdgeShape {
   double tables_weight = 0.55;               // w
   double closest_distance = 0.05 * kDegree;  // D_min
   double log_reach = 10.0 * kDegree;         // D_reach, 0 for E (the logarithm reaches the zenith)
-  double high_sun_share = 1.0;               // k of X's mapping (primitives.glsl), 0 for the tables' own 1/2
+  double high_sun_share = 1.0;               // k of X's mapping (primitives.glsl; the tables' is 1/2)
 };
 // Nearer the tables' columns in daylight: more weight on X and the
 // logarithm only within 5 degrees of E.
@@ -261,16 +254,15 @@ class ShadowEdgeSunAxis : public SunAxis {
     const double lowest = std::acos(p_.scattering_mu_s_min);
     return std::max(lowest - edge, 2.0 * kDegree) / (shape_.past - 1);
   }
-  // X in [0, 1] from the tables' lowest sun to the zenith.
+  // X in [0, 1] from the tables' lowest sun to the zenith: the tables' unit
+  // mu_s (GetScatteringUnitMuS) with k = high_sun_share.
   double X(double sun) const {
-    if (shape_.high_sun_share == 0.0) return TablesColumnPosition(p_, sun) / (p_.scattering_mu_s_size - 1);
     const double d_min = p_.top_radius - p_.bottom_radius, d_max = glsl::HorizonDistanceAtTop(p_);
-    auto unit = [&](double mu_s) {  // ScatteringUnitMuSFromDistance with k = high_sun_share
-      auto a = [&](double cosine) {
-        return (glsl::DistanceToTopAtmosphereBoundary(p_, p_.bottom_radius, cosine) - d_min) / (d_max - d_min);
-      };
-      return (1.0 - a(mu_s) / a(p_.scattering_mu_s_min)) / (1.0 + shape_.high_sun_share * a(mu_s));
+    auto a = [&](double mu_s) {
+      return (glsl::DistanceToTopAtmosphereBoundary(p_, p_.bottom_radius, mu_s) - d_min) / (d_max - d_min);
     };
+    const double lowest = a(p_.scattering_mu_s_min);
+    auto unit = [&](double mu_s) { return (1.0 - a(mu_s) / lowest) / (1.0 + shape_.high_sun_share * a(mu_s)); };
     return std::max(unit(std::max(std::cos(sun), p_.scattering_mu_s_min)), 0.0) / unit(1.0);
   }
   double RawUnit(double sun, double edge) const {
