@@ -36,6 +36,7 @@
 #include "bake/bake.h"
 #include "bake/ray_integrals.h"
 #include "core/constants.h"
+#include "report/error_stats.h"
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/twin.h"
 #include "test_atmospheres.h"
@@ -659,6 +660,45 @@ TEST(TwilightSunAxis, ShadowEdgeAxisWithTheHigherOrders) {
   EXPECT_GT(errors[2][0].Rms(), errors[0][0].Rms());
   EXPECT_GT(errors[3][0].Rms(), errors[0][0].Rms());
   EXPECT_GT(errors[5][2].Rms(), errors[4][2].Rms());
+
+  // Smooth through sunset, as Twilight.SkyLuminanceFallsSmoothlyThroughSunset
+  // holds the baked tables: the luminance 1 m above the ground at the
+  // zenith and 88 degrees from it toward and away from the sun falls at
+  // every 0.05 degree step of the sun from 85 to 102 degrees, and the fall
+  // of ln L changes from one step to the next by less than 1.3 times.
+  const glsl::AtmosphereParameters& p = luts.parameters;
+  for (int layout = 0; layout < 2; ++layout) {
+    const StudyTable table(luts, layouts[layout].axis, higher_orders);
+    for (const auto& [name, view_zenith, azimuth] :
+         {std::make_tuple("zenith", 0.0, 0.0), std::make_tuple("sunward", 88.0, 0.0),
+          std::make_tuple("antisolar", 88.0, 180.0)}) {
+      const double r = p.bottom_radius + 1.0, mu = std::cos(view_zenith * kDegree), phi = azimuth * kDegree;
+      std::vector<double> suns, luminance;
+      for (int i = 0; 85.0 + 0.05 * i <= 102.0 + 1e-9; ++i) {
+        const double sun = (85.0 + 0.05 * i) * kDegree, nu = ViewSunCosine(mu, sun, phi);
+        const Light light = table.Lookup(r, mu, sun, phi);
+        const Spectrum radiance =
+            light.rayleigh * glsl::RayleighPhaseFunction(nu) + light.mie * glsl::MiePhaseFunction(p, nu);
+        suns.push_back(85.0 + 0.05 * i);
+        luminance.push_back(report::Luminance(glm::dvec3(radiance)));
+      }
+      double worst = 1.0, worst_sun = 0.0;
+      bool falls = true;
+      for (std::size_t i = 0; i + 2 < luminance.size(); ++i) {
+        falls = falls && luminance[i + 1] < luminance[i] && luminance[i + 2] < luminance[i + 1];
+        const double first = std::log(luminance[i] / luminance[i + 1]);
+        const double second = std::log(luminance[i + 1] / luminance[i + 2]);
+        const double change = std::max(first / second, second / first);
+        if (change > worst) worst = change, worst_sun = suns[i + 1];
+      }
+      std::printf("%s, %s: falls at every step: %s; largest change of the fall of ln L: x%.3g (sun %.2f)\n",
+                  layouts[layout].name, name, falls ? "yes" : "no", worst, worst_sun);
+      if (layout == 1) {
+        EXPECT_TRUE(falls) << name;
+        EXPECT_LT(worst, 1.3) << name;
+      }
+    }
+  }
 }
 
 }  // namespace
