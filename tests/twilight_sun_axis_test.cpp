@@ -12,10 +12,10 @@
 // few past it. The r and mu rows and the nu slices are the tables' (slices
 // of the sun's azimuth are measured as an alternative). The texels are
 // computed by one quadrature, the same as the exact values they are
-// compared with, so the figures
-// measure where the texels lie and how a lookup blends them, nothing else;
-// the blends are the runtime's own (LogMonotoneCubicMix along the sun,
-// SunCosineMix across slices, bilinear in r and mu as a texture fetch is).
+// compared with, so the figures measure where the texels lie and how a
+// lookup blends them, nothing else; the blends are the runtime's own
+// (LogMonotoneCubicMix along the sun, SunCosineMix across slices, bilinear
+// in r and mu as a texture fetch is).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -198,10 +198,10 @@ class TableSunAxis : public SunAxis {
 
 // The axis measured from the shadow edge E (ShadowEdgeSunZenith) of each
 // ray and sun azimuth, below a split: from the zenith down to the split,
-// the lowest of the tables' columns with the sun at most `split_sun`
-// from the zenith, the tables' own columns for every ray (at a split of 0
-// only the zenith's); below it each ray's own. Of those, `past` lie at and past E,
-// evenly up to the tables' lowest sun (at least 2 degrees past E), where
+// the lowest of the tables' columns with the sun at most `split_sun` from
+// the zenith, the tables' own columns for every ray (at a split of 0 only
+// the zenith's); below it each ray's own. Of those, `past` lie at and past
+// E, evenly up to the tables' lowest sun (at least 2 degrees past E), where
 // single scattering is 0 and only the higher orders remain; the others on
 // the lit side, from D_min before E up to the split, at even steps of
 //   x = w (X(theta) - X(E - D_min)) / (X(split) - X(E - D_min))
