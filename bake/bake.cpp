@@ -84,6 +84,25 @@ void BakeSettings::Validate() const {
   }
 }
 
+namespace {
+// The split of the scattering tables' sun axis (functions.glsl, "The sun
+// axis after sunset"): the lowest column whose sun is at most 80 degrees
+// from the zenith, where the sun is up for every point of every ray, or
+// where no column is that high the highest, if its sun is at most 89
+// degrees (every ray's shadow edge lies past 90 degrees and the disc's
+// radius). 0, every column the same for every ray, where that leaves fewer
+// than two lit columns below it.
+int ScatteringMuSSplit(const glsl::AtmosphereParameters& p) {
+  constexpr double kSplitSun = 80.0 * kPi / 180.0, kHighestSplitSun = 89.0 * kPi / 180.0;
+  const int last = p.scattering_mu_s_size - 1;
+  auto sun = [&](int column) { return std::acos(glsl::GetScatteringMuSFromUnitRange(p, double(column) / last)); };
+  int split = last;
+  while (split > 0 && sun(split - 1) <= kSplitSun) --split;
+  if (sun(split) > kHighestSplitSun || split < glsl::SHADOW_EDGE_PAST_COLUMNS + 2) return 0;
+  return split;
+}
+}  // namespace
+
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings) {
   glsl::AtmosphereParameters p;
   p.solar_irradiance = atmosphere.solar_irradiance;
@@ -135,18 +154,22 @@ glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere
     p.scattering_mu_s_min = range->mu_s_min;
     p.scattering_mu_s_max = range->mu_s_max;
   }
+  p.scattering_mu_s_split = ScatteringMuSSplit(p);
   SetAltitudeProfiles(atmosphere, &p);
   return p;
 }
 
 glsl::AtmosphereParameters AtmosphereGrid(const Atmosphere& atmosphere, const BakeSettings& settings) {
-  if (!settings.scattering_range) return MakeAtmosphereParameters(atmosphere, settings);
   BakeSettings whole = settings;
-  whole.scattering_range.reset();
-  whole.scattering_r_size = settings.scattering_range->atmosphere_r_size;
-  whole.scattering_mu_size = settings.scattering_range->atmosphere_mu_size;
-  whole.scattering_mu_s_size = settings.scattering_range->atmosphere_mu_s_size;
-  return MakeAtmosphereParameters(atmosphere, whole);
+  if (settings.scattering_range) {
+    whole.scattering_range.reset();
+    whole.scattering_r_size = settings.scattering_range->atmosphere_r_size;
+    whole.scattering_mu_size = settings.scattering_range->atmosphere_mu_size;
+    whole.scattering_mu_s_size = settings.scattering_range->atmosphere_mu_s_size;
+  }
+  glsl::AtmosphereParameters grid = MakeAtmosphereParameters(atmosphere, whole);
+  grid.scattering_mu_s_split = 0;
+  return grid;
 }
 
 void SetAltitudeProfiles(const Atmosphere& atmosphere, glsl::AtmosphereParameters* parameters) {

@@ -71,10 +71,12 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
 
   Phase("transmittance", [&] { ComputeTransmittance(); });
   Phase("single scattering", [&] { single_ = ComputeSingleScattering(params_, s.ray_samples); });
-  if (s.orders != 1 && TableRestricted()) {
-    // It feeds only the next order, through an integral over the sphere.
+  if ((s.orders != 1 || s.single_scattering_sky_irradiance) && !TableOnAtmosphereGrid()) {
+    // It feeds only the next order and the sky irradiance, through
+    // integrals over the sphere.
     Phase("single scattering, whole atmosphere", [&] {
-      grid_single_ = ComputeSingleScattering(atmosphere_grid_, s.scattering_range->atmosphere_ray_samples);
+      grid_single_ = ComputeSingleScattering(
+          atmosphere_grid_, TableRestricted() ? s.scattering_range->atmosphere_ray_samples : s.ray_samples);
     });
   }
   if (s.orders == 1 && s.single_scattering_sky_irradiance) {
@@ -197,7 +199,9 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
   tbb::parallel_for(0, grid.scattering_mu_size * grid.scattering_r_size, [&](int row) {
     const int y = row % grid.scattering_mu_size, z = row / grid.scattering_mu_size;
     const double mu = GetScatteringTexel(grid, 0, y, z).mu;
-    for (int column = 0; column < mu_s_size; ++column) {
+    // (Not below the split, where the slices of a column lie at different
+    // suns, each the ray's own.)
+    for (int column = grid.scattering_mu_s_split; column < mu_s_size; ++column) {
       const double mu_s = columns.mu_s[column];
       const double lowest = ClampedNu(-1.0, mu, mu_s), highest = ClampedNu(1.0, mu, mu_s);
       const bool geometric = mu_s < glsl::LOW_SUN_MU_S;  // SunCosineMix's blend for this column

@@ -150,12 +150,16 @@ class Baker {
   // Whether the table covers less than the whole atmosphere (a scene's bake):
   // its grid is then not the one the orders are computed on.
   bool TableRestricted() const { return settings_.scattering_range.has_value(); }
+  // Whether the table's grid is the one the orders are computed on: not
+  // where it is restricted, nor where its mu_s columns below the split are
+  // each ray's own (functions.glsl, "The sun axis after sunset").
+  bool TableOnAtmosphereGrid() const { return !TableRestricted() && params_.scattering_mu_s_split == 0; }
   // Whether the orders are gathered on another grid than the table's, so
   // that the table's higher orders come from one gather of their summed
   // densities at the end.
-  bool GatherAtEnd() const { return settings_.higher_order_divisor > 1 || TableRestricted(); }
+  bool GatherAtEnd() const { return settings_.higher_order_divisor > 1 || !TableOnAtmosphereGrid(); }
   // Single scattering on the atmosphere's grid, the light of order 1.
-  const SingleScattering& GridSingle() const { return TableRestricted() ? grid_single_ : single_; }
+  const SingleScattering& GridSingle() const { return TableOnAtmosphereGrid() ? single_ : grid_single_; }
   // The scattering table: single Rayleigh plus the higher orders, in the
   // memory of `storage` (a texture no longer needed) where it is large
   // enough.
@@ -241,7 +245,7 @@ class Baker {
   Texture transmittance_;
   Texture irradiance_;
   SingleScattering single_;       // on the table's grid
-  SingleScattering grid_single_;  // on atmosphere_grid_ where the table is restricted
+  SingleScattering grid_single_;  // on atmosphere_grid_ where the table is not on it
   Texture delta_multiple_;        // radiance of the latest order >= 2, on orders_grid_
   // J of the current order per unit scattering coefficient, on atmosphere_grid_.
   Texture scattering_density_;

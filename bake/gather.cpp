@@ -307,7 +307,6 @@ struct Baker::GatherPlan {
     std::vector<glm::vec3> weight;  // per sample k and channel, of J
     std::vector<ThickInterval> thick_intervals;
     std::vector<Spectrum> optical_depth;  // the view's, per sample k (where there are thick intervals)
-    double mu = 0.0;                      // the view's cosine, whose sun directions are the ray's (RaySunDirections)
   };
   AtmosphereParameters grid, density_grid;
   int samples_per_ray = 0;  // intervals per ray
@@ -387,7 +386,6 @@ std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters&
                              row(fy < 0.5 ? y0 : y1, fz < 0.5 ? z0 : z1), float(ray.r / ray.radius[k]),
                              float(ray.t[k] / ray.radius[k])});
     }
-    out.mu = ray.mu;
   });
   return plan;
 }
@@ -419,7 +417,7 @@ void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSF
     // order: kept in the plan they would take more memory than all the
     // rest of it (docs/benchmark.md).
     JRows rows(density_mu_s_size, density_nu_size);
-    const DirectionsBySlice by_slice(RaySunDirections(columns, ray.mu), density_grid, rows.PermutesRows());
+    const DirectionsBySlice by_slice(RaySunDirections(columns, grid, y, z), density_grid, rows.PermutesRows());
     const int count = by_slice.count();
     const std::vector<float>&mu_s = by_slice.mu_s, &nu = by_slice.nu, &nu_weight = by_slice.nu_weight;
     std::vector<float> mu_s_k(count), mu_s_weight(count), values(count);

@@ -75,7 +75,7 @@ Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameter
 void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
                                      const ChannelPlanes& transmittance, SingleScattering& out) const {
   const RaySamples ray = SampleRay(grid, y, z, n);
-  const SunDirections directions = RaySunDirections(columns, ray.mu);
+  const SunDirections directions = RaySunDirections(columns, grid, y, z);
   const RaySingleScattering single = SingleScatteringOfRay(ray, directions.mu_s, directions.nu, transmittance);
   const auto& sums = single.sums;
   for (int x = 0; x < int(directions.of_texel.size()); ++x) {

@@ -34,30 +34,51 @@ struct SunColumns {
   }
 };
 
-// The distinct sun directions of one ray (view cosine mu) of a scattering
-// grid: its (mu_s, nu) texels, nu clamped as GetScatteringTexel clamps it to
-// the range that mu and mu_s allow, with the slices that clamping gave the
-// same nu merged, as their integrals are the same; in order of mu_s (the
-// lowest sun first), padded to whole vectors.
+// The distinct sun directions of the ray (mu index y, r index z) of a
+// scattering grid: its (mu_s, nu) texels, nu clamped as GetScatteringTexel
+// clamps it to the range that mu and mu_s allow, with the slices that
+// clamping gave the same direction merged, as their integrals are the same;
+// in order of mu_s (the lowest sun first), padded to whole vectors. The
+// columns from the grid's split up are `columns`' (the same for every
+// ray); those below it the ray's own (functions.glsl, "The sun axis after
+// sunset").
 struct SunDirections {
   std::vector<double> mu_s, nu;  // per direction
   std::vector<int> of_texel;     // texel x -> direction
 };
 
-inline SunDirections RaySunDirections(const SunColumns& columns, double mu) {
+inline SunDirections RaySunDirections(const SunColumns& columns, const AtmosphereParameters& grid, int y, int z) {
   SunDirections directions;
   directions.of_texel.resize(columns.mu_s.size());
+  const double mu = GetScatteringTexel(grid, 0, y, z).mu;
   for (int mu_s_index = 0; mu_s_index < columns.mu_s_size; ++mu_s_index) {
+    const bool own = mu_s_index < grid.scattering_mu_s_split;
     for (int nu_index = 0; nu_index < columns.nu_size; ++nu_index) {
       const int x = nu_index * columns.mu_s_size + mu_s_index;
-      const double mu_s = columns.mu_s[x];
+      const double mu_s = own ? GetScatteringTexel(grid, x, y, z).mu_s : columns.mu_s[x];
       const double nu = ClampedNu(columns.grid_nu[x], mu, mu_s);
-      if (nu_index == 0 || nu != directions.nu.back()) {
+      if (nu_index == 0 || nu != directions.nu.back() || mu_s != directions.mu_s.back()) {
         directions.mu_s.push_back(mu_s);
         directions.nu.push_back(nu);
       }
       directions.of_texel[x] = static_cast<int>(directions.nu.size()) - 1;
     }
+  }
+  if (grid.scattering_mu_s_split > 0) {
+    // The rays' own columns interleave in mu_s across slices: sorted.
+    std::vector<int> order(directions.mu_s.size()), position(order.size());
+    for (std::size_t j = 0; j < order.size(); ++j) order[j] = static_cast<int>(j);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return directions.mu_s[a] < directions.mu_s[b]; });
+    SunDirections sorted;
+    for (std::size_t j = 0; j < order.size(); ++j) {
+      position[order[j]] = static_cast<int>(j);
+      sorted.mu_s.push_back(directions.mu_s[order[j]]);
+      sorted.nu.push_back(directions.nu[order[j]]);
+    }
+    for (int& texel : directions.of_texel) texel = position[texel];
+    sorted.of_texel = std::move(directions.of_texel);
+    directions = std::move(sorted);
   }
   // Padded with copies of the last direction to whole vectors, so that the
   // loops over the directions leave no scalar remainder (no texel reads the

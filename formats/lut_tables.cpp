@@ -58,6 +58,7 @@ ordered_json ParametersToJson(const glsl::AtmosphereParameters& p) {
       {"scattering_r_max", p.scattering_r_max},
       {"scattering_mu_s_min", p.scattering_mu_s_min},
       {"scattering_mu_s_max", p.scattering_mu_s_max},
+      {"scattering_mu_s_split", p.scattering_mu_s_split},
       {"irradiance_width", p.irradiance_width},
       {"irradiance_height", p.irradiance_height},
   };
@@ -87,6 +88,9 @@ glsl::AtmosphereParameters ParametersFromJson(const json& j) {
   p.scattering_r_max = j.at("scattering_r_max").get<double>();
   p.scattering_mu_s_min = j.at("scattering_mu_s_min").get<double>();
   p.scattering_mu_s_max = j.at("scattering_mu_s_max").get<double>();
+  // (Absent from the manifests of earlier versions, whose columns were the
+  // same for every ray.)
+  p.scattering_mu_s_split = j.value("scattering_mu_s_split", 0);
   p.irradiance_width = j.at("irradiance_width").get<int>();
   p.irradiance_height = j.at("irradiance_height").get<int>();
   return p;

@@ -71,6 +71,11 @@ struct AtmosphereParameters {
   Number scattering_r_max;
   Number scattering_mu_s_min;
   Number scattering_mu_s_max;
+  // The first mu_s column of the scattering tables that lies at the same
+  // sun for every ray; below it each ray has its own columns, placed from
+  // its shadow edge (functions.glsl, "The sun axis after sunset"). 0: every
+  // column is the same for every ray.
+  int scattering_mu_s_split;
   int irradiance_width;   // mu_s
   int irradiance_height;  // r
   // Extinction and scattering coefficients, m^-1, at the profile altitudes:

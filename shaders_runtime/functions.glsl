@@ -203,6 +203,166 @@ Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s
   return GetTextureCoordFromUnitRange(min(x, 1.0), atmosphere.scattering_mu_s_size);
 }
 
+// ---------------------------------------------------------------------------
+// The sun axis after sunset. From column scattering_mu_s_split up the
+// scattering tables' mu_s columns lie at the same suns for every ray
+// (GetScatteringMuSFromUnitRange); below it, where the split is above 0,
+// every ray (r, mu) and sun azimuth from the view has its own columns,
+// placed from its shadow edge E (ShadowEdgeSunZenith), the sun zenith angle
+// past which no point of the ray sees the sun. After sunset a ray's single
+// scattering falls off a cliff where its last lit point sets, by orders of
+// magnitude within a fraction of a degree, at a sun that differs from ray
+// to ray; on columns at the same suns for every ray the lookup's blend
+// between two of them misses it in either direction, and light in the
+// Earth's shadow read as bright (docs/accuracy.md, "Twilight: a sun axis
+// measured from each ray's shadow edge"). Of a ray's own columns,
+// SHADOW_EDGE_PAST_COLUMNS lie at and past E (the last of them at E, the
+// others evenly up to the tables' lowest sun, at least
+// SHADOW_EDGE_LEAST_PAST_SPAN past E), where single scattering is 0 and
+// only the higher orders remain; the others on the lit side, from
+// SHADOW_EDGE_CLOSEST before E to the split, at even steps of
+// ShadowEdgeLitUnit. The split's column is the lowest at most 80 degrees
+// from the zenith: above it the sun is up for every point of every ray.
+const int SHADOW_EDGE_PAST_COLUMNS = 6;
+const Number SHADOW_EDGE_TABLES_WEIGHT = 0.3;
+const Number SHADOW_EDGE_CLOSEST = 8.726646259971648e-4;          // 0.05 degrees
+const Number SHADOW_EDGE_LEAST_PAST_SPAN = 0.03490658503988659;  // 2 degrees
+
+// The cosine of the azimuth between the view (zenith cosine mu) and the sun
+// (mu_s) at the cosine nu between them: nu = mu mu_s + sqrt((1 - mu^2)
+// (1 - mu_s^2)) cos(phi); 1 where the azimuth is undefined.
+Number ViewSunAzimuthCosine(Number mu, Number mu_s, Number nu) {
+  Number across = SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
+  return across > 0.0 ? ClampCosine((nu - mu * mu_s) / across) : 1.0;
+}
+
+// The sun zenith angle past which no point of the ray (r, mu) sees any of
+// the sun's disc, for the sun at azimuth phi from the view. The Earth's
+// shadow is a half cylinder behind the planet, so the last lit point of a
+// ray is one of its ends: the start, lit while the sun is above its horizon
+// (zenith cosine -c(r), HorizonZenithCosine), or the far end, seen from the
+// start at angle alpha around the planet's centre, where the sun's cosine
+// is cos(theta) cos(alpha) + sin(theta) sin(alpha) cos(phi) =
+// rho cos(theta - beta), rho cos(beta) = cos(alpha), rho sin(beta) =
+// sin(alpha) cos(phi), above the far end's horizon until theta = beta +
+// acos(c(r_end) / rho). Plus the disc's angular radius: its top sets last.
+Number ShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number cos_phi,
+                           bool ray_r_mu_intersects_ground) {
+  Number d = DistanceToNearestAtmosphereBoundary(atmosphere, r, mu, ray_r_mu_intersects_ground);
+  Number r_d = RadiusAtDistance(atmosphere, r, mu, d);
+  Number cos_alpha = ClampCosine((r + d * mu) / r_d);
+  Number across = d * SafeSqrt(1.0 - mu * mu) / r_d * cos_phi;
+  Number rho = sqrt(across * across + cos_alpha * cos_alpha);
+  Number c_end = -HorizonZenithCosine(atmosphere.bottom_radius, r_d);
+  Number end = c_end >= rho ? PI : atan(across, cos_alpha) + acos(-c_end / rho);
+  Number start = acos(HorizonZenithCosine(atmosphere.bottom_radius, r));
+  return max(start, end) + atmosphere.sun_angular_radius;
+}
+
+// The sun zenith angle of the split's column.
+Number GetScatteringSplitSunZenith(IN(AtmosphereParameters) atmosphere) {
+  return acos(GetScatteringMuSFromUnitRange(
+      atmosphere, Number(atmosphere.scattering_mu_s_split) / Number(atmosphere.scattering_mu_s_size - 1)));
+}
+
+// X, a unit sun from 1 at the zenith to 0 at the tables' lowest sun (and
+// below), like GetScatteringUnitMuS but with Bruneton's k = 1, and its
+// derivative in the sun zenith angle theta: with a = (d - d_min) / (d_max -
+// d_min) (as there) and A its value at scattering_mu_s_min, X = (1 - a / A)
+// / (1 + a); d = -R mu_s + sqrt(R^2 mu_s^2 + top^2 - R^2) (R the bottom
+// radius) has dd/dmu_s = -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta).
+Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number sun_zenith, OUT(Number) derivative) {
+  Number bottom = atmosphere.bottom_radius;
+  Number mu_s = cos(sun_zenith);
+  bool below = mu_s <= atmosphere.scattering_mu_s_min;
+  mu_s = max(mu_s, atmosphere.scattering_mu_s_min);
+  Number d = DistanceToTopAtmosphereBoundary(atmosphere, bottom, mu_s);
+  Number d_min = atmosphere.top_radius - bottom;
+  Number span = HorizonDistanceAtTop(atmosphere) - d_min;
+  Number a = (d - d_min) / span;
+  Number inverse_A = 1.0 / GetScatteringLowestSunDistance(atmosphere);
+  Number da_dtheta = bottom * d / (d + bottom * mu_s) / span * sin(sun_zenith);
+  derivative = below ? 0.0 : -(inverse_A + 1.0) / ((1.0 + a) * (1.0 + a)) * da_dtheta;
+  return (1.0 - a * inverse_A) / (1.0 + a);
+}
+
+// The position in [0, 1] between a ray's lit columns of the sun at
+// distance D = E - theta from its edge (at least SHADOW_EDGE_CLOSEST, at
+// most the split's E - theta_split):
+//   x = w (X(E - D) - X(E - D_min)) / (X(theta_split) - X(E - D_min))
+//       + (1 - w) ln(D / D_min) / ln((E - theta_split) / D_min),
+// w = SHADOW_EDGE_TABLES_WEIGHT, D_min = SHADOW_EDGE_CLOSEST. The logarithm
+// closes in on the edge, near which the light falls as D^3 (the disc's
+// smooth step times the lit stretch) and farther out as fast as the
+// sunlight's grazing path thickens; X keeps the tables' density of columns
+// toward a low sun, where light grazing the ground changes fast too. Also
+// dx/ds in s = ln D.
+Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, Number distance, Number edge, Number split_sun,
+                         OUT(Number) derivative) {
+  Number D = clamp(distance, SHADOW_EDGE_CLOSEST, edge - split_sun);
+  Number unused;
+  Number dX_dtheta;
+  Number X_closest = ShadowEdgeUnitSun(atmosphere, edge - SHADOW_EDGE_CLOSEST, unused);
+  Number X_span = ShadowEdgeUnitSun(atmosphere, split_sun, unused) - X_closest;
+  Number X = ShadowEdgeUnitSun(atmosphere, edge - D, dX_dtheta);
+  Number log_span = log((edge - split_sun) / SHADOW_EDGE_CLOSEST);
+  derivative = -SHADOW_EDGE_TABLES_WEIGHT * dX_dtheta * D / X_span + (1.0 - SHADOW_EDGE_TABLES_WEIGHT) / log_span;
+  return SHADOW_EDGE_TABLES_WEIGHT * (X - X_closest) / X_span +
+         (1.0 - SHADOW_EDGE_TABLES_WEIGHT) * log(D / SHADOW_EDGE_CLOSEST) / log_span;
+}
+
+// Its inverse: D at position x in [0, 1], by Newton's method in s = ln D
+// from the logarithm's term alone (x rises with s, at least at 1 - w times
+// the logarithm's rate; eight steps reach the double's precision).
+Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, Number x, Number edge, Number split_sun) {
+  Number s_min = log(SHADOW_EDGE_CLOSEST);
+  Number s_max = log(edge - split_sun);
+  Number s = mix(s_min, s_max, x);
+  for (int i = 0; i < 8; ++i) {
+    Number slope;
+    Number error = ShadowEdgeLitUnit(atmosphere, exp(s), edge, split_sun, slope) - x;
+    s = clamp(s - error / slope, s_min, s_max);
+  }
+  return exp(s);
+}
+
+// The span in sun zenith angle between two of a ray's columns past its
+// edge E: evenly from E to the tables' lowest sun, or at least
+// SHADOW_EDGE_LEAST_PAST_SPAN past E.
+Number ShadowEdgePastStep(IN(AtmosphereParameters) atmosphere, Number edge) {
+  Number lowest = acos(atmosphere.scattering_mu_s_min);
+  return max(lowest - edge, SHADOW_EDGE_LEAST_PAST_SPAN) / Number(SHADOW_EDGE_PAST_COLUMNS - 1);
+}
+
+// The position, in columns from the first, of the sun at zenith angle
+// sun_zenith below the split, for a ray whose edge is `edge`: between the lit
+// columns at x (ShadowEdgeLitUnit); within SHADOW_EDGE_CLOSEST of the edge,
+// in proportion to D between the columns at E and D_min; past the edge, in
+// proportion to the angle past it, held at the last column.
+Number GetScatteringShadowEdgePosition(IN(AtmosphereParameters) atmosphere, Number sun_zenith, Number edge) {
+  Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
+  Number split_sun = GetScatteringSplitSunZenith(atmosphere);
+  Number D = edge - sun_zenith;
+  Number unused;
+  if (D >= SHADOW_EDGE_CLOSEST) {
+    return past + ShadowEdgeLitUnit(atmosphere, D, edge, split_sun, unused) *
+                      (Number(atmosphere.scattering_mu_s_split) - past);
+  }
+  if (D >= 0.0) return past - 1.0 + D / SHADOW_EDGE_CLOSEST;
+  return max(past - 1.0 + D / ShadowEdgePastStep(atmosphere, edge), 0.0);
+}
+
+// Its inverse: the sun zenith angle at `position` (below the split).
+Number GetScatteringShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number position, Number edge) {
+  Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
+  if (position >= past) {
+    Number x = (position - past) / (Number(atmosphere.scattering_mu_s_split) - past);
+    return edge - ShadowEdgeLitDistance(atmosphere, x, edge, GetScatteringSplitSunZenith(atmosphere));
+  }
+  if (position >= past - 1.0) return edge - (position - past + 1.0) * SHADOW_EDGE_CLOSEST;
+  return edge + (past - 1.0 - position) * ShadowEdgePastStep(atmosphere, edge);
+}
+
 // r over the table's radii: rows at evenly spaced distances to the horizon
 // rho, which crowds them near the ground (at h = rho^2 / (r + bottom)), and
 // between two rows linear in rho, except for a ray that hits the ground.
@@ -258,8 +418,15 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
   }
   Number u_r = GetScatteringTextureUR(atmosphere, r, rho, ray_r_mu_intersects_ground, x_mu);
 
-  Number u_nu = ScatteringUnitNu(nu);
-  return vec4(u_nu, GetScatteringTextureUMuS(atmosphere, mu_s), u_mu, u_r);
+  // Below the split, the position on the ray's own columns.
+  Number u_mu_s = GetScatteringTextureUMuS(atmosphere, mu_s);
+  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  if (atmosphere.scattering_mu_s_split > 0 && u_mu_s * mu_s_size - 0.5 < Number(atmosphere.scattering_mu_s_split)) {
+    Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu),
+                                      ray_r_mu_intersects_ground);
+    u_mu_s = (GetScatteringShadowEdgePosition(atmosphere, acos(mu_s), edge) + 0.5) / mu_s_size;
+  }
+  return vec4(ScatteringUnitNu(nu), u_mu_s, u_mu, u_r);
 }
 #endif
 
@@ -498,12 +665,64 @@ vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(Scattering
                       nu_t, low_sun);
 }
 
+// The light of one nu slice at a ray's own column (below the split),
+// bilinear in (mu, r) by the texture unit.
+vec4 GetScatteringAtOwnColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                              IN(vec4) uvwz, Number column, Number nu_slice) {
+  Number x = (column + 0.5) / Number(atmosphere.scattering_mu_s_size);
+  return SampleTexture3D(scattering_texture,
+                         vec3((nu_slice + x) / Number(atmosphere.scattering_nu_size), uvwz.z, uvwz.w));
+}
+
+// The light of one nu slice below the split at `position` on the ray's
+// own columns (GetScatteringShadowEdgePosition): between its lit columns
+// LogMonotoneCubicMix of the four around it (the split's column the last);
+// within SHADOW_EDGE_CLOSEST of the edge, the light at the edge plus the
+// rise to the first lit column times (D / D_min)^p, p from the rise to the
+// second (where both rise, in [1, 10]; else 3, the fall of the light next
+// to the edge), log_first_span = ln(D_1 / D_min) with D_1 the second lit
+// column's distance to the edge; past the edge SunCosineMix of the two
+// columns around it.
+vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                             IN(vec4) uvwz, Number position, Number nu_slice, Number log_first_span) {
+  Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
+  Number intervals = Number(atmosphere.scattering_mu_s_split) - past;
+  if (position >= past) {
+    Number k = min(floor(position - past), intervals - 1.0);
+    Number column = past + k;
+    return LogMonotoneCubicMix(
+        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column - 1.0, nu_slice),
+        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice),
+        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column + 1.0, nu_slice),
+        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, min(column + 2.0, past + intervals), nu_slice),
+        k >= 1.0, k + 2.0 <= intervals, position - column);
+  }
+  if (position >= past - 1.0) {
+    vec4 at_edge = GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 1.0, nu_slice);
+    vec4 rise = GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past, nu_slice) - at_edge;
+    vec4 second_rise = GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past + 1.0, nu_slice) - at_edge;
+    vec4 tiny = vec4(1e-30);
+    vec4 rises = step(tiny, rise) * (vec4(1.0) - step(second_rise, rise));
+    vec4 power = mix(vec4(3.0),
+                     clamp(log(max(second_rise, tiny) / max(rise, tiny)) / log_first_span, vec4(1.0), vec4(10.0)),
+                     rises);
+    return at_edge + rise * pow(vec4(position - past + 1.0), power);
+  }
+  Number x = past - 1.0 - position;
+  Number k = min(floor(x), past - 2.0);
+  return SunCosineMix(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 1.0 - k, nu_slice),
+                      GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 2.0 - k, nu_slice),
+                      x - k, true);
+}
+
 // 4D lookup: the mu_s texel columns either side of mu_s
 // (GetScatteringAtMuSColumn, two fetches each), blended linearly in
 // daylight (four fetches); for a low sun between two columns by
 // LogMonotoneCubicMix of the four columns around it (eight fetches), and
 // below the table's lowest sun by LowestSunLogFall of the two lowest
-// columns (four fetches).
+// columns (four fetches). Below the split, each nu slice's light on the
+// ray's own columns (GetScatteringBelowSplit, four fetches each),
+// geometric between the two slices.
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
@@ -511,6 +730,22 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   Number nu_coord = uvwz.x * (nu_size - 1.0);
   Number nu_slice = min(floor(nu_coord), nu_size - 2.0);
   Number nu_t = nu_coord - nu_slice;
+  Number position = uvwz.y * Number(atmosphere.scattering_mu_s_size) - 0.5;
+  if (atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)) {
+    Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
+    Number log_first_span = 1.0;
+    if (position >= past - 1.0 && position < past) {
+      Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu),
+                                        ray_r_mu_intersects_ground);
+      Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
+      log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge, GetScatteringSplitSunZenith(atmosphere)) /
+                           SHADOW_EDGE_CLOSEST);
+    }
+    return SunCosineMix(
+        GetScatteringBelowSplit(atmosphere, scattering_texture, uvwz, position, nu_slice, log_first_span),
+        GetScatteringBelowSplit(atmosphere, scattering_texture, uvwz, position, nu_slice + 1.0, log_first_span),
+        nu_t, true);
+  }
   Number x_below;
   Number x_above;
   Number mu_s_t;

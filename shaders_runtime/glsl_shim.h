@@ -36,10 +36,17 @@ using glm::mix;
 using glm::normalize;
 using glm::smoothstep;
 using glm::step;
+using glm::pow;
+using std::abs;
+using std::acos;
+using std::cos;
+using std::sin;
 using std::exp;
 using std::floor;
 using std::log;
 using std::sqrt;
+// GLSL's two-argument arc tangent.
+inline Number atan(Number y, Number x) { return std::atan2(y, x); }
 
 constexpr Number PI = kPi;
 constexpr int PHASE_NONE = 0;
@@ -69,6 +76,7 @@ struct AtmosphereParameters {
   Number scattering_r_max = 0.0;
   Number scattering_mu_s_min = -1.0;
   Number scattering_mu_s_max = 1.0;
+  int scattering_mu_s_split = 0;
   int irradiance_width = 0;
   int irradiance_height = 0;
   vec3 extinction_profile[ALTITUDE_PROFILE_SIZE] = {};

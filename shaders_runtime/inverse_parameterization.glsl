@@ -17,6 +17,34 @@ void GetRMuFromTransmittanceTextureUv(IN(AtmosphereParameters) atmosphere, IN(ve
   mu = d == 0.0 ? 1.0 : ClampCosine((H * H - rho * rho - d * d) / (2.0 * r * d));
 }
 
+// nu clamped to the range that the view and sun zenith cosines allow:
+// nu = mu mu_s + sqrt((1 - mu^2)(1 - mu_s^2)) cos(azimuth), azimuth in [0, pi].
+Number ClampNuToDirections(Number nu, Number mu, Number mu_s) {
+  Number spread = SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
+  return clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
+}
+
+// The sun zenith angle of a ray's own column at `position` below the split
+// (GetScatteringShadowEdgeSunZenith) for the nu slice at nu: the column's
+// sun sets the azimuth at which nu lies (nu clamped to the range mu and the
+// sun allow), which sets the ray's edge, which sets the column's sun; the
+// fixed point of the three, from the sun at the horizon (a few steps; the
+// edge moves less than the sun does).
+Number GetScatteringOwnColumnSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
+                                       bool ray_r_mu_intersects_ground, Number position) {
+  Number sun = 0.5 * PI;
+  for (int i = 0; i < 50; ++i) {
+    Number mu_s = cos(sun);
+    Number cos_phi = ViewSunAzimuthCosine(mu, mu_s, ClampNuToDirections(nu, mu, mu_s));
+    Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
+    Number next = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge);
+    bool converged = abs(next - sun) < 1e-12;
+    sun = next;
+    if (converged) break;
+  }
+  return sun;
+}
+
 // uvwz = (u_nu, u_mu_s, u_mu, u_r) as returned by
 // GetScatteringTextureUvwzFromRMuMuSNu. nu is not clamped to the range that
 // (mu, mu_s) allow; callers that need a physical direction clamp it.
@@ -46,9 +74,12 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
     ray_r_mu_intersects_ground = false;
   }
 
-  mu_s = GetScatteringMuSFromUnitRange(atmosphere,
-                                       GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size));
   nu = ClampCosine(uvwz.x * 2.0 - 1.0);
+  Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size);
+  Number position = x_mu_s * Number(atmosphere.scattering_mu_s_size - 1);
+  mu_s = atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)
+             ? cos(GetScatteringOwnColumnSunZenith(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, position))
+             : GetScatteringMuSFromUnitRange(atmosphere, x_mu_s);
 }
 
 void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2) uv, OUT(Number) r,
@@ -72,11 +103,4 @@ vec4 GetScatteringTextureUvwzFromTexel(IN(AtmosphereParameters) atmosphere, int 
               (Number(mu_s_index) + 0.5) / Number(mu_s_size),
               (Number(y) + 0.5) / Number(atmosphere.scattering_mu_size),
               (Number(z) + 0.5) / Number(atmosphere.scattering_r_size));
-}
-
-// nu clamped to the range that the view and sun zenith cosines allow:
-// nu = mu mu_s + sqrt((1 - mu^2)(1 - mu_s^2)) cos(azimuth), azimuth in [0, pi].
-Number ClampNuToDirections(Number nu, Number mu, Number mu_s) {
-  Number spread = SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
-  return clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
 }

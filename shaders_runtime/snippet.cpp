@@ -182,6 +182,7 @@ std::string AtmosphereConstants(ShadingLanguage language, const glsl::Atmosphere
        ",  // scattering_r_min, scattering_r_max, m\n";
   s += "    " + FloatLiteral(p.scattering_mu_s_min) + ", " + FloatLiteral(p.scattering_mu_s_max) +
        ",  // scattering_mu_s_min, scattering_mu_s_max\n";
+  s += "    " + std::to_string(p.scattering_mu_s_split) + ",  // scattering_mu_s_split\n";
   s += "    " + std::to_string(p.irradiance_width) + ", " + std::to_string(p.irradiance_height) +
        ",  // irradiance_width (mu_s), irradiance_height (r)\n";
   s += "    // extinction_profile, m^-1\n    " + ProfileLiteral(syntax, p.extinction_profile) + ",\n";
