@@ -38,7 +38,7 @@ LutSet Baker::AssembleTables(Texture transmittance, Texture irradiance, Texture 
   result.parameters = params_;
   result.transmittance = std::move(transmittance);
   result.irradiance = std::move(irradiance);
-  ExtendSlicesPastTheirRange(params_, single_mie);
+  ExtendSlicesPastTheirRange(params_, own_suns_.get(), single_mie);
   if (params_.single_mie_in_scattering_alpha == 1) {
     for (size_t i = 0; i < scattering.texels.size(); i += 4) scattering.texels[i + 3] = single_mie.texels[i];
   } else {
@@ -70,13 +70,39 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   irradiance_ = Texture(s.irradiance_width, s.irradiance_height);
 
   Phase("transmittance", [&] { ComputeTransmittance(); });
-  Phase("single scattering", [&] { single_ = ComputeSingleScattering(params_, s.ray_samples); });
-  if ((s.orders != 1 || s.single_scattering_sky_irradiance) && !TableOnAtmosphereGrid()) {
-    // It feeds only the next order and the sky irradiance, through
-    // integrals over the sphere.
+  // The orders' grid needs single scattering (for the next order and the
+  // sky irradiance, through integrals over the sphere) at its columns with
+  // mu_s >= LOW_SUN_MU_S (below them they integrate it along their rings:
+  // RingSingleScattering). Where it is not the table's grid but has its
+  // rows, that is the table's from the split up and the rest is computed
+  // along the table's rays; else on the grid itself.
+  const bool grid_single = (s.orders != 1 || s.single_scattering_sky_irradiance) && !TableOnAtmosphereGrid();
+  Phase("single scattering", [&] {
+    OtherColumns other;
+    SunColumns grid_columns(atmosphere_grid_);
+    if (params_.scattering_mu_s_split > 0) own_suns_ = std::make_unique<OwnColumnSuns>(params_);
+    if (grid_single && !TableRestricted()) {
+      other = {&grid_columns, LowSunColumnCount(grid_columns), params_.scattering_mu_s_split};
+      grid_single_ = {ScatteringGridTexture(atmosphere_grid_), ScatteringGridTexture(atmosphere_grid_)};
+    }
+    single_ = ComputeSingleScattering(params_, s.ray_samples, own_suns_.get(), other,
+                                      other.columns ? &grid_single_ : nullptr);
+    if (other.columns) {
+      const int split = params_.scattering_mu_s_split, mu_s_size = params_.scattering_mu_s_size;
+      for (auto [from, to] : {std::pair{&single_.rayleigh, &grid_single_.rayleigh},
+                              std::pair{&single_.mie, &grid_single_.mie}}) {
+        ForEachRow(*to, [&](int, std::size_t first, std::size_t end) {
+          for (std::size_t i = first; i < end; i += 4) {
+            if (int((i - first) / 4) % mu_s_size < split) continue;
+            for (int c = 0; c < 4; ++c) to->texels[i + c] = from->texels[i + c];
+          }
+        });
+      }
+    }
+  });
+  if (grid_single && TableRestricted()) {
     Phase("single scattering, whole atmosphere", [&] {
-      grid_single_ = ComputeSingleScattering(
-          atmosphere_grid_, TableRestricted() ? s.scattering_range->atmosphere_ray_samples : s.ray_samples);
+      grid_single_ = ComputeSingleScattering(atmosphere_grid_, s.scattering_range->atmosphere_ray_samples, nullptr);
     });
   }
   if (s.orders == 1 && s.single_scattering_sky_irradiance) {
@@ -95,7 +121,10 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   OrderConvergence convergence;
   // Convergence is measured on means over the tables (each order's on its own grid).
   OrderSums sums;
-  sums.table = TableMean(GridSingle().rayleigh, atmosphere_grid_, {});
+  // (Where the table has the grid's rows, its own: the grid's single
+  // scattering lacks the low suns.)
+  sums.table = TableRestricted() ? TableMean(GridSingle().rayleigh, atmosphere_grid_, {})
+                                 : TableMean(single_.rayleigh, params_, {});
   const std::vector<double> orders_packing = PackingFactors(orders_grid_);
   const bool gather_at_end = GatherAtEnd();
   std::shared_ptr<GatherPlan> orders_plan;  // every order's gather is along the same rays
@@ -119,7 +148,7 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
       // Earth's shadow tens of times too bright); only deep-shadow samples
       // read it, and the tail tests hold.
       const MuSFall fall = MuSFallOf(scattering_density_, order == 2);
-      if (!orders_plan) orders_plan = PlanGather(orders_grid_, atmosphere_grid_);
+      if (!orders_plan) orders_plan = PlanGather(orders_grid_, nullptr, atmosphere_grid_);
       GatherAlongRays(*orders_plan, scattering_density_, &fall, &delta_multiple_);
       AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
@@ -167,11 +196,18 @@ Texture Baker::ScatteringTable(Texture storage) const {
   Texture table = std::move(storage);
   table = single_.rayleigh;  // into the storage's memory if it is large enough
   if (report_.orders_used < 2) {
-    ExtendSlicesPastTheirRange(params_, table);
+    ExtendSlicesPastTheirRange(params_, own_suns_.get(), table);
     return table;
   }
   Texture gathered;
-  if (GatherAtEnd()) GatherAlongRays(*PlanGather(params_, atmosphere_grid_), higher_orders_, nullptr, &gathered);
+  if (GatherAtEnd()) {
+    // The summed J falls after sunset as its orders do, the second's
+    // fastest: gathered along its fall between columns and below the
+    // grid's lowest sun (as the second order's own gather is; linear in J
+    // it would read the deep twilight several times too bright).
+    const MuSFall fall = MuSFallOf(higher_orders_, true);
+    GatherAlongRays(*PlanGather(params_, own_suns_.get(), atmosphere_grid_), higher_orders_, &fall, &gathered);
+  }
   const Texture& higher = GatherAtEnd() ? gathered : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;
   const std::vector<double> packing = PackingFactors(params_);
@@ -183,13 +219,13 @@ Texture Baker::ScatteringTable(Texture storage) const {
   });
   // At a slice's clamped nu the runtime multiplies the higher orders by the
   // Rayleigh phase there, not at the slice's own nu.
-  ExtendSlicesPastTheirRange(params_, table, [&](int x, int y, int z, double nu) {
+  ExtendSlicesPastTheirRange(params_, own_suns_.get(), table, [&](int x, int y, int z, double nu) {
     return vec3(single_.rayleigh.Fetch(x, y, z)) + vec3(higher.Fetch(x, y, z)) / glsl::RayleighPhaseFunction(nu);
   });
   return table;
 }
 
-void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture& table,
+void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, const OwnColumnSuns* own, Texture& table,
                                        const std::function<vec3(int x, int y, int z, double nu)>& edge_value) {
   const int nu_size = grid.scattering_nu_size, mu_s_size = grid.scattering_mu_s_size;
   // Rows are independent, and within a row each slice past the range is
@@ -199,14 +235,16 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
   tbb::parallel_for(0, grid.scattering_mu_size * grid.scattering_r_size, [&](int row) {
     const int y = row % grid.scattering_mu_size, z = row / grid.scattering_mu_size;
     const double mu = GetScatteringTexel(grid, 0, y, z).mu;
-    // (Not below the split, where the slices of a column lie at different
-    // suns, each the ray's own.)
-    for (int column = grid.scattering_mu_s_split; column < mu_s_size; ++column) {
-      const double mu_s = columns.mu_s[column];
-      const double lowest = ClampedNu(-1.0, mu, mu_s), highest = ClampedNu(1.0, mu, mu_s);
-      const bool geometric = mu_s < glsl::LOW_SUN_MU_S;  // SunCosineMix's blend for this column
+    for (int column = 0; column < mu_s_size; ++column) {
+      // Below the split each slice's texel lies at its own sun, whose range
+      // of nu bounds it (the lookup there blends the slices geometrically).
+      const bool own_column = column < grid.scattering_mu_s_split;
+      const bool geometric = own_column || columns.mu_s[column] < glsl::LOW_SUN_MU_S;  // SunCosineMix's blend
       for (int k = 0; k + 1 < nu_size; ++k) {
         const int x0 = k * mu_s_size + column, x1 = x0 + mu_s_size;
+        const double mu_s0 = own_column ? own->MuS(x0, y, z) : columns.mu_s[column];
+        const double mu_s1 = own_column ? own->MuS(x1, y, z) : columns.mu_s[column];
+        const double lowest = ClampedNu(-1.0, mu, mu_s0), highest = ClampedNu(1.0, mu, mu_s1);
         const double nu_k = columns.grid_nu[x0], spacing = columns.grid_nu[x1] - nu_k;
         const double start = std::max(nu_k, lowest), end = std::min(nu_k + spacing, highest);
         const bool k_clamped = start > nu_k, next_clamped = end < nu_k + spacing;
@@ -215,9 +253,10 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, Texture
         if (!(k_clamped || next_clamped) || end - start < kSmallestExtendedFraction * spacing) continue;
         // (A texel's nu is its slice's clamped as GetScatteringTexel clamps it.)
         const vec3 at_start =
-            k_clamped && edge_value ? edge_value(x0, y, z, ClampedNu(nu_k, mu, mu_s)) : vec3(table.Fetch(x0, y, z));
-        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z, ClampedNu(columns.grid_nu[x1], mu, mu_s))
-                                                       : vec3(table.Fetch(x1, y, z));
+            k_clamped && edge_value ? edge_value(x0, y, z, ClampedNu(nu_k, mu, mu_s0)) : vec3(table.Fetch(x0, y, z));
+        const vec3 at_end = next_clamped && edge_value
+                                ? edge_value(x1, y, z, ClampedNu(columns.grid_nu[x1], mu, mu_s1))
+                                : vec3(table.Fetch(x1, y, z));
         const double t_start = (start - nu_k) / spacing, t_end = (end - nu_k) / spacing;
         vec4 value0 = table.Fetch(x0, y, z), value1 = table.Fetch(x1, y, z);
         for (int c = 0; c < 3; ++c) {

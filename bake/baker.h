@@ -64,13 +64,21 @@ class Baker {
   };
 
   void ComputeTransmittance();
-  // Single scattering on `grid`, with `ray_samples` intervals per ray.
-  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples) const;
+  // Single scattering on `grid`, with `ray_samples` intervals per ray;
+  // `own`: the suns of the rays' own columns where the grid has a split.
+  // Along the same rays, that of `other`'s columns into `other_out` (a
+  // texture of its grid's size), where given.
+  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples,
+                                           const OwnColumnSuns* own, const OtherColumns& other = {},
+                                           SingleScattering* other_out = nullptr) const;
   // Single scattering of the texels of one ray of `grid` (mu index y, r
-  // index z), n intervals, into `out`. `columns`: the grid's sun
-  // directions; `transmittance`: the transmittance table's channels.
+  // index z), n intervals, into `out`, and of `other`'s into `other_out`.
+  // `columns`, `own`: the grid's sun directions (RaySunDirections);
+  // `transmittance`: the transmittance table's channels.
   void SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
-                                const ChannelPlanes& transmittance, SingleScattering& out) const;
+                                const OwnColumnSuns* own, const OtherColumns& other,
+                                const ChannelPlanes& transmittance, SingleScattering& out,
+                                SingleScattering* other_out) const;
   // Per sun direction of a ray, its single scattering before the solar
   // irradiance: sums[0] the scattering table's (every group but the Mie
   // group, over the Rayleigh phase), sums[1] the single Mie table's (phase
@@ -94,13 +102,14 @@ class Baker {
   // degrees of azimuth apart and its linear blend between them reads the
   // peak tens of percent high; so at the low-sun columns (mu_s <
   // LOW_SUN_MU_S, and for the irradiance the two above, which its cubic
-  // reads), for the azimuths within 90 degrees of the sun's, it is
-  // integrated along each ring's own ray instead. Per (radius, ring), the
-  // sums of SingleScatteringOfRay for the directions j * sunward_azimuths +
-  // m: sun column j, azimuth index m from the sun's (the light is symmetric
+  // reads) it is integrated along each ring's own ray instead, at every
+  // azimuth (there the orders' grid has no single scattering of its own
+  // where the table's columns are each ray's: Run). Per (radius, ring), the
+  // sums of SingleScatteringOfRay for the directions j * half_azimuths + m:
+  // sun column j, azimuth index m from the sun's (the light is symmetric
   // about the sun's plane, so the mirror azimuths share them).
   struct RingSingleScattering {
-    int columns = 0, rings = 0, azimuths = 0, sunward_azimuths = 0;
+    int columns = 0, rings = 0, azimuths = 0, half_azimuths = 0;
     std::vector<RaySingleScattering> of_ring;
   };
   // For rings of zenith cosines ring_cosines[i] (as many for every radius)
@@ -131,11 +140,12 @@ class Baker {
     std::vector<float> lowest_log_slope, lowest_log_curvature;
   };
   MuSFall MuSFallOf(const Texture& density, bool between_columns) const;
-  // The rays of a table on the grid `grid`, prepared for gathering
-  // densities on the grid `density_grid`: what each gather needs of them
-  // whatever the density (gather.cpp), built once for all the orders.
+  // The rays of a table on the grid `grid` (`own`: the suns of its rays'
+  // own columns where it has a split), prepared for gathering densities on
+  // the grid `density_grid`: what each gather needs of them whatever the
+  // density (gather.cpp), built once for all the orders.
   struct GatherPlan;
-  std::shared_ptr<GatherPlan> PlanGather(const AtmosphereParameters& grid,
+  std::shared_ptr<GatherPlan> PlanGather(const AtmosphereParameters& grid, const OwnColumnSuns* own,
                                          const AtmosphereParameters& density_grid) const;
   // The light of the orders whose scattering density (per unit scattering
   // coefficient, on the plan's density grid) is `density`, arriving at
@@ -171,11 +181,13 @@ class Baker {
   // gives each such slice the value to which GetScattering's blend between
   // the two ends of the allowed part of its interval extends (linear, or
   // geometric for a low sun as in SunCosineMix), so that the lookup returns
-  // the light at the edge and follows its change toward it. `edge_value`:
-  // the light a clamped texel (x, y, z) with clamped nu stands for, in the
-  // units the lookup blends (none: the texel's own value).
+  // the light at the edge and follows its change toward it. Below the
+  // split (`own`: the suns there) each slice's range is that of its
+  // texel's own sun. `edge_value`: the light a clamped texel (x, y, z) with
+  // clamped nu stands for, in the units the lookup blends (none: the
+  // texel's own value).
   static void ExtendSlicesPastTheirRange(
-      const AtmosphereParameters& grid, Texture& table,
+      const AtmosphereParameters& grid, const OwnColumnSuns* own, Texture& table,
       const std::function<vec3(int x, int y, int z, double nu)>& edge_value = nullptr);
   // Intervals with less than this fraction of them allowed keep their
   // slices; an extended slice holds at most kLargestExtension times the
@@ -242,6 +254,8 @@ class Baker {
   BakeReport report_;
   BakeProgress progress_;
 
+  // The suns of the table's rays' own columns, where it has a split.
+  std::unique_ptr<OwnColumnSuns> own_suns_;
   Texture transmittance_;
   Texture irradiance_;
   SingleScattering single_;       // on the table's grid

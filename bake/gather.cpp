@@ -309,6 +309,7 @@ struct Baker::GatherPlan {
     std::vector<Spectrum> optical_depth;  // the view's, per sample k (where there are thick intervals)
   };
   AtmosphereParameters grid, density_grid;
+  const OwnColumnSuns* own_suns = nullptr;  // of grid, where it has a split
   int samples_per_ray = 0;  // intervals per ray
   std::vector<Ray> rays;    // per ray index z * mu_size + y
   // The gathered order's J in JRows's layout (JRows::Rows): kept with the
@@ -317,10 +318,10 @@ struct Baker::GatherPlan {
   std::vector<float> density_rows;
 };
 
-std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters& grid,
+std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters& grid, const OwnColumnSuns* own,
                                                      const AtmosphereParameters& density_grid) const {
   auto plan = std::make_shared<GatherPlan>();
-  plan->grid = grid, plan->density_grid = density_grid;
+  plan->grid = grid, plan->density_grid = density_grid, plan->own_suns = own;
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const int density_height = density_grid.scattering_mu_size, density_depth = density_grid.scattering_r_size;
   const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
@@ -417,7 +418,7 @@ void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSF
     // order: kept in the plan they would take more memory than all the
     // rest of it (docs/benchmark.md).
     JRows rows(density_mu_s_size, density_nu_size);
-    const DirectionsBySlice by_slice(RaySunDirections(columns, grid, y, z), density_grid, rows.PermutesRows());
+    const DirectionsBySlice by_slice(RaySunDirections(columns, plan.own_suns, grid, y, z), density_grid, rows.PermutesRows());
     const int count = by_slice.count();
     const std::vector<float>&mu_s = by_slice.mu_s, &nu = by_slice.nu, &nu_weight = by_slice.nu_weight;
     std::vector<float> mu_s_k(count), mu_s_weight(count), values(count);

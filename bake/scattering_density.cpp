@@ -131,7 +131,7 @@ Baker::RingSingleScattering Baker::SingleScatteringOnRings(const std::vector<dou
   RingSingleScattering result;
   result.columns = static_cast<int>(sun_mu_s.size());
   result.azimuths = azimuths;
-  result.sunward_azimuths = azimuths / 4;
+  result.half_azimuths = azimuths / 2;
   result.rings = ring_cosines.empty() ? 0 : static_cast<int>(ring_cosines.front().size());
   if (result.columns == 0 || result.rings == 0) return result;
   // Half the single-scattering table's intervals: the sphere's rule
@@ -147,11 +147,11 @@ Baker::RingSingleScattering Baker::SingleScatteringOnRings(const std::vector<dou
     const int i = index / result.rings, l = index % result.rings;
     const double r = radii[i], cos_theta = ring_cosines[i][l];
     const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
-    // The ring's sun directions: per column, the azimuths within 90 degrees of the sun's.
+    // The ring's sun directions: per column, the azimuths from the sun's to the opposite.
     std::vector<double> mu_s, nu;
     for (double column_mu_s : sun_mu_s) {
       const double sun_sin = std::sqrt(std::max(0.0, 1.0 - column_mu_s * column_mu_s));
-      for (int m = 0; m < result.sunward_azimuths; ++m) {
+      for (int m = 0; m < result.half_azimuths; ++m) {
         mu_s.push_back(column_mu_s);
         nu.push_back(glsl::ClampCosine(azimuth.cos[m] * sin_theta * sun_sin + cos_theta * column_mu_s));
       }
@@ -167,9 +167,7 @@ std::optional<vec3> Baker::RingIncident(const RingSingleScattering& rings, int r
   if (column >= rings.columns || rings.of_ring.empty()) return std::nullopt;
   // The light is symmetric about the sun's plane: azimuth m has the single
   // scattering of its mirror image 2 pi - phi.
-  const int sunward = m < rings.azimuths / 2 ? m : rings.azimuths - 1 - m;
-  if (sunward >= rings.sunward_azimuths) return std::nullopt;
-  const int j = column * rings.sunward_azimuths + sunward;
+  const int j = column * rings.half_azimuths + (m < rings.half_azimuths ? m : rings.azimuths - 1 - m);
   const auto& sums = rings.of_ring[std::size_t(radius) * rings.rings + ring].sums;
   const vec3 rayleigh(sums[0][0][j], sums[0][1][j], sums[0][2][j]), mie(sums[1][0][j], sums[1][1][j], sums[1][2][j]);
   return (rayleigh * glsl::RayleighPhaseFunction(nu) + mie * glsl::MiePhaseFunction(params_, nu)) *
@@ -197,8 +195,7 @@ void Baker::ComputeScatteringDensity(int order) {
   }
   RingSingleScattering ring_single;
   if (order == 2) {
-    std::vector<double> low_sun;
-    for (int j = 0; j < mu_s_size && columns.mu_s[j] < glsl::LOW_SUN_MU_S; ++j) low_sun.push_back(columns.mu_s[j]);
+    const std::vector<double> low_sun(columns.mu_s.begin(), columns.mu_s.begin() + LowSunColumnCount(columns));
     ring_single = SingleScatteringOnRings(radii, ring_cosines, low_sun, azimuths);
   }
   // Per r row, the weights of the rings' series terms in the mean of each
@@ -371,8 +368,7 @@ void Baker::ComputeIndirectIrradiance(int order) {
   const AtmosphereParameters& grid = order == 1 ? atmosphere_grid_ : orders_grid_;  // as IncidentAlongNu reads
   const int mu_s_size = grid.scattering_mu_s_size;
   const SunColumns columns(grid);
-  int low_sun_columns = 0;
-  while (low_sun_columns < mu_s_size && columns.mu_s[low_sun_columns] < glsl::LOW_SUN_MU_S) ++low_sun_columns;
+  const int low_sun_columns = LowSunColumnCount(columns);
   const int integrated_columns = std::min(mu_s_size, low_sun_columns + 2);  // and two above, for the cubic
   auto row_radius = [&](int y) {
     double r, mu_s;

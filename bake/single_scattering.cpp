@@ -60,30 +60,40 @@ RaySamples Baker::SampleRay(double r, double mu, bool intersects_ground, int n) 
   return ray;
 }
 
-Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples) const {
+Baker::SingleScattering Baker::ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples,
+                                                       const OwnColumnSuns* own, const OtherColumns& other,
+                                                       SingleScattering* other_out) const {
   const int mu_size = grid.scattering_mu_size, r_size = grid.scattering_r_size;
   const ChannelPlanes transmittance(transmittance_);
   const SunColumns columns(grid);
   SingleScattering result{ScatteringGridTexture(grid), ScatteringGridTexture(grid)};
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
-    SingleScatteringAlongRay(grid, ray_samples, ray_index % mu_size, ray_index / mu_size, columns, transmittance,
-                             result);
+    SingleScatteringAlongRay(grid, ray_samples, ray_index % mu_size, ray_index / mu_size, columns, own, other,
+                             transmittance, result, other_out);
   });
   return result;
 }
 
 void Baker::SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
-                                     const ChannelPlanes& transmittance, SingleScattering& out) const {
+                                     const OwnColumnSuns* own, const OtherColumns& other,
+                                     const ChannelPlanes& transmittance, SingleScattering& out,
+                                     SingleScattering* other_out) const {
   const RaySamples ray = SampleRay(grid, y, z, n);
-  const SunDirections directions = RaySunDirections(columns, grid, y, z);
+  const SunDirections directions = RaySunDirections(columns, own, grid, y, z, other);
   const RaySingleScattering single = SingleScatteringOfRay(ray, directions.mu_s, directions.nu, transmittance);
   const auto& sums = single.sums;
-  for (int x = 0; x < int(directions.of_texel.size()); ++x) {
-    const int j = directions.of_texel[x];
-    const vec3 rayleigh(sums[0][0][j], sums[0][1][j], sums[0][2][j]), mie_sum(sums[1][0][j], sums[1][1][j], sums[1][2][j]);
-    out.rayleigh.Store(x, y, z, vec4(rayleigh * params_.solar_irradiance, 0.0));
-    out.mie.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
-  }
+  auto store = [&](const std::vector<int>& of_texel, SingleScattering& into) {
+    for (int x = 0; x < int(of_texel.size()); ++x) {
+      const int j = of_texel[x];
+      if (j < 0) continue;
+      const vec3 rayleigh(sums[0][0][j], sums[0][1][j], sums[0][2][j]);
+      const vec3 mie_sum(sums[1][0][j], sums[1][1][j], sums[1][2][j]);
+      into.rayleigh.Store(x, y, z, vec4(rayleigh * params_.solar_irradiance, 0.0));
+      into.mie.Store(x, y, z, vec4(mie_sum * params_.solar_irradiance, 0.0));
+    }
+  };
+  store(directions.of_texel, out);
+  if (other_out) store(directions.of_other_texel, *other_out);
 }
 
 Baker::RaySingleScattering Baker::SingleScatteringOfRay(const RaySamples& ray, const std::vector<double>& sun_mu_s,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -13,6 +14,7 @@
 
 #include "bake/colour.h"
 #include "bake/medium.h"
+#include "bake/sun_lookups.h"
 #include "core/constants.h"
 #include "core/errors.h"
 #include "shaders_runtime/runtime.h"
@@ -207,16 +209,24 @@ namespace {
 // The first batch's higher orders H_j (its table of all orders less its
 // first orders' part, per channel j) and, per key, the reference spectrum
 // N_j they are relative to (HigherOrderInterpolation). A texel's key is its
-// index for the irradiance table and its mu_s column for the scattering
-// table: (t % width) % mu_s_size.
+// index for the irradiance table and its sun for the scattering table: its
+// mu_s column, (t % width) % mu_s_size, or below the table's split (where
+// every ray has its own suns) mu_s_size and its index there.
 struct HigherOrderSource {
   const glsl::Texture* all_orders = nullptr;
   const glsl::Texture* first_orders = nullptr;
   std::vector<glm::dvec3> reference;  // per key
   glm::dvec3 sun{0.0};                // E at its channels, the reference where a key has none
-  std::size_t width = 0, mu_s_size = 0;  // mu_s_size 0: the key is the texel's index
+  std::size_t width = 0, height = 0, mu_s_size = 0;  // mu_s_size 0: the key is the texel's index
+  const detail::OwnColumnSuns* own = nullptr;       // the table's suns below its split, if it has one
+  int split = 0;
 
-  std::size_t Key(std::size_t t) const { return mu_s_size == 0 ? t : (t % width) % mu_s_size; }
+  std::size_t Key(std::size_t t) const {
+    if (mu_s_size == 0) return t;
+    const std::size_t x = t % width, column = x % mu_s_size;
+    if (column >= std::size_t(split)) return column;
+    return mu_s_size + own->Index(int(x), int(t / width % height), int(t / width / height));
+  }
 };
 
 // The higher orders of one batch that does not compute them: per channel c,
@@ -323,19 +333,25 @@ std::vector<glm::dvec3> IrradianceReference(const glsl::Texture& sky_light) {
 // docs/colour.md). 0 where I1 is not positive (AddInterpolated then takes
 // the sun's).
 std::vector<glm::dvec3> ScatteringReference(const glsl::AtmosphereParameters& grid, const glsl::Texture& sky_light,
-                                            const glm::dvec3& sun) {
+                                            const glm::dvec3& sun, const detail::OwnColumnSuns* own) {
   constexpr double kLitAirDepth = 4.0 * kPi / 180.0, kReferenceBlend = 4.0 * kPi / 180.0;
-  std::vector<glm::dvec3> reference;
-  for (int x = 0; x < grid.scattering_mu_s_size; ++x) {
-    const double mu_s = GetScatteringTexel(grid, x, 0, 0).mu_s;
+  auto reference_at = [&](double mu_s) {
     const double depth = std::acos(mu_s) - kPi / 2.0;
     const double w = std::clamp((kLitAirDepth + kReferenceBlend - depth) / kReferenceBlend, 0.0, 1.0);
     const glm::dvec3 light(glsl::GetIrradiance(grid, glsl::sampler2D{&sky_light}, grid.bottom_radius, mu_s));
-    if (!Positive(light) || (w < 1.0 && !Positive(sun))) {
-      reference.push_back(glm::dvec3(0.0));
-    } else {
-      reference.push_back(w < 1.0 ? glm::exp(w * glm::log(light) + (1.0 - w) * glm::log(sun)) : light);
-    }
+    if (!Positive(light) || (w < 1.0 && !Positive(sun))) return glm::dvec3(0.0);
+    return w < 1.0 ? glm::exp(w * glm::log(light) + (1.0 - w) * glm::log(sun)) : light;
+  };
+  const std::size_t columns = std::size_t(grid.scattering_mu_s_size);
+  std::vector<glm::dvec3> reference(columns + (own ? own->size() : 0));
+  for (std::size_t x = 0; x < columns; ++x) reference[x] = reference_at(GetScatteringTexel(grid, int(x), 0, 0).mu_s);
+  if (own) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own->size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                          reference[columns + i] = reference_at(own->MuSAt(i));
+                        }
+                      });
   }
   return reference;
 }
@@ -459,6 +475,7 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
   LutSet source_luts;
   glsl::Texture source_single_scattering, source_sky_light;
   HigherOrderSource scattering_source, irradiance_source;
+  std::unique_ptr<detail::OwnColumnSuns> own_suns;  // of the source's table, where it has a split
   for (std::size_t b = 0; b < batches.size(); ++b) {
     const Spectrum& nm = batches.batch_wavelengths_nm[b];
     const Atmosphere& atmosphere = atmospheres[b];
@@ -506,7 +523,7 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
       irradiance->AddInterpolated(m, luts.irradiance, irradiance_source, interpolation[b],
                                   IrradianceReference(luts.irradiance));
       scattering->AddInterpolated(m, luts.scattering, scattering_source, interpolation[b],
-                                  ScatteringReference(grid, luts.irradiance, interpolation[b].sun));
+                                  ScatteringReference(grid, luts.irradiance, interpolation[b].sun, own_suns.get()));
     }
     single_mie->Add(m, luts.single_mie_scattering);
     // The sun's XYZ weight of each of the batch's wavelengths: column w of m
@@ -526,11 +543,15 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
       const glsl::Texture& table = source_luts.scattering;
       scattering_source.all_orders = &table;
       scattering_source.first_orders = &source_single_scattering;
-      scattering_source.reference =
-          ScatteringReference(source_luts.parameters, source_sky_light, interpolation[0].sun);
+      const glsl::AtmosphereParameters& grid = source_luts.parameters;
+      if (grid.scattering_mu_s_split > 0) own_suns = std::make_unique<detail::OwnColumnSuns>(grid);
+      scattering_source.reference = ScatteringReference(grid, source_sky_light, interpolation[0].sun, own_suns.get());
       scattering_source.sun = interpolation[0].sun;
       scattering_source.width = std::size_t(table.width);
-      scattering_source.mu_s_size = std::size_t(source_luts.parameters.scattering_mu_s_size);
+      scattering_source.height = std::size_t(table.height);
+      scattering_source.mu_s_size = std::size_t(grid.scattering_mu_s_size);
+      scattering_source.own = own_suns.get();
+      scattering_source.split = grid.scattering_mu_s_split;
       irradiance_source = {&source_luts.irradiance, &source_sky_light, IrradianceReference(source_sky_light),
                            interpolation[0].sun};
     }

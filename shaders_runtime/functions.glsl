@@ -221,8 +221,10 @@ Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s
 // SHADOW_EDGE_LEAST_PAST_SPAN past E), where single scattering is 0 and
 // only the higher orders remain; the others on the lit side, from
 // SHADOW_EDGE_CLOSEST before E to the split, at even steps of
-// ShadowEdgeLitUnit. The split's column is the lowest at most 80 degrees
-// from the zenith: above it the sun is up for every point of every ray.
+// ShadowEdgeLitUnit. The bake puts the split at the lowest column at most
+// 83 degrees from the zenith: above it the sun is up for every point of
+// every ray. Past a ray's first column (its lowest sun) the lookup
+// continues the fall of the first two.
 const int SHADOW_EDGE_PAST_COLUMNS = 6;
 const Number SHADOW_EDGE_TABLES_WEIGHT = 0.3;
 const Number SHADOW_EDGE_CLOSEST = 8.726646259971648e-4;          // 0.05 degrees
@@ -266,23 +268,22 @@ Number GetScatteringSplitSunZenith(IN(AtmosphereParameters) atmosphere) {
 }
 
 // X, a unit sun from 1 at the zenith to 0 at the tables' lowest sun (and
-// below), like GetScatteringUnitMuS but with Bruneton's k = 1, and its
-// derivative in the sun zenith angle theta: with a = (d - d_min) / (d_max -
-// d_min) (as there) and A its value at scattering_mu_s_min, X = (1 - a / A)
-// / (1 + a); d = -R mu_s + sqrt(R^2 mu_s^2 + top^2 - R^2) (R the bottom
-// radius) has dd/dmu_s = -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta).
+// on below it, negative and smooth), like GetScatteringUnitMuS but with
+// Bruneton's k = 1, and its derivative in the sun zenith angle theta: with
+// a = (d - d_min) / (d_max - d_min) (as there) and A its value at
+// scattering_mu_s_min, X = (1 - a / A) / (1 + a); d = -R mu_s +
+// sqrt(R^2 mu_s^2 + top^2 - R^2) (R the bottom radius) has dd/dmu_s =
+// -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta).
 Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number sun_zenith, OUT(Number) derivative) {
   Number bottom = atmosphere.bottom_radius;
   Number mu_s = cos(sun_zenith);
-  bool below = mu_s <= atmosphere.scattering_mu_s_min;
-  mu_s = max(mu_s, atmosphere.scattering_mu_s_min);
   Number d = DistanceToTopAtmosphereBoundary(atmosphere, bottom, mu_s);
   Number d_min = atmosphere.top_radius - bottom;
   Number span = HorizonDistanceAtTop(atmosphere) - d_min;
   Number a = (d - d_min) / span;
   Number inverse_A = 1.0 / GetScatteringLowestSunDistance(atmosphere);
   Number da_dtheta = bottom * d / (d + bottom * mu_s) / span * sin(sun_zenith);
-  derivative = below ? 0.0 : -(inverse_A + 1.0) / ((1.0 + a) * (1.0 + a)) * da_dtheta;
+  derivative = -(inverse_A + 1.0) / ((1.0 + a) * (1.0 + a)) * da_dtheta;
   return (1.0 - a * inverse_A) / (1.0 + a);
 }
 
@@ -295,33 +296,56 @@ Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number sun_zenith,
 // closes in on the edge, near which the light falls as D^3 (the disc's
 // smooth step times the lit stretch) and farther out as fast as the
 // sunlight's grazing path thickens; X keeps the tables' density of columns
-// toward a low sun, where light grazing the ground changes fast too. Also
-// dx/ds in s = ln D.
-Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, Number distance, Number edge, Number split_sun,
-                         OUT(Number) derivative) {
-  Number D = clamp(distance, SHADOW_EDGE_CLOSEST, edge - split_sun);
-  Number unused;
+// toward a low sun, where light grazing the ground changes fast too. From
+// the edge's X(E - D_min) (X_closest), X(theta_split) - X(E - D_min)
+// (X_span) and ln((E - theta_split) / D_min) (log_span); also dx/ds in
+// s = ln D.
+Number ShadowEdgeLitUnitFrom(IN(AtmosphereParameters) atmosphere, Number D, Number edge, Number X_closest,
+                             Number X_span, Number log_span, OUT(Number) derivative) {
   Number dX_dtheta;
-  Number X_closest = ShadowEdgeUnitSun(atmosphere, edge - SHADOW_EDGE_CLOSEST, unused);
-  Number X_span = ShadowEdgeUnitSun(atmosphere, split_sun, unused) - X_closest;
   Number X = ShadowEdgeUnitSun(atmosphere, edge - D, dX_dtheta);
-  Number log_span = log((edge - split_sun) / SHADOW_EDGE_CLOSEST);
   derivative = -SHADOW_EDGE_TABLES_WEIGHT * dX_dtheta * D / X_span + (1.0 - SHADOW_EDGE_TABLES_WEIGHT) / log_span;
   return SHADOW_EDGE_TABLES_WEIGHT * (X - X_closest) / X_span +
          (1.0 - SHADOW_EDGE_TABLES_WEIGHT) * log(D / SHADOW_EDGE_CLOSEST) / log_span;
 }
 
+// ShadowEdgeLitUnitFrom's constants for the edge.
+void ShadowEdgeLitUnitSpans(IN(AtmosphereParameters) atmosphere, Number edge, Number split_sun,
+                            OUT(Number) X_closest, OUT(Number) X_span, OUT(Number) log_span) {
+  Number unused;
+  X_closest = ShadowEdgeUnitSun(atmosphere, edge - SHADOW_EDGE_CLOSEST, unused);
+  X_span = ShadowEdgeUnitSun(atmosphere, split_sun, unused) - X_closest;
+  log_span = log((edge - split_sun) / SHADOW_EDGE_CLOSEST);
+}
+
+Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, Number distance, Number edge, Number split_sun) {
+  Number X_closest;
+  Number X_span;
+  Number log_span;
+  ShadowEdgeLitUnitSpans(atmosphere, edge, split_sun, X_closest, X_span, log_span);
+  Number unused;
+  return ShadowEdgeLitUnitFrom(atmosphere, clamp(distance, SHADOW_EDGE_CLOSEST, edge - split_sun), edge, X_closest,
+                               X_span, log_span, unused);
+}
+
 // Its inverse: D at position x in [0, 1], by Newton's method in s = ln D
 // from the logarithm's term alone (x rises with s, at least at 1 - w times
-// the logarithm's rate; eight steps reach the double's precision).
+// the logarithm's rate), to 1e-11 in ln D in a few steps.
 Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, Number x, Number edge, Number split_sun) {
+  Number X_closest;
+  Number X_span;
+  Number log_span;
+  ShadowEdgeLitUnitSpans(atmosphere, edge, split_sun, X_closest, X_span, log_span);
   Number s_min = log(SHADOW_EDGE_CLOSEST);
-  Number s_max = log(edge - split_sun);
+  Number s_max = s_min + log_span;
   Number s = mix(s_min, s_max, x);
-  for (int i = 0; i < 8; ++i) {
+  for (int i = 0; i < 12; ++i) {
     Number slope;
-    Number error = ShadowEdgeLitUnit(atmosphere, exp(s), edge, split_sun, slope) - x;
-    s = clamp(s - error / slope, s_min, s_max);
+    Number error = ShadowEdgeLitUnitFrom(atmosphere, exp(s), edge, X_closest, X_span, log_span, slope) - x;
+    Number next = clamp(s - error / slope, s_min, s_max);
+    bool converged = abs(next - s) < 1e-11;
+    s = next;
+    if (converged) break;
   }
   return exp(s);
 }
@@ -338,26 +362,26 @@ Number ShadowEdgePastStep(IN(AtmosphereParameters) atmosphere, Number edge) {
 // sun_zenith below the split, for a ray whose edge is `edge`: between the lit
 // columns at x (ShadowEdgeLitUnit); within SHADOW_EDGE_CLOSEST of the edge,
 // in proportion to D between the columns at E and D_min; past the edge, in
-// proportion to the angle past it, held at the last column.
+// proportion to the angle past it (negative past the first column).
 Number GetScatteringShadowEdgePosition(IN(AtmosphereParameters) atmosphere, Number sun_zenith, Number edge) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
   Number split_sun = GetScatteringSplitSunZenith(atmosphere);
   Number D = edge - sun_zenith;
-  Number unused;
   if (D >= SHADOW_EDGE_CLOSEST) {
-    return past + ShadowEdgeLitUnit(atmosphere, D, edge, split_sun, unused) *
-                      (Number(atmosphere.scattering_mu_s_split) - past);
+    return past + ShadowEdgeLitUnit(atmosphere, D, edge, split_sun) * (Number(atmosphere.scattering_mu_s_split) - past);
   }
   if (D >= 0.0) return past - 1.0 + D / SHADOW_EDGE_CLOSEST;
-  return max(past - 1.0 + D / ShadowEdgePastStep(atmosphere, edge), 0.0);
+  return past - 1.0 + D / ShadowEdgePastStep(atmosphere, edge);
 }
 
-// Its inverse: the sun zenith angle at `position` (below the split).
-Number GetScatteringShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number position, Number edge) {
+// Its inverse: the sun zenith angle at `position` (below the split, whose
+// sun zenith angle is split_sun).
+Number GetScatteringShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number position, Number edge,
+                                        Number split_sun) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
   if (position >= past) {
     Number x = (position - past) / (Number(atmosphere.scattering_mu_s_split) - past);
-    return edge - ShadowEdgeLitDistance(atmosphere, x, edge, GetScatteringSplitSunZenith(atmosphere));
+    return edge - ShadowEdgeLitDistance(atmosphere, x, edge, split_sun);
   }
   if (position >= past - 1.0) return edge - (position - past + 1.0) * SHADOW_EDGE_CLOSEST;
   return edge + (past - 1.0 - position) * ShadowEdgePastStep(atmosphere, edge);
@@ -715,14 +739,24 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
                       x - k, true);
 }
 
+// The light of a ray's own column, the two nu slices blended geometrically.
+vec4 GetScatteringAtOwnColumnBetweenSlices(IN(AtmosphereParameters) atmosphere,
+                                           IN(ScatteringTexture) scattering_texture, IN(vec4) uvwz, Number column,
+                                           Number nu_slice, Number nu_t) {
+  return SunCosineMix(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice),
+                      GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice + 1.0), nu_t,
+                      true);
+}
+
 // 4D lookup: the mu_s texel columns either side of mu_s
 // (GetScatteringAtMuSColumn, two fetches each), blended linearly in
 // daylight (four fetches); for a low sun between two columns by
 // LogMonotoneCubicMix of the four columns around it (eight fetches), and
 // below the table's lowest sun by LowestSunLogFall of the two lowest
 // columns (four fetches). Below the split, each nu slice's light on the
-// ray's own columns (GetScatteringBelowSplit, four fetches each),
-// geometric between the two slices.
+// ray's own columns (GetScatteringBelowSplit, up to four fetches each),
+// geometric between the two slices, and past the ray's first column
+// LowestSunLogFall of its first two (four fetches).
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
@@ -734,12 +768,28 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   if (atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)) {
     Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
     Number log_first_span = 1.0;
-    if (position >= past - 1.0 && position < past) {
+    if (position < past) {
       Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu),
                                         ray_r_mu_intersects_ground);
-      Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
-      log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge, GetScatteringSplitSunZenith(atmosphere)) /
-                           SHADOW_EDGE_CLOSEST);
+      if (position < 0.0) {
+        // Past the first column (the tables' lowest sun, or
+        // SHADOW_EDGE_LEAST_PAST_SPAN past the edge): ln L continued from
+        // the first two (LowestSunLogFall), as below the tables' lowest sun.
+        Number step = ShadowEdgePastStep(atmosphere, edge);
+        Number mu_s_first = cos(edge + (past - 1.0) * step);
+        vec4 first = GetScatteringAtOwnColumnBetweenSlices(atmosphere, scattering_texture, uvwz, 0.0, nu_slice, nu_t);
+        vec4 second = GetScatteringAtOwnColumnBetweenSlices(atmosphere, scattering_texture, uvwz, 1.0, nu_slice, nu_t);
+        vec4 slope;
+        vec4 curvature;
+        LowestSunLogFall(first, second, mu_s_first, cos(edge + (past - 2.0) * step), slope, curvature);
+        Number d = mu_s - mu_s_first;
+        return first * exp(d * (slope + d * curvature));
+      }
+      if (position >= past - 1.0) {
+        Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
+        log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge, GetScatteringSplitSunZenith(atmosphere)) /
+                             SHADOW_EDGE_CLOSEST);
+      }
     }
     return SunCosineMix(
         GetScatteringBelowSplit(atmosphere, scattering_texture, uvwz, position, nu_slice, log_first_span),

@@ -25,24 +25,36 @@ Number ClampNuToDirections(Number nu, Number mu, Number mu_s) {
 }
 
 // The sun zenith angle of a ray's own column at `position` below the split
-// (GetScatteringShadowEdgeSunZenith) for the nu slice at nu: the column's
-// sun sets the azimuth at which nu lies (nu clamped to the range mu and the
-// sun allow), which sets the ray's edge, which sets the column's sun; the
-// fixed point of the three, from the sun at the horizon (a few steps; the
-// edge moves less than the sun does).
+// (GetScatteringShadowEdgeSunZenith; split_sun the split's sun zenith
+// angle) for the nu slice at nu: the column's sun sets the azimuth at which
+// nu lies (nu clamped to the range mu and the sun allow), which sets the
+// ray's edge, which sets the column's sun. Their fixed point, from the edge
+// start_edge (the edge moves less than the sun does: on Earth's default
+// table three steps from the edge of a sun at the horizon, on average, to
+// 1e-11 radians); `edge` is the column's.
 Number GetScatteringOwnColumnSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
-                                       bool ray_r_mu_intersects_ground, Number position) {
-  Number sun = 0.5 * PI;
+                                       bool ray_r_mu_intersects_ground, Number position, Number split_sun,
+                                       Number start_edge, OUT(Number) edge) {
+  edge = start_edge;
+  Number sun = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge, split_sun);
   for (int i = 0; i < 50; ++i) {
     Number mu_s = cos(sun);
     Number cos_phi = ViewSunAzimuthCosine(mu, mu_s, ClampNuToDirections(nu, mu, mu_s));
-    Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
-    Number next = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge);
-    bool converged = abs(next - sun) < 1e-12;
+    edge = ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
+    Number next = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge, split_sun);
+    bool converged = abs(next - sun) < 1e-11;
     sun = next;
     if (converged) break;
   }
   return sun;
+}
+
+// The edge of the ray (r, mu) for the sun at the horizon in the direction
+// of the slice at nu: the first guess of GetScatteringOwnColumnSunZenith.
+Number GetScatteringHorizonSunEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
+                                   bool ray_r_mu_intersects_ground) {
+  Number cos_phi = ViewSunAzimuthCosine(mu, 0.0, ClampNuToDirections(nu, mu, 0.0));
+  return ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
 }
 
 // uvwz = (u_nu, u_mu_s, u_mu, u_r) as returned by
@@ -77,9 +89,13 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
   nu = ClampCosine(uvwz.x * 2.0 - 1.0);
   Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size);
   Number position = x_mu_s * Number(atmosphere.scattering_mu_s_size - 1);
-  mu_s = atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)
-             ? cos(GetScatteringOwnColumnSunZenith(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, position))
-             : GetScatteringMuSFromUnitRange(atmosphere, x_mu_s);
+  mu_s = GetScatteringMuSFromUnitRange(atmosphere, x_mu_s);
+  if (atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)) {
+    Number edge;
+    mu_s = cos(GetScatteringOwnColumnSunZenith(
+        atmosphere, r, mu, nu, ray_r_mu_intersects_ground, position, GetScatteringSplitSunZenith(atmosphere),
+        GetScatteringHorizonSunEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground), edge));
+  }
 }
 
 void GetRMuSFromIrradianceTextureUv(IN(AtmosphereParameters) atmosphere, IN(vec2) uv, OUT(Number) r,

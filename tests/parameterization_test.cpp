@@ -51,17 +51,19 @@ void ExpectScatteringRoundTrip(const glsl::AtmosphereParameters& p) {
         glsl::vec4 uvwz = glsl::GetScatteringTextureUvwzFromRMuMuSNu(p, t.r, t.mu, t.mu_s, t.grid_nu,
                                                                      t.ray_intersects_ground);
         int nu_index = x / p.scattering_mu_s_size, mu_s_index = x % p.scattering_mu_s_size;
-        EXPECT_NEAR(uvwz.x, double(nu_index) / (p.scattering_nu_size - 1), 1e-12);
-        EXPECT_NEAR(uvwz.y, (mu_s_index + 0.5) / p.scattering_mu_s_size, 1e-7);
         // On the ground (r = bottom) every downward ray has length zero, so the
         // ground half of the mu axis collapses to one point by construction.
         bool degenerate = t.ray_intersects_ground && t.r == p.bottom_radius;
         // The first and last mu texels are the tangent ray, seen from each half.
         // It is ill-conditioned: its distances are square roots of a
         // discriminant that vanishes, so a rounding error of 1e-16 in mu moves
-        // u_mu by ~1e-7, and a numerical ground test cannot decide.
+        // u_mu by ~1e-7, and a numerical ground test cannot decide; below the
+        // split its shadow edge, and with it its own columns' u_mu_s, move
+        // as much.
         bool tangent = y == 0 || y == p.scattering_mu_size - 1;
         double tolerance = tangent ? 1e-5 : 1e-7;
+        EXPECT_NEAR(uvwz.x, double(nu_index) / (p.scattering_nu_size - 1), 1e-12);
+        EXPECT_NEAR(uvwz.y, (mu_s_index + 0.5) / p.scattering_mu_s_size, tolerance) << "z " << z << " y " << y;
         if (!degenerate) {
           EXPECT_NEAR(uvwz.z, (y + 0.5) / p.scattering_mu_size, tolerance) << "z " << z << " y " << y;
         }
@@ -84,14 +86,25 @@ TEST(Parameterization, RestrictedScatteringRoundTripBothHalves) { ExpectScatteri
 
 TEST(Parameterization, RestrictedAxesSpanTheirRanges) {
   // The first and last texel centres of the r and mu_s axes are the ends of
-  // the scene's ranges; the mu axis is the full one at each radius.
+  // the scene's ranges, the first mu_s column where a ray's shadow edge
+  // lies at least 2 degrees before the lowest sun (its own columns below
+  // the split end there; else 2 degrees past the edge); the mu axis is the
+  // full one at each radius.
   const glsl::AtmosphereParameters p = RestrictedParameters();
+  ASSERT_GT(p.scattering_mu_s_split, 0);
   double r, mu, mu_s, nu;
   bool ground;
-  const double n_r = p.scattering_r_size, n_mu_s = p.scattering_mu_s_size;
+  const double n_r = p.scattering_r_size, n_mu_s = p.scattering_mu_s_size, degree = glsl::PI / 180.0;
   glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 0.5 / n_mu_s, 0.75, 0.5 / n_r), r, mu, mu_s, nu,
                                              ground);
   EXPECT_NEAR(r, p.bottom_radius + 500.0, 1e-6);
+  const double edge = glsl::ShadowEdgeSunZenith(p, r, mu, glsl::ViewSunAzimuthCosine(mu, mu_s, nu), ground);
+  EXPECT_NEAR(mu_s, std::cos(std::max(95.0 * degree, edge + 2.0 * degree)), 1e-9);
+  // A ray from 500 m up whose edge is 2 degrees and more before 95 degrees:
+  // straight down.
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 0.5 / n_mu_s, 0.5 - 0.5 / p.scattering_mu_size, 0.5 / n_r), r,
+                                             mu, mu_s, nu, ground);
+  ASSERT_LT(glsl::ShadowEdgeSunZenith(p, r, mu, glsl::ViewSunAzimuthCosine(mu, mu_s, nu), ground), 93.0 * degree);
   EXPECT_NEAR(mu_s, std::cos(95.0 * glsl::PI / 180.0), 1e-9);
   glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 1.0 - 0.5 / n_mu_s, 0.75, 1.0 - 0.5 / n_r), r, mu,
                                              mu_s, nu, ground);

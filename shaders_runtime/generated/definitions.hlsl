@@ -22,6 +22,7 @@ struct AtmosphereParameters
     float scattering_r_max;
     float scattering_mu_s_min;
     float scattering_mu_s_max;
+    int scattering_mu_s_split;
     int irradiance_width;
     int irradiance_height;
     float3 extinction_profile[64];

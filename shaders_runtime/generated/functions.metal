@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _848 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _934 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_848)
+    if (!_934)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _711 = mu < 0.0;
-    bool _723;
-    if (_711)
+    bool _797 = mu < 0.0;
+    bool _809;
+    if (_797)
     {
-        _723 = (((r * r) * mu) * mu) >= c;
+        _809 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _723 = _711;
+        _809 = _797;
     }
-    return _723;
+    return _809;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _481;
+    float _567;
     if (r_mu > 0.0)
     {
-        _481 = c / (r_mu + s);
+        _567 = c / (r_mu + s);
     }
     else
     {
-        _481 = s - r_mu;
+        _567 = s - r_mu;
     }
-    float param_1 = _481;
+    float param_1 = _567;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _940;
+    float _1026;
     if (d_max > d_min)
     {
-        _940 = (d - d_min) / (d_max - d_min);
+        _1026 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _940 = 0.0;
+        _1026 = 0.0;
     }
-    float x_mu = _940;
+    float x_mu = _1026;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -251,14 +251,6 @@ float GetScatteringTextureUR(thread const AtmosphereParameters& atmosphere, thre
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float ScatteringUnitNu(thread const float& nu)
-{
-    return (nu + 1.0) / 2.0;
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
 float GetScatteringLowestSunDistance(thread const AtmosphereParameters& atmosphere)
 {
     float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
@@ -316,122 +308,107 @@ float GetScatteringTextureUMuS(thread const AtmosphereParameters& atmosphere, th
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
+float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thread const float& nu)
 {
-    AtmosphereParameters param = atmosphere;
-    float H = HorizonDistanceAtTop(param);
-    AtmosphereParameters param_1 = atmosphere;
-    float param_2 = r;
-    float rho = HorizonDistance(param_1, param_2);
-    float half_mu_size = float(atmosphere.scattering_mu_size / 2);
-    float x_mu;
-    float u_mu;
+    float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
+    float across = SafeSqrt(param);
+    float _1231;
+    if (across > 0.0)
+    {
+        float param_1 = (nu - (mu * mu_s)) / across;
+        _1231 = ClampCosine(param_1);
+    }
+    else
+    {
+        _1231 = 1.0;
+    }
+    return _1231;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
+{
+    float _813;
     if (ray_r_mu_intersects_ground)
+    {
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        _813 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+    }
+    else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
-        float d_min = r - atmosphere.bottom_radius;
-        float d_max = rho;
-        float _1280;
-        if (d_max == d_min)
-        {
-            _1280 = 0.0;
-        }
-        else
-        {
-            _1280 = (d - d_min) / (d_max - d_min);
-        }
-        x_mu = _1280;
-        u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
+        _813 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    else
-    {
-        AtmosphereParameters param_6 = atmosphere;
-        float param_7 = r;
-        float param_8 = mu;
-        float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
-        float d_min_1 = atmosphere.top_radius - r;
-        float d_max_1 = rho + H;
-        float _1324;
-        if (d_max_1 > d_min_1)
-        {
-            _1324 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
-        }
-        else
-        {
-            _1324 = 0.0;
-        }
-        x_mu = _1324;
-        u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
-    }
-    AtmosphereParameters param_9 = atmosphere;
-    float param_10 = r;
-    float param_11 = rho;
-    bool param_12 = ray_r_mu_intersects_ground;
-    float param_13 = x_mu;
-    float u_r = GetScatteringTextureUR(param_9, param_10, param_11, param_12, param_13);
-    float param_14 = nu;
-    float u_nu = ScatteringUnitNu(param_14);
-    AtmosphereParameters param_15 = atmosphere;
-    float param_16 = mu_s;
-    return float4(u_nu, GetScatteringTextureUMuS(param_15, param_16), u_mu, u_r);
+    return _813;
 }
 #endif
 
 static inline __attribute__((always_inline))
-float SunCosinePosition(thread const float& t, thread const bool& low_sun)
+float ClampRadius(thread const AtmosphereParameters& atmosphere, thread const float& r)
 {
-    float _1699;
-    if (low_sun)
-    {
-        _1699 = fast::min(t, 1.0);
-    }
-    else
-    {
-        _1699 = fast::clamp(t, 0.0, 1.0);
-    }
-    return _1699;
+    return fast::clamp(r, atmosphere.bottom_radius, atmosphere.top_radius);
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thread const float& u_mu_s, thread const float& x_low_sun, thread float& x_below, thread float& x_above, thread float& mu_s_t, thread bool& low_sun_below)
+float RadiusAtDistance(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& d)
 {
-    float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    float mu_s_coord = (u_mu_s * mu_s_size) - 0.5;
-    float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
-    x_below = (mu_s_column + 0.5) / mu_s_size;
-    x_above = (mu_s_column + 1.5) / mu_s_size;
-    low_sun_below = x_below < x_low_sun;
-    float param = mu_s_coord - mu_s_column;
-    bool param_1 = low_sun_below;
-    mu_s_t = SunCosinePosition(param, param_1);
+    AtmosphereParameters param = atmosphere;
+    float param_1 = sqrt(((d * d) + (((2.0 * r) * mu) * d)) + (r * r));
+    return ClampRadius(param, param_1);
 }
 #endif
 
 static inline __attribute__((always_inline))
-float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
+float HorizonZenithCosine(thread const float& bottom_radius, thread const float& r)
 {
-    if (!low_sun)
-    {
-        return mix(a, b, float4(t));
-    }
-    float4 dark = float4(1.0000000031710768509710513471353e-30);
-    return exp(mix(log(fast::max(a, dark)), log(fast::max(b, dark)), float4(t))) * step(dark, fast::max(a, b));
+    float param = bottom_radius;
+    float param_1 = r;
+    return (-DistanceToHorizon(param, param_1)) / r;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
+float ShadowEdgeSunZenith(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& cos_phi, thread const bool& ray_r_mu_intersects_ground)
 {
-    float nu_size = float(atmosphere.scattering_nu_size);
-    float4 param = scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / nu_size, uvwz.z, uvwz.w), level(0.0));
-    float4 param_1 = scattering_texture.sample(scattering_textureSmplr, float3(((nu_slice + 1.0) + x) / nu_size, uvwz.z, uvwz.w), level(0.0));
-    float param_2 = nu_t;
-    bool param_3 = low_sun;
-    return SunCosineMix(param, param_1, param_2, param_3);
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    bool param_3 = ray_r_mu_intersects_ground;
+    float d = DistanceToNearestAtmosphereBoundary(param, param_1, param_2, param_3);
+    AtmosphereParameters param_4 = atmosphere;
+    float param_5 = r;
+    float param_6 = mu;
+    float param_7 = d;
+    float r_d = RadiusAtDistance(param_4, param_5, param_6, param_7);
+    float param_8 = (r + (d * mu)) / r_d;
+    float cos_alpha = ClampCosine(param_8);
+    float param_9 = 1.0 - (mu * mu);
+    float across = ((d * SafeSqrt(param_9)) / r_d) * cos_phi;
+    float rho = sqrt((across * across) + (cos_alpha * cos_alpha));
+    float param_10 = atmosphere.bottom_radius;
+    float param_11 = r_d;
+    float c_end = -HorizonZenithCosine(param_10, param_11);
+    float _1311;
+    if (c_end >= rho)
+    {
+        _1311 = 3.1415927410125732421875;
+    }
+    else
+    {
+        _1311 = precise::atan2(across, cos_alpha) + acos((-c_end) / rho);
+    }
+    float end = _1311;
+    float param_12 = atmosphere.bottom_radius;
+    float param_13 = r;
+    float start = acos(HorizonZenithCosine(param_12, param_13));
+    return fast::max(start, end) + atmosphere.sun_angular_radius;
 }
 #endif
 
@@ -461,17 +438,287 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_5 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1087;
+    float _1173;
     if (d == 0.0)
     {
-        _1087 = 1.0;
+        _1173 = 1.0;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1087 = ClampCosine(param_6);
+        _1173 = ClampCosine(param_6);
     }
-    return _1087;
+    return _1173;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float GetScatteringSplitSunZenith(thread const AtmosphereParameters& atmosphere)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = float(atmosphere.scattering_mu_s_split) / float(atmosphere.scattering_mu_s_size - 1);
+    return acos(GetScatteringMuSFromUnitRange(param, param_1));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float ShadowEdgeUnitSun(thread const AtmosphereParameters& atmosphere, thread const float& sun_zenith, thread float& derivative)
+{
+    float bottom = atmosphere.bottom_radius;
+    float mu_s = cos(sun_zenith);
+    AtmosphereParameters param = atmosphere;
+    float param_1 = bottom;
+    float param_2 = mu_s;
+    float d = DistanceToTopAtmosphereBoundary(param, param_1, param_2);
+    float d_min = atmosphere.top_radius - bottom;
+    AtmosphereParameters param_3 = atmosphere;
+    float span = HorizonDistanceAtTop(param_3) - d_min;
+    float a = (d - d_min) / span;
+    AtmosphereParameters param_4 = atmosphere;
+    float inverse_A = 1.0 / GetScatteringLowestSunDistance(param_4);
+    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * sin(sun_zenith);
+    derivative = ((-(inverse_A + 1.0)) / ((1.0 + a) * (1.0 + a))) * da_dtheta;
+    return (1.0 - (a * inverse_A)) / (1.0 + a);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, thread const float& edge, thread const float& split_sun, thread float& X_closest, thread float& X_span, thread float& log_span)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = edge - 0.0008726646192371845245361328125;
+    float param_2;
+    float _1476 = ShadowEdgeUnitSun(param, param_1, param_2);
+    float unused = param_2;
+    X_closest = _1476;
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = split_sun;
+    float param_5;
+    float _1483 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    unused = param_5;
+    X_span = _1483 - X_closest;
+    log_span = log((edge - split_sun) / 0.0008726646192371845245361328125);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, thread const float& D, thread const float& edge, thread const float& X_closest, thread const float& X_span, thread const float& log_span, thread float& derivative)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = edge - D;
+    float param_2;
+    float _1439 = ShadowEdgeUnitSun(param, param_1, param_2);
+    float dX_dtheta = param_2;
+    float X = _1439;
+    derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
+    return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread const float& _distance, thread const float& edge, thread const float& split_sun)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = edge;
+    float param_2 = split_sun;
+    float param_3;
+    float param_4;
+    float param_5;
+    ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5);
+    float X_closest = param_3;
+    float X_span = param_4;
+    float log_span = param_5;
+    AtmosphereParameters param_6 = atmosphere;
+    float param_7 = fast::clamp(_distance, 0.0008726646192371845245361328125, edge - split_sun);
+    float param_8 = edge;
+    float param_9 = X_closest;
+    float param_10 = X_span;
+    float param_11 = log_span;
+    float param_12;
+    float _1526 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float unused = param_12;
+    return _1526;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float ShadowEdgePastStep(thread const AtmosphereParameters& atmosphere, thread const float& edge)
+{
+    float lowest = acos(atmosphere.scattering_mu_s_min);
+    return fast::max(lowest - edge, 0.0349065847694873809814453125) / 5.0;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float GetScatteringShadowEdgePosition(thread const AtmosphereParameters& atmosphere, thread const float& sun_zenith, thread const float& edge)
+{
+    float past = 6.0;
+    AtmosphereParameters param = atmosphere;
+    float split_sun = GetScatteringSplitSunZenith(param);
+    float D = edge - sun_zenith;
+    if (D >= 0.0008726646192371845245361328125)
+    {
+        AtmosphereParameters param_1 = atmosphere;
+        float param_2 = D;
+        float param_3 = edge;
+        float param_4 = split_sun;
+        return past + (ShadowEdgeLitUnit(param_1, param_2, param_3, param_4) * (float(atmosphere.scattering_mu_s_split) - past));
+    }
+    if (D >= 0.0)
+    {
+        return (past - 1.0) + (D / 0.0008726646192371845245361328125);
+    }
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = edge;
+    return (past - 1.0) + (D / ShadowEdgePastStep(param_5, param_6));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float ScatteringUnitNu(thread const float& nu)
+{
+    return (nu + 1.0) / 2.0;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float H = HorizonDistanceAtTop(param);
+    AtmosphereParameters param_1 = atmosphere;
+    float param_2 = r;
+    float rho = HorizonDistance(param_1, param_2);
+    float half_mu_size = float(atmosphere.scattering_mu_size / 2);
+    float x_mu;
+    float u_mu;
+    if (ray_r_mu_intersects_ground)
+    {
+        AtmosphereParameters param_3 = atmosphere;
+        float param_4 = r;
+        float param_5 = mu;
+        float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
+        float d_min = r - atmosphere.bottom_radius;
+        float d_max = rho;
+        float _1828;
+        if (d_max == d_min)
+        {
+            _1828 = 0.0;
+        }
+        else
+        {
+            _1828 = (d - d_min) / (d_max - d_min);
+        }
+        x_mu = _1828;
+        u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
+    }
+    else
+    {
+        AtmosphereParameters param_6 = atmosphere;
+        float param_7 = r;
+        float param_8 = mu;
+        float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
+        float d_min_1 = atmosphere.top_radius - r;
+        float d_max_1 = rho + H;
+        float _1872;
+        if (d_max_1 > d_min_1)
+        {
+            _1872 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+        }
+        else
+        {
+            _1872 = 0.0;
+        }
+        x_mu = _1872;
+        u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
+    }
+    AtmosphereParameters param_9 = atmosphere;
+    float param_10 = r;
+    float param_11 = rho;
+    bool param_12 = ray_r_mu_intersects_ground;
+    float param_13 = x_mu;
+    float u_r = GetScatteringTextureUR(param_9, param_10, param_11, param_12, param_13);
+    AtmosphereParameters param_14 = atmosphere;
+    float param_15 = mu_s;
+    float u_mu_s = GetScatteringTextureUMuS(param_14, param_15);
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    bool _1918 = atmosphere.scattering_mu_s_split > 0;
+    bool _1929;
+    if (_1918)
+    {
+        _1929 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+    }
+    else
+    {
+        _1929 = _1918;
+    }
+    if (_1929)
+    {
+        float param_16 = mu;
+        float param_17 = mu_s;
+        float param_18 = nu;
+        AtmosphereParameters param_19 = atmosphere;
+        float param_20 = r;
+        float param_21 = mu;
+        float param_22 = ViewSunAzimuthCosine(param_16, param_17, param_18);
+        bool param_23 = ray_r_mu_intersects_ground;
+        float edge = ShadowEdgeSunZenith(param_19, param_20, param_21, param_22, param_23);
+        AtmosphereParameters param_24 = atmosphere;
+        float param_25 = acos(mu_s);
+        float param_26 = edge;
+        u_mu_s = (GetScatteringShadowEdgePosition(param_24, param_25, param_26) + 0.5) / mu_s_size;
+    }
+    float param_27 = nu;
+    return float4(ScatteringUnitNu(param_27), u_mu_s, u_mu, u_r);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 GetScatteringAtOwnColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& column, thread const float& nu_slice)
+{
+    float x = (column + 0.5) / float(atmosphere.scattering_mu_s_size);
+    return scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / float(atmosphere.scattering_nu_size), uvwz.z, uvwz.w), level(0.0));
+}
+#endif
+
+static inline __attribute__((always_inline))
+float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
+{
+    if (!low_sun)
+    {
+        return mix(a, b, float4(t));
+    }
+    float4 dark = float4(1.0000000031710768509710513471353e-30);
+    return exp(mix(log(fast::max(a, dark)), log(fast::max(b, dark)), float4(t))) * step(dark, fast::max(a, b));
+}
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 GetScatteringAtOwnColumnBetweenSlices(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& column, thread const float& nu_slice, thread const float& nu_t)
+{
+    AtmosphereParameters param = atmosphere;
+    float4 param_1 = uvwz;
+    float param_2 = column;
+    float param_3 = nu_slice;
+    AtmosphereParameters param_4 = atmosphere;
+    float4 param_5 = uvwz;
+    float param_6 = column;
+    float param_7 = nu_slice + 1.0;
+    float4 param_8 = GetScatteringAtOwnColumn(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
+    float4 param_9 = GetScatteringAtOwnColumn(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
+    float param_10 = nu_t;
+    bool param_11 = true;
+    return SunCosineMix(param_8, param_9, param_10, param_11);
 }
 #endif
 
@@ -497,31 +744,72 @@ void LowestSunLogFall(thread const float4& a, thread const float4& b, thread con
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
+float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, thread const float& x, thread const float& edge, thread const float& split_sun)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = edge;
+    float param_2 = split_sun;
+    float param_3;
+    float param_4;
+    float param_5;
+    ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5);
+    float X_closest = param_3;
+    float X_span = param_4;
+    float log_span = param_5;
+    float s_min = -7.043959140777587890625;
+    float s_max = s_min + log_span;
+    float s = mix(s_min, s_max, x);
+    float param_12;
+    for (int i = 0; i < 12; i++)
+    {
+        AtmosphereParameters param_6 = atmosphere;
+        float param_7 = exp(s);
+        float param_8 = edge;
+        float param_9 = X_closest;
+        float param_10 = X_span;
+        float param_11 = log_span;
+        float _1583 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float slope = param_12;
+        float error = _1583 - x;
+        float next = fast::clamp(s - (error / slope), s_min, s_max);
+        bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
+        s = next;
+        if (converged)
+        {
+            break;
+        }
+    }
+    return exp(s);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
 float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, thread const float4& c, thread const float4& d, thread const bool& has_a, thread const bool& has_d, thread const float& t)
 {
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _1780;
+    float4 _2377;
     if (has_a)
     {
-        _1780 = log(fast::max(a, dark));
+        _2377 = log(fast::max(a, dark));
     }
     else
     {
-        _1780 = (lb * 2.0) - lc;
+        _2377 = (lb * 2.0) - lc;
     }
-    float4 la = _1780;
-    float4 _1795;
+    float4 la = _2377;
+    float4 _2392;
     if (has_d)
     {
-        _1795 = log(fast::max(d, dark));
+        _2392 = log(fast::max(d, dark));
     }
     else
     {
-        _1795 = (lc * 2.0) - lb;
+        _2392 = (lc * 2.0) - lb;
     }
-    float4 ld = _1795;
+    float4 ld = _2392;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -541,6 +829,125 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
+float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& position, thread const float& nu_slice, thread const float& log_first_span)
+{
+    float past = 6.0;
+    float intervals = float(atmosphere.scattering_mu_s_split) - past;
+    if (position >= past)
+    {
+        float k = fast::min(floor(position - past), intervals - 1.0);
+        float column = past + k;
+        AtmosphereParameters param = atmosphere;
+        float4 param_1 = uvwz;
+        float param_2 = column - 1.0;
+        float param_3 = nu_slice;
+        AtmosphereParameters param_4 = atmosphere;
+        float4 param_5 = uvwz;
+        float param_6 = column;
+        float param_7 = nu_slice;
+        AtmosphereParameters param_8 = atmosphere;
+        float4 param_9 = uvwz;
+        float param_10 = column + 1.0;
+        float param_11 = nu_slice;
+        AtmosphereParameters param_12 = atmosphere;
+        float4 param_13 = uvwz;
+        float param_14 = fast::min(column + 2.0, past + intervals);
+        float param_15 = nu_slice;
+        float4 param_16 = GetScatteringAtOwnColumn(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
+        float4 param_17 = GetScatteringAtOwnColumn(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
+        float4 param_18 = GetScatteringAtOwnColumn(param_8, scattering_texture, scattering_textureSmplr, param_9, param_10, param_11);
+        float4 param_19 = GetScatteringAtOwnColumn(param_12, scattering_texture, scattering_textureSmplr, param_13, param_14, param_15);
+        bool param_20 = k >= 1.0;
+        bool param_21 = (k + 2.0) <= intervals;
+        float param_22 = position - column;
+        return LogMonotoneCubicMix(param_16, param_17, param_18, param_19, param_20, param_21, param_22);
+    }
+    if (position >= (past - 1.0))
+    {
+        AtmosphereParameters param_23 = atmosphere;
+        float4 param_24 = uvwz;
+        float param_25 = past - 1.0;
+        float param_26 = nu_slice;
+        float4 at_edge = GetScatteringAtOwnColumn(param_23, scattering_texture, scattering_textureSmplr, param_24, param_25, param_26);
+        AtmosphereParameters param_27 = atmosphere;
+        float4 param_28 = uvwz;
+        float param_29 = past;
+        float param_30 = nu_slice;
+        float4 rise = GetScatteringAtOwnColumn(param_27, scattering_texture, scattering_textureSmplr, param_28, param_29, param_30) - at_edge;
+        AtmosphereParameters param_31 = atmosphere;
+        float4 param_32 = uvwz;
+        float param_33 = past + 1.0;
+        float param_34 = nu_slice;
+        float4 second_rise = GetScatteringAtOwnColumn(param_31, scattering_texture, scattering_textureSmplr, param_32, param_33, param_34) - at_edge;
+        float4 tiny = float4(1.0000000031710768509710513471353e-30);
+        float4 rises = step(tiny, rise) * (float4(1.0) - step(second_rise, rise));
+        float4 power = mix(float4(3.0), fast::clamp(log(fast::max(second_rise, tiny) / fast::max(rise, tiny)) / float4(log_first_span), float4(1.0), float4(10.0)), rises);
+        return at_edge + (rise * pow(float4((position - past) + 1.0), power));
+    }
+    float x = (past - 1.0) - position;
+    float k_1 = fast::min(floor(x), past - 2.0);
+    AtmosphereParameters param_35 = atmosphere;
+    float4 param_36 = uvwz;
+    float param_37 = (past - 1.0) - k_1;
+    float param_38 = nu_slice;
+    AtmosphereParameters param_39 = atmosphere;
+    float4 param_40 = uvwz;
+    float param_41 = (past - 2.0) - k_1;
+    float param_42 = nu_slice;
+    float4 param_43 = GetScatteringAtOwnColumn(param_35, scattering_texture, scattering_textureSmplr, param_36, param_37, param_38);
+    float4 param_44 = GetScatteringAtOwnColumn(param_39, scattering_texture, scattering_textureSmplr, param_40, param_41, param_42);
+    float param_45 = x - k_1;
+    bool param_46 = true;
+    return SunCosineMix(param_43, param_44, param_45, param_46);
+}
+#endif
+
+static inline __attribute__((always_inline))
+float SunCosinePosition(thread const float& t, thread const bool& low_sun)
+{
+    float _2296;
+    if (low_sun)
+    {
+        _2296 = fast::min(t, 1.0);
+    }
+    else
+    {
+        _2296 = fast::clamp(t, 0.0, 1.0);
+    }
+    return _2296;
+}
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thread const float& u_mu_s, thread const float& x_low_sun, thread float& x_below, thread float& x_above, thread float& mu_s_t, thread bool& low_sun_below)
+{
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    float mu_s_coord = (u_mu_s * mu_s_size) - 0.5;
+    float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
+    x_below = (mu_s_column + 0.5) / mu_s_size;
+    x_above = (mu_s_column + 1.5) / mu_s_size;
+    low_sun_below = x_below < x_low_sun;
+    float param = mu_s_coord - mu_s_column;
+    bool param_1 = low_sun_below;
+    mu_s_t = SunCosinePosition(param, param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
+{
+    float nu_size = float(atmosphere.scattering_nu_size);
+    float4 param = scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / nu_size, uvwz.z, uvwz.w), level(0.0));
+    float4 param_1 = scattering_texture.sample(scattering_textureSmplr, float3(((nu_slice + 1.0) + x) / nu_size, uvwz.z, uvwz.w), level(0.0));
+    float param_2 = nu_t;
+    bool param_3 = low_sun;
+    return SunCosineMix(param, param_1, param_2, param_3);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
 float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
 {
     AtmosphereParameters param = atmosphere;
@@ -554,52 +961,135 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float nu_coord = uvwz.x * (nu_size - 1.0);
     float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
     float nu_t = nu_coord - nu_slice;
-    AtmosphereParameters param_6 = atmosphere;
-    float param_7 = 0.100000001490116119384765625;
-    float x_low_sun = GetScatteringTextureUMuS(param_6, param_7);
-    AtmosphereParameters param_8 = atmosphere;
-    float param_9 = uvwz.y;
-    float param_10 = x_low_sun;
-    float param_11;
-    float param_12;
-    float param_13;
-    bool param_14;
-    GetScatteringMuSColumns(param_8, param_9, param_10, param_11, param_12, param_13, param_14);
-    float x_below = param_11;
-    float x_above = param_12;
-    float mu_s_t = param_13;
-    bool low_sun_below = param_14;
-    AtmosphereParameters param_15 = atmosphere;
-    float4 param_16 = uvwz;
-    float param_17 = x_below;
-    float param_18 = nu_slice;
-    float param_19 = nu_t;
-    bool param_20 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_15, scattering_texture, scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20);
-    AtmosphereParameters param_21 = atmosphere;
-    float4 param_22 = uvwz;
-    float param_23 = x_above;
-    float param_24 = nu_slice;
-    float param_25 = nu_t;
-    bool param_26 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_21, scattering_texture, scattering_textureSmplr, param_22, param_23, param_24, param_25, param_26);
+    float position = (uvwz.y * float(atmosphere.scattering_mu_s_size)) - 0.5;
+    bool _2923 = atmosphere.scattering_mu_s_split > 0;
+    bool _2931;
+    if (_2923)
+    {
+        _2931 = position < float(atmosphere.scattering_mu_s_split);
+    }
+    else
+    {
+        _2931 = _2923;
+    }
+    if (_2931)
+    {
+        float past = 6.0;
+        float log_first_span = 1.0;
+        if (position < past)
+        {
+            float param_6 = mu;
+            float param_7 = mu_s;
+            float param_8 = nu;
+            AtmosphereParameters param_9 = atmosphere;
+            float param_10 = r;
+            float param_11 = mu;
+            float param_12 = ViewSunAzimuthCosine(param_6, param_7, param_8);
+            bool param_13 = ray_r_mu_intersects_ground;
+            float edge = ShadowEdgeSunZenith(param_9, param_10, param_11, param_12, param_13);
+            if (position < 0.0)
+            {
+                AtmosphereParameters param_14 = atmosphere;
+                float param_15 = edge;
+                float _step = ShadowEdgePastStep(param_14, param_15);
+                float mu_s_first = cos(edge + ((past - 1.0) * _step));
+                AtmosphereParameters param_16 = atmosphere;
+                float4 param_17 = uvwz;
+                float param_18 = 0.0;
+                float param_19 = nu_slice;
+                float param_20 = nu_t;
+                float4 first = GetScatteringAtOwnColumnBetweenSlices(param_16, scattering_texture, scattering_textureSmplr, param_17, param_18, param_19, param_20);
+                AtmosphereParameters param_21 = atmosphere;
+                float4 param_22 = uvwz;
+                float param_23 = 1.0;
+                float param_24 = nu_slice;
+                float param_25 = nu_t;
+                float4 second = GetScatteringAtOwnColumnBetweenSlices(param_21, scattering_texture, scattering_textureSmplr, param_22, param_23, param_24, param_25);
+                float4 param_26 = first;
+                float4 param_27 = second;
+                float param_28 = mu_s_first;
+                float param_29 = cos(edge + ((past - 2.0) * _step));
+                float4 param_30;
+                float4 param_31;
+                LowestSunLogFall(param_26, param_27, param_28, param_29, param_30, param_31);
+                float4 slope = param_30;
+                float4 curvature = param_31;
+                float d = mu_s - mu_s_first;
+                return first * exp((slope + (curvature * d)) * d);
+            }
+            if (position >= (past - 1.0))
+            {
+                float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
+                AtmosphereParameters param_32 = atmosphere;
+                AtmosphereParameters param_33 = atmosphere;
+                float param_34 = x;
+                float param_35 = edge;
+                float param_36 = GetScatteringSplitSunZenith(param_32);
+                log_first_span = log(ShadowEdgeLitDistance(param_33, param_34, param_35, param_36) / 0.0008726646192371845245361328125);
+            }
+        }
+        AtmosphereParameters param_37 = atmosphere;
+        float4 param_38 = uvwz;
+        float param_39 = position;
+        float param_40 = nu_slice;
+        float param_41 = log_first_span;
+        AtmosphereParameters param_42 = atmosphere;
+        float4 param_43 = uvwz;
+        float param_44 = position;
+        float param_45 = nu_slice + 1.0;
+        float param_46 = log_first_span;
+        float4 param_47 = GetScatteringBelowSplit(param_37, scattering_texture, scattering_textureSmplr, param_38, param_39, param_40, param_41);
+        float4 param_48 = GetScatteringBelowSplit(param_42, scattering_texture, scattering_textureSmplr, param_43, param_44, param_45, param_46);
+        float param_49 = nu_t;
+        bool param_50 = true;
+        return SunCosineMix(param_47, param_48, param_49, param_50);
+    }
+    AtmosphereParameters param_51 = atmosphere;
+    float param_52 = 0.100000001490116119384765625;
+    float x_low_sun = GetScatteringTextureUMuS(param_51, param_52);
+    AtmosphereParameters param_53 = atmosphere;
+    float param_54 = uvwz.y;
+    float param_55 = x_low_sun;
+    float param_56;
+    float param_57;
+    float param_58;
+    bool param_59;
+    GetScatteringMuSColumns(param_53, param_54, param_55, param_56, param_57, param_58, param_59);
+    float x_below = param_56;
+    float x_above = param_57;
+    float mu_s_t = param_58;
+    bool low_sun_below = param_59;
+    AtmosphereParameters param_60 = atmosphere;
+    float4 param_61 = uvwz;
+    float param_62 = x_below;
+    float param_63 = nu_slice;
+    float param_64 = nu_t;
+    bool param_65 = low_sun_below;
+    float4 below = GetScatteringAtMuSColumn(param_60, scattering_texture, scattering_textureSmplr, param_61, param_62, param_63, param_64, param_65);
+    AtmosphereParameters param_66 = atmosphere;
+    float4 param_67 = uvwz;
+    float param_68 = x_above;
+    float param_69 = nu_slice;
+    float param_70 = nu_t;
+    bool param_71 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_66, scattering_texture, scattering_textureSmplr, param_67, param_68, param_69, param_70, param_71);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     if (mu_s_t < 0.0)
     {
         float mu_s_min = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_27 = atmosphere;
-        float param_28 = 1.0 / (mu_s_size - 1.0);
-        float4 param_29 = below;
-        float4 param_30 = above;
-        float param_31 = mu_s_min;
-        float param_32 = GetScatteringMuSFromUnitRange(param_27, param_28);
-        float4 param_33;
-        float4 param_34;
-        LowestSunLogFall(param_29, param_30, param_31, param_32, param_33, param_34);
-        float4 slope = param_33;
-        float4 curvature = param_34;
-        float d = mu_s - mu_s_min;
-        return below * exp((slope + (curvature * d)) * d);
+        AtmosphereParameters param_72 = atmosphere;
+        float param_73 = 1.0 / (mu_s_size - 1.0);
+        float4 param_74 = below;
+        float4 param_75 = above;
+        float param_76 = mu_s_min;
+        float param_77 = GetScatteringMuSFromUnitRange(param_72, param_73);
+        float4 param_78;
+        float4 param_79;
+        LowestSunLogFall(param_74, param_75, param_76, param_77, param_78, param_79);
+        float4 slope_1 = param_78;
+        float4 curvature_1 = param_79;
+        float d_1 = mu_s - mu_s_min;
+        return below * exp((slope_1 + (curvature_1 * d_1)) * d_1);
     }
     if (!low_sun_below)
     {
@@ -608,28 +1098,28 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float column = (x_below * mu_s_size) - 0.5;
     float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
     float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_35 = atmosphere;
-    float4 param_36 = uvwz;
-    float param_37 = x_first;
-    float param_38 = nu_slice;
-    float param_39 = nu_t;
-    bool param_40 = true;
-    float4 first = GetScatteringAtMuSColumn(param_35, scattering_texture, scattering_textureSmplr, param_36, param_37, param_38, param_39, param_40);
-    AtmosphereParameters param_41 = atmosphere;
-    float4 param_42 = uvwz;
-    float param_43 = x_last;
-    float param_44 = nu_slice;
-    float param_45 = nu_t;
-    bool param_46 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_41, scattering_texture, scattering_textureSmplr, param_42, param_43, param_44, param_45, param_46);
-    float4 param_47 = first;
-    float4 param_48 = below;
-    float4 param_49 = above;
-    float4 param_50 = last;
-    bool param_51 = column > 0.5;
-    bool param_52 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_53 = mu_s_t;
-    return LogMonotoneCubicMix(param_47, param_48, param_49, param_50, param_51, param_52, param_53);
+    AtmosphereParameters param_80 = atmosphere;
+    float4 param_81 = uvwz;
+    float param_82 = x_first;
+    float param_83 = nu_slice;
+    float param_84 = nu_t;
+    bool param_85 = true;
+    float4 first_1 = GetScatteringAtMuSColumn(param_80, scattering_texture, scattering_textureSmplr, param_81, param_82, param_83, param_84, param_85);
+    AtmosphereParameters param_86 = atmosphere;
+    float4 param_87 = uvwz;
+    float param_88 = x_last;
+    float param_89 = nu_slice;
+    float param_90 = nu_t;
+    bool param_91 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_86, scattering_texture, scattering_textureSmplr, param_87, param_88, param_89, param_90, param_91);
+    float4 param_92 = first_1;
+    float4 param_93 = below;
+    float4 param_94 = above;
+    float4 param_95 = last;
+    bool param_96 = column > 0.5;
+    bool param_97 = (column + 2.0) < (mu_s_size - 0.5);
+    float param_98 = mu_s_t;
+    return LogMonotoneCubicMix(param_92, param_93, param_94, param_95, param_96, param_97, param_98);
 }
 #endif
 
@@ -646,16 +1136,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _2369;
+        float3 _3406;
         if (scattering.x > 0.0)
         {
-            _2369 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3406 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _2369 = float3(0.0);
+            _3406 = float3(0.0);
         }
-        single_mie_scattering = _2369;
+        single_mie_scattering = _3406;
     }
     else
     {
@@ -732,13 +1222,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _2437 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3474 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_2437)
+    if (!_3474)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -747,19 +1237,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _2457;
+    float3 _3494;
     if (ray_r_mu_intersects_ground)
     {
-        _2457 = float3(0.0);
+        _3494 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _2457 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _3494 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _2457;
+    transmittance = _3494;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -767,29 +1257,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _2484 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _3521 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _2484;
+    float3 scattering = _3521;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
     return (scattering * RayleighPhaseFunction(param_22)) + (single_mie_scattering * MiePhaseFunction(param_23, param_24));
-}
-#endif
-
-static inline __attribute__((always_inline))
-float ClampRadius(thread const AtmosphereParameters& atmosphere, thread const float& r)
-{
-    return fast::clamp(r, atmosphere.bottom_radius, atmosphere.top_radius);
-}
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-static inline __attribute__((always_inline))
-float RadiusAtDistance(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& d)
-{
-    AtmosphereParameters param = atmosphere;
-    float param_1 = sqrt(((d * d) + (((2.0 * r) * mu) * d)) + (r * r));
-    return ClampRadius(param, param_1);
 }
 #endif
 
@@ -823,16 +1297,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _2578;
+    float _3615;
     if ((a > 0.0) && (b > 0.0))
     {
-        _2578 = a * exp(f * log(b / a));
+        _3615 = a * exp(f * log(b / a));
     }
     else
     {
-        _2578 = mix(a, b, f);
+        _3615 = mix(a, b, f);
     }
-    return _2578;
+    return _3615;
 }
 #endif
 
@@ -882,14 +1356,6 @@ float3 GetCoefficientsAtAltitude(thread const AtmosphereParameters& atmosphere, 
 #endif
 
 static inline __attribute__((always_inline))
-float HorizonZenithCosine(thread const float& bottom_radius, thread const float& r)
-{
-    float param = bottom_radius;
-    float param_1 = r;
-    return (-DistanceToHorizon(param, param_1)) / r;
-}
-
-static inline __attribute__((always_inline))
 float SunVisibleFractionAboveHorizon(thread const float& mu_s, thread const float& horizon_cosine, thread const float& half_disc)
 {
     return smoothstep(-half_disc, half_disc, mu_s - horizon_cosine);
@@ -911,16 +1377,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _2830;
+    float _3866;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _2830 = 1.0 - (0.5 * depth);
+        _3866 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _2830 = (1.0 - exp(-depth)) / depth;
+        _3866 = (1.0 - exp(-depth)) / depth;
     }
-    return _2830;
+    return _3866;
 }
 #endif
 
@@ -957,10 +1423,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _2910 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _3946 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _2910;
+        float3 extinction = _3946;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1019,10 +1485,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _2775 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _3811 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _2775;
+        float3 extinction = _3811;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1097,14 +1563,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _2800;
+    float3 _3836;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _2800 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _3836 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1113,32 +1579,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _2800 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _3836 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _2800;
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-static inline __attribute__((always_inline))
-float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
-{
-    float _727;
-    if (ray_r_mu_intersects_ground)
-    {
-        AtmosphereParameters param = atmosphere;
-        float param_1 = r;
-        float param_2 = mu;
-        _727 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
-    }
-    else
-    {
-        AtmosphereParameters param_3 = atmosphere;
-        float param_4 = r;
-        float param_5 = mu;
-        _727 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
-    }
-    return _727;
+    return _3836;
 }
 #endif
 
@@ -1152,16 +1595,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _2540;
+    float _3577;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _2540 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3577 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _2540 = up;
+        _3577 = up;
     }
-    return _2540;
+    return _3577;
 }
 #endif
 
@@ -1185,13 +1628,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _3056 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4092 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3056)
+    if (!_4092)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1231,11 +1674,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _3151 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4187 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _3151;
+        lit_optical_depth = _4187;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1249,11 +1692,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _3185 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4221 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _3185;
+        optical_depth += _4221;
     }
     if (direct < 1.0)
     {
@@ -1272,9 +1715,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _3228 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4264 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _3228;
+    float3 scattering = _4264;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1295,11 +1738,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _3276 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4312 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _3276;
+        float3 far_optical_depth = _4312;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1319,9 +1762,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _3330 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4366 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _3330);
+            scattering -= (exp(-far_optical_depth) * _4366);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1342,9 +1785,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _3395 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4431 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _3395;
+    float3 scattering_p = _4431;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1365,9 +1808,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _3439 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4475 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _3439;
+    return _4475;
 }
 #endif
 
@@ -1375,16 +1818,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1378;
+    float _1975;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1378 = 0.100000001490116119384765625;
+        _1975 = 0.100000001490116119384765625;
     }
     else
     {
-        _1378 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1975 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1378;
+    return _1975;
 }
 #endif
 
@@ -1394,16 +1837,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1396;
+    float _1993;
     if (mu_s < knee)
     {
-        _1396 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1993 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1396 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1993 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1396;
+    return _1993;
 }
 #endif
 
@@ -1432,16 +1875,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1427;
+    float _2024;
     if (x < 0.5)
     {
-        _1427 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _2024 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1427 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _2024 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1427;
+    return _2024;
 }
 #endif
 
@@ -1454,16 +1897,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _1722;
+    float4 _2319;
     if (t < 0.0)
     {
-        _1722 = fast::min(blend, a);
+        _2319 = fast::min(blend, a);
     }
     else
     {
-        _1722 = blend;
+        _2319 = blend;
     }
-    return _1722;
+    return _2319;
 }
 #endif
 

@@ -23,6 +23,7 @@ struct AtmosphereParameters {
     scattering_r_max: f32,
     scattering_mu_s_min: f32,
     scattering_mu_s_max: f32,
+    scattering_mu_s_split: i32,
     irradiance_width: i32,
     irradiance_height: i32,
     extinction_profile: array<vec3<f32>, 64>,
@@ -41,6 +42,14 @@ const PHASE_CORNETTE_SHANKS: i32 = 2i;
 const ALTITUDE_PROFILE_SIZE: i32 = 64i;
 
 const SCATTERING_MU_S_HIGH_SUN_SHARE: f32 = 0.5f;
+
+const SHADOW_EDGE_PAST_COLUMNS: i32 = 6i;
+
+const SHADOW_EDGE_TABLES_WEIGHT: f32 = 0.3f;
+
+const SHADOW_EDGE_CLOSEST: f32 = 0.0008726646f;
+
+const SHADOW_EDGE_LEAST_PAST_SPAN: f32 = 0.034906585f;
 
 const LOW_SUN_MU_S: f32 = 0.1f;
 
@@ -763,637 +772,1118 @@ fn GetScatteringTextureUMuS(atmosphere_28: AtmosphereParameters, mu_s_5: f32) ->
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_30: AtmosphereParameters, r_24: f32, rho_3: f32, ray_r_mu_intersects_ground_2: bool, x_mu_1: f32) -> f32 {
+fn ViewSunAzimuthCosine(mu_17: f32, mu_s_7: f32, nu_9: f32) -> f32 {
+    var mu_18: f32;
+    var mu_s_8: f32;
+    var nu_10: f32;
+    var across: f32;
+    var local_4: f32;
+
+    mu_18 = mu_17;
+    mu_s_8 = mu_s_7;
+    nu_10 = nu_9;
+    let _e18 = mu_18;
+    let _e19 = mu_18;
+    let _e23 = mu_s_8;
+    let _e24 = mu_s_8;
+    let _e28 = SafeSqrt(((1f - (_e18 * _e19)) * (1f - (_e23 * _e24))));
+    across = _e28;
+    let _e30 = across;
+    if (_e30 > 0f) {
+        let _e33 = nu_10;
+        let _e34 = mu_18;
+        let _e35 = mu_s_8;
+        let _e38 = across;
+        let _e40 = ClampCosine(((_e33 - (_e34 * _e35)) / _e38));
+        local_4 = _e40;
+    } else {
+        local_4 = 1f;
+    }
+    let _e43 = local_4;
+    return _e43;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeSunZenith(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_phi: f32, ray_r_mu_intersects_ground_2: bool) -> f32 {
     var atmosphere_31: AtmosphereParameters;
     var r_25: f32;
-    var rho_4: f32;
+    var mu_20: f32;
+    var cos_phi_1: f32;
     var ray_r_mu_intersects_ground_3: bool;
+    var d_9: f32;
+    var r_d_2: f32;
+    var cos_alpha: f32;
+    var across_1: f32;
+    var rho_3: f32;
+    var c_end: f32;
+    var local_5: f32;
+    var end: f32;
+    var start_1: f32;
+
+    atmosphere_31 = atmosphere_30;
+    r_25 = r_24;
+    mu_20 = mu_19;
+    cos_phi_1 = cos_phi;
+    ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
+    let _e21 = atmosphere_31;
+    let _e22 = r_25;
+    let _e23 = mu_20;
+    let _e24 = ray_r_mu_intersects_ground_3;
+    let _e25 = DistanceToNearestAtmosphereBoundary(_e21, _e22, _e23, _e24);
+    d_9 = _e25;
+    let _e27 = atmosphere_31;
+    let _e28 = r_25;
+    let _e29 = mu_20;
+    let _e30 = d_9;
+    let _e31 = RadiusAtDistance(_e27, _e28, _e29, _e30);
+    r_d_2 = _e31;
+    let _e33 = r_25;
+    let _e34 = d_9;
+    let _e35 = mu_20;
+    let _e38 = r_d_2;
+    let _e40 = ClampCosine(((_e33 + (_e34 * _e35)) / _e38));
+    cos_alpha = _e40;
+    let _e42 = d_9;
+    let _e44 = mu_20;
+    let _e45 = mu_20;
+    let _e48 = SafeSqrt((1f - (_e44 * _e45)));
+    let _e50 = r_d_2;
+    let _e52 = cos_phi_1;
+    across_1 = (((_e42 * _e48) / _e50) * _e52);
+    let _e55 = across_1;
+    let _e56 = across_1;
+    let _e58 = cos_alpha;
+    let _e59 = cos_alpha;
+    rho_3 = sqrt(((_e55 * _e56) + (_e58 * _e59)));
+    let _e64 = atmosphere_31;
+    let _e66 = r_d_2;
+    let _e67 = HorizonZenithCosine(_e64.bottom_radius, _e66);
+    c_end = -(_e67);
+    let _e70 = c_end;
+    let _e71 = rho_3;
+    if (_e70 >= _e71) {
+        local_5 = PI;
+    } else {
+        let _e73 = across_1;
+        let _e74 = cos_alpha;
+        let _e76 = c_end;
+        let _e78 = rho_3;
+        local_5 = (atan2(_e73, _e74) + acos((-(_e76) / _e78)));
+    }
+    let _e83 = local_5;
+    end = _e83;
+    let _e85 = atmosphere_31;
+    let _e87 = r_25;
+    let _e88 = HorizonZenithCosine(_e85.bottom_radius, _e87);
+    start_1 = acos(_e88);
+    let _e91 = start_1;
+    let _e92 = end;
+    let _e94 = atmosphere_31;
+    return (max(_e91, _e92) + _e94.sun_angular_radius);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringSplitSunZenith(atmosphere_32: AtmosphereParameters) -> f32 {
+    var atmosphere_33: AtmosphereParameters;
+
+    atmosphere_33 = atmosphere_32;
+    let _e13 = atmosphere_33;
+    let _e14 = atmosphere_33;
+    let _e17 = atmosphere_33;
+    let _e23 = GetScatteringMuSFromUnitRange(_e13, (f32(_e14.scattering_mu_s_split) / f32((_e17.scattering_mu_s_size - 1i))));
+    return acos(_e23);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeUnitSun(atmosphere_34: AtmosphereParameters, sun_zenith: f32, derivative: ptr<function, f32>) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
+    var sun_zenith_1: f32;
+    var bottom_1: f32;
+    var mu_s_9: f32;
+    var d_10: f32;
+    var d_min_4: f32;
+    var span: f32;
+    var a_6: f32;
+    var inverse_A_4: f32;
+    var da_dtheta: f32;
+
+    atmosphere_35 = atmosphere_34;
+    sun_zenith_1 = sun_zenith;
+    let _e16 = atmosphere_35;
+    bottom_1 = _e16.bottom_radius;
+    let _e19 = sun_zenith_1;
+    mu_s_9 = cos(_e19);
+    let _e22 = atmosphere_35;
+    let _e23 = bottom_1;
+    let _e24 = mu_s_9;
+    let _e25 = DistanceToTopAtmosphereBoundary(_e22, _e23, _e24);
+    d_10 = _e25;
+    let _e27 = atmosphere_35;
+    let _e29 = bottom_1;
+    d_min_4 = (_e27.top_radius - _e29);
+    let _e32 = atmosphere_35;
+    let _e33 = HorizonDistanceAtTop(_e32);
+    let _e34 = d_min_4;
+    span = (_e33 - _e34);
+    let _e37 = d_10;
+    let _e38 = d_min_4;
+    let _e40 = span;
+    a_6 = ((_e37 - _e38) / _e40);
+    let _e44 = atmosphere_35;
+    let _e45 = GetScatteringLowestSunDistance(_e44);
+    inverse_A_4 = (1f / _e45);
+    let _e48 = bottom_1;
+    let _e49 = d_10;
+    let _e51 = d_10;
+    let _e52 = bottom_1;
+    let _e53 = mu_s_9;
+    let _e57 = span;
+    let _e59 = sun_zenith_1;
+    da_dtheta = ((((_e48 * _e49) / (_e51 + (_e52 * _e53))) / _e57) * sin(_e59));
+    let _e63 = inverse_A_4;
+    let _e68 = a_6;
+    let _e71 = a_6;
+    let _e75 = da_dtheta;
+    (*derivative) = ((-((_e63 + 1f)) / ((1f + _e68) * (1f + _e71))) * _e75);
+    let _e78 = a_6;
+    let _e79 = inverse_A_4;
+    let _e83 = a_6;
+    return ((1f - (_e78 * _e79)) / (1f + _e83));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeLitUnitFrom(atmosphere_36: AtmosphereParameters, D_1: f32, edge: f32, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
+    var atmosphere_37: AtmosphereParameters;
+    var D_2: f32;
+    var edge_1: f32;
+    var X_closest_1: f32;
+    var X_span_1: f32;
+    var log_span_1: f32;
+    var dX_dtheta: f32;
+    var X: f32;
+
+    atmosphere_37 = atmosphere_36;
+    D_2 = D_1;
+    edge_1 = edge;
+    X_closest_1 = X_closest;
+    X_span_1 = X_span;
+    log_span_1 = log_span;
+    let _e25 = atmosphere_37;
+    let _e26 = edge_1;
+    let _e27 = D_2;
+    let _e31 = ShadowEdgeUnitSun(_e25, (_e26 - _e27), (&dX_dtheta));
+    X = _e31;
+    let _e35 = dX_dtheta;
+    let _e37 = D_2;
+    let _e39 = X_span_1;
+    let _e44 = log_span_1;
+    (*derivative_1) = ((((-0.3f * _e35) * _e37) / _e39) + (0.7f / _e44));
+    let _e47 = X;
+    let _e48 = X_closest_1;
+    let _e51 = X_span_1;
+    let _e56 = D_2;
+    let _e60 = log_span_1;
+    return (((SHADOW_EDGE_TABLES_WEIGHT * (_e47 - _e48)) / _e51) + ((0.7f * log((_e56 / SHADOW_EDGE_CLOSEST))) / _e60));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeLitUnitSpans(atmosphere_38: AtmosphereParameters, edge_2: f32, split_sun: f32, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>) {
+    var atmosphere_39: AtmosphereParameters;
+    var edge_3: f32;
+    var split_sun_1: f32;
+    var unused: f32;
+
+    atmosphere_39 = atmosphere_38;
+    edge_3 = edge_2;
+    split_sun_1 = split_sun;
+    let _e21 = atmosphere_39;
+    let _e22 = edge_3;
+    let _e26 = ShadowEdgeUnitSun(_e21, (_e22 - SHADOW_EDGE_CLOSEST), (&unused));
+    (*X_closest_2) = _e26;
+    let _e27 = atmosphere_39;
+    let _e28 = split_sun_1;
+    let _e31 = ShadowEdgeUnitSun(_e27, _e28, (&unused));
+    let _e32 = (*X_closest_2);
+    (*X_span_2) = (_e31 - _e32);
+    let _e34 = edge_3;
+    let _e35 = split_sun_1;
+    (*log_span_2) = log(((_e34 - _e35) / SHADOW_EDGE_CLOSEST));
+    return;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeLitUnit(atmosphere_40: AtmosphereParameters, distance_: f32, edge_4: f32, split_sun_2: f32) -> f32 {
+    var atmosphere_41: AtmosphereParameters;
+    var distance_1: f32;
+    var edge_5: f32;
+    var split_sun_3: f32;
+    var X_closest_3: f32;
+    var X_span_3: f32;
+    var log_span_3: f32;
+    var unused_1: f32;
+
+    atmosphere_41 = atmosphere_40;
+    distance_1 = distance_;
+    edge_5 = edge_4;
+    split_sun_3 = split_sun_2;
+    let _e22 = atmosphere_41;
+    let _e23 = edge_5;
+    let _e24 = split_sun_3;
+    ShadowEdgeLitUnitSpans(_e22, _e23, _e24, (&X_closest_3), (&X_span_3), (&log_span_3));
+    let _e32 = atmosphere_41;
+    let _e33 = distance_1;
+    let _e34 = edge_5;
+    let _e35 = split_sun_3;
+    let _e38 = edge_5;
+    let _e39 = X_closest_3;
+    let _e40 = X_span_3;
+    let _e41 = log_span_3;
+    let _e44 = ShadowEdgeLitUnitFrom(_e32, clamp(_e33, SHADOW_EDGE_CLOSEST, (_e34 - _e35)), _e38, _e39, _e40, _e41, (&unused_1));
+    return _e44;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeLitDistance(atmosphere_42: AtmosphereParameters, x_7: f32, edge_6: f32, split_sun_4: f32) -> f32 {
+    var atmosphere_43: AtmosphereParameters;
+    var x_8: f32;
+    var edge_7: f32;
+    var split_sun_5: f32;
+    var X_closest_4: f32;
+    var X_span_4: f32;
+    var log_span_4: f32;
+    var s_min: f32 = -7.043959f;
+    var s_max: f32;
+    var s_2: f32;
+    var i: i32 = 0i;
+    var slope: f32;
+    var error: f32;
+    var next: f32;
+    var converged: bool;
+
+    atmosphere_43 = atmosphere_42;
+    x_8 = x_7;
+    edge_7 = edge_6;
+    split_sun_5 = split_sun_4;
+    let _e22 = atmosphere_43;
+    let _e23 = edge_7;
+    let _e24 = split_sun_5;
+    ShadowEdgeLitUnitSpans(_e22, _e23, _e24, (&X_closest_4), (&X_span_4), (&log_span_4));
+    let _e34 = s_min;
+    let _e35 = log_span_4;
+    s_max = (_e34 + _e35);
+    let _e38 = s_min;
+    let _e39 = s_max;
+    let _e40 = x_8;
+    s_2 = mix(_e38, _e39, _e40);
+    loop {
+        let _e45 = i;
+        if !((_e45 < 12i)) {
+            break;
+        }
+        {
+            let _e53 = atmosphere_43;
+            let _e54 = s_2;
+            let _e56 = edge_7;
+            let _e57 = X_closest_4;
+            let _e58 = X_span_4;
+            let _e59 = log_span_4;
+            let _e62 = ShadowEdgeLitUnitFrom(_e53, exp(_e54), _e56, _e57, _e58, _e59, (&slope));
+            let _e63 = x_8;
+            error = (_e62 - _e63);
+            let _e66 = s_2;
+            let _e67 = error;
+            let _e68 = slope;
+            let _e71 = s_min;
+            let _e72 = s_max;
+            next = clamp((_e66 - (_e67 / _e68)), _e71, _e72);
+            let _e75 = next;
+            let _e76 = s_2;
+            converged = (abs((_e75 - _e76)) < 0.00000000001f);
+            let _e82 = next;
+            s_2 = _e82;
+            let _e83 = converged;
+            if _e83 {
+                break;
+            }
+        }
+        continuing {
+            let _e49 = i;
+            i = (_e49 + 1i);
+        }
+    }
+    let _e84 = s_2;
+    return exp(_e84);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgePastStep(atmosphere_44: AtmosphereParameters, edge_8: f32) -> f32 {
+    var atmosphere_45: AtmosphereParameters;
+    var edge_9: f32;
+    var lowest: f32;
+
+    atmosphere_45 = atmosphere_44;
+    edge_9 = edge_8;
+    let _e15 = atmosphere_45;
+    lowest = acos(_e15.scattering_mu_s_min);
+    let _e19 = lowest;
+    let _e20 = edge_9;
+    return (max((_e19 - _e20), SHADOW_EDGE_LEAST_PAST_SPAN) / 5f);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringShadowEdgePosition(atmosphere_46: AtmosphereParameters, sun_zenith_2: f32, edge_10: f32) -> f32 {
+    var atmosphere_47: AtmosphereParameters;
+    var sun_zenith_3: f32;
+    var edge_11: f32;
+    var past: f32 = 6f;
+    var split_sun_6: f32;
+    var D_3: f32;
+
+    atmosphere_47 = atmosphere_46;
+    sun_zenith_3 = sun_zenith_2;
+    edge_11 = edge_10;
+    let _e20 = atmosphere_47;
+    let _e21 = GetScatteringSplitSunZenith(_e20);
+    split_sun_6 = _e21;
+    let _e23 = edge_11;
+    let _e24 = sun_zenith_3;
+    D_3 = (_e23 - _e24);
+    let _e27 = D_3;
+    if (_e27 >= SHADOW_EDGE_CLOSEST) {
+        {
+            let _e29 = past;
+            let _e30 = atmosphere_47;
+            let _e31 = D_3;
+            let _e32 = edge_11;
+            let _e33 = split_sun_6;
+            let _e34 = ShadowEdgeLitUnit(_e30, _e31, _e32, _e33);
+            let _e35 = atmosphere_47;
+            let _e38 = past;
+            return (_e29 + (_e34 * (f32(_e35.scattering_mu_s_split) - _e38)));
+        }
+    }
+    let _e42 = D_3;
+    if (_e42 >= 0f) {
+        let _e45 = past;
+        let _e48 = D_3;
+        return ((_e45 - 1f) + (_e48 / SHADOW_EDGE_CLOSEST));
+    }
+    let _e51 = past;
+    let _e54 = D_3;
+    let _e55 = atmosphere_47;
+    let _e56 = edge_11;
+    let _e57 = ShadowEdgePastStep(_e55, _e56);
+    return ((_e51 - 1f) + (_e54 / _e57));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringShadowEdgeSunZenith(atmosphere_48: AtmosphereParameters, position: f32, edge_12: f32, split_sun_7: f32) -> f32 {
+    var atmosphere_49: AtmosphereParameters;
+    var position_1: f32;
+    var edge_13: f32;
+    var split_sun_8: f32;
+    var past_1: f32 = 6f;
+    var x_9: f32;
+
+    atmosphere_49 = atmosphere_48;
+    position_1 = position;
+    edge_13 = edge_12;
+    split_sun_8 = split_sun_7;
+    let _e22 = position_1;
+    let _e23 = past_1;
+    if (_e22 >= _e23) {
+        {
+            let _e25 = position_1;
+            let _e26 = past_1;
+            let _e28 = atmosphere_49;
+            let _e31 = past_1;
+            x_9 = ((_e25 - _e26) / (f32(_e28.scattering_mu_s_split) - _e31));
+            let _e35 = edge_13;
+            let _e36 = atmosphere_49;
+            let _e37 = x_9;
+            let _e38 = edge_13;
+            let _e39 = split_sun_8;
+            let _e40 = ShadowEdgeLitDistance(_e36, _e37, _e38, _e39);
+            return (_e35 - _e40);
+        }
+    }
+    let _e42 = position_1;
+    let _e43 = past_1;
+    if (_e42 >= (_e43 - 1f)) {
+        let _e47 = edge_13;
+        let _e48 = position_1;
+        let _e49 = past_1;
+        return (_e47 - (((_e48 - _e49) + 1f) * SHADOW_EDGE_CLOSEST));
+    }
+    let _e55 = edge_13;
+    let _e56 = past_1;
+    let _e59 = position_1;
+    let _e61 = atmosphere_49;
+    let _e62 = edge_13;
+    let _e63 = ShadowEdgePastStep(_e61, _e62);
+    return (_e55 + (((_e56 - 1f) - _e59) * _e63));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4: f32, ray_r_mu_intersects_ground_4: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_51: AtmosphereParameters;
+    var r_27: f32;
+    var rho_5: f32;
+    var ray_r_mu_intersects_ground_5: bool;
     var x_mu_2: f32;
     var rho_min: f32;
     var rho_max: f32;
     var last_row: f32;
-    var position: f32;
+    var position_2: f32;
     var row: f32;
     var rho_below: f32;
     var rho_above: f32;
-    var bottom_1: f32;
+    var bottom_2: f32;
     var d_below: f32;
     var d_above: f32;
-    var d_9: f32;
+    var d_11: f32;
     var t: f32;
 
-    atmosphere_31 = atmosphere_30;
-    r_25 = r_24;
-    rho_4 = rho_3;
-    ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
+    atmosphere_51 = atmosphere_50;
+    r_27 = r_26;
+    rho_5 = rho_4;
+    ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
     x_mu_2 = x_mu_1;
-    let _e17 = atmosphere_31;
-    let _e18 = atmosphere_31;
-    let _e20 = HorizonDistance(_e17, _e18.scattering_r_min);
-    rho_min = _e20;
-    let _e22 = atmosphere_31;
-    let _e23 = atmosphere_31;
-    let _e25 = HorizonDistance(_e22, _e23.scattering_r_max);
-    rho_max = _e25;
-    let _e27 = atmosphere_31;
-    last_row = f32((_e27.scattering_r_size - 1i));
-    let _e33 = rho_4;
-    let _e34 = rho_min;
-    let _e36 = rho_max;
-    let _e37 = rho_min;
-    let _e43 = last_row;
-    position = (clamp(((_e33 - _e34) / (_e36 - _e37)), 0f, 1f) * _e43);
-    let _e46 = ray_r_mu_intersects_ground_3;
-    if !(_e46) {
-        let _e48 = position;
-        let _e51 = last_row;
-        return ((_e48 + 0.5f) / (_e51 + 1f));
+    let _e21 = atmosphere_51;
+    let _e22 = atmosphere_51;
+    let _e24 = HorizonDistance(_e21, _e22.scattering_r_min);
+    rho_min = _e24;
+    let _e26 = atmosphere_51;
+    let _e27 = atmosphere_51;
+    let _e29 = HorizonDistance(_e26, _e27.scattering_r_max);
+    rho_max = _e29;
+    let _e31 = atmosphere_51;
+    last_row = f32((_e31.scattering_r_size - 1i));
+    let _e37 = rho_5;
+    let _e38 = rho_min;
+    let _e40 = rho_max;
+    let _e41 = rho_min;
+    let _e47 = last_row;
+    position_2 = (clamp(((_e37 - _e38) / (_e40 - _e41)), 0f, 1f) * _e47);
+    let _e50 = ray_r_mu_intersects_ground_5;
+    if !(_e50) {
+        let _e52 = position_2;
+        let _e55 = last_row;
+        return ((_e52 + 0.5f) / (_e55 + 1f));
     }
-    let _e55 = position;
-    let _e57 = last_row;
-    row = min(floor(_e55), (_e57 - 1f));
-    let _e62 = rho_min;
-    let _e63 = rho_max;
-    let _e64 = row;
-    let _e65 = last_row;
-    rho_below = mix(_e62, _e63, (_e64 / _e65));
-    let _e69 = rho_min;
-    let _e70 = rho_max;
-    let _e71 = row;
-    let _e74 = last_row;
-    rho_above = mix(_e69, _e70, ((_e71 + 1f) / _e74));
-    let _e78 = atmosphere_31;
-    bottom_1 = _e78.bottom_radius;
-    let _e81 = bottom_1;
-    let _e82 = rho_below;
-    let _e83 = HeightFromHorizonDistance(_e81, _e82);
-    let _e84 = rho_below;
-    let _e85 = x_mu_2;
-    d_below = mix(_e83, _e84, _e85);
-    let _e88 = bottom_1;
-    let _e89 = rho_above;
-    let _e90 = HeightFromHorizonDistance(_e88, _e89);
-    let _e91 = rho_above;
-    let _e92 = x_mu_2;
-    d_above = mix(_e90, _e91, _e92);
-    let _e95 = r_25;
-    let _e96 = bottom_1;
-    let _e98 = rho_4;
-    let _e99 = x_mu_2;
-    d_9 = mix((_e95 - _e96), _e98, _e99);
-    let _e102 = d_9;
-    let _e103 = d_below;
-    let _e105 = d_above;
-    let _e106 = d_below;
-    t = clamp(((_e102 - _e103) / (_e105 - _e106)), 0f, 1f);
-    let _e113 = row;
-    let _e114 = t;
-    let _e118 = last_row;
-    return (((_e113 + _e114) + 0.5f) / (_e118 + 1f));
+    let _e59 = position_2;
+    let _e61 = last_row;
+    row = min(floor(_e59), (_e61 - 1f));
+    let _e66 = rho_min;
+    let _e67 = rho_max;
+    let _e68 = row;
+    let _e69 = last_row;
+    rho_below = mix(_e66, _e67, (_e68 / _e69));
+    let _e73 = rho_min;
+    let _e74 = rho_max;
+    let _e75 = row;
+    let _e78 = last_row;
+    rho_above = mix(_e73, _e74, ((_e75 + 1f) / _e78));
+    let _e82 = atmosphere_51;
+    bottom_2 = _e82.bottom_radius;
+    let _e85 = bottom_2;
+    let _e86 = rho_below;
+    let _e87 = HeightFromHorizonDistance(_e85, _e86);
+    let _e88 = rho_below;
+    let _e89 = x_mu_2;
+    d_below = mix(_e87, _e88, _e89);
+    let _e92 = bottom_2;
+    let _e93 = rho_above;
+    let _e94 = HeightFromHorizonDistance(_e92, _e93);
+    let _e95 = rho_above;
+    let _e96 = x_mu_2;
+    d_above = mix(_e94, _e95, _e96);
+    let _e99 = r_27;
+    let _e100 = bottom_2;
+    let _e102 = rho_5;
+    let _e103 = x_mu_2;
+    d_11 = mix((_e99 - _e100), _e102, _e103);
+    let _e106 = d_11;
+    let _e107 = d_below;
+    let _e109 = d_above;
+    let _e110 = d_below;
+    t = clamp(((_e106 - _e107) / (_e109 - _e110)), 0f, 1f);
+    let _e117 = row;
+    let _e118 = t;
+    let _e122 = last_row;
+    return (((_e117 + _e118) + 0.5f) / (_e122 + 1f));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_32: AtmosphereParameters, r_26: f32, mu_17: f32, mu_s_7: f32, nu_9: f32, ray_r_mu_intersects_ground_4: bool) -> vec4<f32> {
-    var atmosphere_33: AtmosphereParameters;
-    var r_27: f32;
-    var mu_18: f32;
-    var mu_s_8: f32;
-    var nu_10: f32;
-    var ray_r_mu_intersects_ground_5: bool;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_52: AtmosphereParameters, r_28: f32, mu_21: f32, mu_s_10: f32, nu_11: f32, ray_r_mu_intersects_ground_6: bool) -> vec4<f32> {
+    var atmosphere_53: AtmosphereParameters;
+    var r_29: f32;
+    var mu_22: f32;
+    var mu_s_11: f32;
+    var nu_12: f32;
+    var ray_r_mu_intersects_ground_7: bool;
     var H_2: f32;
-    var rho_5: f32;
+    var rho_6: f32;
     var half_mu_size: f32;
     var u_mu: f32;
     var x_mu_3: f32;
-    var d_10: f32;
-    var d_min_4: f32;
-    var d_max_4: f32;
-    var local_4: f32;
-    var d_11: f32;
+    var d_12: f32;
     var d_min_5: f32;
-    var d_max_5: f32;
-    var local_5: f32;
-    var u_r: f32;
-    var u_nu: f32;
-
-    atmosphere_33 = atmosphere_32;
-    r_27 = r_26;
-    mu_18 = mu_17;
-    mu_s_8 = mu_s_7;
-    nu_10 = nu_9;
-    ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
-    let _e19 = atmosphere_33;
-    let _e20 = HorizonDistanceAtTop(_e19);
-    H_2 = _e20;
-    let _e22 = atmosphere_33;
-    let _e23 = r_27;
-    let _e24 = HorizonDistance(_e22, _e23);
-    rho_5 = _e24;
-    let _e26 = atmosphere_33;
-    half_mu_size = f32((_e26.scattering_mu_size / 2i));
-    let _e34 = ray_r_mu_intersects_ground_5;
-    if _e34 {
-        {
-            let _e35 = atmosphere_33;
-            let _e36 = r_27;
-            let _e37 = mu_18;
-            let _e38 = DistanceToBottomAtmosphereBoundary(_e35, _e36, _e37);
-            d_10 = _e38;
-            let _e40 = r_27;
-            let _e41 = atmosphere_33;
-            d_min_4 = (_e40 - _e41.bottom_radius);
-            let _e45 = rho_5;
-            d_max_4 = _e45;
-            let _e47 = d_max_4;
-            let _e48 = d_min_4;
-            if (_e47 == _e48) {
-                local_4 = 0f;
-            } else {
-                let _e51 = d_10;
-                let _e52 = d_min_4;
-                let _e54 = d_max_4;
-                let _e55 = d_min_4;
-                local_4 = ((_e51 - _e52) / (_e54 - _e55));
-            }
-            let _e59 = local_4;
-            x_mu_3 = _e59;
-            let _e63 = half_mu_size;
-            let _e65 = x_mu_3;
-            let _e68 = half_mu_size;
-            u_mu = (0.5f - (0.5f * ((0.5f / _e63) + (_e65 * (1f - (1f / _e68))))));
-        }
-    } else {
-        {
-            let _e75 = atmosphere_33;
-            let _e76 = r_27;
-            let _e77 = mu_18;
-            let _e78 = DistanceToTopAtmosphereBoundary(_e75, _e76, _e77);
-            d_11 = _e78;
-            let _e80 = atmosphere_33;
-            let _e82 = r_27;
-            d_min_5 = (_e80.top_radius - _e82);
-            let _e85 = rho_5;
-            let _e86 = H_2;
-            d_max_5 = (_e85 + _e86);
-            let _e89 = d_max_5;
-            let _e90 = d_min_5;
-            if (_e89 > _e90) {
-                let _e92 = d_11;
-                let _e93 = d_min_5;
-                let _e95 = d_max_5;
-                let _e96 = d_min_5;
-                local_5 = ((_e92 - _e93) / (_e95 - _e96));
-            } else {
-                local_5 = 0f;
-            }
-            let _e101 = local_5;
-            x_mu_3 = _e101;
-            let _e105 = half_mu_size;
-            let _e107 = x_mu_3;
-            let _e110 = half_mu_size;
-            u_mu = (0.5f + (0.5f * ((0.5f / _e105) + (_e107 * (1f - (1f / _e110))))));
-        }
-    }
-    let _e117 = atmosphere_33;
-    let _e118 = r_27;
-    let _e119 = rho_5;
-    let _e120 = ray_r_mu_intersects_ground_5;
-    let _e121 = x_mu_3;
-    let _e122 = GetScatteringTextureUR(_e117, _e118, _e119, _e120, _e121);
-    u_r = _e122;
-    let _e124 = nu_10;
-    let _e125 = ScatteringUnitNu(_e124);
-    u_nu = _e125;
-    let _e127 = u_nu;
-    let _e128 = atmosphere_33;
-    let _e129 = mu_s_8;
-    let _e130 = GetScatteringTextureUMuS(_e128, _e129);
-    let _e131 = u_mu;
-    let _e132 = u_r;
-    return vec4<f32>(_e127, _e130, _e131, _e132);
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_34: AtmosphereParameters) -> f32 {
-    var atmosphere_35: AtmosphereParameters;
+    var d_max_4: f32;
     var local_6: f32;
-
-    atmosphere_35 = atmosphere_34;
-    let _e10 = atmosphere_35;
-    if (_e10.mu_s_min < LOW_SUN_MU_S) {
-        local_6 = LOW_SUN_MU_S;
-    } else {
-        let _e14 = atmosphere_35;
-        local_6 = (0.5f * (_e14.mu_s_min + 1f));
-    }
-    let _e20 = local_6;
-    return _e20;
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_36: AtmosphereParameters, mu_s_9: f32) -> f32 {
-    var atmosphere_37: AtmosphereParameters;
-    var mu_s_10: f32;
-    var knee: f32;
+    var d_13: f32;
+    var d_min_6: f32;
+    var d_max_5: f32;
     var local_7: f32;
+    var u_r: f32;
+    var u_mu_s: f32;
+    var mu_s_size: f32;
+    var edge_14: f32;
 
-    atmosphere_37 = atmosphere_36;
-    mu_s_10 = mu_s_9;
-    let _e12 = atmosphere_37;
-    let _e13 = IrradianceKneeMuS(_e12);
-    knee = _e13;
-    let _e15 = mu_s_10;
-    let _e16 = knee;
-    if (_e15 < _e16) {
-        let _e19 = mu_s_10;
-        let _e20 = atmosphere_37;
-        let _e24 = knee;
-        let _e25 = atmosphere_37;
-        local_7 = ((0.5f * (_e19 - _e20.mu_s_min)) / (_e24 - _e25.mu_s_min));
+    atmosphere_53 = atmosphere_52;
+    r_29 = r_28;
+    mu_22 = mu_21;
+    mu_s_11 = mu_s_10;
+    nu_12 = nu_11;
+    ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
+    let _e23 = atmosphere_53;
+    let _e24 = HorizonDistanceAtTop(_e23);
+    H_2 = _e24;
+    let _e26 = atmosphere_53;
+    let _e27 = r_29;
+    let _e28 = HorizonDistance(_e26, _e27);
+    rho_6 = _e28;
+    let _e30 = atmosphere_53;
+    half_mu_size = f32((_e30.scattering_mu_size / 2i));
+    let _e38 = ray_r_mu_intersects_ground_7;
+    if _e38 {
+        {
+            let _e39 = atmosphere_53;
+            let _e40 = r_29;
+            let _e41 = mu_22;
+            let _e42 = DistanceToBottomAtmosphereBoundary(_e39, _e40, _e41);
+            d_12 = _e42;
+            let _e44 = r_29;
+            let _e45 = atmosphere_53;
+            d_min_5 = (_e44 - _e45.bottom_radius);
+            let _e49 = rho_6;
+            d_max_4 = _e49;
+            let _e51 = d_max_4;
+            let _e52 = d_min_5;
+            if (_e51 == _e52) {
+                local_6 = 0f;
+            } else {
+                let _e55 = d_12;
+                let _e56 = d_min_5;
+                let _e58 = d_max_4;
+                let _e59 = d_min_5;
+                local_6 = ((_e55 - _e56) / (_e58 - _e59));
+            }
+            let _e63 = local_6;
+            x_mu_3 = _e63;
+            let _e67 = half_mu_size;
+            let _e69 = x_mu_3;
+            let _e72 = half_mu_size;
+            u_mu = (0.5f - (0.5f * ((0.5f / _e67) + (_e69 * (1f - (1f / _e72))))));
+        }
     } else {
-        let _e31 = mu_s_10;
-        let _e32 = knee;
-        let _e36 = knee;
-        local_7 = (0.5f + ((0.5f * (_e31 - _e32)) / (1f - _e36)));
+        {
+            let _e79 = atmosphere_53;
+            let _e80 = r_29;
+            let _e81 = mu_22;
+            let _e82 = DistanceToTopAtmosphereBoundary(_e79, _e80, _e81);
+            d_13 = _e82;
+            let _e84 = atmosphere_53;
+            let _e86 = r_29;
+            d_min_6 = (_e84.top_radius - _e86);
+            let _e89 = rho_6;
+            let _e90 = H_2;
+            d_max_5 = (_e89 + _e90);
+            let _e93 = d_max_5;
+            let _e94 = d_min_6;
+            if (_e93 > _e94) {
+                let _e96 = d_13;
+                let _e97 = d_min_6;
+                let _e99 = d_max_5;
+                let _e100 = d_min_6;
+                local_7 = ((_e96 - _e97) / (_e99 - _e100));
+            } else {
+                local_7 = 0f;
+            }
+            let _e105 = local_7;
+            x_mu_3 = _e105;
+            let _e109 = half_mu_size;
+            let _e111 = x_mu_3;
+            let _e114 = half_mu_size;
+            u_mu = (0.5f + (0.5f * ((0.5f / _e109) + (_e111 * (1f - (1f / _e114))))));
+        }
     }
-    let _e41 = local_7;
-    return _e41;
+    let _e121 = atmosphere_53;
+    let _e122 = r_29;
+    let _e123 = rho_6;
+    let _e124 = ray_r_mu_intersects_ground_7;
+    let _e125 = x_mu_3;
+    let _e126 = GetScatteringTextureUR(_e121, _e122, _e123, _e124, _e125);
+    u_r = _e126;
+    let _e128 = atmosphere_53;
+    let _e129 = mu_s_11;
+    let _e130 = GetScatteringTextureUMuS(_e128, _e129);
+    u_mu_s = _e130;
+    let _e132 = atmosphere_53;
+    mu_s_size = f32(_e132.scattering_mu_s_size);
+    let _e136 = atmosphere_53;
+    let _e140 = u_mu_s;
+    let _e141 = mu_s_size;
+    let _e145 = atmosphere_53;
+    if ((_e136.scattering_mu_s_split > 0i) && (((_e140 * _e141) - 0.5f) < f32(_e145.scattering_mu_s_split))) {
+        {
+            let _e150 = atmosphere_53;
+            let _e151 = r_29;
+            let _e152 = mu_22;
+            let _e153 = mu_22;
+            let _e154 = mu_s_11;
+            let _e155 = nu_12;
+            let _e156 = ViewSunAzimuthCosine(_e153, _e154, _e155);
+            let _e157 = ray_r_mu_intersects_ground_7;
+            let _e158 = ShadowEdgeSunZenith(_e150, _e151, _e152, _e156, _e157);
+            edge_14 = _e158;
+            let _e160 = atmosphere_53;
+            let _e161 = mu_s_11;
+            let _e163 = edge_14;
+            let _e164 = GetScatteringShadowEdgePosition(_e160, acos(_e161), _e163);
+            let _e167 = mu_s_size;
+            u_mu_s = ((_e164 + 0.5f) / _e167);
+        }
+    }
+    let _e169 = nu_12;
+    let _e170 = ScatteringUnitNu(_e169);
+    let _e171 = u_mu_s;
+    let _e172 = u_mu;
+    let _e173 = u_r;
+    return vec4<f32>(_e170, _e171, _e172, _e173);
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_38: AtmosphereParameters, x_7: f32) -> f32 {
-    var atmosphere_39: AtmosphereParameters;
-    var x_8: f32;
-    var knee_1: f32;
+fn IrradianceKneeMuS(atmosphere_54: AtmosphereParameters) -> f32 {
+    var atmosphere_55: AtmosphereParameters;
     var local_8: f32;
 
-    atmosphere_39 = atmosphere_38;
-    x_8 = x_7;
-    let _e12 = atmosphere_39;
-    let _e13 = IrradianceKneeMuS(_e12);
-    knee_1 = _e13;
-    let _e15 = x_8;
-    if (_e15 < 0.5f) {
-        let _e18 = atmosphere_39;
-        let _e21 = x_8;
-        let _e23 = knee_1;
-        let _e24 = atmosphere_39;
-        local_8 = (_e18.mu_s_min + ((2f * _e21) * (_e23 - _e24.mu_s_min)));
+    atmosphere_55 = atmosphere_54;
+    let _e14 = atmosphere_55;
+    if (_e14.mu_s_min < LOW_SUN_MU_S) {
+        local_8 = LOW_SUN_MU_S;
     } else {
-        let _e29 = knee_1;
-        let _e31 = x_8;
-        let _e36 = knee_1;
-        local_8 = (_e29 + (((2f * _e31) - 1f) * (1f - _e36)));
+        let _e18 = atmosphere_55;
+        local_8 = (0.5f * (_e18.mu_s_min + 1f));
     }
-    let _e41 = local_8;
-    return _e41;
+    let _e24 = local_8;
+    return _e24;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_40: AtmosphereParameters, r_28: f32, mu_s_11: f32) -> vec2<f32> {
-    var atmosphere_41: AtmosphereParameters;
-    var r_29: f32;
-    var mu_s_12: f32;
+fn GetIrradianceUnitMuS(atmosphere_56: AtmosphereParameters, mu_s_12: f32) -> f32 {
+    var atmosphere_57: AtmosphereParameters;
+    var mu_s_13: f32;
+    var knee: f32;
+    var local_9: f32;
+
+    atmosphere_57 = atmosphere_56;
+    mu_s_13 = mu_s_12;
+    let _e16 = atmosphere_57;
+    let _e17 = IrradianceKneeMuS(_e16);
+    knee = _e17;
+    let _e19 = mu_s_13;
+    let _e20 = knee;
+    if (_e19 < _e20) {
+        let _e23 = mu_s_13;
+        let _e24 = atmosphere_57;
+        let _e28 = knee;
+        let _e29 = atmosphere_57;
+        local_9 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
+    } else {
+        let _e35 = mu_s_13;
+        let _e36 = knee;
+        let _e40 = knee;
+        local_9 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
+    }
+    let _e45 = local_9;
+    return _e45;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceMuSFromUnit(atmosphere_58: AtmosphereParameters, x_10: f32) -> f32 {
+    var atmosphere_59: AtmosphereParameters;
+    var x_11: f32;
+    var knee_1: f32;
+    var local_10: f32;
+
+    atmosphere_59 = atmosphere_58;
+    x_11 = x_10;
+    let _e16 = atmosphere_59;
+    let _e17 = IrradianceKneeMuS(_e16);
+    knee_1 = _e17;
+    let _e19 = x_11;
+    if (_e19 < 0.5f) {
+        let _e22 = atmosphere_59;
+        let _e25 = x_11;
+        let _e27 = knee_1;
+        let _e28 = atmosphere_59;
+        local_10 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
+    } else {
+        let _e33 = knee_1;
+        let _e35 = x_11;
+        let _e40 = knee_1;
+        local_10 = (_e33 + (((2f * _e35) - 1f) * (1f - _e40)));
+    }
+    let _e45 = local_10;
+    return _e45;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceTextureUvFromRMuS(atmosphere_60: AtmosphereParameters, r_30: f32, mu_s_14: f32) -> vec2<f32> {
+    var atmosphere_61: AtmosphereParameters;
+    var r_31: f32;
+    var mu_s_15: f32;
     var x_r_1: f32;
     var x_mu_s_1: f32;
 
-    atmosphere_41 = atmosphere_40;
-    r_29 = r_28;
-    mu_s_12 = mu_s_11;
-    let _e14 = atmosphere_41;
-    let _e15 = r_29;
-    let _e16 = HorizonDistance(_e14, _e15);
-    let _e17 = atmosphere_41;
-    let _e18 = HorizonDistanceAtTop(_e17);
-    x_r_1 = (_e16 / _e18);
-    let _e21 = atmosphere_41;
-    let _e22 = mu_s_12;
-    let _e23 = GetIrradianceUnitMuS(_e21, _e22);
-    x_mu_s_1 = clamp(_e23, 0f, 1f);
-    let _e28 = x_mu_s_1;
-    let _e29 = atmosphere_41;
-    let _e31 = GetTextureCoordFromUnitRange(_e28, _e29.irradiance_width);
-    let _e32 = x_r_1;
-    let _e33 = atmosphere_41;
-    let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_height);
-    return vec2<f32>(_e31, _e35);
+    atmosphere_61 = atmosphere_60;
+    r_31 = r_30;
+    mu_s_15 = mu_s_14;
+    let _e18 = atmosphere_61;
+    let _e19 = r_31;
+    let _e20 = HorizonDistance(_e18, _e19);
+    let _e21 = atmosphere_61;
+    let _e22 = HorizonDistanceAtTop(_e21);
+    x_r_1 = (_e20 / _e22);
+    let _e25 = atmosphere_61;
+    let _e26 = mu_s_15;
+    let _e27 = GetIrradianceUnitMuS(_e25, _e26);
+    x_mu_s_1 = clamp(_e27, 0f, 1f);
+    let _e32 = x_mu_s_1;
+    let _e33 = atmosphere_61;
+    let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_width);
+    let _e36 = x_r_1;
+    let _e37 = atmosphere_61;
+    let _e39 = GetTextureCoordFromUnitRange(_e36, _e37.irradiance_height);
+    return vec2<f32>(_e35, _e39);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_42: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_30: f32, mu_19: f32) -> vec3<f32> {
-    var atmosphere_43: AtmosphereParameters;
-    var r_31: f32;
-    var mu_20: f32;
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_62: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_32: f32, mu_23: f32) -> vec3<f32> {
+    var atmosphere_63: AtmosphereParameters;
+    var r_33: f32;
+    var mu_24: f32;
     var uv_2: vec2<f32>;
 
-    atmosphere_43 = atmosphere_42;
-    r_31 = r_30;
-    mu_20 = mu_19;
-    let _e15 = atmosphere_43;
-    let _e16 = r_31;
-    let _e17 = mu_20;
-    let _e18 = GetTransmittanceTextureUvFromRMu(_e15, _e16, _e17);
-    uv_2 = _e18;
-    let _e20 = uv_2;
-    let _e21 = SampleTexture2D(transmittance_texture, _e20);
-    return vec3<f32>(_e21.xyz);
-}
-
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_44: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_32: f32, mu_21: f32) -> vec3<f32> {
-    var atmosphere_45: AtmosphereParameters;
-    var r_33: f32;
-    var mu_22: f32;
-
-    atmosphere_45 = atmosphere_44;
+    atmosphere_63 = atmosphere_62;
     r_33 = r_32;
-    mu_22 = mu_21;
-    let _e15 = atmosphere_45;
-    let _e16 = r_33;
-    let _e17 = mu_22;
-    let _e18 = GetOpticalDepthToTopAtmosphereBoundary(_e15, transmittance_texture_1, _e16, _e17);
-    return exp(-(_e18));
+    mu_24 = mu_23;
+    let _e19 = atmosphere_63;
+    let _e20 = r_33;
+    let _e21 = mu_24;
+    let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
+    uv_2 = _e22;
+    let _e24 = uv_2;
+    let _e25 = SampleTexture2D(transmittance_texture, _e24);
+    return vec3<f32>(_e25.xyz);
 }
 
-fn GetOpticalDepth(atmosphere_46: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_34: f32, mu_23: f32, d_12: f32, ray_r_mu_intersects_ground_6: bool) -> vec3<f32> {
-    var atmosphere_47: AtmosphereParameters;
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_64: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_34: f32, mu_25: f32) -> vec3<f32> {
+    var atmosphere_65: AtmosphereParameters;
     var r_35: f32;
-    var mu_24: f32;
-    var d_13: f32;
-    var ray_r_mu_intersects_ground_7: bool;
-    var r_d_2: f32;
+    var mu_26: f32;
+
+    atmosphere_65 = atmosphere_64;
+    r_35 = r_34;
+    mu_26 = mu_25;
+    let _e19 = atmosphere_65;
+    let _e20 = r_35;
+    let _e21 = mu_26;
+    let _e22 = GetOpticalDepthToTopAtmosphereBoundary(_e19, transmittance_texture_1, _e20, _e21);
+    return exp(-(_e22));
+}
+
+fn GetOpticalDepth(atmosphere_66: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_36: f32, mu_27: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
+    var atmosphere_67: AtmosphereParameters;
+    var r_37: f32;
+    var mu_28: f32;
+    var d_15: f32;
+    var ray_r_mu_intersects_ground_9: bool;
+    var r_d_3: f32;
     var mu_d: f32;
     var tau: vec3<f32>;
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_47 = atmosphere_46;
-    r_35 = r_34;
-    mu_24 = mu_23;
-    d_13 = d_12;
-    ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
-    let _e19 = atmosphere_47;
-    let _e20 = r_35;
-    let _e21 = mu_24;
-    let _e22 = d_13;
-    let _e23 = RadiusAtDistance(_e19, _e20, _e21, _e22);
-    r_d_2 = _e23;
-    let _e25 = r_35;
-    let _e26 = mu_24;
-    let _e27 = d_13;
-    let _e28 = r_d_2;
-    let _e29 = CosineAtDistance(_e25, _e26, _e27, _e28);
-    mu_d = _e29;
-    let _e32 = ray_r_mu_intersects_ground_7;
-    let _e33 = mu_d;
-    if (_e32 || (_e33 < 0f)) {
+    atmosphere_67 = atmosphere_66;
+    r_37 = r_36;
+    mu_28 = mu_27;
+    d_15 = d_14;
+    ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
+    let _e23 = atmosphere_67;
+    let _e24 = r_37;
+    let _e25 = mu_28;
+    let _e26 = d_15;
+    let _e27 = RadiusAtDistance(_e23, _e24, _e25, _e26);
+    r_d_3 = _e27;
+    let _e29 = r_37;
+    let _e30 = mu_28;
+    let _e31 = d_15;
+    let _e32 = r_d_3;
+    let _e33 = CosineAtDistance(_e29, _e30, _e31, _e32);
+    mu_d = _e33;
+    let _e36 = ray_r_mu_intersects_ground_9;
+    let _e37 = mu_d;
+    if (_e36 || (_e37 < 0f)) {
         {
-            let _e37 = atmosphere_47;
-            let _e38 = r_d_2;
-            let _e39 = mu_d;
-            let _e41 = GetOpticalDepthToTopAtmosphereBoundary(_e37, transmittance_texture_2, _e38, -(_e39));
-            let _e42 = atmosphere_47;
-            let _e43 = r_35;
-            let _e44 = mu_24;
-            let _e46 = GetOpticalDepthToTopAtmosphereBoundary(_e42, transmittance_texture_2, _e43, -(_e44));
-            tau = (_e41 - _e46);
+            let _e41 = atmosphere_67;
+            let _e42 = r_d_3;
+            let _e43 = mu_d;
+            let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
+            let _e46 = atmosphere_67;
+            let _e47 = r_37;
+            let _e48 = mu_28;
+            let _e50 = GetOpticalDepthToTopAtmosphereBoundary(_e46, transmittance_texture_2, _e47, -(_e48));
+            tau = (_e45 - _e50);
         }
     } else {
-        let _e48 = mu_24;
-        if (_e48 >= 0f) {
+        let _e52 = mu_28;
+        if (_e52 >= 0f) {
             {
-                let _e51 = atmosphere_47;
-                let _e52 = r_35;
-                let _e53 = mu_24;
-                let _e54 = GetOpticalDepthToTopAtmosphereBoundary(_e51, transmittance_texture_2, _e52, _e53);
-                let _e55 = atmosphere_47;
-                let _e56 = r_d_2;
-                let _e57 = mu_d;
+                let _e55 = atmosphere_67;
+                let _e56 = r_37;
+                let _e57 = mu_28;
                 let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
-                tau = (_e54 - _e58);
+                let _e59 = atmosphere_67;
+                let _e60 = r_d_3;
+                let _e61 = mu_d;
+                let _e62 = GetOpticalDepthToTopAtmosphereBoundary(_e59, transmittance_texture_2, _e60, _e61);
+                tau = (_e58 - _e62);
             }
         } else {
             {
-                let _e60 = atmosphere_47;
-                let _e61 = r_35;
-                let _e63 = mu_24;
-                let _e64 = mu_24;
-                let _e67 = SafeSqrt((1f - (_e63 * _e64)));
-                let _e69 = ClampRadius(_e60, (_e61 * _e67));
-                r_low = _e69;
-                let _e71 = atmosphere_47;
-                let _e72 = r_low;
-                let _e74 = GetOpticalDepthToTopAtmosphereBoundary(_e71, transmittance_texture_2, _e72, 0f);
-                tau_low = _e74;
-                let _e76 = tau_low;
-                let _e77 = atmosphere_47;
-                let _e78 = r_35;
-                let _e79 = mu_24;
-                let _e81 = GetOpticalDepthToTopAtmosphereBoundary(_e77, transmittance_texture_2, _e78, -(_e79));
-                let _e86 = tau_low;
-                let _e87 = atmosphere_47;
-                let _e88 = r_d_2;
-                let _e89 = mu_d;
-                let _e90 = GetOpticalDepthToTopAtmosphereBoundary(_e87, transmittance_texture_2, _e88, _e89);
-                tau = (max((_e76 - _e81), vec3(0f)) + max((_e86 - _e90), vec3(0f)));
+                let _e64 = atmosphere_67;
+                let _e65 = r_37;
+                let _e67 = mu_28;
+                let _e68 = mu_28;
+                let _e71 = SafeSqrt((1f - (_e67 * _e68)));
+                let _e73 = ClampRadius(_e64, (_e65 * _e71));
+                r_low = _e73;
+                let _e75 = atmosphere_67;
+                let _e76 = r_low;
+                let _e78 = GetOpticalDepthToTopAtmosphereBoundary(_e75, transmittance_texture_2, _e76, 0f);
+                tau_low = _e78;
+                let _e80 = tau_low;
+                let _e81 = atmosphere_67;
+                let _e82 = r_37;
+                let _e83 = mu_28;
+                let _e85 = GetOpticalDepthToTopAtmosphereBoundary(_e81, transmittance_texture_2, _e82, -(_e83));
+                let _e90 = tau_low;
+                let _e91 = atmosphere_67;
+                let _e92 = r_d_3;
+                let _e93 = mu_d;
+                let _e94 = GetOpticalDepthToTopAtmosphereBoundary(_e91, transmittance_texture_2, _e92, _e93);
+                tau = (max((_e80 - _e85), vec3(0f)) + max((_e90 - _e94), vec3(0f)));
             }
         }
     }
-    let _e96 = tau;
-    return max(_e96, vec3(0f));
+    let _e100 = tau;
+    return max(_e100, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_48: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_36: f32, mu_25: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
-    var atmosphere_49: AtmosphereParameters;
-    var r_37: f32;
-    var mu_26: f32;
-    var d_15: f32;
-    var ray_r_mu_intersects_ground_9: bool;
-
-    atmosphere_49 = atmosphere_48;
-    r_37 = r_36;
-    mu_26 = mu_25;
-    d_15 = d_14;
-    ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e19 = atmosphere_49;
-    let _e20 = r_37;
-    let _e21 = mu_26;
-    let _e22 = d_15;
-    let _e23 = ray_r_mu_intersects_ground_9;
-    let _e24 = GetOpticalDepth(_e19, transmittance_texture_3, _e20, _e21, _e22, _e23);
-    return exp(-(_e24));
-}
-
-fn SunVisibleFraction(atmosphere_50: AtmosphereParameters, r_38: f32, mu_s_13: f32) -> f32 {
-    var atmosphere_51: AtmosphereParameters;
+fn GetTransmittance(atmosphere_68: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_38: f32, mu_29: f32, d_16: f32, ray_r_mu_intersects_ground_10: bool) -> vec3<f32> {
+    var atmosphere_69: AtmosphereParameters;
     var r_39: f32;
-    var mu_s_14: f32;
+    var mu_30: f32;
+    var d_17: f32;
+    var ray_r_mu_intersects_ground_11: bool;
+
+    atmosphere_69 = atmosphere_68;
+    r_39 = r_38;
+    mu_30 = mu_29;
+    d_17 = d_16;
+    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
+    let _e23 = atmosphere_69;
+    let _e24 = r_39;
+    let _e25 = mu_30;
+    let _e26 = d_17;
+    let _e27 = ray_r_mu_intersects_ground_11;
+    let _e28 = GetOpticalDepth(_e23, transmittance_texture_3, _e24, _e25, _e26, _e27);
+    return exp(-(_e28));
+}
+
+fn SunVisibleFraction(atmosphere_70: AtmosphereParameters, r_40: f32, mu_s_16: f32) -> f32 {
+    var atmosphere_71: AtmosphereParameters;
+    var r_41: f32;
+    var mu_s_17: f32;
     var sin_theta_h: f32;
 
-    atmosphere_51 = atmosphere_50;
-    r_39 = r_38;
-    mu_s_14 = mu_s_13;
-    let _e14 = atmosphere_51;
-    let _e16 = r_39;
-    sin_theta_h = (_e14.bottom_radius / _e16);
-    let _e19 = mu_s_14;
-    let _e20 = atmosphere_51;
-    let _e22 = r_39;
-    let _e23 = HorizonZenithCosine(_e20.bottom_radius, _e22);
-    let _e24 = sin_theta_h;
-    let _e25 = atmosphere_51;
-    let _e28 = SunVisibleFractionAboveHorizon(_e19, _e23, (_e24 * _e25.sun_angular_radius));
-    return _e28;
-}
-
-fn GetTransmittanceToSun(atmosphere_52: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_40: f32, mu_s_15: f32) -> vec3<f32> {
-    var atmosphere_53: AtmosphereParameters;
-    var r_41: f32;
-    var mu_s_16: f32;
-
-    atmosphere_53 = atmosphere_52;
+    atmosphere_71 = atmosphere_70;
     r_41 = r_40;
-    mu_s_16 = mu_s_15;
-    let _e15 = atmosphere_53;
-    let _e16 = r_41;
-    let _e17 = mu_s_16;
-    let _e18 = GetTransmittanceToTopAtmosphereBoundary(_e15, transmittance_texture_4, _e16, _e17);
-    let _e19 = atmosphere_53;
+    mu_s_17 = mu_s_16;
+    let _e18 = atmosphere_71;
     let _e20 = r_41;
-    let _e21 = mu_s_16;
-    let _e22 = SunVisibleFraction(_e19, _e20, _e21);
-    return (_e18 * _e22);
+    sin_theta_h = (_e18.bottom_radius / _e20);
+    let _e23 = mu_s_17;
+    let _e24 = atmosphere_71;
+    let _e26 = r_41;
+    let _e27 = HorizonZenithCosine(_e24.bottom_radius, _e26);
+    let _e28 = sin_theta_h;
+    let _e29 = atmosphere_71;
+    let _e32 = SunVisibleFractionAboveHorizon(_e23, _e27, (_e28 * _e29.sun_angular_radius));
+    return _e32;
 }
 
-fn SunCosineMix(a_6: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
-    var a_7: vec4<f32>;
+fn GetTransmittanceToSun(atmosphere_72: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_42: f32, mu_s_18: f32) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
+    var r_43: f32;
+    var mu_s_19: f32;
+
+    atmosphere_73 = atmosphere_72;
+    r_43 = r_42;
+    mu_s_19 = mu_s_18;
+    let _e19 = atmosphere_73;
+    let _e20 = r_43;
+    let _e21 = mu_s_19;
+    let _e22 = GetTransmittanceToTopAtmosphereBoundary(_e19, transmittance_texture_4, _e20, _e21);
+    let _e23 = atmosphere_73;
+    let _e24 = r_43;
+    let _e25 = mu_s_19;
+    let _e26 = SunVisibleFraction(_e23, _e24, _e25);
+    return (_e22 * _e26);
+}
+
+fn SunCosineMix(a_7: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
+    var a_8: vec4<f32>;
     var b_1: vec4<f32>;
     var t_2: f32;
     var low_sun_1: bool;
     var dark: vec4<f32> = vec4(0.000000000000000000000000000001f);
 
-    a_7 = a_6;
+    a_8 = a_7;
     b_1 = b;
     t_2 = t_1;
     low_sun_1 = low_sun;
-    let _e16 = low_sun_1;
-    if !(_e16) {
-        let _e18 = a_7;
-        let _e19 = b_1;
-        let _e20 = t_2;
-        return mix(_e18, _e19, vec4(_e20));
+    let _e20 = low_sun_1;
+    if !(_e20) {
+        let _e22 = a_8;
+        let _e23 = b_1;
+        let _e24 = t_2;
+        return mix(_e22, _e23, vec4(_e24));
     }
-    let _e26 = a_7;
-    let _e27 = dark;
-    let _e30 = b_1;
+    let _e30 = a_8;
     let _e31 = dark;
-    let _e34 = t_2;
-    let _e38 = dark;
-    let _e39 = a_7;
-    let _e40 = b_1;
-    return (exp(mix(log(max(_e26, _e27)), log(max(_e30, _e31)), vec4(_e34))) * step(_e38, max(_e39, _e40)));
+    let _e34 = b_1;
+    let _e35 = dark;
+    let _e38 = t_2;
+    let _e42 = dark;
+    let _e43 = a_8;
+    let _e44 = b_1;
+    return (exp(mix(log(max(_e30, _e31)), log(max(_e34, _e35)), vec4(_e38))) * step(_e42, max(_e43, _e44)));
 }
 
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
     var t_4: f32;
     var low_sun_3: bool;
-    var local_9: f32;
+    var local_11: f32;
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
-    let _e12 = low_sun_3;
-    if _e12 {
-        let _e13 = t_4;
-        local_9 = min(_e13, 1f);
+    let _e16 = low_sun_3;
+    if _e16 {
+        let _e17 = t_4;
+        local_11 = min(_e17, 1f);
     } else {
-        let _e16 = t_4;
-        local_9 = clamp(_e16, 0f, 1f);
+        let _e20 = t_4;
+        local_11 = clamp(_e20, 0f, 1f);
     }
-    let _e21 = local_9;
-    return _e21;
+    let _e25 = local_11;
+    return _e25;
 }
 
-fn SunBelowTableMix(a_8: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
-    var a_9: vec4<f32>;
+fn SunBelowTableMix(a_9: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
+    var a_10: vec4<f32>;
     var b_3: vec4<f32>;
     var t_6: f32;
     var low_sun_5: bool;
     var blend: vec4<f32>;
-    var local_10: vec4<f32>;
+    var local_12: vec4<f32>;
 
-    a_9 = a_8;
+    a_10 = a_9;
     b_3 = b_2;
     t_6 = t_5;
     low_sun_5 = low_sun_4;
-    let _e16 = a_9;
-    let _e17 = b_3;
-    let _e18 = t_6;
-    let _e19 = low_sun_5;
-    let _e20 = SunCosineMix(_e16, _e17, _e18, _e19);
-    blend = _e20;
+    let _e20 = a_10;
+    let _e21 = b_3;
     let _e22 = t_6;
-    if (_e22 < 0f) {
-        let _e25 = blend;
-        let _e26 = a_9;
-        local_10 = min(_e25, _e26);
+    let _e23 = low_sun_5;
+    let _e24 = SunCosineMix(_e20, _e21, _e22, _e23);
+    blend = _e24;
+    let _e26 = t_6;
+    if (_e26 < 0f) {
+        let _e29 = blend;
+        let _e30 = a_10;
+        local_12 = min(_e29, _e30);
     } else {
-        let _e28 = blend;
-        local_10 = _e28;
+        let _e32 = blend;
+        local_12 = _e32;
     }
-    let _e30 = local_10;
-    return _e30;
+    let _e34 = local_12;
+    return _e34;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_54: AtmosphereParameters, u_mu_s: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_55: AtmosphereParameters;
-    var u_mu_s_1: f32;
+fn GetScatteringMuSColumns(atmosphere_74: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_75: AtmosphereParameters;
+    var u_mu_s_2: f32;
     var x_low_sun_1: f32;
-    var mu_s_size: f32;
+    var mu_s_size_1: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_55 = atmosphere_54;
-    u_mu_s_1 = u_mu_s;
+    atmosphere_75 = atmosphere_74;
+    u_mu_s_2 = u_mu_s_1;
     x_low_sun_1 = x_low_sun;
-    let _e18 = atmosphere_55;
-    mu_s_size = f32(_e18.scattering_mu_s_size);
-    let _e22 = u_mu_s_1;
-    let _e23 = mu_s_size;
-    mu_s_coord = ((_e22 * _e23) - 0.5f);
-    let _e28 = mu_s_coord;
-    let _e31 = mu_s_size;
-    mu_s_column = clamp(floor(_e28), 0f, (_e31 - 2f));
-    let _e36 = mu_s_column;
-    let _e39 = mu_s_size;
-    (*x_below) = ((_e36 + 0.5f) / _e39);
-    let _e41 = mu_s_column;
-    let _e44 = mu_s_size;
-    (*x_above) = ((_e41 + 1.5f) / _e44);
-    let _e46 = (*x_below);
-    let _e47 = x_low_sun_1;
-    (*low_sun_below) = (_e46 < _e47);
-    let _e49 = mu_s_coord;
-    let _e50 = mu_s_column;
-    let _e52 = (*low_sun_below);
-    let _e53 = SunCosinePosition((_e49 - _e50), _e52);
-    (*mu_s_t) = _e53;
+    let _e22 = atmosphere_75;
+    mu_s_size_1 = f32(_e22.scattering_mu_s_size);
+    let _e26 = u_mu_s_2;
+    let _e27 = mu_s_size_1;
+    mu_s_coord = ((_e26 * _e27) - 0.5f);
+    let _e32 = mu_s_coord;
+    let _e35 = mu_s_size_1;
+    mu_s_column = clamp(floor(_e32), 0f, (_e35 - 2f));
+    let _e40 = mu_s_column;
+    let _e43 = mu_s_size_1;
+    (*x_below) = ((_e40 + 0.5f) / _e43);
+    let _e45 = mu_s_column;
+    let _e48 = mu_s_size_1;
+    (*x_above) = ((_e45 + 1.5f) / _e48);
+    let _e50 = (*x_below);
+    let _e51 = x_low_sun_1;
+    (*low_sun_below) = (_e50 < _e51);
+    let _e53 = mu_s_coord;
+    let _e54 = mu_s_column;
+    let _e56 = (*low_sun_below);
+    let _e57 = SunCosinePosition((_e53 - _e54), _e56);
+    (*mu_s_t) = _e57;
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LogMonotoneCubicMix(a_10: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_16: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
-    var a_11: vec4<f32>;
+fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
+    var a_12: vec4<f32>;
     var b_5: vec4<f32>;
     var c_7: vec4<f32>;
-    var d_17: vec4<f32>;
+    var d_19: vec4<f32>;
     var has_a_1: bool;
     var has_d_1: bool;
     var t_8: f32;
     var dark_1: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var lb: vec4<f32>;
     var lc: vec4<f32>;
-    var local_11: vec4<f32>;
+    var local_13: vec4<f32>;
     var la: vec4<f32>;
-    var local_12: vec4<f32>;
+    var local_14: vec4<f32>;
     var ld: vec4<f32>;
     var secant_a: vec4<f32>;
     var secant: vec4<f32>;
@@ -1409,114 +1899,114 @@ fn LogMonotoneCubicMix(a_10: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_16: ve
     var cubic: vec4<f32>;
     var lit: vec4<f32>;
 
-    a_11 = a_10;
+    a_12 = a_11;
     b_5 = b_4;
     c_7 = c_6;
-    d_17 = d_16;
+    d_19 = d_18;
     has_a_1 = has_a;
     has_d_1 = has_d;
     t_8 = t_7;
-    let _e25 = b_5;
-    let _e26 = dark_1;
-    lb = log(max(_e25, _e26));
-    let _e30 = c_7;
-    let _e31 = dark_1;
-    lc = log(max(_e30, _e31));
-    let _e35 = has_a_1;
-    if _e35 {
-        let _e36 = a_11;
-        let _e37 = dark_1;
-        local_11 = log(max(_e36, _e37));
+    let _e29 = b_5;
+    let _e30 = dark_1;
+    lb = log(max(_e29, _e30));
+    let _e34 = c_7;
+    let _e35 = dark_1;
+    lc = log(max(_e34, _e35));
+    let _e39 = has_a_1;
+    if _e39 {
+        let _e40 = a_12;
+        let _e41 = dark_1;
+        local_13 = log(max(_e40, _e41));
     } else {
-        let _e41 = lb;
-        let _e43 = lc;
-        local_11 = ((2f * _e41) - _e43);
+        let _e45 = lb;
+        let _e47 = lc;
+        local_13 = ((2f * _e45) - _e47);
     }
-    let _e46 = local_11;
-    la = _e46;
-    let _e48 = has_d_1;
-    if _e48 {
-        let _e49 = d_17;
-        let _e50 = dark_1;
-        local_12 = log(max(_e49, _e50));
+    let _e50 = local_13;
+    la = _e50;
+    let _e52 = has_d_1;
+    if _e52 {
+        let _e53 = d_19;
+        let _e54 = dark_1;
+        local_14 = log(max(_e53, _e54));
     } else {
-        let _e54 = lc;
-        let _e56 = lb;
-        local_12 = ((2f * _e54) - _e56);
+        let _e58 = lc;
+        let _e60 = lb;
+        local_14 = ((2f * _e58) - _e60);
     }
-    let _e59 = local_12;
-    ld = _e59;
-    let _e61 = lb;
-    let _e62 = la;
-    secant_a = (_e61 - _e62);
-    let _e65 = lc;
-    let _e66 = lb;
-    secant = (_e65 - _e66);
-    let _e69 = ld;
-    let _e70 = lc;
-    secant_d = (_e69 - _e70);
-    let _e73 = secant_a;
-    let _e74 = secant;
-    product_b = (_e73 * _e74);
-    let _e77 = secant;
-    let _e78 = secant_d;
-    product_c = (_e77 * _e78);
-    let _e83 = product_b;
-    agree_b = (vec4(1f) - step(_e83, vec4(0f)));
-    let _e91 = product_c;
-    agree_c = (vec4(1f) - step(_e91, vec4(0f)));
-    let _e97 = agree_b;
-    let _e100 = product_b;
-    let _e104 = secant_a;
-    let _e105 = secant;
-    let _e107 = agree_b;
-    slope_b = (((_e97 * 2f) * _e100) / mix(vec4(1f), (_e104 + _e105), _e107));
-    let _e111 = agree_c;
-    let _e114 = product_c;
-    let _e118 = secant;
-    let _e119 = secant_d;
-    let _e121 = agree_c;
-    slope_c = (((_e111 * 2f) * _e114) / mix(vec4(1f), (_e118 + _e119), _e121));
-    let _e125 = t_8;
-    let _e126 = t_8;
-    t2_ = (_e125 * _e126);
-    let _e129 = t2_;
+    let _e63 = local_14;
+    ld = _e63;
+    let _e65 = lb;
+    let _e66 = la;
+    secant_a = (_e65 - _e66);
+    let _e69 = lc;
+    let _e70 = lb;
+    secant = (_e69 - _e70);
+    let _e73 = ld;
+    let _e74 = lc;
+    secant_d = (_e73 - _e74);
+    let _e77 = secant_a;
+    let _e78 = secant;
+    product_b = (_e77 * _e78);
+    let _e81 = secant;
+    let _e82 = secant_d;
+    product_c = (_e81 * _e82);
+    let _e87 = product_b;
+    agree_b = (vec4(1f) - step(_e87, vec4(0f)));
+    let _e95 = product_c;
+    agree_c = (vec4(1f) - step(_e95, vec4(0f)));
+    let _e101 = agree_b;
+    let _e104 = product_b;
+    let _e108 = secant_a;
+    let _e109 = secant;
+    let _e111 = agree_b;
+    slope_b = (((_e101 * 2f) * _e104) / mix(vec4(1f), (_e108 + _e109), _e111));
+    let _e115 = agree_c;
+    let _e118 = product_c;
+    let _e122 = secant;
+    let _e123 = secant_d;
+    let _e125 = agree_c;
+    slope_c = (((_e115 * 2f) * _e118) / mix(vec4(1f), (_e122 + _e123), _e125));
+    let _e129 = t_8;
     let _e130 = t_8;
-    t3_ = (_e129 * _e130);
-    let _e134 = t3_;
-    let _e137 = t2_;
-    let _e142 = lb;
-    let _e144 = t3_;
-    let _e146 = t2_;
-    let _e149 = t_8;
-    let _e151 = slope_b;
-    let _e155 = t2_;
-    let _e158 = t3_;
-    let _e161 = lc;
-    let _e164 = t3_;
-    let _e165 = t2_;
-    let _e167 = slope_c;
-    cubic = (((((((2f * _e134) - (3f * _e137)) + 1f) * _e142) + (((_e144 - (2f * _e146)) + _e149) * _e151)) + (((3f * _e155) - (2f * _e158)) * _e161)) + ((_e164 - _e165) * _e167));
-    let _e171 = dark_1;
-    let _e172 = a_11;
-    let _e173 = b_5;
-    let _e175 = c_7;
-    let _e176 = d_17;
-    lit = step(_e171, min(min(_e172, _e173), min(_e175, _e176)));
-    let _e181 = lb;
-    let _e182 = lc;
-    let _e183 = t_8;
-    let _e186 = cubic;
-    let _e187 = lit;
-    let _e190 = dark_1;
-    let _e191 = b_5;
-    let _e192 = c_7;
-    return (exp(mix(mix(_e181, _e182, vec4(_e183)), _e186, _e187)) * step(_e190, max(_e191, _e192)));
+    t2_ = (_e129 * _e130);
+    let _e133 = t2_;
+    let _e134 = t_8;
+    t3_ = (_e133 * _e134);
+    let _e138 = t3_;
+    let _e141 = t2_;
+    let _e146 = lb;
+    let _e148 = t3_;
+    let _e150 = t2_;
+    let _e153 = t_8;
+    let _e155 = slope_b;
+    let _e159 = t2_;
+    let _e162 = t3_;
+    let _e165 = lc;
+    let _e168 = t3_;
+    let _e169 = t2_;
+    let _e171 = slope_c;
+    cubic = (((((((2f * _e138) - (3f * _e141)) + 1f) * _e146) + (((_e148 - (2f * _e150)) + _e153) * _e155)) + (((3f * _e159) - (2f * _e162)) * _e165)) + ((_e168 - _e169) * _e171));
+    let _e175 = dark_1;
+    let _e176 = a_12;
+    let _e177 = b_5;
+    let _e179 = c_7;
+    let _e180 = d_19;
+    lit = step(_e175, min(min(_e176, _e177), min(_e179, _e180)));
+    let _e185 = lb;
+    let _e186 = lc;
+    let _e187 = t_8;
+    let _e190 = cubic;
+    let _e191 = lit;
+    let _e194 = dark_1;
+    let _e195 = b_5;
+    let _e196 = c_7;
+    return (exp(mix(mix(_e185, _e186, vec4(_e187)), _e190, _e191)) * step(_e194, max(_e195, _e196)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
-    var a_13: vec4<f32>;
+fn LowestSunLogFall(a_13: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope_1: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
+    var a_14: vec4<f32>;
     var b_7: vec4<f32>;
     var mu_s_a_1: f32;
     var mu_s_b_1: f32;
@@ -1524,41 +2014,41 @@ fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
     var rise: vec4<f32>;
     var k_2: vec4<f32>;
 
-    a_13 = a_12;
+    a_14 = a_13;
     b_7 = b_6;
     mu_s_a_1 = mu_s_a;
     mu_s_b_1 = mu_s_b;
-    let _e21 = b_7;
-    let _e22 = dark_2;
-    let _e25 = a_13;
+    let _e25 = b_7;
     let _e26 = dark_2;
+    let _e29 = a_14;
     let _e30 = dark_2;
-    let _e31 = a_13;
-    let _e36 = b_7;
-    let _e37 = a_13;
-    rise = (((log(max(_e21, _e22)) - log(max(_e25, _e26))) * step(_e30, _e31)) * (vec4(1f) - step(_e36, _e37)));
-    let _e42 = mu_s_b_1;
-    if (_e42 < 0f) {
+    let _e34 = dark_2;
+    let _e35 = a_14;
+    let _e40 = b_7;
+    let _e41 = a_14;
+    rise = (((log(max(_e25, _e26)) - log(max(_e29, _e30))) * step(_e34, _e35)) * (vec4(1f) - step(_e40, _e41)));
+    let _e46 = mu_s_b_1;
+    if (_e46 < 0f) {
         {
-            let _e45 = rise;
-            let _e46 = mu_s_a_1;
-            let _e47 = mu_s_a_1;
-            let _e49 = mu_s_b_1;
-            let _e50 = mu_s_b_1;
-            k_2 = (_e45 / vec4(((_e46 * _e47) - (_e49 * _e50))));
-            let _e58 = mu_s_a_1;
-            let _e60 = k_2;
-            (*slope) = ((-2f * _e58) * _e60);
-            let _e62 = k_2;
-            (*curvature) = -(_e62);
+            let _e49 = rise;
+            let _e50 = mu_s_a_1;
+            let _e51 = mu_s_a_1;
+            let _e53 = mu_s_b_1;
+            let _e54 = mu_s_b_1;
+            k_2 = (_e49 / vec4(((_e50 * _e51) - (_e53 * _e54))));
+            let _e62 = mu_s_a_1;
+            let _e64 = k_2;
+            (*slope_1) = ((-2f * _e62) * _e64);
+            let _e66 = k_2;
+            (*curvature) = -(_e66);
             return;
         }
     } else {
         {
-            let _e64 = rise;
-            let _e65 = mu_s_b_1;
-            let _e66 = mu_s_a_1;
-            (*slope) = (_e64 / vec4((_e65 - _e66)));
+            let _e68 = rise;
+            let _e69 = mu_s_b_1;
+            let _e70 = mu_s_a_1;
+            (*slope_1) = (_e68 / vec4((_e69 - _e70)));
             (*curvature) = vec4(0f);
             return;
         }
@@ -1566,54 +2056,256 @@ fn LowestSunLogFall(a_12: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_56: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_9: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_57: AtmosphereParameters;
+fn GetScatteringAtMuSColumn(atmosphere_76: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_77: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
-    var x_10: f32;
+    var x_13: f32;
     var nu_slice_1: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
     var nu_size: f32;
 
-    atmosphere_57 = atmosphere_56;
+    atmosphere_77 = atmosphere_76;
     uvwz_1 = uvwz;
-    x_10 = x_9;
+    x_13 = x_12;
     nu_slice_1 = nu_slice;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e21 = atmosphere_57;
-    nu_size = f32(_e21.scattering_nu_size);
-    let _e25 = nu_slice_1;
-    let _e26 = x_10;
-    let _e28 = nu_size;
-    let _e30 = uvwz_1;
-    let _e32 = uvwz_1;
-    let _e35 = SampleTexture3D(scattering_texture, vec3<f32>(((_e25 + _e26) / _e28), _e30.z, _e32.w));
-    let _e36 = nu_slice_1;
-    let _e39 = x_10;
-    let _e41 = nu_size;
-    let _e43 = uvwz_1;
-    let _e45 = uvwz_1;
-    let _e48 = SampleTexture3D(scattering_texture, vec3<f32>((((_e36 + 1f) + _e39) / _e41), _e43.z, _e45.w));
-    let _e49 = nu_t_1;
-    let _e50 = low_sun_7;
-    let _e51 = SunCosineMix(_e35, _e48, _e49, _e50);
-    return _e51;
+    let _e25 = atmosphere_77;
+    nu_size = f32(_e25.scattering_nu_size);
+    let _e29 = nu_slice_1;
+    let _e30 = x_13;
+    let _e32 = nu_size;
+    let _e34 = uvwz_1;
+    let _e36 = uvwz_1;
+    let _e39 = SampleTexture3D(scattering_texture, vec3<f32>(((_e29 + _e30) / _e32), _e34.z, _e36.w));
+    let _e40 = nu_slice_1;
+    let _e43 = x_13;
+    let _e45 = nu_size;
+    let _e47 = uvwz_1;
+    let _e49 = uvwz_1;
+    let _e52 = SampleTexture3D(scattering_texture, vec3<f32>((((_e40 + 1f) + _e43) / _e45), _e47.z, _e49.w));
+    let _e53 = nu_t_1;
+    let _e54 = low_sun_7;
+    let _e55 = SunCosineMix(_e39, _e52, _e53, _e54);
+    return _e55;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_58: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, r_42: f32, mu_27: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
-    var atmosphere_59: AtmosphereParameters;
-    var r_43: f32;
-    var mu_28: f32;
-    var mu_s_18: f32;
-    var nu_12: f32;
-    var ray_r_mu_intersects_ground_11: bool;
-    var uvwz_2: vec4<f32>;
+fn GetScatteringAtOwnColumn(atmosphere_78: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, column: f32, nu_slice_2: f32) -> vec4<f32> {
+    var atmosphere_79: AtmosphereParameters;
+    var uvwz_3: vec4<f32>;
+    var column_1: f32;
+    var nu_slice_3: f32;
+    var x_14: f32;
+
+    atmosphere_79 = atmosphere_78;
+    uvwz_3 = uvwz_2;
+    column_1 = column;
+    nu_slice_3 = nu_slice_2;
+    let _e21 = column_1;
+    let _e24 = atmosphere_79;
+    x_14 = ((_e21 + 0.5f) / f32(_e24.scattering_mu_s_size));
+    let _e29 = nu_slice_3;
+    let _e30 = x_14;
+    let _e32 = atmosphere_79;
+    let _e36 = uvwz_3;
+    let _e38 = uvwz_3;
+    let _e41 = SampleTexture3D(scattering_texture_1, vec3<f32>(((_e29 + _e30) / f32(_e32.scattering_nu_size)), _e36.z, _e38.w));
+    return _e41;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringBelowSplit(atmosphere_80: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, position_3: f32, nu_slice_4: f32, log_first_span: f32) -> vec4<f32> {
+    var atmosphere_81: AtmosphereParameters;
+    var uvwz_5: vec4<f32>;
+    var position_4: f32;
+    var nu_slice_5: f32;
+    var log_first_span_1: f32;
+    var past_2: f32 = 6f;
+    var intervals: f32;
+    var k_3: f32;
+    var column_2: f32;
+    var at_edge: vec4<f32>;
+    var rise_1: vec4<f32>;
+    var second_rise: vec4<f32>;
+    var tiny: vec4<f32> = vec4(0.000000000000000000000000000001f);
+    var rises: vec4<f32>;
+    var power: vec4<f32>;
+    var x_15: f32;
+    var k_4: f32;
+
+    atmosphere_81 = atmosphere_80;
+    uvwz_5 = uvwz_4;
+    position_4 = position_3;
+    nu_slice_5 = nu_slice_4;
+    log_first_span_1 = log_first_span;
+    let _e26 = atmosphere_81;
+    let _e29 = past_2;
+    intervals = (f32(_e26.scattering_mu_s_split) - _e29);
+    let _e32 = position_4;
+    let _e33 = past_2;
+    if (_e32 >= _e33) {
+        {
+            let _e35 = position_4;
+            let _e36 = past_2;
+            let _e39 = intervals;
+            k_3 = min(floor((_e35 - _e36)), (_e39 - 1f));
+            let _e44 = past_2;
+            let _e45 = k_3;
+            column_2 = (_e44 + _e45);
+            let _e48 = atmosphere_81;
+            let _e49 = uvwz_5;
+            let _e50 = column_2;
+            let _e53 = nu_slice_5;
+            let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_2, _e49, (_e50 - 1f), _e53);
+            let _e55 = atmosphere_81;
+            let _e56 = uvwz_5;
+            let _e57 = column_2;
+            let _e58 = nu_slice_5;
+            let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_2, _e56, _e57, _e58);
+            let _e60 = atmosphere_81;
+            let _e61 = uvwz_5;
+            let _e62 = column_2;
+            let _e65 = nu_slice_5;
+            let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_2, _e61, (_e62 + 1f), _e65);
+            let _e67 = atmosphere_81;
+            let _e68 = uvwz_5;
+            let _e69 = column_2;
+            let _e72 = past_2;
+            let _e73 = intervals;
+            let _e76 = nu_slice_5;
+            let _e77 = GetScatteringAtOwnColumn(_e67, scattering_texture_2, _e68, min((_e69 + 2f), (_e72 + _e73)), _e76);
+            let _e78 = k_3;
+            let _e81 = k_3;
+            let _e84 = intervals;
+            let _e86 = position_4;
+            let _e87 = column_2;
+            let _e89 = LogMonotoneCubicMix(_e54, _e59, _e66, _e77, (_e78 >= 1f), ((_e81 + 2f) <= _e84), (_e86 - _e87));
+            return _e89;
+        }
+    }
+    let _e90 = position_4;
+    let _e91 = past_2;
+    if (_e90 >= (_e91 - 1f)) {
+        {
+            let _e95 = atmosphere_81;
+            let _e96 = uvwz_5;
+            let _e97 = past_2;
+            let _e100 = nu_slice_5;
+            let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_2, _e96, (_e97 - 1f), _e100);
+            at_edge = _e101;
+            let _e103 = atmosphere_81;
+            let _e104 = uvwz_5;
+            let _e105 = past_2;
+            let _e106 = nu_slice_5;
+            let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_2, _e104, _e105, _e106);
+            let _e108 = at_edge;
+            rise_1 = (_e107 - _e108);
+            let _e111 = atmosphere_81;
+            let _e112 = uvwz_5;
+            let _e113 = past_2;
+            let _e116 = nu_slice_5;
+            let _e117 = GetScatteringAtOwnColumn(_e111, scattering_texture_2, _e112, (_e113 + 1f), _e116);
+            let _e118 = at_edge;
+            second_rise = (_e117 - _e118);
+            let _e124 = tiny;
+            let _e125 = rise_1;
+            let _e129 = second_rise;
+            let _e130 = rise_1;
+            rises = (step(_e124, _e125) * (vec4(1f) - step(_e129, _e130)));
+            let _e137 = second_rise;
+            let _e138 = tiny;
+            let _e140 = rise_1;
+            let _e141 = tiny;
+            let _e145 = log_first_span_1;
+            let _e153 = rises;
+            power = mix(vec4(3f), clamp((log((max(_e137, _e138) / max(_e140, _e141))) / vec4(_e145)), vec4(1f), vec4(10f)), _e153);
+            let _e156 = at_edge;
+            let _e157 = rise_1;
+            let _e158 = position_4;
+            let _e159 = past_2;
+            let _e164 = power;
+            return (_e156 + (_e157 * pow(vec4(((_e158 - _e159) + 1f)), _e164)));
+        }
+    }
+    let _e168 = past_2;
+    let _e171 = position_4;
+    x_15 = ((_e168 - 1f) - _e171);
+    let _e174 = x_15;
+    let _e176 = past_2;
+    k_4 = min(floor(_e174), (_e176 - 2f));
+    let _e181 = atmosphere_81;
+    let _e182 = uvwz_5;
+    let _e183 = past_2;
+    let _e186 = k_4;
+    let _e188 = nu_slice_5;
+    let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_2, _e182, ((_e183 - 1f) - _e186), _e188);
+    let _e190 = atmosphere_81;
+    let _e191 = uvwz_5;
+    let _e192 = past_2;
+    let _e195 = k_4;
+    let _e197 = nu_slice_5;
+    let _e198 = GetScatteringAtOwnColumn(_e190, scattering_texture_2, _e191, ((_e192 - 2f) - _e195), _e197);
+    let _e199 = x_15;
+    let _e200 = k_4;
+    let _e203 = SunCosineMix(_e189, _e198, (_e199 - _e200), true);
+    return _e203;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringAtOwnColumnBetweenSlices(atmosphere_82: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, column_3: f32, nu_slice_6: f32, nu_t_2: f32) -> vec4<f32> {
+    var atmosphere_83: AtmosphereParameters;
+    var uvwz_7: vec4<f32>;
+    var column_4: f32;
+    var nu_slice_7: f32;
+    var nu_t_3: f32;
+
+    atmosphere_83 = atmosphere_82;
+    uvwz_7 = uvwz_6;
+    column_4 = column_3;
+    nu_slice_7 = nu_slice_6;
+    nu_t_3 = nu_t_2;
+    let _e23 = atmosphere_83;
+    let _e24 = uvwz_7;
+    let _e25 = column_4;
+    let _e26 = nu_slice_7;
+    let _e27 = GetScatteringAtOwnColumn(_e23, scattering_texture_3, _e24, _e25, _e26);
+    let _e28 = atmosphere_83;
+    let _e29 = uvwz_7;
+    let _e30 = column_4;
+    let _e31 = nu_slice_7;
+    let _e34 = GetScatteringAtOwnColumn(_e28, scattering_texture_3, _e29, _e30, (_e31 + 1f));
+    let _e35 = nu_t_3;
+    let _e37 = SunCosineMix(_e27, _e34, _e35, true);
+    return _e37;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_44: f32, mu_31: f32, mu_s_20: f32, nu_13: f32, ray_r_mu_intersects_ground_12: bool) -> vec4<f32> {
+    var atmosphere_85: AtmosphereParameters;
+    var r_45: f32;
+    var mu_32: f32;
+    var mu_s_21: f32;
+    var nu_14: f32;
+    var ray_r_mu_intersects_ground_13: bool;
+    var uvwz_8: vec4<f32>;
     var nu_size_1: f32;
     var nu_coord: f32;
-    var nu_slice_2: f32;
-    var nu_t_2: f32;
+    var nu_slice_8: f32;
+    var nu_t_4: f32;
+    var position_5: f32;
+    var past_3: f32 = 6f;
+    var log_first_span_2: f32 = 1f;
+    var edge_15: f32;
+    var step_: f32;
+    var mu_s_first: f32;
+    var first: vec4<f32>;
+    var second: vec4<f32>;
+    var slope_2: vec4<f32>;
+    var curvature_1: vec4<f32>;
+    var d_20: f32;
+    var x_16: f32;
     var x_below_1: f32;
     var x_above_1: f32;
     var mu_s_t_1: f32;
@@ -1621,141 +2313,239 @@ fn GetScattering(atmosphere_58: AtmosphereParameters, scattering_texture_1: text
     var x_low_sun_2: f32;
     var below: vec4<f32>;
     var above: vec4<f32>;
-    var mu_s_size_1: f32;
+    var mu_s_size_2: f32;
     var mu_s_min: f32;
-    var slope_1: vec4<f32>;
-    var curvature_1: vec4<f32>;
-    var d_18: f32;
-    var column: f32;
+    var slope_3: vec4<f32>;
+    var curvature_2: vec4<f32>;
+    var d_21: f32;
+    var column_5: f32;
     var x_first: f32;
     var x_last: f32;
-    var first: vec4<f32>;
+    var first_1: vec4<f32>;
     var last: vec4<f32>;
 
-    atmosphere_59 = atmosphere_58;
-    r_43 = r_42;
-    mu_28 = mu_27;
-    mu_s_18 = mu_s_17;
-    nu_12 = nu_11;
-    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e21 = atmosphere_59;
-    let _e22 = r_43;
-    let _e23 = mu_28;
-    let _e24 = mu_s_18;
-    let _e25 = nu_12;
-    let _e26 = ray_r_mu_intersects_ground_11;
-    let _e27 = GetScatteringTextureUvwzFromRMuMuSNu(_e21, _e22, _e23, _e24, _e25, _e26);
-    uvwz_2 = _e27;
-    let _e29 = atmosphere_59;
-    nu_size_1 = f32(_e29.scattering_nu_size);
-    let _e33 = uvwz_2;
-    let _e35 = nu_size_1;
-    nu_coord = (_e33.x * (_e35 - 1f));
-    let _e40 = nu_coord;
-    let _e42 = nu_size_1;
-    nu_slice_2 = min(floor(_e40), (_e42 - 2f));
-    let _e47 = nu_coord;
-    let _e48 = nu_slice_2;
-    nu_t_2 = (_e47 - _e48);
-    let _e55 = atmosphere_59;
-    let _e56 = GetScatteringTextureUMuS(_e55, LOW_SUN_MU_S);
-    x_low_sun_2 = _e56;
-    let _e58 = atmosphere_59;
-    let _e59 = uvwz_2;
-    let _e61 = x_low_sun_2;
-    GetScatteringMuSColumns(_e58, _e59.y, _e61, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e70 = atmosphere_59;
-    let _e71 = uvwz_2;
-    let _e72 = x_below_1;
-    let _e73 = nu_slice_2;
-    let _e74 = nu_t_2;
-    let _e75 = low_sun_below_1;
-    let _e76 = GetScatteringAtMuSColumn(_e70, scattering_texture_1, _e71, _e72, _e73, _e74, _e75);
-    below = _e76;
-    let _e78 = atmosphere_59;
-    let _e79 = uvwz_2;
-    let _e80 = x_above_1;
-    let _e81 = nu_slice_2;
-    let _e82 = nu_t_2;
-    let _e83 = x_above_1;
-    let _e84 = x_low_sun_2;
-    let _e86 = GetScatteringAtMuSColumn(_e78, scattering_texture_1, _e79, _e80, _e81, _e82, (_e83 < _e84));
-    above = _e86;
-    let _e88 = atmosphere_59;
-    mu_s_size_1 = f32(_e88.scattering_mu_s_size);
-    let _e92 = mu_s_t_1;
-    if (_e92 < 0f) {
+    atmosphere_85 = atmosphere_84;
+    r_45 = r_44;
+    mu_32 = mu_31;
+    mu_s_21 = mu_s_20;
+    nu_14 = nu_13;
+    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
+    let _e25 = atmosphere_85;
+    let _e26 = r_45;
+    let _e27 = mu_32;
+    let _e28 = mu_s_21;
+    let _e29 = nu_14;
+    let _e30 = ray_r_mu_intersects_ground_13;
+    let _e31 = GetScatteringTextureUvwzFromRMuMuSNu(_e25, _e26, _e27, _e28, _e29, _e30);
+    uvwz_8 = _e31;
+    let _e33 = atmosphere_85;
+    nu_size_1 = f32(_e33.scattering_nu_size);
+    let _e37 = uvwz_8;
+    let _e39 = nu_size_1;
+    nu_coord = (_e37.x * (_e39 - 1f));
+    let _e44 = nu_coord;
+    let _e46 = nu_size_1;
+    nu_slice_8 = min(floor(_e44), (_e46 - 2f));
+    let _e51 = nu_coord;
+    let _e52 = nu_slice_8;
+    nu_t_4 = (_e51 - _e52);
+    let _e55 = uvwz_8;
+    let _e57 = atmosphere_85;
+    position_5 = ((_e55.y * f32(_e57.scattering_mu_s_size)) - 0.5f);
+    let _e64 = atmosphere_85;
+    let _e68 = position_5;
+    let _e69 = atmosphere_85;
+    if ((_e64.scattering_mu_s_split > 0i) && (_e68 < f32(_e69.scattering_mu_s_split))) {
         {
-            let _e95 = atmosphere_59;
-            mu_s_min = _e95.scattering_mu_s_min;
-            let _e100 = below;
-            let _e101 = above;
-            let _e102 = mu_s_min;
-            let _e103 = atmosphere_59;
-            let _e105 = mu_s_size_1;
-            let _e109 = GetScatteringMuSFromUnitRange(_e103, (1f / (_e105 - 1f)));
-            LowestSunLogFall(_e100, _e101, _e102, _e109, (&slope_1), (&curvature_1));
-            let _e114 = mu_s_18;
-            let _e115 = mu_s_min;
-            d_18 = (_e114 - _e115);
-            let _e118 = below;
-            let _e119 = d_18;
-            let _e120 = slope_1;
-            let _e121 = d_18;
-            let _e122 = curvature_1;
-            return (_e118 * exp((_e119 * (_e120 + (_e121 * _e122)))));
+            let _e79 = position_5;
+            let _e80 = past_3;
+            if (_e79 < _e80) {
+                {
+                    let _e82 = atmosphere_85;
+                    let _e83 = r_45;
+                    let _e84 = mu_32;
+                    let _e85 = mu_32;
+                    let _e86 = mu_s_21;
+                    let _e87 = nu_14;
+                    let _e88 = ViewSunAzimuthCosine(_e85, _e86, _e87);
+                    let _e89 = ray_r_mu_intersects_ground_13;
+                    let _e90 = ShadowEdgeSunZenith(_e82, _e83, _e84, _e88, _e89);
+                    edge_15 = _e90;
+                    let _e92 = position_5;
+                    if (_e92 < 0f) {
+                        {
+                            let _e95 = atmosphere_85;
+                            let _e96 = edge_15;
+                            let _e97 = ShadowEdgePastStep(_e95, _e96);
+                            step_ = _e97;
+                            let _e99 = edge_15;
+                            let _e100 = past_3;
+                            let _e103 = step_;
+                            mu_s_first = cos((_e99 + ((_e100 - 1f) * _e103)));
+                            let _e108 = atmosphere_85;
+                            let _e109 = uvwz_8;
+                            let _e111 = nu_slice_8;
+                            let _e112 = nu_t_4;
+                            let _e113 = GetScatteringAtOwnColumnBetweenSlices(_e108, scattering_texture_4, _e109, 0f, _e111, _e112);
+                            first = _e113;
+                            let _e115 = atmosphere_85;
+                            let _e116 = uvwz_8;
+                            let _e118 = nu_slice_8;
+                            let _e119 = nu_t_4;
+                            let _e120 = GetScatteringAtOwnColumnBetweenSlices(_e115, scattering_texture_4, _e116, 1f, _e118, _e119);
+                            second = _e120;
+                            let _e124 = first;
+                            let _e125 = second;
+                            let _e126 = mu_s_first;
+                            let _e127 = edge_15;
+                            let _e128 = past_3;
+                            let _e131 = step_;
+                            LowestSunLogFall(_e124, _e125, _e126, cos((_e127 + ((_e128 - 2f) * _e131))), (&slope_2), (&curvature_1));
+                            let _e139 = mu_s_21;
+                            let _e140 = mu_s_first;
+                            d_20 = (_e139 - _e140);
+                            let _e143 = first;
+                            let _e144 = d_20;
+                            let _e145 = slope_2;
+                            let _e146 = d_20;
+                            let _e147 = curvature_1;
+                            return (_e143 * exp((_e144 * (_e145 + (_e146 * _e147)))));
+                        }
+                    }
+                    let _e153 = position_5;
+                    let _e154 = past_3;
+                    if (_e153 >= (_e154 - 1f)) {
+                        {
+                            let _e159 = atmosphere_85;
+                            let _e162 = past_3;
+                            x_16 = (1f / (f32(_e159.scattering_mu_s_split) - _e162));
+                            let _e166 = atmosphere_85;
+                            let _e167 = x_16;
+                            let _e168 = edge_15;
+                            let _e169 = atmosphere_85;
+                            let _e170 = GetScatteringSplitSunZenith(_e169);
+                            let _e171 = ShadowEdgeLitDistance(_e166, _e167, _e168, _e170);
+                            log_first_span_2 = log((_e171 / SHADOW_EDGE_CLOSEST));
+                        }
+                    }
+                }
+            }
+            let _e174 = atmosphere_85;
+            let _e175 = uvwz_8;
+            let _e176 = position_5;
+            let _e177 = nu_slice_8;
+            let _e178 = log_first_span_2;
+            let _e179 = GetScatteringBelowSplit(_e174, scattering_texture_4, _e175, _e176, _e177, _e178);
+            let _e180 = atmosphere_85;
+            let _e181 = uvwz_8;
+            let _e182 = position_5;
+            let _e183 = nu_slice_8;
+            let _e186 = log_first_span_2;
+            let _e187 = GetScatteringBelowSplit(_e180, scattering_texture_4, _e181, _e182, (_e183 + 1f), _e186);
+            let _e188 = nu_t_4;
+            let _e190 = SunCosineMix(_e179, _e187, _e188, true);
+            return _e190;
         }
     }
-    let _e128 = low_sun_below_1;
-    if !(_e128) {
-        let _e130 = below;
-        let _e131 = above;
-        let _e132 = mu_s_t_1;
-        return mix(_e130, _e131, vec4(_e132));
+    let _e195 = atmosphere_85;
+    let _e196 = GetScatteringTextureUMuS(_e195, LOW_SUN_MU_S);
+    x_low_sun_2 = _e196;
+    let _e198 = atmosphere_85;
+    let _e199 = uvwz_8;
+    let _e201 = x_low_sun_2;
+    GetScatteringMuSColumns(_e198, _e199.y, _e201, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
+    let _e210 = atmosphere_85;
+    let _e211 = uvwz_8;
+    let _e212 = x_below_1;
+    let _e213 = nu_slice_8;
+    let _e214 = nu_t_4;
+    let _e215 = low_sun_below_1;
+    let _e216 = GetScatteringAtMuSColumn(_e210, scattering_texture_4, _e211, _e212, _e213, _e214, _e215);
+    below = _e216;
+    let _e218 = atmosphere_85;
+    let _e219 = uvwz_8;
+    let _e220 = x_above_1;
+    let _e221 = nu_slice_8;
+    let _e222 = nu_t_4;
+    let _e223 = x_above_1;
+    let _e224 = x_low_sun_2;
+    let _e226 = GetScatteringAtMuSColumn(_e218, scattering_texture_4, _e219, _e220, _e221, _e222, (_e223 < _e224));
+    above = _e226;
+    let _e228 = atmosphere_85;
+    mu_s_size_2 = f32(_e228.scattering_mu_s_size);
+    let _e232 = mu_s_t_1;
+    if (_e232 < 0f) {
+        {
+            let _e235 = atmosphere_85;
+            mu_s_min = _e235.scattering_mu_s_min;
+            let _e240 = below;
+            let _e241 = above;
+            let _e242 = mu_s_min;
+            let _e243 = atmosphere_85;
+            let _e245 = mu_s_size_2;
+            let _e249 = GetScatteringMuSFromUnitRange(_e243, (1f / (_e245 - 1f)));
+            LowestSunLogFall(_e240, _e241, _e242, _e249, (&slope_3), (&curvature_2));
+            let _e254 = mu_s_21;
+            let _e255 = mu_s_min;
+            d_21 = (_e254 - _e255);
+            let _e258 = below;
+            let _e259 = d_21;
+            let _e260 = slope_3;
+            let _e261 = d_21;
+            let _e262 = curvature_2;
+            return (_e258 * exp((_e259 * (_e260 + (_e261 * _e262)))));
+        }
     }
-    let _e135 = x_below_1;
-    let _e136 = mu_s_size_1;
-    column = ((_e135 * _e136) - 0.5f);
-    let _e141 = column;
-    let _e148 = mu_s_size_1;
-    x_first = ((max((_e141 - 1f), 0f) + 0.5f) / _e148);
-    let _e151 = column;
-    let _e154 = mu_s_size_1;
-    let _e160 = mu_s_size_1;
-    x_last = ((min((_e151 + 2f), (_e154 - 1f)) + 0.5f) / _e160);
-    let _e163 = atmosphere_59;
-    let _e164 = uvwz_2;
-    let _e165 = x_first;
-    let _e166 = nu_slice_2;
-    let _e167 = nu_t_2;
-    let _e169 = GetScatteringAtMuSColumn(_e163, scattering_texture_1, _e164, _e165, _e166, _e167, true);
-    first = _e169;
-    let _e171 = atmosphere_59;
-    let _e172 = uvwz_2;
-    let _e173 = x_last;
-    let _e174 = nu_slice_2;
-    let _e175 = nu_t_2;
-    let _e176 = x_last;
-    let _e177 = x_low_sun_2;
-    let _e179 = GetScatteringAtMuSColumn(_e171, scattering_texture_1, _e172, _e173, _e174, _e175, (_e176 < _e177));
-    last = _e179;
-    let _e181 = first;
-    let _e182 = below;
-    let _e183 = above;
-    let _e184 = last;
-    let _e185 = column;
-    let _e188 = column;
-    let _e191 = mu_s_size_1;
-    let _e195 = mu_s_t_1;
-    let _e196 = LogMonotoneCubicMix(_e181, _e182, _e183, _e184, (_e185 > 0.5f), ((_e188 + 2f) < (_e191 - 0.5f)), _e195);
-    return _e196;
+    let _e268 = low_sun_below_1;
+    if !(_e268) {
+        let _e270 = below;
+        let _e271 = above;
+        let _e272 = mu_s_t_1;
+        return mix(_e270, _e271, vec4(_e272));
+    }
+    let _e275 = x_below_1;
+    let _e276 = mu_s_size_2;
+    column_5 = ((_e275 * _e276) - 0.5f);
+    let _e281 = column_5;
+    let _e288 = mu_s_size_2;
+    x_first = ((max((_e281 - 1f), 0f) + 0.5f) / _e288);
+    let _e291 = column_5;
+    let _e294 = mu_s_size_2;
+    let _e300 = mu_s_size_2;
+    x_last = ((min((_e291 + 2f), (_e294 - 1f)) + 0.5f) / _e300);
+    let _e303 = atmosphere_85;
+    let _e304 = uvwz_8;
+    let _e305 = x_first;
+    let _e306 = nu_slice_8;
+    let _e307 = nu_t_4;
+    let _e309 = GetScatteringAtMuSColumn(_e303, scattering_texture_4, _e304, _e305, _e306, _e307, true);
+    first_1 = _e309;
+    let _e311 = atmosphere_85;
+    let _e312 = uvwz_8;
+    let _e313 = x_last;
+    let _e314 = nu_slice_8;
+    let _e315 = nu_t_4;
+    let _e316 = x_last;
+    let _e317 = x_low_sun_2;
+    let _e319 = GetScatteringAtMuSColumn(_e311, scattering_texture_4, _e312, _e313, _e314, _e315, (_e316 < _e317));
+    last = _e319;
+    let _e321 = first_1;
+    let _e322 = below;
+    let _e323 = above;
+    let _e324 = last;
+    let _e325 = column_5;
+    let _e328 = column_5;
+    let _e331 = mu_s_size_2;
+    let _e335 = mu_s_t_1;
+    let _e336 = LogMonotoneCubicMix(_e321, _e322, _e323, _e324, (_e325 > 0.5f), ((_e328 + 2f) < (_e331 - 0.5f)), _e335);
+    return _e336;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_60: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_44: f32, mu_s_19: f32) -> vec3<f32> {
-    var atmosphere_61: AtmosphereParameters;
-    var r_45: f32;
-    var mu_s_20: f32;
+fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_46: f32, mu_s_22: f32) -> vec3<f32> {
+    var atmosphere_87: AtmosphereParameters;
+    var r_47: f32;
+    var mu_s_23: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
@@ -1765,533 +2555,533 @@ fn GetIrradiance(atmosphere_60: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_61 = atmosphere_60;
-    r_45 = r_44;
-    mu_s_20 = mu_s_19;
-    let _e15 = atmosphere_61;
-    let _e16 = r_45;
-    let _e17 = mu_s_20;
-    let _e18 = GetIrradianceTextureUvFromRMuS(_e15, _e16, _e17);
-    uv_3 = _e18;
-    let _e20 = atmosphere_61;
-    width = f32(_e20.irradiance_width);
-    let _e24 = atmosphere_61;
-    let _e25 = mu_s_20;
-    let _e26 = GetIrradianceUnitMuS(_e24, _e25);
-    let _e27 = width;
-    mu_s_coord_1 = (_e26 * (_e27 - 1f));
-    let _e32 = mu_s_coord_1;
-    let _e35 = width;
-    mu_s_column_1 = clamp(floor(_e32), 0f, (_e35 - 2f));
-    let _e40 = atmosphere_61;
-    let _e41 = mu_s_column_1;
-    let _e42 = width;
-    let _e46 = GetIrradianceMuSFromUnit(_e40, (_e41 / (_e42 - 1f)));
-    mu_s_below = _e46;
-    let _e48 = mu_s_below;
-    low_sun_8 = (_e48 < LOW_SUN_MU_S);
-    let _e51 = mu_s_column_1;
-    let _e54 = width;
-    let _e56 = uv_3;
-    let _e59 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e51 + 0.5f) / _e54), _e56.y));
-    below_1 = _e59;
-    let _e61 = mu_s_column_1;
-    let _e64 = width;
-    let _e66 = uv_3;
-    let _e69 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e61 + 1.5f) / _e64), _e66.y));
-    above_1 = _e69;
-    let _e71 = below_1;
-    let _e72 = above_1;
-    let _e73 = mu_s_coord_1;
-    let _e74 = mu_s_column_1;
-    let _e76 = low_sun_8;
-    let _e77 = SunCosinePosition((_e73 - _e74), _e76);
-    let _e78 = low_sun_8;
-    let _e79 = SunBelowTableMix(_e71, _e72, _e77, _e78);
-    return vec3<f32>(_e79.xyz);
+    atmosphere_87 = atmosphere_86;
+    r_47 = r_46;
+    mu_s_23 = mu_s_22;
+    let _e19 = atmosphere_87;
+    let _e20 = r_47;
+    let _e21 = mu_s_23;
+    let _e22 = GetIrradianceTextureUvFromRMuS(_e19, _e20, _e21);
+    uv_3 = _e22;
+    let _e24 = atmosphere_87;
+    width = f32(_e24.irradiance_width);
+    let _e28 = atmosphere_87;
+    let _e29 = mu_s_23;
+    let _e30 = GetIrradianceUnitMuS(_e28, _e29);
+    let _e31 = width;
+    mu_s_coord_1 = (_e30 * (_e31 - 1f));
+    let _e36 = mu_s_coord_1;
+    let _e39 = width;
+    mu_s_column_1 = clamp(floor(_e36), 0f, (_e39 - 2f));
+    let _e44 = atmosphere_87;
+    let _e45 = mu_s_column_1;
+    let _e46 = width;
+    let _e50 = GetIrradianceMuSFromUnit(_e44, (_e45 / (_e46 - 1f)));
+    mu_s_below = _e50;
+    let _e52 = mu_s_below;
+    low_sun_8 = (_e52 < LOW_SUN_MU_S);
+    let _e55 = mu_s_column_1;
+    let _e58 = width;
+    let _e60 = uv_3;
+    let _e63 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e55 + 0.5f) / _e58), _e60.y));
+    below_1 = _e63;
+    let _e65 = mu_s_column_1;
+    let _e68 = width;
+    let _e70 = uv_3;
+    let _e73 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e65 + 1.5f) / _e68), _e70.y));
+    above_1 = _e73;
+    let _e75 = below_1;
+    let _e76 = above_1;
+    let _e77 = mu_s_coord_1;
+    let _e78 = mu_s_column_1;
+    let _e80 = low_sun_8;
+    let _e81 = SunCosinePosition((_e77 - _e78), _e80);
+    let _e82 = low_sun_8;
+    let _e83 = SunBelowTableMix(_e75, _e76, _e81, _e82);
+    return vec3<f32>(_e83.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_62: AtmosphereParameters, nu_13: f32) -> f32 {
-    var atmosphere_63: AtmosphereParameters;
-    var nu_14: f32;
+fn MiePhaseFunction(atmosphere_88: AtmosphereParameters, nu_15: f32) -> f32 {
+    var atmosphere_89: AtmosphereParameters;
+    var nu_16: f32;
 
-    atmosphere_63 = atmosphere_62;
-    nu_14 = nu_13;
-    let _e12 = atmosphere_63;
-    if (_e12.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e15 = atmosphere_63;
-        let _e17 = nu_14;
-        let _e18 = HenyeyGreensteinPhaseFunction(_e15.mie_g, _e17);
-        return _e18;
+    atmosphere_89 = atmosphere_88;
+    nu_16 = nu_15;
+    let _e16 = atmosphere_89;
+    if (_e16.mie_phase == PHASE_HENYEY_GREENSTEIN) {
+        let _e19 = atmosphere_89;
+        let _e21 = nu_16;
+        let _e22 = HenyeyGreensteinPhaseFunction(_e19.mie_g, _e21);
+        return _e22;
     }
-    let _e19 = atmosphere_63;
-    if (_e19.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e22 = atmosphere_63;
-        let _e24 = nu_14;
-        let _e25 = CornetteShanksPhaseFunction(_e22.mie_g, _e24);
-        return _e25;
+    let _e23 = atmosphere_89;
+    if (_e23.mie_phase == PHASE_CORNETTE_SHANKS) {
+        let _e26 = atmosphere_89;
+        let _e28 = nu_16;
+        let _e29 = CornetteShanksPhaseFunction(_e26.mie_g, _e28);
+        return _e29;
     }
     return 0f;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_64: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_46: f32, mu_29: f32, mu_s_21: f32, nu_15: f32, ray_r_mu_intersects_ground_12: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_65: AtmosphereParameters;
-    var r_47: f32;
-    var mu_30: f32;
-    var mu_s_22: f32;
-    var nu_16: f32;
-    var ray_r_mu_intersects_ground_13: bool;
+fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_48: f32, mu_33: f32, mu_s_24: f32, nu_17: f32, ray_r_mu_intersects_ground_14: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_91: AtmosphereParameters;
+    var r_49: f32;
+    var mu_34: f32;
+    var mu_s_25: f32;
+    var nu_18: f32;
+    var ray_r_mu_intersects_ground_15: bool;
     var scattering: vec4<f32>;
-    var local_13: vec3<f32>;
+    var local_15: vec3<f32>;
 
-    atmosphere_65 = atmosphere_64;
-    r_47 = r_46;
-    mu_30 = mu_29;
-    mu_s_22 = mu_s_21;
-    nu_16 = nu_15;
-    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e23 = atmosphere_65;
-    let _e24 = r_47;
-    let _e25 = mu_30;
-    let _e26 = mu_s_22;
-    let _e27 = nu_16;
-    let _e28 = ray_r_mu_intersects_ground_13;
-    let _e29 = GetScattering(_e23, scattering_texture_2, _e24, _e25, _e26, _e27, _e28);
-    scattering = _e29;
-    let _e31 = atmosphere_65;
-    if (_e31.single_mie_in_scattering_alpha == 1i) {
+    atmosphere_91 = atmosphere_90;
+    r_49 = r_48;
+    mu_34 = mu_33;
+    mu_s_25 = mu_s_24;
+    nu_18 = nu_17;
+    ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
+    let _e27 = atmosphere_91;
+    let _e28 = r_49;
+    let _e29 = mu_34;
+    let _e30 = mu_s_25;
+    let _e31 = nu_18;
+    let _e32 = ray_r_mu_intersects_ground_15;
+    let _e33 = GetScattering(_e27, scattering_texture_5, _e28, _e29, _e30, _e31, _e32);
+    scattering = _e33;
+    let _e35 = atmosphere_91;
+    if (_e35.single_mie_in_scattering_alpha == 1i) {
         {
-            let _e35 = scattering;
-            if (_e35.x > 0f) {
-                let _e39 = scattering;
-                let _e42 = scattering;
-                let _e45 = scattering;
-                let _e49 = atmosphere_65;
-                let _e51 = atmosphere_65;
-                local_13 = (((vec3<f32>(_e39.xyz) * _e42.w) / vec3(_e45.x)) * (_e49.mie_to_rayleigh_scattering_ratio / vec3(_e51.mie_to_rayleigh_scattering_ratio.x)));
+            let _e39 = scattering;
+            if (_e39.x > 0f) {
+                let _e43 = scattering;
+                let _e46 = scattering;
+                let _e49 = scattering;
+                let _e53 = atmosphere_91;
+                let _e55 = atmosphere_91;
+                local_15 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_13 = vec3(0f);
+                local_15 = vec3(0f);
             }
-            let _e60 = local_13;
-            (*single_mie_scattering) = _e60;
+            let _e64 = local_15;
+            (*single_mie_scattering) = _e64;
         }
     } else {
         {
-            let _e61 = atmosphere_65;
-            let _e62 = r_47;
-            let _e63 = mu_30;
-            let _e64 = mu_s_22;
-            let _e65 = nu_16;
-            let _e66 = ray_r_mu_intersects_ground_13;
-            let _e67 = GetScattering(_e61, single_mie_scattering_texture, _e62, _e63, _e64, _e65, _e66);
-            (*single_mie_scattering) = vec3<f32>(_e67.xyz);
+            let _e65 = atmosphere_91;
+            let _e66 = r_49;
+            let _e67 = mu_34;
+            let _e68 = mu_s_25;
+            let _e69 = nu_18;
+            let _e70 = ray_r_mu_intersects_ground_15;
+            let _e71 = GetScattering(_e65, single_mie_scattering_texture, _e66, _e67, _e68, _e69, _e70);
+            (*single_mie_scattering) = vec3<f32>(_e71.xyz);
         }
     }
-    let _e70 = scattering;
-    return vec3<f32>(_e70.xyz);
+    let _e74 = scattering;
+    return vec3<f32>(_e74.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_66: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_3: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_67: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_92: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_93: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
-    var start_1: vec3<f32>;
-    var r_48: f32;
-    var mu_31: f32;
-    var mu_s_23: f32;
-    var nu_17: f32;
-    var ray_r_mu_intersects_ground_14: bool;
-    var local_14: vec3<f32>;
+    var start_2: vec3<f32>;
+    var r_50: f32;
+    var mu_35: f32;
+    var mu_s_26: f32;
+    var nu_19: f32;
+    var ray_r_mu_intersects_ground_16: bool;
+    var local_16: vec3<f32>;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_67 = atmosphere_66;
+    atmosphere_93 = atmosphere_92;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e25 = atmosphere_67;
-    let _e26 = camera_5;
-    let _e27 = view_ray_5;
-    let _e28 = sun_direction_3;
-    let _e39 = GetViewRayStart(_e25, _e26, _e27, _e28, (&start_1), (&r_48), (&mu_31), (&mu_s_23), (&nu_17));
-    if !(_e39) {
+    let _e29 = atmosphere_93;
+    let _e30 = camera_5;
+    let _e31 = view_ray_5;
+    let _e32 = sun_direction_3;
+    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_50), (&mu_35), (&mu_s_26), (&nu_19));
+    if !(_e43) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e45 = atmosphere_67;
-    let _e46 = r_48;
-    let _e47 = mu_31;
-    let _e48 = RayIntersectsGround(_e45, _e46, _e47);
-    ray_r_mu_intersects_ground_14 = _e48;
-    let _e50 = ray_r_mu_intersects_ground_14;
-    if _e50 {
-        local_14 = vec3(0f);
+    let _e49 = atmosphere_93;
+    let _e50 = r_50;
+    let _e51 = mu_35;
+    let _e52 = RayIntersectsGround(_e49, _e50, _e51);
+    ray_r_mu_intersects_ground_16 = _e52;
+    let _e54 = ray_r_mu_intersects_ground_16;
+    if _e54 {
+        local_16 = vec3(0f);
     } else {
-        let _e53 = atmosphere_67;
-        let _e54 = r_48;
-        let _e55 = mu_31;
-        let _e56 = GetTransmittanceToTopAtmosphereBoundary(_e53, transmittance_texture_5, _e54, _e55);
-        local_14 = _e56;
+        let _e57 = atmosphere_93;
+        let _e58 = r_50;
+        let _e59 = mu_35;
+        let _e60 = GetTransmittanceToTopAtmosphereBoundary(_e57, transmittance_texture_5, _e58, _e59);
+        local_16 = _e60;
     }
-    let _e58 = local_14;
-    (*transmittance) = _e58;
-    let _e60 = atmosphere_67;
-    let _e61 = r_48;
-    let _e62 = mu_31;
-    let _e63 = mu_s_23;
-    let _e64 = nu_17;
-    let _e65 = ray_r_mu_intersects_ground_14;
-    let _e68 = GetCombinedScattering(_e60, scattering_texture_3, single_mie_scattering_texture_1, _e61, _e62, _e63, _e64, _e65, (&single_mie_scattering_1));
-    scattering_1 = _e68;
-    let _e70 = scattering_1;
-    let _e71 = nu_17;
-    let _e72 = RayleighPhaseFunction(_e71);
-    let _e74 = single_mie_scattering_1;
-    let _e75 = atmosphere_67;
-    let _e76 = nu_17;
-    let _e77 = MiePhaseFunction(_e75, _e76);
-    return ((_e70 * _e72) + (_e74 * _e77));
+    let _e62 = local_16;
+    (*transmittance) = _e62;
+    let _e64 = atmosphere_93;
+    let _e65 = r_50;
+    let _e66 = mu_35;
+    let _e67 = mu_s_26;
+    let _e68 = nu_19;
+    let _e69 = ray_r_mu_intersects_ground_16;
+    let _e72 = GetCombinedScattering(_e64, scattering_texture_6, single_mie_scattering_texture_1, _e65, _e66, _e67, _e68, _e69, (&single_mie_scattering_1));
+    scattering_1 = _e72;
+    let _e74 = scattering_1;
+    let _e75 = nu_19;
+    let _e76 = RayleighPhaseFunction(_e75);
+    let _e78 = single_mie_scattering_1;
+    let _e79 = atmosphere_93;
+    let _e80 = nu_19;
+    let _e81 = MiePhaseFunction(_e79, _e80);
+    return ((_e74 * _e76) + (_e78 * _e81));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_68: AtmosphereParameters, r_49: f32, mu_32: f32) -> f32 {
-    var atmosphere_69: AtmosphereParameters;
-    var r_50: f32;
-    var mu_33: f32;
+fn DistanceInsideScatteringRadii(atmosphere_94: AtmosphereParameters, r_51: f32, mu_36: f32) -> f32 {
+    var atmosphere_95: AtmosphereParameters;
+    var r_52: f32;
+    var mu_37: f32;
     var r_max: f32;
     var r_min: f32;
-    var across: f32;
+    var across_2: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_15: f32;
+    var local_17: f32;
 
-    atmosphere_69 = atmosphere_68;
-    r_50 = r_49;
-    mu_33 = mu_32;
-    let _e15 = atmosphere_69;
-    r_max = _e15.scattering_r_max;
-    let _e18 = atmosphere_69;
-    r_min = _e18.scattering_r_min;
-    let _e21 = r_50;
-    let _e22 = r_50;
-    let _e24 = mu_33;
-    let _e25 = mu_33;
-    across = ((_e21 * _e22) * ((_e24 * _e25) - 1f));
-    let _e31 = r_50;
-    let _e33 = mu_33;
-    let _e35 = across;
-    let _e36 = r_max;
-    let _e37 = r_max;
-    let _e40 = SafeSqrt((_e35 + (_e36 * _e37)));
-    up = ((-(_e31) * _e33) + _e40);
-    let _e43 = across;
-    let _e44 = r_min;
-    let _e45 = r_min;
-    down_discriminant = (_e43 + (_e44 * _e45));
-    let _e49 = mu_33;
-    let _e52 = down_discriminant;
-    if ((_e49 < 0f) && (_e52 >= 0f)) {
-        let _e56 = up;
-        let _e57 = r_50;
-        let _e59 = mu_33;
-        let _e61 = down_discriminant;
-        local_15 = min(_e56, ((-(_e57) * _e59) - sqrt(_e61)));
+    atmosphere_95 = atmosphere_94;
+    r_52 = r_51;
+    mu_37 = mu_36;
+    let _e19 = atmosphere_95;
+    r_max = _e19.scattering_r_max;
+    let _e22 = atmosphere_95;
+    r_min = _e22.scattering_r_min;
+    let _e25 = r_52;
+    let _e26 = r_52;
+    let _e28 = mu_37;
+    let _e29 = mu_37;
+    across_2 = ((_e25 * _e26) * ((_e28 * _e29) - 1f));
+    let _e35 = r_52;
+    let _e37 = mu_37;
+    let _e39 = across_2;
+    let _e40 = r_max;
+    let _e41 = r_max;
+    let _e44 = SafeSqrt((_e39 + (_e40 * _e41)));
+    up = ((-(_e35) * _e37) + _e44);
+    let _e47 = across_2;
+    let _e48 = r_min;
+    let _e49 = r_min;
+    down_discriminant = (_e47 + (_e48 * _e49));
+    let _e53 = mu_37;
+    let _e56 = down_discriminant;
+    if ((_e53 < 0f) && (_e56 >= 0f)) {
+        let _e60 = up;
+        let _e61 = r_52;
+        let _e63 = mu_37;
+        let _e65 = down_discriminant;
+        local_17 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
     } else {
-        let _e65 = up;
-        local_15 = _e65;
+        let _e69 = up;
+        local_17 = _e69;
     }
-    let _e67 = local_15;
-    return _e67;
+    let _e71 = local_17;
+    return _e71;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_70: AtmosphereParameters, i: i32) -> f32 {
-    var atmosphere_71: AtmosphereParameters;
-    var i_1: i32;
-    var x_11: f32;
+fn ProfileSampleAltitude(atmosphere_96: AtmosphereParameters, i_1: i32) -> f32 {
+    var atmosphere_97: AtmosphereParameters;
+    var i_2: i32;
+    var x_17: f32;
 
-    atmosphere_71 = atmosphere_70;
-    i_1 = i;
-    let _e14 = i_1;
-    x_11 = (f32(_e14) / 63f);
-    let _e22 = atmosphere_71;
-    let _e24 = atmosphere_71;
-    let _e27 = x_11;
-    let _e29 = x_11;
-    return (((_e22.top_radius - _e24.bottom_radius) * _e27) * _e29);
+    atmosphere_97 = atmosphere_96;
+    i_2 = i_1;
+    let _e18 = i_2;
+    x_17 = (f32(_e18) / 63f);
+    let _e26 = atmosphere_97;
+    let _e28 = atmosphere_97;
+    let _e31 = x_17;
+    let _e33 = x_17;
+    return (((_e26.top_radius - _e28.bottom_radius) * _e31) * _e33);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_14: f32, b_8: f32, f: f32) -> f32 {
-    var a_15: f32;
+fn InterpolateCoefficient(a_15: f32, b_8: f32, f: f32) -> f32 {
+    var a_16: f32;
     var b_9: f32;
     var f_1: f32;
-    var local_16: f32;
+    var local_18: f32;
 
-    a_15 = a_14;
+    a_16 = a_15;
     b_9 = b_8;
     f_1 = f;
-    let _e16 = a_15;
-    let _e19 = b_9;
-    if ((_e16 > 0f) && (_e19 > 0f)) {
-        let _e23 = a_15;
-        let _e24 = f_1;
-        let _e25 = b_9;
-        let _e26 = a_15;
-        local_16 = (_e23 * exp((_e24 * log((_e25 / _e26)))));
+    let _e20 = a_16;
+    let _e23 = b_9;
+    if ((_e20 > 0f) && (_e23 > 0f)) {
+        let _e27 = a_16;
+        let _e28 = f_1;
+        let _e29 = b_9;
+        let _e30 = a_16;
+        local_18 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
     } else {
-        let _e32 = a_15;
-        let _e33 = b_9;
-        let _e34 = f_1;
-        local_16 = mix(_e32, _e33, _e34);
+        let _e36 = a_16;
+        let _e37 = b_9;
+        let _e38 = f_1;
+        local_18 = mix(_e36, _e37, _e38);
     }
-    let _e37 = local_16;
-    return _e37;
+    let _e41 = local_18;
+    return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_16: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_17: vec3<f32>;
+fn InterpolateCoefficients(a_17: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_18: vec3<f32>;
     var b_11: vec3<f32>;
     var f_3: f32;
 
-    a_17 = a_16;
+    a_18 = a_17;
     b_11 = b_10;
     f_3 = f_2;
-    let _e16 = a_17;
-    let _e18 = b_11;
-    let _e20 = f_3;
-    let _e21 = InterpolateCoefficient(_e16.x, _e18.x, _e20);
-    let _e22 = a_17;
-    let _e24 = b_11;
-    let _e26 = f_3;
-    let _e27 = InterpolateCoefficient(_e22.y, _e24.y, _e26);
-    let _e28 = a_17;
-    let _e30 = b_11;
-    let _e32 = f_3;
-    let _e33 = InterpolateCoefficient(_e28.z, _e30.z, _e32);
-    return vec3<f32>(_e21, _e27, _e33);
+    let _e20 = a_18;
+    let _e22 = b_11;
+    let _e24 = f_3;
+    let _e25 = InterpolateCoefficient(_e20.x, _e22.x, _e24);
+    let _e26 = a_18;
+    let _e28 = b_11;
+    let _e30 = f_3;
+    let _e31 = InterpolateCoefficient(_e26.y, _e28.y, _e30);
+    let _e32 = a_18;
+    let _e34 = b_11;
+    let _e36 = f_3;
+    let _e37 = InterpolateCoefficient(_e32.z, _e34.z, _e36);
+    return vec3<f32>(_e25, _e31, _e37);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_72: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_98: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_99: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_12: f32;
-    var i_2: i32;
+    var x_18: f32;
+    var i_3: i32;
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_73 = atmosphere_72;
+    atmosphere_99 = atmosphere_98;
     altitude_1 = altitude;
-    let _e16 = atmosphere_73;
-    let _e18 = atmosphere_73;
-    height = (_e16.top_radius - _e18.bottom_radius);
-    let _e22 = altitude_1;
-    let _e23 = height;
-    x_12 = (sqrt(clamp((_e22 / _e23), 0f, 1f)) * 63f);
-    let _e35 = x_12;
-    i_2 = min(i32(_e35), 62i);
-    let _e42 = atmosphere_73;
-    let _e43 = i_2;
-    let _e44 = ProfileSampleAltitude(_e42, _e43);
-    h0_ = _e44;
-    let _e46 = altitude_1;
-    let _e47 = h0_;
-    let _e49 = atmosphere_73;
-    let _e50 = i_2;
-    let _e53 = ProfileSampleAltitude(_e49, (_e50 + 1i));
-    let _e54 = h0_;
-    f_4 = clamp(((_e46 - _e47) / (_e53 - _e54)), 0f, 1f);
-    let _e61 = i_2;
-    let _e64 = atmosphere_73.mie_scattering_profile[_e61];
-    let _e65 = i_2;
-    let _e70 = atmosphere_73.mie_scattering_profile[(_e65 + 1i)];
-    let _e71 = f_4;
-    let _e72 = InterpolateCoefficients(_e64, _e70, _e71);
-    (*mie_scattering) = _e72;
-    let _e73 = i_2;
-    let _e76 = atmosphere_73.rayleigh_scattering_profile[_e73];
-    let _e77 = i_2;
-    let _e82 = atmosphere_73.rayleigh_scattering_profile[(_e77 + 1i)];
-    let _e83 = f_4;
-    let _e84 = InterpolateCoefficients(_e76, _e82, _e83);
-    (*rayleigh_scattering) = _e84;
-    let _e85 = i_2;
-    let _e88 = atmosphere_73.extinction_profile[_e85];
-    let _e89 = i_2;
-    let _e94 = atmosphere_73.extinction_profile[(_e89 + 1i)];
-    let _e95 = f_4;
-    let _e96 = InterpolateCoefficients(_e88, _e94, _e95);
-    return _e96;
+    let _e20 = atmosphere_99;
+    let _e22 = atmosphere_99;
+    height = (_e20.top_radius - _e22.bottom_radius);
+    let _e26 = altitude_1;
+    let _e27 = height;
+    x_18 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
+    let _e39 = x_18;
+    i_3 = min(i32(_e39), 62i);
+    let _e46 = atmosphere_99;
+    let _e47 = i_3;
+    let _e48 = ProfileSampleAltitude(_e46, _e47);
+    h0_ = _e48;
+    let _e50 = altitude_1;
+    let _e51 = h0_;
+    let _e53 = atmosphere_99;
+    let _e54 = i_3;
+    let _e57 = ProfileSampleAltitude(_e53, (_e54 + 1i));
+    let _e58 = h0_;
+    f_4 = clamp(((_e50 - _e51) / (_e57 - _e58)), 0f, 1f);
+    let _e65 = i_3;
+    let _e68 = atmosphere_99.mie_scattering_profile[_e65];
+    let _e69 = i_3;
+    let _e74 = atmosphere_99.mie_scattering_profile[(_e69 + 1i)];
+    let _e75 = f_4;
+    let _e76 = InterpolateCoefficients(_e68, _e74, _e75);
+    (*mie_scattering) = _e76;
+    let _e77 = i_3;
+    let _e80 = atmosphere_99.rayleigh_scattering_profile[_e77];
+    let _e81 = i_3;
+    let _e86 = atmosphere_99.rayleigh_scattering_profile[(_e81 + 1i)];
+    let _e87 = f_4;
+    let _e88 = InterpolateCoefficients(_e80, _e86, _e87);
+    (*rayleigh_scattering) = _e88;
+    let _e89 = i_3;
+    let _e92 = atmosphere_99.extinction_profile[_e89];
+    let _e93 = i_3;
+    let _e98 = atmosphere_99.extinction_profile[(_e93 + 1i)];
+    let _e99 = f_4;
+    let _e100 = InterpolateCoefficients(_e92, _e98, _e99);
+    return _e100;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_74: AtmosphereParameters, r_51: f32, mu_34: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_75: AtmosphereParameters;
-    var r_52: f32;
-    var mu_35: f32;
+fn AltitudeAtDistance(atmosphere_100: AtmosphereParameters, r_53: f32, mu_38: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_101: AtmosphereParameters;
+    var r_54: f32;
+    var mu_39: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_75 = atmosphere_74;
-    r_52 = r_51;
-    mu_35 = mu_34;
+    atmosphere_101 = atmosphere_100;
+    r_54 = r_53;
+    mu_39 = mu_38;
     t_10 = t_9;
     r_t_1 = r_t;
-    let _e20 = r_52;
-    let _e21 = atmosphere_75;
-    let _e24 = t_10;
-    let _e25 = t_10;
-    let _e27 = r_52;
-    let _e29 = mu_35;
-    let _e33 = r_t_1;
-    let _e34 = r_52;
-    return ((_e20 - _e21.bottom_radius) + ((_e24 * (_e25 + ((2f * _e27) * _e29))) / (_e33 + _e34)));
+    let _e24 = r_54;
+    let _e25 = atmosphere_101;
+    let _e28 = t_10;
+    let _e29 = t_10;
+    let _e31 = r_54;
+    let _e33 = mu_39;
+    let _e37 = r_t_1;
+    let _e38 = r_54;
+    return ((_e24 - _e25.bottom_radius) + ((_e28 * (_e29 + ((2f * _e31) * _e33))) / (_e37 + _e38)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_76: AtmosphereParameters, r_53: f32, mu_36: f32, d_19: f32) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
-    var r_54: f32;
-    var mu_37: f32;
-    var d_20: f32;
+fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32, mu_40: f32, d_22: f32) -> vec3<f32> {
+    var atmosphere_103: AtmosphereParameters;
+    var r_56: f32;
+    var mu_41: f32;
+    var d_23: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
-    var k_3: i32 = 0i;
+    var k_5: i32 = 0i;
     var t_11: f32;
     var r_t_2: f32;
     var mie_scattering_1: vec3<f32>;
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_77 = atmosphere_76;
-    r_54 = r_53;
-    mu_37 = mu_36;
-    d_20 = d_19;
-    let _e18 = d_20;
-    dt = (_e18 / 16f);
+    atmosphere_103 = atmosphere_102;
+    r_56 = r_55;
+    mu_41 = mu_40;
+    d_23 = d_22;
+    let _e22 = d_23;
+    dt = (_e22 / 16f);
     loop {
-        let _e31 = k_3;
-        if !((_e31 <= SEGMENT_INTERVALS)) {
+        let _e35 = k_5;
+        if !((_e35 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e37 = dt;
-            let _e38 = k_3;
-            t_11 = (_e37 * f32(_e38));
-            let _e42 = atmosphere_77;
-            let _e43 = r_54;
-            let _e44 = mu_37;
-            let _e45 = t_11;
-            let _e46 = RadiusAtDistance(_e42, _e43, _e44, _e45);
-            r_t_2 = _e46;
-            let _e50 = atmosphere_77;
-            let _e51 = atmosphere_77;
-            let _e52 = r_54;
-            let _e53 = mu_37;
-            let _e54 = t_11;
-            let _e55 = r_t_2;
-            let _e56 = AltitudeAtDistance(_e51, _e52, _e53, _e54, _e55);
-            let _e61 = GetCoefficientsAtAltitude(_e50, _e56, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e61;
-            let _e63 = k_3;
-            if (_e63 > 0i) {
-                let _e66 = optical_depth;
-                let _e67 = previous_extinction;
-                let _e68 = extinction;
-                let _e71 = dt;
-                optical_depth = (_e66 + ((_e67 + _e68) * (0.5f * _e71)));
+            let _e41 = dt;
+            let _e42 = k_5;
+            t_11 = (_e41 * f32(_e42));
+            let _e46 = atmosphere_103;
+            let _e47 = r_56;
+            let _e48 = mu_41;
+            let _e49 = t_11;
+            let _e50 = RadiusAtDistance(_e46, _e47, _e48, _e49);
+            r_t_2 = _e50;
+            let _e54 = atmosphere_103;
+            let _e55 = atmosphere_103;
+            let _e56 = r_56;
+            let _e57 = mu_41;
+            let _e58 = t_11;
+            let _e59 = r_t_2;
+            let _e60 = AltitudeAtDistance(_e55, _e56, _e57, _e58, _e59);
+            let _e65 = GetCoefficientsAtAltitude(_e54, _e60, (&mie_scattering_1), (&rayleigh_scattering_1));
+            extinction = _e65;
+            let _e67 = k_5;
+            if (_e67 > 0i) {
+                let _e70 = optical_depth;
+                let _e71 = previous_extinction;
+                let _e72 = extinction;
+                let _e75 = dt;
+                optical_depth = (_e70 + ((_e71 + _e72) * (0.5f * _e75)));
             }
-            let _e75 = extinction;
-            previous_extinction = _e75;
+            let _e79 = extinction;
+            previous_extinction = _e79;
         }
         continuing {
-            let _e34 = k_3;
-            k_3 = (_e34 + 1i);
+            let _e38 = k_5;
+            k_5 = (_e38 + 1i);
         }
     }
-    let _e76 = optical_depth;
-    return _e76;
+    let _e80 = optical_depth;
+    return _e80;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_78: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_55: f32, mu_38: f32, d_21: f32, ray_r_mu_intersects_ground_15: bool) -> vec3<f32> {
-    var atmosphere_79: AtmosphereParameters;
-    var r_56: f32;
-    var mu_39: f32;
-    var d_22: f32;
-    var ray_r_mu_intersects_ground_16: bool;
-    var local_17: vec3<f32>;
+fn LongSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_57: f32, mu_42: f32, d_24: f32, ray_r_mu_intersects_ground_17: bool) -> vec3<f32> {
+    var atmosphere_105: AtmosphereParameters;
+    var r_58: f32;
+    var mu_43: f32;
+    var d_25: f32;
+    var ray_r_mu_intersects_ground_18: bool;
+    var local_19: vec3<f32>;
 
-    atmosphere_79 = atmosphere_78;
-    r_56 = r_55;
-    mu_39 = mu_38;
-    d_22 = d_21;
-    ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e21 = atmosphere_79;
-    if (_e21.transmittance_is_colour != 0i) {
-        let _e25 = atmosphere_79;
-        let _e26 = r_56;
-        let _e27 = mu_39;
-        let _e28 = d_22;
-        let _e29 = IntegrateSegmentOpticalDepth(_e25, _e26, _e27, _e28);
-        local_17 = _e29;
+    atmosphere_105 = atmosphere_104;
+    r_58 = r_57;
+    mu_43 = mu_42;
+    d_25 = d_24;
+    ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
+    let _e25 = atmosphere_105;
+    if (_e25.transmittance_is_colour != 0i) {
+        let _e29 = atmosphere_105;
+        let _e30 = r_58;
+        let _e31 = mu_43;
+        let _e32 = d_25;
+        let _e33 = IntegrateSegmentOpticalDepth(_e29, _e30, _e31, _e32);
+        local_19 = _e33;
     } else {
-        let _e30 = atmosphere_79;
-        let _e31 = r_56;
-        let _e32 = mu_39;
-        let _e33 = d_22;
-        let _e34 = ray_r_mu_intersects_ground_16;
-        let _e35 = GetOpticalDepth(_e30, transmittance_texture_6, _e31, _e32, _e33, _e34);
-        local_17 = _e35;
+        let _e34 = atmosphere_105;
+        let _e35 = r_58;
+        let _e36 = mu_43;
+        let _e37 = d_25;
+        let _e38 = ray_r_mu_intersects_ground_18;
+        let _e39 = GetOpticalDepth(_e34, transmittance_texture_6, _e35, _e36, _e37, _e38);
+        local_19 = _e39;
     }
-    let _e37 = local_17;
-    return _e37;
+    let _e41 = local_19;
+    return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_18: f32;
+    var local_20: f32;
 
     depth_1 = depth;
-    let _e12 = depth_1;
-    if (_e12 < 0.0001f) {
-        let _e17 = depth_1;
-        local_18 = (1f - (0.5f * _e17));
-    } else {
+    let _e16 = depth_1;
+    if (_e16 < 0.0001f) {
         let _e21 = depth_1;
+        local_20 = (1f - (0.5f * _e21));
+    } else {
         let _e25 = depth_1;
-        local_18 = ((1f - exp(-(_e21))) / _e25);
+        let _e29 = depth_1;
+        local_20 = ((1f - exp(-(_e25))) / _e29);
     }
-    let _e28 = local_18;
-    return _e28;
+    let _e32 = local_20;
+    return _e32;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_80: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_57: f32, mu_40: f32, mu_s_24: f32, nu_18: f32, d_23: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_81: AtmosphereParameters;
-    var r_58: f32;
-    var mu_41: f32;
-    var mu_s_25: f32;
-    var nu_19: f32;
-    var d_24: f32;
+fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_59: f32, mu_44: f32, mu_s_27: f32, nu_20: f32, d_26: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_107: AtmosphereParameters;
+    var r_60: f32;
+    var mu_45: f32;
+    var mu_s_28: f32;
+    var nu_21: f32;
+    var d_27: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
     var previous_extinction_1: vec3<f32> = vec3(0f);
     var previous_rayleigh: vec3<f32> = vec3(0f);
     var previous_mie: vec3<f32> = vec3(0f);
     var previous_scattering: vec3<f32> = vec3(0f);
-    var k_4: i32 = 0i;
+    var k_6: i32 = 0i;
     var t_12: f32;
     var r_t_3: f32;
     var altitude_2: f32;
@@ -2307,149 +3097,149 @@ fn IntegrateSegment(atmosphere_80: AtmosphereParameters, transmittance_texture_7
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_81 = atmosphere_80;
-    r_58 = r_57;
-    mu_41 = mu_40;
-    mu_s_25 = mu_s_24;
-    nu_19 = nu_18;
-    d_24 = d_23;
-    let _e26 = d_24;
-    dt_1 = (_e26 / 16f);
+    atmosphere_107 = atmosphere_106;
+    r_60 = r_59;
+    mu_45 = mu_44;
+    mu_s_28 = mu_s_27;
+    nu_21 = nu_20;
+    d_27 = d_26;
+    let _e30 = d_27;
+    dt_1 = (_e30 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
     (*scattering_weight) = vec3(0f);
     loop {
-        let _e54 = k_4;
-        if !((_e54 <= SEGMENT_INTERVALS)) {
+        let _e58 = k_6;
+        if !((_e58 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e60 = dt_1;
-            let _e61 = k_4;
-            t_12 = (_e60 * f32(_e61));
-            let _e65 = atmosphere_81;
-            let _e66 = r_58;
-            let _e67 = mu_41;
-            let _e68 = t_12;
-            let _e69 = RadiusAtDistance(_e65, _e66, _e67, _e68);
-            r_t_3 = _e69;
-            let _e71 = atmosphere_81;
-            let _e72 = r_58;
-            let _e73 = mu_41;
-            let _e74 = t_12;
-            let _e75 = r_t_3;
-            let _e76 = AltitudeAtDistance(_e71, _e72, _e73, _e74, _e75);
-            altitude_2 = _e76;
-            let _e78 = r_58;
-            let _e79 = mu_s_25;
-            let _e81 = t_12;
-            let _e82 = nu_19;
-            let _e85 = r_t_3;
-            let _e87 = ClampCosine((((_e78 * _e79) + (_e81 * _e82)) / _e85));
-            mu_s_t_2 = _e87;
-            let _e91 = atmosphere_81;
-            let _e92 = altitude_2;
-            let _e97 = GetCoefficientsAtAltitude(_e91, _e92, (&mie_scattering_2), (&rayleigh_scattering_2));
-            extinction_1 = _e97;
-            let _e99 = atmosphere_81;
-            let _e100 = r_t_3;
-            let _e101 = mu_s_t_2;
-            let _e102 = GetOpticalDepthToTopAtmosphereBoundary(_e99, transmittance_texture_7, _e100, _e101);
-            let _e105 = atmosphere_81;
-            let _e106 = r_t_3;
-            let _e107 = mu_s_t_2;
-            let _e108 = SunVisibleFraction(_e105, _e106, _e107);
-            sunlight = (exp(-(_e102)) * _e108);
-            let _e111 = rayleigh_scattering_2;
-            let _e112 = sunlight;
-            rayleigh = (_e111 * _e112);
-            let _e115 = mie_scattering_2;
+            let _e64 = dt_1;
+            let _e65 = k_6;
+            t_12 = (_e64 * f32(_e65));
+            let _e69 = atmosphere_107;
+            let _e70 = r_60;
+            let _e71 = mu_45;
+            let _e72 = t_12;
+            let _e73 = RadiusAtDistance(_e69, _e70, _e71, _e72);
+            r_t_3 = _e73;
+            let _e75 = atmosphere_107;
+            let _e76 = r_60;
+            let _e77 = mu_45;
+            let _e78 = t_12;
+            let _e79 = r_t_3;
+            let _e80 = AltitudeAtDistance(_e75, _e76, _e77, _e78, _e79);
+            altitude_2 = _e80;
+            let _e82 = r_60;
+            let _e83 = mu_s_28;
+            let _e85 = t_12;
+            let _e86 = nu_21;
+            let _e89 = r_t_3;
+            let _e91 = ClampCosine((((_e82 * _e83) + (_e85 * _e86)) / _e89));
+            mu_s_t_2 = _e91;
+            let _e95 = atmosphere_107;
+            let _e96 = altitude_2;
+            let _e101 = GetCoefficientsAtAltitude(_e95, _e96, (&mie_scattering_2), (&rayleigh_scattering_2));
+            extinction_1 = _e101;
+            let _e103 = atmosphere_107;
+            let _e104 = r_t_3;
+            let _e105 = mu_s_t_2;
+            let _e106 = GetOpticalDepthToTopAtmosphereBoundary(_e103, transmittance_texture_7, _e104, _e105);
+            let _e109 = atmosphere_107;
+            let _e110 = r_t_3;
+            let _e111 = mu_s_t_2;
+            let _e112 = SunVisibleFraction(_e109, _e110, _e111);
+            sunlight = (exp(-(_e106)) * _e112);
+            let _e115 = rayleigh_scattering_2;
             let _e116 = sunlight;
-            mie = (_e115 * _e116);
-            let _e119 = rayleigh_scattering_2;
-            let _e120 = mie_scattering_2;
-            scattering_2 = (_e119 + _e120);
-            let _e123 = k_4;
-            if (_e123 > 0i) {
+            rayleigh = (_e115 * _e116);
+            let _e119 = mie_scattering_2;
+            let _e120 = sunlight;
+            mie = (_e119 * _e120);
+            let _e123 = rayleigh_scattering_2;
+            let _e124 = mie_scattering_2;
+            scattering_2 = (_e123 + _e124);
+            let _e127 = k_6;
+            if (_e127 > 0i) {
                 {
-                    let _e126 = previous_extinction_1;
-                    let _e127 = extinction_1;
-                    let _e130 = dt_1;
-                    interval_depth = ((_e126 + _e127) * (0.5f * _e130));
-                    let _e134 = optical_depth_1;
-                    start_transmittance = exp(-(_e134));
-                    let _e138 = start_transmittance;
-                    let _e139 = interval_depth;
-                    let _e141 = MeanAttenuation(_e139.x);
-                    let _e142 = interval_depth;
-                    let _e144 = MeanAttenuation(_e142.y);
-                    let _e145 = interval_depth;
-                    let _e147 = MeanAttenuation(_e145.z);
-                    mean_transmittance = (_e138 * vec3<f32>(_e141, _e144, _e147));
-                    let _e151 = (*single_rayleigh);
-                    let _e152 = previous_rayleigh;
-                    let _e153 = rayleigh;
-                    let _e156 = dt_1;
-                    let _e159 = mean_transmittance;
-                    (*single_rayleigh) = (_e151 + (((_e152 + _e153) * (0.5f * _e156)) * _e159));
-                    let _e162 = (*single_mie);
-                    let _e163 = previous_mie;
-                    let _e164 = mie;
-                    let _e167 = dt_1;
-                    let _e170 = mean_transmittance;
-                    (*single_mie) = (_e162 + (((_e163 + _e164) * (0.5f * _e167)) * _e170));
-                    let _e173 = (*scattering_weight);
-                    let _e174 = previous_scattering;
-                    let _e175 = scattering_2;
-                    let _e178 = dt_1;
-                    let _e181 = mean_transmittance;
-                    (*scattering_weight) = (_e173 + (((_e174 + _e175) * (0.5f * _e178)) * _e181));
-                    let _e184 = optical_depth_1;
-                    let _e185 = interval_depth;
-                    optical_depth_1 = (_e184 + _e185);
+                    let _e130 = previous_extinction_1;
+                    let _e131 = extinction_1;
+                    let _e134 = dt_1;
+                    interval_depth = ((_e130 + _e131) * (0.5f * _e134));
+                    let _e138 = optical_depth_1;
+                    start_transmittance = exp(-(_e138));
+                    let _e142 = start_transmittance;
+                    let _e143 = interval_depth;
+                    let _e145 = MeanAttenuation(_e143.x);
+                    let _e146 = interval_depth;
+                    let _e148 = MeanAttenuation(_e146.y);
+                    let _e149 = interval_depth;
+                    let _e151 = MeanAttenuation(_e149.z);
+                    mean_transmittance = (_e142 * vec3<f32>(_e145, _e148, _e151));
+                    let _e155 = (*single_rayleigh);
+                    let _e156 = previous_rayleigh;
+                    let _e157 = rayleigh;
+                    let _e160 = dt_1;
+                    let _e163 = mean_transmittance;
+                    (*single_rayleigh) = (_e155 + (((_e156 + _e157) * (0.5f * _e160)) * _e163));
+                    let _e166 = (*single_mie);
+                    let _e167 = previous_mie;
+                    let _e168 = mie;
+                    let _e171 = dt_1;
+                    let _e174 = mean_transmittance;
+                    (*single_mie) = (_e166 + (((_e167 + _e168) * (0.5f * _e171)) * _e174));
+                    let _e177 = (*scattering_weight);
+                    let _e178 = previous_scattering;
+                    let _e179 = scattering_2;
+                    let _e182 = dt_1;
+                    let _e185 = mean_transmittance;
+                    (*scattering_weight) = (_e177 + (((_e178 + _e179) * (0.5f * _e182)) * _e185));
+                    let _e188 = optical_depth_1;
+                    let _e189 = interval_depth;
+                    optical_depth_1 = (_e188 + _e189);
                 }
             }
-            let _e187 = extinction_1;
-            previous_extinction_1 = _e187;
-            let _e188 = rayleigh;
-            previous_rayleigh = _e188;
-            let _e189 = mie;
-            previous_mie = _e189;
-            let _e190 = scattering_2;
-            previous_scattering = _e190;
+            let _e191 = extinction_1;
+            previous_extinction_1 = _e191;
+            let _e192 = rayleigh;
+            previous_rayleigh = _e192;
+            let _e193 = mie;
+            previous_mie = _e193;
+            let _e194 = scattering_2;
+            previous_scattering = _e194;
         }
         continuing {
-            let _e57 = k_4;
-            k_4 = (_e57 + 1i);
+            let _e61 = k_6;
+            k_6 = (_e61 + 1i);
         }
     }
-    let _e191 = (*single_rayleigh);
-    let _e192 = atmosphere_81;
-    (*single_rayleigh) = (_e191 * _e192.solar_irradiance);
-    let _e195 = (*single_mie);
-    let _e196 = atmosphere_81;
-    (*single_mie) = (_e195 * _e196.solar_irradiance);
-    let _e199 = optical_depth_1;
-    return _e199;
+    let _e195 = (*single_rayleigh);
+    let _e196 = atmosphere_107;
+    (*single_rayleigh) = (_e195 * _e196.solar_irradiance);
+    let _e199 = (*single_mie);
+    let _e200 = atmosphere_107;
+    (*single_mie) = (_e199 * _e200.solar_irradiance);
+    let _e203 = optical_depth_1;
+    return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_82: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_4: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_109: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
     var sun_direction_5: vec3<f32>;
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
-    var start_2: vec3<f32>;
-    var r_59: f32;
-    var mu_42: f32;
-    var mu_s_26: f32;
-    var nu_20: f32;
-    var d_25: f32;
+    var start_3: vec3<f32>;
+    var r_61: f32;
+    var mu_46: f32;
+    var mu_s_29: f32;
+    var nu_22: f32;
+    var d_28: f32;
     var lit_1: f32;
-    var ray_r_mu_intersects_ground_17: bool;
+    var ray_r_mu_intersects_ground_19: bool;
     var r_p: f32;
     var mu_p: f32;
     var mu_s_p: f32;
@@ -2478,310 +3268,310 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_82: AtmosphereParameters, transmit
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_109 = atmosphere_108;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
     sun_direction_5 = sun_direction_4;
-    let _e24 = point_1;
-    let _e25 = camera_7;
-    camera_to_point = (_e24 - _e25);
-    let _e28 = camera_to_point;
-    let _e29 = camera_to_point;
-    if (dot(_e28, _e29) == 0f) {
+    let _e28 = point_1;
+    let _e29 = camera_7;
+    camera_to_point = (_e28 - _e29);
+    let _e32 = camera_to_point;
+    let _e33 = camera_to_point;
+    if (dot(_e32, _e33) == 0f) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e37 = camera_to_point;
-    view_ray_6 = normalize(_e37);
-    let _e45 = atmosphere_83;
-    let _e46 = camera_7;
-    let _e47 = view_ray_6;
-    let _e48 = sun_direction_5;
-    let _e59 = GetViewRayStart(_e45, _e46, _e47, _e48, (&start_2), (&r_59), (&mu_42), (&mu_s_26), (&nu_20));
-    if !(_e59) {
+    let _e41 = camera_to_point;
+    view_ray_6 = normalize(_e41);
+    let _e49 = atmosphere_109;
+    let _e50 = camera_7;
+    let _e51 = view_ray_6;
+    let _e52 = sun_direction_5;
+    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_61), (&mu_46), (&mu_s_29), (&nu_22));
+    if !(_e63) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e65 = point_1;
-    let _e66 = start_2;
-    d_25 = max(length((_e65 - _e66)), 0f);
-    let _e72 = d_25;
-    let _e73 = shadow_length_1;
-    lit_1 = max((_e72 - max(_e73, 0f)), 0f);
-    let _e80 = atmosphere_83;
-    let _e81 = r_59;
-    let _e82 = mu_42;
-    let _e83 = RayIntersectsGround(_e80, _e81, _e82);
-    ray_r_mu_intersects_ground_17 = _e83;
-    let _e85 = atmosphere_83;
-    let _e86 = r_59;
-    let _e87 = mu_42;
-    let _e88 = lit_1;
-    let _e89 = RadiusAtDistance(_e85, _e86, _e87, _e88);
-    r_p = _e89;
-    let _e91 = r_59;
-    let _e92 = mu_42;
-    let _e93 = lit_1;
-    let _e94 = r_p;
-    let _e95 = CosineAtDistance(_e91, _e92, _e93, _e94);
-    mu_p = _e95;
-    let _e97 = r_59;
-    let _e98 = mu_s_26;
-    let _e100 = lit_1;
-    let _e101 = nu_20;
-    let _e104 = r_p;
-    let _e106 = ClampCosine((((_e97 * _e98) + (_e100 * _e101)) / _e104));
-    mu_s_p = _e106;
-    let _e112 = d_25;
-    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e112));
-    let _e120 = lit_1;
-    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e120));
-    let _e136 = lit_direct;
-    if (_e136 > 0f) {
+    let _e69 = point_1;
+    let _e70 = start_3;
+    d_28 = max(length((_e69 - _e70)), 0f);
+    let _e76 = d_28;
+    let _e77 = shadow_length_1;
+    lit_1 = max((_e76 - max(_e77, 0f)), 0f);
+    let _e84 = atmosphere_109;
+    let _e85 = r_61;
+    let _e86 = mu_46;
+    let _e87 = RayIntersectsGround(_e84, _e85, _e86);
+    ray_r_mu_intersects_ground_19 = _e87;
+    let _e89 = atmosphere_109;
+    let _e90 = r_61;
+    let _e91 = mu_46;
+    let _e92 = lit_1;
+    let _e93 = RadiusAtDistance(_e89, _e90, _e91, _e92);
+    r_p = _e93;
+    let _e95 = r_61;
+    let _e96 = mu_46;
+    let _e97 = lit_1;
+    let _e98 = r_p;
+    let _e99 = CosineAtDistance(_e95, _e96, _e97, _e98);
+    mu_p = _e99;
+    let _e101 = r_61;
+    let _e102 = mu_s_29;
+    let _e104 = lit_1;
+    let _e105 = nu_22;
+    let _e108 = r_p;
+    let _e110 = ClampCosine((((_e101 * _e102) + (_e104 * _e105)) / _e108));
+    mu_s_p = _e110;
+    let _e116 = d_28;
+    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e116));
+    let _e124 = lit_1;
+    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e124));
+    let _e140 = lit_direct;
+    if (_e140 > 0f) {
         {
-            let _e139 = atmosphere_83;
-            let _e140 = r_59;
-            let _e141 = mu_42;
-            let _e142 = mu_s_26;
-            let _e143 = nu_20;
-            let _e144 = lit_1;
-            let _e151 = IntegrateSegment(_e139, transmittance_texture_8, _e140, _e141, _e142, _e143, _e144, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
-            lit_optical_depth = _e151;
+            let _e143 = atmosphere_109;
+            let _e144 = r_61;
+            let _e145 = mu_46;
+            let _e146 = mu_s_29;
+            let _e147 = nu_22;
+            let _e148 = lit_1;
+            let _e155 = IntegrateSegment(_e143, transmittance_texture_8, _e144, _e145, _e146, _e147, _e148, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
+            lit_optical_depth = _e155;
         }
     }
-    let _e152 = lit_optical_depth;
-    optical_depth_2 = _e152;
-    let _e154 = direct;
-    let _e157 = lit_1;
-    let _e158 = d_25;
-    if ((_e154 > 0f) && (_e157 < _e158)) {
+    let _e156 = lit_optical_depth;
+    optical_depth_2 = _e156;
+    let _e158 = direct;
+    let _e161 = lit_1;
+    let _e162 = d_28;
+    if ((_e158 > 0f) && (_e161 < _e162)) {
         {
-            let _e164 = optical_depth_2;
-            let _e165 = atmosphere_83;
-            let _e166 = r_p;
-            let _e167 = mu_p;
-            let _e168 = mu_s_p;
-            let _e169 = nu_20;
-            let _e170 = d_25;
-            let _e171 = lit_1;
-            let _e179 = IntegrateSegment(_e165, transmittance_texture_8, _e166, _e167, _e168, _e169, (_e170 - _e171), (&unused_rayleigh), (&unused_mie), (&unused_weight));
-            optical_depth_2 = (_e164 + _e179);
+            let _e168 = optical_depth_2;
+            let _e169 = atmosphere_109;
+            let _e170 = r_p;
+            let _e171 = mu_p;
+            let _e172 = mu_s_p;
+            let _e173 = nu_22;
+            let _e174 = d_28;
+            let _e175 = lit_1;
+            let _e183 = IntegrateSegment(_e169, transmittance_texture_8, _e170, _e171, _e172, _e173, (_e174 - _e175), (&unused_rayleigh), (&unused_mie), (&unused_weight));
+            optical_depth_2 = (_e168 + _e183);
         }
     }
-    let _e181 = direct;
-    if (_e181 < 1f) {
+    let _e185 = direct;
+    if (_e185 < 1f) {
         {
-            let _e184 = atmosphere_83;
-            let _e185 = r_59;
-            let _e186 = mu_42;
-            let _e187 = d_25;
-            let _e188 = ray_r_mu_intersects_ground_17;
-            let _e189 = LongSegmentOpticalDepth(_e184, transmittance_texture_8, _e185, _e186, _e187, _e188);
-            let _e190 = optical_depth_2;
-            let _e191 = direct;
-            optical_depth_2 = mix(_e189, _e190, vec3(_e191));
+            let _e188 = atmosphere_109;
+            let _e189 = r_61;
+            let _e190 = mu_46;
+            let _e191 = d_28;
+            let _e192 = ray_r_mu_intersects_ground_19;
+            let _e193 = LongSegmentOpticalDepth(_e188, transmittance_texture_8, _e189, _e190, _e191, _e192);
+            let _e194 = optical_depth_2;
+            let _e195 = direct;
+            optical_depth_2 = mix(_e193, _e194, vec3(_e195));
         }
     }
-    let _e194 = optical_depth_2;
-    (*transmittance_1) = exp(-(_e194));
-    let _e198 = atmosphere_83;
-    let _e199 = r_59;
-    let _e200 = mu_42;
-    let _e201 = mu_s_26;
-    let _e202 = nu_20;
-    let _e203 = ray_r_mu_intersects_ground_17;
-    let _e206 = GetCombinedScattering(_e198, scattering_texture_4, single_mie_scattering_texture_2, _e199, _e200, _e201, _e202, _e203, (&single_mie_scattering_2));
-    scattering_3 = _e206;
-    let _e208 = lit_1;
-    if (_e208 < DIRECT_SEGMENT_LENGTH) {
+    let _e198 = optical_depth_2;
+    (*transmittance_1) = exp(-(_e198));
+    let _e202 = atmosphere_109;
+    let _e203 = r_61;
+    let _e204 = mu_46;
+    let _e205 = mu_s_29;
+    let _e206 = nu_22;
+    let _e207 = ray_r_mu_intersects_ground_19;
+    let _e210 = GetCombinedScattering(_e202, scattering_texture_7, single_mie_scattering_texture_2, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
+    scattering_3 = _e210;
+    let _e212 = lit_1;
+    if (_e212 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e210 = atmosphere_83;
-            let _e211 = r_59;
-            let _e212 = mu_42;
-            let _e213 = ray_r_mu_intersects_ground_17;
-            let _e214 = DistanceToNearestAtmosphereBoundary(_e210, _e211, _e212, _e213);
-            boundary = _e214;
-            let _e216 = boundary;
-            let _e218 = atmosphere_83;
-            let _e219 = r_59;
-            let _e220 = mu_42;
-            let _e221 = DistanceInsideScatteringRadii(_e218, _e219, _e220);
-            let _e223 = lit_1;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e216), _e221), _e223);
-            let _e229 = atmosphere_83;
-            let _e230 = r_59;
-            let _e231 = mu_42;
-            let _e232 = mu_s_26;
-            let _e233 = nu_20;
-            let _e234 = far;
-            let _e241 = IntegrateSegment(_e229, transmittance_texture_8, _e230, _e231, _e232, _e233, _e234, (&far_rayleigh), (&far_mie), (&far_weight));
-            far_optical_depth = _e241;
-            let _e243 = far;
-            let _e244 = boundary;
-            if (_e243 < _e244) {
+            let _e214 = atmosphere_109;
+            let _e215 = r_61;
+            let _e216 = mu_46;
+            let _e217 = ray_r_mu_intersects_ground_19;
+            let _e218 = DistanceToNearestAtmosphereBoundary(_e214, _e215, _e216, _e217);
+            boundary = _e218;
+            let _e220 = boundary;
+            let _e222 = atmosphere_109;
+            let _e223 = r_61;
+            let _e224 = mu_46;
+            let _e225 = DistanceInsideScatteringRadii(_e222, _e223, _e224);
+            let _e227 = lit_1;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e220), _e225), _e227);
+            let _e233 = atmosphere_109;
+            let _e234 = r_61;
+            let _e235 = mu_46;
+            let _e236 = mu_s_29;
+            let _e237 = nu_22;
+            let _e238 = far;
+            let _e245 = IntegrateSegment(_e233, transmittance_texture_8, _e234, _e235, _e236, _e237, _e238, (&far_rayleigh), (&far_mie), (&far_weight));
+            far_optical_depth = _e245;
+            let _e247 = far;
+            let _e248 = boundary;
+            if (_e247 < _e248) {
                 {
-                    let _e246 = atmosphere_83;
-                    let _e247 = r_59;
-                    let _e248 = mu_42;
-                    let _e249 = far;
-                    let _e250 = RadiusAtDistance(_e246, _e247, _e248, _e249);
-                    r_far = _e250;
-                    let _e253 = scattering_3;
-                    let _e254 = far_optical_depth;
-                    let _e257 = atmosphere_83;
-                    let _e258 = r_far;
-                    let _e259 = r_59;
-                    let _e260 = mu_42;
-                    let _e261 = far;
+                    let _e250 = atmosphere_109;
+                    let _e251 = r_61;
+                    let _e252 = mu_46;
+                    let _e253 = far;
+                    let _e254 = RadiusAtDistance(_e250, _e251, _e252, _e253);
+                    r_far = _e254;
+                    let _e257 = scattering_3;
+                    let _e258 = far_optical_depth;
+                    let _e261 = atmosphere_109;
                     let _e262 = r_far;
-                    let _e263 = CosineAtDistance(_e259, _e260, _e261, _e262);
-                    let _e264 = r_59;
-                    let _e265 = mu_s_26;
-                    let _e267 = far;
-                    let _e268 = nu_20;
-                    let _e271 = r_far;
-                    let _e273 = ClampCosine((((_e264 * _e265) + (_e267 * _e268)) / _e271));
-                    let _e274 = nu_20;
-                    let _e275 = ray_r_mu_intersects_ground_17;
-                    let _e278 = GetCombinedScattering(_e257, scattering_texture_4, single_mie_scattering_texture_2, _e258, _e263, _e273, _e274, _e275, (&unused_far_mie));
-                    scattering_3 = (_e253 - (exp(-(_e254)) * _e278));
+                    let _e263 = r_61;
+                    let _e264 = mu_46;
+                    let _e265 = far;
+                    let _e266 = r_far;
+                    let _e267 = CosineAtDistance(_e263, _e264, _e265, _e266);
+                    let _e268 = r_61;
+                    let _e269 = mu_s_29;
+                    let _e271 = far;
+                    let _e272 = nu_22;
+                    let _e275 = r_far;
+                    let _e277 = ClampCosine((((_e268 * _e269) + (_e271 * _e272)) / _e275));
+                    let _e278 = nu_22;
+                    let _e279 = ray_r_mu_intersects_ground_19;
+                    let _e282 = GetCombinedScattering(_e261, scattering_texture_7, single_mie_scattering_texture_2, _e262, _e267, _e277, _e278, _e279, (&unused_far_mie));
+                    scattering_3 = (_e257 - (exp(-(_e258)) * _e282));
                 }
             }
-            let _e281 = scattering_3;
-            let _e282 = far_rayleigh;
-            let _e287 = lit_weight;
-            let _e289 = far_weight;
-            multiple = ((max((_e281 - _e282), vec3(0f)) * _e287) / max(_e289, vec3(0.000000000000000000000000000001f)));
-            let _e295 = single_rayleigh_1;
-            let _e296 = multiple;
-            let _e298 = nu_20;
-            let _e299 = RayleighPhaseFunction(_e298);
-            let _e301 = single_mie_1;
-            let _e302 = atmosphere_83;
-            let _e303 = nu_20;
-            let _e304 = MiePhaseFunction(_e302, _e303);
-            return (((_e295 + _e296) * _e299) + (_e301 * _e304));
+            let _e285 = scattering_3;
+            let _e286 = far_rayleigh;
+            let _e291 = lit_weight;
+            let _e293 = far_weight;
+            multiple = ((max((_e285 - _e286), vec3(0f)) * _e291) / max(_e293, vec3(0.000000000000000000000000000001f)));
+            let _e299 = single_rayleigh_1;
+            let _e300 = multiple;
+            let _e302 = nu_22;
+            let _e303 = RayleighPhaseFunction(_e302);
+            let _e305 = single_mie_1;
+            let _e306 = atmosphere_109;
+            let _e307 = nu_22;
+            let _e308 = MiePhaseFunction(_e306, _e307);
+            return (((_e299 + _e300) * _e303) + (_e305 * _e308));
         }
     }
-    let _e307 = atmosphere_83;
-    let _e308 = r_59;
-    let _e309 = mu_42;
-    let _e310 = lit_1;
-    let _e311 = ray_r_mu_intersects_ground_17;
-    let _e312 = LongSegmentOpticalDepth(_e307, transmittance_texture_8, _e308, _e309, _e310, _e311);
-    let _e313 = lit_optical_depth;
-    let _e314 = lit_direct;
-    lit_transmittance = exp(-(mix(_e312, _e313, vec3(_e314))));
-    let _e321 = atmosphere_83;
-    let _e322 = r_p;
-    let _e323 = mu_p;
-    let _e324 = mu_s_p;
-    let _e325 = nu_20;
-    let _e326 = ray_r_mu_intersects_ground_17;
-    let _e329 = GetCombinedScattering(_e321, scattering_texture_4, single_mie_scattering_texture_2, _e322, _e323, _e324, _e325, _e326, (&single_mie_scattering_p));
-    scattering_p = _e329;
-    let _e331 = scattering_3;
-    let _e332 = lit_transmittance;
-    let _e333 = scattering_p;
-    scattering_3 = max((_e331 - (_e332 * _e333)), vec3(0f));
-    let _e339 = single_mie_scattering_2;
-    let _e340 = lit_transmittance;
-    let _e341 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e339 - (_e340 * _e341)), vec3(0f));
-    let _e347 = single_mie_scattering_2;
-    let _e348 = single_mie_1;
-    let _e349 = lit_direct;
-    single_mie_scattering_2 = mix(_e347, _e348, vec3(_e349));
-    let _e352 = scattering_3;
-    let _e353 = nu_20;
-    let _e354 = RayleighPhaseFunction(_e353);
-    let _e356 = single_mie_scattering_2;
-    let _e357 = atmosphere_83;
-    let _e358 = nu_20;
-    let _e359 = MiePhaseFunction(_e357, _e358);
-    return ((_e352 * _e354) + (_e356 * _e359));
+    let _e311 = atmosphere_109;
+    let _e312 = r_61;
+    let _e313 = mu_46;
+    let _e314 = lit_1;
+    let _e315 = ray_r_mu_intersects_ground_19;
+    let _e316 = LongSegmentOpticalDepth(_e311, transmittance_texture_8, _e312, _e313, _e314, _e315);
+    let _e317 = lit_optical_depth;
+    let _e318 = lit_direct;
+    lit_transmittance = exp(-(mix(_e316, _e317, vec3(_e318))));
+    let _e325 = atmosphere_109;
+    let _e326 = r_p;
+    let _e327 = mu_p;
+    let _e328 = mu_s_p;
+    let _e329 = nu_22;
+    let _e330 = ray_r_mu_intersects_ground_19;
+    let _e333 = GetCombinedScattering(_e325, scattering_texture_7, single_mie_scattering_texture_2, _e326, _e327, _e328, _e329, _e330, (&single_mie_scattering_p));
+    scattering_p = _e333;
+    let _e335 = scattering_3;
+    let _e336 = lit_transmittance;
+    let _e337 = scattering_p;
+    scattering_3 = max((_e335 - (_e336 * _e337)), vec3(0f));
+    let _e343 = single_mie_scattering_2;
+    let _e344 = lit_transmittance;
+    let _e345 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e343 - (_e344 * _e345)), vec3(0f));
+    let _e351 = single_mie_scattering_2;
+    let _e352 = single_mie_1;
+    let _e353 = lit_direct;
+    single_mie_scattering_2 = mix(_e351, _e352, vec3(_e353));
+    let _e356 = scattering_3;
+    let _e357 = nu_22;
+    let _e358 = RayleighPhaseFunction(_e357);
+    let _e360 = single_mie_scattering_2;
+    let _e361 = atmosphere_109;
+    let _e362 = nu_22;
+    let _e363 = MiePhaseFunction(_e361, _e362);
+    return ((_e356 * _e358) + (_e360 * _e363));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_84: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_85: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_110: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_111: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_85 = atmosphere_84;
+    atmosphere_111 = atmosphere_110;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e22 = atmosphere_85;
-    let _e23 = camera_9;
-    let _e24 = point_3;
-    let _e26 = sun_direction_7;
-    let _e29 = GetSkyRadianceToPointWithShadow(_e22, transmittance_texture_9, scattering_texture_5, single_mie_scattering_texture_3, _e23, _e24, 0f, _e26, transmittance_2);
-    return _e29;
+    let _e26 = atmosphere_111;
+    let _e27 = camera_9;
+    let _e28 = point_3;
+    let _e30 = sun_direction_7;
+    let _e33 = GetSkyRadianceToPointWithShadow(_e26, transmittance_texture_9, scattering_texture_8, single_mie_scattering_texture_3, _e27, _e28, 0f, _e30, transmittance_2);
+    return _e33;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_86: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_87: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_112: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_113: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_60: f32;
-    var mu_s_27: f32;
+    var r_62: f32;
+    var mu_s_30: f32;
 
-    atmosphere_87 = atmosphere_86;
+    atmosphere_113 = atmosphere_112;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e21 = atmosphere_87;
-    let _e22 = point_5;
-    let _e24 = ClampRadius(_e21, length(_e22));
-    r_60 = _e24;
+    let _e25 = atmosphere_113;
     let _e26 = point_5;
-    let _e27 = sun_direction_9;
-    let _e29 = point_5;
-    let _e32 = ClampCosine((dot(_e26, _e27) / length(_e29)));
-    mu_s_27 = _e32;
-    let _e34 = atmosphere_87;
-    let _e35 = r_60;
-    let _e36 = mu_s_27;
-    let _e37 = GetIrradiance(_e34, irradiance_texture_1, _e35, _e36);
-    let _e39 = normal_1;
-    let _e40 = point_5;
-    let _e42 = point_5;
-    (*sky_irradiance) = ((_e37 * (1f + (dot(_e39, _e40) / length(_e42)))) * 0.5f);
-    let _e49 = atmosphere_87;
-    let _e51 = atmosphere_87;
-    let _e52 = r_60;
-    let _e53 = mu_s_27;
-    let _e54 = GetTransmittanceToSun(_e51, transmittance_texture_10, _e52, _e53);
-    let _e56 = normal_1;
-    let _e57 = sun_direction_9;
-    return ((_e49.solar_irradiance * _e54) * max(dot(_e56, _e57), 0f));
+    let _e28 = ClampRadius(_e25, length(_e26));
+    r_62 = _e28;
+    let _e30 = point_5;
+    let _e31 = sun_direction_9;
+    let _e33 = point_5;
+    let _e36 = ClampCosine((dot(_e30, _e31) / length(_e33)));
+    mu_s_30 = _e36;
+    let _e38 = atmosphere_113;
+    let _e39 = r_62;
+    let _e40 = mu_s_30;
+    let _e41 = GetIrradiance(_e38, irradiance_texture_1, _e39, _e40);
+    let _e43 = normal_1;
+    let _e44 = point_5;
+    let _e46 = point_5;
+    (*sky_irradiance) = ((_e41 * (1f + (dot(_e43, _e44) / length(_e46)))) * 0.5f);
+    let _e53 = atmosphere_113;
+    let _e55 = atmosphere_113;
+    let _e56 = r_62;
+    let _e57 = mu_s_30;
+    let _e58 = GetTransmittanceToSun(_e55, transmittance_texture_10, _e56, _e57);
+    let _e60 = normal_1;
+    let _e61 = sun_direction_9;
+    return ((_e53.solar_irradiance * _e58) * max(dot(_e60, _e61), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_88: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_89: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_114: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_115: AtmosphereParameters;
 
-    atmosphere_89 = atmosphere_88;
-    let _e12 = atmosphere_89;
-    let _e14 = atmosphere_89;
-    let _e17 = atmosphere_89;
-    return (_e12.solar_irradiance / vec3(((PI * _e14.sun_angular_radius) * _e17.sun_angular_radius)));
+    atmosphere_115 = atmosphere_114;
+    let _e16 = atmosphere_115;
+    let _e18 = atmosphere_115;
+    let _e21 = atmosphere_115;
+    return (_e16.solar_irradiance / vec3(((PI * _e18.sun_angular_radius) * _e21.sun_angular_radius)));
 }
 
 fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     var xyz_1: vec3<f32>;
 
     xyz_1 = xyz;
-    let _e18 = xyz_1;
-    let _e25 = xyz_1;
-    let _e32 = xyz_1;
-    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e18), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e25), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e32));
+    let _e22 = xyz_1;
+    let _e29 = xyz_1;
+    let _e36 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e22), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e29), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e36));
 }
