@@ -127,7 +127,6 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
                                  : TableMean(single_.rayleigh, params_, {});
   const std::vector<double> orders_packing = PackingFactors(orders_grid_);
   const bool gather_at_end = GatherAtEnd();
-  std::shared_ptr<GatherPlan> orders_plan;  // every order's gather is along the same rays
   for (int order = 2; order <= (auto_orders ? s.max_orders : s.orders); ++order) {
     std::string prefix = "order " + std::to_string(order) + ": ";
     Phase(prefix + "scattering density", [&] { ComputeScatteringDensity(order); });
@@ -148,8 +147,8 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
       // Earth's shadow tens of times too bright); only deep-shadow samples
       // read it, and the tail tests hold.
       const MuSFall fall = MuSFallOf(scattering_density_, order == 2);
-      if (!orders_plan) orders_plan = PlanGather(orders_grid_, nullptr, atmosphere_grid_);
-      GatherAlongRays(*orders_plan, scattering_density_, &fall, &delta_multiple_);
+      if (!orders_plan_) orders_plan_ = PlanGather(orders_grid_, nullptr, atmosphere_grid_);
+      GatherAlongRays(*orders_plan_, scattering_density_, &fall, &delta_multiple_);
       AddScaled(newest, Spectrum(1.0), higher_orders_);
     });
     report_.orders_used = order;
@@ -206,7 +205,11 @@ Texture Baker::ScatteringTable(Texture storage) const {
     // grid's lowest sun (as the second order's own gather is; linear in J
     // it would read the deep twilight several times too bright).
     const MuSFall fall = MuSFallOf(higher_orders_, true);
-    GatherAlongRays(*PlanGather(params_, own_suns_.get(), atmosphere_grid_), higher_orders_, &fall, &gathered);
+    // Where the table has the orders' rows, along the orders' rays.
+    const bool orders_rows = !TableRestricted() && settings_.higher_order_divisor == 1;
+    GatherAlongRays(orders_rows ? *PlanGatherForColumns(*orders_plan_, params_, own_suns_.get())
+                                : *PlanGather(params_, own_suns_.get(), atmosphere_grid_),
+                    higher_orders_, &fall, &gathered);
   }
   const Texture& higher = GatherAtEnd() ? gathered : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;

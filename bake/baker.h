@@ -147,6 +147,10 @@ class Baker {
   struct GatherPlan;
   std::shared_ptr<GatherPlan> PlanGather(const AtmosphereParameters& grid, const OwnColumnSuns* own,
                                          const AtmosphereParameters& density_grid) const;
+  // A plan along the rays of `plan` for a grid with the same r and mu rows
+  // and other mu_s columns (`own`: its rays' own columns' suns).
+  std::shared_ptr<GatherPlan> PlanGatherForColumns(const GatherPlan& plan, const AtmosphereParameters& grid,
+                                                   const OwnColumnSuns* own) const;
   // The light of the orders whose scattering density (per unit scattering
   // coefficient, on the plan's density grid) is `density`, arriving at
   // every texel of a table on the plan's grid: the density integrated along
@@ -256,6 +260,8 @@ class Baker {
 
   // The suns of the table's rays' own columns, where it has a split.
   std::unique_ptr<OwnColumnSuns> own_suns_;
+  // Every order's gather is along the same rays, planned once.
+  std::shared_ptr<GatherPlan> orders_plan_;
   Texture transmittance_;
   Texture irradiance_;
   SingleScattering single_;       // on the table's grid

@@ -310,8 +310,11 @@ struct Baker::GatherPlan {
   };
   AtmosphereParameters grid, density_grid;
   const OwnColumnSuns* own_suns = nullptr;  // of grid, where it has a split
-  int samples_per_ray = 0;  // intervals per ray
-  std::vector<Ray> rays;    // per ray index z * mu_size + y
+  int samples_per_ray = 0;                  // intervals per ray
+  // Per ray index z * mu_size + y; they depend on the grid's r and mu rows
+  // alone, and a plan for the same rows and other columns shares them
+  // (PlanGatherForColumns).
+  std::shared_ptr<std::vector<Ray>> rays;
   // The gathered order's J in JRows's layout (JRows::Rows): kept with the
   // plan so that every order's gather writes into pages already touched,
   // instead of faulting in a fresh buffer on the calling thread.
@@ -326,10 +329,10 @@ std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters&
   const int density_height = density_grid.scattering_mu_size, density_depth = density_grid.scattering_r_size;
   const int n = std::max(std::min(settings_.ray_samples, 32), settings_.ray_samples / 2);
   plan->samples_per_ray = n;
-  plan->rays.resize(std::size_t(r_size) * mu_size);
+  plan->rays = std::make_shared<std::vector<GatherPlan::Ray>>(std::size_t(r_size) * mu_size);
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
-    GatherPlan::Ray& out = plan->rays[ray_index];
+    GatherPlan::Ray& out = (*plan->rays)[ray_index];
     const RaySamples ray = SampleRay(grid, y, z, n);
     // The integrand is J times the scattering coefficient times the view's
     // transmittance. Over optically thin intervals J varies slowly and is
@@ -391,6 +394,15 @@ std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters&
   return plan;
 }
 
+std::shared_ptr<Baker::GatherPlan> Baker::PlanGatherForColumns(const GatherPlan& plan, const AtmosphereParameters& grid,
+                                                               const OwnColumnSuns* own) const {
+  auto same_rays = std::make_shared<GatherPlan>();
+  same_rays->grid = grid, same_rays->density_grid = plan.density_grid, same_rays->own_suns = own;
+  same_rays->samples_per_ray = plan.samples_per_ray;
+  same_rays->rays = plan.rays;
+  return same_rays;
+}
+
 void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSFall* fall, Texture* result_out) const {
   const AtmosphereParameters &grid = plan.grid, &density_grid = plan.density_grid;
   // Every texel is written below, so the texture's memory is reused as it is.
@@ -410,7 +422,7 @@ void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSF
   auto rows_at = [&](int row) { return &density_rows[std::size_t(row) * per_row]; };
   tbb::parallel_for(0, r_size * mu_size, [&](int ray_index) {
     const int z = ray_index / mu_size, y = ray_index % mu_size;
-    const GatherPlan::Ray& ray = plan.rays[ray_index];
+    const GatherPlan::Ray& ray = (*plan.rays)[ray_index];
     // The ray's sun directions, grouped by the nu slice below them where
     // JRows's lookups along mu_s are permutations of rows held in registers
     // (each vector of directions then reads the same two nu rows of J);
