@@ -88,9 +88,7 @@ glsl::AtmosphereParameters ParametersFromJson(const json& j) {
   p.scattering_r_max = j.at("scattering_r_max").get<double>();
   p.scattering_mu_s_min = j.at("scattering_mu_s_min").get<double>();
   p.scattering_mu_s_max = j.at("scattering_mu_s_max").get<double>();
-  // (Absent from the manifests of earlier versions, whose columns were the
-  // same for every ray.)
-  p.scattering_mu_s_split = j.value("scattering_mu_s_split", 0);
+  p.scattering_mu_s_split = j.at("scattering_mu_s_split").get<int>();
   p.irradiance_width = j.at("irradiance_width").get<int>();
   p.irradiance_height = j.at("irradiance_height").get<int>();
   return p;
@@ -157,7 +155,13 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
        "a = (d - d_min) / (d_max - d_min) with d = distance from the ground to the top boundary along mu_s, "
        "d_min = top_radius - bottom_radius, d_max = H; A = a at scattering_mu_s_min; f = max(1 - a / A, 0) / (1 + "
        "a / 2); x = f / f(scattering_mu_s_max)" +
-           std::string(kTexelCentres)},
+           std::string(kTexelCentres) +
+           "; from column scattering_mu_s_split up. Below it (where it is above 0) every ray (r, mu) and sun azimuth "
+           "has its own columns, placed from the sun zenith angle E past which no point of the ray sees the sun "
+           "(GetScatteringShadowEdgePosition in functions.glsl): 6 at and past E (the last at E, the others evenly to "
+           "max(theta(scattering_mu_s_min), E + 2 degrees)), the others from D = E - theta = 0.05 degrees (D_min) to "
+           "the split's sun at even steps of 0.3 (X(E - D) - X(E - D_min)) / (X(theta_split) - X(E - D_min)) + 0.7 "
+           "ln(D / D_min) / ln((E - theta_split) / D_min), X = (1 - a / A) / (1 + a)"},
       {"y", "mu", p.scattering_mu_size, -1.0, 1.0, "1",
        "two halves of n / 2 texels, discontinuous at the horizon: rays that hit the ground in the lower half, "
        "u = 0.5 - 0.5 * (0.5 / (n / 2) + x * (1 - 1 / (n / 2))), x = (d - d_min) / (d_max - d_min), d = distance "

@@ -22,7 +22,7 @@ namespace skybake {
 
 inline constexpr const char kManifestFileName[] = "skybake.json";
 inline constexpr const char kManifestSchema[] = "skybake.manifest";
-inline constexpr int kManifestSchemaVersion = 7;
+inline constexpr int kManifestSchemaVersion = 8;
 
 class ManifestWriter {
  public:

@@ -77,7 +77,7 @@ TEST_F(BakedSetTest, InfoDescribesEveryFileOfABakedSet) {
 
   ASSERT_EQ(RunCommand(Skybake() + " info --json " + ShellQuote(Lut()), dir, &out, &err), 0) << err;
   const json report = json::parse(out);
-  EXPECT_EQ(report["schema_version"], 7);
+  EXPECT_EQ(report["schema_version"], 8);
   ASSERT_EQ(report["files"].size(), 8u);
   for (const json& f : report["files"]) {
     SCOPED_TRACE(f["file"].get<std::string>());

@@ -153,7 +153,7 @@ TEST_F(LutFilesTest, ManifestListsEveryFileWithMatchingChecksum) {
   WriteLutSet(Luts(), dir.path(), options);
   const json manifest = json::parse(ReadFileText(dir.path() / kManifestFileName));
   EXPECT_EQ(manifest["schema"], "skybake.manifest");
-  EXPECT_EQ(manifest["schema_version"], 7);
+  EXPECT_EQ(manifest["schema_version"], 8);
   EXPECT_EQ(manifest["command"], "skybake bake earth -o somewhere");
   EXPECT_EQ(manifest["wavelengths_nm"], json::array({680.0, 550.0, 440.0}));
   EXPECT_EQ(manifest["parameters"]["scattering_mu_size"], 32);
@@ -320,7 +320,7 @@ TEST_F(LutFilesTest, ManifestErrors) {
     WriteFileAtomically(path, manifest.dump(2));
     return IoErrorOf([&] { LoadLutSet(dir.path()); });
   };
-  EXPECT_NE(error_with([](json& m) { m["schema_version"] = 1; }).find("schema version 1, this skybake reads version 7"),
+  EXPECT_NE(error_with([](json& m) { m["schema_version"] = 1; }).find("schema version 1, this skybake reads version 8"),
             std::string::npos);
   EXPECT_NE(error_with([](json& m) { m["schema"] = "other"; }).find("not a skybake manifest"), std::string::npos);
   EXPECT_NE(error_with([](json& m) { m["tables"][0]["files"][0]["file"] = "../transmittance.exr"; })
