@@ -77,10 +77,12 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   // rows, that is the table's from the split up and the rest is computed
   // along the table's rays; else on the grid itself.
   const bool grid_single = (s.orders != 1 || s.single_scattering_sky_irradiance) && !TableOnAtmosphereGrid();
+  if (params_.scattering_mu_s_split > 0) {
+    Phase("each ray's own sun columns", [&] { own_suns_ = std::make_unique<OwnColumnSuns>(params_); });
+  }
   Phase("single scattering", [&] {
+    const SunColumns grid_columns(atmosphere_grid_);
     OtherColumns other;
-    SunColumns grid_columns(atmosphere_grid_);
-    if (params_.scattering_mu_s_split > 0) own_suns_ = std::make_unique<OwnColumnSuns>(params_);
     if (grid_single && !TableRestricted()) {
       other = {&grid_columns, LowSunColumnCount(grid_columns), params_.scattering_mu_s_split};
       grid_single_ = {ScatteringGridTexture(atmosphere_grid_), ScatteringGridTexture(atmosphere_grid_)};
@@ -88,16 +90,8 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
     single_ = ComputeSingleScattering(params_, s.ray_samples, own_suns_.get(), other,
                                       other.columns ? &grid_single_ : nullptr);
     if (other.columns) {
-      const int split = params_.scattering_mu_s_split, mu_s_size = params_.scattering_mu_s_size;
-      for (auto [from, to] : {std::pair{&single_.rayleigh, &grid_single_.rayleigh},
-                              std::pair{&single_.mie, &grid_single_.mie}}) {
-        ForEachRow(*to, [&](int, std::size_t first, std::size_t end) {
-          for (std::size_t i = first; i < end; i += 4) {
-            if (int((i - first) / 4) % mu_s_size < split) continue;
-            for (int c = 0; c < 4; ++c) to->texels[i + c] = from->texels[i + c];
-          }
-        });
-      }
+      CopyColumnsFrom(single_.rayleigh, params_, params_.scattering_mu_s_split, &grid_single_.rayleigh);
+      CopyColumnsFrom(single_.mie, params_, params_.scattering_mu_s_split, &grid_single_.mie);
     }
   });
   if (grid_single && TableRestricted()) {

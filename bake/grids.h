@@ -51,6 +51,18 @@ inline void SizeForScatteringGrid(const AtmosphereParameters& grid, Texture* tex
   texture->texels.resize(std::size_t(4) * texture->width * texture->height * texture->depth, 0.0f);
 }
 
+// Copies the texels of the mu_s columns from `first_column` up of a
+// texture on `grid` into `to`, a texture of the same size.
+inline void CopyColumnsFrom(const Texture& from, const AtmosphereParameters& grid, int first_column, Texture* to) {
+  const int mu_s_size = grid.scattering_mu_s_size;
+  ForEachRow(*to, [&](int, std::size_t first, std::size_t end) {
+    for (std::size_t i = first; i < end; i += 4) {
+      if (int((i - first) / 4) % mu_s_size < first_column) continue;
+      for (int c = 0; c < 4; ++c) to->texels[i + c] = from.texels[i + c];
+    }
+  });
+}
+
 inline Texture ScatteringGridTexture(const AtmosphereParameters& grid) {
   Texture texture;
   SizeForScatteringGrid(grid, &texture);
