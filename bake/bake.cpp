@@ -90,16 +90,18 @@ namespace {
 // from the zenith (on Earth's default table 82.6 degrees), where the sun
 // is up for every point of every ray and the light changes slowly with it,
 // so that the daylight sky reads as on columns at the same suns for every
-// ray, or
-// where no column is that high the highest, if its sun is at most 89
+// ray; where no column is that high, the highest, if its sun is at most 89
 // degrees (every ray's shadow edge lies past 90 degrees and the disc's
-// radius). 0, every column the same for every ray, where that leaves fewer
-// than two lit columns below it, or where the tables' lowest sun is less
-// than SHADOW_EDGE_LEAST_PAST_SPAN below the horizon: with no twilight to
-// follow, the columns at and past each ray's edge would lie past the
-// tables' suns, lost to the suns they cover (with them the daytime scene
-// of SceneBake.ReproducesTheFullBakeInsideTheScenesRanges read its sky 3.3
-// % from a finer bake on average, without them 2.2 %).
+// radius). 0, every column the same for every ray, where the tables'
+// lowest sun is less than SHADOW_EDGE_LEAST_PAST_SPAN below the horizon
+// (with no twilight to follow, the columns at and past each ray's edge
+// would lie past the tables' suns), or where fewer than kLeastLitColumns
+// would lie on the lit side (the ray's own axis then spreads too few over
+// the low sun, whose light changes with the sunlight's air mass).
+// docs/accuracy.md ("Twilight: a sun axis measured from each ray's shadow
+// edge") measures both.
+constexpr int kLeastLitColumns = 10;
+
 int ScatteringMuSSplit(const glsl::AtmosphereParameters& p) {
   constexpr double kSplitSun = 83.0 * kPi / 180.0, kHighestSplitSun = 89.0 * kPi / 180.0;
   const int last = p.scattering_mu_s_size - 1;
@@ -107,7 +109,7 @@ int ScatteringMuSSplit(const glsl::AtmosphereParameters& p) {
   if (sun(0) < 0.5 * kPi + glsl::SHADOW_EDGE_LEAST_PAST_SPAN) return 0;
   int split = last;
   while (split > 0 && sun(split - 1) <= kSplitSun) --split;
-  if (sun(split) > kHighestSplitSun || split < glsl::SHADOW_EDGE_PAST_COLUMNS + 2) return 0;
+  if (sun(split) > kHighestSplitSun || split < glsl::SHADOW_EDGE_PAST_COLUMNS + kLeastLitColumns) return 0;
   return split;
 }
 }  // namespace
