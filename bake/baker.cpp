@@ -194,16 +194,20 @@ Texture Baker::ScatteringTable(Texture storage) const {
   }
   Texture gathered;
   if (GatherAtEnd()) {
-    // The summed J falls after sunset as its orders do, the second's
-    // fastest: gathered along its fall between columns and below the
+    // Below the split the table's texels reach far into the Earth's
+    // shadow, where the summed J falls as its orders do, the second's
+    // fastest: gathered there along its fall between columns and below the
     // grid's lowest sun (as the second order's own gather is; linear in J
-    // it would read the deep twilight several times too bright).
-    const MuSFall fall = MuSFallOf(higher_orders_, true);
+    // it read the deep twilight several times too bright). A table with no
+    // split (a daytime scene's) keeps J linear: on a scene's coarse grid of
+    // the orders the fall read its sky at sunset worse (docs/accuracy.md).
+    std::optional<MuSFall> fall;
+    if (params_.scattering_mu_s_split > 0) fall = MuSFallOf(higher_orders_, true);
     // Where the table has the orders' rows, along the orders' rays.
     const bool orders_rows = !TableRestricted() && settings_.higher_order_divisor == 1;
     GatherAlongRays(orders_rows ? *PlanGatherForColumns(*orders_plan_, params_, own_suns_.get())
                                 : *PlanGather(params_, own_suns_.get(), atmosphere_grid_),
-                    higher_orders_, &fall, &gathered);
+                    higher_orders_, fall ? &*fall : nullptr, &gathered);
   }
   const Texture& higher = GatherAtEnd() ? gathered : higher_orders_;
   const int mu_s_size = params_.scattering_mu_s_size;
