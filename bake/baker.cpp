@@ -255,9 +255,8 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, const O
         // (A texel's nu is its slice's clamped as GetScatteringTexel clamps it.)
         const vec3 at_start =
             k_clamped && edge_value ? edge_value(x0, y, z, ClampedNu(nu_k, mu, mu_s0)) : vec3(table.Fetch(x0, y, z));
-        const vec3 at_end = next_clamped && edge_value
-                                ? edge_value(x1, y, z, ClampedNu(columns.grid_nu[x1], mu, mu_s1))
-                                : vec3(table.Fetch(x1, y, z));
+        const vec3 at_end = next_clamped && edge_value ? edge_value(x1, y, z, ClampedNu(columns.grid_nu[x1], mu, mu_s1))
+                                                       : vec3(table.Fetch(x1, y, z));
         const double t_start = (start - nu_k) / spacing, t_end = (end - nu_k) / spacing;
         vec4 value0 = table.Fetch(x0, y, z), value1 = table.Fetch(x1, y, z);
         for (int c = 0; c < 3; ++c) {

@@ -68,17 +68,15 @@ class Baker {
   // `own`: the suns of the rays' own columns where the grid has a split.
   // Along the same rays, that of `other`'s columns into `other_out` (a
   // texture of its grid's size), where given.
-  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples,
-                                           const OwnColumnSuns* own, const OtherColumns& other = {},
-                                           SingleScattering* other_out = nullptr) const;
+  SingleScattering ComputeSingleScattering(const AtmosphereParameters& grid, int ray_samples, const OwnColumnSuns* own,
+                                           const OtherColumns& other = {}, SingleScattering* other_out = nullptr) const;
   // Single scattering of the texels of one ray of `grid` (mu index y, r
   // index z), n intervals, into `out`, and of `other`'s into `other_out`.
   // `columns`, `own`: the grid's sun directions (RaySunDirections);
   // `transmittance`: the transmittance table's channels.
   void SingleScatteringAlongRay(const AtmosphereParameters& grid, int n, int y, int z, const SunColumns& columns,
-                                const OwnColumnSuns* own, const OtherColumns& other,
-                                const ChannelPlanes& transmittance, SingleScattering& out,
-                                SingleScattering* other_out) const;
+                                const OwnColumnSuns* own, const OtherColumns& other, const ChannelPlanes& transmittance,
+                                SingleScattering& out, SingleScattering* other_out) const;
   // Per sun direction of a ray, its single scattering before the solar
   // irradiance: sums[0] the scattering table's (every group but the Mie
   // group, over the Rayleigh phase), sums[1] the single Mie table's (phase

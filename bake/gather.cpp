@@ -430,7 +430,8 @@ void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSF
     // order: kept in the plan they would take more memory than all the
     // rest of it (docs/benchmark.md).
     JRows rows(density_mu_s_size, density_nu_size);
-    const DirectionsBySlice by_slice(RaySunDirections(columns, plan.own_suns, grid, y, z), density_grid, rows.PermutesRows());
+    const DirectionsBySlice by_slice(RaySunDirections(columns, plan.own_suns, grid, y, z), density_grid,
+                                     rows.PermutesRows());
     const int count = by_slice.count();
     const std::vector<float>&mu_s = by_slice.mu_s, &nu = by_slice.nu, &nu_weight = by_slice.nu_weight;
     std::vector<float> mu_s_k(count), mu_s_weight(count), values(count);

@@ -14,7 +14,7 @@
 
 #include "bake/colour.h"
 #include "bake/medium.h"
-#include "bake/sun_lookups.h"
+#include "bake/own_column_suns.h"
 #include "core/constants.h"
 #include "core/errors.h"
 #include "shaders_runtime/runtime.h"
@@ -218,7 +218,7 @@ struct HigherOrderSource {
   std::vector<glm::dvec3> reference;  // per key
   glm::dvec3 sun{0.0};                // E at its channels, the reference where a key has none
   std::size_t width = 0, height = 0, mu_s_size = 0;  // mu_s_size 0: the key is the texel's index
-  const detail::OwnColumnSuns* own = nullptr;       // the table's suns below its split, if it has one
+  const detail::OwnColumnSuns* own = nullptr;        // the table's suns below its split, if it has one
   int split = 0;
 
   std::size_t Key(std::size_t t) const {

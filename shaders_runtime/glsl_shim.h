@@ -34,16 +34,16 @@ using glm::max;
 using glm::min;
 using glm::mix;
 using glm::normalize;
+using glm::pow;
 using glm::smoothstep;
 using glm::step;
-using glm::pow;
 using std::abs;
 using std::acos;
 using std::cos;
-using std::sin;
 using std::exp;
 using std::floor;
 using std::log;
+using std::sin;
 using std::sqrt;
 // GLSL's two-argument arc tangent.
 inline Number atan(Number y, Number x) { return std::atan2(y, x); }

@@ -102,8 +102,8 @@ TEST(Parameterization, RestrictedAxesSpanTheirRanges) {
   EXPECT_NEAR(mu_s, std::cos(std::max(95.0 * degree, edge + 2.0 * degree)), 1e-9);
   // A ray from 500 m up whose edge is 2 degrees and more before 95 degrees:
   // straight down.
-  glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 0.5 / n_mu_s, 0.5 - 0.5 / p.scattering_mu_size, 0.5 / n_r), r,
-                                             mu, mu_s, nu, ground);
+  glsl::GetRMuMuSNuFromScatteringTextureUvwz(
+      p, glsl::vec4(0.5, 0.5 / n_mu_s, 0.5 - 0.5 / p.scattering_mu_size, 0.5 / n_r), r, mu, mu_s, nu, ground);
   ASSERT_LT(glsl::ShadowEdgeSunZenith(p, r, mu, glsl::ViewSunAzimuthCosine(mu, mu_s, nu), ground), 93.0 * degree);
   EXPECT_NEAR(mu_s, std::cos(95.0 * glsl::PI / 180.0), 1e-9);
   glsl::GetRMuMuSNuFromScatteringTextureUvwz(p, glsl::vec4(0.5, 1.0 - 0.5 / n_mu_s, 0.75, 1.0 - 0.5 / n_r), r, mu,

@@ -143,16 +143,19 @@ TEST(SingleScattering, MatchesBruteForceQuadratureWithinHalfPercent) {
         double error = std::abs(got - want) / want;
         double& worst = near_edge ? worst_near_edge : twilight ? worst_twilight : worst_day;
         worst = std::max(worst, error);
-        EXPECT_LE(error, near_edge ? 2.5e-2 : twilight ? 1.5e-2 : 5e-3)
-            << "texel " << x << "," << y << "," << z << " r " << t.r << " mu " << t.mu << " mu_s " << t.mu_s
-            << " nu " << t.nu << " channel " << c;
+        EXPECT_LE(error, near_edge  ? 2.5e-2
+                         : twilight ? 1.5e-2
+                                    : 5e-3)
+            << "texel " << x << "," << y << "," << z << " r " << t.r << " mu " << t.mu << " mu_s " << t.mu_s << " nu "
+            << t.nu << " channel " << c;
         ++compared;
       }
     }
   }
-  std::printf("single scattering vs brute force: %d values (%d texels near the horizon): max relative error "
-              "%.3g with the sun up, %.3g in twilight, %.3g within a degree of the ray's shadow edge\n",
-              compared, near_horizon, worst_day, worst_twilight, worst_near_edge);
+  std::printf(
+      "single scattering vs brute force: %d values (%d texels near the horizon): max relative error "
+      "%.3g with the sun up, %.3g in twilight, %.3g within a degree of the ray's shadow edge\n",
+      compared, near_horizon, worst_day, worst_twilight, worst_near_edge);
   EXPECT_GE(compared, 600);  // 6 values per texel, less those below the table's scale
 }
 

@@ -18,7 +18,7 @@
 #include "bake/bake.h"
 #include "bake/config.h"
 #include "bake/ray_integrals.h"
-#include "bake/sun_lookups.h"
+#include "bake/own_column_suns.h"
 #include "core/constants.h"
 #include "shaders_runtime/runtime.h"
 #include "test_atmospheres.h"
@@ -78,9 +78,9 @@ Light SingleScatteringQuadrature(const LutSet& luts, double r, double mu, double
     const double mu_s_t = glsl::ClampCosine((r * mu_s + t * nu) / radius);
     s.visible = glsl::SunVisibleFraction(p, radius, mu_s_t);
     if (s.visible > 0.0) {
-      const Spectrum attenuation =
-          glm::exp(-(s.optical_depth + glsl::GetOpticalDepthToTopAtmosphereBoundary(p, transmittance, radius, mu_s_t))) *
-          s.visible;
+      const Spectrum attenuation = glm::exp(-(s.optical_depth + glsl::GetOpticalDepthToTopAtmosphereBoundary(
+                                                                    p, transmittance, radius, mu_s_t))) *
+                                   s.visible;
       for (std::size_t c = 0; c < a.constituents.size(); ++c) {
         const Spectrum scattered = a.constituents[c].scattering_per_m * s.density[c] * attenuation;
         (a.constituents[c].phase.kind == PhaseKind::kRayleigh ? s.light.rayleigh : s.light.mie) += scattered;
@@ -327,7 +327,7 @@ TEST(TwilightSunAxis, OwnColumnsLieWhereTheLookupReadsThem) {
 TEST(TwilightSunAxis, SingleScatteringMeetsItsTargetsOnTheDefaultTable) {
   const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
   std::vector<std::pair<std::string, std::vector<double>>> sun_sets = {{"whole degrees", kTwilightSuns},
-                                                                        {"every 0.1 degree", {}}};
+                                                                       {"every 0.1 degree", {}}};
   for (int i = 0; i <= 200; ++i) sun_sets[1].second.push_back(80.037 + 0.1 * i);
   for (double offset : {0.25, 0.5, 0.75}) {
     sun_sets.push_back({"offset " + std::to_string(offset).substr(0, 4), {}});

@@ -1,0 +1,127 @@
+// The suns of a scattering grid's own columns below its split
+// (functions.glsl, "The sun axis after sunset"), solved once per grid for
+// the bake's passes over its texels.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "bake/bake.h"
+#include "bake/detail.h"
+#include "core/constants.h"
+#include "shaders_runtime/runtime.h"
+
+namespace skybake::detail {
+
+// Per ray of a scattering grid with a split, the sun cosines of its own
+// columns below it (functions.glsl, "The sun axis after sunset") per nu
+// slice, as GetScatteringTexel gives them, solved once for the grid:
+// GetScatteringOwnColumnSunZenith's fixed point, each column's from the
+// edge of the column above it (which lies close to its own), with each lit
+// column's distance to the edge (ShadowEdgeLitDistance, a Newton solve)
+// read from a table over the edge (LitDistances), which
+// TwilightSunAxis.OwnColumnsLieWhereTheLookupReadsThem holds within 1e-7
+// radians of the exact solve.
+class OwnColumnSuns {
+ public:
+  explicit OwnColumnSuns(const AtmosphereParameters& grid)
+      : split_(grid.scattering_mu_s_split),
+        mu_s_size_(grid.scattering_mu_s_size),
+        nu_size_(grid.scattering_nu_size),
+        mu_size_(grid.scattering_mu_size),
+        distances_(grid),
+        mu_s_(std::size_t(grid.scattering_r_size) * mu_size_ * nu_size_ * split_) {
+    tbb::parallel_for(0, grid.scattering_r_size * mu_size_, [&](int ray) {
+      const int y = ray % mu_size_, z = ray / mu_size_;
+      for (int slice = 0; slice < nu_size_; ++slice) {
+        const glsl::vec4 uvwz = glsl::GetScatteringTextureUvwzFromTexel(grid, slice * mu_s_size_, y, z);
+        double r, mu, mu_s, nu;
+        bool ground;
+        glsl::GetRMuMuSNuFromScatteringTextureUvwz(grid, glsl::vec4(uvwz.x, 1.0, uvwz.z, uvwz.w), r, mu, mu_s, nu,
+                                                   ground);
+        double edge = glsl::GetScatteringHorizonSunEdge(grid, r, mu, nu, ground);
+        for (int column = split_ - 1; column >= 0; --column) {
+          double sun = distances_.SunZenith(grid, column, edge);
+          for (int i = 0; i < 50; ++i) {
+            const double column_mu_s = std::cos(sun);
+            edge = glsl::ShadowEdgeSunZenith(
+                grid, r, mu, glsl::ViewSunAzimuthCosine(mu, column_mu_s, ClampedNu(nu, mu, column_mu_s)), ground);
+            const double next = distances_.SunZenith(grid, column, edge);
+            const bool converged = std::abs(next - sun) < 1e-11;
+            sun = next;
+            if (converged) break;
+          }
+          mu_s_[Index(slice * mu_s_size_ + column, y, z)] = std::cos(sun);
+        }
+      }
+    });
+  }
+  // Of texel (x, y, z), x's column below the split.
+  double MuS(int x, int y, int z) const { return mu_s_[Index(x, y, z)]; }
+  // The same by an index of the texels below the split, in [0, size()).
+  std::size_t Index(int x, int y, int z) const {
+    const int slice = x / mu_s_size_, column = x % mu_s_size_;
+    return ((std::size_t(z) * mu_size_ + y) * nu_size_ + slice) * split_ + column;
+  }
+  std::size_t size() const { return mu_s_.size(); }
+  double MuSAt(std::size_t index) const { return mu_s_[index]; }
+
+ private:
+  // Each lit column's D(E) = ShadowEdgeLitDistance at its position, as a
+  // cubic in E between nodes kStep apart (Hermite, with the slopes of exact
+  // solves kSlopeStep either side of each node), over the edges of every
+  // ray: from the start's at the ground (90 degrees and the disc's radius)
+  // to pi and the disc's radius. D(E) is smooth (ShadowEdgeUnitSun goes on
+  // smoothly past the tables' lowest sun), so the cubic's error is of order
+  // kStep^4 times D's fourth derivative.
+  class LitDistances {
+   public:
+    explicit LitDistances(const AtmosphereParameters& grid)
+        : past_(glsl::SHADOW_EDGE_PAST_COLUMNS),
+          lit_(grid.scattering_mu_s_split - past_),
+          lowest_edge_(0.5 * kPi + grid.sun_angular_radius),
+          nodes_(int(std::ceil(0.5 * kPi / kStep)) + 1),
+          split_sun_(glsl::GetScatteringSplitSunZenith(grid)),
+          distance_(std::size_t(lit_) * nodes_),
+          slope_(distance_.size()) {
+      tbb::parallel_for(0, lit_ * nodes_, [&](int i) {
+        const int k = i / nodes_;
+        const double edge = lowest_edge_ + (i % nodes_) * kStep, x = double(k) / lit_;
+        distance_[i] = glsl::ShadowEdgeLitDistance(grid, x, edge, split_sun_);
+        slope_[i] = (glsl::ShadowEdgeLitDistance(grid, x, edge + kSlopeStep, split_sun_) -
+                     glsl::ShadowEdgeLitDistance(grid, x, edge - kSlopeStep, split_sun_)) /
+                    (2.0 * kSlopeStep);
+      });
+    }
+    // GetScatteringShadowEdgeSunZenith at a column, with the table's D.
+    double SunZenith(const AtmosphereParameters& grid, int column, double edge) const {
+      if (column < past_ || edge < lowest_edge_) {
+        return glsl::GetScatteringShadowEdgeSunZenith(grid, column, edge, split_sun_);
+      }
+      const double position = std::min((edge - lowest_edge_) / kStep, nodes_ - 1.0 - 1e-9);
+      const int node = int(position);
+      const double t = position - node, t2 = t * t, t3 = t2 * t;
+      const std::size_t i = std::size_t(column - past_) * nodes_ + node;
+      return edge - ((2.0 * t3 - 3.0 * t2 + 1.0) * distance_[i] + (t3 - 2.0 * t2 + t) * kStep * slope_[i] +
+                     (3.0 * t2 - 2.0 * t3) * distance_[i + 1] + (t3 - t2) * kStep * slope_[i + 1]);
+    }
+
+   private:
+    static constexpr double kStep = 0.05 * kPi / 180.0, kSlopeStep = 1e-5;
+    int past_, lit_;
+    double lowest_edge_;
+    int nodes_;
+    double split_sun_;
+    std::vector<double> distance_, slope_;  // per lit column, then node
+  };
+
+  int split_, mu_s_size_, nu_size_, mu_size_;
+  LitDistances distances_;
+  std::vector<double> mu_s_;
+};
+
+}  // namespace skybake::detail
