@@ -25,6 +25,10 @@ ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters,
   return t;
 }
 
+ScatteringTexel GetScatteringSliceTexel(const glsl::AtmosphereParameters& parameters, int nu_index, int y, int z) {
+  return GetScatteringTexel(parameters, (nu_index + 1) * parameters.scattering_mu_s_size - 1, y, z);
+}
+
 double ClampedNu(double nu, double mu, double mu_s) { return glsl::ClampNuToDirections(nu, mu, mu_s); }
 
 double EstimatedBakeBytes(const BakeSettings& s) {

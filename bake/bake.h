@@ -173,6 +173,11 @@ struct ScatteringTexel {
   bool ray_intersects_ground = false;
 };
 ScatteringTexel GetScatteringTexel(const glsl::AtmosphereParameters& parameters, int x, int y, int z);
+// The texel of nu slice nu_index and row (y, z) at the highest mu_s column,
+// whose sun is the same for every ray: for a caller that needs the ray (r,
+// mu) or the slice's nu, without the fixed point that finds the sun of a
+// column below the split.
+ScatteringTexel GetScatteringSliceTexel(const glsl::AtmosphereParameters& parameters, int nu_index, int y, int z);
 // A slice whose grid nu lies past the range its (mu, mu_s) allow holds, in
 // the tables as written, the light to which the lookup's blend extends from
 // the allowed part of its interval, at most this many times the light there.

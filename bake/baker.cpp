@@ -235,7 +235,7 @@ void Baker::ExtendSlicesPastTheirRange(const AtmosphereParameters& grid, const O
   const SunColumns columns(grid);
   tbb::parallel_for(0, grid.scattering_mu_size * grid.scattering_r_size, [&](int row) {
     const int y = row % grid.scattering_mu_size, z = row / grid.scattering_mu_size;
-    const double mu = GetScatteringTexel(grid, 0, y, z).mu;
+    const double mu = GetScatteringSliceTexel(grid, 0, y, z).mu;
     for (int column = 0; column < mu_s_size; ++column) {
       // Below the split each slice's texel lies at its own sun, whose range
       // of nu bounds it (the lookup there blends the slices geometrically).

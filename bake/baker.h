@@ -221,7 +221,7 @@ class Baker {
   // smooth higher orders by up to P(1)/P(0) = 2.
   static double MultipleScatteringPackingFactor(const AtmosphereParameters& grid, int nu_index) {
     return 1.0 /
-           glsl::RayleighPhaseFunction(GetScatteringTexel(grid, nu_index * grid.scattering_mu_s_size, 0, 0).grid_nu);
+           glsl::RayleighPhaseFunction(GetScatteringSliceTexel(grid, nu_index, 0, 0).grid_nu);
   }
 
   // Radiance of scattering order `order` arriving at radius r from the

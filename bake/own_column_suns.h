@@ -38,18 +38,14 @@ class OwnColumnSuns {
     tbb::parallel_for(0, grid.scattering_r_size * mu_size_, [&](int ray) {
       const int y = ray % mu_size_, z = ray / mu_size_;
       for (int slice = 0; slice < nu_size_; ++slice) {
-        const glsl::vec4 uvwz = glsl::GetScatteringTextureUvwzFromTexel(grid, slice * mu_s_size_, y, z);
-        double r, mu, mu_s, nu;
-        bool ground;
-        glsl::GetRMuMuSNuFromScatteringTextureUvwz(grid, glsl::vec4(uvwz.x, 1.0, uvwz.z, uvwz.w), r, mu, mu_s, nu,
-                                                   ground);
-        double edge = glsl::GetScatteringHorizonSunEdge(grid, r, mu, nu, ground);
+        const ScatteringTexel slice_ray = GetScatteringSliceTexel(grid, slice, y, z);
+        const double r = slice_ray.r, mu = slice_ray.mu, nu = slice_ray.grid_nu;
+        const bool ground = slice_ray.ray_intersects_ground;
+        double edge = glsl::GetScatteringSliceEdge(grid, r, mu, nu, ground, 0.0);
         for (int column = split_ - 1; column >= 0; --column) {
           double sun = distances_.SunZenith(grid, column, edge);
           for (int i = 0; i < 50; ++i) {
-            const double column_mu_s = std::cos(sun);
-            edge = glsl::ShadowEdgeSunZenith(
-                grid, r, mu, glsl::ViewSunAzimuthCosine(mu, column_mu_s, ClampedNu(nu, mu, column_mu_s)), ground);
+            edge = glsl::GetScatteringSliceEdge(grid, r, mu, nu, ground, std::cos(sun));
             const double next = distances_.SunZenith(grid, column, edge);
             const bool converged = std::abs(next - sun) < 1e-11;
             sun = next;

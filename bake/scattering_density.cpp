@@ -189,7 +189,7 @@ void Baker::ComputeScatteringDensity(int order) {
   std::vector<double> radii;
   std::vector<std::vector<double>> ring_cosines(r_size), ring_weights(r_size);
   for (int z = 0; z < r_size; ++z) {
-    radii.push_back(GetScatteringTexel(grid, 0, 0, z).r);
+    radii.push_back(GetScatteringSliceTexel(grid, 0, 0, z).r);
     AppendDensityRule(polar, glsl::HorizonZenithCosine(params_.bottom_radius, radii.back()), ring_cosines[z],
                       ring_weights[z]);
   }
@@ -213,7 +213,7 @@ void Baker::ComputeScatteringDensity(int order) {
   for (int g = 0; g < groups; ++g) series.emplace_back(medium_.groups()[g].phase, terms);
   std::vector<double> view_mu(std::size_t(r_size) * mu_size);
   for (int z = 0; z < r_size; ++z) {
-    for (int y = 0; y < mu_size; ++y) view_mu[std::size_t(z) * mu_size + y] = GetScatteringTexel(grid, 0, y, z).mu;
+    for (int y = 0; y < mu_size; ++y) view_mu[std::size_t(z) * mu_size + y] = GetScatteringSliceTexel(grid, 0, y, z).mu;
   }
   // The weights of row z for its views [first, end).
   auto row_weights = [&](int z, int first, int end) {

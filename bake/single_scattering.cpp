@@ -25,7 +25,7 @@ namespace skybake::detail {
 constexpr int kShadowEdgeSubdivisions = 4;
 
 RaySamples Baker::SampleRay(const AtmosphereParameters& grid, int mu_index, int r_index, int n) const {
-  const ScatteringTexel texel = GetScatteringTexel(grid, 0, mu_index, r_index);
+  const ScatteringTexel texel = GetScatteringSliceTexel(grid, 0, mu_index, r_index);
   return SampleRay(texel.r, texel.mu, texel.ray_intersects_ground, n);
 }
 

@@ -61,7 +61,7 @@ struct SunDirections {
 inline SunDirections RaySunDirections(const SunColumns& columns, const OwnColumnSuns* own,
                                       const AtmosphereParameters& grid, int y, int z, const OtherColumns& other = {}) {
   SunDirections directions;
-  const double mu = GetScatteringTexel(grid, 0, y, z).mu;
+  const double mu = GetScatteringSliceTexel(grid, 0, y, z).mu;
   // The directions of one grid's columns [first, end), into `of_texel`.
   auto add = [&](const SunColumns& grid_columns, int split, int first, int end, std::vector<int>& of_texel) {
     of_texel.assign(grid_columns.mu_s.size(), -1);

@@ -24,37 +24,36 @@ Number ClampNuToDirections(Number nu, Number mu, Number mu_s) {
   return clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
 }
 
+// The shadow edge (ShadowEdgeSunZenith) of the ray (r, mu) for the sun at
+// zenith cosine mu_s in the direction of the nu slice at nu: at the azimuth
+// where nu, clamped to the range mu and mu_s allow, lies.
+Number GetScatteringSliceEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
+                              bool ray_r_mu_intersects_ground, Number mu_s) {
+  Number cos_phi = ViewSunAzimuthCosine(mu, mu_s, ClampNuToDirections(nu, mu, mu_s));
+  return ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
+}
+
 // The sun zenith angle of a ray's own column at `position` below the split
 // (GetScatteringShadowEdgeSunZenith; split_sun the split's sun zenith
 // angle) for the nu slice at nu: the column's sun sets the azimuth at which
-// nu lies (nu clamped to the range mu and the sun allow), which sets the
-// ray's edge, which sets the column's sun. Their fixed point, from the edge
-// start_edge (the edge moves less than the sun does: on Earth's default
-// table three steps from the edge of a sun at the horizon, on average, to
-// 1e-11 radians); `edge` is the column's.
+// nu lies, which sets the ray's edge (GetScatteringSliceEdge), which sets
+// the column's sun. Their fixed point, from the edge start_edge (the edge
+// moves less than the sun does: on Earth's default table three steps from
+// the edge of a sun at the horizon, on average, to 1e-11 radians); `edge`
+// is the column's.
 Number GetScatteringOwnColumnSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
                                        bool ray_r_mu_intersects_ground, Number position, Number split_sun,
                                        Number start_edge, OUT(Number) edge) {
   edge = start_edge;
   Number sun = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge, split_sun);
   for (int i = 0; i < 50; ++i) {
-    Number mu_s = cos(sun);
-    Number cos_phi = ViewSunAzimuthCosine(mu, mu_s, ClampNuToDirections(nu, mu, mu_s));
-    edge = ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
+    edge = GetScatteringSliceEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, cos(sun));
     Number next = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge, split_sun);
     bool converged = abs(next - sun) < 1e-11;
     sun = next;
     if (converged) break;
   }
   return sun;
-}
-
-// The edge of the ray (r, mu) for the sun at the horizon in the direction
-// of the slice at nu: the first guess of GetScatteringOwnColumnSunZenith.
-Number GetScatteringHorizonSunEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
-                                   bool ray_r_mu_intersects_ground) {
-  Number cos_phi = ViewSunAzimuthCosine(mu, 0.0, ClampNuToDirections(nu, mu, 0.0));
-  return ShadowEdgeSunZenith(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground);
 }
 
 // uvwz = (u_nu, u_mu_s, u_mu, u_r) as returned by
@@ -94,7 +93,7 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
     Number edge;
     mu_s = cos(GetScatteringOwnColumnSunZenith(
         atmosphere, r, mu, nu, ray_r_mu_intersects_ground, position, GetScatteringSplitSunZenith(atmosphere),
-        GetScatteringHorizonSunEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground), edge));
+        GetScatteringSliceEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, 0.0), edge));
   }
 }
 
