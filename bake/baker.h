@@ -220,8 +220,7 @@ class Baker {
   // clamped nu and multiplying by the phase at the query's nu would scale the
   // smooth higher orders by up to P(1)/P(0) = 2.
   static double MultipleScatteringPackingFactor(const AtmosphereParameters& grid, int nu_index) {
-    return 1.0 /
-           glsl::RayleighPhaseFunction(GetScatteringSliceTexel(grid, nu_index, 0, 0).grid_nu);
+    return 1.0 / glsl::RayleighPhaseFunction(GetScatteringSliceTexel(grid, nu_index, 0, 0).grid_nu);
   }
 
   // Radiance of scattering order `order` arriving at radius r from the
