@@ -678,24 +678,37 @@ void LowestSunLogFall(IN(vec4) a, IN(vec4) b, Number mu_s_a, Number mu_s_b, OUT(
   }
 }
 
-// The light at the mu_s texel column at texture coordinate x: the two nu
-// slices either side of nu, each bilinear in (mu, r) by the texture unit,
-// blended by SunCosineMix.
-vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
-                              IN(vec4) uvwz, Number x, Number nu_slice, Number nu_t, bool low_sun) {
-  Number nu_size = Number(atmosphere.scattering_nu_size);
-  return SunCosineMix(SampleTexture3D(scattering_texture, vec3((nu_slice + x) / nu_size, uvwz.z, uvwz.w)),
-                      SampleTexture3D(scattering_texture, vec3((nu_slice + 1.0 + x) / nu_size, uvwz.z, uvwz.w)),
-                      nu_t, low_sun);
+// a, the light at a column at sun cosine mu_s_a, continued to mu_s below
+// it as LowestSunLogFall of a and b (at mu_s_b) has ln L fall.
+vec4 LowestSunContinued(IN(vec4) a, IN(vec4) b, Number mu_s_a, Number mu_s_b, Number mu_s) {
+  vec4 slope;
+  vec4 curvature;
+  LowestSunLogFall(a, b, mu_s_a, mu_s_b, slope, curvature);
+  Number d = mu_s - mu_s_a;
+  return a * exp(d * (slope + d * curvature));
 }
 
-// The light of one nu slice at a ray's own column (below the split),
-// bilinear in (mu, r) by the texture unit.
-vec4 GetScatteringAtOwnColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
-                              IN(vec4) uvwz, Number column, Number nu_slice) {
-  Number x = (column + 0.5) / Number(atmosphere.scattering_mu_s_size);
+// The light of nu slice nu_slice at the mu_s texel column at texture
+// coordinate x, bilinear in (mu, r) by the texture unit.
+vec4 GetScatteringInSlice(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                          IN(vec4) uvwz, Number x, Number nu_slice) {
   return SampleTexture3D(scattering_texture,
                          vec3((nu_slice + x) / Number(atmosphere.scattering_nu_size), uvwz.z, uvwz.w));
+}
+
+// The light at the mu_s texel column at texture coordinate x: the two nu
+// slices either side of nu blended by SunCosineMix.
+vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                              IN(vec4) uvwz, Number x, Number nu_slice, Number nu_t, bool low_sun) {
+  return SunCosineMix(GetScatteringInSlice(atmosphere, scattering_texture, uvwz, x, nu_slice),
+                      GetScatteringInSlice(atmosphere, scattering_texture, uvwz, x, nu_slice + 1.0), nu_t, low_sun);
+}
+
+// The light of one nu slice at a ray's own column (below the split).
+vec4 GetScatteringAtOwnColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                              IN(vec4) uvwz, Number column, Number nu_slice) {
+  return GetScatteringInSlice(atmosphere, scattering_texture, uvwz,
+                              (column + 0.5) / Number(atmosphere.scattering_mu_s_size), nu_slice);
 }
 
 // The light of one nu slice below the split at `position` on the ray's
@@ -739,15 +752,6 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
                       x - k, true);
 }
 
-// The light of a ray's own column, the two nu slices blended geometrically.
-vec4 GetScatteringAtOwnColumnBetweenSlices(IN(AtmosphereParameters) atmosphere,
-                                           IN(ScatteringTexture) scattering_texture, IN(vec4) uvwz, Number column,
-                                           Number nu_slice, Number nu_t) {
-  return SunCosineMix(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice),
-                      GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice + 1.0), nu_t,
-                      true);
-}
-
 // 4D lookup: the mu_s texel columns either side of mu_s
 // (GetScatteringAtMuSColumn, two fetches each), blended linearly in
 // daylight (four fetches); for a low sun between two columns by
@@ -764,7 +768,8 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   Number nu_coord = uvwz.x * (nu_size - 1.0);
   Number nu_slice = min(floor(nu_coord), nu_size - 2.0);
   Number nu_t = nu_coord - nu_slice;
-  Number position = uvwz.y * Number(atmosphere.scattering_mu_s_size) - 0.5;
+  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  Number position = uvwz.y * mu_s_size - 0.5;
   if (atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)) {
     Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
     Number log_first_span = 1.0;
@@ -776,14 +781,10 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
         // SHADOW_EDGE_LEAST_PAST_SPAN past the edge): ln L continued from
         // the first two (LowestSunLogFall), as below the tables' lowest sun.
         Number step = ShadowEdgePastStep(atmosphere, edge);
-        Number mu_s_first = cos(edge + (past - 1.0) * step);
-        vec4 first = GetScatteringAtOwnColumnBetweenSlices(atmosphere, scattering_texture, uvwz, 0.0, nu_slice, nu_t);
-        vec4 second = GetScatteringAtOwnColumnBetweenSlices(atmosphere, scattering_texture, uvwz, 1.0, nu_slice, nu_t);
-        vec4 slope;
-        vec4 curvature;
-        LowestSunLogFall(first, second, mu_s_first, cos(edge + (past - 2.0) * step), slope, curvature);
-        Number d = mu_s - mu_s_first;
-        return first * exp(d * (slope + d * curvature));
+        return LowestSunContinued(
+            GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 0.5 / mu_s_size, nu_slice, nu_t, true),
+            GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 1.5 / mu_s_size, nu_slice, nu_t, true),
+            cos(edge + (past - 1.0) * step), cos(edge + (past - 2.0) * step), mu_s);
       }
       if (position >= past - 1.0) {
         Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
@@ -806,15 +807,9 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, low_sun_below);
   vec4 above =
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_above, nu_slice, nu_t, x_above < x_low_sun);
-  Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
   if (mu_s_t < 0.0) {
-    Number mu_s_min = atmosphere.scattering_mu_s_min;
-    vec4 slope;
-    vec4 curvature;
-    LowestSunLogFall(below, above, mu_s_min, GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)), slope,
-                     curvature);
-    Number d = mu_s - mu_s_min;
-    return below * exp(d * (slope + d * curvature));
+    return LowestSunContinued(below, above, atmosphere.scattering_mu_s_min,
+                              GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)), mu_s);
   }
   if (!low_sun_below) return mix(below, above, mu_s_t);
   Number column = x_below * mu_s_size - 0.5;

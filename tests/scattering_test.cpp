@@ -194,10 +194,7 @@ TEST(Twilight, LowSunBlendAlongMuSIsAMonotoneCubicInLnL) {
 // the lowest is dark; per channel.
 TEST(Twilight, BelowTheLowestSunLnLIsContinuedFromTheTwoLowestColumns) {
   auto continued = [](glsl::vec4 a, glsl::vec4 b, double mu_s_a, double mu_s_b, double mu_s) {
-    glsl::vec4 slope, curvature;
-    glsl::LowestSunLogFall(a, b, mu_s_a, mu_s_b, slope, curvature);
-    const double d = mu_s - mu_s_a;
-    return a * glm::exp(d * (slope + d * curvature));
+    return glsl::LowestSunContinued(a, b, mu_s_a, mu_s_b, mu_s);
   };
   auto shadowed = [](double mu_s) { return std::exp(-3.0 - 400.0 * mu_s * mu_s); };
   const double mu_s_a = -0.2079, mu_s_b = -0.1862;

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _934 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _941 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_934)
+    if (!_941)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _797 = mu < 0.0;
-    bool _809;
-    if (_797)
+    bool _804 = mu < 0.0;
+    bool _816;
+    if (_804)
     {
-        _809 = (((r * r) * mu) * mu) >= c;
+        _816 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _809 = _797;
+        _816 = _804;
     }
-    return _809;
+    return _816;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _567;
+    float _574;
     if (r_mu > 0.0)
     {
-        _567 = c / (r_mu + s);
+        _574 = c / (r_mu + s);
     }
     else
     {
-        _567 = s - r_mu;
+        _574 = s - r_mu;
     }
-    float param_1 = _567;
+    float param_1 = _574;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1026;
+    float _1033;
     if (d_max > d_min)
     {
-        _1026 = (d - d_min) / (d_max - d_min);
+        _1033 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1026 = 0.0;
+        _1033 = 0.0;
     }
-    float x_mu = _1026;
+    float x_mu = _1033;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -312,17 +312,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1231;
+    float _1238;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1231 = ClampCosine(param_1);
+        _1238 = ClampCosine(param_1);
     }
     else
     {
-        _1231 = 1.0;
+        _1238 = 1.0;
     }
-    return _1231;
+    return _1238;
 }
 #endif
 
@@ -330,22 +330,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _813;
+    float _820;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _813 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _820 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _813 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _820 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _813;
+    return _820;
 }
 #endif
 
@@ -395,16 +395,16 @@ float ShadowEdgeSunZenith(thread const AtmosphereParameters& atmosphere, thread 
     float param_10 = atmosphere.bottom_radius;
     float param_11 = r_d;
     float c_end = -HorizonZenithCosine(param_10, param_11);
-    float _1311;
+    float _1318;
     if (c_end >= rho)
     {
-        _1311 = 3.1415927410125732421875;
+        _1318 = 3.1415927410125732421875;
     }
     else
     {
-        _1311 = precise::atan2(across, cos_alpha) + acos((-c_end) / rho);
+        _1318 = precise::atan2(across, cos_alpha) + acos((-c_end) / rho);
     }
-    float end = _1311;
+    float end = _1318;
     float param_12 = atmosphere.bottom_radius;
     float param_13 = r;
     float start = acos(HorizonZenithCosine(param_12, param_13));
@@ -438,17 +438,17 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_5 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1173;
+    float _1180;
     if (d == 0.0)
     {
-        _1173 = 1.0;
+        _1180 = 1.0;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1173 = ClampCosine(param_6);
+        _1180 = ClampCosine(param_6);
     }
-    return _1173;
+    return _1180;
 }
 #endif
 
@@ -491,15 +491,15 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param = atmosphere;
     float param_1 = edge - 0.0008726646192371845245361328125;
     float param_2;
-    float _1476 = ShadowEdgeUnitSun(param, param_1, param_2);
+    float _1483 = ShadowEdgeUnitSun(param, param_1, param_2);
     float unused = param_2;
-    X_closest = _1476;
+    X_closest = _1483;
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = split_sun;
     float param_5;
-    float _1483 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _1490 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     unused = param_5;
-    X_span = _1483 - X_closest;
+    X_span = _1490 - X_closest;
     log_span = log((edge - split_sun) / 0.0008726646192371845245361328125);
 }
 #endif
@@ -511,9 +511,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param = atmosphere;
     float param_1 = edge - D;
     float param_2;
-    float _1439 = ShadowEdgeUnitSun(param, param_1, param_2);
+    float _1446 = ShadowEdgeUnitSun(param, param_1, param_2);
     float dX_dtheta = param_2;
-    float X = _1439;
+    float X = _1446;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -540,9 +540,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1526 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _1533 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1526;
+    return _1533;
 }
 #endif
 
@@ -609,16 +609,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1828;
+        float _1835;
         if (d_max == d_min)
         {
-            _1828 = 0.0;
+            _1835 = 0.0;
         }
         else
         {
-            _1828 = (d - d_min) / (d_max - d_min);
+            _1835 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1828;
+        x_mu = _1835;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -629,16 +629,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1872;
+        float _1879;
         if (d_max_1 > d_min_1)
         {
-            _1872 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _1879 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1872 = 0.0;
+            _1879 = 0.0;
         }
-        x_mu = _1872;
+        x_mu = _1879;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -651,17 +651,17 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
     float param_15 = mu_s;
     float u_mu_s = GetScatteringTextureUMuS(param_14, param_15);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    bool _1918 = atmosphere.scattering_mu_s_split > 0;
-    bool _1929;
-    if (_1918)
+    bool _1925 = atmosphere.scattering_mu_s_split > 0;
+    bool _1936;
+    if (_1925)
     {
-        _1929 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _1936 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _1929 = _1918;
+        _1936 = _1925;
     }
-    if (_1929)
+    if (_1936)
     {
         float param_16 = mu;
         float param_17 = mu_s;
@@ -684,9 +684,8 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringAtOwnColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& column, thread const float& nu_slice)
+float4 GetScatteringInSlice(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice)
 {
-    float x = (column + 0.5) / float(atmosphere.scattering_mu_s_size);
     return scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / float(atmosphere.scattering_nu_size), uvwz.z, uvwz.w), level(0.0));
 }
 #endif
@@ -704,20 +703,20 @@ float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringAtOwnColumnBetweenSlices(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& column, thread const float& nu_slice, thread const float& nu_t)
+float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
 {
     AtmosphereParameters param = atmosphere;
     float4 param_1 = uvwz;
-    float param_2 = column;
+    float param_2 = x;
     float param_3 = nu_slice;
     AtmosphereParameters param_4 = atmosphere;
     float4 param_5 = uvwz;
-    float param_6 = column;
+    float param_6 = x;
     float param_7 = nu_slice + 1.0;
-    float4 param_8 = GetScatteringAtOwnColumn(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
-    float4 param_9 = GetScatteringAtOwnColumn(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
+    float4 param_8 = GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
+    float4 param_9 = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
     float param_10 = nu_t;
-    bool param_11 = true;
+    bool param_11 = low_sun;
     return SunCosineMix(param_8, param_9, param_10, param_11);
 }
 #endif
@@ -739,6 +738,24 @@ void LowestSunLogFall(thread const float4& a, thread const float4& b, thread con
         slope = rise / float4(mu_s_b - mu_s_a);
         curvature = float4(0.0);
     }
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 LowestSunContinued(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread const float& mu_s)
+{
+    float4 param = a;
+    float4 param_1 = b;
+    float param_2 = mu_s_a;
+    float param_3 = mu_s_b;
+    float4 param_4;
+    float4 param_5;
+    LowestSunLogFall(param, param_1, param_2, param_3, param_4, param_5);
+    float4 slope = param_4;
+    float4 curvature = param_5;
+    float d = mu_s - mu_s_a;
+    return a * exp((slope + (curvature * d)) * d);
 }
 #endif
 
@@ -768,9 +785,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1583 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _1590 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1583 - x;
+        float error = _1590 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -785,31 +802,43 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
+float4 GetScatteringAtOwnColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& column, thread const float& nu_slice)
+{
+    AtmosphereParameters param = atmosphere;
+    float4 param_1 = uvwz;
+    float param_2 = (column + 0.5) / float(atmosphere.scattering_mu_s_size);
+    float param_3 = nu_slice;
+    return GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
 float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, thread const float4& c, thread const float4& d, thread const bool& has_a, thread const bool& has_d, thread const float& t)
 {
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _2377;
+    float4 _2384;
     if (has_a)
     {
-        _2377 = log(fast::max(a, dark));
+        _2384 = log(fast::max(a, dark));
     }
     else
     {
-        _2377 = (lb * 2.0) - lc;
+        _2384 = (lb * 2.0) - lc;
     }
-    float4 la = _2377;
-    float4 _2392;
+    float4 la = _2384;
+    float4 _2399;
     if (has_d)
     {
-        _2392 = log(fast::max(d, dark));
+        _2399 = log(fast::max(d, dark));
     }
     else
     {
-        _2392 = (lc * 2.0) - lb;
+        _2399 = (lc * 2.0) - lb;
     }
-    float4 ld = _2392;
+    float4 ld = _2399;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -905,16 +934,16 @@ float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _2296;
+    float _2303;
     if (low_sun)
     {
-        _2296 = fast::min(t, 1.0);
+        _2303 = fast::min(t, 1.0);
     }
     else
     {
-        _2296 = fast::clamp(t, 0.0, 1.0);
+        _2303 = fast::clamp(t, 0.0, 1.0);
     }
-    return _2296;
+    return _2303;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -935,19 +964,6 @@ void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thre
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
-{
-    float nu_size = float(atmosphere.scattering_nu_size);
-    float4 param = scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / nu_size, uvwz.z, uvwz.w), level(0.0));
-    float4 param_1 = scattering_texture.sample(scattering_textureSmplr, float3(((nu_slice + 1.0) + x) / nu_size, uvwz.z, uvwz.w), level(0.0));
-    float param_2 = nu_t;
-    bool param_3 = low_sun;
-    return SunCosineMix(param, param_1, param_2, param_3);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
 float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
 {
     AtmosphereParameters param = atmosphere;
@@ -961,18 +977,19 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float nu_coord = uvwz.x * (nu_size - 1.0);
     float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
     float nu_t = nu_coord - nu_slice;
-    float position = (uvwz.y * float(atmosphere.scattering_mu_s_size)) - 0.5;
-    bool _2923 = atmosphere.scattering_mu_s_split > 0;
-    bool _2931;
-    if (_2923)
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    float position = (uvwz.y * mu_s_size) - 0.5;
+    bool _2935 = atmosphere.scattering_mu_s_split > 0;
+    bool _2943;
+    if (_2935)
     {
-        _2931 = position < float(atmosphere.scattering_mu_s_split);
+        _2943 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2931 = _2923;
+        _2943 = _2935;
     }
-    if (_2931)
+    if (_2943)
     {
         float past = 6.0;
         float log_first_span = 1.0;
@@ -992,104 +1009,91 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
                 AtmosphereParameters param_14 = atmosphere;
                 float param_15 = edge;
                 float _step = ShadowEdgePastStep(param_14, param_15);
-                float mu_s_first = cos(edge + ((past - 1.0) * _step));
                 AtmosphereParameters param_16 = atmosphere;
                 float4 param_17 = uvwz;
-                float param_18 = 0.0;
+                float param_18 = 0.5 / mu_s_size;
                 float param_19 = nu_slice;
                 float param_20 = nu_t;
-                float4 first = GetScatteringAtOwnColumnBetweenSlices(param_16, scattering_texture, scattering_textureSmplr, param_17, param_18, param_19, param_20);
-                AtmosphereParameters param_21 = atmosphere;
-                float4 param_22 = uvwz;
-                float param_23 = 1.0;
-                float param_24 = nu_slice;
-                float param_25 = nu_t;
-                float4 second = GetScatteringAtOwnColumnBetweenSlices(param_21, scattering_texture, scattering_textureSmplr, param_22, param_23, param_24, param_25);
-                float4 param_26 = first;
-                float4 param_27 = second;
-                float param_28 = mu_s_first;
-                float param_29 = cos(edge + ((past - 2.0) * _step));
-                float4 param_30;
-                float4 param_31;
-                LowestSunLogFall(param_26, param_27, param_28, param_29, param_30, param_31);
-                float4 slope = param_30;
-                float4 curvature = param_31;
-                float d = mu_s - mu_s_first;
-                return first * exp((slope + (curvature * d)) * d);
+                bool param_21 = true;
+                AtmosphereParameters param_22 = atmosphere;
+                float4 param_23 = uvwz;
+                float param_24 = 1.5 / mu_s_size;
+                float param_25 = nu_slice;
+                float param_26 = nu_t;
+                bool param_27 = true;
+                float4 param_28 = GetScatteringAtMuSColumn(param_16, scattering_texture, scattering_textureSmplr, param_17, param_18, param_19, param_20, param_21);
+                float4 param_29 = GetScatteringAtMuSColumn(param_22, scattering_texture, scattering_textureSmplr, param_23, param_24, param_25, param_26, param_27);
+                float param_30 = cos(edge + ((past - 1.0) * _step));
+                float param_31 = cos(edge + ((past - 2.0) * _step));
+                float param_32 = mu_s;
+                return LowestSunContinued(param_28, param_29, param_30, param_31, param_32);
             }
             if (position >= (past - 1.0))
             {
                 float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
-                AtmosphereParameters param_32 = atmosphere;
                 AtmosphereParameters param_33 = atmosphere;
-                float param_34 = x;
-                float param_35 = edge;
-                float param_36 = GetScatteringSplitSunZenith(param_32);
-                log_first_span = log(ShadowEdgeLitDistance(param_33, param_34, param_35, param_36) / 0.0008726646192371845245361328125);
+                AtmosphereParameters param_34 = atmosphere;
+                float param_35 = x;
+                float param_36 = edge;
+                float param_37 = GetScatteringSplitSunZenith(param_33);
+                log_first_span = log(ShadowEdgeLitDistance(param_34, param_35, param_36, param_37) / 0.0008726646192371845245361328125);
             }
         }
-        AtmosphereParameters param_37 = atmosphere;
-        float4 param_38 = uvwz;
-        float param_39 = position;
-        float param_40 = nu_slice;
-        float param_41 = log_first_span;
-        AtmosphereParameters param_42 = atmosphere;
-        float4 param_43 = uvwz;
-        float param_44 = position;
-        float param_45 = nu_slice + 1.0;
-        float param_46 = log_first_span;
-        float4 param_47 = GetScatteringBelowSplit(param_37, scattering_texture, scattering_textureSmplr, param_38, param_39, param_40, param_41);
-        float4 param_48 = GetScatteringBelowSplit(param_42, scattering_texture, scattering_textureSmplr, param_43, param_44, param_45, param_46);
-        float param_49 = nu_t;
-        bool param_50 = true;
-        return SunCosineMix(param_47, param_48, param_49, param_50);
+        AtmosphereParameters param_38 = atmosphere;
+        float4 param_39 = uvwz;
+        float param_40 = position;
+        float param_41 = nu_slice;
+        float param_42 = log_first_span;
+        AtmosphereParameters param_43 = atmosphere;
+        float4 param_44 = uvwz;
+        float param_45 = position;
+        float param_46 = nu_slice + 1.0;
+        float param_47 = log_first_span;
+        float4 param_48 = GetScatteringBelowSplit(param_38, scattering_texture, scattering_textureSmplr, param_39, param_40, param_41, param_42);
+        float4 param_49 = GetScatteringBelowSplit(param_43, scattering_texture, scattering_textureSmplr, param_44, param_45, param_46, param_47);
+        float param_50 = nu_t;
+        bool param_51 = true;
+        return SunCosineMix(param_48, param_49, param_50, param_51);
     }
-    AtmosphereParameters param_51 = atmosphere;
-    float param_52 = 0.100000001490116119384765625;
-    float x_low_sun = GetScatteringTextureUMuS(param_51, param_52);
-    AtmosphereParameters param_53 = atmosphere;
-    float param_54 = uvwz.y;
-    float param_55 = x_low_sun;
-    float param_56;
+    AtmosphereParameters param_52 = atmosphere;
+    float param_53 = 0.100000001490116119384765625;
+    float x_low_sun = GetScatteringTextureUMuS(param_52, param_53);
+    AtmosphereParameters param_54 = atmosphere;
+    float param_55 = uvwz.y;
+    float param_56 = x_low_sun;
     float param_57;
     float param_58;
-    bool param_59;
-    GetScatteringMuSColumns(param_53, param_54, param_55, param_56, param_57, param_58, param_59);
-    float x_below = param_56;
-    float x_above = param_57;
-    float mu_s_t = param_58;
-    bool low_sun_below = param_59;
-    AtmosphereParameters param_60 = atmosphere;
-    float4 param_61 = uvwz;
-    float param_62 = x_below;
-    float param_63 = nu_slice;
-    float param_64 = nu_t;
-    bool param_65 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_60, scattering_texture, scattering_textureSmplr, param_61, param_62, param_63, param_64, param_65);
-    AtmosphereParameters param_66 = atmosphere;
-    float4 param_67 = uvwz;
-    float param_68 = x_above;
-    float param_69 = nu_slice;
-    float param_70 = nu_t;
-    bool param_71 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_66, scattering_texture, scattering_textureSmplr, param_67, param_68, param_69, param_70, param_71);
-    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    float param_59;
+    bool param_60;
+    GetScatteringMuSColumns(param_54, param_55, param_56, param_57, param_58, param_59, param_60);
+    float x_below = param_57;
+    float x_above = param_58;
+    float mu_s_t = param_59;
+    bool low_sun_below = param_60;
+    AtmosphereParameters param_61 = atmosphere;
+    float4 param_62 = uvwz;
+    float param_63 = x_below;
+    float param_64 = nu_slice;
+    float param_65 = nu_t;
+    bool param_66 = low_sun_below;
+    float4 below = GetScatteringAtMuSColumn(param_61, scattering_texture, scattering_textureSmplr, param_62, param_63, param_64, param_65, param_66);
+    AtmosphereParameters param_67 = atmosphere;
+    float4 param_68 = uvwz;
+    float param_69 = x_above;
+    float param_70 = nu_slice;
+    float param_71 = nu_t;
+    bool param_72 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_67, scattering_texture, scattering_textureSmplr, param_68, param_69, param_70, param_71, param_72);
     if (mu_s_t < 0.0)
     {
-        float mu_s_min = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_72 = atmosphere;
-        float param_73 = 1.0 / (mu_s_size - 1.0);
-        float4 param_74 = below;
-        float4 param_75 = above;
-        float param_76 = mu_s_min;
-        float param_77 = GetScatteringMuSFromUnitRange(param_72, param_73);
-        float4 param_78;
-        float4 param_79;
-        LowestSunLogFall(param_74, param_75, param_76, param_77, param_78, param_79);
-        float4 slope_1 = param_78;
-        float4 curvature_1 = param_79;
-        float d_1 = mu_s - mu_s_min;
-        return below * exp((slope_1 + (curvature_1 * d_1)) * d_1);
+        AtmosphereParameters param_73 = atmosphere;
+        float param_74 = 1.0 / (mu_s_size - 1.0);
+        float4 param_75 = below;
+        float4 param_76 = above;
+        float param_77 = atmosphere.scattering_mu_s_min;
+        float param_78 = GetScatteringMuSFromUnitRange(param_73, param_74);
+        float param_79 = mu_s;
+        return LowestSunContinued(param_75, param_76, param_77, param_78, param_79);
     }
     if (!low_sun_below)
     {
@@ -1104,7 +1108,7 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float param_83 = nu_slice;
     float param_84 = nu_t;
     bool param_85 = true;
-    float4 first_1 = GetScatteringAtMuSColumn(param_80, scattering_texture, scattering_textureSmplr, param_81, param_82, param_83, param_84, param_85);
+    float4 first = GetScatteringAtMuSColumn(param_80, scattering_texture, scattering_textureSmplr, param_81, param_82, param_83, param_84, param_85);
     AtmosphereParameters param_86 = atmosphere;
     float4 param_87 = uvwz;
     float param_88 = x_last;
@@ -1112,7 +1116,7 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float param_90 = nu_t;
     bool param_91 = x_last < x_low_sun;
     float4 last = GetScatteringAtMuSColumn(param_86, scattering_texture, scattering_textureSmplr, param_87, param_88, param_89, param_90, param_91);
-    float4 param_92 = first_1;
+    float4 param_92 = first;
     float4 param_93 = below;
     float4 param_94 = above;
     float4 param_95 = last;
@@ -1136,16 +1140,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3406;
+        float3 _3376;
         if (scattering.x > 0.0)
         {
-            _3406 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3376 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3406 = float3(0.0);
+            _3376 = float3(0.0);
         }
-        single_mie_scattering = _3406;
+        single_mie_scattering = _3376;
     }
     else
     {
@@ -1222,13 +1226,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3474 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3444 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3474)
+    if (!_3444)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1237,19 +1241,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3494;
+    float3 _3464;
     if (ray_r_mu_intersects_ground)
     {
-        _3494 = float3(0.0);
+        _3464 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3494 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _3464 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _3494;
+    transmittance = _3464;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1257,9 +1261,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _3521 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _3491 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _3521;
+    float3 scattering = _3491;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -1297,16 +1301,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _3615;
+    float _3585;
     if ((a > 0.0) && (b > 0.0))
     {
-        _3615 = a * exp(f * log(b / a));
+        _3585 = a * exp(f * log(b / a));
     }
     else
     {
-        _3615 = mix(a, b, f);
+        _3585 = mix(a, b, f);
     }
-    return _3615;
+    return _3585;
 }
 #endif
 
@@ -1377,16 +1381,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _3866;
+    float _3836;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _3866 = 1.0 - (0.5 * depth);
+        _3836 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _3866 = (1.0 - exp(-depth)) / depth;
+        _3836 = (1.0 - exp(-depth)) / depth;
     }
-    return _3866;
+    return _3836;
 }
 #endif
 
@@ -1423,10 +1427,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _3946 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _3916 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _3946;
+        float3 extinction = _3916;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1485,10 +1489,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _3811 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _3781 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _3811;
+        float3 extinction = _3781;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1563,14 +1567,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _3836;
+    float3 _3806;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _3836 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _3806 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1579,9 +1583,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _3836 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _3806 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _3836;
+    return _3806;
 }
 #endif
 
@@ -1595,16 +1599,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3577;
+    float _3547;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _3577 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3547 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3577 = up;
+        _3547 = up;
     }
-    return _3577;
+    return _3547;
 }
 #endif
 
@@ -1628,13 +1632,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4092 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4062 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4092)
+    if (!_4062)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1674,11 +1678,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4187 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4157 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4187;
+        lit_optical_depth = _4157;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1692,11 +1696,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4221 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4191 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4221;
+        optical_depth += _4191;
     }
     if (direct < 1.0)
     {
@@ -1715,9 +1719,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4264 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4234 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4264;
+    float3 scattering = _4234;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1738,11 +1742,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4312 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4282 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4312;
+        float3 far_optical_depth = _4282;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1762,9 +1766,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4366 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4336 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4366);
+            scattering -= (exp(-far_optical_depth) * _4336);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1785,9 +1789,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4431 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4401 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4431;
+    float3 scattering_p = _4401;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1808,9 +1812,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4475 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4445 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4475;
+    return _4445;
 }
 #endif
 
@@ -1818,16 +1822,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1975;
+    float _1982;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1975 = 0.100000001490116119384765625;
+        _1982 = 0.100000001490116119384765625;
     }
     else
     {
-        _1975 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1982 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1975;
+    return _1982;
 }
 #endif
 
@@ -1837,16 +1841,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1993;
+    float _2000;
     if (mu_s < knee)
     {
-        _1993 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _2000 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1993 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _2000 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1993;
+    return _2000;
 }
 #endif
 
@@ -1875,16 +1879,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2024;
+    float _2031;
     if (x < 0.5)
     {
-        _2024 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _2031 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2024 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _2031 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _2024;
+    return _2031;
 }
 #endif
 
@@ -1897,16 +1901,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2319;
+    float4 _2326;
     if (t < 0.0)
     {
-        _2319 = fast::min(blend, a);
+        _2326 = fast::min(blend, a);
     }
     else
     {
-        _2319 = blend;
+        _2326 = blend;
     }
-    return _2319;
+    return _2326;
 }
 #endif
 

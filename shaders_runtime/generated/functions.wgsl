@@ -2056,71 +2056,114 @@ fn LowestSunLogFall(a_13: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_76: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+fn LowestSunContinued(a_15: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_20: f32) -> vec4<f32> {
+    var a_16: vec4<f32>;
+    var b_9: vec4<f32>;
+    var mu_s_a_3: f32;
+    var mu_s_b_3: f32;
+    var mu_s_21: f32;
+    var slope_2: vec4<f32>;
+    var curvature_1: vec4<f32>;
+    var d_20: f32;
+
+    a_16 = a_15;
+    b_9 = b_8;
+    mu_s_a_3 = mu_s_a_2;
+    mu_s_b_3 = mu_s_b_2;
+    mu_s_21 = mu_s_20;
+    let _e24 = a_16;
+    let _e25 = b_9;
+    let _e26 = mu_s_a_3;
+    let _e27 = mu_s_b_3;
+    LowestSunLogFall(_e24, _e25, _e26, _e27, (&slope_2), (&curvature_1));
+    let _e32 = mu_s_21;
+    let _e33 = mu_s_a_3;
+    d_20 = (_e32 - _e33);
+    let _e36 = a_16;
+    let _e37 = d_20;
+    let _e38 = slope_2;
+    let _e39 = d_20;
+    let _e40 = curvature_1;
+    return (_e36 * exp((_e37 * (_e38 + (_e39 * _e40)))));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringInSlice(atmosphere_76: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32) -> vec4<f32> {
     var atmosphere_77: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
     var x_13: f32;
     var nu_slice_1: f32;
-    var nu_t_1: f32;
-    var low_sun_7: bool;
-    var nu_size: f32;
 
     atmosphere_77 = atmosphere_76;
     uvwz_1 = uvwz;
     x_13 = x_12;
     nu_slice_1 = nu_slice;
-    nu_t_1 = nu_t;
-    low_sun_7 = low_sun_6;
-    let _e25 = atmosphere_77;
-    nu_size = f32(_e25.scattering_nu_size);
-    let _e29 = nu_slice_1;
-    let _e30 = x_13;
-    let _e32 = nu_size;
-    let _e34 = uvwz_1;
-    let _e36 = uvwz_1;
-    let _e39 = SampleTexture3D(scattering_texture, vec3<f32>(((_e29 + _e30) / _e32), _e34.z, _e36.w));
-    let _e40 = nu_slice_1;
-    let _e43 = x_13;
-    let _e45 = nu_size;
-    let _e47 = uvwz_1;
-    let _e49 = uvwz_1;
-    let _e52 = SampleTexture3D(scattering_texture, vec3<f32>((((_e40 + 1f) + _e43) / _e45), _e47.z, _e49.w));
-    let _e53 = nu_t_1;
-    let _e54 = low_sun_7;
-    let _e55 = SunCosineMix(_e39, _e52, _e53, _e54);
-    return _e55;
+    let _e21 = nu_slice_1;
+    let _e22 = x_13;
+    let _e24 = atmosphere_77;
+    let _e28 = uvwz_1;
+    let _e30 = uvwz_1;
+    let _e33 = SampleTexture3D(scattering_texture, vec3<f32>(((_e21 + _e22) / f32(_e24.scattering_nu_size)), _e28.z, _e30.w));
+    return _e33;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtOwnColumn(atmosphere_78: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, column: f32, nu_slice_2: f32) -> vec4<f32> {
+fn GetScatteringAtMuSColumn(atmosphere_78: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_14: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
     var atmosphere_79: AtmosphereParameters;
     var uvwz_3: vec4<f32>;
-    var column_1: f32;
+    var x_15: f32;
     var nu_slice_3: f32;
-    var x_14: f32;
+    var nu_t_1: f32;
+    var low_sun_7: bool;
 
     atmosphere_79 = atmosphere_78;
     uvwz_3 = uvwz_2;
-    column_1 = column;
+    x_15 = x_14;
     nu_slice_3 = nu_slice_2;
-    let _e21 = column_1;
-    let _e24 = atmosphere_79;
-    x_14 = ((_e21 + 0.5f) / f32(_e24.scattering_mu_s_size));
-    let _e29 = nu_slice_3;
-    let _e30 = x_14;
-    let _e32 = atmosphere_79;
-    let _e36 = uvwz_3;
-    let _e38 = uvwz_3;
-    let _e41 = SampleTexture3D(scattering_texture_1, vec3<f32>(((_e29 + _e30) / f32(_e32.scattering_nu_size)), _e36.z, _e38.w));
-    return _e41;
+    nu_t_1 = nu_t;
+    low_sun_7 = low_sun_6;
+    let _e25 = atmosphere_79;
+    let _e26 = uvwz_3;
+    let _e27 = x_15;
+    let _e28 = nu_slice_3;
+    let _e29 = GetScatteringInSlice(_e25, scattering_texture_1, _e26, _e27, _e28);
+    let _e30 = atmosphere_79;
+    let _e31 = uvwz_3;
+    let _e32 = x_15;
+    let _e33 = nu_slice_3;
+    let _e36 = GetScatteringInSlice(_e30, scattering_texture_1, _e31, _e32, (_e33 + 1f));
+    let _e37 = nu_t_1;
+    let _e38 = low_sun_7;
+    let _e39 = SunCosineMix(_e29, _e36, _e37, _e38);
+    return _e39;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringBelowSplit(atmosphere_80: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, position_3: f32, nu_slice_4: f32, log_first_span: f32) -> vec4<f32> {
+fn GetScatteringAtOwnColumn(atmosphere_80: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
     var atmosphere_81: AtmosphereParameters;
     var uvwz_5: vec4<f32>;
-    var position_4: f32;
+    var column_1: f32;
     var nu_slice_5: f32;
+
+    atmosphere_81 = atmosphere_80;
+    uvwz_5 = uvwz_4;
+    column_1 = column;
+    nu_slice_5 = nu_slice_4;
+    let _e21 = atmosphere_81;
+    let _e22 = uvwz_5;
+    let _e23 = column_1;
+    let _e26 = atmosphere_81;
+    let _e30 = nu_slice_5;
+    let _e31 = GetScatteringInSlice(_e21, scattering_texture_2, _e22, ((_e23 + 0.5f) / f32(_e26.scattering_mu_s_size)), _e30);
+    return _e31;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
+    var atmosphere_83: AtmosphereParameters;
+    var uvwz_7: vec4<f32>;
+    var position_4: f32;
+    var nu_slice_7: f32;
     var log_first_span_1: f32;
     var past_2: f32 = 6f;
     var intervals: f32;
@@ -2132,15 +2175,15 @@ fn GetScatteringBelowSplit(atmosphere_80: AtmosphereParameters, scattering_textu
     var tiny: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var rises: vec4<f32>;
     var power: vec4<f32>;
-    var x_15: f32;
+    var x_16: f32;
     var k_4: f32;
 
-    atmosphere_81 = atmosphere_80;
-    uvwz_5 = uvwz_4;
+    atmosphere_83 = atmosphere_82;
+    uvwz_7 = uvwz_6;
     position_4 = position_3;
-    nu_slice_5 = nu_slice_4;
+    nu_slice_7 = nu_slice_6;
     log_first_span_1 = log_first_span;
-    let _e26 = atmosphere_81;
+    let _e26 = atmosphere_83;
     let _e29 = past_2;
     intervals = (f32(_e26.scattering_mu_s_split) - _e29);
     let _e32 = position_4;
@@ -2154,28 +2197,28 @@ fn GetScatteringBelowSplit(atmosphere_80: AtmosphereParameters, scattering_textu
             let _e44 = past_2;
             let _e45 = k_3;
             column_2 = (_e44 + _e45);
-            let _e48 = atmosphere_81;
-            let _e49 = uvwz_5;
+            let _e48 = atmosphere_83;
+            let _e49 = uvwz_7;
             let _e50 = column_2;
-            let _e53 = nu_slice_5;
-            let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_2, _e49, (_e50 - 1f), _e53);
-            let _e55 = atmosphere_81;
-            let _e56 = uvwz_5;
+            let _e53 = nu_slice_7;
+            let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_3, _e49, (_e50 - 1f), _e53);
+            let _e55 = atmosphere_83;
+            let _e56 = uvwz_7;
             let _e57 = column_2;
-            let _e58 = nu_slice_5;
-            let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_2, _e56, _e57, _e58);
-            let _e60 = atmosphere_81;
-            let _e61 = uvwz_5;
+            let _e58 = nu_slice_7;
+            let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_3, _e56, _e57, _e58);
+            let _e60 = atmosphere_83;
+            let _e61 = uvwz_7;
             let _e62 = column_2;
-            let _e65 = nu_slice_5;
-            let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_2, _e61, (_e62 + 1f), _e65);
-            let _e67 = atmosphere_81;
-            let _e68 = uvwz_5;
+            let _e65 = nu_slice_7;
+            let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_3, _e61, (_e62 + 1f), _e65);
+            let _e67 = atmosphere_83;
+            let _e68 = uvwz_7;
             let _e69 = column_2;
             let _e72 = past_2;
             let _e73 = intervals;
-            let _e76 = nu_slice_5;
-            let _e77 = GetScatteringAtOwnColumn(_e67, scattering_texture_2, _e68, min((_e69 + 2f), (_e72 + _e73)), _e76);
+            let _e76 = nu_slice_7;
+            let _e77 = GetScatteringAtOwnColumn(_e67, scattering_texture_3, _e68, min((_e69 + 2f), (_e72 + _e73)), _e76);
             let _e78 = k_3;
             let _e81 = k_3;
             let _e84 = intervals;
@@ -2189,24 +2232,24 @@ fn GetScatteringBelowSplit(atmosphere_80: AtmosphereParameters, scattering_textu
     let _e91 = past_2;
     if (_e90 >= (_e91 - 1f)) {
         {
-            let _e95 = atmosphere_81;
-            let _e96 = uvwz_5;
+            let _e95 = atmosphere_83;
+            let _e96 = uvwz_7;
             let _e97 = past_2;
-            let _e100 = nu_slice_5;
-            let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_2, _e96, (_e97 - 1f), _e100);
+            let _e100 = nu_slice_7;
+            let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_3, _e96, (_e97 - 1f), _e100);
             at_edge = _e101;
-            let _e103 = atmosphere_81;
-            let _e104 = uvwz_5;
+            let _e103 = atmosphere_83;
+            let _e104 = uvwz_7;
             let _e105 = past_2;
-            let _e106 = nu_slice_5;
-            let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_2, _e104, _e105, _e106);
+            let _e106 = nu_slice_7;
+            let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_3, _e104, _e105, _e106);
             let _e108 = at_edge;
             rise_1 = (_e107 - _e108);
-            let _e111 = atmosphere_81;
-            let _e112 = uvwz_5;
+            let _e111 = atmosphere_83;
+            let _e112 = uvwz_7;
             let _e113 = past_2;
-            let _e116 = nu_slice_5;
-            let _e117 = GetScatteringAtOwnColumn(_e111, scattering_texture_2, _e112, (_e113 + 1f), _e116);
+            let _e116 = nu_slice_7;
+            let _e117 = GetScatteringAtOwnColumn(_e111, scattering_texture_3, _e112, (_e113 + 1f), _e116);
             let _e118 = at_edge;
             second_rise = (_e117 - _e118);
             let _e124 = tiny;
@@ -2231,81 +2274,48 @@ fn GetScatteringBelowSplit(atmosphere_80: AtmosphereParameters, scattering_textu
     }
     let _e168 = past_2;
     let _e171 = position_4;
-    x_15 = ((_e168 - 1f) - _e171);
-    let _e174 = x_15;
+    x_16 = ((_e168 - 1f) - _e171);
+    let _e174 = x_16;
     let _e176 = past_2;
     k_4 = min(floor(_e174), (_e176 - 2f));
-    let _e181 = atmosphere_81;
-    let _e182 = uvwz_5;
+    let _e181 = atmosphere_83;
+    let _e182 = uvwz_7;
     let _e183 = past_2;
     let _e186 = k_4;
-    let _e188 = nu_slice_5;
-    let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_2, _e182, ((_e183 - 1f) - _e186), _e188);
-    let _e190 = atmosphere_81;
-    let _e191 = uvwz_5;
+    let _e188 = nu_slice_7;
+    let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_3, _e182, ((_e183 - 1f) - _e186), _e188);
+    let _e190 = atmosphere_83;
+    let _e191 = uvwz_7;
     let _e192 = past_2;
     let _e195 = k_4;
-    let _e197 = nu_slice_5;
-    let _e198 = GetScatteringAtOwnColumn(_e190, scattering_texture_2, _e191, ((_e192 - 2f) - _e195), _e197);
-    let _e199 = x_15;
+    let _e197 = nu_slice_7;
+    let _e198 = GetScatteringAtOwnColumn(_e190, scattering_texture_3, _e191, ((_e192 - 2f) - _e195), _e197);
+    let _e199 = x_16;
     let _e200 = k_4;
     let _e203 = SunCosineMix(_e189, _e198, (_e199 - _e200), true);
     return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtOwnColumnBetweenSlices(atmosphere_82: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, column_3: f32, nu_slice_6: f32, nu_t_2: f32) -> vec4<f32> {
-    var atmosphere_83: AtmosphereParameters;
-    var uvwz_7: vec4<f32>;
-    var column_4: f32;
-    var nu_slice_7: f32;
-    var nu_t_3: f32;
-
-    atmosphere_83 = atmosphere_82;
-    uvwz_7 = uvwz_6;
-    column_4 = column_3;
-    nu_slice_7 = nu_slice_6;
-    nu_t_3 = nu_t_2;
-    let _e23 = atmosphere_83;
-    let _e24 = uvwz_7;
-    let _e25 = column_4;
-    let _e26 = nu_slice_7;
-    let _e27 = GetScatteringAtOwnColumn(_e23, scattering_texture_3, _e24, _e25, _e26);
-    let _e28 = atmosphere_83;
-    let _e29 = uvwz_7;
-    let _e30 = column_4;
-    let _e31 = nu_slice_7;
-    let _e34 = GetScatteringAtOwnColumn(_e28, scattering_texture_3, _e29, _e30, (_e31 + 1f));
-    let _e35 = nu_t_3;
-    let _e37 = SunCosineMix(_e27, _e34, _e35, true);
-    return _e37;
-}
-
-// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_44: f32, mu_31: f32, mu_s_20: f32, nu_13: f32, ray_r_mu_intersects_ground_12: bool) -> vec4<f32> {
+fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_44: f32, mu_31: f32, mu_s_22: f32, nu_13: f32, ray_r_mu_intersects_ground_12: bool) -> vec4<f32> {
     var atmosphere_85: AtmosphereParameters;
     var r_45: f32;
     var mu_32: f32;
-    var mu_s_21: f32;
+    var mu_s_23: f32;
     var nu_14: f32;
     var ray_r_mu_intersects_ground_13: bool;
     var uvwz_8: vec4<f32>;
-    var nu_size_1: f32;
+    var nu_size: f32;
     var nu_coord: f32;
     var nu_slice_8: f32;
-    var nu_t_4: f32;
+    var nu_t_2: f32;
+    var mu_s_size_2: f32;
     var position_5: f32;
     var past_3: f32 = 6f;
     var log_first_span_2: f32 = 1f;
     var edge_15: f32;
     var step_: f32;
-    var mu_s_first: f32;
-    var first: vec4<f32>;
-    var second: vec4<f32>;
-    var slope_2: vec4<f32>;
-    var curvature_1: vec4<f32>;
-    var d_20: f32;
-    var x_16: f32;
+    var x_17: f32;
     var x_below_1: f32;
     var x_above_1: f32;
     var mu_s_t_1: f32;
@@ -2313,239 +2323,214 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     var x_low_sun_2: f32;
     var below: vec4<f32>;
     var above: vec4<f32>;
-    var mu_s_size_2: f32;
-    var mu_s_min: f32;
-    var slope_3: vec4<f32>;
-    var curvature_2: vec4<f32>;
-    var d_21: f32;
-    var column_5: f32;
+    var column_3: f32;
     var x_first: f32;
     var x_last: f32;
-    var first_1: vec4<f32>;
+    var first: vec4<f32>;
     var last: vec4<f32>;
 
     atmosphere_85 = atmosphere_84;
     r_45 = r_44;
     mu_32 = mu_31;
-    mu_s_21 = mu_s_20;
+    mu_s_23 = mu_s_22;
     nu_14 = nu_13;
     ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
     let _e25 = atmosphere_85;
     let _e26 = r_45;
     let _e27 = mu_32;
-    let _e28 = mu_s_21;
+    let _e28 = mu_s_23;
     let _e29 = nu_14;
     let _e30 = ray_r_mu_intersects_ground_13;
     let _e31 = GetScatteringTextureUvwzFromRMuMuSNu(_e25, _e26, _e27, _e28, _e29, _e30);
     uvwz_8 = _e31;
     let _e33 = atmosphere_85;
-    nu_size_1 = f32(_e33.scattering_nu_size);
+    nu_size = f32(_e33.scattering_nu_size);
     let _e37 = uvwz_8;
-    let _e39 = nu_size_1;
+    let _e39 = nu_size;
     nu_coord = (_e37.x * (_e39 - 1f));
     let _e44 = nu_coord;
-    let _e46 = nu_size_1;
+    let _e46 = nu_size;
     nu_slice_8 = min(floor(_e44), (_e46 - 2f));
     let _e51 = nu_coord;
     let _e52 = nu_slice_8;
-    nu_t_4 = (_e51 - _e52);
-    let _e55 = uvwz_8;
-    let _e57 = atmosphere_85;
-    position_5 = ((_e55.y * f32(_e57.scattering_mu_s_size)) - 0.5f);
-    let _e64 = atmosphere_85;
-    let _e68 = position_5;
-    let _e69 = atmosphere_85;
-    if ((_e64.scattering_mu_s_split > 0i) && (_e68 < f32(_e69.scattering_mu_s_split))) {
+    nu_t_2 = (_e51 - _e52);
+    let _e55 = atmosphere_85;
+    mu_s_size_2 = f32(_e55.scattering_mu_s_size);
+    let _e59 = uvwz_8;
+    let _e61 = mu_s_size_2;
+    position_5 = ((_e59.y * _e61) - 0.5f);
+    let _e66 = atmosphere_85;
+    let _e70 = position_5;
+    let _e71 = atmosphere_85;
+    if ((_e66.scattering_mu_s_split > 0i) && (_e70 < f32(_e71.scattering_mu_s_split))) {
         {
-            let _e79 = position_5;
-            let _e80 = past_3;
-            if (_e79 < _e80) {
+            let _e81 = position_5;
+            let _e82 = past_3;
+            if (_e81 < _e82) {
                 {
-                    let _e82 = atmosphere_85;
-                    let _e83 = r_45;
-                    let _e84 = mu_32;
-                    let _e85 = mu_32;
-                    let _e86 = mu_s_21;
-                    let _e87 = nu_14;
-                    let _e88 = ViewSunAzimuthCosine(_e85, _e86, _e87);
-                    let _e89 = ray_r_mu_intersects_ground_13;
-                    let _e90 = ShadowEdgeSunZenith(_e82, _e83, _e84, _e88, _e89);
-                    edge_15 = _e90;
-                    let _e92 = position_5;
-                    if (_e92 < 0f) {
+                    let _e84 = atmosphere_85;
+                    let _e85 = r_45;
+                    let _e86 = mu_32;
+                    let _e87 = mu_32;
+                    let _e88 = mu_s_23;
+                    let _e89 = nu_14;
+                    let _e90 = ViewSunAzimuthCosine(_e87, _e88, _e89);
+                    let _e91 = ray_r_mu_intersects_ground_13;
+                    let _e92 = ShadowEdgeSunZenith(_e84, _e85, _e86, _e90, _e91);
+                    edge_15 = _e92;
+                    let _e94 = position_5;
+                    if (_e94 < 0f) {
                         {
-                            let _e95 = atmosphere_85;
-                            let _e96 = edge_15;
-                            let _e97 = ShadowEdgePastStep(_e95, _e96);
-                            step_ = _e97;
-                            let _e99 = edge_15;
-                            let _e100 = past_3;
-                            let _e103 = step_;
-                            mu_s_first = cos((_e99 + ((_e100 - 1f) * _e103)));
-                            let _e108 = atmosphere_85;
-                            let _e109 = uvwz_8;
-                            let _e111 = nu_slice_8;
-                            let _e112 = nu_t_4;
-                            let _e113 = GetScatteringAtOwnColumnBetweenSlices(_e108, scattering_texture_4, _e109, 0f, _e111, _e112);
-                            first = _e113;
-                            let _e115 = atmosphere_85;
-                            let _e116 = uvwz_8;
-                            let _e118 = nu_slice_8;
-                            let _e119 = nu_t_4;
-                            let _e120 = GetScatteringAtOwnColumnBetweenSlices(_e115, scattering_texture_4, _e116, 1f, _e118, _e119);
-                            second = _e120;
-                            let _e124 = first;
-                            let _e125 = second;
-                            let _e126 = mu_s_first;
+                            let _e97 = atmosphere_85;
+                            let _e98 = edge_15;
+                            let _e99 = ShadowEdgePastStep(_e97, _e98);
+                            step_ = _e99;
+                            let _e101 = atmosphere_85;
+                            let _e102 = uvwz_8;
+                            let _e104 = mu_s_size_2;
+                            let _e106 = nu_slice_8;
+                            let _e107 = nu_t_2;
+                            let _e109 = GetScatteringAtMuSColumn(_e101, scattering_texture_4, _e102, (0.5f / _e104), _e106, _e107, true);
+                            let _e110 = atmosphere_85;
+                            let _e111 = uvwz_8;
+                            let _e113 = mu_s_size_2;
+                            let _e115 = nu_slice_8;
+                            let _e116 = nu_t_2;
+                            let _e118 = GetScatteringAtMuSColumn(_e110, scattering_texture_4, _e111, (1.5f / _e113), _e115, _e116, true);
+                            let _e119 = edge_15;
+                            let _e120 = past_3;
+                            let _e123 = step_;
                             let _e127 = edge_15;
                             let _e128 = past_3;
                             let _e131 = step_;
-                            LowestSunLogFall(_e124, _e125, _e126, cos((_e127 + ((_e128 - 2f) * _e131))), (&slope_2), (&curvature_1));
-                            let _e139 = mu_s_21;
-                            let _e140 = mu_s_first;
-                            d_20 = (_e139 - _e140);
-                            let _e143 = first;
-                            let _e144 = d_20;
-                            let _e145 = slope_2;
-                            let _e146 = d_20;
-                            let _e147 = curvature_1;
-                            return (_e143 * exp((_e144 * (_e145 + (_e146 * _e147)))));
+                            let _e135 = mu_s_23;
+                            let _e136 = LowestSunContinued(_e109, _e118, cos((_e119 + ((_e120 - 1f) * _e123))), cos((_e127 + ((_e128 - 2f) * _e131))), _e135);
+                            return _e136;
                         }
                     }
-                    let _e153 = position_5;
-                    let _e154 = past_3;
-                    if (_e153 >= (_e154 - 1f)) {
+                    let _e137 = position_5;
+                    let _e138 = past_3;
+                    if (_e137 >= (_e138 - 1f)) {
                         {
-                            let _e159 = atmosphere_85;
-                            let _e162 = past_3;
-                            x_16 = (1f / (f32(_e159.scattering_mu_s_split) - _e162));
-                            let _e166 = atmosphere_85;
-                            let _e167 = x_16;
-                            let _e168 = edge_15;
-                            let _e169 = atmosphere_85;
-                            let _e170 = GetScatteringSplitSunZenith(_e169);
-                            let _e171 = ShadowEdgeLitDistance(_e166, _e167, _e168, _e170);
-                            log_first_span_2 = log((_e171 / SHADOW_EDGE_CLOSEST));
+                            let _e143 = atmosphere_85;
+                            let _e146 = past_3;
+                            x_17 = (1f / (f32(_e143.scattering_mu_s_split) - _e146));
+                            let _e150 = atmosphere_85;
+                            let _e151 = x_17;
+                            let _e152 = edge_15;
+                            let _e153 = atmosphere_85;
+                            let _e154 = GetScatteringSplitSunZenith(_e153);
+                            let _e155 = ShadowEdgeLitDistance(_e150, _e151, _e152, _e154);
+                            log_first_span_2 = log((_e155 / SHADOW_EDGE_CLOSEST));
                         }
                     }
                 }
             }
-            let _e174 = atmosphere_85;
-            let _e175 = uvwz_8;
-            let _e176 = position_5;
-            let _e177 = nu_slice_8;
-            let _e178 = log_first_span_2;
-            let _e179 = GetScatteringBelowSplit(_e174, scattering_texture_4, _e175, _e176, _e177, _e178);
-            let _e180 = atmosphere_85;
-            let _e181 = uvwz_8;
-            let _e182 = position_5;
-            let _e183 = nu_slice_8;
-            let _e186 = log_first_span_2;
-            let _e187 = GetScatteringBelowSplit(_e180, scattering_texture_4, _e181, _e182, (_e183 + 1f), _e186);
-            let _e188 = nu_t_4;
-            let _e190 = SunCosineMix(_e179, _e187, _e188, true);
-            return _e190;
+            let _e158 = atmosphere_85;
+            let _e159 = uvwz_8;
+            let _e160 = position_5;
+            let _e161 = nu_slice_8;
+            let _e162 = log_first_span_2;
+            let _e163 = GetScatteringBelowSplit(_e158, scattering_texture_4, _e159, _e160, _e161, _e162);
+            let _e164 = atmosphere_85;
+            let _e165 = uvwz_8;
+            let _e166 = position_5;
+            let _e167 = nu_slice_8;
+            let _e170 = log_first_span_2;
+            let _e171 = GetScatteringBelowSplit(_e164, scattering_texture_4, _e165, _e166, (_e167 + 1f), _e170);
+            let _e172 = nu_t_2;
+            let _e174 = SunCosineMix(_e163, _e171, _e172, true);
+            return _e174;
         }
     }
-    let _e195 = atmosphere_85;
-    let _e196 = GetScatteringTextureUMuS(_e195, LOW_SUN_MU_S);
-    x_low_sun_2 = _e196;
-    let _e198 = atmosphere_85;
-    let _e199 = uvwz_8;
-    let _e201 = x_low_sun_2;
-    GetScatteringMuSColumns(_e198, _e199.y, _e201, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e210 = atmosphere_85;
-    let _e211 = uvwz_8;
-    let _e212 = x_below_1;
-    let _e213 = nu_slice_8;
-    let _e214 = nu_t_4;
-    let _e215 = low_sun_below_1;
-    let _e216 = GetScatteringAtMuSColumn(_e210, scattering_texture_4, _e211, _e212, _e213, _e214, _e215);
-    below = _e216;
-    let _e218 = atmosphere_85;
-    let _e219 = uvwz_8;
-    let _e220 = x_above_1;
-    let _e221 = nu_slice_8;
-    let _e222 = nu_t_4;
-    let _e223 = x_above_1;
-    let _e224 = x_low_sun_2;
-    let _e226 = GetScatteringAtMuSColumn(_e218, scattering_texture_4, _e219, _e220, _e221, _e222, (_e223 < _e224));
-    above = _e226;
-    let _e228 = atmosphere_85;
-    mu_s_size_2 = f32(_e228.scattering_mu_s_size);
-    let _e232 = mu_s_t_1;
-    if (_e232 < 0f) {
+    let _e179 = atmosphere_85;
+    let _e180 = GetScatteringTextureUMuS(_e179, LOW_SUN_MU_S);
+    x_low_sun_2 = _e180;
+    let _e182 = atmosphere_85;
+    let _e183 = uvwz_8;
+    let _e185 = x_low_sun_2;
+    GetScatteringMuSColumns(_e182, _e183.y, _e185, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
+    let _e194 = atmosphere_85;
+    let _e195 = uvwz_8;
+    let _e196 = x_below_1;
+    let _e197 = nu_slice_8;
+    let _e198 = nu_t_2;
+    let _e199 = low_sun_below_1;
+    let _e200 = GetScatteringAtMuSColumn(_e194, scattering_texture_4, _e195, _e196, _e197, _e198, _e199);
+    below = _e200;
+    let _e202 = atmosphere_85;
+    let _e203 = uvwz_8;
+    let _e204 = x_above_1;
+    let _e205 = nu_slice_8;
+    let _e206 = nu_t_2;
+    let _e207 = x_above_1;
+    let _e208 = x_low_sun_2;
+    let _e210 = GetScatteringAtMuSColumn(_e202, scattering_texture_4, _e203, _e204, _e205, _e206, (_e207 < _e208));
+    above = _e210;
+    let _e212 = mu_s_t_1;
+    if (_e212 < 0f) {
         {
-            let _e235 = atmosphere_85;
-            mu_s_min = _e235.scattering_mu_s_min;
-            let _e240 = below;
-            let _e241 = above;
-            let _e242 = mu_s_min;
-            let _e243 = atmosphere_85;
-            let _e245 = mu_s_size_2;
-            let _e249 = GetScatteringMuSFromUnitRange(_e243, (1f / (_e245 - 1f)));
-            LowestSunLogFall(_e240, _e241, _e242, _e249, (&slope_3), (&curvature_2));
-            let _e254 = mu_s_21;
-            let _e255 = mu_s_min;
-            d_21 = (_e254 - _e255);
-            let _e258 = below;
-            let _e259 = d_21;
-            let _e260 = slope_3;
-            let _e261 = d_21;
-            let _e262 = curvature_2;
-            return (_e258 * exp((_e259 * (_e260 + (_e261 * _e262)))));
+            let _e215 = below;
+            let _e216 = above;
+            let _e217 = atmosphere_85;
+            let _e219 = atmosphere_85;
+            let _e221 = mu_s_size_2;
+            let _e225 = GetScatteringMuSFromUnitRange(_e219, (1f / (_e221 - 1f)));
+            let _e226 = mu_s_23;
+            let _e227 = LowestSunContinued(_e215, _e216, _e217.scattering_mu_s_min, _e225, _e226);
+            return _e227;
         }
     }
-    let _e268 = low_sun_below_1;
-    if !(_e268) {
-        let _e270 = below;
-        let _e271 = above;
-        let _e272 = mu_s_t_1;
-        return mix(_e270, _e271, vec4(_e272));
+    let _e228 = low_sun_below_1;
+    if !(_e228) {
+        let _e230 = below;
+        let _e231 = above;
+        let _e232 = mu_s_t_1;
+        return mix(_e230, _e231, vec4(_e232));
     }
-    let _e275 = x_below_1;
-    let _e276 = mu_s_size_2;
-    column_5 = ((_e275 * _e276) - 0.5f);
-    let _e281 = column_5;
-    let _e288 = mu_s_size_2;
-    x_first = ((max((_e281 - 1f), 0f) + 0.5f) / _e288);
-    let _e291 = column_5;
-    let _e294 = mu_s_size_2;
-    let _e300 = mu_s_size_2;
-    x_last = ((min((_e291 + 2f), (_e294 - 1f)) + 0.5f) / _e300);
-    let _e303 = atmosphere_85;
-    let _e304 = uvwz_8;
-    let _e305 = x_first;
-    let _e306 = nu_slice_8;
-    let _e307 = nu_t_4;
-    let _e309 = GetScatteringAtMuSColumn(_e303, scattering_texture_4, _e304, _e305, _e306, _e307, true);
-    first_1 = _e309;
-    let _e311 = atmosphere_85;
-    let _e312 = uvwz_8;
-    let _e313 = x_last;
-    let _e314 = nu_slice_8;
-    let _e315 = nu_t_4;
-    let _e316 = x_last;
-    let _e317 = x_low_sun_2;
-    let _e319 = GetScatteringAtMuSColumn(_e311, scattering_texture_4, _e312, _e313, _e314, _e315, (_e316 < _e317));
-    last = _e319;
-    let _e321 = first_1;
-    let _e322 = below;
-    let _e323 = above;
-    let _e324 = last;
-    let _e325 = column_5;
-    let _e328 = column_5;
-    let _e331 = mu_s_size_2;
-    let _e335 = mu_s_t_1;
-    let _e336 = LogMonotoneCubicMix(_e321, _e322, _e323, _e324, (_e325 > 0.5f), ((_e328 + 2f) < (_e331 - 0.5f)), _e335);
-    return _e336;
+    let _e235 = x_below_1;
+    let _e236 = mu_s_size_2;
+    column_3 = ((_e235 * _e236) - 0.5f);
+    let _e241 = column_3;
+    let _e248 = mu_s_size_2;
+    x_first = ((max((_e241 - 1f), 0f) + 0.5f) / _e248);
+    let _e251 = column_3;
+    let _e254 = mu_s_size_2;
+    let _e260 = mu_s_size_2;
+    x_last = ((min((_e251 + 2f), (_e254 - 1f)) + 0.5f) / _e260);
+    let _e263 = atmosphere_85;
+    let _e264 = uvwz_8;
+    let _e265 = x_first;
+    let _e266 = nu_slice_8;
+    let _e267 = nu_t_2;
+    let _e269 = GetScatteringAtMuSColumn(_e263, scattering_texture_4, _e264, _e265, _e266, _e267, true);
+    first = _e269;
+    let _e271 = atmosphere_85;
+    let _e272 = uvwz_8;
+    let _e273 = x_last;
+    let _e274 = nu_slice_8;
+    let _e275 = nu_t_2;
+    let _e276 = x_last;
+    let _e277 = x_low_sun_2;
+    let _e279 = GetScatteringAtMuSColumn(_e271, scattering_texture_4, _e272, _e273, _e274, _e275, (_e276 < _e277));
+    last = _e279;
+    let _e281 = first;
+    let _e282 = below;
+    let _e283 = above;
+    let _e284 = last;
+    let _e285 = column_3;
+    let _e288 = column_3;
+    let _e291 = mu_s_size_2;
+    let _e295 = mu_s_t_1;
+    let _e296 = LogMonotoneCubicMix(_e281, _e282, _e283, _e284, (_e285 > 0.5f), ((_e288 + 2f) < (_e291 - 0.5f)), _e295);
+    return _e296;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_46: f32, mu_s_22: f32) -> vec3<f32> {
+fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_46: f32, mu_s_24: f32) -> vec3<f32> {
     var atmosphere_87: AtmosphereParameters;
     var r_47: f32;
-    var mu_s_23: f32;
+    var mu_s_25: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
@@ -2557,16 +2542,16 @@ fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: textur
 
     atmosphere_87 = atmosphere_86;
     r_47 = r_46;
-    mu_s_23 = mu_s_22;
+    mu_s_25 = mu_s_24;
     let _e19 = atmosphere_87;
     let _e20 = r_47;
-    let _e21 = mu_s_23;
+    let _e21 = mu_s_25;
     let _e22 = GetIrradianceTextureUvFromRMuS(_e19, _e20, _e21);
     uv_3 = _e22;
     let _e24 = atmosphere_87;
     width = f32(_e24.irradiance_width);
     let _e28 = atmosphere_87;
-    let _e29 = mu_s_23;
+    let _e29 = mu_s_25;
     let _e30 = GetIrradianceUnitMuS(_e28, _e29);
     let _e31 = width;
     mu_s_coord_1 = (_e30 * (_e31 - 1f));
@@ -2626,11 +2611,11 @@ fn MiePhaseFunction(atmosphere_88: AtmosphereParameters, nu_15: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_48: f32, mu_33: f32, mu_s_24: f32, nu_17: f32, ray_r_mu_intersects_ground_14: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_48: f32, mu_33: f32, mu_s_26: f32, nu_17: f32, ray_r_mu_intersects_ground_14: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_91: AtmosphereParameters;
     var r_49: f32;
     var mu_34: f32;
-    var mu_s_25: f32;
+    var mu_s_27: f32;
     var nu_18: f32;
     var ray_r_mu_intersects_ground_15: bool;
     var scattering: vec4<f32>;
@@ -2639,13 +2624,13 @@ fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture
     atmosphere_91 = atmosphere_90;
     r_49 = r_48;
     mu_34 = mu_33;
-    mu_s_25 = mu_s_24;
+    mu_s_27 = mu_s_26;
     nu_18 = nu_17;
     ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
     let _e27 = atmosphere_91;
     let _e28 = r_49;
     let _e29 = mu_34;
-    let _e30 = mu_s_25;
+    let _e30 = mu_s_27;
     let _e31 = nu_18;
     let _e32 = ray_r_mu_intersects_ground_15;
     let _e33 = GetScattering(_e27, scattering_texture_5, _e28, _e29, _e30, _e31, _e32);
@@ -2672,7 +2657,7 @@ fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture
             let _e65 = atmosphere_91;
             let _e66 = r_49;
             let _e67 = mu_34;
-            let _e68 = mu_s_25;
+            let _e68 = mu_s_27;
             let _e69 = nu_18;
             let _e70 = ray_r_mu_intersects_ground_15;
             let _e71 = GetScattering(_e65, single_mie_scattering_texture, _e66, _e67, _e68, _e69, _e70);
@@ -2692,7 +2677,7 @@ fn GetSkyRadiance(atmosphere_92: AtmosphereParameters, transmittance_texture_5: 
     var start_2: vec3<f32>;
     var r_50: f32;
     var mu_35: f32;
-    var mu_s_26: f32;
+    var mu_s_28: f32;
     var nu_19: f32;
     var ray_r_mu_intersects_ground_16: bool;
     var local_16: vec3<f32>;
@@ -2707,7 +2692,7 @@ fn GetSkyRadiance(atmosphere_92: AtmosphereParameters, transmittance_texture_5: 
     let _e30 = camera_5;
     let _e31 = view_ray_5;
     let _e32 = sun_direction_3;
-    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_50), (&mu_35), (&mu_s_26), (&nu_19));
+    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_50), (&mu_35), (&mu_s_28), (&nu_19));
     if !(_e43) {
         {
             (*transmittance) = vec3(1f);
@@ -2734,7 +2719,7 @@ fn GetSkyRadiance(atmosphere_92: AtmosphereParameters, transmittance_texture_5: 
     let _e64 = atmosphere_93;
     let _e65 = r_50;
     let _e66 = mu_35;
-    let _e67 = mu_s_26;
+    let _e67 = mu_s_28;
     let _e68 = nu_19;
     let _e69 = ray_r_mu_intersects_ground_16;
     let _e72 = GetCombinedScattering(_e64, scattering_texture_6, single_mie_scattering_texture_1, _e65, _e66, _e67, _e68, _e69, (&single_mie_scattering_1));
@@ -2804,40 +2789,40 @@ fn DistanceInsideScatteringRadii(atmosphere_94: AtmosphereParameters, r_51: f32,
 fn ProfileSampleAltitude(atmosphere_96: AtmosphereParameters, i_1: i32) -> f32 {
     var atmosphere_97: AtmosphereParameters;
     var i_2: i32;
-    var x_17: f32;
+    var x_18: f32;
 
     atmosphere_97 = atmosphere_96;
     i_2 = i_1;
     let _e18 = i_2;
-    x_17 = (f32(_e18) / 63f);
+    x_18 = (f32(_e18) / 63f);
     let _e26 = atmosphere_97;
     let _e28 = atmosphere_97;
-    let _e31 = x_17;
-    let _e33 = x_17;
+    let _e31 = x_18;
+    let _e33 = x_18;
     return (((_e26.top_radius - _e28.bottom_radius) * _e31) * _e33);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_15: f32, b_8: f32, f: f32) -> f32 {
-    var a_16: f32;
-    var b_9: f32;
+fn InterpolateCoefficient(a_17: f32, b_10: f32, f: f32) -> f32 {
+    var a_18: f32;
+    var b_11: f32;
     var f_1: f32;
     var local_18: f32;
 
-    a_16 = a_15;
-    b_9 = b_8;
+    a_18 = a_17;
+    b_11 = b_10;
     f_1 = f;
-    let _e20 = a_16;
-    let _e23 = b_9;
+    let _e20 = a_18;
+    let _e23 = b_11;
     if ((_e20 > 0f) && (_e23 > 0f)) {
-        let _e27 = a_16;
+        let _e27 = a_18;
         let _e28 = f_1;
-        let _e29 = b_9;
-        let _e30 = a_16;
+        let _e29 = b_11;
+        let _e30 = a_18;
         local_18 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
     } else {
-        let _e36 = a_16;
-        let _e37 = b_9;
+        let _e36 = a_18;
+        let _e37 = b_11;
         let _e38 = f_1;
         local_18 = mix(_e36, _e37, _e38);
     }
@@ -2846,24 +2831,24 @@ fn InterpolateCoefficient(a_15: f32, b_8: f32, f: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_17: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_18: vec3<f32>;
-    var b_11: vec3<f32>;
+fn InterpolateCoefficients(a_19: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_20: vec3<f32>;
+    var b_13: vec3<f32>;
     var f_3: f32;
 
-    a_18 = a_17;
-    b_11 = b_10;
+    a_20 = a_19;
+    b_13 = b_12;
     f_3 = f_2;
-    let _e20 = a_18;
-    let _e22 = b_11;
+    let _e20 = a_20;
+    let _e22 = b_13;
     let _e24 = f_3;
     let _e25 = InterpolateCoefficient(_e20.x, _e22.x, _e24);
-    let _e26 = a_18;
-    let _e28 = b_11;
+    let _e26 = a_20;
+    let _e28 = b_13;
     let _e30 = f_3;
     let _e31 = InterpolateCoefficient(_e26.y, _e28.y, _e30);
-    let _e32 = a_18;
-    let _e34 = b_11;
+    let _e32 = a_20;
+    let _e34 = b_13;
     let _e36 = f_3;
     let _e37 = InterpolateCoefficient(_e32.z, _e34.z, _e36);
     return vec3<f32>(_e25, _e31, _e37);
@@ -2874,7 +2859,7 @@ fn GetCoefficientsAtAltitude(atmosphere_98: AtmosphereParameters, altitude: f32,
     var atmosphere_99: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_18: f32;
+    var x_19: f32;
     var i_3: i32;
     var h0_: f32;
     var f_4: f32;
@@ -2886,8 +2871,8 @@ fn GetCoefficientsAtAltitude(atmosphere_98: AtmosphereParameters, altitude: f32,
     height = (_e20.top_radius - _e22.bottom_radius);
     let _e26 = altitude_1;
     let _e27 = height;
-    x_18 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
-    let _e39 = x_18;
+    x_19 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
+    let _e39 = x_19;
     i_3 = min(i32(_e39), 62i);
     let _e46 = atmosphere_99;
     let _e47 = i_3;
@@ -2948,11 +2933,11 @@ fn AltitudeAtDistance(atmosphere_100: AtmosphereParameters, r_53: f32, mu_38: f3
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32, mu_40: f32, d_22: f32) -> vec3<f32> {
+fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32, mu_40: f32, d_21: f32) -> vec3<f32> {
     var atmosphere_103: AtmosphereParameters;
     var r_56: f32;
     var mu_41: f32;
-    var d_23: f32;
+    var d_22: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
@@ -2966,8 +2951,8 @@ fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32,
     atmosphere_103 = atmosphere_102;
     r_56 = r_55;
     mu_41 = mu_40;
-    d_23 = d_22;
-    let _e22 = d_23;
+    d_22 = d_21;
+    let _e22 = d_22;
     dt = (_e22 / 16f);
     loop {
         let _e35 = k_5;
@@ -3014,32 +2999,32 @@ fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_57: f32, mu_42: f32, d_24: f32, ray_r_mu_intersects_ground_17: bool) -> vec3<f32> {
+fn LongSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_57: f32, mu_42: f32, d_23: f32, ray_r_mu_intersects_ground_17: bool) -> vec3<f32> {
     var atmosphere_105: AtmosphereParameters;
     var r_58: f32;
     var mu_43: f32;
-    var d_25: f32;
+    var d_24: f32;
     var ray_r_mu_intersects_ground_18: bool;
     var local_19: vec3<f32>;
 
     atmosphere_105 = atmosphere_104;
     r_58 = r_57;
     mu_43 = mu_42;
-    d_25 = d_24;
+    d_24 = d_23;
     ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
     let _e25 = atmosphere_105;
     if (_e25.transmittance_is_colour != 0i) {
         let _e29 = atmosphere_105;
         let _e30 = r_58;
         let _e31 = mu_43;
-        let _e32 = d_25;
+        let _e32 = d_24;
         let _e33 = IntegrateSegmentOpticalDepth(_e29, _e30, _e31, _e32);
         local_19 = _e33;
     } else {
         let _e34 = atmosphere_105;
         let _e35 = r_58;
         let _e36 = mu_43;
-        let _e37 = d_25;
+        let _e37 = d_24;
         let _e38 = ray_r_mu_intersects_ground_18;
         let _e39 = GetOpticalDepth(_e34, transmittance_texture_6, _e35, _e36, _e37, _e38);
         local_19 = _e39;
@@ -3068,13 +3053,13 @@ fn MeanAttenuation(depth: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_59: f32, mu_44: f32, mu_s_27: f32, nu_20: f32, d_26: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_59: f32, mu_44: f32, mu_s_29: f32, nu_20: f32, d_25: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
     var atmosphere_107: AtmosphereParameters;
     var r_60: f32;
     var mu_45: f32;
-    var mu_s_28: f32;
+    var mu_s_30: f32;
     var nu_21: f32;
-    var d_27: f32;
+    var d_26: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
     var previous_extinction_1: vec3<f32> = vec3(0f);
@@ -3100,10 +3085,10 @@ fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_
     atmosphere_107 = atmosphere_106;
     r_60 = r_59;
     mu_45 = mu_44;
-    mu_s_28 = mu_s_27;
+    mu_s_30 = mu_s_29;
     nu_21 = nu_20;
-    d_27 = d_26;
-    let _e30 = d_27;
+    d_26 = d_25;
+    let _e30 = d_26;
     dt_1 = (_e30 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
@@ -3131,7 +3116,7 @@ fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_
             let _e80 = AltitudeAtDistance(_e75, _e76, _e77, _e78, _e79);
             altitude_2 = _e80;
             let _e82 = r_60;
-            let _e83 = mu_s_28;
+            let _e83 = mu_s_30;
             let _e85 = t_12;
             let _e86 = nu_21;
             let _e89 = r_t_3;
@@ -3235,9 +3220,9 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     var start_3: vec3<f32>;
     var r_61: f32;
     var mu_46: f32;
-    var mu_s_29: f32;
+    var mu_s_31: f32;
     var nu_22: f32;
-    var d_28: f32;
+    var d_27: f32;
     var lit_1: f32;
     var ray_r_mu_intersects_ground_19: bool;
     var r_p: f32;
@@ -3290,7 +3275,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e50 = camera_7;
     let _e51 = view_ray_6;
     let _e52 = sun_direction_5;
-    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_61), (&mu_46), (&mu_s_29), (&nu_22));
+    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_61), (&mu_46), (&mu_s_31), (&nu_22));
     if !(_e63) {
         {
             (*transmittance_1) = vec3(1f);
@@ -3299,8 +3284,8 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     }
     let _e69 = point_1;
     let _e70 = start_3;
-    d_28 = max(length((_e69 - _e70)), 0f);
-    let _e76 = d_28;
+    d_27 = max(length((_e69 - _e70)), 0f);
+    let _e76 = d_27;
     let _e77 = shadow_length_1;
     lit_1 = max((_e76 - max(_e77, 0f)), 0f);
     let _e84 = atmosphere_109;
@@ -3321,13 +3306,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e99 = CosineAtDistance(_e95, _e96, _e97, _e98);
     mu_p = _e99;
     let _e101 = r_61;
-    let _e102 = mu_s_29;
+    let _e102 = mu_s_31;
     let _e104 = lit_1;
     let _e105 = nu_22;
     let _e108 = r_p;
     let _e110 = ClampCosine((((_e101 * _e102) + (_e104 * _e105)) / _e108));
     mu_s_p = _e110;
-    let _e116 = d_28;
+    let _e116 = d_27;
     direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e116));
     let _e124 = lit_1;
     lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e124));
@@ -3337,7 +3322,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
             let _e143 = atmosphere_109;
             let _e144 = r_61;
             let _e145 = mu_46;
-            let _e146 = mu_s_29;
+            let _e146 = mu_s_31;
             let _e147 = nu_22;
             let _e148 = lit_1;
             let _e155 = IntegrateSegment(_e143, transmittance_texture_8, _e144, _e145, _e146, _e147, _e148, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
@@ -3348,7 +3333,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     optical_depth_2 = _e156;
     let _e158 = direct;
     let _e161 = lit_1;
-    let _e162 = d_28;
+    let _e162 = d_27;
     if ((_e158 > 0f) && (_e161 < _e162)) {
         {
             let _e168 = optical_depth_2;
@@ -3357,7 +3342,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
             let _e171 = mu_p;
             let _e172 = mu_s_p;
             let _e173 = nu_22;
-            let _e174 = d_28;
+            let _e174 = d_27;
             let _e175 = lit_1;
             let _e183 = IntegrateSegment(_e169, transmittance_texture_8, _e170, _e171, _e172, _e173, (_e174 - _e175), (&unused_rayleigh), (&unused_mie), (&unused_weight));
             optical_depth_2 = (_e168 + _e183);
@@ -3369,7 +3354,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
             let _e188 = atmosphere_109;
             let _e189 = r_61;
             let _e190 = mu_46;
-            let _e191 = d_28;
+            let _e191 = d_27;
             let _e192 = ray_r_mu_intersects_ground_19;
             let _e193 = LongSegmentOpticalDepth(_e188, transmittance_texture_8, _e189, _e190, _e191, _e192);
             let _e194 = optical_depth_2;
@@ -3382,7 +3367,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e202 = atmosphere_109;
     let _e203 = r_61;
     let _e204 = mu_46;
-    let _e205 = mu_s_29;
+    let _e205 = mu_s_31;
     let _e206 = nu_22;
     let _e207 = ray_r_mu_intersects_ground_19;
     let _e210 = GetCombinedScattering(_e202, scattering_texture_7, single_mie_scattering_texture_2, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
@@ -3406,7 +3391,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
             let _e233 = atmosphere_109;
             let _e234 = r_61;
             let _e235 = mu_46;
-            let _e236 = mu_s_29;
+            let _e236 = mu_s_31;
             let _e237 = nu_22;
             let _e238 = far;
             let _e245 = IntegrateSegment(_e233, transmittance_texture_8, _e234, _e235, _e236, _e237, _e238, (&far_rayleigh), (&far_mie), (&far_weight));
@@ -3431,7 +3416,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
                     let _e266 = r_far;
                     let _e267 = CosineAtDistance(_e263, _e264, _e265, _e266);
                     let _e268 = r_61;
-                    let _e269 = mu_s_29;
+                    let _e269 = mu_s_31;
                     let _e271 = far;
                     let _e272 = nu_22;
                     let _e275 = r_far;
@@ -3523,7 +3508,7 @@ fn GetSunAndSkyIrradiance(atmosphere_112: AtmosphereParameters, transmittance_te
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
     var r_62: f32;
-    var mu_s_30: f32;
+    var mu_s_32: f32;
 
     atmosphere_113 = atmosphere_112;
     point_5 = point_4;
@@ -3537,10 +3522,10 @@ fn GetSunAndSkyIrradiance(atmosphere_112: AtmosphereParameters, transmittance_te
     let _e31 = sun_direction_9;
     let _e33 = point_5;
     let _e36 = ClampCosine((dot(_e30, _e31) / length(_e33)));
-    mu_s_30 = _e36;
+    mu_s_32 = _e36;
     let _e38 = atmosphere_113;
     let _e39 = r_62;
-    let _e40 = mu_s_30;
+    let _e40 = mu_s_32;
     let _e41 = GetIrradiance(_e38, irradiance_texture_1, _e39, _e40);
     let _e43 = normal_1;
     let _e44 = point_5;
@@ -3549,7 +3534,7 @@ fn GetSunAndSkyIrradiance(atmosphere_112: AtmosphereParameters, transmittance_te
     let _e53 = atmosphere_113;
     let _e55 = atmosphere_113;
     let _e56 = r_62;
-    let _e57 = mu_s_30;
+    let _e57 = mu_s_32;
     let _e58 = GetTransmittanceToSun(_e55, transmittance_texture_10, _e56, _e57);
     let _e60 = normal_1;
     let _e61 = sun_direction_9;
