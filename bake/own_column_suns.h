@@ -81,22 +81,21 @@ class OwnColumnSuns {
           lit_(grid.scattering_mu_s_split - past_),
           lowest_edge_(0.5 * kPi + grid.sun_angular_radius),
           nodes_(int(std::ceil(0.5 * kPi / kStep)) + 1),
-          split_sun_(glsl::GetScatteringSplitSunZenith(grid)),
           distance_(std::size_t(lit_) * nodes_),
           slope_(distance_.size()) {
       tbb::parallel_for(0, lit_ * nodes_, [&](int i) {
         const int k = i / nodes_;
         const double edge = lowest_edge_ + (i % nodes_) * kStep, x = double(k) / lit_;
-        distance_[i] = glsl::ShadowEdgeLitDistance(grid, x, edge, split_sun_);
-        slope_[i] = (glsl::ShadowEdgeLitDistance(grid, x, edge + kSlopeStep, split_sun_) -
-                     glsl::ShadowEdgeLitDistance(grid, x, edge - kSlopeStep, split_sun_)) /
-                    (2.0 * kSlopeStep);
+        auto distance = [&](double e) { return glsl::ShadowEdgeLitDistance(grid, x, glsl::ShadowEdgeDirection(e)); };
+        distance_[i] = distance(edge);
+        slope_[i] = (distance(edge + kSlopeStep) - distance(edge - kSlopeStep)) / (2.0 * kSlopeStep);
       });
     }
-    // GetScatteringShadowEdgeSunZenith at a column, with the table's D.
+    // The sun zenith angle of a column, E - GetScatteringShadowEdgeDistance,
+    // with the table's D.
     double SunZenith(const AtmosphereParameters& grid, int column, double edge) const {
       if (column < past_ || edge < lowest_edge_) {
-        return glsl::GetScatteringShadowEdgeSunZenith(grid, column, edge, split_sun_);
+        return edge - glsl::GetScatteringShadowEdgeDistance(grid, column, glsl::ShadowEdgeDirection(edge));
       }
       const double position = std::min((edge - lowest_edge_) / kStep, nodes_ - 1.0 - 1e-9);
       const int node = int(position);
@@ -111,7 +110,6 @@ class OwnColumnSuns {
     int past_, lit_;
     double lowest_edge_;
     int nodes_;
-    double split_sun_;
     std::vector<double> distance_, slope_;  // per lit column, then node
   };
 

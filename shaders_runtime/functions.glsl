@@ -238,8 +238,8 @@ Number ViewSunAzimuthCosine(Number mu, Number mu_s, Number nu) {
   return across > 0.0 ? ClampCosine((nu - mu * mu_s) / across) : 1.0;
 }
 
-// The sun zenith angle past which no point of the ray (r, mu) sees any of
-// the sun's disc, for the sun at azimuth phi from the view. The Earth's
+// The sun zenith angle E past which no point of the ray (r, mu) sees any
+// of the sun's disc, for the sun at azimuth phi from the view. The Earth's
 // shadow is a half cylinder behind the planet, so the last lit point of a
 // ray is one of its ends: the start, lit while the sun is above its horizon
 // (zenith cosine -c(r), HorizonZenithCosine), or the far end, seen from the
@@ -247,42 +247,89 @@ Number ViewSunAzimuthCosine(Number mu, Number mu_s, Number nu) {
 // is cos(theta) cos(alpha) + sin(theta) sin(alpha) cos(phi) =
 // rho cos(theta - beta), rho cos(beta) = cos(alpha), rho sin(beta) =
 // sin(alpha) cos(phi), above the far end's horizon until theta = beta +
-// acos(c(r_end) / rho). Plus the disc's angular radius: its top sets last.
-Number ShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number cos_phi,
-                           bool ray_r_mu_intersects_ground) {
+// gamma, gamma = acos(c(r_end) / rho). Plus the disc's angular radius: its
+// top sets last.
+//
+// The lookup places a ray's own columns by E and by the sun's distance to
+// it, D = E - theta, from a twentieth of a degree (SHADOW_EDGE_CLOSEST)
+// on, so both must be right to far better than that. GPUs approximate acos
+// and atan loosely (the GLSL specifications allow it; on Mesa's llvmpipe
+// acos is off by up to 1.6e-4 rad, atan by 3e-6), so the lookup never
+// takes an angle from them: E is carried as the direction (cos E, sin E),
+// composed from the cosines and sines of the angles above, and enters the
+// lookup as differences of angles (ShadowEdgeDistance, whose atan of a
+// small angle errs relatively, by 2e-5 on llvmpipe) and as cosines
+// (ShadowEdgeSunCosine). The angle itself (for the bake) is returned.
+Number ShadowEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number cos_phi,
+                  bool ray_r_mu_intersects_ground, OUT(vec2) direction) {
   Number d = DistanceToNearestAtmosphereBoundary(atmosphere, r, mu, ray_r_mu_intersects_ground);
   Number r_d = RadiusAtDistance(atmosphere, r, mu, d);
   Number cos_alpha = ClampCosine((r + d * mu) / r_d);
   Number across = d * SafeSqrt(1.0 - mu * mu) / r_d * cos_phi;
   Number rho = sqrt(across * across + cos_alpha * cos_alpha);
   Number c_end = -HorizonZenithCosine(atmosphere.bottom_radius, r_d);
-  Number end = c_end >= rho ? PI : atan(across, cos_alpha) + acos(-c_end / rho);
-  Number start = acos(HorizonZenithCosine(atmosphere.bottom_radius, r));
-  return max(start, end) + atmosphere.sun_angular_radius;
+  Number c_start = HorizonZenithCosine(atmosphere.bottom_radius, r);
+  vec2 start = vec2(c_start, atmosphere.bottom_radius / r);
+  Number cos_gamma = -c_end / rho;
+  Number sin_gamma = SafeSqrt(1.0 - cos_gamma * cos_gamma);
+  vec2 end = c_end >= rho ? vec2(-1.0, 0.0)
+                          : vec2(cos_alpha * cos_gamma - across * sin_gamma, across * cos_gamma + cos_alpha * sin_gamma) /
+                                rho;
+  // The end that sets last has the smaller cosine (both angles lie in
+  // [0, pi], unless beta + gamma passes pi, where the sine is negative).
+  bool end_sets_last = end.y < 0.0 || end.x < start.x;
+  // The disc's radius a by its series (a is below 0.01: to 1e-14), free of
+  // the GPU's sin and cos, whose absolute errors are large next to a.
+  Number a = atmosphere.sun_angular_radius;
+  Number cos_a = 1.0 - 0.5 * a * a * (1.0 - a * a / 12.0);
+  Number sin_a = a * (1.0 - a * a / 6.0);
+  vec2 last = end_sets_last ? end : start;
+  direction = vec2(last.x * cos_a - last.y * sin_a, last.y * cos_a + last.x * sin_a);
+  Number angle = end_sets_last ? (c_end >= rho ? PI : atan(across, cos_alpha) + acos(cos_gamma)) : acos(c_start);
+  return angle + a;
 }
 
-// The sun zenith angle of the split's column.
-Number GetScatteringSplitSunZenith(IN(AtmosphereParameters) atmosphere) {
-  return acos(GetScatteringMuSFromUnitRange(
-      atmosphere, Number(atmosphere.scattering_mu_s_split) / Number(atmosphere.scattering_mu_s_size - 1)));
+Number ShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number cos_phi,
+                           bool ray_r_mu_intersects_ground) {
+  vec2 unused;
+  return ShadowEdge(atmosphere, r, mu, cos_phi, ray_r_mu_intersects_ground, unused);
+}
+
+// The direction (cos E, sin E) of an edge given as an angle (the bake's).
+vec2 ShadowEdgeDirection(Number edge) { return vec2(cos(edge), sin(edge)); }
+
+// D = E - theta for the edge's direction (cos E, sin E) and the sun at
+// zenith cosine mu_s: atan(sin(E - theta), cos(E - theta)), as accurate
+// near the edge as the arithmetic.
+Number ShadowEdgeDistance(IN(vec2) edge, Number mu_s) {
+  Number sin_theta = SafeSqrt(1.0 - mu_s * mu_s);
+  return atan(edge.y * mu_s - edge.x * sin_theta, edge.x * mu_s + edge.y * sin_theta);
+}
+
+// The sun's zenith cosine at distance D to the edge: cos(E - D).
+Number ShadowEdgeSunCosine(IN(vec2) edge, Number D) { return edge.x * cos(D) + edge.y * sin(D); }
+
+// The sun cosine of the split's column.
+Number GetScatteringSplitMuS(IN(AtmosphereParameters) atmosphere) {
+  return GetScatteringMuSFromUnitRange(
+      atmosphere, Number(atmosphere.scattering_mu_s_split) / Number(atmosphere.scattering_mu_s_size - 1));
 }
 
 // X, a unit sun from 1 at the zenith to 0 at the tables' lowest sun (and
 // on below it, negative and smooth), like GetScatteringUnitMuS but with
-// Bruneton's k = 1, and its derivative in the sun zenith angle theta: with
-// a = (d - d_min) / (d_max - d_min) (as there) and A its value at
-// scattering_mu_s_min, X = (1 - a / A) / (1 + a); d = -R mu_s +
-// sqrt(R^2 mu_s^2 + top^2 - R^2) (R the bottom radius) has dd/dmu_s =
-// -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta).
-Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number sun_zenith, OUT(Number) derivative) {
+// Bruneton's k = 1, at sun zenith cosine mu_s, and its derivative in the
+// sun zenith angle theta: with a = (d - d_min) / (d_max - d_min) (as there)
+// and A its value at scattering_mu_s_min, X = (1 - a / A) / (1 + a); d =
+// -R mu_s + sqrt(R^2 mu_s^2 + top^2 - R^2) (R the bottom radius) has dd/dmu_s
+// = -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta).
+Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number mu_s, OUT(Number) derivative) {
   Number bottom = atmosphere.bottom_radius;
-  Number mu_s = cos(sun_zenith);
   Number d = DistanceToTopAtmosphereBoundary(atmosphere, bottom, mu_s);
   Number d_min = atmosphere.top_radius - bottom;
   Number span = HorizonDistanceAtTop(atmosphere) - d_min;
   Number a = (d - d_min) / span;
   Number inverse_A = 1.0 / GetScatteringLowestSunDistance(atmosphere);
-  Number da_dtheta = bottom * d / (d + bottom * mu_s) / span * sin(sun_zenith);
+  Number da_dtheta = bottom * d / (d + bottom * mu_s) / span * SafeSqrt(1.0 - mu_s * mu_s);
   derivative = -(inverse_A + 1.0) / ((1.0 + a) * (1.0 + a)) * da_dtheta;
   return (1.0 - a * inverse_A) / (1.0 + a);
 }
@@ -300,42 +347,46 @@ Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number sun_zenith,
 // the edge's X(E - D_min) (X_closest), X(theta_split) - X(E - D_min)
 // (X_span) and ln((E - theta_split) / D_min) (log_span); also dx/ds in
 // s = ln D.
-Number ShadowEdgeLitUnitFrom(IN(AtmosphereParameters) atmosphere, Number D, Number edge, Number X_closest,
+Number ShadowEdgeLitUnitFrom(IN(AtmosphereParameters) atmosphere, Number D, IN(vec2) edge, Number X_closest,
                              Number X_span, Number log_span, OUT(Number) derivative) {
   Number dX_dtheta;
-  Number X = ShadowEdgeUnitSun(atmosphere, edge - D, dX_dtheta);
+  Number X = ShadowEdgeUnitSun(atmosphere, ShadowEdgeSunCosine(edge, D), dX_dtheta);
   derivative = -SHADOW_EDGE_TABLES_WEIGHT * dX_dtheta * D / X_span + (1.0 - SHADOW_EDGE_TABLES_WEIGHT) / log_span;
   return SHADOW_EDGE_TABLES_WEIGHT * (X - X_closest) / X_span +
          (1.0 - SHADOW_EDGE_TABLES_WEIGHT) * log(D / SHADOW_EDGE_CLOSEST) / log_span;
 }
 
-// ShadowEdgeLitUnitFrom's constants for the edge.
-void ShadowEdgeLitUnitSpans(IN(AtmosphereParameters) atmosphere, Number edge, Number split_sun,
-                            OUT(Number) X_closest, OUT(Number) X_span, OUT(Number) log_span) {
+// ShadowEdgeLitUnitFrom's constants for the edge, and the split's D.
+void ShadowEdgeLitUnitSpans(IN(AtmosphereParameters) atmosphere, IN(vec2) edge, OUT(Number) X_closest,
+                            OUT(Number) X_span, OUT(Number) log_span, OUT(Number) split_distance) {
   Number unused;
-  X_closest = ShadowEdgeUnitSun(atmosphere, edge - SHADOW_EDGE_CLOSEST, unused);
-  X_span = ShadowEdgeUnitSun(atmosphere, split_sun, unused) - X_closest;
-  log_span = log((edge - split_sun) / SHADOW_EDGE_CLOSEST);
+  Number split_mu_s = GetScatteringSplitMuS(atmosphere);
+  X_closest = ShadowEdgeUnitSun(atmosphere, ShadowEdgeSunCosine(edge, SHADOW_EDGE_CLOSEST), unused);
+  X_span = ShadowEdgeUnitSun(atmosphere, split_mu_s, unused) - X_closest;
+  split_distance = ShadowEdgeDistance(edge, split_mu_s);
+  log_span = log(split_distance / SHADOW_EDGE_CLOSEST);
 }
 
-Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, Number distance, Number edge, Number split_sun) {
+Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, Number distance, IN(vec2) edge) {
   Number X_closest;
   Number X_span;
   Number log_span;
-  ShadowEdgeLitUnitSpans(atmosphere, edge, split_sun, X_closest, X_span, log_span);
+  Number split_distance;
+  ShadowEdgeLitUnitSpans(atmosphere, edge, X_closest, X_span, log_span, split_distance);
   Number unused;
-  return ShadowEdgeLitUnitFrom(atmosphere, clamp(distance, SHADOW_EDGE_CLOSEST, edge - split_sun), edge, X_closest,
+  return ShadowEdgeLitUnitFrom(atmosphere, clamp(distance, SHADOW_EDGE_CLOSEST, split_distance), edge, X_closest,
                                X_span, log_span, unused);
 }
 
 // Its inverse: D at position x in [0, 1], by Newton's method in s = ln D
 // from the logarithm's term alone (x rises with s, at least at 1 - w times
 // the logarithm's rate), to 1e-11 in ln D in a few steps.
-Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, Number x, Number edge, Number split_sun) {
+Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, Number x, IN(vec2) edge) {
   Number X_closest;
   Number X_span;
   Number log_span;
-  ShadowEdgeLitUnitSpans(atmosphere, edge, split_sun, X_closest, X_span, log_span);
+  Number split_distance;
+  ShadowEdgeLitUnitSpans(atmosphere, edge, X_closest, X_span, log_span, split_distance);
   Number s_min = log(SHADOW_EDGE_CLOSEST);
   Number s_max = s_min + log_span;
   Number s = mix(s_min, s_max, x);
@@ -353,38 +404,35 @@ Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, Number x, Numb
 // The span in sun zenith angle between two of a ray's columns past its
 // edge E: evenly from E to the tables' lowest sun, or at least
 // SHADOW_EDGE_LEAST_PAST_SPAN past E.
-Number ShadowEdgePastStep(IN(AtmosphereParameters) atmosphere, Number edge) {
-  Number lowest = acos(atmosphere.scattering_mu_s_min);
-  return max(lowest - edge, SHADOW_EDGE_LEAST_PAST_SPAN) / Number(SHADOW_EDGE_PAST_COLUMNS - 1);
+Number ShadowEdgePastStep(IN(AtmosphereParameters) atmosphere, IN(vec2) edge) {
+  Number past_lowest = -ShadowEdgeDistance(edge, atmosphere.scattering_mu_s_min);
+  return max(past_lowest, SHADOW_EDGE_LEAST_PAST_SPAN) / Number(SHADOW_EDGE_PAST_COLUMNS - 1);
 }
 
-// The position, in columns from the first, of the sun at zenith angle
-// sun_zenith below the split, for a ray whose edge is `edge`: between the lit
-// columns at x (ShadowEdgeLitUnit); within SHADOW_EDGE_CLOSEST of the edge,
-// in proportion to D between the columns at E and D_min; past the edge, in
-// proportion to the angle past it (negative past the first column).
-Number GetScatteringShadowEdgePosition(IN(AtmosphereParameters) atmosphere, Number sun_zenith, Number edge) {
+// The position, in columns from the first, of the sun at distance D to the
+// edge (ShadowEdgeDistance) below the split, for a ray whose edge's
+// direction is `edge`: between the lit columns at x (ShadowEdgeLitUnit);
+// within SHADOW_EDGE_CLOSEST of the edge, in proportion to D between the
+// columns at E and D_min; past the edge, in proportion to the angle past it
+// (negative past the first column).
+Number GetScatteringShadowEdgePosition(IN(AtmosphereParameters) atmosphere, Number D, IN(vec2) edge) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
-  Number split_sun = GetScatteringSplitSunZenith(atmosphere);
-  Number D = edge - sun_zenith;
   if (D >= SHADOW_EDGE_CLOSEST) {
-    return past + ShadowEdgeLitUnit(atmosphere, D, edge, split_sun) * (Number(atmosphere.scattering_mu_s_split) - past);
+    return past + ShadowEdgeLitUnit(atmosphere, D, edge) * (Number(atmosphere.scattering_mu_s_split) - past);
   }
   if (D >= 0.0) return past - 1.0 + D / SHADOW_EDGE_CLOSEST;
   return past - 1.0 + D / ShadowEdgePastStep(atmosphere, edge);
 }
 
-// Its inverse: the sun zenith angle at `position` (below the split, whose
-// sun zenith angle is split_sun).
-Number GetScatteringShadowEdgeSunZenith(IN(AtmosphereParameters) atmosphere, Number position, Number edge,
-                                        Number split_sun) {
+// Its inverse: the sun's distance D to the edge at `position`.
+Number GetScatteringShadowEdgeDistance(IN(AtmosphereParameters) atmosphere, Number position, IN(vec2) edge) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
   if (position >= past) {
     Number x = (position - past) / (Number(atmosphere.scattering_mu_s_split) - past);
-    return edge - ShadowEdgeLitDistance(atmosphere, x, edge, split_sun);
+    return ShadowEdgeLitDistance(atmosphere, x, edge);
   }
-  if (position >= past - 1.0) return edge - (position - past + 1.0) * SHADOW_EDGE_CLOSEST;
-  return edge + (past - 1.0 - position) * ShadowEdgePastStep(atmosphere, edge);
+  if (position >= past - 1.0) return (position - past + 1.0) * SHADOW_EDGE_CLOSEST;
+  return (position - past + 1.0) * ShadowEdgePastStep(atmosphere, edge);
 }
 
 // r over the table's radii: rows at evenly spaced distances to the horizon
@@ -446,9 +494,9 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
   Number u_mu_s = GetScatteringTextureUMuS(atmosphere, mu_s);
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
   if (atmosphere.scattering_mu_s_split > 0 && u_mu_s * mu_s_size - 0.5 < Number(atmosphere.scattering_mu_s_split)) {
-    Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu),
-                                      ray_r_mu_intersects_ground);
-    u_mu_s = (GetScatteringShadowEdgePosition(atmosphere, acos(mu_s), edge) + 0.5) / mu_s_size;
+    vec2 edge;
+    ShadowEdge(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu), ray_r_mu_intersects_ground, edge);
+    u_mu_s = (GetScatteringShadowEdgePosition(atmosphere, ShadowEdgeDistance(edge, mu_s), edge) + 0.5) / mu_s_size;
   }
   return vec4(ScatteringUnitNu(nu), u_mu_s, u_mu, u_r);
 }
@@ -774,8 +822,8 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
     Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
     Number log_first_span = 1.0;
     if (position < past) {
-      Number edge = ShadowEdgeSunZenith(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu),
-                                        ray_r_mu_intersects_ground);
+      vec2 edge;
+      ShadowEdge(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu), ray_r_mu_intersects_ground, edge);
       if (position < 0.0) {
         // Past the first column (the tables' lowest sun, or
         // SHADOW_EDGE_LEAST_PAST_SPAN past the edge): ln L continued from
@@ -784,12 +832,11 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
         return LowestSunContinued(
             GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 0.5 / mu_s_size, nu_slice, nu_t, true),
             GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 1.5 / mu_s_size, nu_slice, nu_t, true),
-            cos(edge + (past - 1.0) * step), cos(edge + (past - 2.0) * step), mu_s);
+            ShadowEdgeSunCosine(edge, -(past - 1.0) * step), ShadowEdgeSunCosine(edge, -(past - 2.0) * step), mu_s);
       }
       if (position >= past - 1.0) {
         Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
-        log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge, GetScatteringSplitSunZenith(atmosphere)) /
-                             SHADOW_EDGE_CLOSEST);
+        log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge) / SHADOW_EDGE_CLOSEST);
       }
     }
     return SunCosineMix(

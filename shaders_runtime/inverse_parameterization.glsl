@@ -34,21 +34,20 @@ Number GetScatteringSliceEdge(IN(AtmosphereParameters) atmosphere, Number r, Num
 }
 
 // The sun zenith angle of a ray's own column at `position` below the split
-// (GetScatteringShadowEdgeSunZenith; split_sun the split's sun zenith
-// angle) for the nu slice at nu: the column's sun sets the azimuth at which
-// nu lies, which sets the ray's edge (GetScatteringSliceEdge), which sets
-// the column's sun. Their fixed point, from the edge start_edge (the edge
-// moves less than the sun does: on Earth's default table three steps from
-// the edge of a sun at the horizon, on average, to 1e-11 radians); `edge`
-// is the column's.
+// (E - GetScatteringShadowEdgeDistance) for the nu slice at nu: the
+// column's sun sets the azimuth at which nu lies, which sets the ray's edge
+// (GetScatteringSliceEdge), which sets the column's sun. Their fixed
+// point, from the edge start_edge (the edge moves less than the sun does:
+// on Earth's default table three steps from the edge of a sun at the
+// horizon, on average, to 1e-11 radians); `edge` is the column's.
 Number GetScatteringOwnColumnSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
-                                       bool ray_r_mu_intersects_ground, Number position, Number split_sun,
-                                       Number start_edge, OUT(Number) edge) {
+                                       bool ray_r_mu_intersects_ground, Number position, Number start_edge,
+                                       OUT(Number) edge) {
   edge = start_edge;
-  Number sun = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge, split_sun);
+  Number sun = edge - GetScatteringShadowEdgeDistance(atmosphere, position, ShadowEdgeDirection(edge));
   for (int i = 0; i < 50; ++i) {
     edge = GetScatteringSliceEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, cos(sun));
-    Number next = GetScatteringShadowEdgeSunZenith(atmosphere, position, edge, split_sun);
+    Number next = edge - GetScatteringShadowEdgeDistance(atmosphere, position, ShadowEdgeDirection(edge));
     bool converged = abs(next - sun) < 1e-11;
     sun = next;
     if (converged) break;
@@ -92,7 +91,7 @@ void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, I
   if (atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)) {
     Number edge;
     mu_s = cos(GetScatteringOwnColumnSunZenith(
-        atmosphere, r, mu, nu, ray_r_mu_intersects_ground, position, GetScatteringSplitSunZenith(atmosphere),
+        atmosphere, r, mu, nu, ray_r_mu_intersects_ground, position,
         GetScatteringSliceEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, 0.0), edge));
   }
 }

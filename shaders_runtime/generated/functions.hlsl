@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _941 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _952 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_941)
+    if (!_952)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _804 = mu < 0.0f;
-    bool _816;
-    if (_804)
+    bool _815 = mu < 0.0f;
+    bool _827;
+    if (_815)
     {
-        _816 = (((r * r) * mu) * mu) >= c;
+        _827 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _816 = _804;
+        _827 = _815;
     }
-    return _816;
+    return _827;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _574;
+    float _585;
     if (r_mu > 0.0f)
     {
-        _574 = c / (r_mu + s);
+        _585 = c / (r_mu + s);
     }
     else
     {
-        _574 = s - r_mu;
+        _585 = s - r_mu;
     }
-    float param_1 = _574;
+    float param_1 = _585;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1033;
+    float _1044;
     if (d_max > d_min)
     {
-        _1033 = (d - d_min) / (d_max - d_min);
+        _1044 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1033 = 0.0f;
+        _1044 = 0.0f;
     }
-    float x_mu = _1033;
+    float x_mu = _1044;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -289,39 +289,39 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1238;
+    float _1249;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1238 = ClampCosine(param_1);
+        _1249 = ClampCosine(param_1);
     }
     else
     {
-        _1238 = 1.0f;
+        _1249 = 1.0f;
     }
-    return _1238;
+    return _1249;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _820;
+    float _831;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _820 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _831 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _820 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _831 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _820;
+    return _831;
 }
 #endif
 
@@ -347,7 +347,7 @@ float HorizonZenithCosine(float bottom_radius, float r)
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ShadowEdgeSunZenith(AtmosphereParameters atmosphere, float r, float mu, float cos_phi, bool ray_r_mu_intersects_ground)
+float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_phi, bool ray_r_mu_intersects_ground, out float2 direction)
 {
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
@@ -367,20 +367,69 @@ float ShadowEdgeSunZenith(AtmosphereParameters atmosphere, float r, float mu, fl
     float param_10 = atmosphere.bottom_radius;
     float param_11 = r_d;
     float c_end = -HorizonZenithCosine(param_10, param_11);
-    float _1318;
+    float param_12 = atmosphere.bottom_radius;
+    float param_13 = r;
+    float c_start = HorizonZenithCosine(param_12, param_13);
+    float2 start = float2(c_start, atmosphere.bottom_radius / r);
+    float cos_gamma = (-c_end) / rho;
+    float param_14 = 1.0f - (cos_gamma * cos_gamma);
+    float sin_gamma = SafeSqrt(param_14);
+    float2 _1355;
     if (c_end >= rho)
     {
-        _1318 = 3.1415927410125732421875f;
+        _1355 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1318 = atan2(across, cos_alpha) + acos((-c_end) / rho);
+        _1355 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float end = _1318;
-    float param_12 = atmosphere.bottom_radius;
-    float param_13 = r;
-    float start = acos(HorizonZenithCosine(param_12, param_13));
-    return max(start, end) + atmosphere.sun_angular_radius;
+    float2 end = _1355;
+    bool _1383 = end.y < 0.0f;
+    bool _1393;
+    if (!_1383)
+    {
+        _1393 = end.x < start.x;
+    }
+    else
+    {
+        _1393 = _1383;
+    }
+    bool end_sets_last = _1393;
+    float a = atmosphere.sun_angular_radius;
+    float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
+    float sin_a = a * (1.0f - ((a * a) / 6.0f));
+    bool2 _1425 = end_sets_last.xx;
+    float2 last = float2(_1425.x ? end.x : start.x, _1425.y ? end.y : start.y);
+    direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
+    float _1448;
+    if (end_sets_last)
+    {
+        float _1454;
+        if (c_end >= rho)
+        {
+            _1454 = 3.1415927410125732421875f;
+        }
+        else
+        {
+            _1454 = atan2(across, cos_alpha) + acos(cos_gamma);
+        }
+        _1448 = _1454;
+    }
+    else
+    {
+        _1448 = acos(c_start);
+    }
+    float angle = _1448;
+    return angle + a;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float ShadowEdgeDistance(float2 edge, float mu_s)
+{
+    float param = 1.0f - (mu_s * mu_s);
+    float sin_theta = SafeSqrt(param);
+    return atan2((edge.y * mu_s) - (edge.x * sin_theta), (edge.x * mu_s) + (edge.y * sin_theta));
 }
 #endif
 
@@ -408,34 +457,40 @@ float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
     float param_5 = 1.0f / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1180;
+    float _1191;
     if (d == 0.0f)
     {
-        _1180 = 1.0f;
+        _1191 = 1.0f;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1180 = ClampCosine(param_6);
+        _1191 = ClampCosine(param_6);
     }
-    return _1180;
+    return _1191;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float GetScatteringSplitSunZenith(AtmosphereParameters atmosphere)
+float GetScatteringSplitMuS(AtmosphereParameters atmosphere)
 {
     AtmosphereParameters param = atmosphere;
     float param_1 = float(atmosphere.scattering_mu_s_split) / float(atmosphere.scattering_mu_s_size - 1);
-    return acos(GetScatteringMuSFromUnitRange(param, param_1));
+    return GetScatteringMuSFromUnitRange(param, param_1);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ShadowEdgeUnitSun(AtmosphereParameters atmosphere, float sun_zenith, out float derivative)
+float ShadowEdgeSunCosine(float2 edge, float D)
+{
+    return (edge.x * cos(D)) + (edge.y * sin(D));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float ShadowEdgeUnitSun(AtmosphereParameters atmosphere, float mu_s, out float derivative)
 {
     float bottom = atmosphere.bottom_radius;
-    float mu_s = cos(sun_zenith);
     AtmosphereParameters param = atmosphere;
     float param_1 = bottom;
     float param_2 = mu_s;
@@ -446,101 +501,110 @@ float ShadowEdgeUnitSun(AtmosphereParameters atmosphere, float sun_zenith, out f
     float a = (d - d_min) / span;
     AtmosphereParameters param_4 = atmosphere;
     float inverse_A = 1.0f / GetScatteringLowestSunDistance(param_4);
-    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * sin(sun_zenith);
+    float param_5 = 1.0f - (mu_s * mu_s);
+    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * SafeSqrt(param_5);
     derivative = ((-(inverse_A + 1.0f)) / ((1.0f + a) * (1.0f + a))) * da_dtheta;
     return (1.0f - (a * inverse_A)) / (1.0f + a);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, float edge, float split_sun, inout float X_closest, out float X_span, out float log_span)
+void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, float2 edge, inout float X_closest, out float X_span, out float log_span, inout float split_distance)
 {
     AtmosphereParameters param = atmosphere;
-    float param_1 = edge - 0.0008726646192371845245361328125f;
-    float param_2;
-    float _1483 = ShadowEdgeUnitSun(param, param_1, param_2);
-    float unused = param_2;
-    X_closest = _1483;
+    float split_mu_s = GetScatteringSplitMuS(param);
+    float2 param_1 = edge;
+    float param_2 = 0.0008726646192371845245361328125f;
     AtmosphereParameters param_3 = atmosphere;
-    float param_4 = split_sun;
+    float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1490 = ShadowEdgeUnitSun(param_3, param_4, param_5);
-    unused = param_5;
-    X_span = _1490 - X_closest;
-    log_span = log((edge - split_sun) / 0.0008726646192371845245361328125f);
+    float _1657 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float unused = param_5;
+    X_closest = _1657;
+    AtmosphereParameters param_6 = atmosphere;
+    float param_7 = split_mu_s;
+    float param_8;
+    float _1664 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    unused = param_8;
+    X_span = _1664 - X_closest;
+    float2 param_9 = edge;
+    float param_10 = split_mu_s;
+    split_distance = ShadowEdgeDistance(param_9, param_10);
+    log_span = log(split_distance / 0.0008726646192371845245361328125f);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, float D, float edge, float X_closest, float X_span, float log_span, out float derivative)
+float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, float D, float2 edge, float X_closest, float X_span, float log_span, out float derivative)
 {
-    AtmosphereParameters param = atmosphere;
-    float param_1 = edge - D;
-    float param_2;
-    float _1446 = ShadowEdgeUnitSun(param, param_1, param_2);
-    float dX_dtheta = param_2;
-    float X = _1446;
+    float2 param = edge;
+    float param_1 = D;
+    AtmosphereParameters param_2 = atmosphere;
+    float param_3 = ShadowEdgeSunCosine(param, param_1);
+    float param_4;
+    float _1614 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float dX_dtheta = param_4;
+    float X = _1614;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, float _distance, float edge, float split_sun)
+float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, float _distance, float2 edge)
 {
     AtmosphereParameters param = atmosphere;
-    float param_1 = edge;
-    float param_2 = split_sun;
+    float2 param_1 = edge;
+    float param_2;
     float param_3;
     float param_4;
     float param_5;
     ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5);
-    float X_closest = param_3;
-    float X_span = param_4;
-    float log_span = param_5;
+    float X_closest = param_2;
+    float X_span = param_3;
+    float log_span = param_4;
+    float split_distance = param_5;
     AtmosphereParameters param_6 = atmosphere;
-    float param_7 = clamp(_distance, 0.0008726646192371845245361328125f, edge - split_sun);
-    float param_8 = edge;
+    float param_7 = clamp(_distance, 0.0008726646192371845245361328125f, split_distance);
+    float2 param_8 = edge;
     float param_9 = X_closest;
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1533 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _1709 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1533;
+    return _1709;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ShadowEdgePastStep(AtmosphereParameters atmosphere, float edge)
+float ShadowEdgePastStep(AtmosphereParameters atmosphere, float2 edge)
 {
-    float lowest = acos(atmosphere.scattering_mu_s_min);
-    return max(lowest - edge, 0.0349065847694873809814453125f) / 5.0f;
+    float2 param = edge;
+    float param_1 = atmosphere.scattering_mu_s_min;
+    float past_lowest = -ShadowEdgeDistance(param, param_1);
+    return max(past_lowest, 0.0349065847694873809814453125f) / 5.0f;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float GetScatteringShadowEdgePosition(AtmosphereParameters atmosphere, float sun_zenith, float edge)
+float GetScatteringShadowEdgePosition(AtmosphereParameters atmosphere, float D, float2 edge)
 {
     float past = 6.0f;
-    AtmosphereParameters param = atmosphere;
-    float split_sun = GetScatteringSplitSunZenith(param);
-    float D = edge - sun_zenith;
     if (D >= 0.0008726646192371845245361328125f)
     {
-        AtmosphereParameters param_1 = atmosphere;
-        float param_2 = D;
-        float param_3 = edge;
-        float param_4 = split_sun;
-        return past + (ShadowEdgeLitUnit(param_1, param_2, param_3, param_4) * (float(atmosphere.scattering_mu_s_split) - past));
+        AtmosphereParameters param = atmosphere;
+        float param_1 = D;
+        float2 param_2 = edge;
+        return past + (ShadowEdgeLitUnit(param, param_1, param_2) * (float(atmosphere.scattering_mu_s_split) - past));
     }
     if (D >= 0.0f)
     {
         return (past - 1.0f) + (D / 0.0008726646192371845245361328125f);
     }
-    AtmosphereParameters param_5 = atmosphere;
-    float param_6 = edge;
-    return (past - 1.0f) + (D / ShadowEdgePastStep(param_5, param_6));
+    AtmosphereParameters param_3 = atmosphere;
+    float2 param_4 = edge;
+    return (past - 1.0f) + (D / ShadowEdgePastStep(param_3, param_4));
 }
 #endif
 
@@ -570,16 +634,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _1835;
+        float _2003;
         if (d_max == d_min)
         {
-            _1835 = 0.0f;
+            _2003 = 0.0f;
         }
         else
         {
-            _1835 = (d - d_min) / (d_max - d_min);
+            _2003 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _1835;
+        x_mu = _2003;
         u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     else
@@ -590,16 +654,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _1879;
+        float _2047;
         if (d_max_1 > d_min_1)
         {
-            _1879 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _2047 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _1879 = 0.0f;
+            _2047 = 0.0f;
         }
-        x_mu = _1879;
+        x_mu = _2047;
         u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -612,17 +676,17 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
     float param_15 = mu_s;
     float u_mu_s = GetScatteringTextureUMuS(param_14, param_15);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    bool _1925 = atmosphere.scattering_mu_s_split > 0;
-    bool _1936;
-    if (_1925)
+    bool _2093 = atmosphere.scattering_mu_s_split > 0;
+    bool _2104;
+    if (_2093)
     {
-        _1936 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2104 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _1936 = _1925;
+        _2104 = _2093;
     }
-    if (_1936)
+    if (_2104)
     {
         float param_16 = mu;
         float param_17 = mu_s;
@@ -632,14 +696,18 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(AtmosphereParameters atmosphere, flo
         float param_21 = mu;
         float param_22 = ViewSunAzimuthCosine(param_16, param_17, param_18);
         bool param_23 = ray_r_mu_intersects_ground;
-        float edge = ShadowEdgeSunZenith(param_19, param_20, param_21, param_22, param_23);
-        AtmosphereParameters param_24 = atmosphere;
-        float param_25 = acos(mu_s);
-        float param_26 = edge;
-        u_mu_s = (GetScatteringShadowEdgePosition(param_24, param_25, param_26) + 0.5f) / mu_s_size;
+        float2 param_24;
+        float _2125 = ShadowEdge(param_19, param_20, param_21, param_22, param_23, param_24);
+        float2 edge = param_24;
+        float2 param_25 = edge;
+        float param_26 = mu_s;
+        AtmosphereParameters param_27 = atmosphere;
+        float param_28 = ShadowEdgeDistance(param_25, param_26);
+        float2 param_29 = edge;
+        u_mu_s = (GetScatteringShadowEdgePosition(param_27, param_28, param_29) + 0.5f) / mu_s_size;
     }
-    float param_27 = nu;
-    return float4(ScatteringUnitNu(param_27), u_mu_s, u_mu, u_r);
+    float param_30 = nu;
+    return float4(ScatteringUnitNu(param_30), u_mu_s, u_mu, u_r);
 }
 #endif
 
@@ -716,18 +784,19 @@ float4 LowestSunContinued(float4 a, float4 b, float mu_s_a, float mu_s_b, float 
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float edge, float split_sun)
+float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edge)
 {
     AtmosphereParameters param = atmosphere;
-    float param_1 = edge;
-    float param_2 = split_sun;
+    float2 param_1 = edge;
+    float param_2;
     float param_3;
     float param_4;
     float param_5;
     ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5);
-    float X_closest = param_3;
-    float X_span = param_4;
-    float log_span = param_5;
+    float X_closest = param_2;
+    float X_span = param_3;
+    float log_span = param_4;
+    float split_distance = param_5;
     float s_min = -7.043959140777587890625f;
     float s_max = s_min + log_span;
     float s = lerp(s_min, s_max, x);
@@ -736,13 +805,13 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float edge
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = exp(s);
-        float param_8 = edge;
+        float2 param_8 = edge;
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1590 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _1767 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1590 - x;
+        float error = _1767 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -772,26 +841,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _2384;
+    float4 _2556;
     if (has_a)
     {
-        _2384 = log(max(a, dark));
+        _2556 = log(max(a, dark));
     }
     else
     {
-        _2384 = (lb * 2.0f) - lc;
+        _2556 = (lb * 2.0f) - lc;
     }
-    float4 la = _2384;
-    float4 _2399;
+    float4 la = _2556;
+    float4 _2571;
     if (has_d)
     {
-        _2399 = log(max(d, dark));
+        _2571 = log(max(d, dark));
     }
     else
     {
-        _2399 = (lc * 2.0f) - lb;
+        _2571 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2399;
+    float4 ld = _2571;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -885,16 +954,16 @@ float4 GetScatteringBelowSplit(AtmosphereParameters atmosphere, Texture3D<float4
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _2303;
+    float _2475;
     if (low_sun)
     {
-        _2303 = min(t, 1.0f);
+        _2475 = min(t, 1.0f);
     }
     else
     {
-        _2303 = clamp(t, 0.0f, 1.0f);
+        _2475 = clamp(t, 0.0f, 1.0f);
     }
-    return _2303;
+    return _2475;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -928,17 +997,17 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float nu_t = nu_coord - nu_slice;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float position = (uvwz.y * mu_s_size) - 0.5f;
-    bool _2935 = atmosphere.scattering_mu_s_split > 0;
-    bool _2943;
-    if (_2935)
+    bool _3105 = atmosphere.scattering_mu_s_split > 0;
+    bool _3113;
+    if (_3105)
     {
-        _2943 = position < float(atmosphere.scattering_mu_s_split);
+        _3113 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2943 = _2935;
+        _3113 = _3105;
     }
-    if (_2943)
+    if (_3113)
     {
         float past = 6.0f;
         float log_first_span = 1.0f;
@@ -952,97 +1021,101 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
             float param_11 = mu;
             float param_12 = ViewSunAzimuthCosine(param_6, param_7, param_8);
             bool param_13 = ray_r_mu_intersects_ground;
-            float edge = ShadowEdgeSunZenith(param_9, param_10, param_11, param_12, param_13);
+            float2 param_14;
+            float _3141 = ShadowEdge(param_9, param_10, param_11, param_12, param_13, param_14);
+            float2 edge = param_14;
             if (position < 0.0f)
             {
-                AtmosphereParameters param_14 = atmosphere;
-                float param_15 = edge;
-                float _step = ShadowEdgePastStep(param_14, param_15);
-                AtmosphereParameters param_16 = atmosphere;
-                float4 param_17 = uvwz;
-                float param_18 = 0.5f / mu_s_size;
-                float param_19 = nu_slice;
-                float param_20 = nu_t;
-                bool param_21 = true;
-                AtmosphereParameters param_22 = atmosphere;
-                float4 param_23 = uvwz;
-                float param_24 = 1.5f / mu_s_size;
-                float param_25 = nu_slice;
-                float param_26 = nu_t;
-                bool param_27 = true;
-                float4 param_28 = GetScatteringAtMuSColumn(param_16, scattering_texture_1, _scattering_texture_1_sampler, param_17, param_18, param_19, param_20, param_21);
-                float4 param_29 = GetScatteringAtMuSColumn(param_22, scattering_texture_1, _scattering_texture_1_sampler, param_23, param_24, param_25, param_26, param_27);
-                float param_30 = cos(edge + ((past - 1.0f) * _step));
-                float param_31 = cos(edge + ((past - 2.0f) * _step));
-                float param_32 = mu_s;
-                return LowestSunContinued(param_28, param_29, param_30, param_31, param_32);
+                AtmosphereParameters param_15 = atmosphere;
+                float2 param_16 = edge;
+                float _step = ShadowEdgePastStep(param_15, param_16);
+                AtmosphereParameters param_17 = atmosphere;
+                float4 param_18 = uvwz;
+                float param_19 = 0.5f / mu_s_size;
+                float param_20 = nu_slice;
+                float param_21 = nu_t;
+                bool param_22 = true;
+                AtmosphereParameters param_23 = atmosphere;
+                float4 param_24 = uvwz;
+                float param_25 = 1.5f / mu_s_size;
+                float param_26 = nu_slice;
+                float param_27 = nu_t;
+                bool param_28 = true;
+                float2 param_29 = edge;
+                float param_30 = (-(past - 1.0f)) * _step;
+                float2 param_31 = edge;
+                float param_32 = (-(past - 2.0f)) * _step;
+                float4 param_33 = GetScatteringAtMuSColumn(param_17, scattering_texture_1, _scattering_texture_1_sampler, param_18, param_19, param_20, param_21, param_22);
+                float4 param_34 = GetScatteringAtMuSColumn(param_23, scattering_texture_1, _scattering_texture_1_sampler, param_24, param_25, param_26, param_27, param_28);
+                float param_35 = ShadowEdgeSunCosine(param_29, param_30);
+                float param_36 = ShadowEdgeSunCosine(param_31, param_32);
+                float param_37 = mu_s;
+                return LowestSunContinued(param_33, param_34, param_35, param_36, param_37);
             }
             if (position >= (past - 1.0f))
             {
                 float x = 1.0f / (float(atmosphere.scattering_mu_s_split) - past);
-                AtmosphereParameters param_33 = atmosphere;
-                AtmosphereParameters param_34 = atmosphere;
-                float param_35 = x;
-                float param_36 = edge;
-                float param_37 = GetScatteringSplitSunZenith(param_33);
-                log_first_span = log(ShadowEdgeLitDistance(param_34, param_35, param_36, param_37) / 0.0008726646192371845245361328125f);
+                AtmosphereParameters param_38 = atmosphere;
+                float param_39 = x;
+                float2 param_40 = edge;
+                log_first_span = log(ShadowEdgeLitDistance(param_38, param_39, param_40) / 0.0008726646192371845245361328125f);
             }
         }
-        AtmosphereParameters param_38 = atmosphere;
-        float4 param_39 = uvwz;
-        float param_40 = position;
-        float param_41 = nu_slice;
-        float param_42 = log_first_span;
-        AtmosphereParameters param_43 = atmosphere;
-        float4 param_44 = uvwz;
-        float param_45 = position;
-        float param_46 = nu_slice + 1.0f;
-        float param_47 = log_first_span;
-        float4 param_48 = GetScatteringBelowSplit(param_38, scattering_texture_1, _scattering_texture_1_sampler, param_39, param_40, param_41, param_42);
-        float4 param_49 = GetScatteringBelowSplit(param_43, scattering_texture_1, _scattering_texture_1_sampler, param_44, param_45, param_46, param_47);
-        float param_50 = nu_t;
-        bool param_51 = true;
-        return SunCosineMix(param_48, param_49, param_50, param_51);
+        AtmosphereParameters param_41 = atmosphere;
+        float4 param_42 = uvwz;
+        float param_43 = position;
+        float param_44 = nu_slice;
+        float param_45 = log_first_span;
+        AtmosphereParameters param_46 = atmosphere;
+        float4 param_47 = uvwz;
+        float param_48 = position;
+        float param_49 = nu_slice + 1.0f;
+        float param_50 = log_first_span;
+        float4 param_51 = GetScatteringBelowSplit(param_41, scattering_texture_1, _scattering_texture_1_sampler, param_42, param_43, param_44, param_45);
+        float4 param_52 = GetScatteringBelowSplit(param_46, scattering_texture_1, _scattering_texture_1_sampler, param_47, param_48, param_49, param_50);
+        float param_53 = nu_t;
+        bool param_54 = true;
+        return SunCosineMix(param_51, param_52, param_53, param_54);
     }
-    AtmosphereParameters param_52 = atmosphere;
-    float param_53 = 0.100000001490116119384765625f;
-    float x_low_sun = GetScatteringTextureUMuS(param_52, param_53);
-    AtmosphereParameters param_54 = atmosphere;
-    float param_55 = uvwz.y;
-    float param_56 = x_low_sun;
-    float param_57;
-    float param_58;
-    float param_59;
-    bool param_60;
-    GetScatteringMuSColumns(param_54, param_55, param_56, param_57, param_58, param_59, param_60);
-    float x_below = param_57;
-    float x_above = param_58;
-    float mu_s_t = param_59;
-    bool low_sun_below = param_60;
-    AtmosphereParameters param_61 = atmosphere;
-    float4 param_62 = uvwz;
-    float param_63 = x_below;
-    float param_64 = nu_slice;
-    float param_65 = nu_t;
-    bool param_66 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_61, scattering_texture_1, _scattering_texture_1_sampler, param_62, param_63, param_64, param_65, param_66);
-    AtmosphereParameters param_67 = atmosphere;
-    float4 param_68 = uvwz;
-    float param_69 = x_above;
-    float param_70 = nu_slice;
-    float param_71 = nu_t;
-    bool param_72 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_67, scattering_texture_1, _scattering_texture_1_sampler, param_68, param_69, param_70, param_71, param_72);
+    AtmosphereParameters param_55 = atmosphere;
+    float param_56 = 0.100000001490116119384765625f;
+    float x_low_sun = GetScatteringTextureUMuS(param_55, param_56);
+    AtmosphereParameters param_57 = atmosphere;
+    float param_58 = uvwz.y;
+    float param_59 = x_low_sun;
+    float param_60;
+    float param_61;
+    float param_62;
+    bool param_63;
+    GetScatteringMuSColumns(param_57, param_58, param_59, param_60, param_61, param_62, param_63);
+    float x_below = param_60;
+    float x_above = param_61;
+    float mu_s_t = param_62;
+    bool low_sun_below = param_63;
+    AtmosphereParameters param_64 = atmosphere;
+    float4 param_65 = uvwz;
+    float param_66 = x_below;
+    float param_67 = nu_slice;
+    float param_68 = nu_t;
+    bool param_69 = low_sun_below;
+    float4 below = GetScatteringAtMuSColumn(param_64, scattering_texture_1, _scattering_texture_1_sampler, param_65, param_66, param_67, param_68, param_69);
+    AtmosphereParameters param_70 = atmosphere;
+    float4 param_71 = uvwz;
+    float param_72 = x_above;
+    float param_73 = nu_slice;
+    float param_74 = nu_t;
+    bool param_75 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_70, scattering_texture_1, _scattering_texture_1_sampler, param_71, param_72, param_73, param_74, param_75);
     if (mu_s_t < 0.0f)
     {
-        AtmosphereParameters param_73 = atmosphere;
-        float param_74 = 1.0f / (mu_s_size - 1.0f);
-        float4 param_75 = below;
-        float4 param_76 = above;
-        float param_77 = atmosphere.scattering_mu_s_min;
-        float param_78 = GetScatteringMuSFromUnitRange(param_73, param_74);
-        float param_79 = mu_s;
-        return LowestSunContinued(param_75, param_76, param_77, param_78, param_79);
+        AtmosphereParameters param_76 = atmosphere;
+        float param_77 = 1.0f / (mu_s_size - 1.0f);
+        float4 param_78 = below;
+        float4 param_79 = above;
+        float param_80 = atmosphere.scattering_mu_s_min;
+        float param_81 = GetScatteringMuSFromUnitRange(param_76, param_77);
+        float param_82 = mu_s;
+        return LowestSunContinued(param_78, param_79, param_80, param_81, param_82);
     }
     if (!low_sun_below)
     {
@@ -1051,28 +1124,28 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float column = (x_below * mu_s_size) - 0.5f;
     float x_first = (max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size;
     float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
-    AtmosphereParameters param_80 = atmosphere;
-    float4 param_81 = uvwz;
-    float param_82 = x_first;
-    float param_83 = nu_slice;
-    float param_84 = nu_t;
-    bool param_85 = true;
-    float4 first = GetScatteringAtMuSColumn(param_80, scattering_texture_1, _scattering_texture_1_sampler, param_81, param_82, param_83, param_84, param_85);
-    AtmosphereParameters param_86 = atmosphere;
-    float4 param_87 = uvwz;
-    float param_88 = x_last;
-    float param_89 = nu_slice;
-    float param_90 = nu_t;
-    bool param_91 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_86, scattering_texture_1, _scattering_texture_1_sampler, param_87, param_88, param_89, param_90, param_91);
-    float4 param_92 = first;
-    float4 param_93 = below;
-    float4 param_94 = above;
-    float4 param_95 = last;
-    bool param_96 = column > 0.5f;
-    bool param_97 = (column + 2.0f) < (mu_s_size - 0.5f);
-    float param_98 = mu_s_t;
-    return LogMonotoneCubicMix(param_92, param_93, param_94, param_95, param_96, param_97, param_98);
+    AtmosphereParameters param_83 = atmosphere;
+    float4 param_84 = uvwz;
+    float param_85 = x_first;
+    float param_86 = nu_slice;
+    float param_87 = nu_t;
+    bool param_88 = true;
+    float4 first = GetScatteringAtMuSColumn(param_83, scattering_texture_1, _scattering_texture_1_sampler, param_84, param_85, param_86, param_87, param_88);
+    AtmosphereParameters param_89 = atmosphere;
+    float4 param_90 = uvwz;
+    float param_91 = x_last;
+    float param_92 = nu_slice;
+    float param_93 = nu_t;
+    bool param_94 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_89, scattering_texture_1, _scattering_texture_1_sampler, param_90, param_91, param_92, param_93, param_94);
+    float4 param_95 = first;
+    float4 param_96 = below;
+    float4 param_97 = above;
+    float4 param_98 = last;
+    bool param_99 = column > 0.5f;
+    bool param_100 = (column + 2.0f) < (mu_s_size - 0.5f);
+    float param_101 = mu_s_t;
+    return LogMonotoneCubicMix(param_95, param_96, param_97, param_98, param_99, param_100, param_101);
 }
 #endif
 
@@ -1088,16 +1161,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3376;
+        float3 _3548;
         if (scattering.x > 0.0f)
         {
-            _3376 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3548 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3376 = 0.0f.xxx;
+            _3548 = 0.0f.xxx;
         }
-        single_mie_scattering = _3376;
+        single_mie_scattering = _3548;
     }
     else
     {
@@ -1169,13 +1242,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _3444 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3616 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3444)
+    if (!_3616)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1184,19 +1257,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3464;
+    float3 _3636;
     if (ray_r_mu_intersects_ground)
     {
-        _3464 = 0.0f.xxx;
+        _3636 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3464 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _3636 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _3464;
+    transmittance = _3636;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1204,9 +1277,9 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _3491 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _3663 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _3491;
+    float3 scattering = _3663;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -1240,16 +1313,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _3585;
+    float _3757;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _3585 = a * exp(f * log(b / a));
+        _3757 = a * exp(f * log(b / a));
     }
     else
     {
-        _3585 = lerp(a, b, f);
+        _3757 = lerp(a, b, f);
     }
-    return _3585;
+    return _3757;
 }
 #endif
 
@@ -1315,16 +1388,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _3836;
+    float _4008;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _3836 = 1.0f - (0.5f * depth);
+        _4008 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _3836 = (1.0f - exp(-depth)) / depth;
+        _4008 = (1.0f - exp(-depth)) / depth;
     }
-    return _3836;
+    return _4008;
 }
 #endif
 
@@ -1360,10 +1433,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _3916 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4088 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _3916;
+        float3 extinction = _4088;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1421,10 +1494,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _3781 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _3953 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _3781;
+        float3 extinction = _3953;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1497,14 +1570,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _3806;
+    float3 _3978;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _3806 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _3978 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1513,9 +1586,9 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _3806 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _3978 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _3806;
+    return _3978;
 }
 #endif
 
@@ -1528,16 +1601,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3547;
+    float _3719;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _3547 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3719 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3547 = up;
+        _3719 = up;
     }
-    return _3547;
+    return _3719;
 }
 #endif
 
@@ -1560,13 +1633,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4062 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4234 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4062)
+    if (!_4234)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1606,11 +1679,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4157 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4329 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4157;
+        lit_optical_depth = _4329;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1624,11 +1697,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4191 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4363 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4191;
+        optical_depth += _4363;
     }
     if (direct < 1.0f)
     {
@@ -1647,9 +1720,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4234 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4406 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4234;
+    float3 scattering = _4406;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1670,11 +1743,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4282 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4454 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4282;
+        float3 far_optical_depth = _4454;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1694,9 +1767,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4336 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4508 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4336);
+            scattering -= (exp(-far_optical_depth) * _4508);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1717,9 +1790,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4401 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4573 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4401;
+    float3 scattering_p = _4573;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1739,25 +1812,25 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4445 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _4617 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4445;
+    return _4617;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1982;
+    float _2155;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1982 = 0.100000001490116119384765625f;
+        _2155 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1982 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _2155 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1982;
+    return _2155;
 }
 #endif
 
@@ -1766,16 +1839,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2000;
+    float _2173;
     if (mu_s < knee)
     {
-        _2000 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _2173 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _2000 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _2173 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _2000;
+    return _2173;
 }
 #endif
 
@@ -1802,16 +1875,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2031;
+    float _2204;
     if (x < 0.5f)
     {
-        _2031 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _2204 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2031 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _2204 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _2031;
+    return _2204;
 }
 #endif
 
@@ -1823,16 +1896,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2326;
+    float4 _2498;
     if (t < 0.0f)
     {
-        _2326 = min(blend, a);
+        _2498 = min(blend, a);
     }
     else
     {
-        _2326 = blend;
+        _2498 = blend;
     }
-    return _2326;
+    return _2498;
 }
 #endif
 

@@ -804,7 +804,7 @@ fn ViewSunAzimuthCosine(mu_17: f32, mu_s_7: f32, nu_9: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeSunZenith(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_phi: f32, ray_r_mu_intersects_ground_2: bool) -> f32 {
+fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_phi: f32, ray_r_mu_intersects_ground_2: bool, direction: ptr<function, vec2<f32>>) -> f32 {
     var atmosphere_31: AtmosphereParameters;
     var r_25: f32;
     var mu_20: f32;
@@ -816,241 +816,395 @@ fn ShadowEdgeSunZenith(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f3
     var across_1: f32;
     var rho_3: f32;
     var c_end: f32;
-    var local_5: f32;
-    var end: f32;
-    var start_1: f32;
+    var c_start: f32;
+    var start_1: vec2<f32>;
+    var cos_gamma: f32;
+    var sin_gamma: f32;
+    var local_5: vec2<f32>;
+    var end: vec2<f32>;
+    var end_sets_last: bool;
+    var a_6: f32;
+    var cos_a: f32;
+    var sin_a: f32;
+    var local_6: vec2<f32>;
+    var last: vec2<f32>;
+    var local_7: f32;
+    var local_8: f32;
+    var angle: f32;
 
     atmosphere_31 = atmosphere_30;
     r_25 = r_24;
     mu_20 = mu_19;
     cos_phi_1 = cos_phi;
     ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
-    let _e21 = atmosphere_31;
-    let _e22 = r_25;
-    let _e23 = mu_20;
-    let _e24 = ray_r_mu_intersects_ground_3;
-    let _e25 = DistanceToNearestAtmosphereBoundary(_e21, _e22, _e23, _e24);
-    d_9 = _e25;
-    let _e27 = atmosphere_31;
-    let _e28 = r_25;
-    let _e29 = mu_20;
-    let _e30 = d_9;
-    let _e31 = RadiusAtDistance(_e27, _e28, _e29, _e30);
-    r_d_2 = _e31;
-    let _e33 = r_25;
-    let _e34 = d_9;
-    let _e35 = mu_20;
-    let _e38 = r_d_2;
-    let _e40 = ClampCosine(((_e33 + (_e34 * _e35)) / _e38));
-    cos_alpha = _e40;
-    let _e42 = d_9;
-    let _e44 = mu_20;
+    let _e22 = atmosphere_31;
+    let _e23 = r_25;
+    let _e24 = mu_20;
+    let _e25 = ray_r_mu_intersects_ground_3;
+    let _e26 = DistanceToNearestAtmosphereBoundary(_e22, _e23, _e24, _e25);
+    d_9 = _e26;
+    let _e28 = atmosphere_31;
+    let _e29 = r_25;
+    let _e30 = mu_20;
+    let _e31 = d_9;
+    let _e32 = RadiusAtDistance(_e28, _e29, _e30, _e31);
+    r_d_2 = _e32;
+    let _e34 = r_25;
+    let _e35 = d_9;
+    let _e36 = mu_20;
+    let _e39 = r_d_2;
+    let _e41 = ClampCosine(((_e34 + (_e35 * _e36)) / _e39));
+    cos_alpha = _e41;
+    let _e43 = d_9;
     let _e45 = mu_20;
-    let _e48 = SafeSqrt((1f - (_e44 * _e45)));
-    let _e50 = r_d_2;
-    let _e52 = cos_phi_1;
-    across_1 = (((_e42 * _e48) / _e50) * _e52);
-    let _e55 = across_1;
+    let _e46 = mu_20;
+    let _e49 = SafeSqrt((1f - (_e45 * _e46)));
+    let _e51 = r_d_2;
+    let _e53 = cos_phi_1;
+    across_1 = (((_e43 * _e49) / _e51) * _e53);
     let _e56 = across_1;
-    let _e58 = cos_alpha;
+    let _e57 = across_1;
     let _e59 = cos_alpha;
-    rho_3 = sqrt(((_e55 * _e56) + (_e58 * _e59)));
-    let _e64 = atmosphere_31;
-    let _e66 = r_d_2;
-    let _e67 = HorizonZenithCosine(_e64.bottom_radius, _e66);
-    c_end = -(_e67);
-    let _e70 = c_end;
-    let _e71 = rho_3;
-    if (_e70 >= _e71) {
-        local_5 = PI;
+    let _e60 = cos_alpha;
+    rho_3 = sqrt(((_e56 * _e57) + (_e59 * _e60)));
+    let _e65 = atmosphere_31;
+    let _e67 = r_d_2;
+    let _e68 = HorizonZenithCosine(_e65.bottom_radius, _e67);
+    c_end = -(_e68);
+    let _e71 = atmosphere_31;
+    let _e73 = r_25;
+    let _e74 = HorizonZenithCosine(_e71.bottom_radius, _e73);
+    c_start = _e74;
+    let _e76 = c_start;
+    let _e77 = atmosphere_31;
+    let _e79 = r_25;
+    start_1 = vec2<f32>(_e76, (_e77.bottom_radius / _e79));
+    let _e83 = c_end;
+    let _e85 = rho_3;
+    cos_gamma = (-(_e83) / _e85);
+    let _e89 = cos_gamma;
+    let _e90 = cos_gamma;
+    let _e93 = SafeSqrt((1f - (_e89 * _e90)));
+    sin_gamma = _e93;
+    let _e95 = c_end;
+    let _e96 = rho_3;
+    if (_e95 >= _e96) {
+        local_5 = vec2<f32>(-1f, 0f);
     } else {
-        let _e73 = across_1;
-        let _e74 = cos_alpha;
-        let _e76 = c_end;
-        let _e78 = rho_3;
-        local_5 = (atan2(_e73, _e74) + acos((-(_e76) / _e78)));
+        let _e102 = cos_alpha;
+        let _e103 = cos_gamma;
+        let _e105 = across_1;
+        let _e106 = sin_gamma;
+        let _e109 = across_1;
+        let _e110 = cos_gamma;
+        let _e112 = cos_alpha;
+        let _e113 = sin_gamma;
+        let _e117 = rho_3;
+        local_5 = (vec2<f32>(((_e102 * _e103) - (_e105 * _e106)), ((_e109 * _e110) + (_e112 * _e113))) / vec2(_e117));
     }
-    let _e83 = local_5;
-    end = _e83;
-    let _e85 = atmosphere_31;
-    let _e87 = r_25;
-    let _e88 = HorizonZenithCosine(_e85.bottom_radius, _e87);
-    start_1 = acos(_e88);
-    let _e91 = start_1;
-    let _e92 = end;
-    let _e94 = atmosphere_31;
-    return (max(_e91, _e92) + _e94.sun_angular_radius);
+    let _e121 = local_5;
+    end = _e121;
+    let _e123 = end;
+    let _e127 = end;
+    let _e129 = start_1;
+    end_sets_last = ((_e123.y < 0f) || (_e127.x < _e129.x));
+    let _e134 = atmosphere_31;
+    a_6 = _e134.sun_angular_radius;
+    let _e139 = a_6;
+    let _e141 = a_6;
+    let _e144 = a_6;
+    let _e145 = a_6;
+    cos_a = (1f - (((0.5f * _e139) * _e141) * (1f - ((_e144 * _e145) / 12f))));
+    let _e153 = a_6;
+    let _e155 = a_6;
+    let _e156 = a_6;
+    sin_a = (_e153 * (1f - ((_e155 * _e156) / 6f)));
+    let _e163 = end_sets_last;
+    if _e163 {
+        let _e164 = end;
+        local_6 = _e164;
+    } else {
+        let _e165 = start_1;
+        local_6 = _e165;
+    }
+    let _e167 = local_6;
+    last = _e167;
+    let _e169 = last;
+    let _e171 = cos_a;
+    let _e173 = last;
+    let _e175 = sin_a;
+    let _e178 = last;
+    let _e180 = cos_a;
+    let _e182 = last;
+    let _e184 = sin_a;
+    (*direction) = vec2<f32>(((_e169.x * _e171) - (_e173.y * _e175)), ((_e178.y * _e180) + (_e182.x * _e184)));
+    let _e188 = end_sets_last;
+    if _e188 {
+        let _e189 = c_end;
+        let _e190 = rho_3;
+        if (_e189 >= _e190) {
+            local_7 = PI;
+        } else {
+            let _e192 = across_1;
+            let _e193 = cos_alpha;
+            let _e195 = cos_gamma;
+            local_7 = (atan2(_e192, _e193) + acos(_e195));
+        }
+        let _e199 = local_7;
+        local_8 = _e199;
+    } else {
+        let _e200 = c_start;
+        local_8 = acos(_e200);
+    }
+    let _e203 = local_8;
+    angle = _e203;
+    let _e205 = angle;
+    let _e206 = a_6;
+    return (_e205 + _e206);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringSplitSunZenith(atmosphere_32: AtmosphereParameters) -> f32 {
+fn ShadowEdgeSunZenith(atmosphere_32: AtmosphereParameters, r_26: f32, mu_21: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_4: bool) -> f32 {
     var atmosphere_33: AtmosphereParameters;
+    var r_27: f32;
+    var mu_22: f32;
+    var cos_phi_3: f32;
+    var ray_r_mu_intersects_ground_5: bool;
+    var unused: vec2<f32>;
 
     atmosphere_33 = atmosphere_32;
-    let _e13 = atmosphere_33;
-    let _e14 = atmosphere_33;
-    let _e17 = atmosphere_33;
-    let _e23 = GetScatteringMuSFromUnitRange(_e13, (f32(_e14.scattering_mu_s_split) / f32((_e17.scattering_mu_s_size - 1i))));
-    return acos(_e23);
+    r_27 = r_26;
+    mu_22 = mu_21;
+    cos_phi_3 = cos_phi_2;
+    ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
+    let _e22 = atmosphere_33;
+    let _e23 = r_27;
+    let _e24 = mu_22;
+    let _e25 = cos_phi_3;
+    let _e26 = ray_r_mu_intersects_ground_5;
+    let _e29 = ShadowEdge(_e22, _e23, _e24, _e25, _e26, (&unused));
+    return _e29;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeUnitSun(atmosphere_34: AtmosphereParameters, sun_zenith: f32, derivative: ptr<function, f32>) -> f32 {
+fn ShadowEdgeDirection(edge: f32) -> vec2<f32> {
+    var edge_1: f32;
+
+    edge_1 = edge;
+    let _e13 = edge_1;
+    let _e15 = edge_1;
+    return vec2<f32>(cos(_e13), sin(_e15));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeDistance(edge_2: vec2<f32>, mu_s_9: f32) -> f32 {
+    var edge_3: vec2<f32>;
+    var mu_s_10: f32;
+    var sin_theta: f32;
+
+    edge_3 = edge_2;
+    mu_s_10 = mu_s_9;
+    let _e16 = mu_s_10;
+    let _e17 = mu_s_10;
+    let _e20 = SafeSqrt((1f - (_e16 * _e17)));
+    sin_theta = _e20;
+    let _e22 = edge_3;
+    let _e24 = mu_s_10;
+    let _e26 = edge_3;
+    let _e28 = sin_theta;
+    let _e31 = edge_3;
+    let _e33 = mu_s_10;
+    let _e35 = edge_3;
+    let _e37 = sin_theta;
+    return atan2(((_e22.y * _e24) - (_e26.x * _e28)), ((_e31.x * _e33) + (_e35.y * _e37)));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeSunCosine(edge_4: vec2<f32>, D_1: f32) -> f32 {
+    var edge_5: vec2<f32>;
+    var D_2: f32;
+
+    edge_5 = edge_4;
+    D_2 = D_1;
+    let _e15 = edge_5;
+    let _e17 = D_2;
+    let _e20 = edge_5;
+    let _e22 = D_2;
+    return ((_e15.x * cos(_e17)) + (_e20.y * sin(_e22)));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringSplitMuS(atmosphere_34: AtmosphereParameters) -> f32 {
     var atmosphere_35: AtmosphereParameters;
-    var sun_zenith_1: f32;
+
+    atmosphere_35 = atmosphere_34;
+    let _e13 = atmosphere_35;
+    let _e14 = atmosphere_35;
+    let _e17 = atmosphere_35;
+    let _e23 = GetScatteringMuSFromUnitRange(_e13, (f32(_e14.scattering_mu_s_split) / f32((_e17.scattering_mu_s_size - 1i))));
+    return _e23;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdgeUnitSun(atmosphere_36: AtmosphereParameters, mu_s_11: f32, derivative: ptr<function, f32>) -> f32 {
+    var atmosphere_37: AtmosphereParameters;
+    var mu_s_12: f32;
     var bottom_1: f32;
-    var mu_s_9: f32;
     var d_10: f32;
     var d_min_4: f32;
     var span: f32;
-    var a_6: f32;
+    var a_7: f32;
     var inverse_A_4: f32;
     var da_dtheta: f32;
 
-    atmosphere_35 = atmosphere_34;
-    sun_zenith_1 = sun_zenith;
-    let _e16 = atmosphere_35;
+    atmosphere_37 = atmosphere_36;
+    mu_s_12 = mu_s_11;
+    let _e16 = atmosphere_37;
     bottom_1 = _e16.bottom_radius;
-    let _e19 = sun_zenith_1;
-    mu_s_9 = cos(_e19);
-    let _e22 = atmosphere_35;
-    let _e23 = bottom_1;
-    let _e24 = mu_s_9;
-    let _e25 = DistanceToTopAtmosphereBoundary(_e22, _e23, _e24);
-    d_10 = _e25;
-    let _e27 = atmosphere_35;
-    let _e29 = bottom_1;
-    d_min_4 = (_e27.top_radius - _e29);
-    let _e32 = atmosphere_35;
-    let _e33 = HorizonDistanceAtTop(_e32);
-    let _e34 = d_min_4;
-    span = (_e33 - _e34);
-    let _e37 = d_10;
-    let _e38 = d_min_4;
-    let _e40 = span;
-    a_6 = ((_e37 - _e38) / _e40);
-    let _e44 = atmosphere_35;
-    let _e45 = GetScatteringLowestSunDistance(_e44);
-    inverse_A_4 = (1f / _e45);
-    let _e48 = bottom_1;
-    let _e49 = d_10;
-    let _e51 = d_10;
-    let _e52 = bottom_1;
-    let _e53 = mu_s_9;
-    let _e57 = span;
-    let _e59 = sun_zenith_1;
-    da_dtheta = ((((_e48 * _e49) / (_e51 + (_e52 * _e53))) / _e57) * sin(_e59));
-    let _e63 = inverse_A_4;
-    let _e68 = a_6;
-    let _e71 = a_6;
-    let _e75 = da_dtheta;
-    (*derivative) = ((-((_e63 + 1f)) / ((1f + _e68) * (1f + _e71))) * _e75);
-    let _e78 = a_6;
-    let _e79 = inverse_A_4;
-    let _e83 = a_6;
-    return ((1f - (_e78 * _e79)) / (1f + _e83));
+    let _e19 = atmosphere_37;
+    let _e20 = bottom_1;
+    let _e21 = mu_s_12;
+    let _e22 = DistanceToTopAtmosphereBoundary(_e19, _e20, _e21);
+    d_10 = _e22;
+    let _e24 = atmosphere_37;
+    let _e26 = bottom_1;
+    d_min_4 = (_e24.top_radius - _e26);
+    let _e29 = atmosphere_37;
+    let _e30 = HorizonDistanceAtTop(_e29);
+    let _e31 = d_min_4;
+    span = (_e30 - _e31);
+    let _e34 = d_10;
+    let _e35 = d_min_4;
+    let _e37 = span;
+    a_7 = ((_e34 - _e35) / _e37);
+    let _e41 = atmosphere_37;
+    let _e42 = GetScatteringLowestSunDistance(_e41);
+    inverse_A_4 = (1f / _e42);
+    let _e45 = bottom_1;
+    let _e46 = d_10;
+    let _e48 = d_10;
+    let _e49 = bottom_1;
+    let _e50 = mu_s_12;
+    let _e54 = span;
+    let _e57 = mu_s_12;
+    let _e58 = mu_s_12;
+    let _e61 = SafeSqrt((1f - (_e57 * _e58)));
+    da_dtheta = ((((_e45 * _e46) / (_e48 + (_e49 * _e50))) / _e54) * _e61);
+    let _e64 = inverse_A_4;
+    let _e69 = a_7;
+    let _e72 = a_7;
+    let _e76 = da_dtheta;
+    (*derivative) = ((-((_e64 + 1f)) / ((1f + _e69) * (1f + _e72))) * _e76);
+    let _e79 = a_7;
+    let _e80 = inverse_A_4;
+    let _e84 = a_7;
+    return ((1f - (_e79 * _e80)) / (1f + _e84));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitFrom(atmosphere_36: AtmosphereParameters, D_1: f32, edge: f32, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
-    var atmosphere_37: AtmosphereParameters;
-    var D_2: f32;
-    var edge_1: f32;
+fn ShadowEdgeLitUnitFrom(atmosphere_38: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
+    var atmosphere_39: AtmosphereParameters;
+    var D_4: f32;
+    var edge_7: vec2<f32>;
     var X_closest_1: f32;
     var X_span_1: f32;
     var log_span_1: f32;
     var dX_dtheta: f32;
     var X: f32;
 
-    atmosphere_37 = atmosphere_36;
-    D_2 = D_1;
-    edge_1 = edge;
+    atmosphere_39 = atmosphere_38;
+    D_4 = D_3;
+    edge_7 = edge_6;
     X_closest_1 = X_closest;
     X_span_1 = X_span;
     log_span_1 = log_span;
-    let _e25 = atmosphere_37;
-    let _e26 = edge_1;
-    let _e27 = D_2;
-    let _e31 = ShadowEdgeUnitSun(_e25, (_e26 - _e27), (&dX_dtheta));
+    let _e25 = atmosphere_39;
+    let _e26 = edge_7;
+    let _e27 = D_4;
+    let _e28 = ShadowEdgeSunCosine(_e26, _e27);
+    let _e31 = ShadowEdgeUnitSun(_e25, _e28, (&dX_dtheta));
     X = _e31;
     let _e35 = dX_dtheta;
-    let _e37 = D_2;
+    let _e37 = D_4;
     let _e39 = X_span_1;
     let _e44 = log_span_1;
     (*derivative_1) = ((((-0.3f * _e35) * _e37) / _e39) + (0.7f / _e44));
     let _e47 = X;
     let _e48 = X_closest_1;
     let _e51 = X_span_1;
-    let _e56 = D_2;
+    let _e56 = D_4;
     let _e60 = log_span_1;
     return (((SHADOW_EDGE_TABLES_WEIGHT * (_e47 - _e48)) / _e51) + ((0.7f * log((_e56 / SHADOW_EDGE_CLOSEST))) / _e60));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitSpans(atmosphere_38: AtmosphereParameters, edge_2: f32, split_sun: f32, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>) {
-    var atmosphere_39: AtmosphereParameters;
-    var edge_3: f32;
-    var split_sun_1: f32;
-    var unused: f32;
+fn ShadowEdgeLitUnitSpans(atmosphere_40: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
+    var atmosphere_41: AtmosphereParameters;
+    var edge_9: vec2<f32>;
+    var unused_1: f32;
+    var split_mu_s: f32;
 
-    atmosphere_39 = atmosphere_38;
-    edge_3 = edge_2;
-    split_sun_1 = split_sun;
-    let _e21 = atmosphere_39;
-    let _e22 = edge_3;
-    let _e26 = ShadowEdgeUnitSun(_e21, (_e22 - SHADOW_EDGE_CLOSEST), (&unused));
-    (*X_closest_2) = _e26;
-    let _e27 = atmosphere_39;
-    let _e28 = split_sun_1;
-    let _e31 = ShadowEdgeUnitSun(_e27, _e28, (&unused));
-    let _e32 = (*X_closest_2);
-    (*X_span_2) = (_e31 - _e32);
-    let _e34 = edge_3;
-    let _e35 = split_sun_1;
-    (*log_span_2) = log(((_e34 - _e35) / SHADOW_EDGE_CLOSEST));
+    atmosphere_41 = atmosphere_40;
+    edge_9 = edge_8;
+    let _e20 = atmosphere_41;
+    let _e21 = GetScatteringSplitMuS(_e20);
+    split_mu_s = _e21;
+    let _e23 = atmosphere_41;
+    let _e24 = edge_9;
+    let _e25 = ShadowEdgeSunCosine(_e24, SHADOW_EDGE_CLOSEST);
+    let _e28 = ShadowEdgeUnitSun(_e23, _e25, (&unused_1));
+    (*X_closest_2) = _e28;
+    let _e29 = atmosphere_41;
+    let _e30 = split_mu_s;
+    let _e33 = ShadowEdgeUnitSun(_e29, _e30, (&unused_1));
+    let _e34 = (*X_closest_2);
+    (*X_span_2) = (_e33 - _e34);
+    let _e36 = edge_9;
+    let _e37 = split_mu_s;
+    let _e38 = ShadowEdgeDistance(_e36, _e37);
+    (*split_distance) = _e38;
+    let _e39 = (*split_distance);
+    (*log_span_2) = log((_e39 / SHADOW_EDGE_CLOSEST));
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnit(atmosphere_40: AtmosphereParameters, distance_: f32, edge_4: f32, split_sun_2: f32) -> f32 {
-    var atmosphere_41: AtmosphereParameters;
+fn ShadowEdgeLitUnit(atmosphere_42: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
+    var atmosphere_43: AtmosphereParameters;
     var distance_1: f32;
-    var edge_5: f32;
-    var split_sun_3: f32;
+    var edge_11: vec2<f32>;
     var X_closest_3: f32;
     var X_span_3: f32;
     var log_span_3: f32;
-    var unused_1: f32;
+    var split_distance_1: f32;
+    var unused_2: f32;
 
-    atmosphere_41 = atmosphere_40;
+    atmosphere_43 = atmosphere_42;
     distance_1 = distance_;
-    edge_5 = edge_4;
-    split_sun_3 = split_sun_2;
-    let _e22 = atmosphere_41;
-    let _e23 = edge_5;
-    let _e24 = split_sun_3;
-    ShadowEdgeLitUnitSpans(_e22, _e23, _e24, (&X_closest_3), (&X_span_3), (&log_span_3));
-    let _e32 = atmosphere_41;
+    edge_11 = edge_10;
+    let _e21 = atmosphere_43;
+    let _e22 = edge_11;
+    ShadowEdgeLitUnitSpans(_e21, _e22, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
+    let _e32 = atmosphere_43;
     let _e33 = distance_1;
-    let _e34 = edge_5;
-    let _e35 = split_sun_3;
-    let _e38 = edge_5;
-    let _e39 = X_closest_3;
-    let _e40 = X_span_3;
-    let _e41 = log_span_3;
-    let _e44 = ShadowEdgeLitUnitFrom(_e32, clamp(_e33, SHADOW_EDGE_CLOSEST, (_e34 - _e35)), _e38, _e39, _e40, _e41, (&unused_1));
-    return _e44;
+    let _e34 = split_distance_1;
+    let _e36 = edge_11;
+    let _e37 = X_closest_3;
+    let _e38 = X_span_3;
+    let _e39 = log_span_3;
+    let _e42 = ShadowEdgeLitUnitFrom(_e32, clamp(_e33, SHADOW_EDGE_CLOSEST, _e34), _e36, _e37, _e38, _e39, (&unused_2));
+    return _e42;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitDistance(atmosphere_42: AtmosphereParameters, x_7: f32, edge_6: f32, split_sun_4: f32) -> f32 {
-    var atmosphere_43: AtmosphereParameters;
+fn ShadowEdgeLitDistance(atmosphere_44: AtmosphereParameters, x_7: f32, edge_12: vec2<f32>) -> f32 {
+    var atmosphere_45: AtmosphereParameters;
     var x_8: f32;
-    var edge_7: f32;
-    var split_sun_5: f32;
+    var edge_13: vec2<f32>;
     var X_closest_4: f32;
     var X_span_4: f32;
     var log_span_4: f32;
+    var split_distance_2: f32;
     var s_min: f32 = -7.043959f;
     var s_max: f32;
     var s_2: f32;
@@ -1060,14 +1214,12 @@ fn ShadowEdgeLitDistance(atmosphere_42: AtmosphereParameters, x_7: f32, edge_6: 
     var next: f32;
     var converged: bool;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_45 = atmosphere_44;
     x_8 = x_7;
-    edge_7 = edge_6;
-    split_sun_5 = split_sun_4;
-    let _e22 = atmosphere_43;
-    let _e23 = edge_7;
-    let _e24 = split_sun_5;
-    ShadowEdgeLitUnitSpans(_e22, _e23, _e24, (&X_closest_4), (&X_span_4), (&log_span_4));
+    edge_13 = edge_12;
+    let _e21 = atmosphere_45;
+    let _e22 = edge_13;
+    ShadowEdgeLitUnitSpans(_e21, _e22, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
     let _e34 = s_min;
     let _e35 = log_span_4;
     s_max = (_e34 + _e35);
@@ -1081,9 +1233,9 @@ fn ShadowEdgeLitDistance(atmosphere_42: AtmosphereParameters, x_7: f32, edge_6: 
             break;
         }
         {
-            let _e53 = atmosphere_43;
+            let _e53 = atmosphere_45;
             let _e54 = s_2;
-            let _e56 = edge_7;
+            let _e56 = edge_13;
             let _e57 = X_closest_4;
             let _e58 = X_span_4;
             let _e59 = log_span_4;
@@ -1116,120 +1268,106 @@ fn ShadowEdgeLitDistance(atmosphere_42: AtmosphereParameters, x_7: f32, edge_6: 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgePastStep(atmosphere_44: AtmosphereParameters, edge_8: f32) -> f32 {
-    var atmosphere_45: AtmosphereParameters;
-    var edge_9: f32;
-    var lowest: f32;
-
-    atmosphere_45 = atmosphere_44;
-    edge_9 = edge_8;
-    let _e15 = atmosphere_45;
-    lowest = acos(_e15.scattering_mu_s_min);
-    let _e19 = lowest;
-    let _e20 = edge_9;
-    return (max((_e19 - _e20), SHADOW_EDGE_LEAST_PAST_SPAN) / 5f);
-}
-
-// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgePosition(atmosphere_46: AtmosphereParameters, sun_zenith_2: f32, edge_10: f32) -> f32 {
+fn ShadowEdgePastStep(atmosphere_46: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
     var atmosphere_47: AtmosphereParameters;
-    var sun_zenith_3: f32;
-    var edge_11: f32;
-    var past: f32 = 6f;
-    var split_sun_6: f32;
-    var D_3: f32;
+    var edge_15: vec2<f32>;
+    var past_lowest: f32;
 
     atmosphere_47 = atmosphere_46;
-    sun_zenith_3 = sun_zenith_2;
-    edge_11 = edge_10;
-    let _e20 = atmosphere_47;
-    let _e21 = GetScatteringSplitSunZenith(_e20);
-    split_sun_6 = _e21;
-    let _e23 = edge_11;
-    let _e24 = sun_zenith_3;
-    D_3 = (_e23 - _e24);
-    let _e27 = D_3;
-    if (_e27 >= SHADOW_EDGE_CLOSEST) {
-        {
-            let _e29 = past;
-            let _e30 = atmosphere_47;
-            let _e31 = D_3;
-            let _e32 = edge_11;
-            let _e33 = split_sun_6;
-            let _e34 = ShadowEdgeLitUnit(_e30, _e31, _e32, _e33);
-            let _e35 = atmosphere_47;
-            let _e38 = past;
-            return (_e29 + (_e34 * (f32(_e35.scattering_mu_s_split) - _e38)));
-        }
-    }
-    let _e42 = D_3;
-    if (_e42 >= 0f) {
-        let _e45 = past;
-        let _e48 = D_3;
-        return ((_e45 - 1f) + (_e48 / SHADOW_EDGE_CLOSEST));
-    }
-    let _e51 = past;
-    let _e54 = D_3;
-    let _e55 = atmosphere_47;
-    let _e56 = edge_11;
-    let _e57 = ShadowEdgePastStep(_e55, _e56);
-    return ((_e51 - 1f) + (_e54 / _e57));
+    edge_15 = edge_14;
+    let _e15 = edge_15;
+    let _e16 = atmosphere_47;
+    let _e18 = ShadowEdgeDistance(_e15, _e16.scattering_mu_s_min);
+    past_lowest = -(_e18);
+    let _e21 = past_lowest;
+    return (max(_e21, SHADOW_EDGE_LEAST_PAST_SPAN) / 5f);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgeSunZenith(atmosphere_48: AtmosphereParameters, position: f32, edge_12: f32, split_sun_7: f32) -> f32 {
+fn GetScatteringShadowEdgePosition(atmosphere_48: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
     var atmosphere_49: AtmosphereParameters;
+    var D_6: f32;
+    var edge_17: vec2<f32>;
+    var past: f32 = 6f;
+
+    atmosphere_49 = atmosphere_48;
+    D_6 = D_5;
+    edge_17 = edge_16;
+    let _e20 = D_6;
+    if (_e20 >= SHADOW_EDGE_CLOSEST) {
+        {
+            let _e22 = past;
+            let _e23 = atmosphere_49;
+            let _e24 = D_6;
+            let _e25 = edge_17;
+            let _e26 = ShadowEdgeLitUnit(_e23, _e24, _e25);
+            let _e27 = atmosphere_49;
+            let _e30 = past;
+            return (_e22 + (_e26 * (f32(_e27.scattering_mu_s_split) - _e30)));
+        }
+    }
+    let _e34 = D_6;
+    if (_e34 >= 0f) {
+        let _e37 = past;
+        let _e40 = D_6;
+        return ((_e37 - 1f) + (_e40 / SHADOW_EDGE_CLOSEST));
+    }
+    let _e43 = past;
+    let _e46 = D_6;
+    let _e47 = atmosphere_49;
+    let _e48 = edge_17;
+    let _e49 = ShadowEdgePastStep(_e47, _e48);
+    return ((_e43 - 1f) + (_e46 / _e49));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringShadowEdgeDistance(atmosphere_50: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
+    var atmosphere_51: AtmosphereParameters;
     var position_1: f32;
-    var edge_13: f32;
-    var split_sun_8: f32;
+    var edge_19: vec2<f32>;
     var past_1: f32 = 6f;
     var x_9: f32;
 
-    atmosphere_49 = atmosphere_48;
+    atmosphere_51 = atmosphere_50;
     position_1 = position;
-    edge_13 = edge_12;
-    split_sun_8 = split_sun_7;
-    let _e22 = position_1;
-    let _e23 = past_1;
-    if (_e22 >= _e23) {
+    edge_19 = edge_18;
+    let _e20 = position_1;
+    let _e21 = past_1;
+    if (_e20 >= _e21) {
         {
-            let _e25 = position_1;
-            let _e26 = past_1;
-            let _e28 = atmosphere_49;
-            let _e31 = past_1;
-            x_9 = ((_e25 - _e26) / (f32(_e28.scattering_mu_s_split) - _e31));
-            let _e35 = edge_13;
-            let _e36 = atmosphere_49;
-            let _e37 = x_9;
-            let _e38 = edge_13;
-            let _e39 = split_sun_8;
-            let _e40 = ShadowEdgeLitDistance(_e36, _e37, _e38, _e39);
-            return (_e35 - _e40);
+            let _e23 = position_1;
+            let _e24 = past_1;
+            let _e26 = atmosphere_51;
+            let _e29 = past_1;
+            x_9 = ((_e23 - _e24) / (f32(_e26.scattering_mu_s_split) - _e29));
+            let _e33 = atmosphere_51;
+            let _e34 = x_9;
+            let _e35 = edge_19;
+            let _e36 = ShadowEdgeLitDistance(_e33, _e34, _e35);
+            return _e36;
         }
     }
-    let _e42 = position_1;
-    let _e43 = past_1;
-    if (_e42 >= (_e43 - 1f)) {
-        let _e47 = edge_13;
-        let _e48 = position_1;
-        let _e49 = past_1;
-        return (_e47 - (((_e48 - _e49) + 1f) * SHADOW_EDGE_CLOSEST));
+    let _e37 = position_1;
+    let _e38 = past_1;
+    if (_e37 >= (_e38 - 1f)) {
+        let _e42 = position_1;
+        let _e43 = past_1;
+        return (((_e42 - _e43) + 1f) * SHADOW_EDGE_CLOSEST);
     }
-    let _e55 = edge_13;
-    let _e56 = past_1;
-    let _e59 = position_1;
-    let _e61 = atmosphere_49;
-    let _e62 = edge_13;
-    let _e63 = ShadowEdgePastStep(_e61, _e62);
-    return (_e55 + (((_e56 - 1f) - _e59) * _e63));
+    let _e48 = position_1;
+    let _e49 = past_1;
+    let _e53 = atmosphere_51;
+    let _e54 = edge_19;
+    let _e55 = ShadowEdgePastStep(_e53, _e54);
+    return (((_e48 - _e49) + 1f) * _e55);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4: f32, ray_r_mu_intersects_ground_4: bool, x_mu_1: f32) -> f32 {
-    var atmosphere_51: AtmosphereParameters;
-    var r_27: f32;
+fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4: f32, ray_r_mu_intersects_ground_6: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_53: AtmosphereParameters;
+    var r_29: f32;
     var rho_5: f32;
-    var ray_r_mu_intersects_ground_5: bool;
+    var ray_r_mu_intersects_ground_7: bool;
     var x_mu_2: f32;
     var rho_min: f32;
     var rho_max: f32;
@@ -1244,20 +1382,20 @@ fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4:
     var d_11: f32;
     var t: f32;
 
-    atmosphere_51 = atmosphere_50;
-    r_27 = r_26;
+    atmosphere_53 = atmosphere_52;
+    r_29 = r_28;
     rho_5 = rho_4;
-    ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
+    ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
     x_mu_2 = x_mu_1;
-    let _e21 = atmosphere_51;
-    let _e22 = atmosphere_51;
+    let _e21 = atmosphere_53;
+    let _e22 = atmosphere_53;
     let _e24 = HorizonDistance(_e21, _e22.scattering_r_min);
     rho_min = _e24;
-    let _e26 = atmosphere_51;
-    let _e27 = atmosphere_51;
+    let _e26 = atmosphere_53;
+    let _e27 = atmosphere_53;
     let _e29 = HorizonDistance(_e26, _e27.scattering_r_max);
     rho_max = _e29;
-    let _e31 = atmosphere_51;
+    let _e31 = atmosphere_53;
     last_row = f32((_e31.scattering_r_size - 1i));
     let _e37 = rho_5;
     let _e38 = rho_min;
@@ -1265,7 +1403,7 @@ fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4:
     let _e41 = rho_min;
     let _e47 = last_row;
     position_2 = (clamp(((_e37 - _e38) / (_e40 - _e41)), 0f, 1f) * _e47);
-    let _e50 = ray_r_mu_intersects_ground_5;
+    let _e50 = ray_r_mu_intersects_ground_7;
     if !(_e50) {
         let _e52 = position_2;
         let _e55 = last_row;
@@ -1284,7 +1422,7 @@ fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4:
     let _e75 = row;
     let _e78 = last_row;
     rho_above = mix(_e73, _e74, ((_e75 + 1f) / _e78));
-    let _e82 = atmosphere_51;
+    let _e82 = atmosphere_53;
     bottom_2 = _e82.bottom_radius;
     let _e85 = bottom_2;
     let _e86 = rho_below;
@@ -1298,7 +1436,7 @@ fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4:
     let _e95 = rho_above;
     let _e96 = x_mu_2;
     d_above = mix(_e94, _e95, _e96);
-    let _e99 = r_27;
+    let _e99 = r_29;
     let _e100 = bottom_2;
     let _e102 = rho_5;
     let _e103 = x_mu_2;
@@ -1315,13 +1453,13 @@ fn GetScatteringTextureUR(atmosphere_50: AtmosphereParameters, r_26: f32, rho_4:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_52: AtmosphereParameters, r_28: f32, mu_21: f32, mu_s_10: f32, nu_11: f32, ray_r_mu_intersects_ground_6: bool) -> vec4<f32> {
-    var atmosphere_53: AtmosphereParameters;
-    var r_29: f32;
-    var mu_22: f32;
-    var mu_s_11: f32;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_54: AtmosphereParameters, r_30: f32, mu_23: f32, mu_s_13: f32, nu_11: f32, ray_r_mu_intersects_ground_8: bool) -> vec4<f32> {
+    var atmosphere_55: AtmosphereParameters;
+    var r_31: f32;
+    var mu_24: f32;
+    var mu_s_14: f32;
     var nu_12: f32;
-    var ray_r_mu_intersects_ground_7: bool;
+    var ray_r_mu_intersects_ground_9: bool;
     var H_2: f32;
     var rho_6: f32;
     var half_mu_size: f32;
@@ -1330,56 +1468,56 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_52: AtmosphereParameters, r_2
     var d_12: f32;
     var d_min_5: f32;
     var d_max_4: f32;
-    var local_6: f32;
+    var local_9: f32;
     var d_13: f32;
     var d_min_6: f32;
     var d_max_5: f32;
-    var local_7: f32;
+    var local_10: f32;
     var u_r: f32;
     var u_mu_s: f32;
     var mu_s_size: f32;
-    var edge_14: f32;
+    var edge_20: vec2<f32>;
 
-    atmosphere_53 = atmosphere_52;
-    r_29 = r_28;
-    mu_22 = mu_21;
-    mu_s_11 = mu_s_10;
+    atmosphere_55 = atmosphere_54;
+    r_31 = r_30;
+    mu_24 = mu_23;
+    mu_s_14 = mu_s_13;
     nu_12 = nu_11;
-    ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
-    let _e23 = atmosphere_53;
+    ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
+    let _e23 = atmosphere_55;
     let _e24 = HorizonDistanceAtTop(_e23);
     H_2 = _e24;
-    let _e26 = atmosphere_53;
-    let _e27 = r_29;
+    let _e26 = atmosphere_55;
+    let _e27 = r_31;
     let _e28 = HorizonDistance(_e26, _e27);
     rho_6 = _e28;
-    let _e30 = atmosphere_53;
+    let _e30 = atmosphere_55;
     half_mu_size = f32((_e30.scattering_mu_size / 2i));
-    let _e38 = ray_r_mu_intersects_ground_7;
+    let _e38 = ray_r_mu_intersects_ground_9;
     if _e38 {
         {
-            let _e39 = atmosphere_53;
-            let _e40 = r_29;
-            let _e41 = mu_22;
+            let _e39 = atmosphere_55;
+            let _e40 = r_31;
+            let _e41 = mu_24;
             let _e42 = DistanceToBottomAtmosphereBoundary(_e39, _e40, _e41);
             d_12 = _e42;
-            let _e44 = r_29;
-            let _e45 = atmosphere_53;
+            let _e44 = r_31;
+            let _e45 = atmosphere_55;
             d_min_5 = (_e44 - _e45.bottom_radius);
             let _e49 = rho_6;
             d_max_4 = _e49;
             let _e51 = d_max_4;
             let _e52 = d_min_5;
             if (_e51 == _e52) {
-                local_6 = 0f;
+                local_9 = 0f;
             } else {
                 let _e55 = d_12;
                 let _e56 = d_min_5;
                 let _e58 = d_max_4;
                 let _e59 = d_min_5;
-                local_6 = ((_e55 - _e56) / (_e58 - _e59));
+                local_9 = ((_e55 - _e56) / (_e58 - _e59));
             }
-            let _e63 = local_6;
+            let _e63 = local_9;
             x_mu_3 = _e63;
             let _e67 = half_mu_size;
             let _e69 = x_mu_3;
@@ -1388,13 +1526,13 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_52: AtmosphereParameters, r_2
         }
     } else {
         {
-            let _e79 = atmosphere_53;
-            let _e80 = r_29;
-            let _e81 = mu_22;
+            let _e79 = atmosphere_55;
+            let _e80 = r_31;
+            let _e81 = mu_24;
             let _e82 = DistanceToTopAtmosphereBoundary(_e79, _e80, _e81);
             d_13 = _e82;
-            let _e84 = atmosphere_53;
-            let _e86 = r_29;
+            let _e84 = atmosphere_55;
+            let _e86 = r_31;
             d_min_6 = (_e84.top_radius - _e86);
             let _e89 = rho_6;
             let _e90 = H_2;
@@ -1406,11 +1544,11 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_52: AtmosphereParameters, r_2
                 let _e97 = d_min_6;
                 let _e99 = d_max_5;
                 let _e100 = d_min_6;
-                local_7 = ((_e96 - _e97) / (_e99 - _e100));
+                local_10 = ((_e96 - _e97) / (_e99 - _e100));
             } else {
-                local_7 = 0f;
+                local_10 = 0f;
             }
-            let _e105 = local_7;
+            let _e105 = local_10;
             x_mu_3 = _e105;
             let _e109 = half_mu_size;
             let _e111 = x_mu_3;
@@ -1418,180 +1556,163 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_52: AtmosphereParameters, r_2
             u_mu = (0.5f + (0.5f * ((0.5f / _e109) + (_e111 * (1f - (1f / _e114))))));
         }
     }
-    let _e121 = atmosphere_53;
-    let _e122 = r_29;
+    let _e121 = atmosphere_55;
+    let _e122 = r_31;
     let _e123 = rho_6;
-    let _e124 = ray_r_mu_intersects_ground_7;
+    let _e124 = ray_r_mu_intersects_ground_9;
     let _e125 = x_mu_3;
     let _e126 = GetScatteringTextureUR(_e121, _e122, _e123, _e124, _e125);
     u_r = _e126;
-    let _e128 = atmosphere_53;
-    let _e129 = mu_s_11;
+    let _e128 = atmosphere_55;
+    let _e129 = mu_s_14;
     let _e130 = GetScatteringTextureUMuS(_e128, _e129);
     u_mu_s = _e130;
-    let _e132 = atmosphere_53;
+    let _e132 = atmosphere_55;
     mu_s_size = f32(_e132.scattering_mu_s_size);
-    let _e136 = atmosphere_53;
+    let _e136 = atmosphere_55;
     let _e140 = u_mu_s;
     let _e141 = mu_s_size;
-    let _e145 = atmosphere_53;
+    let _e145 = atmosphere_55;
     if ((_e136.scattering_mu_s_split > 0i) && (((_e140 * _e141) - 0.5f) < f32(_e145.scattering_mu_s_split))) {
         {
-            let _e150 = atmosphere_53;
-            let _e151 = r_29;
-            let _e152 = mu_22;
-            let _e153 = mu_22;
-            let _e154 = mu_s_11;
-            let _e155 = nu_12;
-            let _e156 = ViewSunAzimuthCosine(_e153, _e154, _e155);
-            let _e157 = ray_r_mu_intersects_ground_7;
-            let _e158 = ShadowEdgeSunZenith(_e150, _e151, _e152, _e156, _e157);
-            edge_14 = _e158;
-            let _e160 = atmosphere_53;
-            let _e161 = mu_s_11;
-            let _e163 = edge_14;
-            let _e164 = GetScatteringShadowEdgePosition(_e160, acos(_e161), _e163);
-            let _e167 = mu_s_size;
-            u_mu_s = ((_e164 + 0.5f) / _e167);
+            let _e151 = atmosphere_55;
+            let _e152 = r_31;
+            let _e153 = mu_24;
+            let _e154 = mu_24;
+            let _e155 = mu_s_14;
+            let _e156 = nu_12;
+            let _e157 = ViewSunAzimuthCosine(_e154, _e155, _e156);
+            let _e158 = ray_r_mu_intersects_ground_9;
+            let _e161 = ShadowEdge(_e151, _e152, _e153, _e157, _e158, (&edge_20));
+            let _e162 = atmosphere_55;
+            let _e163 = edge_20;
+            let _e164 = mu_s_14;
+            let _e165 = ShadowEdgeDistance(_e163, _e164);
+            let _e166 = edge_20;
+            let _e167 = GetScatteringShadowEdgePosition(_e162, _e165, _e166);
+            let _e170 = mu_s_size;
+            u_mu_s = ((_e167 + 0.5f) / _e170);
         }
     }
-    let _e169 = nu_12;
-    let _e170 = ScatteringUnitNu(_e169);
-    let _e171 = u_mu_s;
-    let _e172 = u_mu;
-    let _e173 = u_r;
-    return vec4<f32>(_e170, _e171, _e172, _e173);
+    let _e172 = nu_12;
+    let _e173 = ScatteringUnitNu(_e172);
+    let _e174 = u_mu_s;
+    let _e175 = u_mu;
+    let _e176 = u_r;
+    return vec4<f32>(_e173, _e174, _e175, _e176);
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_54: AtmosphereParameters) -> f32 {
-    var atmosphere_55: AtmosphereParameters;
-    var local_8: f32;
+fn IrradianceKneeMuS(atmosphere_56: AtmosphereParameters) -> f32 {
+    var atmosphere_57: AtmosphereParameters;
+    var local_11: f32;
 
-    atmosphere_55 = atmosphere_54;
-    let _e14 = atmosphere_55;
+    atmosphere_57 = atmosphere_56;
+    let _e14 = atmosphere_57;
     if (_e14.mu_s_min < LOW_SUN_MU_S) {
-        local_8 = LOW_SUN_MU_S;
+        local_11 = LOW_SUN_MU_S;
     } else {
-        let _e18 = atmosphere_55;
-        local_8 = (0.5f * (_e18.mu_s_min + 1f));
+        let _e18 = atmosphere_57;
+        local_11 = (0.5f * (_e18.mu_s_min + 1f));
     }
-    let _e24 = local_8;
+    let _e24 = local_11;
     return _e24;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_56: AtmosphereParameters, mu_s_12: f32) -> f32 {
-    var atmosphere_57: AtmosphereParameters;
-    var mu_s_13: f32;
+fn GetIrradianceUnitMuS(atmosphere_58: AtmosphereParameters, mu_s_15: f32) -> f32 {
+    var atmosphere_59: AtmosphereParameters;
+    var mu_s_16: f32;
     var knee: f32;
-    var local_9: f32;
+    var local_12: f32;
 
-    atmosphere_57 = atmosphere_56;
-    mu_s_13 = mu_s_12;
-    let _e16 = atmosphere_57;
+    atmosphere_59 = atmosphere_58;
+    mu_s_16 = mu_s_15;
+    let _e16 = atmosphere_59;
     let _e17 = IrradianceKneeMuS(_e16);
     knee = _e17;
-    let _e19 = mu_s_13;
+    let _e19 = mu_s_16;
     let _e20 = knee;
     if (_e19 < _e20) {
-        let _e23 = mu_s_13;
-        let _e24 = atmosphere_57;
+        let _e23 = mu_s_16;
+        let _e24 = atmosphere_59;
         let _e28 = knee;
-        let _e29 = atmosphere_57;
-        local_9 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
+        let _e29 = atmosphere_59;
+        local_12 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
     } else {
-        let _e35 = mu_s_13;
+        let _e35 = mu_s_16;
         let _e36 = knee;
         let _e40 = knee;
-        local_9 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
+        local_12 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
     }
-    let _e45 = local_9;
+    let _e45 = local_12;
     return _e45;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_58: AtmosphereParameters, x_10: f32) -> f32 {
-    var atmosphere_59: AtmosphereParameters;
+fn GetIrradianceMuSFromUnit(atmosphere_60: AtmosphereParameters, x_10: f32) -> f32 {
+    var atmosphere_61: AtmosphereParameters;
     var x_11: f32;
     var knee_1: f32;
-    var local_10: f32;
+    var local_13: f32;
 
-    atmosphere_59 = atmosphere_58;
+    atmosphere_61 = atmosphere_60;
     x_11 = x_10;
-    let _e16 = atmosphere_59;
+    let _e16 = atmosphere_61;
     let _e17 = IrradianceKneeMuS(_e16);
     knee_1 = _e17;
     let _e19 = x_11;
     if (_e19 < 0.5f) {
-        let _e22 = atmosphere_59;
+        let _e22 = atmosphere_61;
         let _e25 = x_11;
         let _e27 = knee_1;
-        let _e28 = atmosphere_59;
-        local_10 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
+        let _e28 = atmosphere_61;
+        local_13 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
     } else {
         let _e33 = knee_1;
         let _e35 = x_11;
         let _e40 = knee_1;
-        local_10 = (_e33 + (((2f * _e35) - 1f) * (1f - _e40)));
+        local_13 = (_e33 + (((2f * _e35) - 1f) * (1f - _e40)));
     }
-    let _e45 = local_10;
+    let _e45 = local_13;
     return _e45;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_60: AtmosphereParameters, r_30: f32, mu_s_14: f32) -> vec2<f32> {
-    var atmosphere_61: AtmosphereParameters;
-    var r_31: f32;
-    var mu_s_15: f32;
+fn GetIrradianceTextureUvFromRMuS(atmosphere_62: AtmosphereParameters, r_32: f32, mu_s_17: f32) -> vec2<f32> {
+    var atmosphere_63: AtmosphereParameters;
+    var r_33: f32;
+    var mu_s_18: f32;
     var x_r_1: f32;
     var x_mu_s_1: f32;
 
-    atmosphere_61 = atmosphere_60;
-    r_31 = r_30;
-    mu_s_15 = mu_s_14;
-    let _e18 = atmosphere_61;
-    let _e19 = r_31;
+    atmosphere_63 = atmosphere_62;
+    r_33 = r_32;
+    mu_s_18 = mu_s_17;
+    let _e18 = atmosphere_63;
+    let _e19 = r_33;
     let _e20 = HorizonDistance(_e18, _e19);
-    let _e21 = atmosphere_61;
+    let _e21 = atmosphere_63;
     let _e22 = HorizonDistanceAtTop(_e21);
     x_r_1 = (_e20 / _e22);
-    let _e25 = atmosphere_61;
-    let _e26 = mu_s_15;
+    let _e25 = atmosphere_63;
+    let _e26 = mu_s_18;
     let _e27 = GetIrradianceUnitMuS(_e25, _e26);
     x_mu_s_1 = clamp(_e27, 0f, 1f);
     let _e32 = x_mu_s_1;
-    let _e33 = atmosphere_61;
+    let _e33 = atmosphere_63;
     let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_width);
     let _e36 = x_r_1;
-    let _e37 = atmosphere_61;
+    let _e37 = atmosphere_63;
     let _e39 = GetTextureCoordFromUnitRange(_e36, _e37.irradiance_height);
     return vec2<f32>(_e35, _e39);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_62: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_32: f32, mu_23: f32) -> vec3<f32> {
-    var atmosphere_63: AtmosphereParameters;
-    var r_33: f32;
-    var mu_24: f32;
-    var uv_2: vec2<f32>;
-
-    atmosphere_63 = atmosphere_62;
-    r_33 = r_32;
-    mu_24 = mu_23;
-    let _e19 = atmosphere_63;
-    let _e20 = r_33;
-    let _e21 = mu_24;
-    let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
-    uv_2 = _e22;
-    let _e24 = uv_2;
-    let _e25 = SampleTexture2D(transmittance_texture, _e24);
-    return vec3<f32>(_e25.xyz);
-}
-
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_64: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_34: f32, mu_25: f32) -> vec3<f32> {
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_64: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_34: f32, mu_25: f32) -> vec3<f32> {
     var atmosphere_65: AtmosphereParameters;
     var r_35: f32;
     var mu_26: f32;
+    var uv_2: vec2<f32>;
 
     atmosphere_65 = atmosphere_64;
     r_35 = r_34;
@@ -1599,62 +1720,80 @@ fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_64: AtmosphereParameters, 
     let _e19 = atmosphere_65;
     let _e20 = r_35;
     let _e21 = mu_26;
+    let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
+    uv_2 = _e22;
+    let _e24 = uv_2;
+    let _e25 = SampleTexture2D(transmittance_texture, _e24);
+    return vec3<f32>(_e25.xyz);
+}
+
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_66: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_36: f32, mu_27: f32) -> vec3<f32> {
+    var atmosphere_67: AtmosphereParameters;
+    var r_37: f32;
+    var mu_28: f32;
+
+    atmosphere_67 = atmosphere_66;
+    r_37 = r_36;
+    mu_28 = mu_27;
+    let _e19 = atmosphere_67;
+    let _e20 = r_37;
+    let _e21 = mu_28;
     let _e22 = GetOpticalDepthToTopAtmosphereBoundary(_e19, transmittance_texture_1, _e20, _e21);
     return exp(-(_e22));
 }
 
-fn GetOpticalDepth(atmosphere_66: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_36: f32, mu_27: f32, d_14: f32, ray_r_mu_intersects_ground_8: bool) -> vec3<f32> {
-    var atmosphere_67: AtmosphereParameters;
-    var r_37: f32;
-    var mu_28: f32;
+fn GetOpticalDepth(atmosphere_68: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_38: f32, mu_29: f32, d_14: f32, ray_r_mu_intersects_ground_10: bool) -> vec3<f32> {
+    var atmosphere_69: AtmosphereParameters;
+    var r_39: f32;
+    var mu_30: f32;
     var d_15: f32;
-    var ray_r_mu_intersects_ground_9: bool;
+    var ray_r_mu_intersects_ground_11: bool;
     var r_d_3: f32;
     var mu_d: f32;
     var tau: vec3<f32>;
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_67 = atmosphere_66;
-    r_37 = r_36;
-    mu_28 = mu_27;
+    atmosphere_69 = atmosphere_68;
+    r_39 = r_38;
+    mu_30 = mu_29;
     d_15 = d_14;
-    ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e23 = atmosphere_67;
-    let _e24 = r_37;
-    let _e25 = mu_28;
+    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
+    let _e23 = atmosphere_69;
+    let _e24 = r_39;
+    let _e25 = mu_30;
     let _e26 = d_15;
     let _e27 = RadiusAtDistance(_e23, _e24, _e25, _e26);
     r_d_3 = _e27;
-    let _e29 = r_37;
-    let _e30 = mu_28;
+    let _e29 = r_39;
+    let _e30 = mu_30;
     let _e31 = d_15;
     let _e32 = r_d_3;
     let _e33 = CosineAtDistance(_e29, _e30, _e31, _e32);
     mu_d = _e33;
-    let _e36 = ray_r_mu_intersects_ground_9;
+    let _e36 = ray_r_mu_intersects_ground_11;
     let _e37 = mu_d;
     if (_e36 || (_e37 < 0f)) {
         {
-            let _e41 = atmosphere_67;
+            let _e41 = atmosphere_69;
             let _e42 = r_d_3;
             let _e43 = mu_d;
             let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
-            let _e46 = atmosphere_67;
-            let _e47 = r_37;
-            let _e48 = mu_28;
+            let _e46 = atmosphere_69;
+            let _e47 = r_39;
+            let _e48 = mu_30;
             let _e50 = GetOpticalDepthToTopAtmosphereBoundary(_e46, transmittance_texture_2, _e47, -(_e48));
             tau = (_e45 - _e50);
         }
     } else {
-        let _e52 = mu_28;
+        let _e52 = mu_30;
         if (_e52 >= 0f) {
             {
-                let _e55 = atmosphere_67;
-                let _e56 = r_37;
-                let _e57 = mu_28;
+                let _e55 = atmosphere_69;
+                let _e56 = r_39;
+                let _e57 = mu_30;
                 let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
-                let _e59 = atmosphere_67;
+                let _e59 = atmosphere_69;
                 let _e60 = r_d_3;
                 let _e61 = mu_d;
                 let _e62 = GetOpticalDepthToTopAtmosphereBoundary(_e59, transmittance_texture_2, _e60, _e61);
@@ -1662,24 +1801,24 @@ fn GetOpticalDepth(atmosphere_66: AtmosphereParameters, transmittance_texture_2:
             }
         } else {
             {
-                let _e64 = atmosphere_67;
-                let _e65 = r_37;
-                let _e67 = mu_28;
-                let _e68 = mu_28;
+                let _e64 = atmosphere_69;
+                let _e65 = r_39;
+                let _e67 = mu_30;
+                let _e68 = mu_30;
                 let _e71 = SafeSqrt((1f - (_e67 * _e68)));
                 let _e73 = ClampRadius(_e64, (_e65 * _e71));
                 r_low = _e73;
-                let _e75 = atmosphere_67;
+                let _e75 = atmosphere_69;
                 let _e76 = r_low;
                 let _e78 = GetOpticalDepthToTopAtmosphereBoundary(_e75, transmittance_texture_2, _e76, 0f);
                 tau_low = _e78;
                 let _e80 = tau_low;
-                let _e81 = atmosphere_67;
-                let _e82 = r_37;
-                let _e83 = mu_28;
+                let _e81 = atmosphere_69;
+                let _e82 = r_39;
+                let _e83 = mu_30;
                 let _e85 = GetOpticalDepthToTopAtmosphereBoundary(_e81, transmittance_texture_2, _e82, -(_e83));
                 let _e90 = tau_low;
-                let _e91 = atmosphere_67;
+                let _e91 = atmosphere_69;
                 let _e92 = r_d_3;
                 let _e93 = mu_d;
                 let _e94 = GetOpticalDepthToTopAtmosphereBoundary(_e91, transmittance_texture_2, _e92, _e93);
@@ -1691,93 +1830,93 @@ fn GetOpticalDepth(atmosphere_66: AtmosphereParameters, transmittance_texture_2:
     return max(_e100, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_68: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_38: f32, mu_29: f32, d_16: f32, ray_r_mu_intersects_ground_10: bool) -> vec3<f32> {
-    var atmosphere_69: AtmosphereParameters;
-    var r_39: f32;
-    var mu_30: f32;
+fn GetTransmittance(atmosphere_70: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_40: f32, mu_31: f32, d_16: f32, ray_r_mu_intersects_ground_12: bool) -> vec3<f32> {
+    var atmosphere_71: AtmosphereParameters;
+    var r_41: f32;
+    var mu_32: f32;
     var d_17: f32;
-    var ray_r_mu_intersects_ground_11: bool;
+    var ray_r_mu_intersects_ground_13: bool;
 
-    atmosphere_69 = atmosphere_68;
-    r_39 = r_38;
-    mu_30 = mu_29;
+    atmosphere_71 = atmosphere_70;
+    r_41 = r_40;
+    mu_32 = mu_31;
     d_17 = d_16;
-    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e23 = atmosphere_69;
-    let _e24 = r_39;
-    let _e25 = mu_30;
+    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
+    let _e23 = atmosphere_71;
+    let _e24 = r_41;
+    let _e25 = mu_32;
     let _e26 = d_17;
-    let _e27 = ray_r_mu_intersects_ground_11;
+    let _e27 = ray_r_mu_intersects_ground_13;
     let _e28 = GetOpticalDepth(_e23, transmittance_texture_3, _e24, _e25, _e26, _e27);
     return exp(-(_e28));
 }
 
-fn SunVisibleFraction(atmosphere_70: AtmosphereParameters, r_40: f32, mu_s_16: f32) -> f32 {
-    var atmosphere_71: AtmosphereParameters;
-    var r_41: f32;
-    var mu_s_17: f32;
+fn SunVisibleFraction(atmosphere_72: AtmosphereParameters, r_42: f32, mu_s_19: f32) -> f32 {
+    var atmosphere_73: AtmosphereParameters;
+    var r_43: f32;
+    var mu_s_20: f32;
     var sin_theta_h: f32;
 
-    atmosphere_71 = atmosphere_70;
-    r_41 = r_40;
-    mu_s_17 = mu_s_16;
-    let _e18 = atmosphere_71;
-    let _e20 = r_41;
+    atmosphere_73 = atmosphere_72;
+    r_43 = r_42;
+    mu_s_20 = mu_s_19;
+    let _e18 = atmosphere_73;
+    let _e20 = r_43;
     sin_theta_h = (_e18.bottom_radius / _e20);
-    let _e23 = mu_s_17;
-    let _e24 = atmosphere_71;
-    let _e26 = r_41;
+    let _e23 = mu_s_20;
+    let _e24 = atmosphere_73;
+    let _e26 = r_43;
     let _e27 = HorizonZenithCosine(_e24.bottom_radius, _e26);
     let _e28 = sin_theta_h;
-    let _e29 = atmosphere_71;
+    let _e29 = atmosphere_73;
     let _e32 = SunVisibleFractionAboveHorizon(_e23, _e27, (_e28 * _e29.sun_angular_radius));
     return _e32;
 }
 
-fn GetTransmittanceToSun(atmosphere_72: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_42: f32, mu_s_18: f32) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
-    var r_43: f32;
-    var mu_s_19: f32;
+fn GetTransmittanceToSun(atmosphere_74: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_44: f32, mu_s_21: f32) -> vec3<f32> {
+    var atmosphere_75: AtmosphereParameters;
+    var r_45: f32;
+    var mu_s_22: f32;
 
-    atmosphere_73 = atmosphere_72;
-    r_43 = r_42;
-    mu_s_19 = mu_s_18;
-    let _e19 = atmosphere_73;
-    let _e20 = r_43;
-    let _e21 = mu_s_19;
+    atmosphere_75 = atmosphere_74;
+    r_45 = r_44;
+    mu_s_22 = mu_s_21;
+    let _e19 = atmosphere_75;
+    let _e20 = r_45;
+    let _e21 = mu_s_22;
     let _e22 = GetTransmittanceToTopAtmosphereBoundary(_e19, transmittance_texture_4, _e20, _e21);
-    let _e23 = atmosphere_73;
-    let _e24 = r_43;
-    let _e25 = mu_s_19;
+    let _e23 = atmosphere_75;
+    let _e24 = r_45;
+    let _e25 = mu_s_22;
     let _e26 = SunVisibleFraction(_e23, _e24, _e25);
     return (_e22 * _e26);
 }
 
-fn SunCosineMix(a_7: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
-    var a_8: vec4<f32>;
+fn SunCosineMix(a_8: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
+    var a_9: vec4<f32>;
     var b_1: vec4<f32>;
     var t_2: f32;
     var low_sun_1: bool;
     var dark: vec4<f32> = vec4(0.000000000000000000000000000001f);
 
-    a_8 = a_7;
+    a_9 = a_8;
     b_1 = b;
     t_2 = t_1;
     low_sun_1 = low_sun;
     let _e20 = low_sun_1;
     if !(_e20) {
-        let _e22 = a_8;
+        let _e22 = a_9;
         let _e23 = b_1;
         let _e24 = t_2;
         return mix(_e22, _e23, vec4(_e24));
     }
-    let _e30 = a_8;
+    let _e30 = a_9;
     let _e31 = dark;
     let _e34 = b_1;
     let _e35 = dark;
     let _e38 = t_2;
     let _e42 = dark;
-    let _e43 = a_8;
+    let _e43 = a_9;
     let _e44 = b_1;
     return (exp(mix(log(max(_e30, _e31)), log(max(_e34, _e35)), vec4(_e38))) * step(_e42, max(_e43, _e44)));
 }
@@ -1785,35 +1924,35 @@ fn SunCosineMix(a_7: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
     var t_4: f32;
     var low_sun_3: bool;
-    var local_11: f32;
+    var local_14: f32;
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
     let _e16 = low_sun_3;
     if _e16 {
         let _e17 = t_4;
-        local_11 = min(_e17, 1f);
+        local_14 = min(_e17, 1f);
     } else {
         let _e20 = t_4;
-        local_11 = clamp(_e20, 0f, 1f);
+        local_14 = clamp(_e20, 0f, 1f);
     }
-    let _e25 = local_11;
+    let _e25 = local_14;
     return _e25;
 }
 
-fn SunBelowTableMix(a_9: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
-    var a_10: vec4<f32>;
+fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
+    var a_11: vec4<f32>;
     var b_3: vec4<f32>;
     var t_6: f32;
     var low_sun_5: bool;
     var blend: vec4<f32>;
-    var local_12: vec4<f32>;
+    var local_15: vec4<f32>;
 
-    a_10 = a_9;
+    a_11 = a_10;
     b_3 = b_2;
     t_6 = t_5;
     low_sun_5 = low_sun_4;
-    let _e20 = a_10;
+    let _e20 = a_11;
     let _e21 = b_3;
     let _e22 = t_6;
     let _e23 = low_sun_5;
@@ -1822,29 +1961,29 @@ fn SunBelowTableMix(a_9: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -
     let _e26 = t_6;
     if (_e26 < 0f) {
         let _e29 = blend;
-        let _e30 = a_10;
-        local_12 = min(_e29, _e30);
+        let _e30 = a_11;
+        local_15 = min(_e29, _e30);
     } else {
         let _e32 = blend;
-        local_12 = _e32;
+        local_15 = _e32;
     }
-    let _e34 = local_12;
+    let _e34 = local_15;
     return _e34;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_74: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_75: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_76: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_77: AtmosphereParameters;
     var u_mu_s_2: f32;
     var x_low_sun_1: f32;
     var mu_s_size_1: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_75 = atmosphere_74;
+    atmosphere_77 = atmosphere_76;
     u_mu_s_2 = u_mu_s_1;
     x_low_sun_1 = x_low_sun;
-    let _e22 = atmosphere_75;
+    let _e22 = atmosphere_77;
     mu_s_size_1 = f32(_e22.scattering_mu_s_size);
     let _e26 = u_mu_s_2;
     let _e27 = mu_s_size_1;
@@ -1870,8 +2009,8 @@ fn GetScatteringMuSColumns(atmosphere_74: AtmosphereParameters, u_mu_s_1: f32, x
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
-    var a_12: vec4<f32>;
+fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
+    var a_13: vec4<f32>;
     var b_5: vec4<f32>;
     var c_7: vec4<f32>;
     var d_19: vec4<f32>;
@@ -1881,9 +2020,9 @@ fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     var dark_1: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var lb: vec4<f32>;
     var lc: vec4<f32>;
-    var local_13: vec4<f32>;
+    var local_16: vec4<f32>;
     var la: vec4<f32>;
-    var local_14: vec4<f32>;
+    var local_17: vec4<f32>;
     var ld: vec4<f32>;
     var secant_a: vec4<f32>;
     var secant: vec4<f32>;
@@ -1899,7 +2038,7 @@ fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     var cubic: vec4<f32>;
     var lit: vec4<f32>;
 
-    a_12 = a_11;
+    a_13 = a_12;
     b_5 = b_4;
     c_7 = c_6;
     d_19 = d_18;
@@ -1914,27 +2053,27 @@ fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     lc = log(max(_e34, _e35));
     let _e39 = has_a_1;
     if _e39 {
-        let _e40 = a_12;
+        let _e40 = a_13;
         let _e41 = dark_1;
-        local_13 = log(max(_e40, _e41));
+        local_16 = log(max(_e40, _e41));
     } else {
         let _e45 = lb;
         let _e47 = lc;
-        local_13 = ((2f * _e45) - _e47);
+        local_16 = ((2f * _e45) - _e47);
     }
-    let _e50 = local_13;
+    let _e50 = local_16;
     la = _e50;
     let _e52 = has_d_1;
     if _e52 {
         let _e53 = d_19;
         let _e54 = dark_1;
-        local_14 = log(max(_e53, _e54));
+        local_17 = log(max(_e53, _e54));
     } else {
         let _e58 = lc;
         let _e60 = lb;
-        local_14 = ((2f * _e58) - _e60);
+        local_17 = ((2f * _e58) - _e60);
     }
-    let _e63 = local_14;
+    let _e63 = local_17;
     ld = _e63;
     let _e65 = lb;
     let _e66 = la;
@@ -1988,7 +2127,7 @@ fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     let _e171 = slope_c;
     cubic = (((((((2f * _e138) - (3f * _e141)) + 1f) * _e146) + (((_e148 - (2f * _e150)) + _e153) * _e155)) + (((3f * _e159) - (2f * _e162)) * _e165)) + ((_e168 - _e169) * _e171));
     let _e175 = dark_1;
-    let _e176 = a_12;
+    let _e176 = a_13;
     let _e177 = b_5;
     let _e179 = c_7;
     let _e180 = d_19;
@@ -2005,8 +2144,8 @@ fn LogMonotoneCubicMix(a_11: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunLogFall(a_13: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope_1: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
-    var a_14: vec4<f32>;
+fn LowestSunLogFall(a_14: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope_1: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
+    var a_15: vec4<f32>;
     var b_7: vec4<f32>;
     var mu_s_a_1: f32;
     var mu_s_b_1: f32;
@@ -2014,18 +2153,18 @@ fn LowestSunLogFall(a_13: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
     var rise: vec4<f32>;
     var k_2: vec4<f32>;
 
-    a_14 = a_13;
+    a_15 = a_14;
     b_7 = b_6;
     mu_s_a_1 = mu_s_a;
     mu_s_b_1 = mu_s_b;
     let _e25 = b_7;
     let _e26 = dark_2;
-    let _e29 = a_14;
+    let _e29 = a_15;
     let _e30 = dark_2;
     let _e34 = dark_2;
-    let _e35 = a_14;
+    let _e35 = a_15;
     let _e40 = b_7;
-    let _e41 = a_14;
+    let _e41 = a_15;
     rise = (((log(max(_e25, _e26)) - log(max(_e29, _e30))) * step(_e34, _e35)) * (vec4(1f) - step(_e40, _e41)));
     let _e46 = mu_s_b_1;
     if (_e46 < 0f) {
@@ -2056,30 +2195,30 @@ fn LowestSunLogFall(a_13: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunContinued(a_15: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_20: f32) -> vec4<f32> {
-    var a_16: vec4<f32>;
+fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_23: f32) -> vec4<f32> {
+    var a_17: vec4<f32>;
     var b_9: vec4<f32>;
     var mu_s_a_3: f32;
     var mu_s_b_3: f32;
-    var mu_s_21: f32;
+    var mu_s_24: f32;
     var slope_2: vec4<f32>;
     var curvature_1: vec4<f32>;
     var d_20: f32;
 
-    a_16 = a_15;
+    a_17 = a_16;
     b_9 = b_8;
     mu_s_a_3 = mu_s_a_2;
     mu_s_b_3 = mu_s_b_2;
-    mu_s_21 = mu_s_20;
-    let _e24 = a_16;
+    mu_s_24 = mu_s_23;
+    let _e24 = a_17;
     let _e25 = b_9;
     let _e26 = mu_s_a_3;
     let _e27 = mu_s_b_3;
     LowestSunLogFall(_e24, _e25, _e26, _e27, (&slope_2), (&curvature_1));
-    let _e32 = mu_s_21;
+    let _e32 = mu_s_24;
     let _e33 = mu_s_a_3;
     d_20 = (_e32 - _e33);
-    let _e36 = a_16;
+    let _e36 = a_17;
     let _e37 = d_20;
     let _e38 = slope_2;
     let _e39 = d_20;
@@ -2088,19 +2227,19 @@ fn LowestSunContinued(a_15: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringInSlice(atmosphere_76: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32) -> vec4<f32> {
-    var atmosphere_77: AtmosphereParameters;
+fn GetScatteringInSlice(atmosphere_78: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32) -> vec4<f32> {
+    var atmosphere_79: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
     var x_13: f32;
     var nu_slice_1: f32;
 
-    atmosphere_77 = atmosphere_76;
+    atmosphere_79 = atmosphere_78;
     uvwz_1 = uvwz;
     x_13 = x_12;
     nu_slice_1 = nu_slice;
     let _e21 = nu_slice_1;
     let _e22 = x_13;
-    let _e24 = atmosphere_77;
+    let _e24 = atmosphere_79;
     let _e28 = uvwz_1;
     let _e30 = uvwz_1;
     let _e33 = SampleTexture3D(scattering_texture, vec3<f32>(((_e21 + _e22) / f32(_e24.scattering_nu_size)), _e28.z, _e30.w));
@@ -2108,26 +2247,26 @@ fn GetScatteringInSlice(atmosphere_76: AtmosphereParameters, scattering_texture:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_78: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_14: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_79: AtmosphereParameters;
+fn GetScatteringAtMuSColumn(atmosphere_80: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_14: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var uvwz_3: vec4<f32>;
     var x_15: f32;
     var nu_slice_3: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_81 = atmosphere_80;
     uvwz_3 = uvwz_2;
     x_15 = x_14;
     nu_slice_3 = nu_slice_2;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e25 = atmosphere_79;
+    let _e25 = atmosphere_81;
     let _e26 = uvwz_3;
     let _e27 = x_15;
     let _e28 = nu_slice_3;
     let _e29 = GetScatteringInSlice(_e25, scattering_texture_1, _e26, _e27, _e28);
-    let _e30 = atmosphere_79;
+    let _e30 = atmosphere_81;
     let _e31 = uvwz_3;
     let _e32 = x_15;
     let _e33 = nu_slice_3;
@@ -2139,28 +2278,28 @@ fn GetScatteringAtMuSColumn(atmosphere_78: AtmosphereParameters, scattering_text
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtOwnColumn(atmosphere_80: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetScatteringAtOwnColumn(atmosphere_82: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
+    var atmosphere_83: AtmosphereParameters;
     var uvwz_5: vec4<f32>;
     var column_1: f32;
     var nu_slice_5: f32;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_83 = atmosphere_82;
     uvwz_5 = uvwz_4;
     column_1 = column;
     nu_slice_5 = nu_slice_4;
-    let _e21 = atmosphere_81;
+    let _e21 = atmosphere_83;
     let _e22 = uvwz_5;
     let _e23 = column_1;
-    let _e26 = atmosphere_81;
+    let _e26 = atmosphere_83;
     let _e30 = nu_slice_5;
     let _e31 = GetScatteringInSlice(_e21, scattering_texture_2, _e22, ((_e23 + 0.5f) / f32(_e26.scattering_mu_s_size)), _e30);
     return _e31;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
+    var atmosphere_85: AtmosphereParameters;
     var uvwz_7: vec4<f32>;
     var position_4: f32;
     var nu_slice_7: f32;
@@ -2178,12 +2317,12 @@ fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_textu
     var x_16: f32;
     var k_4: f32;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_85 = atmosphere_84;
     uvwz_7 = uvwz_6;
     position_4 = position_3;
     nu_slice_7 = nu_slice_6;
     log_first_span_1 = log_first_span;
-    let _e26 = atmosphere_83;
+    let _e26 = atmosphere_85;
     let _e29 = past_2;
     intervals = (f32(_e26.scattering_mu_s_split) - _e29);
     let _e32 = position_4;
@@ -2197,22 +2336,22 @@ fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_textu
             let _e44 = past_2;
             let _e45 = k_3;
             column_2 = (_e44 + _e45);
-            let _e48 = atmosphere_83;
+            let _e48 = atmosphere_85;
             let _e49 = uvwz_7;
             let _e50 = column_2;
             let _e53 = nu_slice_7;
             let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_3, _e49, (_e50 - 1f), _e53);
-            let _e55 = atmosphere_83;
+            let _e55 = atmosphere_85;
             let _e56 = uvwz_7;
             let _e57 = column_2;
             let _e58 = nu_slice_7;
             let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_3, _e56, _e57, _e58);
-            let _e60 = atmosphere_83;
+            let _e60 = atmosphere_85;
             let _e61 = uvwz_7;
             let _e62 = column_2;
             let _e65 = nu_slice_7;
             let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_3, _e61, (_e62 + 1f), _e65);
-            let _e67 = atmosphere_83;
+            let _e67 = atmosphere_85;
             let _e68 = uvwz_7;
             let _e69 = column_2;
             let _e72 = past_2;
@@ -2232,20 +2371,20 @@ fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_textu
     let _e91 = past_2;
     if (_e90 >= (_e91 - 1f)) {
         {
-            let _e95 = atmosphere_83;
+            let _e95 = atmosphere_85;
             let _e96 = uvwz_7;
             let _e97 = past_2;
             let _e100 = nu_slice_7;
             let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_3, _e96, (_e97 - 1f), _e100);
             at_edge = _e101;
-            let _e103 = atmosphere_83;
+            let _e103 = atmosphere_85;
             let _e104 = uvwz_7;
             let _e105 = past_2;
             let _e106 = nu_slice_7;
             let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_3, _e104, _e105, _e106);
             let _e108 = at_edge;
             rise_1 = (_e107 - _e108);
-            let _e111 = atmosphere_83;
+            let _e111 = atmosphere_85;
             let _e112 = uvwz_7;
             let _e113 = past_2;
             let _e116 = nu_slice_7;
@@ -2278,13 +2417,13 @@ fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_textu
     let _e174 = x_16;
     let _e176 = past_2;
     k_4 = min(floor(_e174), (_e176 - 2f));
-    let _e181 = atmosphere_83;
+    let _e181 = atmosphere_85;
     let _e182 = uvwz_7;
     let _e183 = past_2;
     let _e186 = k_4;
     let _e188 = nu_slice_7;
     let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_3, _e182, ((_e183 - 1f) - _e186), _e188);
-    let _e190 = atmosphere_83;
+    let _e190 = atmosphere_85;
     let _e191 = uvwz_7;
     let _e192 = past_2;
     let _e195 = k_4;
@@ -2297,13 +2436,13 @@ fn GetScatteringBelowSplit(atmosphere_82: AtmosphereParameters, scattering_textu
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_44: f32, mu_31: f32, mu_s_22: f32, nu_13: f32, ray_r_mu_intersects_ground_12: bool) -> vec4<f32> {
-    var atmosphere_85: AtmosphereParameters;
-    var r_45: f32;
-    var mu_32: f32;
-    var mu_s_23: f32;
+fn GetScattering(atmosphere_86: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_46: f32, mu_33: f32, mu_s_25: f32, nu_13: f32, ray_r_mu_intersects_ground_14: bool) -> vec4<f32> {
+    var atmosphere_87: AtmosphereParameters;
+    var r_47: f32;
+    var mu_34: f32;
+    var mu_s_26: f32;
     var nu_14: f32;
-    var ray_r_mu_intersects_ground_13: bool;
+    var ray_r_mu_intersects_ground_15: bool;
     var uvwz_8: vec4<f32>;
     var nu_size: f32;
     var nu_coord: f32;
@@ -2313,7 +2452,7 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     var position_5: f32;
     var past_3: f32 = 6f;
     var log_first_span_2: f32 = 1f;
-    var edge_15: f32;
+    var edge_21: vec2<f32>;
     var step_: f32;
     var x_17: f32;
     var x_below_1: f32;
@@ -2327,23 +2466,23 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     var x_first: f32;
     var x_last: f32;
     var first: vec4<f32>;
-    var last: vec4<f32>;
+    var last_1: vec4<f32>;
 
-    atmosphere_85 = atmosphere_84;
-    r_45 = r_44;
-    mu_32 = mu_31;
-    mu_s_23 = mu_s_22;
+    atmosphere_87 = atmosphere_86;
+    r_47 = r_46;
+    mu_34 = mu_33;
+    mu_s_26 = mu_s_25;
     nu_14 = nu_13;
-    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e25 = atmosphere_85;
-    let _e26 = r_45;
-    let _e27 = mu_32;
-    let _e28 = mu_s_23;
+    ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
+    let _e25 = atmosphere_87;
+    let _e26 = r_47;
+    let _e27 = mu_34;
+    let _e28 = mu_s_26;
     let _e29 = nu_14;
-    let _e30 = ray_r_mu_intersects_ground_13;
+    let _e30 = ray_r_mu_intersects_ground_15;
     let _e31 = GetScatteringTextureUvwzFromRMuMuSNu(_e25, _e26, _e27, _e28, _e29, _e30);
     uvwz_8 = _e31;
-    let _e33 = atmosphere_85;
+    let _e33 = atmosphere_87;
     nu_size = f32(_e33.scattering_nu_size);
     let _e37 = uvwz_8;
     let _e39 = nu_size;
@@ -2354,85 +2493,84 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     let _e51 = nu_coord;
     let _e52 = nu_slice_8;
     nu_t_2 = (_e51 - _e52);
-    let _e55 = atmosphere_85;
+    let _e55 = atmosphere_87;
     mu_s_size_2 = f32(_e55.scattering_mu_s_size);
     let _e59 = uvwz_8;
     let _e61 = mu_s_size_2;
     position_5 = ((_e59.y * _e61) - 0.5f);
-    let _e66 = atmosphere_85;
+    let _e66 = atmosphere_87;
     let _e70 = position_5;
-    let _e71 = atmosphere_85;
+    let _e71 = atmosphere_87;
     if ((_e66.scattering_mu_s_split > 0i) && (_e70 < f32(_e71.scattering_mu_s_split))) {
         {
             let _e81 = position_5;
             let _e82 = past_3;
             if (_e81 < _e82) {
                 {
-                    let _e84 = atmosphere_85;
-                    let _e85 = r_45;
-                    let _e86 = mu_32;
-                    let _e87 = mu_32;
-                    let _e88 = mu_s_23;
-                    let _e89 = nu_14;
-                    let _e90 = ViewSunAzimuthCosine(_e87, _e88, _e89);
-                    let _e91 = ray_r_mu_intersects_ground_13;
-                    let _e92 = ShadowEdgeSunZenith(_e84, _e85, _e86, _e90, _e91);
-                    edge_15 = _e92;
-                    let _e94 = position_5;
-                    if (_e94 < 0f) {
+                    let _e85 = atmosphere_87;
+                    let _e86 = r_47;
+                    let _e87 = mu_34;
+                    let _e88 = mu_34;
+                    let _e89 = mu_s_26;
+                    let _e90 = nu_14;
+                    let _e91 = ViewSunAzimuthCosine(_e88, _e89, _e90);
+                    let _e92 = ray_r_mu_intersects_ground_15;
+                    let _e95 = ShadowEdge(_e85, _e86, _e87, _e91, _e92, (&edge_21));
+                    let _e96 = position_5;
+                    if (_e96 < 0f) {
                         {
-                            let _e97 = atmosphere_85;
-                            let _e98 = edge_15;
-                            let _e99 = ShadowEdgePastStep(_e97, _e98);
-                            step_ = _e99;
-                            let _e101 = atmosphere_85;
-                            let _e102 = uvwz_8;
-                            let _e104 = mu_s_size_2;
-                            let _e106 = nu_slice_8;
-                            let _e107 = nu_t_2;
-                            let _e109 = GetScatteringAtMuSColumn(_e101, scattering_texture_4, _e102, (0.5f / _e104), _e106, _e107, true);
-                            let _e110 = atmosphere_85;
-                            let _e111 = uvwz_8;
-                            let _e113 = mu_s_size_2;
-                            let _e115 = nu_slice_8;
-                            let _e116 = nu_t_2;
-                            let _e118 = GetScatteringAtMuSColumn(_e110, scattering_texture_4, _e111, (1.5f / _e113), _e115, _e116, true);
-                            let _e119 = edge_15;
-                            let _e120 = past_3;
-                            let _e123 = step_;
-                            let _e127 = edge_15;
-                            let _e128 = past_3;
-                            let _e131 = step_;
-                            let _e135 = mu_s_23;
-                            let _e136 = LowestSunContinued(_e109, _e118, cos((_e119 + ((_e120 - 1f) * _e123))), cos((_e127 + ((_e128 - 2f) * _e131))), _e135);
-                            return _e136;
+                            let _e99 = atmosphere_87;
+                            let _e100 = edge_21;
+                            let _e101 = ShadowEdgePastStep(_e99, _e100);
+                            step_ = _e101;
+                            let _e103 = atmosphere_87;
+                            let _e104 = uvwz_8;
+                            let _e106 = mu_s_size_2;
+                            let _e108 = nu_slice_8;
+                            let _e109 = nu_t_2;
+                            let _e111 = GetScatteringAtMuSColumn(_e103, scattering_texture_4, _e104, (0.5f / _e106), _e108, _e109, true);
+                            let _e112 = atmosphere_87;
+                            let _e113 = uvwz_8;
+                            let _e115 = mu_s_size_2;
+                            let _e117 = nu_slice_8;
+                            let _e118 = nu_t_2;
+                            let _e120 = GetScatteringAtMuSColumn(_e112, scattering_texture_4, _e113, (1.5f / _e115), _e117, _e118, true);
+                            let _e121 = edge_21;
+                            let _e122 = past_3;
+                            let _e126 = step_;
+                            let _e128 = ShadowEdgeSunCosine(_e121, (-((_e122 - 1f)) * _e126));
+                            let _e129 = edge_21;
+                            let _e130 = past_3;
+                            let _e134 = step_;
+                            let _e136 = ShadowEdgeSunCosine(_e129, (-((_e130 - 2f)) * _e134));
+                            let _e137 = mu_s_26;
+                            let _e138 = LowestSunContinued(_e111, _e120, _e128, _e136, _e137);
+                            return _e138;
                         }
                     }
-                    let _e137 = position_5;
-                    let _e138 = past_3;
-                    if (_e137 >= (_e138 - 1f)) {
+                    let _e139 = position_5;
+                    let _e140 = past_3;
+                    if (_e139 >= (_e140 - 1f)) {
                         {
-                            let _e143 = atmosphere_85;
-                            let _e146 = past_3;
-                            x_17 = (1f / (f32(_e143.scattering_mu_s_split) - _e146));
-                            let _e150 = atmosphere_85;
-                            let _e151 = x_17;
-                            let _e152 = edge_15;
-                            let _e153 = atmosphere_85;
-                            let _e154 = GetScatteringSplitSunZenith(_e153);
-                            let _e155 = ShadowEdgeLitDistance(_e150, _e151, _e152, _e154);
+                            let _e145 = atmosphere_87;
+                            let _e148 = past_3;
+                            x_17 = (1f / (f32(_e145.scattering_mu_s_split) - _e148));
+                            let _e152 = atmosphere_87;
+                            let _e153 = x_17;
+                            let _e154 = edge_21;
+                            let _e155 = ShadowEdgeLitDistance(_e152, _e153, _e154);
                             log_first_span_2 = log((_e155 / SHADOW_EDGE_CLOSEST));
                         }
                     }
                 }
             }
-            let _e158 = atmosphere_85;
+            let _e158 = atmosphere_87;
             let _e159 = uvwz_8;
             let _e160 = position_5;
             let _e161 = nu_slice_8;
             let _e162 = log_first_span_2;
             let _e163 = GetScatteringBelowSplit(_e158, scattering_texture_4, _e159, _e160, _e161, _e162);
-            let _e164 = atmosphere_85;
+            let _e164 = atmosphere_87;
             let _e165 = uvwz_8;
             let _e166 = position_5;
             let _e167 = nu_slice_8;
@@ -2443,14 +2581,14 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
             return _e174;
         }
     }
-    let _e179 = atmosphere_85;
+    let _e179 = atmosphere_87;
     let _e180 = GetScatteringTextureUMuS(_e179, LOW_SUN_MU_S);
     x_low_sun_2 = _e180;
-    let _e182 = atmosphere_85;
+    let _e182 = atmosphere_87;
     let _e183 = uvwz_8;
     let _e185 = x_low_sun_2;
     GetScatteringMuSColumns(_e182, _e183.y, _e185, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e194 = atmosphere_85;
+    let _e194 = atmosphere_87;
     let _e195 = uvwz_8;
     let _e196 = x_below_1;
     let _e197 = nu_slice_8;
@@ -2458,7 +2596,7 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     let _e199 = low_sun_below_1;
     let _e200 = GetScatteringAtMuSColumn(_e194, scattering_texture_4, _e195, _e196, _e197, _e198, _e199);
     below = _e200;
-    let _e202 = atmosphere_85;
+    let _e202 = atmosphere_87;
     let _e203 = uvwz_8;
     let _e204 = x_above_1;
     let _e205 = nu_slice_8;
@@ -2472,11 +2610,11 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
         {
             let _e215 = below;
             let _e216 = above;
-            let _e217 = atmosphere_85;
-            let _e219 = atmosphere_85;
+            let _e217 = atmosphere_87;
+            let _e219 = atmosphere_87;
             let _e221 = mu_s_size_2;
             let _e225 = GetScatteringMuSFromUnitRange(_e219, (1f / (_e221 - 1f)));
-            let _e226 = mu_s_23;
+            let _e226 = mu_s_26;
             let _e227 = LowestSunContinued(_e215, _e216, _e217.scattering_mu_s_min, _e225, _e226);
             return _e227;
         }
@@ -2498,14 +2636,14 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     let _e254 = mu_s_size_2;
     let _e260 = mu_s_size_2;
     x_last = ((min((_e251 + 2f), (_e254 - 1f)) + 0.5f) / _e260);
-    let _e263 = atmosphere_85;
+    let _e263 = atmosphere_87;
     let _e264 = uvwz_8;
     let _e265 = x_first;
     let _e266 = nu_slice_8;
     let _e267 = nu_t_2;
     let _e269 = GetScatteringAtMuSColumn(_e263, scattering_texture_4, _e264, _e265, _e266, _e267, true);
     first = _e269;
-    let _e271 = atmosphere_85;
+    let _e271 = atmosphere_87;
     let _e272 = uvwz_8;
     let _e273 = x_last;
     let _e274 = nu_slice_8;
@@ -2513,11 +2651,11 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
     let _e276 = x_last;
     let _e277 = x_low_sun_2;
     let _e279 = GetScatteringAtMuSColumn(_e271, scattering_texture_4, _e272, _e273, _e274, _e275, (_e276 < _e277));
-    last = _e279;
+    last_1 = _e279;
     let _e281 = first;
     let _e282 = below;
     let _e283 = above;
-    let _e284 = last;
+    let _e284 = last_1;
     let _e285 = column_3;
     let _e288 = column_3;
     let _e291 = mu_s_size_2;
@@ -2527,10 +2665,10 @@ fn GetScattering(atmosphere_84: AtmosphereParameters, scattering_texture_4: text
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_46: f32, mu_s_24: f32) -> vec3<f32> {
-    var atmosphere_87: AtmosphereParameters;
-    var r_47: f32;
-    var mu_s_25: f32;
+fn GetIrradiance(atmosphere_88: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_48: f32, mu_s_27: f32) -> vec3<f32> {
+    var atmosphere_89: AtmosphereParameters;
+    var r_49: f32;
+    var mu_s_28: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
@@ -2540,25 +2678,25 @@ fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_87 = atmosphere_86;
-    r_47 = r_46;
-    mu_s_25 = mu_s_24;
-    let _e19 = atmosphere_87;
-    let _e20 = r_47;
-    let _e21 = mu_s_25;
+    atmosphere_89 = atmosphere_88;
+    r_49 = r_48;
+    mu_s_28 = mu_s_27;
+    let _e19 = atmosphere_89;
+    let _e20 = r_49;
+    let _e21 = mu_s_28;
     let _e22 = GetIrradianceTextureUvFromRMuS(_e19, _e20, _e21);
     uv_3 = _e22;
-    let _e24 = atmosphere_87;
+    let _e24 = atmosphere_89;
     width = f32(_e24.irradiance_width);
-    let _e28 = atmosphere_87;
-    let _e29 = mu_s_25;
+    let _e28 = atmosphere_89;
+    let _e29 = mu_s_28;
     let _e30 = GetIrradianceUnitMuS(_e28, _e29);
     let _e31 = width;
     mu_s_coord_1 = (_e30 * (_e31 - 1f));
     let _e36 = mu_s_coord_1;
     let _e39 = width;
     mu_s_column_1 = clamp(floor(_e36), 0f, (_e39 - 2f));
-    let _e44 = atmosphere_87;
+    let _e44 = atmosphere_89;
     let _e45 = mu_s_column_1;
     let _e46 = width;
     let _e50 = GetIrradianceMuSFromUnit(_e44, (_e45 / (_e46 - 1f)));
@@ -2587,22 +2725,22 @@ fn GetIrradiance(atmosphere_86: AtmosphereParameters, irradiance_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_88: AtmosphereParameters, nu_15: f32) -> f32 {
-    var atmosphere_89: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_90: AtmosphereParameters, nu_15: f32) -> f32 {
+    var atmosphere_91: AtmosphereParameters;
     var nu_16: f32;
 
-    atmosphere_89 = atmosphere_88;
+    atmosphere_91 = atmosphere_90;
     nu_16 = nu_15;
-    let _e16 = atmosphere_89;
+    let _e16 = atmosphere_91;
     if (_e16.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e19 = atmosphere_89;
+        let _e19 = atmosphere_91;
         let _e21 = nu_16;
         let _e22 = HenyeyGreensteinPhaseFunction(_e19.mie_g, _e21);
         return _e22;
     }
-    let _e23 = atmosphere_89;
+    let _e23 = atmosphere_91;
     if (_e23.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e26 = atmosphere_89;
+        let _e26 = atmosphere_91;
         let _e28 = nu_16;
         let _e29 = CornetteShanksPhaseFunction(_e26.mie_g, _e28);
         return _e29;
@@ -2611,31 +2749,31 @@ fn MiePhaseFunction(atmosphere_88: AtmosphereParameters, nu_15: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_48: f32, mu_33: f32, mu_s_26: f32, nu_17: f32, ray_r_mu_intersects_ground_14: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_91: AtmosphereParameters;
-    var r_49: f32;
-    var mu_34: f32;
-    var mu_s_27: f32;
+fn GetCombinedScattering(atmosphere_92: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_50: f32, mu_35: f32, mu_s_29: f32, nu_17: f32, ray_r_mu_intersects_ground_16: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_93: AtmosphereParameters;
+    var r_51: f32;
+    var mu_36: f32;
+    var mu_s_30: f32;
     var nu_18: f32;
-    var ray_r_mu_intersects_ground_15: bool;
+    var ray_r_mu_intersects_ground_17: bool;
     var scattering: vec4<f32>;
-    var local_15: vec3<f32>;
+    var local_18: vec3<f32>;
 
-    atmosphere_91 = atmosphere_90;
-    r_49 = r_48;
-    mu_34 = mu_33;
-    mu_s_27 = mu_s_26;
+    atmosphere_93 = atmosphere_92;
+    r_51 = r_50;
+    mu_36 = mu_35;
+    mu_s_30 = mu_s_29;
     nu_18 = nu_17;
-    ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
-    let _e27 = atmosphere_91;
-    let _e28 = r_49;
-    let _e29 = mu_34;
-    let _e30 = mu_s_27;
+    ray_r_mu_intersects_ground_17 = ray_r_mu_intersects_ground_16;
+    let _e27 = atmosphere_93;
+    let _e28 = r_51;
+    let _e29 = mu_36;
+    let _e30 = mu_s_30;
     let _e31 = nu_18;
-    let _e32 = ray_r_mu_intersects_ground_15;
+    let _e32 = ray_r_mu_intersects_ground_17;
     let _e33 = GetScattering(_e27, scattering_texture_5, _e28, _e29, _e30, _e31, _e32);
     scattering = _e33;
-    let _e35 = atmosphere_91;
+    let _e35 = atmosphere_93;
     if (_e35.single_mie_in_scattering_alpha == 1i) {
         {
             let _e39 = scattering;
@@ -2643,23 +2781,23 @@ fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture
                 let _e43 = scattering;
                 let _e46 = scattering;
                 let _e49 = scattering;
-                let _e53 = atmosphere_91;
-                let _e55 = atmosphere_91;
-                local_15 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
+                let _e53 = atmosphere_93;
+                let _e55 = atmosphere_93;
+                local_18 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_15 = vec3(0f);
+                local_18 = vec3(0f);
             }
-            let _e64 = local_15;
+            let _e64 = local_18;
             (*single_mie_scattering) = _e64;
         }
     } else {
         {
-            let _e65 = atmosphere_91;
-            let _e66 = r_49;
-            let _e67 = mu_34;
-            let _e68 = mu_s_27;
+            let _e65 = atmosphere_93;
+            let _e66 = r_51;
+            let _e67 = mu_36;
+            let _e68 = mu_s_30;
             let _e69 = nu_18;
-            let _e70 = ray_r_mu_intersects_ground_15;
+            let _e70 = ray_r_mu_intersects_ground_17;
             let _e71 = GetScattering(_e65, single_mie_scattering_texture, _e66, _e67, _e68, _e69, _e70);
             (*single_mie_scattering) = vec3<f32>(_e71.xyz);
         }
@@ -2669,97 +2807,97 @@ fn GetCombinedScattering(atmosphere_90: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_92: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_93: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_94: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_95: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
     var start_2: vec3<f32>;
-    var r_50: f32;
-    var mu_35: f32;
-    var mu_s_28: f32;
+    var r_52: f32;
+    var mu_37: f32;
+    var mu_s_31: f32;
     var nu_19: f32;
-    var ray_r_mu_intersects_ground_16: bool;
-    var local_16: vec3<f32>;
+    var ray_r_mu_intersects_ground_18: bool;
+    var local_19: vec3<f32>;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_93 = atmosphere_92;
+    atmosphere_95 = atmosphere_94;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e29 = atmosphere_93;
+    let _e29 = atmosphere_95;
     let _e30 = camera_5;
     let _e31 = view_ray_5;
     let _e32 = sun_direction_3;
-    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_50), (&mu_35), (&mu_s_28), (&nu_19));
+    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_52), (&mu_37), (&mu_s_31), (&nu_19));
     if !(_e43) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e49 = atmosphere_93;
-    let _e50 = r_50;
-    let _e51 = mu_35;
+    let _e49 = atmosphere_95;
+    let _e50 = r_52;
+    let _e51 = mu_37;
     let _e52 = RayIntersectsGround(_e49, _e50, _e51);
-    ray_r_mu_intersects_ground_16 = _e52;
-    let _e54 = ray_r_mu_intersects_ground_16;
+    ray_r_mu_intersects_ground_18 = _e52;
+    let _e54 = ray_r_mu_intersects_ground_18;
     if _e54 {
-        local_16 = vec3(0f);
+        local_19 = vec3(0f);
     } else {
-        let _e57 = atmosphere_93;
-        let _e58 = r_50;
-        let _e59 = mu_35;
+        let _e57 = atmosphere_95;
+        let _e58 = r_52;
+        let _e59 = mu_37;
         let _e60 = GetTransmittanceToTopAtmosphereBoundary(_e57, transmittance_texture_5, _e58, _e59);
-        local_16 = _e60;
+        local_19 = _e60;
     }
-    let _e62 = local_16;
+    let _e62 = local_19;
     (*transmittance) = _e62;
-    let _e64 = atmosphere_93;
-    let _e65 = r_50;
-    let _e66 = mu_35;
-    let _e67 = mu_s_28;
+    let _e64 = atmosphere_95;
+    let _e65 = r_52;
+    let _e66 = mu_37;
+    let _e67 = mu_s_31;
     let _e68 = nu_19;
-    let _e69 = ray_r_mu_intersects_ground_16;
+    let _e69 = ray_r_mu_intersects_ground_18;
     let _e72 = GetCombinedScattering(_e64, scattering_texture_6, single_mie_scattering_texture_1, _e65, _e66, _e67, _e68, _e69, (&single_mie_scattering_1));
     scattering_1 = _e72;
     let _e74 = scattering_1;
     let _e75 = nu_19;
     let _e76 = RayleighPhaseFunction(_e75);
     let _e78 = single_mie_scattering_1;
-    let _e79 = atmosphere_93;
+    let _e79 = atmosphere_95;
     let _e80 = nu_19;
     let _e81 = MiePhaseFunction(_e79, _e80);
     return ((_e74 * _e76) + (_e78 * _e81));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_94: AtmosphereParameters, r_51: f32, mu_36: f32) -> f32 {
-    var atmosphere_95: AtmosphereParameters;
-    var r_52: f32;
-    var mu_37: f32;
+fn DistanceInsideScatteringRadii(atmosphere_96: AtmosphereParameters, r_53: f32, mu_38: f32) -> f32 {
+    var atmosphere_97: AtmosphereParameters;
+    var r_54: f32;
+    var mu_39: f32;
     var r_max: f32;
     var r_min: f32;
     var across_2: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_17: f32;
+    var local_20: f32;
 
-    atmosphere_95 = atmosphere_94;
-    r_52 = r_51;
-    mu_37 = mu_36;
-    let _e19 = atmosphere_95;
+    atmosphere_97 = atmosphere_96;
+    r_54 = r_53;
+    mu_39 = mu_38;
+    let _e19 = atmosphere_97;
     r_max = _e19.scattering_r_max;
-    let _e22 = atmosphere_95;
+    let _e22 = atmosphere_97;
     r_min = _e22.scattering_r_min;
-    let _e25 = r_52;
-    let _e26 = r_52;
-    let _e28 = mu_37;
-    let _e29 = mu_37;
+    let _e25 = r_54;
+    let _e26 = r_54;
+    let _e28 = mu_39;
+    let _e29 = mu_39;
     across_2 = ((_e25 * _e26) * ((_e28 * _e29) - 1f));
-    let _e35 = r_52;
-    let _e37 = mu_37;
+    let _e35 = r_54;
+    let _e37 = mu_39;
     let _e39 = across_2;
     let _e40 = r_max;
     let _e41 = r_max;
@@ -2769,85 +2907,85 @@ fn DistanceInsideScatteringRadii(atmosphere_94: AtmosphereParameters, r_51: f32,
     let _e48 = r_min;
     let _e49 = r_min;
     down_discriminant = (_e47 + (_e48 * _e49));
-    let _e53 = mu_37;
+    let _e53 = mu_39;
     let _e56 = down_discriminant;
     if ((_e53 < 0f) && (_e56 >= 0f)) {
         let _e60 = up;
-        let _e61 = r_52;
-        let _e63 = mu_37;
+        let _e61 = r_54;
+        let _e63 = mu_39;
         let _e65 = down_discriminant;
-        local_17 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
+        local_20 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
     } else {
         let _e69 = up;
-        local_17 = _e69;
+        local_20 = _e69;
     }
-    let _e71 = local_17;
+    let _e71 = local_20;
     return _e71;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_96: AtmosphereParameters, i_1: i32) -> f32 {
-    var atmosphere_97: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_98: AtmosphereParameters, i_1: i32) -> f32 {
+    var atmosphere_99: AtmosphereParameters;
     var i_2: i32;
     var x_18: f32;
 
-    atmosphere_97 = atmosphere_96;
+    atmosphere_99 = atmosphere_98;
     i_2 = i_1;
     let _e18 = i_2;
     x_18 = (f32(_e18) / 63f);
-    let _e26 = atmosphere_97;
-    let _e28 = atmosphere_97;
+    let _e26 = atmosphere_99;
+    let _e28 = atmosphere_99;
     let _e31 = x_18;
     let _e33 = x_18;
     return (((_e26.top_radius - _e28.bottom_radius) * _e31) * _e33);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_17: f32, b_10: f32, f: f32) -> f32 {
-    var a_18: f32;
+fn InterpolateCoefficient(a_18: f32, b_10: f32, f: f32) -> f32 {
+    var a_19: f32;
     var b_11: f32;
     var f_1: f32;
-    var local_18: f32;
+    var local_21: f32;
 
-    a_18 = a_17;
+    a_19 = a_18;
     b_11 = b_10;
     f_1 = f;
-    let _e20 = a_18;
+    let _e20 = a_19;
     let _e23 = b_11;
     if ((_e20 > 0f) && (_e23 > 0f)) {
-        let _e27 = a_18;
+        let _e27 = a_19;
         let _e28 = f_1;
         let _e29 = b_11;
-        let _e30 = a_18;
-        local_18 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
+        let _e30 = a_19;
+        local_21 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
     } else {
-        let _e36 = a_18;
+        let _e36 = a_19;
         let _e37 = b_11;
         let _e38 = f_1;
-        local_18 = mix(_e36, _e37, _e38);
+        local_21 = mix(_e36, _e37, _e38);
     }
-    let _e41 = local_18;
+    let _e41 = local_21;
     return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_19: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_20: vec3<f32>;
+fn InterpolateCoefficients(a_20: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_21: vec3<f32>;
     var b_13: vec3<f32>;
     var f_3: f32;
 
-    a_20 = a_19;
+    a_21 = a_20;
     b_13 = b_12;
     f_3 = f_2;
-    let _e20 = a_20;
+    let _e20 = a_21;
     let _e22 = b_13;
     let _e24 = f_3;
     let _e25 = InterpolateCoefficient(_e20.x, _e22.x, _e24);
-    let _e26 = a_20;
+    let _e26 = a_21;
     let _e28 = b_13;
     let _e30 = f_3;
     let _e31 = InterpolateCoefficient(_e26.y, _e28.y, _e30);
-    let _e32 = a_20;
+    let _e32 = a_21;
     let _e34 = b_13;
     let _e36 = f_3;
     let _e37 = InterpolateCoefficient(_e32.z, _e34.z, _e36);
@@ -2855,8 +2993,8 @@ fn InterpolateCoefficients(a_19: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_98: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_99: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_100: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_101: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
     var x_19: f32;
@@ -2864,79 +3002,79 @@ fn GetCoefficientsAtAltitude(atmosphere_98: AtmosphereParameters, altitude: f32,
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_99 = atmosphere_98;
+    atmosphere_101 = atmosphere_100;
     altitude_1 = altitude;
-    let _e20 = atmosphere_99;
-    let _e22 = atmosphere_99;
+    let _e20 = atmosphere_101;
+    let _e22 = atmosphere_101;
     height = (_e20.top_radius - _e22.bottom_radius);
     let _e26 = altitude_1;
     let _e27 = height;
     x_19 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
     let _e39 = x_19;
     i_3 = min(i32(_e39), 62i);
-    let _e46 = atmosphere_99;
+    let _e46 = atmosphere_101;
     let _e47 = i_3;
     let _e48 = ProfileSampleAltitude(_e46, _e47);
     h0_ = _e48;
     let _e50 = altitude_1;
     let _e51 = h0_;
-    let _e53 = atmosphere_99;
+    let _e53 = atmosphere_101;
     let _e54 = i_3;
     let _e57 = ProfileSampleAltitude(_e53, (_e54 + 1i));
     let _e58 = h0_;
     f_4 = clamp(((_e50 - _e51) / (_e57 - _e58)), 0f, 1f);
     let _e65 = i_3;
-    let _e68 = atmosphere_99.mie_scattering_profile[_e65];
+    let _e68 = atmosphere_101.mie_scattering_profile[_e65];
     let _e69 = i_3;
-    let _e74 = atmosphere_99.mie_scattering_profile[(_e69 + 1i)];
+    let _e74 = atmosphere_101.mie_scattering_profile[(_e69 + 1i)];
     let _e75 = f_4;
     let _e76 = InterpolateCoefficients(_e68, _e74, _e75);
     (*mie_scattering) = _e76;
     let _e77 = i_3;
-    let _e80 = atmosphere_99.rayleigh_scattering_profile[_e77];
+    let _e80 = atmosphere_101.rayleigh_scattering_profile[_e77];
     let _e81 = i_3;
-    let _e86 = atmosphere_99.rayleigh_scattering_profile[(_e81 + 1i)];
+    let _e86 = atmosphere_101.rayleigh_scattering_profile[(_e81 + 1i)];
     let _e87 = f_4;
     let _e88 = InterpolateCoefficients(_e80, _e86, _e87);
     (*rayleigh_scattering) = _e88;
     let _e89 = i_3;
-    let _e92 = atmosphere_99.extinction_profile[_e89];
+    let _e92 = atmosphere_101.extinction_profile[_e89];
     let _e93 = i_3;
-    let _e98 = atmosphere_99.extinction_profile[(_e93 + 1i)];
+    let _e98 = atmosphere_101.extinction_profile[(_e93 + 1i)];
     let _e99 = f_4;
     let _e100 = InterpolateCoefficients(_e92, _e98, _e99);
     return _e100;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_100: AtmosphereParameters, r_53: f32, mu_38: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_101: AtmosphereParameters;
-    var r_54: f32;
-    var mu_39: f32;
+fn AltitudeAtDistance(atmosphere_102: AtmosphereParameters, r_55: f32, mu_40: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_103: AtmosphereParameters;
+    var r_56: f32;
+    var mu_41: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_101 = atmosphere_100;
-    r_54 = r_53;
-    mu_39 = mu_38;
+    atmosphere_103 = atmosphere_102;
+    r_56 = r_55;
+    mu_41 = mu_40;
     t_10 = t_9;
     r_t_1 = r_t;
-    let _e24 = r_54;
-    let _e25 = atmosphere_101;
+    let _e24 = r_56;
+    let _e25 = atmosphere_103;
     let _e28 = t_10;
     let _e29 = t_10;
-    let _e31 = r_54;
-    let _e33 = mu_39;
+    let _e31 = r_56;
+    let _e33 = mu_41;
     let _e37 = r_t_1;
-    let _e38 = r_54;
+    let _e38 = r_56;
     return ((_e24 - _e25.bottom_radius) + ((_e28 * (_e29 + ((2f * _e31) * _e33))) / (_e37 + _e38)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32, mu_40: f32, d_21: f32) -> vec3<f32> {
-    var atmosphere_103: AtmosphereParameters;
-    var r_56: f32;
-    var mu_41: f32;
+fn IntegrateSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, r_57: f32, mu_42: f32, d_21: f32) -> vec3<f32> {
+    var atmosphere_105: AtmosphereParameters;
+    var r_58: f32;
+    var mu_43: f32;
     var d_22: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
@@ -2948,9 +3086,9 @@ fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32,
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_103 = atmosphere_102;
-    r_56 = r_55;
-    mu_41 = mu_40;
+    atmosphere_105 = atmosphere_104;
+    r_58 = r_57;
+    mu_43 = mu_42;
     d_22 = d_21;
     let _e22 = d_22;
     dt = (_e22 / 16f);
@@ -2963,16 +3101,16 @@ fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32,
             let _e41 = dt;
             let _e42 = k_5;
             t_11 = (_e41 * f32(_e42));
-            let _e46 = atmosphere_103;
-            let _e47 = r_56;
-            let _e48 = mu_41;
+            let _e46 = atmosphere_105;
+            let _e47 = r_58;
+            let _e48 = mu_43;
             let _e49 = t_11;
             let _e50 = RadiusAtDistance(_e46, _e47, _e48, _e49);
             r_t_2 = _e50;
-            let _e54 = atmosphere_103;
-            let _e55 = atmosphere_103;
-            let _e56 = r_56;
-            let _e57 = mu_41;
+            let _e54 = atmosphere_105;
+            let _e55 = atmosphere_105;
+            let _e56 = r_58;
+            let _e57 = mu_43;
             let _e58 = t_11;
             let _e59 = r_t_2;
             let _e60 = AltitudeAtDistance(_e55, _e56, _e57, _e58, _e59);
@@ -2999,65 +3137,65 @@ fn IntegrateSegmentOpticalDepth(atmosphere_102: AtmosphereParameters, r_55: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_57: f32, mu_42: f32, d_23: f32, ray_r_mu_intersects_ground_17: bool) -> vec3<f32> {
-    var atmosphere_105: AtmosphereParameters;
-    var r_58: f32;
-    var mu_43: f32;
+fn LongSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_59: f32, mu_44: f32, d_23: f32, ray_r_mu_intersects_ground_19: bool) -> vec3<f32> {
+    var atmosphere_107: AtmosphereParameters;
+    var r_60: f32;
+    var mu_45: f32;
     var d_24: f32;
-    var ray_r_mu_intersects_ground_18: bool;
-    var local_19: vec3<f32>;
+    var ray_r_mu_intersects_ground_20: bool;
+    var local_22: vec3<f32>;
 
-    atmosphere_105 = atmosphere_104;
-    r_58 = r_57;
-    mu_43 = mu_42;
+    atmosphere_107 = atmosphere_106;
+    r_60 = r_59;
+    mu_45 = mu_44;
     d_24 = d_23;
-    ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
-    let _e25 = atmosphere_105;
+    ray_r_mu_intersects_ground_20 = ray_r_mu_intersects_ground_19;
+    let _e25 = atmosphere_107;
     if (_e25.transmittance_is_colour != 0i) {
-        let _e29 = atmosphere_105;
-        let _e30 = r_58;
-        let _e31 = mu_43;
+        let _e29 = atmosphere_107;
+        let _e30 = r_60;
+        let _e31 = mu_45;
         let _e32 = d_24;
         let _e33 = IntegrateSegmentOpticalDepth(_e29, _e30, _e31, _e32);
-        local_19 = _e33;
+        local_22 = _e33;
     } else {
-        let _e34 = atmosphere_105;
-        let _e35 = r_58;
-        let _e36 = mu_43;
+        let _e34 = atmosphere_107;
+        let _e35 = r_60;
+        let _e36 = mu_45;
         let _e37 = d_24;
-        let _e38 = ray_r_mu_intersects_ground_18;
+        let _e38 = ray_r_mu_intersects_ground_20;
         let _e39 = GetOpticalDepth(_e34, transmittance_texture_6, _e35, _e36, _e37, _e38);
-        local_19 = _e39;
+        local_22 = _e39;
     }
-    let _e41 = local_19;
+    let _e41 = local_22;
     return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_20: f32;
+    var local_23: f32;
 
     depth_1 = depth;
     let _e16 = depth_1;
     if (_e16 < 0.0001f) {
         let _e21 = depth_1;
-        local_20 = (1f - (0.5f * _e21));
+        local_23 = (1f - (0.5f * _e21));
     } else {
         let _e25 = depth_1;
         let _e29 = depth_1;
-        local_20 = ((1f - exp(-(_e25))) / _e29);
+        local_23 = ((1f - exp(-(_e25))) / _e29);
     }
-    let _e32 = local_20;
+    let _e32 = local_23;
     return _e32;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_59: f32, mu_44: f32, mu_s_29: f32, nu_20: f32, d_25: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_107: AtmosphereParameters;
-    var r_60: f32;
-    var mu_45: f32;
-    var mu_s_30: f32;
+fn IntegrateSegment(atmosphere_108: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_61: f32, mu_46: f32, mu_s_32: f32, nu_20: f32, d_25: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_109: AtmosphereParameters;
+    var r_62: f32;
+    var mu_47: f32;
+    var mu_s_33: f32;
     var nu_21: f32;
     var d_26: f32;
     var dt_1: f32;
@@ -3082,10 +3220,10 @@ fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_107 = atmosphere_106;
-    r_60 = r_59;
-    mu_45 = mu_44;
-    mu_s_30 = mu_s_29;
+    atmosphere_109 = atmosphere_108;
+    r_62 = r_61;
+    mu_47 = mu_46;
+    mu_s_33 = mu_s_32;
     nu_21 = nu_20;
     d_26 = d_25;
     let _e30 = d_26;
@@ -3102,35 +3240,35 @@ fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_
             let _e64 = dt_1;
             let _e65 = k_6;
             t_12 = (_e64 * f32(_e65));
-            let _e69 = atmosphere_107;
-            let _e70 = r_60;
-            let _e71 = mu_45;
+            let _e69 = atmosphere_109;
+            let _e70 = r_62;
+            let _e71 = mu_47;
             let _e72 = t_12;
             let _e73 = RadiusAtDistance(_e69, _e70, _e71, _e72);
             r_t_3 = _e73;
-            let _e75 = atmosphere_107;
-            let _e76 = r_60;
-            let _e77 = mu_45;
+            let _e75 = atmosphere_109;
+            let _e76 = r_62;
+            let _e77 = mu_47;
             let _e78 = t_12;
             let _e79 = r_t_3;
             let _e80 = AltitudeAtDistance(_e75, _e76, _e77, _e78, _e79);
             altitude_2 = _e80;
-            let _e82 = r_60;
-            let _e83 = mu_s_30;
+            let _e82 = r_62;
+            let _e83 = mu_s_33;
             let _e85 = t_12;
             let _e86 = nu_21;
             let _e89 = r_t_3;
             let _e91 = ClampCosine((((_e82 * _e83) + (_e85 * _e86)) / _e89));
             mu_s_t_2 = _e91;
-            let _e95 = atmosphere_107;
+            let _e95 = atmosphere_109;
             let _e96 = altitude_2;
             let _e101 = GetCoefficientsAtAltitude(_e95, _e96, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e101;
-            let _e103 = atmosphere_107;
+            let _e103 = atmosphere_109;
             let _e104 = r_t_3;
             let _e105 = mu_s_t_2;
             let _e106 = GetOpticalDepthToTopAtmosphereBoundary(_e103, transmittance_texture_7, _e104, _e105);
-            let _e109 = atmosphere_107;
+            let _e109 = atmosphere_109;
             let _e110 = r_t_3;
             let _e111 = mu_s_t_2;
             let _e112 = SunVisibleFraction(_e109, _e110, _e111);
@@ -3199,18 +3337,18 @@ fn IntegrateSegment(atmosphere_106: AtmosphereParameters, transmittance_texture_
         }
     }
     let _e195 = (*single_rayleigh);
-    let _e196 = atmosphere_107;
+    let _e196 = atmosphere_109;
     (*single_rayleigh) = (_e195 * _e196.solar_irradiance);
     let _e199 = (*single_mie);
-    let _e200 = atmosphere_107;
+    let _e200 = atmosphere_109;
     (*single_mie) = (_e199 * _e200.solar_irradiance);
     let _e203 = optical_depth_1;
     return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_109: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_111: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -3218,13 +3356,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_61: f32;
-    var mu_46: f32;
-    var mu_s_31: f32;
+    var r_63: f32;
+    var mu_48: f32;
+    var mu_s_34: f32;
     var nu_22: f32;
     var d_27: f32;
     var lit_1: f32;
-    var ray_r_mu_intersects_ground_19: bool;
+    var ray_r_mu_intersects_ground_21: bool;
     var r_p: f32;
     var mu_p: f32;
     var mu_s_p: f32;
@@ -3253,7 +3391,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_109 = atmosphere_108;
+    atmosphere_111 = atmosphere_110;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -3271,11 +3409,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     }
     let _e41 = camera_to_point;
     view_ray_6 = normalize(_e41);
-    let _e49 = atmosphere_109;
+    let _e49 = atmosphere_111;
     let _e50 = camera_7;
     let _e51 = view_ray_6;
     let _e52 = sun_direction_5;
-    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_61), (&mu_46), (&mu_s_31), (&nu_22));
+    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_63), (&mu_48), (&mu_s_34), (&nu_22));
     if !(_e63) {
         {
             (*transmittance_1) = vec3(1f);
@@ -3288,25 +3426,25 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e76 = d_27;
     let _e77 = shadow_length_1;
     lit_1 = max((_e76 - max(_e77, 0f)), 0f);
-    let _e84 = atmosphere_109;
-    let _e85 = r_61;
-    let _e86 = mu_46;
+    let _e84 = atmosphere_111;
+    let _e85 = r_63;
+    let _e86 = mu_48;
     let _e87 = RayIntersectsGround(_e84, _e85, _e86);
-    ray_r_mu_intersects_ground_19 = _e87;
-    let _e89 = atmosphere_109;
-    let _e90 = r_61;
-    let _e91 = mu_46;
+    ray_r_mu_intersects_ground_21 = _e87;
+    let _e89 = atmosphere_111;
+    let _e90 = r_63;
+    let _e91 = mu_48;
     let _e92 = lit_1;
     let _e93 = RadiusAtDistance(_e89, _e90, _e91, _e92);
     r_p = _e93;
-    let _e95 = r_61;
-    let _e96 = mu_46;
+    let _e95 = r_63;
+    let _e96 = mu_48;
     let _e97 = lit_1;
     let _e98 = r_p;
     let _e99 = CosineAtDistance(_e95, _e96, _e97, _e98);
     mu_p = _e99;
-    let _e101 = r_61;
-    let _e102 = mu_s_31;
+    let _e101 = r_63;
+    let _e102 = mu_s_34;
     let _e104 = lit_1;
     let _e105 = nu_22;
     let _e108 = r_p;
@@ -3319,10 +3457,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e140 = lit_direct;
     if (_e140 > 0f) {
         {
-            let _e143 = atmosphere_109;
-            let _e144 = r_61;
-            let _e145 = mu_46;
-            let _e146 = mu_s_31;
+            let _e143 = atmosphere_111;
+            let _e144 = r_63;
+            let _e145 = mu_48;
+            let _e146 = mu_s_34;
             let _e147 = nu_22;
             let _e148 = lit_1;
             let _e155 = IntegrateSegment(_e143, transmittance_texture_8, _e144, _e145, _e146, _e147, _e148, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
@@ -3337,7 +3475,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     if ((_e158 > 0f) && (_e161 < _e162)) {
         {
             let _e168 = optical_depth_2;
-            let _e169 = atmosphere_109;
+            let _e169 = atmosphere_111;
             let _e170 = r_p;
             let _e171 = mu_p;
             let _e172 = mu_s_p;
@@ -3351,11 +3489,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e185 = direct;
     if (_e185 < 1f) {
         {
-            let _e188 = atmosphere_109;
-            let _e189 = r_61;
-            let _e190 = mu_46;
+            let _e188 = atmosphere_111;
+            let _e189 = r_63;
+            let _e190 = mu_48;
             let _e191 = d_27;
-            let _e192 = ray_r_mu_intersects_ground_19;
+            let _e192 = ray_r_mu_intersects_ground_21;
             let _e193 = LongSegmentOpticalDepth(_e188, transmittance_texture_8, _e189, _e190, _e191, _e192);
             let _e194 = optical_depth_2;
             let _e195 = direct;
@@ -3364,34 +3502,34 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     }
     let _e198 = optical_depth_2;
     (*transmittance_1) = exp(-(_e198));
-    let _e202 = atmosphere_109;
-    let _e203 = r_61;
-    let _e204 = mu_46;
-    let _e205 = mu_s_31;
+    let _e202 = atmosphere_111;
+    let _e203 = r_63;
+    let _e204 = mu_48;
+    let _e205 = mu_s_34;
     let _e206 = nu_22;
-    let _e207 = ray_r_mu_intersects_ground_19;
+    let _e207 = ray_r_mu_intersects_ground_21;
     let _e210 = GetCombinedScattering(_e202, scattering_texture_7, single_mie_scattering_texture_2, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
     scattering_3 = _e210;
     let _e212 = lit_1;
     if (_e212 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e214 = atmosphere_109;
-            let _e215 = r_61;
-            let _e216 = mu_46;
-            let _e217 = ray_r_mu_intersects_ground_19;
+            let _e214 = atmosphere_111;
+            let _e215 = r_63;
+            let _e216 = mu_48;
+            let _e217 = ray_r_mu_intersects_ground_21;
             let _e218 = DistanceToNearestAtmosphereBoundary(_e214, _e215, _e216, _e217);
             boundary = _e218;
             let _e220 = boundary;
-            let _e222 = atmosphere_109;
-            let _e223 = r_61;
-            let _e224 = mu_46;
+            let _e222 = atmosphere_111;
+            let _e223 = r_63;
+            let _e224 = mu_48;
             let _e225 = DistanceInsideScatteringRadii(_e222, _e223, _e224);
             let _e227 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e220), _e225), _e227);
-            let _e233 = atmosphere_109;
-            let _e234 = r_61;
-            let _e235 = mu_46;
-            let _e236 = mu_s_31;
+            let _e233 = atmosphere_111;
+            let _e234 = r_63;
+            let _e235 = mu_48;
+            let _e236 = mu_s_34;
             let _e237 = nu_22;
             let _e238 = far;
             let _e245 = IntegrateSegment(_e233, transmittance_texture_8, _e234, _e235, _e236, _e237, _e238, (&far_rayleigh), (&far_mie), (&far_weight));
@@ -3400,29 +3538,29 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
             let _e248 = boundary;
             if (_e247 < _e248) {
                 {
-                    let _e250 = atmosphere_109;
-                    let _e251 = r_61;
-                    let _e252 = mu_46;
+                    let _e250 = atmosphere_111;
+                    let _e251 = r_63;
+                    let _e252 = mu_48;
                     let _e253 = far;
                     let _e254 = RadiusAtDistance(_e250, _e251, _e252, _e253);
                     r_far = _e254;
                     let _e257 = scattering_3;
                     let _e258 = far_optical_depth;
-                    let _e261 = atmosphere_109;
+                    let _e261 = atmosphere_111;
                     let _e262 = r_far;
-                    let _e263 = r_61;
-                    let _e264 = mu_46;
+                    let _e263 = r_63;
+                    let _e264 = mu_48;
                     let _e265 = far;
                     let _e266 = r_far;
                     let _e267 = CosineAtDistance(_e263, _e264, _e265, _e266);
-                    let _e268 = r_61;
-                    let _e269 = mu_s_31;
+                    let _e268 = r_63;
+                    let _e269 = mu_s_34;
                     let _e271 = far;
                     let _e272 = nu_22;
                     let _e275 = r_far;
                     let _e277 = ClampCosine((((_e268 * _e269) + (_e271 * _e272)) / _e275));
                     let _e278 = nu_22;
-                    let _e279 = ray_r_mu_intersects_ground_19;
+                    let _e279 = ray_r_mu_intersects_ground_21;
                     let _e282 = GetCombinedScattering(_e261, scattering_texture_7, single_mie_scattering_texture_2, _e262, _e267, _e277, _e278, _e279, (&unused_far_mie));
                     scattering_3 = (_e257 - (exp(-(_e258)) * _e282));
                 }
@@ -3437,27 +3575,27 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
             let _e302 = nu_22;
             let _e303 = RayleighPhaseFunction(_e302);
             let _e305 = single_mie_1;
-            let _e306 = atmosphere_109;
+            let _e306 = atmosphere_111;
             let _e307 = nu_22;
             let _e308 = MiePhaseFunction(_e306, _e307);
             return (((_e299 + _e300) * _e303) + (_e305 * _e308));
         }
     }
-    let _e311 = atmosphere_109;
-    let _e312 = r_61;
-    let _e313 = mu_46;
+    let _e311 = atmosphere_111;
+    let _e312 = r_63;
+    let _e313 = mu_48;
     let _e314 = lit_1;
-    let _e315 = ray_r_mu_intersects_ground_19;
+    let _e315 = ray_r_mu_intersects_ground_21;
     let _e316 = LongSegmentOpticalDepth(_e311, transmittance_texture_8, _e312, _e313, _e314, _e315);
     let _e317 = lit_optical_depth;
     let _e318 = lit_direct;
     lit_transmittance = exp(-(mix(_e316, _e317, vec3(_e318))));
-    let _e325 = atmosphere_109;
+    let _e325 = atmosphere_111;
     let _e326 = r_p;
     let _e327 = mu_p;
     let _e328 = mu_s_p;
     let _e329 = nu_22;
-    let _e330 = ray_r_mu_intersects_ground_19;
+    let _e330 = ray_r_mu_intersects_ground_21;
     let _e333 = GetCombinedScattering(_e325, scattering_texture_7, single_mie_scattering_texture_2, _e326, _e327, _e328, _e329, _e330, (&single_mie_scattering_p));
     scattering_p = _e333;
     let _e335 = scattering_3;
@@ -3476,24 +3614,24 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_108: AtmosphereParameters, transmi
     let _e357 = nu_22;
     let _e358 = RayleighPhaseFunction(_e357);
     let _e360 = single_mie_scattering_2;
-    let _e361 = atmosphere_109;
+    let _e361 = atmosphere_111;
     let _e362 = nu_22;
     let _e363 = MiePhaseFunction(_e361, _e362);
     return ((_e356 * _e358) + (_e360 * _e363));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_110: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_111: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_112: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_113: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_111 = atmosphere_110;
+    atmosphere_113 = atmosphere_112;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e26 = atmosphere_111;
+    let _e26 = atmosphere_113;
     let _e27 = camera_9;
     let _e28 = point_3;
     let _e30 = sun_direction_7;
@@ -3502,52 +3640,52 @@ fn GetSkyRadianceToPoint(atmosphere_110: AtmosphereParameters, transmittance_tex
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_112: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_113: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_114: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_115: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_62: f32;
-    var mu_s_32: f32;
+    var r_64: f32;
+    var mu_s_35: f32;
 
-    atmosphere_113 = atmosphere_112;
+    atmosphere_115 = atmosphere_114;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e25 = atmosphere_113;
+    let _e25 = atmosphere_115;
     let _e26 = point_5;
     let _e28 = ClampRadius(_e25, length(_e26));
-    r_62 = _e28;
+    r_64 = _e28;
     let _e30 = point_5;
     let _e31 = sun_direction_9;
     let _e33 = point_5;
     let _e36 = ClampCosine((dot(_e30, _e31) / length(_e33)));
-    mu_s_32 = _e36;
-    let _e38 = atmosphere_113;
-    let _e39 = r_62;
-    let _e40 = mu_s_32;
+    mu_s_35 = _e36;
+    let _e38 = atmosphere_115;
+    let _e39 = r_64;
+    let _e40 = mu_s_35;
     let _e41 = GetIrradiance(_e38, irradiance_texture_1, _e39, _e40);
     let _e43 = normal_1;
     let _e44 = point_5;
     let _e46 = point_5;
     (*sky_irradiance) = ((_e41 * (1f + (dot(_e43, _e44) / length(_e46)))) * 0.5f);
-    let _e53 = atmosphere_113;
-    let _e55 = atmosphere_113;
-    let _e56 = r_62;
-    let _e57 = mu_s_32;
+    let _e53 = atmosphere_115;
+    let _e55 = atmosphere_115;
+    let _e56 = r_64;
+    let _e57 = mu_s_35;
     let _e58 = GetTransmittanceToSun(_e55, transmittance_texture_10, _e56, _e57);
     let _e60 = normal_1;
     let _e61 = sun_direction_9;
     return ((_e53.solar_irradiance * _e58) * max(dot(_e60, _e61), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_114: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_115: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_116: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_117: AtmosphereParameters;
 
-    atmosphere_115 = atmosphere_114;
-    let _e16 = atmosphere_115;
-    let _e18 = atmosphere_115;
-    let _e21 = atmosphere_115;
+    atmosphere_117 = atmosphere_116;
+    let _e16 = atmosphere_117;
+    let _e18 = atmosphere_117;
+    let _e21 = atmosphere_117;
     return (_e16.solar_irradiance / vec3(((PI * _e18.sun_angular_radius) * _e21.sun_angular_radius)));
 }
 
