@@ -9,6 +9,8 @@
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GLES3/gl3.h>
+
+#include "examples/engine/headless_egl.h"
 #endif
 
 namespace skybake::testing {
@@ -131,7 +133,7 @@ GlContext::~GlContext() {
     for (const Impl::BoundTexture& t : impl_->textures) impl_->gl.DeleteTextures(1, &t.id);
     eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(impl_->display, impl_->context);
-    // No eglTerminate: the surfaceless display is shared by every context of
+    // No eglTerminate: the headless display is shared by every context of
     // the process, and terminating it would pull contexts from other tests.
   }
 }
@@ -141,17 +143,12 @@ std::unique_ptr<GlContext> GlContext::Create(Api api, std::string* why_not) {
     *why_not = "no headless GL: " + reason;
     return nullptr;
   };
-  auto get_platform_display =
-      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-  if (!get_platform_display) return fail("eglGetPlatformDisplayEXT is unavailable");
-  EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (display == EGL_NO_DISPLAY) return fail(EglErrorText("eglGetPlatformDisplayEXT(SURFACELESS_MESA)"));
-  EGLint major = 0, minor = 0;
-  if (!eglInitialize(display, &major, &minor)) return fail(EglErrorText("eglInitialize"));
+  EGLDisplay display = HeadlessEglDisplay();
+  if (display == EGL_NO_DISPLAY) return fail("no surfaceless or device EGL display");
 
   bool es = api == Api::kGles30;
   if (!eglBindAPI(es ? EGL_OPENGL_ES_API : EGL_OPENGL_API)) return fail(EglErrorText("eglBindAPI"));
-  // The default EGL_SURFACE_TYPE is EGL_WINDOW_BIT, which a surfaceless
+  // The default EGL_SURFACE_TYPE is EGL_WINDOW_BIT, which a headless
   // display has none of; ask for pbuffer configs, and fall back to
   // EGL_KHR_no_config_context where there are none.
   const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
@@ -161,7 +158,7 @@ std::unique_ptr<GlContext> GlContext::Create(Api api, std::string* why_not) {
   if (!eglChooseConfig(display, config_attributes, &config, 1, &configs) || configs < 1) {
     const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
     if (!extensions || !std::strstr(extensions, "EGL_KHR_no_config_context"))
-      return fail("no EGL config for " + std::string(es ? "OpenGL ES 3" : "OpenGL") + " on the surfaceless display");
+      return fail("no EGL config for " + std::string(es ? "OpenGL ES 3" : "OpenGL") + " on the headless display");
     config = EGL_NO_CONFIG_KHR;
   }
   const EGLint es_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0, EGL_NONE};

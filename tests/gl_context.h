@@ -1,9 +1,8 @@
 // A headless OpenGL context for tests that run shaders on a real driver
-// (Mesa llvmpipe here) and read the results back.
+// (Mesa llvmpipe here, or a GPU) and read the results back.
 //
-// The context comes from EGL's surfaceless platform
-// (EGL_PLATFORM_SURFACELESS_MESA via eglGetPlatformDisplayEXT), so no window
-// system or GPU is needed. Every GL entry point is loaded through
+// The context comes from EGL with no window system (HeadlessEglDisplay:
+// Mesa's surfaceless platform, which needs no GPU, or an EGL device). Every GL entry point is loaded through
 // eglGetProcAddress, which is how one helper serves both OpenGL ES 3.0 and
 // desktop OpenGL 3.3 core without linking either library.
 //

@@ -2,12 +2,13 @@
 // upload them as OpenGL textures (3D for the scattering tables) with the
 // sampling modes shaders_runtime/README.md documents, compile the three GLSL
 // files the bake wrote into a fragment shader, and draw. It renders, headless
-// (EGL on Mesa's surfaceless platform, OpenGL ES 3.0, so no window system or
-// GPU is needed), the `fisheye` sky and the `aerial` view of the ground with
-// aerial perspective, in the geometry of `skybake render` (render/views.h),
-// and writes each as linear EXR and tone-mapped PNG, as `skybake render`
-// does: the two programs draw the same pictures, one on the GPU, one on the
-// CPU twin.
+// (OpenGL ES 3.0 through EGL with no window system: Mesa's surfaceless
+// platform, which needs no GPU, or an EGL device, as NVIDIA's driver offers),
+// the `fisheye` sky and the `aerial` view of the ground with aerial
+// perspective, in the geometry of `skybake render` (render/views.h), and
+// writes each as linear EXR and tone-mapped PNG, as `skybake render` does:
+// the two programs draw the same pictures, one on the GPU, one on the CPU
+// twin.
 //
 //   skybake_engine_example LUT_DIR OUT_DIR [--sun-zenith DEG] [--sun-azimuth DEG]
 //                          [--size N] [--altitude M] [--format ktx2|exr]
@@ -34,6 +35,7 @@
 #include "core/constants.h"
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "examples/engine/headless_egl.h"
 #include "formats/lut_files.h"
 #include "formats/table_file.h"
 #include "render/image_files.h"
@@ -79,17 +81,13 @@ void main() {
 }
 )";
 
-// A current OpenGL ES 3.0 context on EGL's surfaceless platform (the
-// approach of tests/gl_context.cpp); rendering goes to framebuffer objects.
+// A current OpenGL ES 3.0 context with no window system (HeadlessEglDisplay,
+// as tests/gl_context.cpp); rendering goes to framebuffer objects.
 class HeadlessContext {
  public:
   HeadlessContext() {
-    auto get_platform_display =
-        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-    if (!get_platform_display) Fail("eglGetPlatformDisplayEXT is unavailable");
-    display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    EGLint major = 0, minor = 0;
-    if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) Fail("no surfaceless EGL display");
+    display_ = skybake::HeadlessEglDisplay();
+    if (display_ == EGL_NO_DISPLAY) Fail("no surfaceless or device EGL display");
     if (!eglBindAPI(EGL_OPENGL_ES_API)) Fail("eglBindAPI(EGL_OPENGL_ES_API) failed");
     const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT,
                                         EGL_NONE};
