@@ -59,7 +59,9 @@ void ExpectViewMatchesTwin(const Twin& twin, render::View view, const render::Vi
   // daylight one, EV 3.3: after sunset the ground is dark in it).
   render::Rgb8 png = render::ReadPng(images / (name + ".png"));
   ASSERT_EQ(png.width, settings.width);
-  if (settings.sun_zenith_deg < 90.0) EXPECT_GT(*std::max_element(png.rgb.begin(), png.rgb.end()), 100);
+  if (settings.sun_zenith_deg < 90.0) {
+    EXPECT_GT(*std::max_element(png.rgb.begin(), png.rgb.end()), 100);
+  }
   // The linear radiance: finite, and the twin's wherever a pixel is not
   // on the edge of the sun's disc or of the fisheye's circle (where a
   // float rounding can move the pixel centre across the edge).
