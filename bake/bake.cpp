@@ -207,15 +207,25 @@ void SetAltitudeProfiles(const Atmosphere& atmosphere, glsl::AtmosphereParameter
 
 LutSet Bake(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report,
             const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot) {
+  return detail::BakeSharingOwnSuns(atmosphere, settings, report, progress, order_snapshot, nullptr);
+}
+
+namespace detail {
+LutSet BakeSharingOwnSuns(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report,
+                          const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot,
+                          std::shared_ptr<const OwnColumnSuns>* own_suns) {
   settings.Validate();
   std::unique_ptr<tbb::global_control> thread_limit;
   if (settings.threads > 0) {
     thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                          static_cast<size_t>(settings.threads));
   }
-  detail::Baker baker(atmosphere, settings);
-  return baker.Run(report, progress, order_snapshot);
+  Baker baker(atmosphere, settings, own_suns ? *own_suns : nullptr);
+  LutSet luts = baker.Run(report, progress, order_snapshot);
+  if (own_suns) *own_suns = baker.own_suns();
+  return luts;
 }
+}  // namespace detail
 
 TwinTables MakeTwinTables(const LutSet& luts) {
   return TwinTables{luts.parameters, &luts.transmittance, &luts.scattering, &luts.single_mie_scattering,

@@ -77,8 +77,10 @@ LutSet Baker::Run(BakeReport* report, const BakeProgress& progress, const BakeOr
   // rows, that is the table's from the split up and the rest is computed
   // along the table's rays; else on the grid itself.
   const bool grid_single = (s.orders != 1 || s.single_scattering_sky_irradiance) && !TableOnAtmosphereGrid();
-  if (params_.scattering_mu_s_split > 0) {
-    Phase("each ray's own sun columns", [&] { own_suns_ = std::make_unique<OwnColumnSuns>(params_); });
+  if (params_.scattering_mu_s_split == 0) {
+    own_suns_ = nullptr;
+  } else if (!own_suns_ || !own_suns_->HasTheSunsOf(params_)) {
+    Phase("each ray's own sun columns", [&] { own_suns_ = std::make_shared<const OwnColumnSuns>(params_); });
   }
   Phase("single scattering", [&] {
     const SunColumns grid_columns(atmosphere_grid_);

@@ -44,12 +44,19 @@
 namespace skybake::detail {
 class Baker {
  public:
-  Baker(const Atmosphere& atmosphere, const BakeSettings& settings)
+  // own_suns: the suns of the table's own columns if already solved for a
+  // table of the same geometry (a spectral bake's other batches), else null.
+  Baker(const Atmosphere& atmosphere, const BakeSettings& settings,
+        std::shared_ptr<const OwnColumnSuns> own_suns = nullptr)
       : medium_(atmosphere),
         settings_(settings),
         params_(MakeAtmosphereParameters(atmosphere, settings)),
         atmosphere_grid_(AtmosphereGrid(atmosphere, settings)),
-        orders_grid_(HigherOrderGrid(atmosphere_grid_, settings.higher_order_divisor)) {}
+        orders_grid_(HigherOrderGrid(atmosphere_grid_, settings.higher_order_divisor)),
+        own_suns_(std::move(own_suns)) {}
+
+  // The suns of the table's own columns, where it has a split (after Run).
+  std::shared_ptr<const OwnColumnSuns> own_suns() const { return own_suns_; }
 
   LutSet Run(BakeReport* report, const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot);
 
@@ -256,7 +263,7 @@ class Baker {
   BakeProgress progress_;
 
   // The suns of the table's rays' own columns, where it has a split.
-  std::unique_ptr<OwnColumnSuns> own_suns_;
+  std::shared_ptr<const OwnColumnSuns> own_suns_;
   // Every order's gather is along the same rays, planned once.
   std::shared_ptr<GatherPlan> orders_plan_;
   Texture transmittance_;

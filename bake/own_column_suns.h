@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -29,7 +30,8 @@ namespace skybake::detail {
 class OwnColumnSuns {
  public:
   explicit OwnColumnSuns(const AtmosphereParameters& grid)
-      : split_(grid.scattering_mu_s_split),
+      : grid_(grid),
+        split_(grid.scattering_mu_s_split),
         mu_s_size_(grid.scattering_mu_s_size),
         nu_size_(grid.scattering_nu_size),
         mu_size_(grid.scattering_mu_size),
@@ -65,6 +67,17 @@ class OwnColumnSuns {
   }
   std::size_t size() const { return mu_s_.size(); }
   double MuSAt(std::size_t index) const { return mu_s_[index]; }
+  // Whether `grid` has the suns of this one: the same geometry and sizes
+  // (the suns depend on nothing else, not on the wavelengths).
+  bool HasTheSunsOf(const AtmosphereParameters& grid) const {
+    const AtmosphereParameters& a = grid_;
+    return a.bottom_radius == grid.bottom_radius && a.top_radius == grid.top_radius &&
+           a.sun_angular_radius == grid.sun_angular_radius && a.scattering_r_size == grid.scattering_r_size &&
+           a.scattering_mu_size == grid.scattering_mu_size && a.scattering_mu_s_size == grid.scattering_mu_s_size &&
+           a.scattering_nu_size == grid.scattering_nu_size && a.scattering_r_min == grid.scattering_r_min &&
+           a.scattering_r_max == grid.scattering_r_max && a.scattering_mu_s_min == grid.scattering_mu_s_min &&
+           a.scattering_mu_s_max == grid.scattering_mu_s_max && a.scattering_mu_s_split == grid.scattering_mu_s_split;
+  }
 
  private:
   // Each lit column's D(E) = ShadowEdgeLitDistance at its position, as a
@@ -113,9 +126,18 @@ class OwnColumnSuns {
     std::vector<double> distance_, slope_;  // per lit column, then node
   };
 
+  AtmosphereParameters grid_;
   int split_, mu_s_size_, nu_size_, mu_size_;
   LitDistances distances_;
   std::vector<double> mu_s_;
 };
+
+// Bake, with the suns of the table's own columns (OwnColumnSuns) shared
+// between bakes of the same geometry: *own_suns, where not null and of the
+// same geometry, is used instead of solving them again, and receives the
+// ones the bake used (null where the table has no split). Bake passes null.
+LutSet BakeSharingOwnSuns(const Atmosphere& atmosphere, const BakeSettings& settings, BakeReport* report,
+                          const BakeProgress& progress, const BakeOrderSnapshot& order_snapshot,
+                          std::shared_ptr<const OwnColumnSuns>* own_suns);
 
 }  // namespace skybake::detail

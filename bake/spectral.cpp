@@ -475,7 +475,10 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
   LutSet source_luts;
   glsl::Texture source_single_scattering, source_sky_light;
   HigherOrderSource scattering_source, irradiance_source;
-  std::unique_ptr<detail::OwnColumnSuns> own_suns;  // of the source's table, where it has a split
+  // The suns of the table's own columns, where it has a split: the same for
+  // every batch (they depend on the geometry alone), solved by the first;
+  // and the source's (the same ones).
+  std::shared_ptr<const detail::OwnColumnSuns> own_suns, source_own_suns;
   for (std::size_t b = 0; b < batches.size(); ++b) {
     const Spectrum& nm = batches.batch_wavelengths_nm[b];
     const Atmosphere& atmosphere = atmospheres[b];
@@ -489,15 +492,17 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
       batch_settings.single_scattering_sky_irradiance = true;
     }
     BakeReport batch_report;
-    LutSet luts = Bake(atmosphere, batch_settings, &batch_report,
-                       [&](const BakeTiming& t) {
-                         if (progress) progress({name + t.phase, t.seconds});
-                       },
-                       {[&](int order, const LutSet& snapshot, double) {
-                          if (order == 1) source_single_scattering = snapshot.scattering;
-                          if (order == 2) source_sky_light = snapshot.irradiance;
-                        },
-                        interpolated && computes_higher_orders ? 2 : 0});
+    LutSet luts = detail::BakeSharingOwnSuns(
+        atmosphere, batch_settings, &batch_report,
+        [&](const BakeTiming& t) {
+          if (progress) progress({name + t.phase, t.seconds});
+        },
+        {[&](int order, const LutSet& snapshot, double) {
+           if (order == 1) source_single_scattering = snapshot.scattering;
+           if (order == 2) source_sky_light = snapshot.irradiance;
+         },
+         interpolated && computes_higher_orders ? 2 : 0},
+        &own_suns);
     for (const BakeTiming& t : batch_report.timings) total.timings.push_back({name + t.phase, t.seconds});
     total.total_seconds += batch_report.total_seconds;
     total.orders_used = std::max(total.orders_used, batch_report.orders_used);
@@ -522,8 +527,9 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
       const glsl::AtmosphereParameters& grid = source_luts.parameters;
       irradiance->AddInterpolated(m, luts.irradiance, irradiance_source, interpolation[b],
                                   IrradianceReference(luts.irradiance));
-      scattering->AddInterpolated(m, luts.scattering, scattering_source, interpolation[b],
-                                  ScatteringReference(grid, luts.irradiance, interpolation[b].sun, own_suns.get()));
+      scattering->AddInterpolated(
+          m, luts.scattering, scattering_source, interpolation[b],
+          ScatteringReference(grid, luts.irradiance, interpolation[b].sun, source_own_suns.get()));
     }
     single_mie->Add(m, luts.single_mie_scattering);
     // The sun's XYZ weight of each of the batch's wavelengths: column w of m
@@ -544,13 +550,14 @@ LutSet BakeSpectral(const AtmosphereSource& source, const SpectralBatches& batch
       scattering_source.all_orders = &table;
       scattering_source.first_orders = &source_single_scattering;
       const glsl::AtmosphereParameters& grid = source_luts.parameters;
-      if (grid.scattering_mu_s_split > 0) own_suns = std::make_unique<detail::OwnColumnSuns>(grid);
-      scattering_source.reference = ScatteringReference(grid, source_sky_light, interpolation[0].sun, own_suns.get());
+      source_own_suns = own_suns;
+      scattering_source.reference =
+          ScatteringReference(grid, source_sky_light, interpolation[0].sun, source_own_suns.get());
       scattering_source.sun = interpolation[0].sun;
       scattering_source.width = std::size_t(table.width);
       scattering_source.height = std::size_t(table.height);
       scattering_source.mu_s_size = std::size_t(grid.scattering_mu_s_size);
-      scattering_source.own = own_suns.get();
+      scattering_source.own = source_own_suns.get();
       scattering_source.split = grid.scattering_mu_s_split;
       irradiance_source = {&source_luts.irradiance, &source_sky_light, IrradianceReference(source_sky_light),
                            interpolation[0].sun};

@@ -18,6 +18,7 @@
 
 #include "bake/colour.h"
 #include "bake/config.h"
+#include "bake/own_column_suns.h"
 #include "bake/spectral_data.h"
 #include "core/errors.h"
 #include "formats/lut_files.h"
@@ -173,6 +174,38 @@ TEST(HigherOrderInterpolation, ReproducesItsModelAndTheComputedWavelengths) {
   EXPECT_NEAR(predict(h, line, 4), line[4], 1e-9);
   EXPECT_NEAR(predict(h, line, 0), line[computed[0]], 1e-9);
   EXPECT_NEAR(predict(h, line, 14), line[computed[2]], 1e-9);
+}
+
+// The suns of a table's own columns depend on its geometry alone: a
+// spectral bake solves them in its first batch and its other batches reuse
+// them, to the same tables; a bake of another geometry solves its own.
+TEST(SpectralBake, SolvesTheOwnColumnsSunsOnce) {
+  BakeSettings settings = testing::SmallBakeSettings();
+  settings.scattering_mu_s_size = BakeSettings().scattering_mu_s_size;  // enough columns for a split
+  BakeReport report;
+  BakeSpectral(Preset("earth"), MakeSpectralBatches(SpectralWavelengths(9), SpectralHigherOrders::kInterpolated),
+               settings, &report);
+  int solves = 0;
+  for (const BakeTiming& t : report.timings) solves += t.phase.find("each ray's own sun columns") != std::string::npos;
+  EXPECT_EQ(solves, 1);
+
+  std::shared_ptr<const detail::OwnColumnSuns> own;
+  const LutSet first = detail::BakeSharingOwnSuns(testing::Earth(), settings, nullptr, nullptr, {}, &own);
+  ASSERT_TRUE(own);
+  const std::shared_ptr<const detail::OwnColumnSuns> earth_suns = own;
+  BakeReport again;
+  const LutSet second = detail::BakeSharingOwnSuns(testing::Earth(), settings, &again, nullptr, {}, &own);
+  EXPECT_EQ(own, earth_suns);
+  for (const BakeTiming& t : again.timings) EXPECT_EQ(t.phase.find("own sun columns"), std::string::npos) << t.phase;
+  EXPECT_EQ(second.scattering.texels, first.scattering.texels);
+  EXPECT_EQ(second.single_mie_scattering.texels, first.single_mie_scattering.texels);
+
+  const Atmosphere mars = LoadAtmosphere("mars");
+  detail::BakeSharingOwnSuns(mars, settings, nullptr, nullptr, {}, &own);
+  ASSERT_TRUE(own);
+  EXPECT_NE(own, earth_suns);
+  EXPECT_TRUE(own->HasTheSunsOf(MakeAtmosphereParameters(mars, settings)));
+  EXPECT_FALSE(earth_suns->HasTheSunsOf(MakeAtmosphereParameters(mars, settings)));
 }
 
 // An atmosphere whose every coefficient, albedo and sun are the same at all
