@@ -462,9 +462,11 @@ Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r, Num
 }
 
 // 4D scattering table, stored as a 3D texture: x packs nu (slowest) and mu_s,
-// y is mu, z is r. Returns (u_nu, u_mu_s, u_mu, u_r) in [0, 1].
-vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
-                                          Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
+// y is mu, z is r. Returns (u_nu, u_mu_s, u_mu, u_r) in [0, 1]; below the
+// split also the ray's shadow edge (ShadowEdge's direction), which
+// GetScattering reads again, else (0, 0).
+vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number mu_s, Number nu,
+                                     bool ray_r_mu_intersects_ground, OUT(vec2) edge) {
   Number H = HorizonDistanceAtTop(atmosphere);
   Number rho = HorizonDistance(atmosphere, r);
 
@@ -493,12 +495,18 @@ vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, N
   // Below the split, the position on the ray's own columns.
   Number u_mu_s = GetScatteringTextureUMuS(atmosphere, mu_s);
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
+  edge = vec2(0.0);
   if (atmosphere.scattering_mu_s_split > 0 && u_mu_s * mu_s_size - 0.5 < Number(atmosphere.scattering_mu_s_split)) {
-    vec2 edge;
     ShadowEdge(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu), ray_r_mu_intersects_ground, edge);
     u_mu_s = (GetScatteringShadowEdgePosition(atmosphere, ShadowEdgeDistance(edge, mu_s), edge) + 0.5) / mu_s_size;
   }
   return vec4(ScatteringUnitNu(nu), u_mu_s, u_mu, u_r);
+}
+
+vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
+                                          Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
+  vec2 unused;
+  return GetScatteringTextureUvwzAndEdge(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground, unused);
 }
 #endif
 
@@ -811,7 +819,8 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
 // LowestSunLogFall of its first two (four fetches).
 vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                    Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
-  vec4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
+  vec2 edge;
+  vec4 uvwz = GetScatteringTextureUvwzAndEdge(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground, edge);
   Number nu_size = Number(atmosphere.scattering_nu_size);
   Number nu_coord = uvwz.x * (nu_size - 1.0);
   Number nu_slice = min(floor(nu_coord), nu_size - 2.0);
@@ -822,8 +831,6 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
     Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
     Number log_first_span = 1.0;
     if (position < past) {
-      vec2 edge;
-      ShadowEdge(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu), ray_r_mu_intersects_ground, edge);
       if (position < 0.0) {
         // Past the first column (the tables' lowest sun, or
         // SHADOW_EDGE_LEAST_PAST_SPAN past the edge): ln L continued from

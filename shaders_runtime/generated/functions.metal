@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _952 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _953 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_952)
+    if (!_953)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _815 = mu < 0.0;
-    bool _827;
-    if (_815)
+    bool _816 = mu < 0.0;
+    bool _828;
+    if (_816)
     {
-        _827 = (((r * r) * mu) * mu) >= c;
+        _828 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _827 = _815;
+        _828 = _816;
     }
-    return _827;
+    return _828;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _585;
+    float _586;
     if (r_mu > 0.0)
     {
-        _585 = c / (r_mu + s);
+        _586 = c / (r_mu + s);
     }
     else
     {
-        _585 = s - r_mu;
+        _586 = s - r_mu;
     }
-    float param_1 = _585;
+    float param_1 = _586;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1044;
+    float _1045;
     if (d_max > d_min)
     {
-        _1044 = (d - d_min) / (d_max - d_min);
+        _1045 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1044 = 0.0;
+        _1045 = 0.0;
     }
-    float x_mu = _1044;
+    float x_mu = _1045;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -312,17 +312,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1249;
+    float _1250;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1249 = ClampCosine(param_1);
+        _1250 = ClampCosine(param_1);
     }
     else
     {
-        _1249 = 1.0;
+        _1250 = 1.0;
     }
-    return _1249;
+    return _1250;
 }
 #endif
 
@@ -330,22 +330,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _831;
+    float _832;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _831 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _832 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _831 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _832 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _831;
+    return _832;
 }
 #endif
 
@@ -402,51 +402,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1355;
+    float2 _1356;
     if (c_end >= rho)
     {
-        _1355 = float2(-1.0, 0.0);
+        _1356 = float2(-1.0, 0.0);
     }
     else
     {
-        _1355 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1356 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1355;
-    bool _1383 = end.y < 0.0;
-    bool _1393;
-    if (!_1383)
+    float2 end = _1356;
+    bool _1384 = end.y < 0.0;
+    bool _1394;
+    if (!_1384)
     {
-        _1393 = end.x < start.x;
+        _1394 = end.x < start.x;
     }
     else
     {
-        _1393 = _1383;
+        _1394 = _1384;
     }
-    bool end_sets_last = _1393;
+    bool end_sets_last = _1394;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1448;
+    float _1449;
     if (end_sets_last)
     {
-        float _1454;
+        float _1455;
         if (c_end >= rho)
         {
-            _1454 = 3.1415927410125732421875;
+            _1455 = 3.1415927410125732421875;
         }
         else
         {
-            _1454 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1455 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1448 = _1454;
+        _1449 = _1455;
     }
     else
     {
-        _1448 = acos(c_start);
+        _1449 = acos(c_start);
     }
-    float angle = _1448;
+    float angle = _1449;
     return angle + a;
 }
 #endif
@@ -487,17 +487,17 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_5 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1191;
+    float _1192;
     if (d == 0.0)
     {
-        _1191 = 1.0;
+        _1192 = 1.0;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1191 = ClampCosine(param_6);
+        _1192 = ClampCosine(param_6);
     }
-    return _1191;
+    return _1192;
 }
 #endif
 
@@ -552,15 +552,15 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1657 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _1658 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1657;
+    X_closest = _1658;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _1664 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _1665 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _1664 - X_closest;
+    X_span = _1665 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -577,9 +577,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1614 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1615 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1614;
+    float X = _1615;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -607,9 +607,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1709 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _1710 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1709;
+    return _1710;
 }
 #endif
 
@@ -656,7 +656,7 @@ float ScatteringUnitNu(thread const float& nu)
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
+float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground, thread float2& edge)
 {
     AtmosphereParameters param = atmosphere;
     float H = HorizonDistanceAtTop(param);
@@ -674,16 +674,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
         float d_min = r - atmosphere.bottom_radius;
         float d_max = rho;
-        float _2003;
+        float _2004;
         if (d_max == d_min)
         {
-            _2003 = 0.0;
+            _2004 = 0.0;
         }
         else
         {
-            _2003 = (d - d_min) / (d_max - d_min);
+            _2004 = (d - d_min) / (d_max - d_min);
         }
-        x_mu = _2003;
+        x_mu = _2004;
         u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     else
@@ -694,16 +694,16 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
         float d_min_1 = atmosphere.top_radius - r;
         float d_max_1 = rho + H;
-        float _2047;
+        float _2048;
         if (d_max_1 > d_min_1)
         {
-            _2047 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
+            _2048 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
         }
         else
         {
-            _2047 = 0.0;
+            _2048 = 0.0;
         }
-        x_mu = _2047;
+        x_mu = _2048;
         u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
     }
     AtmosphereParameters param_9 = atmosphere;
@@ -716,17 +716,18 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
     float param_15 = mu_s;
     float u_mu_s = GetScatteringTextureUMuS(param_14, param_15);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    bool _2093 = atmosphere.scattering_mu_s_split > 0;
-    bool _2104;
-    if (_2093)
+    edge = float2(0.0);
+    bool _2095 = atmosphere.scattering_mu_s_split > 0;
+    bool _2106;
+    if (_2095)
     {
-        _2104 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2106 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2104 = _2093;
+        _2106 = _2095;
     }
-    if (_2104)
+    if (_2106)
     {
         float param_16 = mu;
         float param_17 = mu_s;
@@ -737,8 +738,8 @@ float4 GetScatteringTextureUvwzFromRMuMuSNu(thread const AtmosphereParameters& a
         float param_22 = ViewSunAzimuthCosine(param_16, param_17, param_18);
         bool param_23 = ray_r_mu_intersects_ground;
         float2 param_24;
-        float _2125 = ShadowEdge(param_19, param_20, param_21, param_22, param_23, param_24);
-        float2 edge = param_24;
+        float _2126 = ShadowEdge(param_19, param_20, param_21, param_22, param_23, param_24);
+        edge = param_24;
         float2 param_25 = edge;
         float param_26 = mu_s;
         AtmosphereParameters param_27 = atmosphere;
@@ -855,9 +856,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1767 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _1768 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1767 - x;
+        float error = _1768 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -889,26 +890,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _2556;
+    float4 _2557;
     if (has_a)
     {
-        _2556 = log(fast::max(a, dark));
+        _2557 = log(fast::max(a, dark));
     }
     else
     {
-        _2556 = (lb * 2.0) - lc;
+        _2557 = (lb * 2.0) - lc;
     }
-    float4 la = _2556;
-    float4 _2571;
+    float4 la = _2557;
+    float4 _2572;
     if (has_d)
     {
-        _2571 = log(fast::max(d, dark));
+        _2572 = log(fast::max(d, dark));
     }
     else
     {
-        _2571 = (lc * 2.0) - lb;
+        _2572 = (lc * 2.0) - lb;
     }
-    float4 ld = _2571;
+    float4 ld = _2572;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1004,16 +1005,16 @@ float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _2475;
+    float _2476;
     if (low_sun)
     {
-        _2475 = fast::min(t, 1.0);
+        _2476 = fast::min(t, 1.0);
     }
     else
     {
-        _2475 = fast::clamp(t, 0.0, 1.0);
+        _2476 = fast::clamp(t, 0.0, 1.0);
     }
-    return _2475;
+    return _2476;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1042,132 +1043,124 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float param_3 = mu_s;
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
-    float4 uvwz = GetScatteringTextureUvwzFromRMuMuSNu(param, param_1, param_2, param_3, param_4, param_5);
+    float2 param_6;
+    float4 _3075 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float2 edge = param_6;
+    float4 uvwz = _3075;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = uvwz.x * (nu_size - 1.0);
     float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
     float nu_t = nu_coord - nu_slice;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float position = (uvwz.y * mu_s_size) - 0.5;
-    bool _3105 = atmosphere.scattering_mu_s_split > 0;
-    bool _3113;
-    if (_3105)
+    bool _3109 = atmosphere.scattering_mu_s_split > 0;
+    bool _3117;
+    if (_3109)
     {
-        _3113 = position < float(atmosphere.scattering_mu_s_split);
+        _3117 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3113 = _3105;
+        _3117 = _3109;
     }
-    if (_3113)
+    if (_3117)
     {
         float past = 6.0;
         float log_first_span = 1.0;
         if (position < past)
         {
-            float param_6 = mu;
-            float param_7 = mu_s;
-            float param_8 = nu;
-            AtmosphereParameters param_9 = atmosphere;
-            float param_10 = r;
-            float param_11 = mu;
-            float param_12 = ViewSunAzimuthCosine(param_6, param_7, param_8);
-            bool param_13 = ray_r_mu_intersects_ground;
-            float2 param_14;
-            float _3141 = ShadowEdge(param_9, param_10, param_11, param_12, param_13, param_14);
-            float2 edge = param_14;
             if (position < 0.0)
             {
+                AtmosphereParameters param_7 = atmosphere;
+                float2 param_8 = edge;
+                float _step = ShadowEdgePastStep(param_7, param_8);
+                AtmosphereParameters param_9 = atmosphere;
+                float4 param_10 = uvwz;
+                float param_11 = 0.5 / mu_s_size;
+                float param_12 = nu_slice;
+                float param_13 = nu_t;
+                bool param_14 = true;
                 AtmosphereParameters param_15 = atmosphere;
-                float2 param_16 = edge;
-                float _step = ShadowEdgePastStep(param_15, param_16);
-                AtmosphereParameters param_17 = atmosphere;
-                float4 param_18 = uvwz;
-                float param_19 = 0.5 / mu_s_size;
-                float param_20 = nu_slice;
-                float param_21 = nu_t;
-                bool param_22 = true;
-                AtmosphereParameters param_23 = atmosphere;
-                float4 param_24 = uvwz;
-                float param_25 = 1.5 / mu_s_size;
-                float param_26 = nu_slice;
-                float param_27 = nu_t;
-                bool param_28 = true;
-                float2 param_29 = edge;
-                float param_30 = (-(past - 1.0)) * _step;
-                float2 param_31 = edge;
-                float param_32 = (-(past - 2.0)) * _step;
-                float4 param_33 = GetScatteringAtMuSColumn(param_17, scattering_texture, scattering_textureSmplr, param_18, param_19, param_20, param_21, param_22);
-                float4 param_34 = GetScatteringAtMuSColumn(param_23, scattering_texture, scattering_textureSmplr, param_24, param_25, param_26, param_27, param_28);
-                float param_35 = ShadowEdgeSunCosine(param_29, param_30);
-                float param_36 = ShadowEdgeSunCosine(param_31, param_32);
-                float param_37 = mu_s;
-                return LowestSunContinued(param_33, param_34, param_35, param_36, param_37);
+                float4 param_16 = uvwz;
+                float param_17 = 1.5 / mu_s_size;
+                float param_18 = nu_slice;
+                float param_19 = nu_t;
+                bool param_20 = true;
+                float2 param_21 = edge;
+                float param_22 = (-(past - 1.0)) * _step;
+                float2 param_23 = edge;
+                float param_24 = (-(past - 2.0)) * _step;
+                float4 param_25 = GetScatteringAtMuSColumn(param_9, scattering_texture, scattering_textureSmplr, param_10, param_11, param_12, param_13, param_14);
+                float4 param_26 = GetScatteringAtMuSColumn(param_15, scattering_texture, scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20);
+                float param_27 = ShadowEdgeSunCosine(param_21, param_22);
+                float param_28 = ShadowEdgeSunCosine(param_23, param_24);
+                float param_29 = mu_s;
+                return LowestSunContinued(param_25, param_26, param_27, param_28, param_29);
             }
             if (position >= (past - 1.0))
             {
                 float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
-                AtmosphereParameters param_38 = atmosphere;
-                float param_39 = x;
-                float2 param_40 = edge;
-                log_first_span = log(ShadowEdgeLitDistance(param_38, param_39, param_40) / 0.0008726646192371845245361328125);
+                AtmosphereParameters param_30 = atmosphere;
+                float param_31 = x;
+                float2 param_32 = edge;
+                log_first_span = log(ShadowEdgeLitDistance(param_30, param_31, param_32) / 0.0008726646192371845245361328125);
             }
         }
-        AtmosphereParameters param_41 = atmosphere;
-        float4 param_42 = uvwz;
-        float param_43 = position;
-        float param_44 = nu_slice;
-        float param_45 = log_first_span;
-        AtmosphereParameters param_46 = atmosphere;
-        float4 param_47 = uvwz;
-        float param_48 = position;
-        float param_49 = nu_slice + 1.0;
-        float param_50 = log_first_span;
-        float4 param_51 = GetScatteringBelowSplit(param_41, scattering_texture, scattering_textureSmplr, param_42, param_43, param_44, param_45);
-        float4 param_52 = GetScatteringBelowSplit(param_46, scattering_texture, scattering_textureSmplr, param_47, param_48, param_49, param_50);
-        float param_53 = nu_t;
-        bool param_54 = true;
-        return SunCosineMix(param_51, param_52, param_53, param_54);
+        AtmosphereParameters param_33 = atmosphere;
+        float4 param_34 = uvwz;
+        float param_35 = position;
+        float param_36 = nu_slice;
+        float param_37 = log_first_span;
+        AtmosphereParameters param_38 = atmosphere;
+        float4 param_39 = uvwz;
+        float param_40 = position;
+        float param_41 = nu_slice + 1.0;
+        float param_42 = log_first_span;
+        float4 param_43 = GetScatteringBelowSplit(param_33, scattering_texture, scattering_textureSmplr, param_34, param_35, param_36, param_37);
+        float4 param_44 = GetScatteringBelowSplit(param_38, scattering_texture, scattering_textureSmplr, param_39, param_40, param_41, param_42);
+        float param_45 = nu_t;
+        bool param_46 = true;
+        return SunCosineMix(param_43, param_44, param_45, param_46);
     }
-    AtmosphereParameters param_55 = atmosphere;
-    float param_56 = 0.100000001490116119384765625;
-    float x_low_sun = GetScatteringTextureUMuS(param_55, param_56);
-    AtmosphereParameters param_57 = atmosphere;
-    float param_58 = uvwz.y;
-    float param_59 = x_low_sun;
-    float param_60;
-    float param_61;
-    float param_62;
-    bool param_63;
-    GetScatteringMuSColumns(param_57, param_58, param_59, param_60, param_61, param_62, param_63);
-    float x_below = param_60;
-    float x_above = param_61;
-    float mu_s_t = param_62;
-    bool low_sun_below = param_63;
-    AtmosphereParameters param_64 = atmosphere;
-    float4 param_65 = uvwz;
-    float param_66 = x_below;
-    float param_67 = nu_slice;
-    float param_68 = nu_t;
-    bool param_69 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_64, scattering_texture, scattering_textureSmplr, param_65, param_66, param_67, param_68, param_69);
-    AtmosphereParameters param_70 = atmosphere;
-    float4 param_71 = uvwz;
-    float param_72 = x_above;
-    float param_73 = nu_slice;
-    float param_74 = nu_t;
-    bool param_75 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_70, scattering_texture, scattering_textureSmplr, param_71, param_72, param_73, param_74, param_75);
+    AtmosphereParameters param_47 = atmosphere;
+    float param_48 = 0.100000001490116119384765625;
+    float x_low_sun = GetScatteringTextureUMuS(param_47, param_48);
+    AtmosphereParameters param_49 = atmosphere;
+    float param_50 = uvwz.y;
+    float param_51 = x_low_sun;
+    float param_52;
+    float param_53;
+    float param_54;
+    bool param_55;
+    GetScatteringMuSColumns(param_49, param_50, param_51, param_52, param_53, param_54, param_55);
+    float x_below = param_52;
+    float x_above = param_53;
+    float mu_s_t = param_54;
+    bool low_sun_below = param_55;
+    AtmosphereParameters param_56 = atmosphere;
+    float4 param_57 = uvwz;
+    float param_58 = x_below;
+    float param_59 = nu_slice;
+    float param_60 = nu_t;
+    bool param_61 = low_sun_below;
+    float4 below = GetScatteringAtMuSColumn(param_56, scattering_texture, scattering_textureSmplr, param_57, param_58, param_59, param_60, param_61);
+    AtmosphereParameters param_62 = atmosphere;
+    float4 param_63 = uvwz;
+    float param_64 = x_above;
+    float param_65 = nu_slice;
+    float param_66 = nu_t;
+    bool param_67 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_62, scattering_texture, scattering_textureSmplr, param_63, param_64, param_65, param_66, param_67);
     if (mu_s_t < 0.0)
     {
-        AtmosphereParameters param_76 = atmosphere;
-        float param_77 = 1.0 / (mu_s_size - 1.0);
-        float4 param_78 = below;
-        float4 param_79 = above;
-        float param_80 = atmosphere.scattering_mu_s_min;
-        float param_81 = GetScatteringMuSFromUnitRange(param_76, param_77);
-        float param_82 = mu_s;
-        return LowestSunContinued(param_78, param_79, param_80, param_81, param_82);
+        AtmosphereParameters param_68 = atmosphere;
+        float param_69 = 1.0 / (mu_s_size - 1.0);
+        float4 param_70 = below;
+        float4 param_71 = above;
+        float param_72 = atmosphere.scattering_mu_s_min;
+        float param_73 = GetScatteringMuSFromUnitRange(param_68, param_69);
+        float param_74 = mu_s;
+        return LowestSunContinued(param_70, param_71, param_72, param_73, param_74);
     }
     if (!low_sun_below)
     {
@@ -1176,28 +1169,28 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float column = (x_below * mu_s_size) - 0.5;
     float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
     float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_83 = atmosphere;
-    float4 param_84 = uvwz;
-    float param_85 = x_first;
-    float param_86 = nu_slice;
-    float param_87 = nu_t;
-    bool param_88 = true;
-    float4 first = GetScatteringAtMuSColumn(param_83, scattering_texture, scattering_textureSmplr, param_84, param_85, param_86, param_87, param_88);
-    AtmosphereParameters param_89 = atmosphere;
-    float4 param_90 = uvwz;
-    float param_91 = x_last;
-    float param_92 = nu_slice;
-    float param_93 = nu_t;
-    bool param_94 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_89, scattering_texture, scattering_textureSmplr, param_90, param_91, param_92, param_93, param_94);
-    float4 param_95 = first;
-    float4 param_96 = below;
-    float4 param_97 = above;
-    float4 param_98 = last;
-    bool param_99 = column > 0.5;
-    bool param_100 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_101 = mu_s_t;
-    return LogMonotoneCubicMix(param_95, param_96, param_97, param_98, param_99, param_100, param_101);
+    AtmosphereParameters param_75 = atmosphere;
+    float4 param_76 = uvwz;
+    float param_77 = x_first;
+    float param_78 = nu_slice;
+    float param_79 = nu_t;
+    bool param_80 = true;
+    float4 first = GetScatteringAtMuSColumn(param_75, scattering_texture, scattering_textureSmplr, param_76, param_77, param_78, param_79, param_80);
+    AtmosphereParameters param_81 = atmosphere;
+    float4 param_82 = uvwz;
+    float param_83 = x_last;
+    float param_84 = nu_slice;
+    float param_85 = nu_t;
+    bool param_86 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_81, scattering_texture, scattering_textureSmplr, param_82, param_83, param_84, param_85, param_86);
+    float4 param_87 = first;
+    float4 param_88 = below;
+    float4 param_89 = above;
+    float4 param_90 = last;
+    bool param_91 = column > 0.5;
+    bool param_92 = (column + 2.0) < (mu_s_size - 0.5);
+    float param_93 = mu_s_t;
+    return LogMonotoneCubicMix(param_87, param_88, param_89, param_90, param_91, param_92, param_93);
 }
 #endif
 
@@ -1214,16 +1207,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3548;
+        float3 _3532;
         if (scattering.x > 0.0)
         {
-            _3548 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3532 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3548 = float3(0.0);
+            _3532 = float3(0.0);
         }
-        single_mie_scattering = _3548;
+        single_mie_scattering = _3532;
     }
     else
     {
@@ -1300,13 +1293,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3616 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3600 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3616)
+    if (!_3600)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1315,19 +1308,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3636;
+    float3 _3620;
     if (ray_r_mu_intersects_ground)
     {
-        _3636 = float3(0.0);
+        _3620 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3636 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _3620 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _3636;
+    transmittance = _3620;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1335,9 +1328,9 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
     float3 param_21;
-    float3 _3663 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
+    float3 _3647 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
     float3 single_mie_scattering = param_21;
-    float3 scattering = _3663;
+    float3 scattering = _3647;
     float param_22 = nu;
     AtmosphereParameters param_23 = atmosphere;
     float param_24 = nu;
@@ -1375,16 +1368,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _3757;
+    float _3741;
     if ((a > 0.0) && (b > 0.0))
     {
-        _3757 = a * exp(f * log(b / a));
+        _3741 = a * exp(f * log(b / a));
     }
     else
     {
-        _3757 = mix(a, b, f);
+        _3741 = mix(a, b, f);
     }
-    return _3757;
+    return _3741;
 }
 #endif
 
@@ -1455,16 +1448,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _4008;
+    float _3992;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _4008 = 1.0 - (0.5 * depth);
+        _3992 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _4008 = (1.0 - exp(-depth)) / depth;
+        _3992 = (1.0 - exp(-depth)) / depth;
     }
-    return _4008;
+    return _3992;
 }
 #endif
 
@@ -1501,10 +1494,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4088 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4072 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4088;
+        float3 extinction = _4072;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1563,10 +1556,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _3953 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _3937 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _3953;
+        float3 extinction = _3937;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1641,14 +1634,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _3978;
+    float3 _3962;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _3978 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _3962 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1657,9 +1650,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _3978 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _3962 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _3978;
+    return _3962;
 }
 #endif
 
@@ -1673,16 +1666,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3719;
+    float _3703;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _3719 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3703 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3719 = up;
+        _3703 = up;
     }
-    return _3719;
+    return _3703;
 }
 #endif
 
@@ -1706,13 +1699,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4234 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4218 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4234)
+    if (!_4218)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1752,11 +1745,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4329 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4313 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4329;
+        lit_optical_depth = _4313;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1770,11 +1763,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4363 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4347 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4363;
+        optical_depth += _4347;
     }
     if (direct < 1.0)
     {
@@ -1793,9 +1786,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4406 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4390 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4406;
+    float3 scattering = _4390;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1816,11 +1809,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4454 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4438 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4454;
+        float3 far_optical_depth = _4438;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1840,9 +1833,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4508 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4492 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4508);
+            scattering -= (exp(-far_optical_depth) * _4492);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1863,9 +1856,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4573 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4557 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4573;
+    float3 scattering_p = _4557;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1886,9 +1879,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4617 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4601 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4617;
+    return _4601;
 }
 #endif
 
@@ -1896,16 +1889,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _2155;
+    float _2156;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _2155 = 0.100000001490116119384765625;
+        _2156 = 0.100000001490116119384765625;
     }
     else
     {
-        _2155 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _2156 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _2155;
+    return _2156;
 }
 #endif
 
@@ -1915,16 +1908,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2173;
+    float _2174;
     if (mu_s < knee)
     {
-        _2173 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _2174 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _2173 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _2174 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _2173;
+    return _2174;
 }
 #endif
 
@@ -1953,16 +1946,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2204;
+    float _2205;
     if (x < 0.5)
     {
-        _2204 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _2205 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2204 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _2205 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _2204;
+    return _2205;
 }
 #endif
 
@@ -1975,16 +1968,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2498;
+    float4 _2499;
     if (t < 0.0)
     {
-        _2498 = fast::min(blend, a);
+        _2499 = fast::min(blend, a);
     }
     else
     {
-        _2498 = blend;
+        _2499 = blend;
     }
-    return _2498;
+    return _2499;
 }
 #endif
 

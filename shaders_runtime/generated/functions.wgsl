@@ -1453,7 +1453,7 @@ fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_54: AtmosphereParameters, r_30: f32, mu_23: f32, mu_s_13: f32, nu_11: f32, ray_r_mu_intersects_ground_8: bool) -> vec4<f32> {
+fn GetScatteringTextureUvwzAndEdge(atmosphere_54: AtmosphereParameters, r_30: f32, mu_23: f32, mu_s_13: f32, nu_11: f32, ray_r_mu_intersects_ground_8: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
     var atmosphere_55: AtmosphereParameters;
     var r_31: f32;
     var mu_24: f32;
@@ -1476,7 +1476,6 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_54: AtmosphereParameters, r_3
     var u_r: f32;
     var u_mu_s: f32;
     var mu_s_size: f32;
-    var edge_20: vec2<f32>;
 
     atmosphere_55 = atmosphere_54;
     r_31 = r_30;
@@ -1484,135 +1483,162 @@ fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_54: AtmosphereParameters, r_3
     mu_s_14 = mu_s_13;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e23 = atmosphere_55;
-    let _e24 = HorizonDistanceAtTop(_e23);
-    H_2 = _e24;
-    let _e26 = atmosphere_55;
-    let _e27 = r_31;
-    let _e28 = HorizonDistance(_e26, _e27);
-    rho_6 = _e28;
-    let _e30 = atmosphere_55;
-    half_mu_size = f32((_e30.scattering_mu_size / 2i));
-    let _e38 = ray_r_mu_intersects_ground_9;
-    if _e38 {
+    let _e24 = atmosphere_55;
+    let _e25 = HorizonDistanceAtTop(_e24);
+    H_2 = _e25;
+    let _e27 = atmosphere_55;
+    let _e28 = r_31;
+    let _e29 = HorizonDistance(_e27, _e28);
+    rho_6 = _e29;
+    let _e31 = atmosphere_55;
+    half_mu_size = f32((_e31.scattering_mu_size / 2i));
+    let _e39 = ray_r_mu_intersects_ground_9;
+    if _e39 {
         {
-            let _e39 = atmosphere_55;
-            let _e40 = r_31;
-            let _e41 = mu_24;
-            let _e42 = DistanceToBottomAtmosphereBoundary(_e39, _e40, _e41);
-            d_12 = _e42;
-            let _e44 = r_31;
-            let _e45 = atmosphere_55;
-            d_min_5 = (_e44 - _e45.bottom_radius);
-            let _e49 = rho_6;
-            d_max_4 = _e49;
-            let _e51 = d_max_4;
-            let _e52 = d_min_5;
-            if (_e51 == _e52) {
+            let _e40 = atmosphere_55;
+            let _e41 = r_31;
+            let _e42 = mu_24;
+            let _e43 = DistanceToBottomAtmosphereBoundary(_e40, _e41, _e42);
+            d_12 = _e43;
+            let _e45 = r_31;
+            let _e46 = atmosphere_55;
+            d_min_5 = (_e45 - _e46.bottom_radius);
+            let _e50 = rho_6;
+            d_max_4 = _e50;
+            let _e52 = d_max_4;
+            let _e53 = d_min_5;
+            if (_e52 == _e53) {
                 local_9 = 0f;
             } else {
-                let _e55 = d_12;
-                let _e56 = d_min_5;
-                let _e58 = d_max_4;
-                let _e59 = d_min_5;
-                local_9 = ((_e55 - _e56) / (_e58 - _e59));
+                let _e56 = d_12;
+                let _e57 = d_min_5;
+                let _e59 = d_max_4;
+                let _e60 = d_min_5;
+                local_9 = ((_e56 - _e57) / (_e59 - _e60));
             }
-            let _e63 = local_9;
-            x_mu_3 = _e63;
-            let _e67 = half_mu_size;
-            let _e69 = x_mu_3;
-            let _e72 = half_mu_size;
-            u_mu = (0.5f - (0.5f * ((0.5f / _e67) + (_e69 * (1f - (1f / _e72))))));
+            let _e64 = local_9;
+            x_mu_3 = _e64;
+            let _e68 = half_mu_size;
+            let _e70 = x_mu_3;
+            let _e73 = half_mu_size;
+            u_mu = (0.5f - (0.5f * ((0.5f / _e68) + (_e70 * (1f - (1f / _e73))))));
         }
     } else {
         {
-            let _e79 = atmosphere_55;
-            let _e80 = r_31;
-            let _e81 = mu_24;
-            let _e82 = DistanceToTopAtmosphereBoundary(_e79, _e80, _e81);
-            d_13 = _e82;
-            let _e84 = atmosphere_55;
-            let _e86 = r_31;
-            d_min_6 = (_e84.top_radius - _e86);
-            let _e89 = rho_6;
-            let _e90 = H_2;
-            d_max_5 = (_e89 + _e90);
-            let _e93 = d_max_5;
-            let _e94 = d_min_6;
-            if (_e93 > _e94) {
-                let _e96 = d_13;
-                let _e97 = d_min_6;
-                let _e99 = d_max_5;
-                let _e100 = d_min_6;
-                local_10 = ((_e96 - _e97) / (_e99 - _e100));
+            let _e80 = atmosphere_55;
+            let _e81 = r_31;
+            let _e82 = mu_24;
+            let _e83 = DistanceToTopAtmosphereBoundary(_e80, _e81, _e82);
+            d_13 = _e83;
+            let _e85 = atmosphere_55;
+            let _e87 = r_31;
+            d_min_6 = (_e85.top_radius - _e87);
+            let _e90 = rho_6;
+            let _e91 = H_2;
+            d_max_5 = (_e90 + _e91);
+            let _e94 = d_max_5;
+            let _e95 = d_min_6;
+            if (_e94 > _e95) {
+                let _e97 = d_13;
+                let _e98 = d_min_6;
+                let _e100 = d_max_5;
+                let _e101 = d_min_6;
+                local_10 = ((_e97 - _e98) / (_e100 - _e101));
             } else {
                 local_10 = 0f;
             }
-            let _e105 = local_10;
-            x_mu_3 = _e105;
-            let _e109 = half_mu_size;
-            let _e111 = x_mu_3;
-            let _e114 = half_mu_size;
-            u_mu = (0.5f + (0.5f * ((0.5f / _e109) + (_e111 * (1f - (1f / _e114))))));
+            let _e106 = local_10;
+            x_mu_3 = _e106;
+            let _e110 = half_mu_size;
+            let _e112 = x_mu_3;
+            let _e115 = half_mu_size;
+            u_mu = (0.5f + (0.5f * ((0.5f / _e110) + (_e112 * (1f - (1f / _e115))))));
         }
     }
-    let _e121 = atmosphere_55;
-    let _e122 = r_31;
-    let _e123 = rho_6;
-    let _e124 = ray_r_mu_intersects_ground_9;
-    let _e125 = x_mu_3;
-    let _e126 = GetScatteringTextureUR(_e121, _e122, _e123, _e124, _e125);
-    u_r = _e126;
-    let _e128 = atmosphere_55;
-    let _e129 = mu_s_14;
-    let _e130 = GetScatteringTextureUMuS(_e128, _e129);
-    u_mu_s = _e130;
-    let _e132 = atmosphere_55;
-    mu_s_size = f32(_e132.scattering_mu_s_size);
-    let _e136 = atmosphere_55;
-    let _e140 = u_mu_s;
-    let _e141 = mu_s_size;
-    let _e145 = atmosphere_55;
-    if ((_e136.scattering_mu_s_split > 0i) && (((_e140 * _e141) - 0.5f) < f32(_e145.scattering_mu_s_split))) {
+    let _e122 = atmosphere_55;
+    let _e123 = r_31;
+    let _e124 = rho_6;
+    let _e125 = ray_r_mu_intersects_ground_9;
+    let _e126 = x_mu_3;
+    let _e127 = GetScatteringTextureUR(_e122, _e123, _e124, _e125, _e126);
+    u_r = _e127;
+    let _e129 = atmosphere_55;
+    let _e130 = mu_s_14;
+    let _e131 = GetScatteringTextureUMuS(_e129, _e130);
+    u_mu_s = _e131;
+    let _e133 = atmosphere_55;
+    mu_s_size = f32(_e133.scattering_mu_s_size);
+    (*edge_20) = vec2(0f);
+    let _e139 = atmosphere_55;
+    let _e143 = u_mu_s;
+    let _e144 = mu_s_size;
+    let _e148 = atmosphere_55;
+    if ((_e139.scattering_mu_s_split > 0i) && (((_e143 * _e144) - 0.5f) < f32(_e148.scattering_mu_s_split))) {
         {
-            let _e151 = atmosphere_55;
-            let _e152 = r_31;
-            let _e153 = mu_24;
-            let _e154 = mu_24;
-            let _e155 = mu_s_14;
-            let _e156 = nu_12;
-            let _e157 = ViewSunAzimuthCosine(_e154, _e155, _e156);
-            let _e158 = ray_r_mu_intersects_ground_9;
-            let _e161 = ShadowEdge(_e151, _e152, _e153, _e157, _e158, (&edge_20));
-            let _e162 = atmosphere_55;
-            let _e163 = edge_20;
-            let _e164 = mu_s_14;
-            let _e165 = ShadowEdgeDistance(_e163, _e164);
-            let _e166 = edge_20;
-            let _e167 = GetScatteringShadowEdgePosition(_e162, _e165, _e166);
-            let _e170 = mu_s_size;
-            u_mu_s = ((_e167 + 0.5f) / _e170);
+            let _e153 = atmosphere_55;
+            let _e154 = r_31;
+            let _e155 = mu_24;
+            let _e156 = mu_24;
+            let _e157 = mu_s_14;
+            let _e158 = nu_12;
+            let _e159 = ViewSunAzimuthCosine(_e156, _e157, _e158);
+            let _e160 = ray_r_mu_intersects_ground_9;
+            let _e163 = ShadowEdge(_e153, _e154, _e155, _e159, _e160, edge_20);
+            let _e164 = atmosphere_55;
+            let _e165 = (*edge_20);
+            let _e166 = mu_s_14;
+            let _e167 = ShadowEdgeDistance(_e165, _e166);
+            let _e168 = (*edge_20);
+            let _e169 = GetScatteringShadowEdgePosition(_e164, _e167, _e168);
+            let _e172 = mu_s_size;
+            u_mu_s = ((_e169 + 0.5f) / _e172);
         }
     }
-    let _e172 = nu_12;
-    let _e173 = ScatteringUnitNu(_e172);
-    let _e174 = u_mu_s;
-    let _e175 = u_mu;
-    let _e176 = u_r;
-    return vec4<f32>(_e173, _e174, _e175, _e176);
+    let _e174 = nu_12;
+    let _e175 = ScatteringUnitNu(_e174);
+    let _e176 = u_mu_s;
+    let _e177 = u_mu;
+    let _e178 = u_r;
+    return vec4<f32>(_e175, _e176, _e177, _e178);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_56: AtmosphereParameters, r_32: f32, mu_25: f32, mu_s_15: f32, nu_13: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
+    var atmosphere_57: AtmosphereParameters;
+    var r_33: f32;
+    var mu_26: f32;
+    var mu_s_16: f32;
+    var nu_14: f32;
+    var ray_r_mu_intersects_ground_11: bool;
+    var unused_3: vec2<f32>;
+
+    atmosphere_57 = atmosphere_56;
+    r_33 = r_32;
+    mu_26 = mu_25;
+    mu_s_16 = mu_s_15;
+    nu_14 = nu_13;
+    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
+    let _e24 = atmosphere_57;
+    let _e25 = r_33;
+    let _e26 = mu_26;
+    let _e27 = mu_s_16;
+    let _e28 = nu_14;
+    let _e29 = ray_r_mu_intersects_ground_11;
+    let _e32 = GetScatteringTextureUvwzAndEdge(_e24, _e25, _e26, _e27, _e28, _e29, (&unused_3));
+    return _e32;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_56: AtmosphereParameters) -> f32 {
-    var atmosphere_57: AtmosphereParameters;
+fn IrradianceKneeMuS(atmosphere_58: AtmosphereParameters) -> f32 {
+    var atmosphere_59: AtmosphereParameters;
     var local_11: f32;
 
-    atmosphere_57 = atmosphere_56;
-    let _e14 = atmosphere_57;
+    atmosphere_59 = atmosphere_58;
+    let _e14 = atmosphere_59;
     if (_e14.mu_s_min < LOW_SUN_MU_S) {
         local_11 = LOW_SUN_MU_S;
     } else {
-        let _e18 = atmosphere_57;
+        let _e18 = atmosphere_59;
         local_11 = (0.5f * (_e18.mu_s_min + 1f));
     }
     let _e24 = local_11;
@@ -1620,27 +1646,27 @@ fn IrradianceKneeMuS(atmosphere_56: AtmosphereParameters) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_58: AtmosphereParameters, mu_s_15: f32) -> f32 {
-    var atmosphere_59: AtmosphereParameters;
-    var mu_s_16: f32;
+fn GetIrradianceUnitMuS(atmosphere_60: AtmosphereParameters, mu_s_17: f32) -> f32 {
+    var atmosphere_61: AtmosphereParameters;
+    var mu_s_18: f32;
     var knee: f32;
     var local_12: f32;
 
-    atmosphere_59 = atmosphere_58;
-    mu_s_16 = mu_s_15;
-    let _e16 = atmosphere_59;
+    atmosphere_61 = atmosphere_60;
+    mu_s_18 = mu_s_17;
+    let _e16 = atmosphere_61;
     let _e17 = IrradianceKneeMuS(_e16);
     knee = _e17;
-    let _e19 = mu_s_16;
+    let _e19 = mu_s_18;
     let _e20 = knee;
     if (_e19 < _e20) {
-        let _e23 = mu_s_16;
-        let _e24 = atmosphere_59;
+        let _e23 = mu_s_18;
+        let _e24 = atmosphere_61;
         let _e28 = knee;
-        let _e29 = atmosphere_59;
+        let _e29 = atmosphere_61;
         local_12 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
     } else {
-        let _e35 = mu_s_16;
+        let _e35 = mu_s_18;
         let _e36 = knee;
         let _e40 = knee;
         local_12 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
@@ -1650,23 +1676,23 @@ fn GetIrradianceUnitMuS(atmosphere_58: AtmosphereParameters, mu_s_15: f32) -> f3
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_60: AtmosphereParameters, x_10: f32) -> f32 {
-    var atmosphere_61: AtmosphereParameters;
+fn GetIrradianceMuSFromUnit(atmosphere_62: AtmosphereParameters, x_10: f32) -> f32 {
+    var atmosphere_63: AtmosphereParameters;
     var x_11: f32;
     var knee_1: f32;
     var local_13: f32;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_63 = atmosphere_62;
     x_11 = x_10;
-    let _e16 = atmosphere_61;
+    let _e16 = atmosphere_63;
     let _e17 = IrradianceKneeMuS(_e16);
     knee_1 = _e17;
     let _e19 = x_11;
     if (_e19 < 0.5f) {
-        let _e22 = atmosphere_61;
+        let _e22 = atmosphere_63;
         let _e25 = x_11;
         let _e27 = knee_1;
-        let _e28 = atmosphere_61;
+        let _e28 = atmosphere_63;
         local_13 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
     } else {
         let _e33 = knee_1;
@@ -1679,58 +1705,40 @@ fn GetIrradianceMuSFromUnit(atmosphere_60: AtmosphereParameters, x_10: f32) -> f
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_62: AtmosphereParameters, r_32: f32, mu_s_17: f32) -> vec2<f32> {
-    var atmosphere_63: AtmosphereParameters;
-    var r_33: f32;
-    var mu_s_18: f32;
+fn GetIrradianceTextureUvFromRMuS(atmosphere_64: AtmosphereParameters, r_34: f32, mu_s_19: f32) -> vec2<f32> {
+    var atmosphere_65: AtmosphereParameters;
+    var r_35: f32;
+    var mu_s_20: f32;
     var x_r_1: f32;
     var x_mu_s_1: f32;
 
-    atmosphere_63 = atmosphere_62;
-    r_33 = r_32;
-    mu_s_18 = mu_s_17;
-    let _e18 = atmosphere_63;
-    let _e19 = r_33;
+    atmosphere_65 = atmosphere_64;
+    r_35 = r_34;
+    mu_s_20 = mu_s_19;
+    let _e18 = atmosphere_65;
+    let _e19 = r_35;
     let _e20 = HorizonDistance(_e18, _e19);
-    let _e21 = atmosphere_63;
+    let _e21 = atmosphere_65;
     let _e22 = HorizonDistanceAtTop(_e21);
     x_r_1 = (_e20 / _e22);
-    let _e25 = atmosphere_63;
-    let _e26 = mu_s_18;
+    let _e25 = atmosphere_65;
+    let _e26 = mu_s_20;
     let _e27 = GetIrradianceUnitMuS(_e25, _e26);
     x_mu_s_1 = clamp(_e27, 0f, 1f);
     let _e32 = x_mu_s_1;
-    let _e33 = atmosphere_63;
+    let _e33 = atmosphere_65;
     let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_width);
     let _e36 = x_r_1;
-    let _e37 = atmosphere_63;
+    let _e37 = atmosphere_65;
     let _e39 = GetTextureCoordFromUnitRange(_e36, _e37.irradiance_height);
     return vec2<f32>(_e35, _e39);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_64: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_34: f32, mu_25: f32) -> vec3<f32> {
-    var atmosphere_65: AtmosphereParameters;
-    var r_35: f32;
-    var mu_26: f32;
-    var uv_2: vec2<f32>;
-
-    atmosphere_65 = atmosphere_64;
-    r_35 = r_34;
-    mu_26 = mu_25;
-    let _e19 = atmosphere_65;
-    let _e20 = r_35;
-    let _e21 = mu_26;
-    let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
-    uv_2 = _e22;
-    let _e24 = uv_2;
-    let _e25 = SampleTexture2D(transmittance_texture, _e24);
-    return vec3<f32>(_e25.xyz);
-}
-
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_66: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_36: f32, mu_27: f32) -> vec3<f32> {
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_66: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_36: f32, mu_27: f32) -> vec3<f32> {
     var atmosphere_67: AtmosphereParameters;
     var r_37: f32;
     var mu_28: f32;
+    var uv_2: vec2<f32>;
 
     atmosphere_67 = atmosphere_66;
     r_37 = r_36;
@@ -1738,62 +1746,80 @@ fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_66: AtmosphereParameters, 
     let _e19 = atmosphere_67;
     let _e20 = r_37;
     let _e21 = mu_28;
+    let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
+    uv_2 = _e22;
+    let _e24 = uv_2;
+    let _e25 = SampleTexture2D(transmittance_texture, _e24);
+    return vec3<f32>(_e25.xyz);
+}
+
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_68: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_38: f32, mu_29: f32) -> vec3<f32> {
+    var atmosphere_69: AtmosphereParameters;
+    var r_39: f32;
+    var mu_30: f32;
+
+    atmosphere_69 = atmosphere_68;
+    r_39 = r_38;
+    mu_30 = mu_29;
+    let _e19 = atmosphere_69;
+    let _e20 = r_39;
+    let _e21 = mu_30;
     let _e22 = GetOpticalDepthToTopAtmosphereBoundary(_e19, transmittance_texture_1, _e20, _e21);
     return exp(-(_e22));
 }
 
-fn GetOpticalDepth(atmosphere_68: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_38: f32, mu_29: f32, d_14: f32, ray_r_mu_intersects_ground_10: bool) -> vec3<f32> {
-    var atmosphere_69: AtmosphereParameters;
-    var r_39: f32;
-    var mu_30: f32;
+fn GetOpticalDepth(atmosphere_70: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_40: f32, mu_31: f32, d_14: f32, ray_r_mu_intersects_ground_12: bool) -> vec3<f32> {
+    var atmosphere_71: AtmosphereParameters;
+    var r_41: f32;
+    var mu_32: f32;
     var d_15: f32;
-    var ray_r_mu_intersects_ground_11: bool;
+    var ray_r_mu_intersects_ground_13: bool;
     var r_d_3: f32;
     var mu_d: f32;
     var tau: vec3<f32>;
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_69 = atmosphere_68;
-    r_39 = r_38;
-    mu_30 = mu_29;
+    atmosphere_71 = atmosphere_70;
+    r_41 = r_40;
+    mu_32 = mu_31;
     d_15 = d_14;
-    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e23 = atmosphere_69;
-    let _e24 = r_39;
-    let _e25 = mu_30;
+    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
+    let _e23 = atmosphere_71;
+    let _e24 = r_41;
+    let _e25 = mu_32;
     let _e26 = d_15;
     let _e27 = RadiusAtDistance(_e23, _e24, _e25, _e26);
     r_d_3 = _e27;
-    let _e29 = r_39;
-    let _e30 = mu_30;
+    let _e29 = r_41;
+    let _e30 = mu_32;
     let _e31 = d_15;
     let _e32 = r_d_3;
     let _e33 = CosineAtDistance(_e29, _e30, _e31, _e32);
     mu_d = _e33;
-    let _e36 = ray_r_mu_intersects_ground_11;
+    let _e36 = ray_r_mu_intersects_ground_13;
     let _e37 = mu_d;
     if (_e36 || (_e37 < 0f)) {
         {
-            let _e41 = atmosphere_69;
+            let _e41 = atmosphere_71;
             let _e42 = r_d_3;
             let _e43 = mu_d;
             let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
-            let _e46 = atmosphere_69;
-            let _e47 = r_39;
-            let _e48 = mu_30;
+            let _e46 = atmosphere_71;
+            let _e47 = r_41;
+            let _e48 = mu_32;
             let _e50 = GetOpticalDepthToTopAtmosphereBoundary(_e46, transmittance_texture_2, _e47, -(_e48));
             tau = (_e45 - _e50);
         }
     } else {
-        let _e52 = mu_30;
+        let _e52 = mu_32;
         if (_e52 >= 0f) {
             {
-                let _e55 = atmosphere_69;
-                let _e56 = r_39;
-                let _e57 = mu_30;
+                let _e55 = atmosphere_71;
+                let _e56 = r_41;
+                let _e57 = mu_32;
                 let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
-                let _e59 = atmosphere_69;
+                let _e59 = atmosphere_71;
                 let _e60 = r_d_3;
                 let _e61 = mu_d;
                 let _e62 = GetOpticalDepthToTopAtmosphereBoundary(_e59, transmittance_texture_2, _e60, _e61);
@@ -1801,24 +1827,24 @@ fn GetOpticalDepth(atmosphere_68: AtmosphereParameters, transmittance_texture_2:
             }
         } else {
             {
-                let _e64 = atmosphere_69;
-                let _e65 = r_39;
-                let _e67 = mu_30;
-                let _e68 = mu_30;
+                let _e64 = atmosphere_71;
+                let _e65 = r_41;
+                let _e67 = mu_32;
+                let _e68 = mu_32;
                 let _e71 = SafeSqrt((1f - (_e67 * _e68)));
                 let _e73 = ClampRadius(_e64, (_e65 * _e71));
                 r_low = _e73;
-                let _e75 = atmosphere_69;
+                let _e75 = atmosphere_71;
                 let _e76 = r_low;
                 let _e78 = GetOpticalDepthToTopAtmosphereBoundary(_e75, transmittance_texture_2, _e76, 0f);
                 tau_low = _e78;
                 let _e80 = tau_low;
-                let _e81 = atmosphere_69;
-                let _e82 = r_39;
-                let _e83 = mu_30;
+                let _e81 = atmosphere_71;
+                let _e82 = r_41;
+                let _e83 = mu_32;
                 let _e85 = GetOpticalDepthToTopAtmosphereBoundary(_e81, transmittance_texture_2, _e82, -(_e83));
                 let _e90 = tau_low;
-                let _e91 = atmosphere_69;
+                let _e91 = atmosphere_71;
                 let _e92 = r_d_3;
                 let _e93 = mu_d;
                 let _e94 = GetOpticalDepthToTopAtmosphereBoundary(_e91, transmittance_texture_2, _e92, _e93);
@@ -1830,64 +1856,64 @@ fn GetOpticalDepth(atmosphere_68: AtmosphereParameters, transmittance_texture_2:
     return max(_e100, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_70: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_40: f32, mu_31: f32, d_16: f32, ray_r_mu_intersects_ground_12: bool) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
-    var r_41: f32;
-    var mu_32: f32;
+fn GetTransmittance(atmosphere_72: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_42: f32, mu_33: f32, d_16: f32, ray_r_mu_intersects_ground_14: bool) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
+    var r_43: f32;
+    var mu_34: f32;
     var d_17: f32;
-    var ray_r_mu_intersects_ground_13: bool;
+    var ray_r_mu_intersects_ground_15: bool;
 
-    atmosphere_71 = atmosphere_70;
-    r_41 = r_40;
-    mu_32 = mu_31;
+    atmosphere_73 = atmosphere_72;
+    r_43 = r_42;
+    mu_34 = mu_33;
     d_17 = d_16;
-    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e23 = atmosphere_71;
-    let _e24 = r_41;
-    let _e25 = mu_32;
+    ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
+    let _e23 = atmosphere_73;
+    let _e24 = r_43;
+    let _e25 = mu_34;
     let _e26 = d_17;
-    let _e27 = ray_r_mu_intersects_ground_13;
+    let _e27 = ray_r_mu_intersects_ground_15;
     let _e28 = GetOpticalDepth(_e23, transmittance_texture_3, _e24, _e25, _e26, _e27);
     return exp(-(_e28));
 }
 
-fn SunVisibleFraction(atmosphere_72: AtmosphereParameters, r_42: f32, mu_s_19: f32) -> f32 {
-    var atmosphere_73: AtmosphereParameters;
-    var r_43: f32;
-    var mu_s_20: f32;
-    var sin_theta_h: f32;
-
-    atmosphere_73 = atmosphere_72;
-    r_43 = r_42;
-    mu_s_20 = mu_s_19;
-    let _e18 = atmosphere_73;
-    let _e20 = r_43;
-    sin_theta_h = (_e18.bottom_radius / _e20);
-    let _e23 = mu_s_20;
-    let _e24 = atmosphere_73;
-    let _e26 = r_43;
-    let _e27 = HorizonZenithCosine(_e24.bottom_radius, _e26);
-    let _e28 = sin_theta_h;
-    let _e29 = atmosphere_73;
-    let _e32 = SunVisibleFractionAboveHorizon(_e23, _e27, (_e28 * _e29.sun_angular_radius));
-    return _e32;
-}
-
-fn GetTransmittanceToSun(atmosphere_74: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_44: f32, mu_s_21: f32) -> vec3<f32> {
+fn SunVisibleFraction(atmosphere_74: AtmosphereParameters, r_44: f32, mu_s_21: f32) -> f32 {
     var atmosphere_75: AtmosphereParameters;
     var r_45: f32;
     var mu_s_22: f32;
+    var sin_theta_h: f32;
 
     atmosphere_75 = atmosphere_74;
     r_45 = r_44;
     mu_s_22 = mu_s_21;
-    let _e19 = atmosphere_75;
+    let _e18 = atmosphere_75;
     let _e20 = r_45;
-    let _e21 = mu_s_22;
+    sin_theta_h = (_e18.bottom_radius / _e20);
+    let _e23 = mu_s_22;
+    let _e24 = atmosphere_75;
+    let _e26 = r_45;
+    let _e27 = HorizonZenithCosine(_e24.bottom_radius, _e26);
+    let _e28 = sin_theta_h;
+    let _e29 = atmosphere_75;
+    let _e32 = SunVisibleFractionAboveHorizon(_e23, _e27, (_e28 * _e29.sun_angular_radius));
+    return _e32;
+}
+
+fn GetTransmittanceToSun(atmosphere_76: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_46: f32, mu_s_23: f32) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
+    var r_47: f32;
+    var mu_s_24: f32;
+
+    atmosphere_77 = atmosphere_76;
+    r_47 = r_46;
+    mu_s_24 = mu_s_23;
+    let _e19 = atmosphere_77;
+    let _e20 = r_47;
+    let _e21 = mu_s_24;
     let _e22 = GetTransmittanceToTopAtmosphereBoundary(_e19, transmittance_texture_4, _e20, _e21);
-    let _e23 = atmosphere_75;
-    let _e24 = r_45;
-    let _e25 = mu_s_22;
+    let _e23 = atmosphere_77;
+    let _e24 = r_47;
+    let _e25 = mu_s_24;
     let _e26 = SunVisibleFraction(_e23, _e24, _e25);
     return (_e22 * _e26);
 }
@@ -1972,18 +1998,18 @@ fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_76: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_77: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_78: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_79: AtmosphereParameters;
     var u_mu_s_2: f32;
     var x_low_sun_1: f32;
     var mu_s_size_1: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_77 = atmosphere_76;
+    atmosphere_79 = atmosphere_78;
     u_mu_s_2 = u_mu_s_1;
     x_low_sun_1 = x_low_sun;
-    let _e22 = atmosphere_77;
+    let _e22 = atmosphere_79;
     mu_s_size_1 = f32(_e22.scattering_mu_s_size);
     let _e26 = u_mu_s_2;
     let _e27 = mu_s_size_1;
@@ -2195,12 +2221,12 @@ fn LowestSunLogFall(a_14: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_23: f32) -> vec4<f32> {
+fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_25: f32) -> vec4<f32> {
     var a_17: vec4<f32>;
     var b_9: vec4<f32>;
     var mu_s_a_3: f32;
     var mu_s_b_3: f32;
-    var mu_s_24: f32;
+    var mu_s_26: f32;
     var slope_2: vec4<f32>;
     var curvature_1: vec4<f32>;
     var d_20: f32;
@@ -2209,13 +2235,13 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
     b_9 = b_8;
     mu_s_a_3 = mu_s_a_2;
     mu_s_b_3 = mu_s_b_2;
-    mu_s_24 = mu_s_23;
+    mu_s_26 = mu_s_25;
     let _e24 = a_17;
     let _e25 = b_9;
     let _e26 = mu_s_a_3;
     let _e27 = mu_s_b_3;
     LowestSunLogFall(_e24, _e25, _e26, _e27, (&slope_2), (&curvature_1));
-    let _e32 = mu_s_24;
+    let _e32 = mu_s_26;
     let _e33 = mu_s_a_3;
     d_20 = (_e32 - _e33);
     let _e36 = a_17;
@@ -2227,19 +2253,19 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringInSlice(atmosphere_78: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32) -> vec4<f32> {
-    var atmosphere_79: AtmosphereParameters;
+fn GetScatteringInSlice(atmosphere_80: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32) -> vec4<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
     var x_13: f32;
     var nu_slice_1: f32;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_81 = atmosphere_80;
     uvwz_1 = uvwz;
     x_13 = x_12;
     nu_slice_1 = nu_slice;
     let _e21 = nu_slice_1;
     let _e22 = x_13;
-    let _e24 = atmosphere_79;
+    let _e24 = atmosphere_81;
     let _e28 = uvwz_1;
     let _e30 = uvwz_1;
     let _e33 = SampleTexture3D(scattering_texture, vec3<f32>(((_e21 + _e22) / f32(_e24.scattering_nu_size)), _e28.z, _e30.w));
@@ -2247,26 +2273,26 @@ fn GetScatteringInSlice(atmosphere_78: AtmosphereParameters, scattering_texture:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_80: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_14: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetScatteringAtMuSColumn(atmosphere_82: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_14: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_83: AtmosphereParameters;
     var uvwz_3: vec4<f32>;
     var x_15: f32;
     var nu_slice_3: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_83 = atmosphere_82;
     uvwz_3 = uvwz_2;
     x_15 = x_14;
     nu_slice_3 = nu_slice_2;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e25 = atmosphere_81;
+    let _e25 = atmosphere_83;
     let _e26 = uvwz_3;
     let _e27 = x_15;
     let _e28 = nu_slice_3;
     let _e29 = GetScatteringInSlice(_e25, scattering_texture_1, _e26, _e27, _e28);
-    let _e30 = atmosphere_81;
+    let _e30 = atmosphere_83;
     let _e31 = uvwz_3;
     let _e32 = x_15;
     let _e33 = nu_slice_3;
@@ -2278,28 +2304,28 @@ fn GetScatteringAtMuSColumn(atmosphere_80: AtmosphereParameters, scattering_text
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtOwnColumn(atmosphere_82: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetScatteringAtOwnColumn(atmosphere_84: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
+    var atmosphere_85: AtmosphereParameters;
     var uvwz_5: vec4<f32>;
     var column_1: f32;
     var nu_slice_5: f32;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_85 = atmosphere_84;
     uvwz_5 = uvwz_4;
     column_1 = column;
     nu_slice_5 = nu_slice_4;
-    let _e21 = atmosphere_83;
+    let _e21 = atmosphere_85;
     let _e22 = uvwz_5;
     let _e23 = column_1;
-    let _e26 = atmosphere_83;
+    let _e26 = atmosphere_85;
     let _e30 = nu_slice_5;
     let _e31 = GetScatteringInSlice(_e21, scattering_texture_2, _e22, ((_e23 + 0.5f) / f32(_e26.scattering_mu_s_size)), _e30);
     return _e31;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
-    var atmosphere_85: AtmosphereParameters;
+fn GetScatteringBelowSplit(atmosphere_86: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
+    var atmosphere_87: AtmosphereParameters;
     var uvwz_7: vec4<f32>;
     var position_4: f32;
     var nu_slice_7: f32;
@@ -2317,12 +2343,12 @@ fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_textu
     var x_16: f32;
     var k_4: f32;
 
-    atmosphere_85 = atmosphere_84;
+    atmosphere_87 = atmosphere_86;
     uvwz_7 = uvwz_6;
     position_4 = position_3;
     nu_slice_7 = nu_slice_6;
     log_first_span_1 = log_first_span;
-    let _e26 = atmosphere_85;
+    let _e26 = atmosphere_87;
     let _e29 = past_2;
     intervals = (f32(_e26.scattering_mu_s_split) - _e29);
     let _e32 = position_4;
@@ -2336,22 +2362,22 @@ fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_textu
             let _e44 = past_2;
             let _e45 = k_3;
             column_2 = (_e44 + _e45);
-            let _e48 = atmosphere_85;
+            let _e48 = atmosphere_87;
             let _e49 = uvwz_7;
             let _e50 = column_2;
             let _e53 = nu_slice_7;
             let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_3, _e49, (_e50 - 1f), _e53);
-            let _e55 = atmosphere_85;
+            let _e55 = atmosphere_87;
             let _e56 = uvwz_7;
             let _e57 = column_2;
             let _e58 = nu_slice_7;
             let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_3, _e56, _e57, _e58);
-            let _e60 = atmosphere_85;
+            let _e60 = atmosphere_87;
             let _e61 = uvwz_7;
             let _e62 = column_2;
             let _e65 = nu_slice_7;
             let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_3, _e61, (_e62 + 1f), _e65);
-            let _e67 = atmosphere_85;
+            let _e67 = atmosphere_87;
             let _e68 = uvwz_7;
             let _e69 = column_2;
             let _e72 = past_2;
@@ -2371,20 +2397,20 @@ fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_textu
     let _e91 = past_2;
     if (_e90 >= (_e91 - 1f)) {
         {
-            let _e95 = atmosphere_85;
+            let _e95 = atmosphere_87;
             let _e96 = uvwz_7;
             let _e97 = past_2;
             let _e100 = nu_slice_7;
             let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_3, _e96, (_e97 - 1f), _e100);
             at_edge = _e101;
-            let _e103 = atmosphere_85;
+            let _e103 = atmosphere_87;
             let _e104 = uvwz_7;
             let _e105 = past_2;
             let _e106 = nu_slice_7;
             let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_3, _e104, _e105, _e106);
             let _e108 = at_edge;
             rise_1 = (_e107 - _e108);
-            let _e111 = atmosphere_85;
+            let _e111 = atmosphere_87;
             let _e112 = uvwz_7;
             let _e113 = past_2;
             let _e116 = nu_slice_7;
@@ -2417,13 +2443,13 @@ fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_textu
     let _e174 = x_16;
     let _e176 = past_2;
     k_4 = min(floor(_e174), (_e176 - 2f));
-    let _e181 = atmosphere_85;
+    let _e181 = atmosphere_87;
     let _e182 = uvwz_7;
     let _e183 = past_2;
     let _e186 = k_4;
     let _e188 = nu_slice_7;
     let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_3, _e182, ((_e183 - 1f) - _e186), _e188);
-    let _e190 = atmosphere_85;
+    let _e190 = atmosphere_87;
     let _e191 = uvwz_7;
     let _e192 = past_2;
     let _e195 = k_4;
@@ -2436,13 +2462,14 @@ fn GetScatteringBelowSplit(atmosphere_84: AtmosphereParameters, scattering_textu
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_86: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_46: f32, mu_33: f32, mu_s_25: f32, nu_13: f32, ray_r_mu_intersects_ground_14: bool) -> vec4<f32> {
-    var atmosphere_87: AtmosphereParameters;
-    var r_47: f32;
-    var mu_34: f32;
-    var mu_s_26: f32;
-    var nu_14: f32;
-    var ray_r_mu_intersects_ground_15: bool;
+fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_48: f32, mu_35: f32, mu_s_27: f32, nu_15: f32, ray_r_mu_intersects_ground_16: bool) -> vec4<f32> {
+    var atmosphere_89: AtmosphereParameters;
+    var r_49: f32;
+    var mu_36: f32;
+    var mu_s_28: f32;
+    var nu_16: f32;
+    var ray_r_mu_intersects_ground_17: bool;
+    var edge_21: vec2<f32>;
     var uvwz_8: vec4<f32>;
     var nu_size: f32;
     var nu_coord: f32;
@@ -2452,7 +2479,6 @@ fn GetScattering(atmosphere_86: AtmosphereParameters, scattering_texture_4: text
     var position_5: f32;
     var past_3: f32 = 6f;
     var log_first_span_2: f32 = 1f;
-    var edge_21: vec2<f32>;
     var step_: f32;
     var x_17: f32;
     var x_below_1: f32;
@@ -2468,207 +2494,198 @@ fn GetScattering(atmosphere_86: AtmosphereParameters, scattering_texture_4: text
     var first: vec4<f32>;
     var last_1: vec4<f32>;
 
-    atmosphere_87 = atmosphere_86;
-    r_47 = r_46;
-    mu_34 = mu_33;
-    mu_s_26 = mu_s_25;
-    nu_14 = nu_13;
-    ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
-    let _e25 = atmosphere_87;
-    let _e26 = r_47;
-    let _e27 = mu_34;
-    let _e28 = mu_s_26;
-    let _e29 = nu_14;
-    let _e30 = ray_r_mu_intersects_ground_15;
-    let _e31 = GetScatteringTextureUvwzFromRMuMuSNu(_e25, _e26, _e27, _e28, _e29, _e30);
-    uvwz_8 = _e31;
-    let _e33 = atmosphere_87;
-    nu_size = f32(_e33.scattering_nu_size);
-    let _e37 = uvwz_8;
-    let _e39 = nu_size;
-    nu_coord = (_e37.x * (_e39 - 1f));
-    let _e44 = nu_coord;
-    let _e46 = nu_size;
-    nu_slice_8 = min(floor(_e44), (_e46 - 2f));
-    let _e51 = nu_coord;
-    let _e52 = nu_slice_8;
-    nu_t_2 = (_e51 - _e52);
-    let _e55 = atmosphere_87;
-    mu_s_size_2 = f32(_e55.scattering_mu_s_size);
-    let _e59 = uvwz_8;
-    let _e61 = mu_s_size_2;
-    position_5 = ((_e59.y * _e61) - 0.5f);
-    let _e66 = atmosphere_87;
-    let _e70 = position_5;
-    let _e71 = atmosphere_87;
-    if ((_e66.scattering_mu_s_split > 0i) && (_e70 < f32(_e71.scattering_mu_s_split))) {
+    atmosphere_89 = atmosphere_88;
+    r_49 = r_48;
+    mu_36 = mu_35;
+    mu_s_28 = mu_s_27;
+    nu_16 = nu_15;
+    ray_r_mu_intersects_ground_17 = ray_r_mu_intersects_ground_16;
+    let _e26 = atmosphere_89;
+    let _e27 = r_49;
+    let _e28 = mu_36;
+    let _e29 = mu_s_28;
+    let _e30 = nu_16;
+    let _e31 = ray_r_mu_intersects_ground_17;
+    let _e34 = GetScatteringTextureUvwzAndEdge(_e26, _e27, _e28, _e29, _e30, _e31, (&edge_21));
+    uvwz_8 = _e34;
+    let _e36 = atmosphere_89;
+    nu_size = f32(_e36.scattering_nu_size);
+    let _e40 = uvwz_8;
+    let _e42 = nu_size;
+    nu_coord = (_e40.x * (_e42 - 1f));
+    let _e47 = nu_coord;
+    let _e49 = nu_size;
+    nu_slice_8 = min(floor(_e47), (_e49 - 2f));
+    let _e54 = nu_coord;
+    let _e55 = nu_slice_8;
+    nu_t_2 = (_e54 - _e55);
+    let _e58 = atmosphere_89;
+    mu_s_size_2 = f32(_e58.scattering_mu_s_size);
+    let _e62 = uvwz_8;
+    let _e64 = mu_s_size_2;
+    position_5 = ((_e62.y * _e64) - 0.5f);
+    let _e69 = atmosphere_89;
+    let _e73 = position_5;
+    let _e74 = atmosphere_89;
+    if ((_e69.scattering_mu_s_split > 0i) && (_e73 < f32(_e74.scattering_mu_s_split))) {
         {
-            let _e81 = position_5;
-            let _e82 = past_3;
-            if (_e81 < _e82) {
+            let _e84 = position_5;
+            let _e85 = past_3;
+            if (_e84 < _e85) {
                 {
-                    let _e85 = atmosphere_87;
-                    let _e86 = r_47;
-                    let _e87 = mu_34;
-                    let _e88 = mu_34;
-                    let _e89 = mu_s_26;
-                    let _e90 = nu_14;
-                    let _e91 = ViewSunAzimuthCosine(_e88, _e89, _e90);
-                    let _e92 = ray_r_mu_intersects_ground_15;
-                    let _e95 = ShadowEdge(_e85, _e86, _e87, _e91, _e92, (&edge_21));
-                    let _e96 = position_5;
-                    if (_e96 < 0f) {
+                    let _e87 = position_5;
+                    if (_e87 < 0f) {
                         {
-                            let _e99 = atmosphere_87;
-                            let _e100 = edge_21;
-                            let _e101 = ShadowEdgePastStep(_e99, _e100);
-                            step_ = _e101;
-                            let _e103 = atmosphere_87;
+                            let _e90 = atmosphere_89;
+                            let _e91 = edge_21;
+                            let _e92 = ShadowEdgePastStep(_e90, _e91);
+                            step_ = _e92;
+                            let _e94 = atmosphere_89;
+                            let _e95 = uvwz_8;
+                            let _e97 = mu_s_size_2;
+                            let _e99 = nu_slice_8;
+                            let _e100 = nu_t_2;
+                            let _e102 = GetScatteringAtMuSColumn(_e94, scattering_texture_4, _e95, (0.5f / _e97), _e99, _e100, true);
+                            let _e103 = atmosphere_89;
                             let _e104 = uvwz_8;
                             let _e106 = mu_s_size_2;
                             let _e108 = nu_slice_8;
                             let _e109 = nu_t_2;
-                            let _e111 = GetScatteringAtMuSColumn(_e103, scattering_texture_4, _e104, (0.5f / _e106), _e108, _e109, true);
-                            let _e112 = atmosphere_87;
-                            let _e113 = uvwz_8;
-                            let _e115 = mu_s_size_2;
-                            let _e117 = nu_slice_8;
-                            let _e118 = nu_t_2;
-                            let _e120 = GetScatteringAtMuSColumn(_e112, scattering_texture_4, _e113, (1.5f / _e115), _e117, _e118, true);
-                            let _e121 = edge_21;
-                            let _e122 = past_3;
-                            let _e126 = step_;
-                            let _e128 = ShadowEdgeSunCosine(_e121, (-((_e122 - 1f)) * _e126));
-                            let _e129 = edge_21;
-                            let _e130 = past_3;
-                            let _e134 = step_;
-                            let _e136 = ShadowEdgeSunCosine(_e129, (-((_e130 - 2f)) * _e134));
-                            let _e137 = mu_s_26;
-                            let _e138 = LowestSunContinued(_e111, _e120, _e128, _e136, _e137);
-                            return _e138;
+                            let _e111 = GetScatteringAtMuSColumn(_e103, scattering_texture_4, _e104, (1.5f / _e106), _e108, _e109, true);
+                            let _e112 = edge_21;
+                            let _e113 = past_3;
+                            let _e117 = step_;
+                            let _e119 = ShadowEdgeSunCosine(_e112, (-((_e113 - 1f)) * _e117));
+                            let _e120 = edge_21;
+                            let _e121 = past_3;
+                            let _e125 = step_;
+                            let _e127 = ShadowEdgeSunCosine(_e120, (-((_e121 - 2f)) * _e125));
+                            let _e128 = mu_s_28;
+                            let _e129 = LowestSunContinued(_e102, _e111, _e119, _e127, _e128);
+                            return _e129;
                         }
                     }
-                    let _e139 = position_5;
-                    let _e140 = past_3;
-                    if (_e139 >= (_e140 - 1f)) {
+                    let _e130 = position_5;
+                    let _e131 = past_3;
+                    if (_e130 >= (_e131 - 1f)) {
                         {
-                            let _e145 = atmosphere_87;
-                            let _e148 = past_3;
-                            x_17 = (1f / (f32(_e145.scattering_mu_s_split) - _e148));
-                            let _e152 = atmosphere_87;
-                            let _e153 = x_17;
-                            let _e154 = edge_21;
-                            let _e155 = ShadowEdgeLitDistance(_e152, _e153, _e154);
-                            log_first_span_2 = log((_e155 / SHADOW_EDGE_CLOSEST));
+                            let _e136 = atmosphere_89;
+                            let _e139 = past_3;
+                            x_17 = (1f / (f32(_e136.scattering_mu_s_split) - _e139));
+                            let _e143 = atmosphere_89;
+                            let _e144 = x_17;
+                            let _e145 = edge_21;
+                            let _e146 = ShadowEdgeLitDistance(_e143, _e144, _e145);
+                            log_first_span_2 = log((_e146 / SHADOW_EDGE_CLOSEST));
                         }
                     }
                 }
             }
-            let _e158 = atmosphere_87;
-            let _e159 = uvwz_8;
-            let _e160 = position_5;
-            let _e161 = nu_slice_8;
-            let _e162 = log_first_span_2;
-            let _e163 = GetScatteringBelowSplit(_e158, scattering_texture_4, _e159, _e160, _e161, _e162);
-            let _e164 = atmosphere_87;
-            let _e165 = uvwz_8;
-            let _e166 = position_5;
-            let _e167 = nu_slice_8;
-            let _e170 = log_first_span_2;
-            let _e171 = GetScatteringBelowSplit(_e164, scattering_texture_4, _e165, _e166, (_e167 + 1f), _e170);
-            let _e172 = nu_t_2;
-            let _e174 = SunCosineMix(_e163, _e171, _e172, true);
-            return _e174;
+            let _e149 = atmosphere_89;
+            let _e150 = uvwz_8;
+            let _e151 = position_5;
+            let _e152 = nu_slice_8;
+            let _e153 = log_first_span_2;
+            let _e154 = GetScatteringBelowSplit(_e149, scattering_texture_4, _e150, _e151, _e152, _e153);
+            let _e155 = atmosphere_89;
+            let _e156 = uvwz_8;
+            let _e157 = position_5;
+            let _e158 = nu_slice_8;
+            let _e161 = log_first_span_2;
+            let _e162 = GetScatteringBelowSplit(_e155, scattering_texture_4, _e156, _e157, (_e158 + 1f), _e161);
+            let _e163 = nu_t_2;
+            let _e165 = SunCosineMix(_e154, _e162, _e163, true);
+            return _e165;
         }
     }
-    let _e179 = atmosphere_87;
-    let _e180 = GetScatteringTextureUMuS(_e179, LOW_SUN_MU_S);
-    x_low_sun_2 = _e180;
-    let _e182 = atmosphere_87;
-    let _e183 = uvwz_8;
-    let _e185 = x_low_sun_2;
-    GetScatteringMuSColumns(_e182, _e183.y, _e185, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e194 = atmosphere_87;
-    let _e195 = uvwz_8;
-    let _e196 = x_below_1;
-    let _e197 = nu_slice_8;
-    let _e198 = nu_t_2;
-    let _e199 = low_sun_below_1;
-    let _e200 = GetScatteringAtMuSColumn(_e194, scattering_texture_4, _e195, _e196, _e197, _e198, _e199);
-    below = _e200;
-    let _e202 = atmosphere_87;
-    let _e203 = uvwz_8;
-    let _e204 = x_above_1;
-    let _e205 = nu_slice_8;
-    let _e206 = nu_t_2;
-    let _e207 = x_above_1;
-    let _e208 = x_low_sun_2;
-    let _e210 = GetScatteringAtMuSColumn(_e202, scattering_texture_4, _e203, _e204, _e205, _e206, (_e207 < _e208));
-    above = _e210;
-    let _e212 = mu_s_t_1;
-    if (_e212 < 0f) {
+    let _e170 = atmosphere_89;
+    let _e171 = GetScatteringTextureUMuS(_e170, LOW_SUN_MU_S);
+    x_low_sun_2 = _e171;
+    let _e173 = atmosphere_89;
+    let _e174 = uvwz_8;
+    let _e176 = x_low_sun_2;
+    GetScatteringMuSColumns(_e173, _e174.y, _e176, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
+    let _e185 = atmosphere_89;
+    let _e186 = uvwz_8;
+    let _e187 = x_below_1;
+    let _e188 = nu_slice_8;
+    let _e189 = nu_t_2;
+    let _e190 = low_sun_below_1;
+    let _e191 = GetScatteringAtMuSColumn(_e185, scattering_texture_4, _e186, _e187, _e188, _e189, _e190);
+    below = _e191;
+    let _e193 = atmosphere_89;
+    let _e194 = uvwz_8;
+    let _e195 = x_above_1;
+    let _e196 = nu_slice_8;
+    let _e197 = nu_t_2;
+    let _e198 = x_above_1;
+    let _e199 = x_low_sun_2;
+    let _e201 = GetScatteringAtMuSColumn(_e193, scattering_texture_4, _e194, _e195, _e196, _e197, (_e198 < _e199));
+    above = _e201;
+    let _e203 = mu_s_t_1;
+    if (_e203 < 0f) {
         {
-            let _e215 = below;
-            let _e216 = above;
-            let _e217 = atmosphere_87;
-            let _e219 = atmosphere_87;
-            let _e221 = mu_s_size_2;
-            let _e225 = GetScatteringMuSFromUnitRange(_e219, (1f / (_e221 - 1f)));
-            let _e226 = mu_s_26;
-            let _e227 = LowestSunContinued(_e215, _e216, _e217.scattering_mu_s_min, _e225, _e226);
-            return _e227;
+            let _e206 = below;
+            let _e207 = above;
+            let _e208 = atmosphere_89;
+            let _e210 = atmosphere_89;
+            let _e212 = mu_s_size_2;
+            let _e216 = GetScatteringMuSFromUnitRange(_e210, (1f / (_e212 - 1f)));
+            let _e217 = mu_s_28;
+            let _e218 = LowestSunContinued(_e206, _e207, _e208.scattering_mu_s_min, _e216, _e217);
+            return _e218;
         }
     }
-    let _e228 = low_sun_below_1;
-    if !(_e228) {
-        let _e230 = below;
-        let _e231 = above;
-        let _e232 = mu_s_t_1;
-        return mix(_e230, _e231, vec4(_e232));
+    let _e219 = low_sun_below_1;
+    if !(_e219) {
+        let _e221 = below;
+        let _e222 = above;
+        let _e223 = mu_s_t_1;
+        return mix(_e221, _e222, vec4(_e223));
     }
-    let _e235 = x_below_1;
-    let _e236 = mu_s_size_2;
-    column_3 = ((_e235 * _e236) - 0.5f);
-    let _e241 = column_3;
-    let _e248 = mu_s_size_2;
-    x_first = ((max((_e241 - 1f), 0f) + 0.5f) / _e248);
-    let _e251 = column_3;
-    let _e254 = mu_s_size_2;
-    let _e260 = mu_s_size_2;
-    x_last = ((min((_e251 + 2f), (_e254 - 1f)) + 0.5f) / _e260);
-    let _e263 = atmosphere_87;
-    let _e264 = uvwz_8;
-    let _e265 = x_first;
-    let _e266 = nu_slice_8;
-    let _e267 = nu_t_2;
-    let _e269 = GetScatteringAtMuSColumn(_e263, scattering_texture_4, _e264, _e265, _e266, _e267, true);
-    first = _e269;
-    let _e271 = atmosphere_87;
-    let _e272 = uvwz_8;
-    let _e273 = x_last;
-    let _e274 = nu_slice_8;
-    let _e275 = nu_t_2;
-    let _e276 = x_last;
-    let _e277 = x_low_sun_2;
-    let _e279 = GetScatteringAtMuSColumn(_e271, scattering_texture_4, _e272, _e273, _e274, _e275, (_e276 < _e277));
-    last_1 = _e279;
-    let _e281 = first;
-    let _e282 = below;
-    let _e283 = above;
-    let _e284 = last_1;
-    let _e285 = column_3;
-    let _e288 = column_3;
-    let _e291 = mu_s_size_2;
-    let _e295 = mu_s_t_1;
-    let _e296 = LogMonotoneCubicMix(_e281, _e282, _e283, _e284, (_e285 > 0.5f), ((_e288 + 2f) < (_e291 - 0.5f)), _e295);
-    return _e296;
+    let _e226 = x_below_1;
+    let _e227 = mu_s_size_2;
+    column_3 = ((_e226 * _e227) - 0.5f);
+    let _e232 = column_3;
+    let _e239 = mu_s_size_2;
+    x_first = ((max((_e232 - 1f), 0f) + 0.5f) / _e239);
+    let _e242 = column_3;
+    let _e245 = mu_s_size_2;
+    let _e251 = mu_s_size_2;
+    x_last = ((min((_e242 + 2f), (_e245 - 1f)) + 0.5f) / _e251);
+    let _e254 = atmosphere_89;
+    let _e255 = uvwz_8;
+    let _e256 = x_first;
+    let _e257 = nu_slice_8;
+    let _e258 = nu_t_2;
+    let _e260 = GetScatteringAtMuSColumn(_e254, scattering_texture_4, _e255, _e256, _e257, _e258, true);
+    first = _e260;
+    let _e262 = atmosphere_89;
+    let _e263 = uvwz_8;
+    let _e264 = x_last;
+    let _e265 = nu_slice_8;
+    let _e266 = nu_t_2;
+    let _e267 = x_last;
+    let _e268 = x_low_sun_2;
+    let _e270 = GetScatteringAtMuSColumn(_e262, scattering_texture_4, _e263, _e264, _e265, _e266, (_e267 < _e268));
+    last_1 = _e270;
+    let _e272 = first;
+    let _e273 = below;
+    let _e274 = above;
+    let _e275 = last_1;
+    let _e276 = column_3;
+    let _e279 = column_3;
+    let _e282 = mu_s_size_2;
+    let _e286 = mu_s_t_1;
+    let _e287 = LogMonotoneCubicMix(_e272, _e273, _e274, _e275, (_e276 > 0.5f), ((_e279 + 2f) < (_e282 - 0.5f)), _e286);
+    return _e287;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_88: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_48: f32, mu_s_27: f32) -> vec3<f32> {
-    var atmosphere_89: AtmosphereParameters;
-    var r_49: f32;
-    var mu_s_28: f32;
+fn GetIrradiance(atmosphere_90: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_50: f32, mu_s_29: f32) -> vec3<f32> {
+    var atmosphere_91: AtmosphereParameters;
+    var r_51: f32;
+    var mu_s_30: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
@@ -2678,25 +2695,25 @@ fn GetIrradiance(atmosphere_88: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_89 = atmosphere_88;
-    r_49 = r_48;
-    mu_s_28 = mu_s_27;
-    let _e19 = atmosphere_89;
-    let _e20 = r_49;
-    let _e21 = mu_s_28;
+    atmosphere_91 = atmosphere_90;
+    r_51 = r_50;
+    mu_s_30 = mu_s_29;
+    let _e19 = atmosphere_91;
+    let _e20 = r_51;
+    let _e21 = mu_s_30;
     let _e22 = GetIrradianceTextureUvFromRMuS(_e19, _e20, _e21);
     uv_3 = _e22;
-    let _e24 = atmosphere_89;
+    let _e24 = atmosphere_91;
     width = f32(_e24.irradiance_width);
-    let _e28 = atmosphere_89;
-    let _e29 = mu_s_28;
+    let _e28 = atmosphere_91;
+    let _e29 = mu_s_30;
     let _e30 = GetIrradianceUnitMuS(_e28, _e29);
     let _e31 = width;
     mu_s_coord_1 = (_e30 * (_e31 - 1f));
     let _e36 = mu_s_coord_1;
     let _e39 = width;
     mu_s_column_1 = clamp(floor(_e36), 0f, (_e39 - 2f));
-    let _e44 = atmosphere_89;
+    let _e44 = atmosphere_91;
     let _e45 = mu_s_column_1;
     let _e46 = width;
     let _e50 = GetIrradianceMuSFromUnit(_e44, (_e45 / (_e46 - 1f)));
@@ -2725,23 +2742,23 @@ fn GetIrradiance(atmosphere_88: AtmosphereParameters, irradiance_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_90: AtmosphereParameters, nu_15: f32) -> f32 {
-    var atmosphere_91: AtmosphereParameters;
-    var nu_16: f32;
+fn MiePhaseFunction(atmosphere_92: AtmosphereParameters, nu_17: f32) -> f32 {
+    var atmosphere_93: AtmosphereParameters;
+    var nu_18: f32;
 
-    atmosphere_91 = atmosphere_90;
-    nu_16 = nu_15;
-    let _e16 = atmosphere_91;
+    atmosphere_93 = atmosphere_92;
+    nu_18 = nu_17;
+    let _e16 = atmosphere_93;
     if (_e16.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e19 = atmosphere_91;
-        let _e21 = nu_16;
+        let _e19 = atmosphere_93;
+        let _e21 = nu_18;
         let _e22 = HenyeyGreensteinPhaseFunction(_e19.mie_g, _e21);
         return _e22;
     }
-    let _e23 = atmosphere_91;
+    let _e23 = atmosphere_93;
     if (_e23.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e26 = atmosphere_91;
-        let _e28 = nu_16;
+        let _e26 = atmosphere_93;
+        let _e28 = nu_18;
         let _e29 = CornetteShanksPhaseFunction(_e26.mie_g, _e28);
         return _e29;
     }
@@ -2749,31 +2766,31 @@ fn MiePhaseFunction(atmosphere_90: AtmosphereParameters, nu_15: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_92: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_50: f32, mu_35: f32, mu_s_29: f32, nu_17: f32, ray_r_mu_intersects_ground_16: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_93: AtmosphereParameters;
-    var r_51: f32;
-    var mu_36: f32;
-    var mu_s_30: f32;
-    var nu_18: f32;
-    var ray_r_mu_intersects_ground_17: bool;
+fn GetCombinedScattering(atmosphere_94: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_52: f32, mu_37: f32, mu_s_31: f32, nu_19: f32, ray_r_mu_intersects_ground_18: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_95: AtmosphereParameters;
+    var r_53: f32;
+    var mu_38: f32;
+    var mu_s_32: f32;
+    var nu_20: f32;
+    var ray_r_mu_intersects_ground_19: bool;
     var scattering: vec4<f32>;
     var local_18: vec3<f32>;
 
-    atmosphere_93 = atmosphere_92;
-    r_51 = r_50;
-    mu_36 = mu_35;
-    mu_s_30 = mu_s_29;
-    nu_18 = nu_17;
-    ray_r_mu_intersects_ground_17 = ray_r_mu_intersects_ground_16;
-    let _e27 = atmosphere_93;
-    let _e28 = r_51;
-    let _e29 = mu_36;
-    let _e30 = mu_s_30;
-    let _e31 = nu_18;
-    let _e32 = ray_r_mu_intersects_ground_17;
+    atmosphere_95 = atmosphere_94;
+    r_53 = r_52;
+    mu_38 = mu_37;
+    mu_s_32 = mu_s_31;
+    nu_20 = nu_19;
+    ray_r_mu_intersects_ground_19 = ray_r_mu_intersects_ground_18;
+    let _e27 = atmosphere_95;
+    let _e28 = r_53;
+    let _e29 = mu_38;
+    let _e30 = mu_s_32;
+    let _e31 = nu_20;
+    let _e32 = ray_r_mu_intersects_ground_19;
     let _e33 = GetScattering(_e27, scattering_texture_5, _e28, _e29, _e30, _e31, _e32);
     scattering = _e33;
-    let _e35 = atmosphere_93;
+    let _e35 = atmosphere_95;
     if (_e35.single_mie_in_scattering_alpha == 1i) {
         {
             let _e39 = scattering;
@@ -2781,8 +2798,8 @@ fn GetCombinedScattering(atmosphere_92: AtmosphereParameters, scattering_texture
                 let _e43 = scattering;
                 let _e46 = scattering;
                 let _e49 = scattering;
-                let _e53 = atmosphere_93;
-                let _e55 = atmosphere_93;
+                let _e53 = atmosphere_95;
+                let _e55 = atmosphere_95;
                 local_18 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
             } else {
                 local_18 = vec3(0f);
@@ -2792,12 +2809,12 @@ fn GetCombinedScattering(atmosphere_92: AtmosphereParameters, scattering_texture
         }
     } else {
         {
-            let _e65 = atmosphere_93;
-            let _e66 = r_51;
-            let _e67 = mu_36;
-            let _e68 = mu_s_30;
-            let _e69 = nu_18;
-            let _e70 = ray_r_mu_intersects_ground_17;
+            let _e65 = atmosphere_95;
+            let _e66 = r_53;
+            let _e67 = mu_38;
+            let _e68 = mu_s_32;
+            let _e69 = nu_20;
+            let _e70 = ray_r_mu_intersects_ground_19;
             let _e71 = GetScattering(_e65, single_mie_scattering_texture, _e66, _e67, _e68, _e69, _e70);
             (*single_mie_scattering) = vec3<f32>(_e71.xyz);
         }
@@ -2807,76 +2824,76 @@ fn GetCombinedScattering(atmosphere_92: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_94: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_95: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_96: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_97: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
     var start_2: vec3<f32>;
-    var r_52: f32;
-    var mu_37: f32;
-    var mu_s_31: f32;
-    var nu_19: f32;
-    var ray_r_mu_intersects_ground_18: bool;
+    var r_54: f32;
+    var mu_39: f32;
+    var mu_s_33: f32;
+    var nu_21: f32;
+    var ray_r_mu_intersects_ground_20: bool;
     var local_19: vec3<f32>;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_95 = atmosphere_94;
+    atmosphere_97 = atmosphere_96;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e29 = atmosphere_95;
+    let _e29 = atmosphere_97;
     let _e30 = camera_5;
     let _e31 = view_ray_5;
     let _e32 = sun_direction_3;
-    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_52), (&mu_37), (&mu_s_31), (&nu_19));
+    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_54), (&mu_39), (&mu_s_33), (&nu_21));
     if !(_e43) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e49 = atmosphere_95;
-    let _e50 = r_52;
-    let _e51 = mu_37;
+    let _e49 = atmosphere_97;
+    let _e50 = r_54;
+    let _e51 = mu_39;
     let _e52 = RayIntersectsGround(_e49, _e50, _e51);
-    ray_r_mu_intersects_ground_18 = _e52;
-    let _e54 = ray_r_mu_intersects_ground_18;
+    ray_r_mu_intersects_ground_20 = _e52;
+    let _e54 = ray_r_mu_intersects_ground_20;
     if _e54 {
         local_19 = vec3(0f);
     } else {
-        let _e57 = atmosphere_95;
-        let _e58 = r_52;
-        let _e59 = mu_37;
+        let _e57 = atmosphere_97;
+        let _e58 = r_54;
+        let _e59 = mu_39;
         let _e60 = GetTransmittanceToTopAtmosphereBoundary(_e57, transmittance_texture_5, _e58, _e59);
         local_19 = _e60;
     }
     let _e62 = local_19;
     (*transmittance) = _e62;
-    let _e64 = atmosphere_95;
-    let _e65 = r_52;
-    let _e66 = mu_37;
-    let _e67 = mu_s_31;
-    let _e68 = nu_19;
-    let _e69 = ray_r_mu_intersects_ground_18;
+    let _e64 = atmosphere_97;
+    let _e65 = r_54;
+    let _e66 = mu_39;
+    let _e67 = mu_s_33;
+    let _e68 = nu_21;
+    let _e69 = ray_r_mu_intersects_ground_20;
     let _e72 = GetCombinedScattering(_e64, scattering_texture_6, single_mie_scattering_texture_1, _e65, _e66, _e67, _e68, _e69, (&single_mie_scattering_1));
     scattering_1 = _e72;
     let _e74 = scattering_1;
-    let _e75 = nu_19;
+    let _e75 = nu_21;
     let _e76 = RayleighPhaseFunction(_e75);
     let _e78 = single_mie_scattering_1;
-    let _e79 = atmosphere_95;
-    let _e80 = nu_19;
+    let _e79 = atmosphere_97;
+    let _e80 = nu_21;
     let _e81 = MiePhaseFunction(_e79, _e80);
     return ((_e74 * _e76) + (_e78 * _e81));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_96: AtmosphereParameters, r_53: f32, mu_38: f32) -> f32 {
-    var atmosphere_97: AtmosphereParameters;
-    var r_54: f32;
-    var mu_39: f32;
+fn DistanceInsideScatteringRadii(atmosphere_98: AtmosphereParameters, r_55: f32, mu_40: f32) -> f32 {
+    var atmosphere_99: AtmosphereParameters;
+    var r_56: f32;
+    var mu_41: f32;
     var r_max: f32;
     var r_min: f32;
     var across_2: f32;
@@ -2884,20 +2901,20 @@ fn DistanceInsideScatteringRadii(atmosphere_96: AtmosphereParameters, r_53: f32,
     var down_discriminant: f32;
     var local_20: f32;
 
-    atmosphere_97 = atmosphere_96;
-    r_54 = r_53;
-    mu_39 = mu_38;
-    let _e19 = atmosphere_97;
+    atmosphere_99 = atmosphere_98;
+    r_56 = r_55;
+    mu_41 = mu_40;
+    let _e19 = atmosphere_99;
     r_max = _e19.scattering_r_max;
-    let _e22 = atmosphere_97;
+    let _e22 = atmosphere_99;
     r_min = _e22.scattering_r_min;
-    let _e25 = r_54;
-    let _e26 = r_54;
-    let _e28 = mu_39;
-    let _e29 = mu_39;
+    let _e25 = r_56;
+    let _e26 = r_56;
+    let _e28 = mu_41;
+    let _e29 = mu_41;
     across_2 = ((_e25 * _e26) * ((_e28 * _e29) - 1f));
-    let _e35 = r_54;
-    let _e37 = mu_39;
+    let _e35 = r_56;
+    let _e37 = mu_41;
     let _e39 = across_2;
     let _e40 = r_max;
     let _e41 = r_max;
@@ -2907,12 +2924,12 @@ fn DistanceInsideScatteringRadii(atmosphere_96: AtmosphereParameters, r_53: f32,
     let _e48 = r_min;
     let _e49 = r_min;
     down_discriminant = (_e47 + (_e48 * _e49));
-    let _e53 = mu_39;
+    let _e53 = mu_41;
     let _e56 = down_discriminant;
     if ((_e53 < 0f) && (_e56 >= 0f)) {
         let _e60 = up;
-        let _e61 = r_54;
-        let _e63 = mu_39;
+        let _e61 = r_56;
+        let _e63 = mu_41;
         let _e65 = down_discriminant;
         local_20 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
     } else {
@@ -2924,17 +2941,17 @@ fn DistanceInsideScatteringRadii(atmosphere_96: AtmosphereParameters, r_53: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_98: AtmosphereParameters, i_1: i32) -> f32 {
-    var atmosphere_99: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_100: AtmosphereParameters, i_1: i32) -> f32 {
+    var atmosphere_101: AtmosphereParameters;
     var i_2: i32;
     var x_18: f32;
 
-    atmosphere_99 = atmosphere_98;
+    atmosphere_101 = atmosphere_100;
     i_2 = i_1;
     let _e18 = i_2;
     x_18 = (f32(_e18) / 63f);
-    let _e26 = atmosphere_99;
-    let _e28 = atmosphere_99;
+    let _e26 = atmosphere_101;
+    let _e28 = atmosphere_101;
     let _e31 = x_18;
     let _e33 = x_18;
     return (((_e26.top_radius - _e28.bottom_radius) * _e31) * _e33);
@@ -2993,8 +3010,8 @@ fn InterpolateCoefficients(a_20: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_100: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_101: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_102: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_103: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
     var x_19: f32;
@@ -3002,79 +3019,79 @@ fn GetCoefficientsAtAltitude(atmosphere_100: AtmosphereParameters, altitude: f32
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_101 = atmosphere_100;
+    atmosphere_103 = atmosphere_102;
     altitude_1 = altitude;
-    let _e20 = atmosphere_101;
-    let _e22 = atmosphere_101;
+    let _e20 = atmosphere_103;
+    let _e22 = atmosphere_103;
     height = (_e20.top_radius - _e22.bottom_radius);
     let _e26 = altitude_1;
     let _e27 = height;
     x_19 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
     let _e39 = x_19;
     i_3 = min(i32(_e39), 62i);
-    let _e46 = atmosphere_101;
+    let _e46 = atmosphere_103;
     let _e47 = i_3;
     let _e48 = ProfileSampleAltitude(_e46, _e47);
     h0_ = _e48;
     let _e50 = altitude_1;
     let _e51 = h0_;
-    let _e53 = atmosphere_101;
+    let _e53 = atmosphere_103;
     let _e54 = i_3;
     let _e57 = ProfileSampleAltitude(_e53, (_e54 + 1i));
     let _e58 = h0_;
     f_4 = clamp(((_e50 - _e51) / (_e57 - _e58)), 0f, 1f);
     let _e65 = i_3;
-    let _e68 = atmosphere_101.mie_scattering_profile[_e65];
+    let _e68 = atmosphere_103.mie_scattering_profile[_e65];
     let _e69 = i_3;
-    let _e74 = atmosphere_101.mie_scattering_profile[(_e69 + 1i)];
+    let _e74 = atmosphere_103.mie_scattering_profile[(_e69 + 1i)];
     let _e75 = f_4;
     let _e76 = InterpolateCoefficients(_e68, _e74, _e75);
     (*mie_scattering) = _e76;
     let _e77 = i_3;
-    let _e80 = atmosphere_101.rayleigh_scattering_profile[_e77];
+    let _e80 = atmosphere_103.rayleigh_scattering_profile[_e77];
     let _e81 = i_3;
-    let _e86 = atmosphere_101.rayleigh_scattering_profile[(_e81 + 1i)];
+    let _e86 = atmosphere_103.rayleigh_scattering_profile[(_e81 + 1i)];
     let _e87 = f_4;
     let _e88 = InterpolateCoefficients(_e80, _e86, _e87);
     (*rayleigh_scattering) = _e88;
     let _e89 = i_3;
-    let _e92 = atmosphere_101.extinction_profile[_e89];
+    let _e92 = atmosphere_103.extinction_profile[_e89];
     let _e93 = i_3;
-    let _e98 = atmosphere_101.extinction_profile[(_e93 + 1i)];
+    let _e98 = atmosphere_103.extinction_profile[(_e93 + 1i)];
     let _e99 = f_4;
     let _e100 = InterpolateCoefficients(_e92, _e98, _e99);
     return _e100;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_102: AtmosphereParameters, r_55: f32, mu_40: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_103: AtmosphereParameters;
-    var r_56: f32;
-    var mu_41: f32;
+fn AltitudeAtDistance(atmosphere_104: AtmosphereParameters, r_57: f32, mu_42: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_105: AtmosphereParameters;
+    var r_58: f32;
+    var mu_43: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_103 = atmosphere_102;
-    r_56 = r_55;
-    mu_41 = mu_40;
+    atmosphere_105 = atmosphere_104;
+    r_58 = r_57;
+    mu_43 = mu_42;
     t_10 = t_9;
     r_t_1 = r_t;
-    let _e24 = r_56;
-    let _e25 = atmosphere_103;
+    let _e24 = r_58;
+    let _e25 = atmosphere_105;
     let _e28 = t_10;
     let _e29 = t_10;
-    let _e31 = r_56;
-    let _e33 = mu_41;
+    let _e31 = r_58;
+    let _e33 = mu_43;
     let _e37 = r_t_1;
-    let _e38 = r_56;
+    let _e38 = r_58;
     return ((_e24 - _e25.bottom_radius) + ((_e28 * (_e29 + ((2f * _e31) * _e33))) / (_e37 + _e38)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, r_57: f32, mu_42: f32, d_21: f32) -> vec3<f32> {
-    var atmosphere_105: AtmosphereParameters;
-    var r_58: f32;
-    var mu_43: f32;
+fn IntegrateSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, r_59: f32, mu_44: f32, d_21: f32) -> vec3<f32> {
+    var atmosphere_107: AtmosphereParameters;
+    var r_60: f32;
+    var mu_45: f32;
     var d_22: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
@@ -3086,9 +3103,9 @@ fn IntegrateSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, r_57: f32,
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_105 = atmosphere_104;
-    r_58 = r_57;
-    mu_43 = mu_42;
+    atmosphere_107 = atmosphere_106;
+    r_60 = r_59;
+    mu_45 = mu_44;
     d_22 = d_21;
     let _e22 = d_22;
     dt = (_e22 / 16f);
@@ -3101,16 +3118,16 @@ fn IntegrateSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, r_57: f32,
             let _e41 = dt;
             let _e42 = k_5;
             t_11 = (_e41 * f32(_e42));
-            let _e46 = atmosphere_105;
-            let _e47 = r_58;
-            let _e48 = mu_43;
+            let _e46 = atmosphere_107;
+            let _e47 = r_60;
+            let _e48 = mu_45;
             let _e49 = t_11;
             let _e50 = RadiusAtDistance(_e46, _e47, _e48, _e49);
             r_t_2 = _e50;
-            let _e54 = atmosphere_105;
-            let _e55 = atmosphere_105;
-            let _e56 = r_58;
-            let _e57 = mu_43;
+            let _e54 = atmosphere_107;
+            let _e55 = atmosphere_107;
+            let _e56 = r_60;
+            let _e57 = mu_45;
             let _e58 = t_11;
             let _e59 = r_t_2;
             let _e60 = AltitudeAtDistance(_e55, _e56, _e57, _e58, _e59);
@@ -3137,33 +3154,33 @@ fn IntegrateSegmentOpticalDepth(atmosphere_104: AtmosphereParameters, r_57: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_59: f32, mu_44: f32, d_23: f32, ray_r_mu_intersects_ground_19: bool) -> vec3<f32> {
-    var atmosphere_107: AtmosphereParameters;
-    var r_60: f32;
-    var mu_45: f32;
+fn LongSegmentOpticalDepth(atmosphere_108: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_61: f32, mu_46: f32, d_23: f32, ray_r_mu_intersects_ground_21: bool) -> vec3<f32> {
+    var atmosphere_109: AtmosphereParameters;
+    var r_62: f32;
+    var mu_47: f32;
     var d_24: f32;
-    var ray_r_mu_intersects_ground_20: bool;
+    var ray_r_mu_intersects_ground_22: bool;
     var local_22: vec3<f32>;
 
-    atmosphere_107 = atmosphere_106;
-    r_60 = r_59;
-    mu_45 = mu_44;
+    atmosphere_109 = atmosphere_108;
+    r_62 = r_61;
+    mu_47 = mu_46;
     d_24 = d_23;
-    ray_r_mu_intersects_ground_20 = ray_r_mu_intersects_ground_19;
-    let _e25 = atmosphere_107;
+    ray_r_mu_intersects_ground_22 = ray_r_mu_intersects_ground_21;
+    let _e25 = atmosphere_109;
     if (_e25.transmittance_is_colour != 0i) {
-        let _e29 = atmosphere_107;
-        let _e30 = r_60;
-        let _e31 = mu_45;
+        let _e29 = atmosphere_109;
+        let _e30 = r_62;
+        let _e31 = mu_47;
         let _e32 = d_24;
         let _e33 = IntegrateSegmentOpticalDepth(_e29, _e30, _e31, _e32);
         local_22 = _e33;
     } else {
-        let _e34 = atmosphere_107;
-        let _e35 = r_60;
-        let _e36 = mu_45;
+        let _e34 = atmosphere_109;
+        let _e35 = r_62;
+        let _e36 = mu_47;
         let _e37 = d_24;
-        let _e38 = ray_r_mu_intersects_ground_20;
+        let _e38 = ray_r_mu_intersects_ground_22;
         let _e39 = GetOpticalDepth(_e34, transmittance_texture_6, _e35, _e36, _e37, _e38);
         local_22 = _e39;
     }
@@ -3191,12 +3208,12 @@ fn MeanAttenuation(depth: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_108: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_61: f32, mu_46: f32, mu_s_32: f32, nu_20: f32, d_25: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_109: AtmosphereParameters;
-    var r_62: f32;
-    var mu_47: f32;
-    var mu_s_33: f32;
-    var nu_21: f32;
+fn IntegrateSegment(atmosphere_110: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_63: f32, mu_48: f32, mu_s_34: f32, nu_22: f32, d_25: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_111: AtmosphereParameters;
+    var r_64: f32;
+    var mu_49: f32;
+    var mu_s_35: f32;
+    var nu_23: f32;
     var d_26: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
@@ -3220,11 +3237,11 @@ fn IntegrateSegment(atmosphere_108: AtmosphereParameters, transmittance_texture_
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_109 = atmosphere_108;
-    r_62 = r_61;
-    mu_47 = mu_46;
-    mu_s_33 = mu_s_32;
-    nu_21 = nu_20;
+    atmosphere_111 = atmosphere_110;
+    r_64 = r_63;
+    mu_49 = mu_48;
+    mu_s_35 = mu_s_34;
+    nu_23 = nu_22;
     d_26 = d_25;
     let _e30 = d_26;
     dt_1 = (_e30 / 16f);
@@ -3240,35 +3257,35 @@ fn IntegrateSegment(atmosphere_108: AtmosphereParameters, transmittance_texture_
             let _e64 = dt_1;
             let _e65 = k_6;
             t_12 = (_e64 * f32(_e65));
-            let _e69 = atmosphere_109;
-            let _e70 = r_62;
-            let _e71 = mu_47;
+            let _e69 = atmosphere_111;
+            let _e70 = r_64;
+            let _e71 = mu_49;
             let _e72 = t_12;
             let _e73 = RadiusAtDistance(_e69, _e70, _e71, _e72);
             r_t_3 = _e73;
-            let _e75 = atmosphere_109;
-            let _e76 = r_62;
-            let _e77 = mu_47;
+            let _e75 = atmosphere_111;
+            let _e76 = r_64;
+            let _e77 = mu_49;
             let _e78 = t_12;
             let _e79 = r_t_3;
             let _e80 = AltitudeAtDistance(_e75, _e76, _e77, _e78, _e79);
             altitude_2 = _e80;
-            let _e82 = r_62;
-            let _e83 = mu_s_33;
+            let _e82 = r_64;
+            let _e83 = mu_s_35;
             let _e85 = t_12;
-            let _e86 = nu_21;
+            let _e86 = nu_23;
             let _e89 = r_t_3;
             let _e91 = ClampCosine((((_e82 * _e83) + (_e85 * _e86)) / _e89));
             mu_s_t_2 = _e91;
-            let _e95 = atmosphere_109;
+            let _e95 = atmosphere_111;
             let _e96 = altitude_2;
             let _e101 = GetCoefficientsAtAltitude(_e95, _e96, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e101;
-            let _e103 = atmosphere_109;
+            let _e103 = atmosphere_111;
             let _e104 = r_t_3;
             let _e105 = mu_s_t_2;
             let _e106 = GetOpticalDepthToTopAtmosphereBoundary(_e103, transmittance_texture_7, _e104, _e105);
-            let _e109 = atmosphere_109;
+            let _e109 = atmosphere_111;
             let _e110 = r_t_3;
             let _e111 = mu_s_t_2;
             let _e112 = SunVisibleFraction(_e109, _e110, _e111);
@@ -3337,18 +3354,18 @@ fn IntegrateSegment(atmosphere_108: AtmosphereParameters, transmittance_texture_
         }
     }
     let _e195 = (*single_rayleigh);
-    let _e196 = atmosphere_109;
+    let _e196 = atmosphere_111;
     (*single_rayleigh) = (_e195 * _e196.solar_irradiance);
     let _e199 = (*single_mie);
-    let _e200 = atmosphere_109;
+    let _e200 = atmosphere_111;
     (*single_mie) = (_e199 * _e200.solar_irradiance);
     let _e203 = optical_depth_1;
     return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_111: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_113: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -3356,13 +3373,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_63: f32;
-    var mu_48: f32;
-    var mu_s_34: f32;
-    var nu_22: f32;
+    var r_65: f32;
+    var mu_50: f32;
+    var mu_s_36: f32;
+    var nu_24: f32;
     var d_27: f32;
     var lit_1: f32;
-    var ray_r_mu_intersects_ground_21: bool;
+    var ray_r_mu_intersects_ground_23: bool;
     var r_p: f32;
     var mu_p: f32;
     var mu_s_p: f32;
@@ -3391,7 +3408,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_111 = atmosphere_110;
+    atmosphere_113 = atmosphere_112;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -3409,11 +3426,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     }
     let _e41 = camera_to_point;
     view_ray_6 = normalize(_e41);
-    let _e49 = atmosphere_111;
+    let _e49 = atmosphere_113;
     let _e50 = camera_7;
     let _e51 = view_ray_6;
     let _e52 = sun_direction_5;
-    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_63), (&mu_48), (&mu_s_34), (&nu_22));
+    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_65), (&mu_50), (&mu_s_36), (&nu_24));
     if !(_e63) {
         {
             (*transmittance_1) = vec3(1f);
@@ -3426,27 +3443,27 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     let _e76 = d_27;
     let _e77 = shadow_length_1;
     lit_1 = max((_e76 - max(_e77, 0f)), 0f);
-    let _e84 = atmosphere_111;
-    let _e85 = r_63;
-    let _e86 = mu_48;
+    let _e84 = atmosphere_113;
+    let _e85 = r_65;
+    let _e86 = mu_50;
     let _e87 = RayIntersectsGround(_e84, _e85, _e86);
-    ray_r_mu_intersects_ground_21 = _e87;
-    let _e89 = atmosphere_111;
-    let _e90 = r_63;
-    let _e91 = mu_48;
+    ray_r_mu_intersects_ground_23 = _e87;
+    let _e89 = atmosphere_113;
+    let _e90 = r_65;
+    let _e91 = mu_50;
     let _e92 = lit_1;
     let _e93 = RadiusAtDistance(_e89, _e90, _e91, _e92);
     r_p = _e93;
-    let _e95 = r_63;
-    let _e96 = mu_48;
+    let _e95 = r_65;
+    let _e96 = mu_50;
     let _e97 = lit_1;
     let _e98 = r_p;
     let _e99 = CosineAtDistance(_e95, _e96, _e97, _e98);
     mu_p = _e99;
-    let _e101 = r_63;
-    let _e102 = mu_s_34;
+    let _e101 = r_65;
+    let _e102 = mu_s_36;
     let _e104 = lit_1;
-    let _e105 = nu_22;
+    let _e105 = nu_24;
     let _e108 = r_p;
     let _e110 = ClampCosine((((_e101 * _e102) + (_e104 * _e105)) / _e108));
     mu_s_p = _e110;
@@ -3457,11 +3474,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     let _e140 = lit_direct;
     if (_e140 > 0f) {
         {
-            let _e143 = atmosphere_111;
-            let _e144 = r_63;
-            let _e145 = mu_48;
-            let _e146 = mu_s_34;
-            let _e147 = nu_22;
+            let _e143 = atmosphere_113;
+            let _e144 = r_65;
+            let _e145 = mu_50;
+            let _e146 = mu_s_36;
+            let _e147 = nu_24;
             let _e148 = lit_1;
             let _e155 = IntegrateSegment(_e143, transmittance_texture_8, _e144, _e145, _e146, _e147, _e148, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
             lit_optical_depth = _e155;
@@ -3475,11 +3492,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     if ((_e158 > 0f) && (_e161 < _e162)) {
         {
             let _e168 = optical_depth_2;
-            let _e169 = atmosphere_111;
+            let _e169 = atmosphere_113;
             let _e170 = r_p;
             let _e171 = mu_p;
             let _e172 = mu_s_p;
-            let _e173 = nu_22;
+            let _e173 = nu_24;
             let _e174 = d_27;
             let _e175 = lit_1;
             let _e183 = IntegrateSegment(_e169, transmittance_texture_8, _e170, _e171, _e172, _e173, (_e174 - _e175), (&unused_rayleigh), (&unused_mie), (&unused_weight));
@@ -3489,11 +3506,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     let _e185 = direct;
     if (_e185 < 1f) {
         {
-            let _e188 = atmosphere_111;
-            let _e189 = r_63;
-            let _e190 = mu_48;
+            let _e188 = atmosphere_113;
+            let _e189 = r_65;
+            let _e190 = mu_50;
             let _e191 = d_27;
-            let _e192 = ray_r_mu_intersects_ground_21;
+            let _e192 = ray_r_mu_intersects_ground_23;
             let _e193 = LongSegmentOpticalDepth(_e188, transmittance_texture_8, _e189, _e190, _e191, _e192);
             let _e194 = optical_depth_2;
             let _e195 = direct;
@@ -3502,35 +3519,35 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     }
     let _e198 = optical_depth_2;
     (*transmittance_1) = exp(-(_e198));
-    let _e202 = atmosphere_111;
-    let _e203 = r_63;
-    let _e204 = mu_48;
-    let _e205 = mu_s_34;
-    let _e206 = nu_22;
-    let _e207 = ray_r_mu_intersects_ground_21;
+    let _e202 = atmosphere_113;
+    let _e203 = r_65;
+    let _e204 = mu_50;
+    let _e205 = mu_s_36;
+    let _e206 = nu_24;
+    let _e207 = ray_r_mu_intersects_ground_23;
     let _e210 = GetCombinedScattering(_e202, scattering_texture_7, single_mie_scattering_texture_2, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
     scattering_3 = _e210;
     let _e212 = lit_1;
     if (_e212 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e214 = atmosphere_111;
-            let _e215 = r_63;
-            let _e216 = mu_48;
-            let _e217 = ray_r_mu_intersects_ground_21;
+            let _e214 = atmosphere_113;
+            let _e215 = r_65;
+            let _e216 = mu_50;
+            let _e217 = ray_r_mu_intersects_ground_23;
             let _e218 = DistanceToNearestAtmosphereBoundary(_e214, _e215, _e216, _e217);
             boundary = _e218;
             let _e220 = boundary;
-            let _e222 = atmosphere_111;
-            let _e223 = r_63;
-            let _e224 = mu_48;
+            let _e222 = atmosphere_113;
+            let _e223 = r_65;
+            let _e224 = mu_50;
             let _e225 = DistanceInsideScatteringRadii(_e222, _e223, _e224);
             let _e227 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e220), _e225), _e227);
-            let _e233 = atmosphere_111;
-            let _e234 = r_63;
-            let _e235 = mu_48;
-            let _e236 = mu_s_34;
-            let _e237 = nu_22;
+            let _e233 = atmosphere_113;
+            let _e234 = r_65;
+            let _e235 = mu_50;
+            let _e236 = mu_s_36;
+            let _e237 = nu_24;
             let _e238 = far;
             let _e245 = IntegrateSegment(_e233, transmittance_texture_8, _e234, _e235, _e236, _e237, _e238, (&far_rayleigh), (&far_mie), (&far_weight));
             far_optical_depth = _e245;
@@ -3538,29 +3555,29 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
             let _e248 = boundary;
             if (_e247 < _e248) {
                 {
-                    let _e250 = atmosphere_111;
-                    let _e251 = r_63;
-                    let _e252 = mu_48;
+                    let _e250 = atmosphere_113;
+                    let _e251 = r_65;
+                    let _e252 = mu_50;
                     let _e253 = far;
                     let _e254 = RadiusAtDistance(_e250, _e251, _e252, _e253);
                     r_far = _e254;
                     let _e257 = scattering_3;
                     let _e258 = far_optical_depth;
-                    let _e261 = atmosphere_111;
+                    let _e261 = atmosphere_113;
                     let _e262 = r_far;
-                    let _e263 = r_63;
-                    let _e264 = mu_48;
+                    let _e263 = r_65;
+                    let _e264 = mu_50;
                     let _e265 = far;
                     let _e266 = r_far;
                     let _e267 = CosineAtDistance(_e263, _e264, _e265, _e266);
-                    let _e268 = r_63;
-                    let _e269 = mu_s_34;
+                    let _e268 = r_65;
+                    let _e269 = mu_s_36;
                     let _e271 = far;
-                    let _e272 = nu_22;
+                    let _e272 = nu_24;
                     let _e275 = r_far;
                     let _e277 = ClampCosine((((_e268 * _e269) + (_e271 * _e272)) / _e275));
-                    let _e278 = nu_22;
-                    let _e279 = ray_r_mu_intersects_ground_21;
+                    let _e278 = nu_24;
+                    let _e279 = ray_r_mu_intersects_ground_23;
                     let _e282 = GetCombinedScattering(_e261, scattering_texture_7, single_mie_scattering_texture_2, _e262, _e267, _e277, _e278, _e279, (&unused_far_mie));
                     scattering_3 = (_e257 - (exp(-(_e258)) * _e282));
                 }
@@ -3572,30 +3589,30 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
             multiple = ((max((_e285 - _e286), vec3(0f)) * _e291) / max(_e293, vec3(0.000000000000000000000000000001f)));
             let _e299 = single_rayleigh_1;
             let _e300 = multiple;
-            let _e302 = nu_22;
+            let _e302 = nu_24;
             let _e303 = RayleighPhaseFunction(_e302);
             let _e305 = single_mie_1;
-            let _e306 = atmosphere_111;
-            let _e307 = nu_22;
+            let _e306 = atmosphere_113;
+            let _e307 = nu_24;
             let _e308 = MiePhaseFunction(_e306, _e307);
             return (((_e299 + _e300) * _e303) + (_e305 * _e308));
         }
     }
-    let _e311 = atmosphere_111;
-    let _e312 = r_63;
-    let _e313 = mu_48;
+    let _e311 = atmosphere_113;
+    let _e312 = r_65;
+    let _e313 = mu_50;
     let _e314 = lit_1;
-    let _e315 = ray_r_mu_intersects_ground_21;
+    let _e315 = ray_r_mu_intersects_ground_23;
     let _e316 = LongSegmentOpticalDepth(_e311, transmittance_texture_8, _e312, _e313, _e314, _e315);
     let _e317 = lit_optical_depth;
     let _e318 = lit_direct;
     lit_transmittance = exp(-(mix(_e316, _e317, vec3(_e318))));
-    let _e325 = atmosphere_111;
+    let _e325 = atmosphere_113;
     let _e326 = r_p;
     let _e327 = mu_p;
     let _e328 = mu_s_p;
-    let _e329 = nu_22;
-    let _e330 = ray_r_mu_intersects_ground_21;
+    let _e329 = nu_24;
+    let _e330 = ray_r_mu_intersects_ground_23;
     let _e333 = GetCombinedScattering(_e325, scattering_texture_7, single_mie_scattering_texture_2, _e326, _e327, _e328, _e329, _e330, (&single_mie_scattering_p));
     scattering_p = _e333;
     let _e335 = scattering_3;
@@ -3611,27 +3628,27 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_110: AtmosphereParameters, transmi
     let _e353 = lit_direct;
     single_mie_scattering_2 = mix(_e351, _e352, vec3(_e353));
     let _e356 = scattering_3;
-    let _e357 = nu_22;
+    let _e357 = nu_24;
     let _e358 = RayleighPhaseFunction(_e357);
     let _e360 = single_mie_scattering_2;
-    let _e361 = atmosphere_111;
-    let _e362 = nu_22;
+    let _e361 = atmosphere_113;
+    let _e362 = nu_24;
     let _e363 = MiePhaseFunction(_e361, _e362);
     return ((_e356 * _e358) + (_e360 * _e363));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_112: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_113: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_114: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_115: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_113 = atmosphere_112;
+    atmosphere_115 = atmosphere_114;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e26 = atmosphere_113;
+    let _e26 = atmosphere_115;
     let _e27 = camera_9;
     let _e28 = point_3;
     let _e30 = sun_direction_7;
@@ -3640,52 +3657,52 @@ fn GetSkyRadianceToPoint(atmosphere_112: AtmosphereParameters, transmittance_tex
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_114: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_115: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_116: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_117: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_64: f32;
-    var mu_s_35: f32;
+    var r_66: f32;
+    var mu_s_37: f32;
 
-    atmosphere_115 = atmosphere_114;
+    atmosphere_117 = atmosphere_116;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e25 = atmosphere_115;
+    let _e25 = atmosphere_117;
     let _e26 = point_5;
     let _e28 = ClampRadius(_e25, length(_e26));
-    r_64 = _e28;
+    r_66 = _e28;
     let _e30 = point_5;
     let _e31 = sun_direction_9;
     let _e33 = point_5;
     let _e36 = ClampCosine((dot(_e30, _e31) / length(_e33)));
-    mu_s_35 = _e36;
-    let _e38 = atmosphere_115;
-    let _e39 = r_64;
-    let _e40 = mu_s_35;
+    mu_s_37 = _e36;
+    let _e38 = atmosphere_117;
+    let _e39 = r_66;
+    let _e40 = mu_s_37;
     let _e41 = GetIrradiance(_e38, irradiance_texture_1, _e39, _e40);
     let _e43 = normal_1;
     let _e44 = point_5;
     let _e46 = point_5;
     (*sky_irradiance) = ((_e41 * (1f + (dot(_e43, _e44) / length(_e46)))) * 0.5f);
-    let _e53 = atmosphere_115;
-    let _e55 = atmosphere_115;
-    let _e56 = r_64;
-    let _e57 = mu_s_35;
+    let _e53 = atmosphere_117;
+    let _e55 = atmosphere_117;
+    let _e56 = r_66;
+    let _e57 = mu_s_37;
     let _e58 = GetTransmittanceToSun(_e55, transmittance_texture_10, _e56, _e57);
     let _e60 = normal_1;
     let _e61 = sun_direction_9;
     return ((_e53.solar_irradiance * _e58) * max(dot(_e60, _e61), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_116: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_117: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_118: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_119: AtmosphereParameters;
 
-    atmosphere_117 = atmosphere_116;
-    let _e16 = atmosphere_117;
-    let _e18 = atmosphere_117;
-    let _e21 = atmosphere_117;
+    atmosphere_119 = atmosphere_118;
+    let _e16 = atmosphere_119;
+    let _e18 = atmosphere_119;
+    let _e21 = atmosphere_119;
     return (_e16.solar_irradiance / vec3(((PI * _e18.sun_angular_radius) * _e21.sun_angular_radius)));
 }
 
