@@ -31,20 +31,18 @@ class OwnColumnSuns {
  public:
   explicit OwnColumnSuns(const AtmosphereParameters& grid)
       : grid_(grid),
-        split_(grid.scattering_mu_s_split),
-        mu_s_size_(grid.scattering_mu_s_size),
-        nu_size_(grid.scattering_nu_size),
-        mu_size_(grid.scattering_mu_size),
         distances_(grid),
-        mu_s_(std::size_t(grid.scattering_r_size) * mu_size_ * nu_size_ * split_) {
-    tbb::parallel_for(0, grid.scattering_r_size * mu_size_, [&](int ray) {
-      const int y = ray % mu_size_, z = ray / mu_size_;
-      for (int slice = 0; slice < nu_size_; ++slice) {
+        mu_s_(std::size_t(grid.scattering_r_size) * grid.scattering_mu_size * grid.scattering_nu_size *
+              grid.scattering_mu_s_split) {
+    const int mu_size = grid.scattering_mu_size;
+    tbb::parallel_for(0, grid.scattering_r_size * mu_size, [&](int ray) {
+      const int y = ray % mu_size, z = ray / mu_size;
+      for (int slice = 0; slice < grid.scattering_nu_size; ++slice) {
         const ScatteringTexel slice_ray = GetScatteringSliceTexel(grid, slice, y, z);
         const double r = slice_ray.r, mu = slice_ray.mu, nu = slice_ray.grid_nu;
         const bool ground = slice_ray.ray_intersects_ground;
         double edge = glsl::GetScatteringSliceEdge(grid, r, mu, nu, ground, 0.0);
-        for (int column = split_ - 1; column >= 0; --column) {
+        for (int column = grid.scattering_mu_s_split - 1; column >= 0; --column) {
           double sun = distances_.SunZenith(grid, column, edge);
           for (int i = 0; i < 50; ++i) {
             edge = glsl::GetScatteringSliceEdge(grid, r, mu, nu, ground, std::cos(sun));
@@ -53,7 +51,7 @@ class OwnColumnSuns {
             sun = next;
             if (converged) break;
           }
-          mu_s_[Index(slice * mu_s_size_ + column, y, z)] = std::cos(sun);
+          mu_s_[Index(slice * grid.scattering_mu_s_size + column, y, z)] = std::cos(sun);
         }
       }
     });
@@ -62,8 +60,10 @@ class OwnColumnSuns {
   double MuS(int x, int y, int z) const { return mu_s_[Index(x, y, z)]; }
   // The same by an index of the texels below the split, in [0, size()).
   std::size_t Index(int x, int y, int z) const {
-    const int slice = x / mu_s_size_, column = x % mu_s_size_;
-    return ((std::size_t(z) * mu_size_ + y) * nu_size_ + slice) * split_ + column;
+    const int slice = x / grid_.scattering_mu_s_size, column = x % grid_.scattering_mu_s_size;
+    return ((std::size_t(z) * grid_.scattering_mu_size + y) * grid_.scattering_nu_size + slice) *
+               grid_.scattering_mu_s_split +
+           column;
   }
   std::size_t size() const { return mu_s_.size(); }
   double MuSAt(std::size_t index) const { return mu_s_[index]; }
@@ -126,8 +126,7 @@ class OwnColumnSuns {
     std::vector<double> distance_, slope_;  // per lit column, then node
   };
 
-  AtmosphereParameters grid_;
-  int split_, mu_s_size_, nu_size_, mu_size_;
+  AtmosphereParameters grid_;  // the grid whose suns these are
   LitDistances distances_;
   std::vector<double> mu_s_;
 };

@@ -106,6 +106,20 @@ void ExpectViewMatchesTwin(const Twin& twin, render::View view, const render::Vi
   std::cout << name << ": " << compared << " values, max relative difference GPU vs twin " << worst << "\n";
 }
 
+// Both views, as the examples are run here (sun azimuth 30 degrees, the
+// camera at their default 100 m), against the twin's.
+void ExpectViewsMatchTwin(const Twin& twin, const glsl::vec3& ground_albedo, int width, double sun_zenith_deg,
+                          const fs::path& images) {
+  render::ViewSettings settings;
+  settings.width = width;
+  settings.sun_zenith_deg = sun_zenith_deg;
+  settings.sun_azimuth_deg = 30.0;
+  settings.camera_altitude_m = 100.0;
+  settings.ground_albedo = ground_albedo;
+  for (render::View view : {render::View::kFisheye, render::View::kAerial})
+    ExpectViewMatchesTwin(twin, view, settings, images);
+}
+
 void ExpectRendersTheViewsOfSkybakeRender(const std::string& example, const char* no_device) {
   testing::TempDir dir;
   const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
@@ -122,14 +136,7 @@ void ExpectRendersTheViewsOfSkybakeRender(const std::string& example, const char
 
   const LutSet luts = LoadLutSet(lut);
   const Twin twin(MakeTwinTables(luts));
-  render::ViewSettings settings;
-  settings.width = 64;
-  settings.sun_zenith_deg = 60.0;
-  settings.sun_azimuth_deg = 30.0;
-  settings.camera_altitude_m = 100.0;  // the example's default
-  settings.ground_albedo = luts.atmosphere.ground_albedo;
-  for (render::View view : {render::View::kFisheye, render::View::kAerial})
-    ExpectViewMatchesTwin(twin, view, settings, images);
+  ExpectViewsMatchTwin(twin, luts.atmosphere.ground_albedo, 64, 60.0, images);
 }
 
 // A scene's bake ships a pruned snippet: the ground-level daytime scene has
@@ -155,16 +162,9 @@ void ExpectDrawsWhatASceneBakeHolds(const std::string& example, const char* no_d
   ASSERT_EQ(code, 0) << err;
   EXPECT_NE(err.find("direct sun only"), std::string::npos) << err;
 
-  render::ViewSettings settings;
-  settings.width = 64;
-  settings.sun_zenith_deg = 60.0;
-  settings.sun_azimuth_deg = 30.0;
-  settings.camera_altitude_m = 100.0;
-  settings.ground_albedo = luts.atmosphere.ground_albedo;
   luts.irradiance = glsl::Texture(4, 4);  // all zeros: no sky light on the ground
   const Twin twin(MakeTwinTables(luts));
-  for (render::View view : {render::View::kFisheye, render::View::kAerial})
-    ExpectViewMatchesTwin(twin, view, settings, images);
+  ExpectViewsMatchTwin(twin, luts.atmosphere.ground_albedo, 64, 60.0, images);
 }
 
 void ExpectBadInputIsOneLineAndAnExitCode(const std::string& example) {
@@ -204,14 +204,7 @@ TEST(EngineExample, PicturesDrawnOnAnotherDriverMatchTheTwin) {
           fs::path(bundle) / "images" / (std::string(example) + "-sun" + std::to_string(sun_zenith_deg));
       SCOPED_TRACE(images.string());
       ASSERT_TRUE(fs::exists(images));
-      render::ViewSettings settings;
-      settings.width = 128;
-      settings.sun_zenith_deg = sun_zenith_deg;
-      settings.sun_azimuth_deg = 30.0;
-      settings.camera_altitude_m = 100.0;
-      settings.ground_albedo = luts.atmosphere.ground_albedo;
-      for (render::View view : {render::View::kFisheye, render::View::kAerial})
-        ExpectViewMatchesTwin(twin, view, settings, images);
+      ExpectViewsMatchTwin(twin, luts.atmosphere.ground_albedo, 128, sun_zenith_deg, images);
       ++drawn;
     }
   }
