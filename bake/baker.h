@@ -139,7 +139,7 @@ class Baker {
   // J below the grid's lowest sun: LowestSunLogFall's slope and curvature
   // of ln J in mu_s from the two lowest columns.
   struct MuSFall {
-    std::vector<float> log_ratio, inverse_ratio_minus_one;
+    LargeBuffer<float> log_ratio, inverse_ratio_minus_one;
     int falling_columns = 0;  // the columns with mu_s < 0, lowest first (not the last)
     float steady_mu_s = 0.0f;  // mu_s of the first column that does not fall
     std::vector<float> lowest_log_slope, lowest_log_curvature;

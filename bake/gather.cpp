@@ -18,6 +18,7 @@
 #include "bake/grids.h"
 #include "bake/sun_lookups.h"
 #include "core/constants.h"
+#include "core/large_buffer.h"
 #include "shaders_runtime/runtime.h"
 
 namespace skybake::detail {
@@ -155,8 +156,8 @@ class JRows {
   // The texture's rgb in rows: per (r, mu) row, PerTexelRow() floats, the
   // padding zero. Into `rows_out`, which a gather of every order reuses: its
   // padding stays zero and every other value is overwritten.
-  void Rows(const Texture& density, std::vector<float>* rows_out) const {
-    std::vector<float>& rows = *rows_out;
+  void Rows(const Texture& density, LargeBuffer<float>* rows_out) const {
+    LargeBuffer<float>& rows = *rows_out;
     rows.resize(std::size_t(density.height) * density.depth * PerTexelRow(), 0.0f);
     ForEachRow(density, [&](int row, std::size_t first, std::size_t) {
       float* out = &rows[row * PerTexelRow()];
@@ -318,7 +319,7 @@ struct Baker::GatherPlan {
   // The gathered order's J in JRows's layout (JRows::Rows): kept with the
   // plan so that every order's gather writes into pages already touched,
   // instead of faulting in a fresh buffer on the calling thread.
-  std::vector<float> density_rows;
+  LargeBuffer<float> density_rows;
 };
 
 std::shared_ptr<Baker::GatherPlan> Baker::PlanGather(const AtmosphereParameters& grid, const OwnColumnSuns* own,
@@ -415,7 +416,7 @@ void Baker::GatherAlongRays(GatherPlan& plan, const Texture& density, const MuSF
   const JRows layout(density_mu_s_size, density_nu_size);
   const std::size_t per_row = layout.PerTexelRow();
   layout.Rows(density, &plan.density_rows);
-  const std::vector<float>& density_rows = plan.density_rows;
+  const LargeBuffer<float>& density_rows = plan.density_rows;
   const SunColumns columns(grid);
   const MuSCoordinate mu_s_coordinate(density_grid);
   const float lowest_mu_s = float(density_grid.scattering_mu_s_min);

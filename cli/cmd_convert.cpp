@@ -77,7 +77,7 @@ void RunConvert(const ConvertOptions& o) {
 
   // Half error only where this conversion rounds: float in, half out.
   const bool rounds = in.pixel_type == PixelType::kFloat && out.pixel_type == PixelType::kHalf;
-  const HalfError error = rounds ? MeasureHalfError(out.values, o.floor) : HalfError{};
+  const HalfError error = rounds ? MeasureHalfError(out.values.data(), out.values.size(), o.floor) : HalfError{};
   if (o.json) {
     json report = {{"input", o.input},
                    {"output", o.output},

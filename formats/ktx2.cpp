@@ -647,13 +647,13 @@ std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& 
   return PackChannels(format, values.data(), values.size() / channels, channels);
 }
 
-std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data) {
+LargeBuffer<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data) {
   const std::size_t channel_bytes = BytesPerChannel(format);
   if (data.size() % channel_bytes != 0) {
     throw InternalError("KTX2 unpack: " + std::to_string(data.size()) + " bytes is not a whole number of " +
                         FormatName(format) + " channels");
   }
-  std::vector<float> out(data.size() / channel_bytes);
+  LargeBuffer<float> out(data.size() / channel_bytes);
   for (std::size_t i = 0; i < out.size(); ++i) {
     std::uint32_t bits = 0;
     for (std::size_t b = 0; b < channel_bytes; ++b) bits |= static_cast<std::uint32_t>(data[i * channel_bytes + b]) << (8 * b);

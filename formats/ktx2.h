@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "core/large_buffer.h"
+
 namespace skybake::ktx2 {
 
 // The VkFormat values from the Vulkan specification (enum VkFormat).
@@ -100,6 +102,6 @@ std::vector<std::uint8_t> PackFloats(VkFormat format, const std::vector<float>& 
 // The same from `channels` (1 to ChannelCount(format)) floats per texel, the
 // format's other channels 0 (an RGB table in an RGBA format).
 std::vector<std::uint8_t> PackChannels(VkFormat format, const float* values, std::size_t texels, int channels);
-std::vector<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data);
+LargeBuffer<float> UnpackFloats(VkFormat format, const std::vector<std::uint8_t>& data);
 
 }  // namespace skybake::ktx2

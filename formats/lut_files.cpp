@@ -98,7 +98,7 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   for (const TableDescription& table : tables) {
     if (IsHalf(table, options)) {
       const TableImage image = MakeTableImage(luts, table, options.formats.front(), PixelType::kFloat);
-      report.half_errors.emplace_back(table.name, MeasureHalfError(image.values));
+      report.half_errors.emplace_back(table.name, MeasureHalfError(image.values.data(), image.values.size()));
     }
   }
   for (const ShaderFile& shader : options.shaders) {

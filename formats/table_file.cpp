@@ -19,6 +19,7 @@
 
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "core/large_buffer.h"
 #include "core/version.h"
 #include "formats/ktx2.h"
 
@@ -153,8 +154,8 @@ std::vector<std::uint8_t> EncodeExr(const TableImage& image) {
   // Planar copies in the stored pixel type; halves rounded by Imath::half so both
   // formats agree bit for bit.
   const std::size_t texels = image.TexelCount();
-  std::vector<float> floats;
-  std::vector<std::uint16_t> halves;
+  LargeBuffer<float> floats;
+  LargeBuffer<std::uint16_t> halves;
   if (half) {
     halves.resize(texels * channels);
     for (std::size_t i = 0; i < texels; ++i) {

@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "core/large_buffer.h"
+
 namespace skybake {
 
 enum class FileFormat { kExr, kKtx2 };
@@ -64,7 +66,7 @@ struct TableImage {
   int width = 0, height = 0, depth = 1;
   bool is_3d = false;  // depth > 1 tables are 3D; a 3D table may also have depth 1
   std::vector<std::string> channel_names;  // as stored ("R", "G", "B", "A" for skybake tables)
-  std::vector<float> values;               // channel_names.size() values per texel
+  LargeBuffer<float> values;               // channel_names.size() values per texel
   // "skybake.*" keys. Decoding also returns what the encoder adds (KTXwriter,
   // KTXorientation, skybake.generator, skybake.size); encoding sets those itself.
   Metadata metadata;

@@ -31,10 +31,11 @@ std::vector<ChannelStats> ComputeChannelStats(const TableImage& image) {
   return stats;
 }
 
-HalfError MeasureHalfError(const std::vector<float>& values, double floor) {
+HalfError MeasureHalfError(const float* values, std::size_t count, double floor) {
   HalfError e;
   e.floor = floor;
-  for (float v : values) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const float v = values[i];
     if (!std::isfinite(v)) continue;
     const float h = static_cast<float>(Imath::half(v));
     if (std::isinf(h)) {

@@ -41,7 +41,8 @@ struct HalfError {
   std::size_t overflowed = 0;       // finite values that became infinite (|v| >= 65520)
 };
 
-HalfError MeasureHalfError(const std::vector<float>& values, double floor = kDefaultHalfErrorFloor);
+// Of the `count` values from `values`.
+HalfError MeasureHalfError(const float* values, std::size_t count, double floor = kDefaultHalfErrorFloor);
 
 // The same figures with the struct's field names, for --json reports.
 nlohmann::json ToJson(const HalfError& error);

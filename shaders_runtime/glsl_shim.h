@@ -17,6 +17,7 @@
 #include <glm/vec4.hpp>
 
 #include "core/constants.h"
+#include "core/large_buffer.h"
 
 namespace skybake::glsl {
 
@@ -89,7 +90,7 @@ struct Texture {
   int width = 0;
   int height = 0;
   int depth = 1;
-  std::vector<float> texels;
+  LargeBuffer<float> texels;
 
   Texture() = default;
   Texture(int w, int h, int d = 1)

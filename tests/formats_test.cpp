@@ -301,7 +301,7 @@ TEST(TableStats, HalfErrorOfHandPickedValues) {
   // the even one, 1: the largest relative rounding error a normal half makes.
   const float tie = 1.0f + std::ldexp(1.0f, -11);
   const std::vector<float> values = {tie, 3.0f, 1e-6f, 1e-9f, 70000.0f, NAN, 0.0f, -0.25f};
-  const HalfError e = MeasureHalfError(values);
+  const HalfError e = MeasureHalfError(values.data(), values.size());
   EXPECT_EQ(e.floor, std::ldexp(1.0, -14));
   EXPECT_EQ(e.measured, 3u);  // tie, 3, -0.25
   EXPECT_DOUBLE_EQ(e.max_relative_error, std::ldexp(1.0, -11) / (1.0 + std::ldexp(1.0, -11)));
@@ -313,7 +313,7 @@ TEST(TableStats, HalfErrorOfHandPickedValues) {
   EXPECT_EQ(e.overflowed, 1u);  // 70000 > 65504
 
   // A lower floor takes in 1e-6, a subnormal half: 17 * 2^-24 = 1.0133e-6.
-  const HalfError low = MeasureHalfError(values, 1e-7);
+  const HalfError low = MeasureHalfError(values.data(), values.size(), 1e-7);
   EXPECT_EQ(low.measured, 4u);
   EXPECT_NEAR(low.max_relative_error, (17.0 * std::ldexp(1.0, -24) - double(1e-6f)) / double(1e-6f), 1e-12);
   EXPECT_EQ(low.worst_value, 1e-6f);

@@ -205,9 +205,7 @@ std::string GlContext::Description() const {
   return text(GL_RENDERER) + ", " + text(GL_VERSION);
 }
 
-void GlContext::SetTexture(const std::string& sampler, int width, int height, int depth,
-                           const std::vector<float>& rgba) {
-  if (rgba.size() != size_t(4) * width * height * depth) throw std::runtime_error("SetTexture: size mismatch");
+void GlContext::SetTexture(const std::string& sampler, int width, int height, int depth, const float* rgba) {
   GlFunctions& gl = impl_->gl;
   GLenum target = depth == 1 ? GL_TEXTURE_2D : GL_TEXTURE_3D;
   GLuint id = 0;
@@ -216,9 +214,9 @@ void GlContext::SetTexture(const std::string& sampler, int width, int height, in
   gl.BindTexture(target, id);
   gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
   if (depth == 1) {
-    gl.TexImage2D(target, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, rgba.data());
+    gl.TexImage2D(target, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, rgba);
   } else {
-    gl.TexImage3D(target, 0, GL_RGBA32F, width, height, depth, 0, GL_RGBA, GL_FLOAT, rgba.data());
+    gl.TexImage3D(target, 0, GL_RGBA32F, width, height, depth, 0, GL_RGBA, GL_FLOAT, rgba);
     gl.TexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
   }
   gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -363,7 +361,7 @@ std::unique_ptr<GlContext> GlContext::Create(Api, std::string* why_not) {
 }
 std::string GlContext::VersionLine() const { return api_ == Api::kGles30 ? "#version 300 es" : "#version 330 core"; }
 std::string GlContext::Description() const { return "none"; }
-void GlContext::SetTexture(const std::string&, int, int, int, const std::vector<float>&) {
+void GlContext::SetTexture(const std::string&, int, int, int, const float*) {
   throw std::runtime_error("no headless GL");
 }
 std::vector<Vec4> GlContext::RunFragmentPass(const std::string&, const std::vector<Vec4>&, int) {

@@ -56,7 +56,8 @@ class GlContext {
   // GL_LINEAR and GL_CLAMP_TO_EDGE, bound for every later fragment pass to
   // the sampler uniform `sampler`, which the caller's source declares.
   // Float linear filtering needs OES_texture_float_linear on ES 3.0.
-  void SetTexture(const std::string& sampler, int width, int height, int depth, const std::vector<float>& rgba);
+  // width * height * depth * 4 floats from `rgba`.
+  void SetTexture(const std::string& sampler, int width, int height, int depth, const float* rgba);
 
   std::vector<Vec4> RunFragmentPass(const std::string& fragment_source, const std::vector<Vec4>& inputs,
                                     int inputs_per_item = 1);

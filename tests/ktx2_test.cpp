@@ -50,7 +50,7 @@ TEST(Ktx2Format, PackFloatsIsLittleEndianAndRoundsHalves) {
   EXPECT_EQ(f32, (Bytes{0x00, 0x00, 0x80, 0x3F}));
   const Bytes f16 = PackFloats(VkFormat::kR16Sfloat, {1.0f, -2.0f, 0.1f});
   EXPECT_EQ(f16, (Bytes{0x00, 0x3C, 0x00, 0xC0, 0x66, 0x2E}));
-  const std::vector<float> back = UnpackFloats(VkFormat::kR16Sfloat, f16);
+  const auto back = UnpackFloats(VkFormat::kR16Sfloat, f16);
   EXPECT_EQ(back[0], 1.0f);
   EXPECT_EQ(back[1], -2.0f);
   EXPECT_EQ(back[2], static_cast<float>(Imath::half(Imath::half::FromBits, 0x2E66)));
@@ -261,7 +261,7 @@ TEST(Ktx2RoundTrip, EveryFormatIn2DAnd3D) {
       t.key_values.emplace("KTXorientation", depth ? "rdi" : "rd");
       EXPECT_TRUE(SameTexture(t, back));
       // Values come back bit for bit (they are exact in half precision too).
-      const std::vector<float> values = UnpackFloats(format, back.data);
+      const auto values = UnpackFloats(format, back.data);
       ASSERT_EQ(values.size(), t.TexelCount() * ChannelCount(format));
       for (std::size_t i = 0; i < values.size(); ++i) {
         ASSERT_EQ(values[i], static_cast<float>(static_cast<int>(i % 1000) - 500) / 8.0f);

@@ -48,7 +48,7 @@ class LutFilesTest : public ::testing::Test {
 };
 LutSet* LutFilesTest::luts_ = nullptr;
 
-bool SameBits(const std::vector<float>& a, const std::vector<float>& b) {
+bool SameBits(const LargeBuffer<float>& a, const LargeBuffer<float>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
@@ -65,7 +65,7 @@ void ExpectSameSet(const LutSet& loaded, const LutSet& original, bool half) {
     ASSERT_EQ(a.width, b.width) << table.name;
     ASSERT_EQ(a.height, b.height) << table.name;
     ASSERT_EQ(a.depth, b.depth) << table.name;
-    std::vector<float> expected = b.texels;
+    LargeBuffer<float> expected = b.texels;
     if (half) {
       for (float& v : expected) v = static_cast<float>(Imath::half(v));
     }

@@ -52,8 +52,9 @@ class VulkanCompute {
   // The device and driver, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), Vulkan 1.3.230, Mesa 22.3.6".
   std::string Description() const;
 
-  // An RGBA32F texture (depth 1: 2D, else 3D), x fastest, at `binding`.
-  void SetTexture(int binding, int width, int height, int depth, const std::vector<float>& rgba);
+  // An RGBA32F texture (depth 1: 2D, else 3D), x fastest, at `binding`:
+  // width * height * depth * 4 floats from `rgba`.
+  void SetTexture(int binding, int width, int height, int depth, const float* rgba);
 
   // Runs the compute shader `spirv` (entry point "main", 64 invocations per
   // workgroup in x) over `items` items: invocation i writes output i,

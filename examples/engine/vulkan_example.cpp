@@ -113,8 +113,12 @@ void Run(const Arguments& args) {
   for (int binding = 0; binding < VulkanCompute::kTextureCount; ++binding) {
     const skybake::glsl::Texture& t = *tables[binding];
     const bool is_3d = binding == 1 || binding == 2;
-    if (t.empty()) vk->SetTexture(binding, 1, 1, is_3d ? 2 : 1, std::vector<float>(is_3d ? 8 : 4, 0.0f));
-    else vk->SetTexture(binding, t.width, t.height, t.depth, t.texels);
+    const float black[8] = {};
+    if (t.empty()) {
+      vk->SetTexture(binding, 1, 1, is_3d ? 2 : 1, black);
+    } else {
+      vk->SetTexture(binding, t.width, t.height, t.depth, t.texels.data());
+    }
   }
 
   std::vector<skybake::render::Image> rendered;
