@@ -12,7 +12,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <set>
 
 #include <Imath/half.h>
@@ -383,34 +385,60 @@ std::string TableImage::StorageName() const {
 
 void ChooseExrCompression(TableImage* image) {
   if (image->format != FileFormat::kExr) return;
-  // OpenEXR's ZIP block: 16 scanlines. Each sampled block lies in the
-  // middle of its share of the image: the first rows (the ground, and views
-  // into it) are the most compressible and would speak for too much.
-  constexpr int kBlockRows = 16, kSampleBlocks = 4;
   const int rows = image->height * image->depth;
-  const int blocks = (rows + kBlockRows - 1) / kBlockRows;
-  const int step = std::max(1, blocks / kSampleBlocks);
-  TableImage sample;
-  sample.format = FileFormat::kExr;
-  sample.pixel_type = image->pixel_type;
-  sample.width = image->width;
-  sample.channel_names = image->channel_names;
   const std::size_t row_values = std::size_t(image->width) * image->channel_names.size();
-  for (int block = step / 2; block < blocks; block += step) {
-    const int first = block * kBlockRows, count = std::min(kBlockRows, rows - first);
+  // The rows [first, first + count) of the image, appended to `sample`.
+  auto append_rows = [&](TableImage* sample, int first, int count) {
     const auto begin = image->values.begin() + std::ptrdiff_t(first * row_values);
-    sample.values.insert(sample.values.end(), begin, begin + std::ptrdiff_t(count * row_values));
-    sample.height += count;
-  }
-  auto size = [&](ExrCompression codec) {
-    sample.exr_compression = codec;
-    return double(EncodeExr(sample).size());
+    sample->values.insert(sample->values.end(), begin, begin + std::ptrdiff_t(count * row_values));
+    sample->height += count;
   };
-  const double stored = size(ExrCompression::kNone);
-  const double rle_saving = 1.0 - size(ExrCompression::kRle) / stored;
-  const double zip_saving = 1.0 - size(ExrCompression::kZip) / stored;
+  // The share of the sample's stored size that each codec saves.
+  auto savings = [&](TableImage sample, std::initializer_list<ExrCompression> codecs) {
+    sample.exr_compression = ExrCompression::kNone;
+    const double stored = double(EncodeExr(sample).size());
+    std::vector<double> result;
+    for (ExrCompression codec : codecs) {
+      sample.exr_compression = codec;
+      result.push_back(1.0 - double(EncodeExr(sample).size()) / stored);
+    }
+    return result;
+  };
+  TableImage empty;
+  empty.format = FileFormat::kExr;
+  empty.pixel_type = image->pixel_type;
+  empty.width = image->width;
+  empty.channel_names = image->channel_names;
+  // RLE codes each row on its own, so single rows spread over the whole
+  // image sample its saving, wherever the runs are: the Earth's single Mie
+  // table saves 9.3 % in every r slice but the ground's, which saves 53 %
+  // and brings the whole to 10.7 %. One row in kRleSampleShare, placed by
+  // the golden ratio's multiples (which no period of the image's rows
+  // aliases, as even steps would a table dark in every other row), in order.
+  constexpr int kRleSampleShare = 16;
+  constexpr double kGoldenRatioFraction = 0.6180339887498949;  // (sqrt(5) - 1) / 2
+  const int rle_rows = (rows + kRleSampleShare - 1) / kRleSampleShare;
+  std::vector<int> sampled_rows(rle_rows);
+  for (int i = 0; i < rle_rows; ++i) sampled_rows[i] = int(std::fmod(0.5 + i * kGoldenRatioFraction, 1.0) * rows);
+  std::sort(sampled_rows.begin(), sampled_rows.end());
+  TableImage rle_sample = empty;
+  for (int row : sampled_rows) append_rows(&rle_sample, row, 1);
+  // ZIP codes blocks of 16 rows: kZipSampleBlocks of them, each in the
+  // middle of its share of the image (the first rows, the ground and views
+  // into it, are the most compressible and would speak for too much), give
+  // its saving and how much more it saves than RLE on the same rows.
+  constexpr int kBlockRows = 16, kZipSampleBlocks = 4;
+  const int blocks = (rows + kBlockRows - 1) / kBlockRows;
+  const int step = std::max(1, blocks / kZipSampleBlocks);
+  TableImage zip_sample = empty;
+  for (int block = step / 2; block < blocks; block += step) {
+    append_rows(&zip_sample, block * kBlockRows, std::min(kBlockRows, rows - block * kBlockRows));
+  }
+  const double rle_saving = savings(std::move(rle_sample), {ExrCompression::kRle})[0];
+  const std::vector<double> on_blocks = savings(std::move(zip_sample), {ExrCompression::kZip, ExrCompression::kRle});
+  const double zip_saving = on_blocks[0], zip_over_rle = on_blocks[0] - on_blocks[1];
   const bool rle_pays = rle_saving >= kExrMinimumSaving;
-  if (zip_saving >= kExrMinimumSaving && (!rle_pays || zip_saving >= rle_saving + kExrMinimumSaving)) {
+  if (zip_saving >= kExrMinimumSaving && (!rle_pays || zip_over_rle >= kExrMinimumSaving)) {
     image->exr_compression = ExrCompression::kZip;
   } else {
     image->exr_compression = rle_pays ? ExrCompression::kRle : ExrCompression::kNone;

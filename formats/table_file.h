@@ -86,10 +86,11 @@ struct TableImage {
 
 // The fastest codec that pays: an OpenEXR image is stored with OpenEXR's
 // run-length coding (RLE, one pass over the byte-reordered differences of
-// neighbouring values) if a sample of its rows (up to 4 of OpenEXR's
-// 16-row ZIP blocks, each in the middle of its quarter of the image) shrinks
-// by at least kExrMinimumSaving of its size with it, ZIP-compressed if ZIP
-// shrinks it by that much and by that much more than RLE, else
+// neighbouring values, row by row) if a sample of its rows (one in 16,
+// spread over the image) shrinks by at least kExrMinimumSaving of its size
+// with it, ZIP-compressed if a sample of ZIP's 16-row blocks (4, each in the
+// middle of its quarter of the image) shrinks by that much with ZIP and by
+// that much more than with RLE, else
 // uncompressed. Float tables whose low mantissa bits are noise shrink by a
 // few percent with either, at about 20 ns per byte for ZIP; RLE takes the
 // runs of zero of dark texels at a fraction of ZIP's cost, and ZIP what
