@@ -9,7 +9,7 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdlib>
+#include <cstdint>
 #include <new>
 #include <vector>
 
@@ -34,22 +34,33 @@ struct LargeBufferAllocator {
     if (n > std::size_t(-1) / sizeof(T)) throw std::bad_alloc();
     const std::size_t bytes = n * sizeof(T);
     if (bytes < kHugePageBytes) return static_cast<T*>(::operator new(bytes));
-    // Whole huge pages, aligned to them, so that every page of the array can be one.
-    const std::size_t rounded = (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-    void* memory = std::aligned_alloc(kHugePageBytes, rounded);
-    if (memory == nullptr) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-    madvise(memory, rounded, MADV_HUGEPAGE);  // a hint: where it is refused, ordinary pages
+    // Whole huge pages, aligned to them, so that every page of the array
+    // can be one: mapped with a huge page to spare, whose unaligned ends go
+    // back. (Not malloc's aligned allocation: its header just before the
+    // array would take a huge page of its own.)
+    const std::size_t rounded = Rounded(bytes);
+    void* mapped = mmap(nullptr, rounded + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (mapped == MAP_FAILED) throw std::bad_alloc();
+    const std::uintptr_t start = (reinterpret_cast<std::uintptr_t>(mapped) + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
+    const std::size_t head = start - reinterpret_cast<std::uintptr_t>(mapped);
+    if (head > 0) munmap(mapped, head);
+    if (head < kHugePageBytes) munmap(reinterpret_cast<void*>(start + rounded), kHugePageBytes - head);
+    madvise(reinterpret_cast<void*>(start), rounded, MADV_HUGEPAGE);  // a hint: where it is refused, ordinary pages
+    return reinterpret_cast<T*>(start);
+#else
+    return static_cast<T*>(::operator new(bytes));
 #endif
-    return static_cast<T*>(memory);
   }
 
   void deallocate(T* memory, std::size_t n) noexcept {
-    if (n * sizeof(T) < kHugePageBytes) {
-      ::operator delete(memory);
-    } else {
-      std::free(memory);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (n * sizeof(T) >= kHugePageBytes) {
+      munmap(memory, Rounded(n * sizeof(T)));
+      return;
     }
+#endif
+    ::operator delete(memory);
   }
 
   template <typename U>
@@ -60,6 +71,9 @@ struct LargeBufferAllocator {
   bool operator!=(const LargeBufferAllocator<U>&) const noexcept {
     return false;
   }
+
+ private:
+  static std::size_t Rounded(std::size_t bytes) { return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes; }
 };
 
 // A vector of a large array.
