@@ -205,7 +205,9 @@ std::string GlContext::Description() const {
   return text(GL_RENDERER) + ", " + text(GL_VERSION);
 }
 
-void GlContext::SetTexture(const std::string& sampler, int width, int height, int depth, const float* rgba) {
+void GlContext::SetTexture(const std::string& sampler, int width, int height, int depth, const float* rgba,
+                           std::size_t values) {
+  if (values != std::size_t(4) * width * height * depth) throw std::runtime_error("SetTexture: size mismatch");
   GlFunctions& gl = impl_->gl;
   GLenum target = depth == 1 ? GL_TEXTURE_2D : GL_TEXTURE_3D;
   GLuint id = 0;
@@ -361,7 +363,7 @@ std::unique_ptr<GlContext> GlContext::Create(Api, std::string* why_not) {
 }
 std::string GlContext::VersionLine() const { return api_ == Api::kGles30 ? "#version 300 es" : "#version 330 core"; }
 std::string GlContext::Description() const { return "none"; }
-void GlContext::SetTexture(const std::string&, int, int, int, const float*) {
+void GlContext::SetTexture(const std::string&, int, int, int, const float*, std::size_t) {
   throw std::runtime_error("no headless GL");
 }
 std::vector<Vec4> GlContext::RunFragmentPass(const std::string&, const std::vector<Vec4>&, int) {

@@ -2,9 +2,10 @@
 // (Mesa llvmpipe here, or a GPU) and read the results back.
 //
 // The context comes from EGL with no window system (HeadlessEglDisplay:
-// Mesa's surfaceless platform, which needs no GPU, or an EGL device). Every GL entry point is loaded through
-// eglGetProcAddress, which is how one helper serves both OpenGL ES 3.0 and
-// desktop OpenGL 3.3 core without linking either library.
+// Mesa's surfaceless platform, which needs no GPU, or an EGL device).
+// Every GL entry point is loaded through eglGetProcAddress, which is how
+// one helper serves both OpenGL ES 3.0 and desktop OpenGL 3.3 core without
+// linking either library.
 //
 // Typical use:
 //   std::string why;
@@ -14,6 +15,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,8 +58,8 @@ class GlContext {
   // GL_LINEAR and GL_CLAMP_TO_EDGE, bound for every later fragment pass to
   // the sampler uniform `sampler`, which the caller's source declares.
   // Float linear filtering needs OES_texture_float_linear on ES 3.0.
-  // width * height * depth * 4 floats from `rgba`.
-  void SetTexture(const std::string& sampler, int width, int height, int depth, const float* rgba);
+  // The `values` floats from `rgba`, width * height * depth * 4 of them.
+  void SetTexture(const std::string& sampler, int width, int height, int depth, const float* rgba, std::size_t values);
 
   std::vector<Vec4> RunFragmentPass(const std::string& fragment_source, const std::vector<Vec4>& inputs,
                                     int inputs_per_item = 1);

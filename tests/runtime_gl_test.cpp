@@ -170,7 +170,7 @@ void ExpectGlMatchesTwin(GlContext* gl, const LutSet& luts, const std::string& s
 // The four tables of `luts` bound to the runtime's samplers.
 void SetTables(GlContext* gl, const LutSet& luts) {
   auto set = [&](const char* sampler, const glsl::Texture& t) {
-    gl->SetTexture(sampler, t.width, t.height, t.depth, t.texels.data());
+    gl->SetTexture(sampler, t.width, t.height, t.depth, t.texels.data(), t.texels.size());
   };
   set("transmittance_texture", luts.transmittance);
   set("scattering_texture", luts.scattering);
@@ -211,10 +211,10 @@ TEST_P(SnippetOnMesa, PrunedForASceneMatchesTheCppTwin) {
   ApplyScenePlan(plan, &planned, &settings);
   static const LutSet luts = Bake(planned, settings);
   gl->SetTexture("transmittance_texture", luts.transmittance.width, luts.transmittance.height, 1,
-                 luts.transmittance.texels.data());
+                 luts.transmittance.texels.data(), luts.transmittance.texels.size());
   for (const char* sampler : {"scattering_texture", "single_mie_scattering_texture"}) {
     gl->SetTexture(sampler, luts.scattering.width, luts.scattering.height, luts.scattering.depth,
-                   luts.scattering.texels.data());
+                   luts.scattering.texels.data(), luts.scattering.texels.size());
   }
   std::vector<testing::RuntimeQuery> items;
   int aerial_items = 0;

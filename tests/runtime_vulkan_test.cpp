@@ -110,7 +110,7 @@ class RuntimeOnVulkan : public ::testing::Test {
                                      &luts.irradiance};
     for (int binding = 0; binding < VulkanCompute::kTextureCount; ++binding) {
       const glsl::Texture& t = *tables[binding];
-      vk->SetTexture(binding, t.width, t.height, t.depth, t.texels.data());
+      vk->SetTexture(binding, t.width, t.height, t.depth, t.texels.data(), t.texels.size());
     }
     std::string log;
     const std::vector<std::uint32_t> spirv = CompileComputeShader(SKYBAKE_GLSLANG_VALIDATOR, source, hlsl, &log);

@@ -276,10 +276,10 @@ std::unique_ptr<VulkanCompute> VulkanCompute::Create(std::string* why_not) {
   return vk;
 }
 
-void VulkanCompute::SetTexture(int binding, int width, int height, int depth, const float* rgba) {
+void VulkanCompute::SetTexture(int binding, int width, int height, int depth, const float* rgba, std::size_t values) {
   Impl& d = *impl_;
   if (binding < 0 || binding >= kTextureCount) throw std::runtime_error("texture binding out of range");
-  const std::size_t bytes = std::size_t(width) * height * depth * 4 * sizeof(float);
+  if (values != std::size_t(width) * height * depth * 4) throw std::runtime_error("texture size mismatch");
   Impl::Texture& t = d.textures[binding];
   d.DestroyTexture(&t);
   const bool is_3d = depth > 1;
@@ -299,7 +299,7 @@ void VulkanCompute::SetTexture(int binding, int width, int height, int depth, co
   t.memory = d.Allocate(requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   Check(vkBindImageMemory(d.device, t.image, t.memory, 0), "vkBindImageMemory");
 
-  Impl::Buffer staging = d.MakeBuffer(VK_BUFFER_USAGE_TRANSFER_SRC_BIT, bytes, rgba);
+  Impl::Buffer staging = d.MakeBuffer(VK_BUFFER_USAGE_TRANSFER_SRC_BIT, values * sizeof(float), rgba);
   d.Submit([&](VkCommandBuffer commands) {
     VkImageMemoryBarrier barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
     barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
@@ -439,7 +439,7 @@ std::unique_ptr<VulkanCompute> VulkanCompute::Create(std::string* why_not) {
   *why_not = "built without the Vulkan headers and loader (libvulkan-dev)";
   return nullptr;
 }
-void VulkanCompute::SetTexture(int, int, int, int, const float*) {}
+void VulkanCompute::SetTexture(int, int, int, int, const float*, std::size_t) {}
 std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint32_t>&, Samplers,
                                                     const std::vector<std::array<float, 4>>&, std::size_t) {
   return {};

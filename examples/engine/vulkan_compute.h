@@ -8,7 +8,7 @@
 //   std::string why;
 //   auto vk = skybake::VulkanCompute::Create(&why);
 //   if (!vk) ... why says what is missing
-//   vk->SetTexture(0, width, height, 1, rgba);
+//   vk->SetTexture(0, width, height, 1, rgba.data(), rgba.size());
 //   auto out = vk->Run(spirv, VulkanCompute::Samplers::kCombined, inputs, items);
 #pragma once
 
@@ -53,8 +53,8 @@ class VulkanCompute {
   std::string Description() const;
 
   // An RGBA32F texture (depth 1: 2D, else 3D), x fastest, at `binding`:
-  // width * height * depth * 4 floats from `rgba`.
-  void SetTexture(int binding, int width, int height, int depth, const float* rgba);
+  // the `values` floats from `rgba`, width * height * depth * 4 of them.
+  void SetTexture(int binding, int width, int height, int depth, const float* rgba, std::size_t values);
 
   // Runs the compute shader `spirv` (entry point "main", 64 invocations per
   // workgroup in x) over `items` items: invocation i writes output i,

@@ -115,9 +115,9 @@ void Run(const Arguments& args) {
     const bool is_3d = binding == 1 || binding == 2;
     const float black[8] = {};
     if (t.empty()) {
-      vk->SetTexture(binding, 1, 1, is_3d ? 2 : 1, black);
+      vk->SetTexture(binding, 1, 1, is_3d ? 2 : 1, black, is_3d ? 8 : 4);
     } else {
-      vk->SetTexture(binding, t.width, t.height, t.depth, t.texels.data());
+      vk->SetTexture(binding, t.width, t.height, t.depth, t.texels.data(), t.texels.size());
     }
   }
 
