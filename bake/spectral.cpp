@@ -25,6 +25,10 @@ std::vector<double> SpectralWavelengths(int count) {
   if (count < kWavelengthCount) {
     throw InputError("a spectral bake needs at least 3 wavelengths, not " + std::to_string(count));
   }
+  if (count > kMaxSpectralWavelengths) {
+    throw InputError("a spectral bake takes at most " + std::to_string(kMaxSpectralWavelengths) +
+                     " wavelengths (one per 5 nm of the colour-matching data), not " + std::to_string(count));
+  }
   std::vector<double> wavelengths;
   for (int i = 0; i < count; ++i) {
     wavelengths.push_back(kSpectralFirstNm + (kSpectralLastNm - kSpectralFirstNm) * double(i) / double(count - 1));

@@ -23,8 +23,13 @@ inline constexpr double kLuminousEfficacyLmPerW = 683.0;
 // The CIE observer's range, over which a spectral bake spreads its wavelengths.
 inline constexpr double kSpectralFirstNm = 360.0, kSpectralLastNm = 830.0;
 inline constexpr int kDefaultSpectralWavelengths = 15;
+// The colour-matching functions are tabulated every 5 nm (data/README.md):
+// 95 wavelengths over 360-830 nm sample them at their own spacing, and more
+// would only interpolate the data (and take minutes).
+inline constexpr int kMaxSpectralWavelengths = 95;
 
-// `count` (>= 3) wavelengths evenly from kSpectralFirstNm to kSpectralLastNm.
+// `count` (3 to kMaxSpectralWavelengths) wavelengths evenly from
+// kSpectralFirstNm to kSpectralLastNm.
 std::vector<double> SpectralWavelengths(int count);
 
 // How a spectral bake computes the scattering orders >= 2 (docs/colour.md).
