@@ -83,7 +83,8 @@ AtmosphereSource ReadAtmosphereSource(const std::string& file_or_preset) {
   if (!SpelledAsPath(file_or_preset) && !std::filesystem::exists(path, error)) {
     throw IoError(file_or_preset + ": no such file or preset (see skybake presets)", ErrorLocation(file_or_preset));
   }
-  return {ReadFileText(path, "an atmosphere file"), InputName(file_or_preset)};
+  return {ReadFileText(path, "an atmosphere file"), InputName(file_or_preset),
+          file_or_preset == kStandardStream ? std::string() : file_or_preset};
 }
 
 Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
