@@ -43,7 +43,7 @@ Atmosphere LoadAtmosphere(const std::string& file_or_preset);
 struct AtmosphereSource {
   std::string text;
   std::string name;
-  std::string file;  // the file read, as named; empty for a preset or standard input
+  std::string file = {};  // the file read, as named; empty for a preset or standard input
 };
 AtmosphereSource ReadAtmosphereSource(const std::string& file_or_preset);
 
