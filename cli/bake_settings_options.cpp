@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bake/spectral.h"
 #include "core/errors.h"
 
 namespace skybake::cli {
@@ -124,6 +125,15 @@ BakeSettings BakeSettingsOptions::Resolve() const {
     throw UsageError("--scattering-size " + ScatteringSize(s) + ": " + text);
   }
   return s;
+}
+
+void CheckWavelengthsOption(int wavelengths) {
+  if (wavelengths == 0) return;
+  try {
+    SpectralWavelengths(wavelengths);
+  } catch (const InputError& e) {
+    throw UsageError(std::string("--wavelengths: ") + e.what());
+  }
 }
 
 }  // namespace skybake::cli

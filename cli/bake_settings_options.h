@@ -23,8 +23,13 @@ struct BakeSettingsOptions {
   // Registers the options on `command`; the values land in this object.
   void AddTo(CLI::App* command);
   // The settings the options describe, validated: UsageError for an --orders
-  // that is neither a count nor auto, InputError for out-of-range values.
+  // that is neither a count nor auto, and for out-of-range values.
   BakeSettings Resolve() const;
 };
+
+// A --wavelengths count (0: the atmosphere's own three; else as
+// SpectralWavelengths takes, bake/spectral.h), checked as an option value:
+// UsageError otherwise. Every command with --wavelengths checks it so.
+void CheckWavelengthsOption(int wavelengths);
 
 }  // namespace skybake::cli

@@ -122,6 +122,7 @@ void RunBake(const BakeOptions& o) {
       std::find(o.atmospheres.begin(), o.atmospheres.end(), standard_input) != o.atmospheres.end()) {
     throw UsageError("-: standard input can only be baked alone");
   }
+  CheckWavelengthsOption(o.wavelengths);
   const std::vector<std::string> dirs = OutputDirs(o);
   InterruptScope interrupts;
   if (o.atmospheres.size() == 1) {

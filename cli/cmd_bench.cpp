@@ -168,6 +168,7 @@ int WavelengthCount(const BenchConfiguration& c) { return c.wavelengths == 0 ? k
 
 void RunBench(const BenchOptions& o) {
   if (o.runs < 1 || o.runs > 1000) throw UsageError("--runs = " + std::to_string(o.runs) + " must be in [1, 1000]");
+  CheckWavelengthsOption(o.wavelengths);
   const AtmosphereSource source = ReadAtmosphereSource(o.atmosphere);
   const Atmosphere atmosphere = ParseAtmosphere(source.text, source.name);
   const BenchConfiguration base_configuration{o.bake.Resolve(), o.wavelengths,

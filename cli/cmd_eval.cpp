@@ -51,6 +51,19 @@ void RunEval(const EvalOptions& o) {
       for (const std::string& c : clamped) std::fprintf(stderr, "warning: %s%s\n", where.c_str(), c.c_str());
     }
   }
+  // Past the tables' lowest sun there is no light to read (`render` refuses
+  // such suns alike).
+  for (size_t row = 0; row < table.queries.size(); ++row) {
+    const double sun_zenith_deg = table.queries[row].sun_zenith_deg;
+    const std::string problem = report::SunZenithOutsideTables(luts.parameters, sun_zenith_deg);
+    if (!problem.empty()) {
+      const int line = table.line_numbers[row];
+      char value[32];
+      std::snprintf(value, sizeof(value), "%g", sun_zenith_deg);
+      throw InputError(LocationPrefix(table.source_name, line) + "sun_zenith_deg = " + value + " " + problem,
+                       {table.source_name, line, "sun_zenith_deg"});
+    }
+  }
   Twin twin(MakeTwinTables(luts));
 
   std::string out;
@@ -72,9 +85,7 @@ void RunEval(const EvalOptions& o) {
     QueryGeometry g = MakeQueryGeometry(q, luts.parameters.bottom_radius);
     glsl::vec3 transmittance;
     glsl::vec3 radiance = report::QuerySkyRadiance(twin, q, g, &transmittance);
-    const std::vector<std::string>& fields = table.fields[row];
-    std::string line;
-    for (size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + fields[i];
+    std::string line = CsvInputColumns(table, row);
     auto append = [&](const glsl::vec3& v) {
       for (int c = 0; c < 3; ++c) {
         std::snprintf(buffer, sizeof(buffer), ",%.9g", v[c]);

@@ -1,6 +1,7 @@
 // `skybake fit`: fits the sky-dome optical-path surface (see fit/sky_dome_fit.h).
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -46,6 +47,13 @@ void RunFit(const FitArguments& args) {
     throw UsageError("fit: --json and --query both print to stdout; use one");
   if (!args.query_file.empty() && args.constituents.size() != 1)
     throw UsageError("fit: --query needs exactly one --constituent NAME");
+  const double low = args.altitude_min_m, high = args.altitude_max_m;
+  if (!(low >= 0.0 && low <= high && std::isfinite(high))) {
+    char message[160];
+    std::snprintf(message, sizeof(message),
+                  "fit: --altitude-min-m %g and --altitude-max-m %g must satisfy 0 <= min <= max < inf", low, high);
+    throw UsageError(message);
+  }
 
   fit::FitOptions options;
   options.altitude_min_m = args.altitude_min_m;

@@ -12,6 +12,7 @@
 
 #include "bake/config.h"
 #include "bake/spectral.h"
+#include "cli/bake_settings_options.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "core/errors.h"
@@ -42,7 +43,13 @@ void RunReference(const ReferenceOptions& o) {
     throw UsageError("--sun-transmittance must be 'quadrature' or 'ratio-tracking', not '" + o.sun_transmittance +
                      "'");
   }
-  settings.Validate();
+  // Out-of-range values are option values, so usage errors.
+  try {
+    settings.Validate();
+  } catch (const InputError& e) {
+    throw UsageError(e.what());
+  }
+  CheckWavelengthsOption(o.wavelengths);
   QueryTable table = ParseQueryCsv(ReadFileText(o.input), InputName(o.input));
   const AtmosphereSource source = ReadAtmosphereSource(o.atmosphere);
   const Atmosphere atmosphere = ParseAtmosphere(source.text, source.name);

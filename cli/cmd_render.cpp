@@ -26,6 +26,7 @@
 #include "render/image_files.h"
 #include "render/lut_plots.h"
 #include "render/views.h"
+#include "report/twin_query.h"
 #include "shaders_runtime/twin.h"
 
 namespace skybake::cli {
@@ -106,14 +107,23 @@ void RunRender(const RenderArguments& args) {
   }
   if (views.empty() && !args.plots) throw UsageError("render: nothing to do; give --views or --plots");
 
-  LutSet luts = LoadLutSet(args.lut_dir);
-  const double lowest_sun_deg = std::acos(std::clamp(luts.parameters.mu_s_min, -1.0, 1.0)) * 180.0 / glsl::PI;
   for (double z : args.sun_zenith_deg) {
-    if (!(z >= 0.0 && z <= lowest_sun_deg)) {
-      char message[160];
-      std::snprintf(message, sizeof(message),
-                    "render: --sun-zenith %g is outside the tables' range 0..%.2f degrees", z, lowest_sun_deg);
-      throw InputError(message);
+    if (!(z >= 0.0 && z <= 180.0)) {
+      char message[96];
+      std::snprintf(message, sizeof(message), "render: --sun-zenith %g is not an angle from the zenith (0 to 180)", z);
+      throw UsageError(message);
+    }
+  }
+
+  LutSet luts = LoadLutSet(args.lut_dir);
+  // An angle the option takes that these tables do not reach: the set is
+  // what cannot answer it.
+  for (double z : args.sun_zenith_deg) {
+    const std::string problem = report::SunZenithOutsideTables(luts.parameters, z);
+    if (!problem.empty()) {
+      char value[32];
+      std::snprintf(value, sizeof(value), "%g", z);
+      throw InputError("render: --sun-zenith " + std::string(value) + " " + problem);
     }
   }
   if (!(args.altitude_m >= 0.0 && args.altitude_m < luts.atmosphere.top_radius_m - luts.atmosphere.bottom_radius_m))
@@ -240,7 +250,8 @@ void AddRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArguments>();
   cmd->add_option("lut_dir", args->lut_dir, "Directory written by `skybake bake`")->required();
   cmd->add_option("-o,--output", args->output_dir, "Output directory (created if needed)")->required();
-  cmd->add_option("--sun-zenith", args->sun_zenith_deg, "Sun zenith angles in degrees, comma separated")
+  cmd->add_option("--sun-zenith", args->sun_zenith_deg,
+                  "Sun zenith angles in degrees (0 to 180, and at most the tables' lowest sun), comma separated")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--sun-azimuth", args->sun_azimuth_deg, "Sun azimuth in degrees (0: +x; see docs/gallery.md)")

@@ -37,6 +37,7 @@ struct ReportOptions {
 };
 
 void RunReport(const ReportOptions& o) {
+  CheckWavelengthsOption(o.wavelengths);
   report::ReportRequest request;
   request.source = ReadAtmosphereSource(o.atmosphere);
   const Atmosphere atmosphere = ParseAtmosphere(request.source.text, request.source.name);

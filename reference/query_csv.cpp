@@ -36,8 +36,7 @@ std::string FormatResultCsv(const QueryTable& table, const std::vector<Result>& 
   out += "\n";
   for (size_t row = 0; row < table.fields.size(); ++row) {
     const Result& result = results.at(row);
-    std::string line;
-    for (size_t i = 0; i < table.fields[row].size(); ++i) line += (i ? "," : "") + table.fields[row][i];
+    std::string line = CsvInputColumns(table, row);
     auto append = [&](const Spectrum& v) {
       char buffer[64];
       for (int w = 0; w < kWavelengthCount; ++w) {

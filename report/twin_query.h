@@ -1,7 +1,10 @@
 // The one place that turns a query (shaders_runtime/query.h) into a call of
 // the CPU twin's sky functions, shared by `skybake eval` and the report's
-// table-lookup model (run_time_models.h).
+// table-lookup model (run_time_models.h), and the range of suns the tables
+// answer, which `eval` and `render` refuse to leave alike.
 #pragma once
+
+#include <string>
 
 #include "shaders_runtime/glsl_shim.h"
 #include "shaders_runtime/query.h"
@@ -14,5 +17,12 @@ namespace skybake::report {
 // the whole ray to the ground or space (GetSkyRadiance). `transmittance`,
 // if given, receives the transmittance along the same path.
 glsl::vec3 QuerySkyRadiance(const Twin& twin, const Query& q, const QueryGeometry& g, glsl::vec3* transmittance);
+
+// Empty where the tables answer a sun `sun_zenith_deg` from the zenith (0
+// to the lowest sun they were baked for, parameters.mu_s_min); otherwise
+// what a message says after naming the value: "is outside the tables'
+// range 0..102.00 degrees". Past the lowest sun the tables hold no light
+// and the lookup clamps to their edge.
+std::string SunZenithOutsideTables(const glsl::AtmosphereParameters& parameters, double sun_zenith_deg);
 
 }  // namespace skybake::report

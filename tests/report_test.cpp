@@ -351,19 +351,25 @@ TEST(ReportCommand, AnAtmosphereWithoutReferenceIsAOneLineInputError) {
   EXPECT_EQ(testing::Lines(stderr_text).size(), 1u) << stderr_text;
 }
 
-// The colour section's options: a count that cannot be baked, or a spectral
-// reference with nothing to bake against it, is a one-line error before any
-// bake, with no output folder; --wavelengths 0 leaves the section out.
+// The colour section's options: a count that cannot be baked (a bad option
+// value, exit 1), or a spectral reference with nothing to bake against it
+// (exit 2), is a one-line error before any bake, with no output folder;
+// --wavelengths 0 leaves the section out.
 TEST(ReportCommand, ColourSectionOptions) {
   testing::TempDir dir;
   const std::filesystem::path out = dir.path() / "report";
   std::string stdout_text, stderr_text;
-  for (const std::string& options : {std::string(" --wavelengths 2"), std::string(" --wavelengths -4"),
-                                     std::string(" --wavelengths 0 --spectral-reference r.csv")}) {
+  struct Refusal {
+    std::string options;
+    int code;
+  };
+  for (const Refusal& r : {Refusal{" --wavelengths 2", 1}, Refusal{" --wavelengths -4", 1},
+                           Refusal{" --wavelengths 0 --spectral-reference r.csv", 2}}) {
+    const std::string& options = r.options;
     EXPECT_EQ(testing::RunCommand(testing::Skybake() + " report earth -o " + testing::ShellQuote(out.string()) +
                                       QuickReportArguments() + options,
                                   dir, nullptr, &stderr_text),
-              2)
+              r.code)
         << options;
     EXPECT_EQ(testing::Lines(stderr_text).size(), 1u) << stderr_text;
     EXPECT_FALSE(std::filesystem::exists(out)) << options;

@@ -602,23 +602,24 @@ TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
   EXPECT_GT(rgb.y, rgb.x);
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / "fisheye_sz30.png"));
 
-  // Refused, one line, exit 2, no folder: a file with values per file
-  // wavelength, single Mie packed into alpha (one wavelength, not a colour),
-  // fewer than three wavelengths.
+  // Refused, one line, no folder: a file with values per file wavelength,
+  // single Mie packed into alpha (one wavelength, not a colour), exit 2;
+  // fewer than three wavelengths, a bad option value, exit 1.
   struct Refusal {
     std::string arguments, message;
+    int exit_code = 2;
   };
   const std::string refused = (dir.path() / "refused").string();
   for (const Refusal& r :
        {Refusal{"light-haze" + std::string(kSmallSpectralBake), "gives a value at each of spectrum.wavelengths_nm only"},
         Refusal{"earth --pack-mie" + std::string(kSmallSpectralBake),
                 "--pack-mie: a spectral bake keeps single Mie in its own table"},
-        Refusal{"earth --wavelengths 2", "a spectral bake needs at least 3 wavelengths, not 2"},
-        Refusal{"earth --wavelengths -3", "a spectral bake needs at least 3 wavelengths, not -3"}}) {
+        Refusal{"earth --wavelengths 2", "a spectral bake needs at least 3 wavelengths, not 2", 1},
+        Refusal{"earth --wavelengths -3", "a spectral bake needs at least 3 wavelengths, not -3", 1}}) {
     SCOPED_TRACE(r.arguments);
     EXPECT_EQ(testing::RunCommand(testing::Skybake() + " bake " + r.arguments + " -o " + testing::ShellQuote(refused),
                                   dir, &out, &err),
-              2);
+              r.exit_code);
     EXPECT_NE(err.find(r.message), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
     EXPECT_FALSE(std::filesystem::exists(refused));

@@ -1,0 +1,158 @@
+// Regression tests for defects of issue 50 ("what a pipeline trusts"), each
+// named after its defect (PipelineDefects.D<N>_..., N the issue's number).
+// The command-line tests run testing::Skybake() (SKYBAKE_TEST_EXE picks
+// another build, e.g. one from before the fix, to see them fail there) on
+// small bakes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.h"
+#include "formats/query_csv.h"
+#include "render/image_files.h"
+#include "tests/test_util.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Lines;
+using testing::ReadText;
+using testing::RunCommand;
+using testing::ShellQuote;
+using testing::Skybake;
+using testing::TempDir;
+using testing::WriteText;
+
+// Table sizes and samples of a bake that takes well under a second, and
+// such a bake, quiet.
+const std::string kSmallTables =
+    " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
+    " --sphere-samples 8";
+const std::string kSmallBake = " -q" + kSmallTables + " --orders 2";
+
+const fs::path kSource = SKYBAKE_SOURCE_DIR;
+
+std::string Quoted(const fs::path& path) { return ShellQuote(path.string()); }
+
+bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Bakes `atmosphere` with the small settings and `extra` arguments into `lut`.
+void SmallBake(const TempDir& dir, const std::string& atmosphere, const fs::path& lut, const std::string& extra = "") {
+  std::string err;
+  ASSERT_EQ(RunCommand(Skybake() + " bake " + atmosphere + " -o " + Quoted(lut) + kSmallBake + extra, dir, nullptr,
+                       &err),
+            0)
+      << err;
+}
+
+// Runs a command that must fail with `code` and one line on stderr; that line.
+std::string OneLineFailure(const std::string& command, const TempDir& dir, int code) {
+  std::string out, err;
+  EXPECT_EQ(RunCommand(command, dir, &out, &err), code) << command << "\n" << err;
+  EXPECT_EQ(Lines(err).size(), 1u) << command << "\n" << err;
+  return err;
+}
+
+// ---- 9: bad option values exit 1 ----
+
+TEST(PipelineDefects, D09_BadOptionValuesExitOne) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out";
+  for (const char* count : {"2", "-1", "1"}) {
+    const std::string err =
+        OneLineFailure(Skybake() + " bake earth -o " + Quoted(out) + kSmallBake + " --wavelengths " + count, dir, 1);
+    EXPECT_TRUE(Contains(err, "--wavelengths")) << err;
+  }
+  WriteText(dir.path() / "q.csv", "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,0,30,0\n");
+  OneLineFailure(Skybake() + " reference earth --in " + Quoted(dir.path() / "q.csv") + " --wavelengths 2 --paths 64",
+                 dir, 1);
+  SmallBake(dir, "earth", dir.path() / "lut");
+  for (const char* zenith : {"200", "-5", "30,181"}) {
+    OneLineFailure(Skybake() + " render -q " + Quoted(dir.path() / "lut") + " -o " + Quoted(dir.path() / "images") +
+                       " --views fisheye --size 8 --sun-zenith " + zenith,
+                   dir, 1);
+  }
+  // An angle render takes but these tables do not reach stays the input's fault.
+  OneLineFailure(Skybake() + " render -q " + Quoted(dir.path() / "lut") + " -o " + Quoted(dir.path() / "images") +
+                     " --views fisheye --size 8 --sun-zenith 150",
+                 dir, 2);
+  const std::string err = OneLineFailure(
+      Skybake() + " fit earth --json --altitude-min-m 5000 --altitude-max-m 100", dir, 1);
+  EXPECT_TRUE(Contains(err, "--altitude-min-m")) << err;
+  OneLineFailure(Skybake() + " fit earth --json --altitude-min-m -1", dir, 1);
+}
+
+// ---- 10: eval's queries ----
+
+TEST(PipelineDefects, D10_EvalParsesQueriesStrictly) {
+  TempDir dir;
+  const fs::path lut = dir.path() / "lut", queries = dir.path() / "q.csv";
+  SmallBake(dir, "earth", lut);
+  const std::string eval = Skybake() + " eval " + Quoted(lut) + " --in " + Quoted(queries);
+  const std::string header = "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n";
+
+  // Decimal numbers only: one line naming the file, the line and the column.
+  for (const char* bad : {"0x10", "inf", "nan", "1e", "12abc", "1,5"}) {
+    SCOPED_TRACE(bad);
+    const std::string text = header + "0,0,30,0\n0," + std::string("\"") + bad + "\",30,0\n";
+    WriteText(queries, text);
+    const std::string err = OneLineFailure(eval, dir, 2);
+    EXPECT_TRUE(Contains(err, queries.string() + ":3: view_zenith_deg")) << err;
+    // The location, as --json errors report it.
+    try {
+      ParseQueryCsv(text, "q.csv");
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.location().file, "q.csv");
+      EXPECT_EQ(e.location().line, 3);
+      EXPECT_EQ(e.location().key, "view_zenith_deg");
+    }
+  }
+  WriteText(queries, header + "0,0x10,30,0\n");
+  EXPECT_TRUE(Contains(OneLineFailure(eval, dir, 2), ":2: view_zenith_deg = '0x10' is not a number")) << "unquoted";
+
+  // A sun past the tables' lowest sun: refused as render refuses it, same
+  // message, same exit code.
+  WriteText(queries, header + "0,0,30,0\n0,0,150,0\n");
+  const std::string eval_error = OneLineFailure(eval, dir, 2);
+  EXPECT_TRUE(Contains(eval_error, ":3: sun_zenith_deg = 150 ")) << eval_error;
+  const std::string render_error =
+      OneLineFailure(Skybake() + " render -q " + Quoted(lut) + " -o " + Quoted(dir.path() / "images") +
+                         " --views fisheye --size 8 --sun-zenith 150",
+                     dir, 2);
+  const std::string problem = "is outside the tables' range 0..102.00 degrees";
+  EXPECT_TRUE(Contains(eval_error, "150 " + problem)) << eval_error;
+  EXPECT_TRUE(Contains(render_error, "150 " + problem)) << render_error;
+  // The lowest sun itself is answered.
+  WriteText(queries, header + "0,0,102,0\n");
+  std::string out, err;
+  EXPECT_EQ(RunCommand(eval, dir, &out, &err), 0) << err;
+
+  // RFC 4180 fields: quoted names and numbers, a quoted comma, a doubled
+  // quote and a line break inside a group label, CRLF line ends; the label
+  // is echoed quoted again, and the answers are those of the plain query.
+  WriteText(queries, "\"altitude_m\",view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,group\r\n"
+                     "\"100\", 45 ,\"30\",0,\"a, \"\"b\"\"\nc\"\r\n"
+                     "100,45,30,0,plain\r\n");
+  ASSERT_EQ(RunCommand(eval, dir, &out, &err), 0) << err;
+  const std::vector<std::string> lines = Lines(out);
+  ASSERT_EQ(lines.size(), 4u) << out;  // the header, the quoted row over two lines, the plain row
+  EXPECT_EQ(lines[1], "100,45,30,0,\"a, \"\"b\"\"");
+  EXPECT_EQ(lines[2].substr(0, 2), "c\"");
+  EXPECT_EQ(lines[2].substr(2), lines[3].substr(std::string("100,45,30,0,plain").size()));
+  // A quote left open is one line naming where the field began.
+  WriteText(queries, header + "0,0,30,0\n0,0,\"30,0\n");
+  EXPECT_TRUE(Contains(OneLineFailure(eval, dir, 2), ":3: field 3: a quoted field is not closed"));
+}
+
+}  // namespace
+}  // namespace skybake
