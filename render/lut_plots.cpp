@@ -19,10 +19,35 @@ constexpr double kDegree = glsl::PI / 180.0;
 // Palette indices (plot/plot.h) that read as red, green and blue.
 constexpr int kChannelColor[3] = {2, 4, 0};
 
-std::string ChannelName(const vec3& wavelengths_nm, int c) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "%.0f nm", wavelengths_nm[c]);
-  return name;
+// How the plots name a set's channels and label their axes: a wavelength
+// per channel, in W m^-2 sr^-1 nm^-1 (W m^-2 nm^-1 for irradiance); or, for
+// a spectral set (bake/bake.h SpectralColour), CIE X, Y and Z in
+// photometric units, Y in cd m^-2 (lux for irradiance).
+struct ChannelLabels {
+  std::string names[3];     // "680 nm" or "X"
+  std::string radiance;     // the sky radiance plot's axis (its channel 1)
+  std::string irradiance;   // the irradiance plot's axis (every channel)
+  std::string luminance;    // the sunset plot's axis
+};
+
+ChannelLabels LabelsOf(const LutSet& luts) {
+  ChannelLabels labels;
+  if (luts.colour) {
+    labels.names[0] = "X", labels.names[1] = "Y", labels.names[2] = "Z";
+    labels.radiance = "luminance Y (cd m^-2)";
+    labels.irradiance = "CIE X, Y, Z (Y: illuminance, lux)";
+    labels.luminance = "luminance Y (cd m^-2)";
+    return labels;
+  }
+  for (int c = 0; c < 3; ++c) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%.0f nm", luts.atmosphere.wavelengths_nm[c]);
+    labels.names[c] = name;
+  }
+  labels.radiance = "radiance (W m^-2 sr^-1 nm^-1)";
+  labels.irradiance = "irradiance (W m^-2 nm^-1)";
+  labels.luminance = "luminance of the three channels (W m^-2 sr^-1 nm^-1, Rec. 709 weights)";
+  return labels;
 }
 
 void Write(const LinePlot& plot, const std::filesystem::path& dir, const std::string& stem, PlotFiles* out) {
@@ -62,27 +87,28 @@ constexpr double kSunsetFirstSunDeg = 85.0;
 
 }  // namespace
 
-SunsetCurves ComputeSunsetCurves(const Twin& twin) {
+SunsetCurves ComputeSunsetCurves(const Twin& twin, bool channels_are_xyz) {
   const glsl::AtmosphereParameters& p = twin.parameters();
   const double lowest_sun_deg = LowestSunZenithDeg(p);
   const vec3 camera(0.0, 0.0, p.bottom_radius + kSunsetCameraAltitudeM);
   const double horizon = 88.0 * kDegree;
   const vec3 sunward(std::sin(horizon), 0.0, std::cos(horizon)), antisolar(-sunward.x, 0.0, sunward.z);
+  auto luminance = [&](const vec3& channels) { return channels_are_xyz ? channels.y : report::Luminance(channels); };
   SunsetCurves curves;
   for (int i = 0; kSunsetFirstSunDeg + 0.05 * i <= lowest_sun_deg + 1e-9; ++i) {
     const double sun_zenith = kSunsetFirstSunDeg + 0.05 * i;
     const vec3 sun(std::sin(sun_zenith * kDegree), 0.0, std::cos(sun_zenith * kDegree));
     curves.sun_zenith_deg.push_back(sun_zenith);
-    curves.zenith.push_back(report::Luminance(twin.SkyRadiance(camera, vec3(0.0, 0.0, 1.0), sun, nullptr)));
-    curves.sunward_horizon.push_back(report::Luminance(twin.SkyRadiance(camera, sunward, sun, nullptr)));
-    curves.antisolar_horizon.push_back(report::Luminance(twin.SkyRadiance(camera, antisolar, sun, nullptr)));
+    curves.zenith.push_back(luminance(twin.SkyRadiance(camera, vec3(0.0, 0.0, 1.0), sun, nullptr)));
+    curves.sunward_horizon.push_back(luminance(twin.SkyRadiance(camera, sunward, sun, nullptr)));
+    curves.antisolar_horizon.push_back(luminance(twin.SkyRadiance(camera, antisolar, sun, nullptr)));
   }
   return curves;
 }
 
 PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, const std::string& caption) {
   const Twin twin(MakeTwinTables(luts));
-  const vec3& wavelengths_nm = luts.atmosphere.wavelengths_nm;
+  const ChannelLabels labels = LabelsOf(luts);
   const glsl::AtmosphereParameters& p = twin.parameters();
   const double lowest_sun_deg = LowestSunZenithDeg(p);
   PlotFiles files;
@@ -100,7 +126,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
       for (int c = 0; c < 3; ++c) {
         PlotSeries s;
         char name[64];
-        std::snprintf(name, sizeof(name), "%s, %g km", ChannelName(wavelengths_nm, c).c_str(), altitudes_km[a]);
+        std::snprintf(name, sizeof(name), "%s, %g km", labels.names[c].c_str(), altitudes_km[a]);
         s.name = name;
         s.style = styles[a];
         s.color = kChannelColor[c];
@@ -133,10 +159,10 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
     files.left_out.push_back("lut_sky_radiance: " + MissingTable(luts, "scattering"));
   } else if (!sky_sun_zeniths.empty()) {
     LinePlot plot;
-    plot.title = "Sky radiance from the ground in the sun's vertical plane (" + ChannelName(wavelengths_nm, 1) + ")";
+    plot.title = "Sky radiance from the ground in the sun's vertical plane (" + labels.names[1] + ")";
     plot.caption = caption;
     plot.x = {"view zenith angle (degrees; negative: away from the sun)", false, -90.0, 90.0};
-    plot.y = {"radiance (W m^-2 sr^-1 nm^-1)", true, {}, {}};
+    plot.y = {labels.radiance, true, {}, {}};
     const vec3 camera(0.0, 0.0, p.bottom_radius + sky_camera_altitude_m);
     for (double sun_zenith : sky_sun_zeniths) {
       PlotSeries s;
@@ -164,12 +190,12 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
     plot.title = "Irradiance on horizontal ground";
     plot.caption = caption;
     plot.x = {"sun zenith angle (degrees)", false, 0.0, lowest_sun_deg};
-    plot.y = {"irradiance (W m^-2 nm^-1)", false, 0.0, {}};
+    plot.y = {labels.irradiance, false, 0.0, {}};
     const vec3 point(0.0, 0.0, p.bottom_radius), normal(0.0, 0.0, 1.0);
     for (int c = 0; c < 3; ++c) {
       PlotSeries sun, sky;
-      sun.name = "sun, " + ChannelName(wavelengths_nm, c);
-      sky.name = "sky, " + ChannelName(wavelengths_nm, c);
+      sun.name = "sun, " + labels.names[c];
+      sky.name = "sky, " + labels.names[c];
       sun.color = sky.color = kChannelColor[c];
       sky.style = LineStyle::kDashed;
       for (int i = 0; i <= 200; ++i) {
@@ -198,12 +224,12 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
   if (!sunset_problem.empty()) {
     files.left_out.push_back("lut_sunset: " + sunset_problem);
   } else {
-    const SunsetCurves curves = ComputeSunsetCurves(twin);
+    const SunsetCurves curves = ComputeSunsetCurves(twin, luts.colour.has_value());
     LinePlot plot;
     plot.title = "Sky luminance from the ground through sunset and twilight";
     plot.caption = caption;
     plot.x = {"sun zenith angle (degrees)", false, kSunsetFirstSunDeg, lowest_sun_deg};
-    plot.y = {"luminance of the three channels (W m^-2 sr^-1 nm^-1, Rec. 709 weights)", true, {}, {}};
+    plot.y = {labels.luminance, true, {}, {}};
     const std::pair<const char*, const std::vector<double>*> views[] = {
         {"zenith", &curves.zenith},
         {"2 deg above the horizon, toward the sun", &curves.sunward_horizon},

@@ -2,7 +2,8 @@
 // for people who would rather look than read:
 //   lut_transmittance.{svg,png}  transmittance to the top of the atmosphere vs
 //                                view zenith, at altitudes 0, 5 and 20 km;
-//   lut_sky_radiance.{svg,png}   sky radiance at 550 nm-ish (the middle channel)
+//   lut_sky_radiance.{svg,png}   sky radiance at 550 nm-ish (the middle channel;
+//                                a spectral set's Y, its luminance)
 //                                seen from the ground in the sun's vertical
 //                                plane, vs signed view zenith (negative: away
 //                                from the sun), for sun zeniths 0, 45, 80, 90;
@@ -37,7 +38,8 @@ struct PlotFiles {
   std::vector<std::string> left_out;
 };
 
-// Sky luminance (report::Luminance of the three channels) seen from 1 m
+// Sky luminance (report::Luminance of the three channels, or Y where
+// `channels_are_xyz`: a spectral set's) seen from 1 m
 // above the ground through sunset and twilight: at the zenith, and 2 degrees
 // above the horizon toward the sun and away from it, for sun zenith angles
 // from 85 degrees to the table's lowest sun (102 for earth) in 0.05 degree
@@ -46,7 +48,7 @@ struct SunsetCurves {
   std::vector<double> sun_zenith_deg;
   std::vector<double> zenith, sunward_horizon, antisolar_horizon;
 };
-SunsetCurves ComputeSunsetCurves(const Twin& twin);
+SunsetCurves ComputeSunsetCurves(const Twin& twin, bool channels_are_xyz);
 
 // Writes the plots of `luts` into `dir` (which must exist), each file
 // atomically. `caption` goes under each plot (e.g. the command line).

@@ -62,6 +62,46 @@ std::string OneLineFailure(const std::string& command, const TempDir& dir, int c
   return err;
 }
 
+// ---- 5: plots of a spectral set ----
+
+// A spectral set holds CIE X, Y, Z in photometric units (Y in cd m^-2, lux
+// for irradiance): `info --plot` names its channels X, Y, Z and its units
+// so, where it named the atmosphere's wavelengths in W m^-2 sr^-1 nm^-1. A
+// three-wavelength set keeps its wavelengths and radiometric units.
+TEST(PipelineDefects, D05_InfoPlotLabelsASpectralSetInXyzAndCandelas) {
+  TempDir dir;
+  SmallBake(dir, "earth", dir.path() / "xyz", " --wavelengths 3");
+  SmallBake(dir, "earth", dir.path() / "rgb");
+  std::string err;
+  ASSERT_EQ(RunCommand(Skybake() + " info " + Quoted(dir.path() / "xyz") + " --plot " + Quoted(dir.path() / "xyz_plots"),
+                       dir, nullptr, &err),
+            0)
+      << err;
+  ASSERT_EQ(RunCommand(Skybake() + " info " + Quoted(dir.path() / "rgb") + " --plot " + Quoted(dir.path() / "rgb_plots"),
+                       dir, nullptr, &err),
+            0)
+      << err;
+  for (const char* plot : {"lut_transmittance", "lut_sky_radiance", "lut_irradiance", "lut_sunset"}) {
+    SCOPED_TRACE(plot);
+    const std::string xyz = ReadText(dir.path() / "xyz_plots" / (std::string(plot) + ".svg"));
+    const std::string rgb = ReadText(dir.path() / "rgb_plots" / (std::string(plot) + ".svg"));
+    ASSERT_FALSE(xyz.empty());
+    ASSERT_FALSE(rgb.empty());
+    // No wavelength and no spectral unit on a spectral set's plots.
+    EXPECT_FALSE(Contains(xyz, "680 nm") || Contains(xyz, "550 nm") || Contains(xyz, "440 nm")) << plot;
+    EXPECT_FALSE(Contains(xyz, "nm^-1")) << plot;
+    EXPECT_TRUE(Contains(rgb, "nm")) << plot;
+  }
+  const std::string sky = ReadText(dir.path() / "xyz_plots" / "lut_sky_radiance.svg");
+  EXPECT_TRUE(Contains(sky, "(Y)")) << "the sky radiance plot shows channel Y";
+  EXPECT_TRUE(Contains(sky, "cd m^-2"));
+  EXPECT_TRUE(Contains(ReadText(dir.path() / "xyz_plots" / "lut_sunset.svg"), "luminance Y (cd m^-2)"));
+  EXPECT_TRUE(Contains(ReadText(dir.path() / "xyz_plots" / "lut_irradiance.svg"), "lux"));
+  EXPECT_TRUE(Contains(ReadText(dir.path() / "xyz_plots" / "lut_transmittance.svg"), "X, 0 km"));
+  EXPECT_TRUE(Contains(ReadText(dir.path() / "rgb_plots" / "lut_sky_radiance.svg"), "W m^-2 sr^-1 nm^-1"));
+  EXPECT_TRUE(Contains(ReadText(dir.path() / "rgb_plots" / "lut_sky_radiance.svg"), "(550 nm)"));
+}
+
 // ---- 9: bad option values exit 1 ----
 
 TEST(PipelineDefects, D09_BadOptionValuesExitOne) {

@@ -332,7 +332,7 @@ TEST(Twilight, LookupsBelowTheLowestSunKeepFalling) {
 TEST(Twilight, SkyLuminanceFallsSmoothlyThroughSunset) {
   const LutSet& luts = DefaultEarth();
   const Twin twin(MakeTwinTables(luts));
-  const render::SunsetCurves curves = render::ComputeSunsetCurves(twin);
+  const render::SunsetCurves curves = render::ComputeSunsetCurves(twin, false);
   ASSERT_EQ(curves.sun_zenith_deg.size(), 341u);  // 85 to 102 degrees
   const std::pair<const char*, const std::vector<double>*> views[] = {
       {"zenith", &curves.zenith}, {"sunward", &curves.sunward_horizon}, {"antisolar", &curves.antisolar_horizon}};
