@@ -266,11 +266,11 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--exposure", args->exposure,
                   "Exposure of the PNGs: radiance x 2^EV (after white balance), then 1 - exp(-x), then sRGB. "
                   "A number of EV, or auto: per image, EV = log2(-ln(1 - 0.18) / Y_med), Y_med the median "
-                  "luminance (Y = 0.2126 R + 0.7152 G + 0.0722 B of the linear radiance) over the pixels with Y > 0 "
-                  "that show sky (rays that miss the ground; from space, the whole planet; all pixels with Y > 0 "
-                  "if none), so it leaves the tone "
-                  "curve at mid-grey 0.18 before the sRGB transfer. The EV used is printed on stderr and recorded "
-                  "in each PNG's ImageDescription and in --json")
+                  "luminance (Y = 0.2126 R + 0.7152 G + 0.0722 B of the linear radiance) over the lit pixels that "
+                  "show sky (rays that miss the ground; from space, the whole planet; all pixels with Y > 0 if "
+                  "none), lit meaning Y at least 1/100 of their 99th percentile (from space at twilight: not the "
+                  "night side), so it leaves the tone curve at mid-grey 0.18 before the sRGB transfer. The EV "
+                  "used is printed on stderr and recorded in each PNG's ImageDescription and in --json")
       ->capture_default_str();
   cmd->add_option("--altitude-m", args->altitude_m, "Camera altitude of the ground views, metres")
       ->capture_default_str();

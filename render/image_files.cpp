@@ -27,6 +27,11 @@ double AutoExposureEv(const Image& image) {
   }
   std::vector<double>& chosen = sky.empty() ? lit : sky;
   if (chosen.empty()) return 0.0;
+  // The part the sun lights: at least kAutoExposureLitFraction of Y_99.
+  auto y99 = chosen.begin() + std::min(chosen.size() - 1, std::size_t(0.99 * double(chosen.size())));
+  std::nth_element(chosen.begin(), y99, chosen.end());
+  const double lit_floor = kAutoExposureLitFraction * *y99;
+  chosen.erase(std::remove_if(chosen.begin(), chosen.end(), [&](double y) { return y < lit_floor; }), chosen.end());
   auto median = chosen.begin() + chosen.size() / 2;
   std::nth_element(chosen.begin(), median, chosen.end());
   return std::log2(-std::log(1.0 - kAutoExposureMidGrey) / *median);

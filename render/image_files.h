@@ -27,17 +27,27 @@ struct ToneMap {
   glsl::vec3 white{1.0};  // per-channel white balance divisor (see WhiteBalance)
 };
 
-// Auto exposure (`render --exposure auto`): with Y = 0.2126 R + 0.7152 G +
-// 0.0722 B the luminance of a pixel's linear radiance, and Y_med the median
-// (the floor(n/2)-th smallest, from 0) of Y over the n pixels with Y > 0
-// that show sky (Image::sky: rays that miss the ground; from space, the
-// whole planet), the exposure is
+// Auto exposure (`render --exposure auto`) exposes for the part of the sky
+// the sun lights. With Y = 0.2126 R + 0.7152 G + 0.0722 B the luminance of a
+// pixel's linear radiance, take the n pixels with Y > 0 that show sky
+// (Image::sky: rays that miss the ground; from space, the whole planet),
+// Y_99 the floor(0.99 n)-th smallest of their Y (from 0; below the few
+// pixels of the sun's disc), and Y_med the median (the floor(m/2)-th
+// smallest) of Y over the m of them lit, Y >= Y_99 / 100. The exposure is
 //   EV = log2(-ln(1 - 0.18) / Y_med),
 // so that a grey pixel of luminance Y_med leaves the tone curve at
 // 1 - exp(-Y_med 2^EV) = 0.18, mid-grey, before the sRGB transfer function.
-// Where no such pixel exists (or the image has no sky mask) Y_med is taken
-// over all pixels with Y > 0; an image without any gets EV 0.
+// In daylight, and in twilight seen from the ground down to a sun about 95
+// degrees from the zenith, no sky pixel is 100 times darker than Y_99, so
+// Y_med is the median of the whole sky. Lower suns leave the darkest sky
+// out (from the ground at 98 to 102 degrees, 0.2 to 0.8 EV less); from
+// space at twilight, the planet's night half, orders of magnitude darker,
+// which the median of every pixel exposed for (EV 10 instead of 3 at sun
+// 95 degrees, the lit limb white). Where no pixel shows sky (or the image
+// has no sky mask) the pixels with Y > 0 are taken instead; an image
+// without any gets EV 0.
 inline constexpr double kAutoExposureMidGrey = 0.18;
+inline constexpr double kAutoExposureLitFraction = 0.01;
 double AutoExposureEv(const Image& image);
 
 // The white-balance divisor for a solar irradiance spectrum: irradiance / mean.

@@ -102,6 +102,66 @@ TEST(PipelineDefects, D05_InfoPlotLabelsASpectralSetInXyzAndCandelas) {
   EXPECT_TRUE(Contains(ReadText(dir.path() / "rgb_plots" / "lut_sky_radiance.svg"), "(550 nm)"));
 }
 
+// ---- 7: auto exposure from space at twilight ----
+
+// The luminance Y = 0.2126 R + 0.7152 G + 0.0722 B of each pixel with Y > 0
+// of a linear EXR written by render.
+std::vector<double> PositiveLuminance(const fs::path& path) {
+  std::vector<double> y;
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) return y;
+  const OIIO::ImageSpec& spec = input->spec();
+  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+  input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+  for (std::size_t i = 0; i < std::size_t(spec.width) * spec.height; ++i) {
+    const float* p = &pixels[i * spec.nchannels];
+    const double v = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    if (v > 0.0) y.push_back(v);
+  }
+  std::sort(y.begin(), y.end());
+  return y;
+}
+
+// The space-to-ground scene's planet from space with the sun 95 degrees
+// from the zenith below the camera is half in the night: the median of
+// every pixel exposed for the night side (EV 10.3) and drew the lit limb
+// pure white. Exposed for the lit part, the limb keeps its colour, and a
+// daylight view, lit all over, is still exposed on the median of all of it.
+TEST(PipelineDefects, D07_AutoExposureDoesNotBlowOutTheLitLimbFromSpaceAtTwilight) {
+  TempDir dir;
+  const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
+  SmallBake(dir, "earth", lut, " --scene " + Quoted(kSource / "examples/scenes/space-to-ground.toml"));
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + " render -q " + Quoted(lut) + " -o " + Quoted(images) +
+                           " --views space --size 64 --sun-zenith 95,30 --json",
+                       dir, &out, &err),
+            0)
+      << err;
+  const nlohmann::json report = nlohmann::json::parse(out);
+  ASSERT_EQ(report["images"].size(), 2u);
+  const double twilight_ev = report["images"][0]["exposure_ev"].get<double>();
+  const double daylight_ev = report["images"][1]["exposure_ev"].get<double>();
+
+  // The lit limb: no pixel clipped to white, and the brightest about as
+  // exposed as the daylight planet's brightest.
+  const render::Rgb8 png = render::ReadPng(images / "space_sz95.png");
+  int white = 0, brightest = 0;
+  for (std::size_t i = 0; i < png.rgb.size(); i += 3) {
+    const int low = std::min({png.rgb[i], png.rgb[i + 1], png.rgb[i + 2]});
+    white += low == 255 ? 1 : 0;
+    brightest = std::max(brightest, low);
+  }
+  EXPECT_EQ(white, 0) << "EV " << twilight_ev;
+  EXPECT_LT(brightest, 240) << "EV " << twilight_ev;
+  EXPECT_LT(twilight_ev, daylight_ev + 2.0);
+
+  // Daylight from space: lit all over, so the median of every pixel, as
+  // before, within the few night pixels at the planet's rim.
+  const std::vector<double> y = PositiveLuminance(images / "space_sz30.exr");
+  ASSERT_FALSE(y.empty());
+  EXPECT_NEAR(daylight_ev, std::log2(-std::log(1.0 - render::kAutoExposureMidGrey) / y[y.size() / 2]), 0.05);
+}
+
 // ---- 9: bad option values exit 1 ----
 
 TEST(PipelineDefects, D09_BadOptionValuesExitOne) {
