@@ -210,7 +210,9 @@ void AddBakeCommand(CLI::App& app) {
                       "exact = at every wavelength (docs/colour.md)")
           ->check(CLI::IsMember({"interpolated", "exact"}))
           ->capture_default_str();
-  cmd->add_flag("--half", o->half, "Store half floats instead of float32 (the error is reported)");
+  cmd->add_flag("--half", o->half,
+                "Store half floats instead of float32 (the error is reported); not with --scene, whose precision "
+                "names each table's");
   cmd->add_option("--ktx2-supercompression", o->ktx2_supercompression, kKtx2SupercompressionHelp)
       ->capture_default_str();
   cmd->add_option("--runtime", o->runtime,

@@ -41,6 +41,10 @@ void RunConvert(const ConvertOptions& o) {
   if (!target) throw UsageError(o.output + ": the output name must end in .exr or .ktx2");
   if (o.half && o.to_float) throw UsageError("--half and --float exclude each other");
   const int zstd_level = ParseKtx2Supercompression(o.ktx2_supercompression);
+  if (zstd_level > 0 && *target != FileFormat::kKtx2) {
+    throw UsageError("--ktx2-supercompression: only KTX2 files are supercompressed, and " + o.output +
+                     " is not one; give one or the other");
+  }
   if (!(o.floor > 0.0)) throw UsageError("--floor must be positive");
 
   // Writing over a file a manifest lists would leave the set failing its

@@ -192,6 +192,10 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     if (job.formats_given) {
       throw UsageError("--format: the scene names the formats (output.formats); give one or the other");
     }
+    if (job.half) {
+      throw UsageError("--half: the scene names each table's precision (precision, \"float\" where it names none); "
+                       "give one or the other");
+    }
     if (job.settings.pack_single_mie_in_alpha) {
       throw UsageError("--pack-mie: the scene decides the packing (effects.sharp_sun_halo); give one or the other");
     }
@@ -217,6 +221,11 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   }
   WriteOptions write_options;
   write_options.formats = ParseFormats(out.formats);
+  if (job.ktx2_zstd_level > 0 && std::find(write_options.formats.begin(), write_options.formats.end(),
+                                            FileFormat::kKtx2) == write_options.formats.end()) {
+    throw UsageError(std::string("--ktx2-supercompression: only KTX2 files are supercompressed, and ") +
+                     (scene ? "the scene's output.formats name" : "--format names") + " no ktx2; give one or the other");
+  }
   write_options.half = job.half;
   write_options.ktx2_zstd_level = job.ktx2_zstd_level;
   if (scene) write_options.half_tables = SceneHalfTables(scene->scene);

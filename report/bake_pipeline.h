@@ -80,8 +80,9 @@ struct BakeOutcome {
 using BakeStepLine = std::function<void(const std::string&)>;
 
 // Runs the pipeline into `output_dir`. UsageError for options that do not go
-// together (formats or --pack-mie with a scene, compare_full without one, a
-// reference without compare_full, an unknown or no format); the scene, the
+// together (formats, half or --pack-mie with a scene, compare_full without
+// one, a reference without compare_full, a KTX2 supercompression without
+// KTX2 files, an unknown or no format); the scene, the
 // reference and the output directory are checked before anything is baked.
 // `on_phase` sees each phase of the written set's bake and its writing; an
 // interrupt (core/interrupt.h) is thrown after any phase, before the commit

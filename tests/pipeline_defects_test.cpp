@@ -162,6 +162,42 @@ TEST(PipelineDefects, D07_AutoExposureDoesNotBlowOutTheLitLimbFromSpaceAtTwiligh
   EXPECT_NEAR(daylight_ev, std::log2(-std::log(1.0 - render::kAutoExposureMidGrey) / y[y.size() / 2]), 0.05);
 }
 
+// ---- 8: options that contradict each other ----
+
+TEST(PipelineDefects, D08_ConflictingOptionsAreUsageErrors) {
+  TempDir dir;
+  // Zstandard supercompresses KTX2 files: with EXR files only there is nothing to compress.
+  std::string err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "exr") + kSmallBake +
+                                       " --format exr --ktx2-supercompression zstd",
+                                   dir, 1);
+  EXPECT_TRUE(Contains(err, "--ktx2-supercompression")) << err;
+  EXPECT_FALSE(fs::exists(dir.path() / "exr"));
+  // The same through a scene that writes EXR only.
+  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "sunset") + kSmallBake + " --scene " +
+                           Quoted(kSource / "examples/scenes/sunset-cinematic.toml") + " --ktx2-supercompression zstd",
+                       dir, 1);
+  EXPECT_TRUE(Contains(err, "output.formats")) << err;
+  // And converting to an EXR file.
+  SmallBake(dir, "earth", dir.path() / "set", " --format ktx2");
+  err = OneLineFailure(Skybake() + " convert " + Quoted(dir.path() / "set" / "transmittance.ktx2") + " " +
+                           Quoted(dir.path() / "t.exr") + " --ktx2-supercompression zstd",
+                       dir, 1);
+  EXPECT_FALSE(fs::exists(dir.path() / "t.exr"));
+
+  // A scene names each table's precision (this one its transmittance
+  // explicitly as float); --half would override it.
+  const fs::path scene = dir.path() / "float-transmittance.toml";
+  std::string text = ReadText(kSource / "examples/scenes/ground-daytime-game.toml");
+  text.replace(text.find("[precision]"), std::string("[precision]").size(),
+               "[precision]\ntransmittance = \"float\"");
+  WriteText(scene, text);
+  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "game") + kSmallBake + " --scene " +
+                           Quoted(scene) + " --half",
+                       dir, 1);
+  EXPECT_TRUE(Contains(err, "--half")) << err;
+  EXPECT_FALSE(fs::exists(dir.path() / "game"));
+}
+
 // ---- 9: bad option values exit 1 ----
 
 TEST(PipelineDefects, D09_BadOptionValuesExitOne) {
