@@ -141,7 +141,9 @@ class SceneReader : public TomlReader {
       if (!node) return;
       const std::string path = Join("precision", key);
       std::string text = ReadString(*node, path);
-      if (text != "half" && text != "float") report_.Fail(path, "= \"" + text + "\" must be \"half\" or \"float\"");
+      if (text != "half" && text != "float") {
+        report_.Fail(path, "unknown precision " + TomlString(text) + " (expected \"half\" or \"float\")");
+      }
       value = text == "half";
     };
     half("transmittance", scene.precision.transmittance_half);
@@ -159,7 +161,9 @@ class SceneReader : public TomlReader {
     for (size_t i = 0; i < array->size(); ++i) {
       const std::string path = Index("output.formats", i);
       std::string format = ReadString(*array->get(i), path);
-      if (format != "exr" && format != "ktx2") report_.Fail(path, "= \"" + format + "\" must be \"exr\" or \"ktx2\"");
+      if (format != "exr" && format != "ktx2") {
+        report_.Fail(path, "unknown format " + TomlString(format) + " (expected \"exr\" or \"ktx2\")");
+      }
       if (std::find(scene.formats.begin(), scene.formats.end(), format) != scene.formats.end())
         report_.Fail(path, "repeats \"" + format + "\"");
       scene.formats.push_back(format);

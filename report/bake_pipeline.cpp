@@ -106,9 +106,20 @@ std::string SceneSummaryText(const SceneSummary& s) {
     Append(&out, "    left out %-22s no aerial_perspective\n", "GetSkyRadianceToPoint");
   }
   constexpr double kDegreesPerRadian = 180.0 / kPi;
-  Append(&out, "    orders computed down to mu_s %.4f (full bake %.4f): lowest sun %.2f deg instead of %.2f deg\n",
-         s.plan.mu_s_min, s.full_mu_s_min, std::acos(s.plan.mu_s_min) * kDegreesPerRadian,
-         std::acos(s.full_mu_s_min) * kDegreesPerRadian);
+  const double lowest_sun_deg = std::acos(s.plan.mu_s_min) * kDegreesPerRadian,
+               full_lowest_sun_deg = std::acos(s.full_mu_s_min) * kDegreesPerRadian;
+  // A scene that shows every sun (space views, a sun range to 180 deg)
+  // keeps the atmosphere's lowest sun: then there is nothing "instead".
+  char lowest[32], full_lowest[32];
+  std::snprintf(lowest, sizeof lowest, "%.2f", lowest_sun_deg);
+  std::snprintf(full_lowest, sizeof full_lowest, "%.2f", full_lowest_sun_deg);
+  if (std::string(lowest) == full_lowest) {
+    Append(&out, "    orders computed down to mu_s %.4f: the lowest sun %s deg, as in the full bake\n", s.plan.mu_s_min,
+           lowest);
+  } else {
+    Append(&out, "    orders computed down to mu_s %.4f (full bake %.4f): lowest sun %s deg instead of %s deg\n",
+           s.plan.mu_s_min, s.full_mu_s_min, lowest, full_lowest);
+  }
   if (const std::optional<ScatteringRange>& range = s.range) {
     Append(&out,
            "    scattering tables restricted to altitudes %.4g-%.4g km and suns %.2f-%.2f deg (%d r texels "

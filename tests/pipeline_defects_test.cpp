@@ -290,5 +290,50 @@ TEST(PipelineDefects, D10_EvalParsesQueriesStrictly) {
   EXPECT_TRUE(Contains(OneLineFailure(eval, dir, 2), ":3: field 3: a quoted field is not closed"));
 }
 
+// ---- 13: the smaller defects ----
+
+// A scene that keeps the atmosphere's lowest sun (space views) said "lowest
+// sun 102.00 deg instead of 102.00 deg"; a scene that lowers it still says
+// what it is instead of.
+TEST(PipelineDefects, D13_SceneSummarySaysInsteadOnlyWhereTheLowestSunMoved) {
+  TempDir dir;
+  const std::regex same("lowest sun ([0-9.]+) deg instead of \\1 deg");
+  std::string err;
+  ASSERT_EQ(RunCommand(Skybake() + " bake earth -o " + Quoted(dir.path() / "space") + kSmallTables + " --scene " +
+                           Quoted(kSource / "examples/scenes/space-to-ground.toml"),
+                       dir, nullptr, &err),
+            0)
+      << err;
+  EXPECT_FALSE(std::regex_search(err, same)) << err;
+  EXPECT_TRUE(Contains(err, "the lowest sun 102.00 deg, as in the full bake")) << err;
+  ASSERT_EQ(RunCommand(Skybake() + " bake earth -o " + Quoted(dir.path() / "game") + kSmallTables + " --scene " +
+                           Quoted(kSource / "examples/scenes/ground-daytime-game.toml"),
+                       dir, nullptr, &err),
+            0)
+      << err;
+  EXPECT_TRUE(std::regex_search(err, std::regex("lowest sun 99\\.[0-9]+ deg instead of 102.00 deg"))) << err;
+}
+
+// A scene's unknown format or precision reads as the atmosphere files' own
+// errors do, "KEY: unknown format "png" (expected ...)", not "KEY: = "png"".
+TEST(PipelineDefects, D13_SceneValueErrorsReadWell) {
+  TempDir dir;
+  std::string text = ReadText(kSource / "examples/scenes/ground-daytime-game.toml");
+  const fs::path scene = dir.path() / "bad.toml";
+  WriteText(scene, text.substr(0, text.find("[output]")) + "[output]\nformats = [\"png\"]\n");
+  std::string err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake +
+                                       " --scene " + Quoted(scene),
+                                   dir, 2);
+  EXPECT_TRUE(Contains(err, "output.formats[0]: unknown format \"png\" (expected \"exr\" or \"ktx2\")")) << err;
+  EXPECT_FALSE(Contains(err, ": =")) << err;
+  text.replace(text.find("scattering = \"half\""), std::string("scattering = \"half\"").size(),
+               "scattering = \"double\"");
+  WriteText(scene, text);
+  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --scene " +
+                           Quoted(scene),
+                       dir, 2);
+  EXPECT_TRUE(Contains(err, "precision.scattering: unknown precision \"double\"")) << err;
+}
+
 }  // namespace
 }  // namespace skybake
