@@ -69,7 +69,8 @@ void BakeSettings::Validate() const {
           "higher-order divisor = " + std::to_string(higher_order_divisor) + " must be in [1, 64]");
   require(sphere_samples >= 2 && sphere_samples <= 1024,
           "sphere samples = " + std::to_string(sphere_samples) + " must be in [2, 1024]");
-  require(threads >= 0, "threads = " + std::to_string(threads) + " must be >= 0");
+  require(threads >= 0 && threads <= kMaxThreads,
+          "threads = " + std::to_string(threads) + " must be in [0, " + std::to_string(kMaxThreads) + "] (0: all cores)");
   if (const std::optional<ScatteringRange>& range = scattering_range) {
     require(range->altitude_min_m >= 0.0 && range->altitude_min_m < range->altitude_max_m,
             "scattering altitude range [" + std::to_string(range->altitude_min_m) + ", " +

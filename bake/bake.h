@@ -31,6 +31,12 @@ struct ScatteringRange {
   int atmosphere_ray_samples = 32;
 };
 
+// The most worker threads a bake takes. It never runs more than the
+// machine's hardware threads (oneTBB's arena has one slot each), so a larger
+// count can only be a mistake; 1024 is above the hardware threads of the
+// largest machines today (two 192-core sockets with two threads a core: 768).
+inline constexpr int kMaxThreads = 1024;
+
 struct BakeSettings {
   // Table sizes. The scattering mu size must be even (two halves: rays that
   // hit the ground and rays that do not).
@@ -87,7 +93,7 @@ struct BakeSettings {
   // With orders = 1: the irradiance table also holds single scattering's
   // light on the ground (what the second order's indirect irradiance adds).
   bool single_scattering_sky_irradiance = false;
-  // Worker threads; 0 = all cores.
+  // Worker threads; 0 = all cores; at most kMaxThreads.
   int threads = 0;
 
   // InputError naming the setting if a value is out of range.

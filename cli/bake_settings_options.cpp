@@ -34,7 +34,7 @@ double PhysicalMemoryBytes() {
   return pages > 0 && page_size > 0 ? double(pages) * double(page_size) : 0.0;
 }
 
-// --orders: a count, or "auto" (0 in BakeSettings).
+// --orders: a count, or "auto", also spelt 0 as in BakeSettings.
 int ParseOrders(const std::string& text) {
   if (text == "auto") return 0;
   std::size_t end = 0;
@@ -45,7 +45,7 @@ int ParseOrders(const std::string& text) {
     end = 0;
   }
   if (end == 0 || end != text.size()) throw UsageError("--orders: '" + text + "' is neither a count nor auto");
-  if (orders < 1) throw UsageError("--orders: " + text + " must be in [1, 100] or auto");
+  if (orders < 0) throw UsageError("--orders: " + text + " must be in [1, 100] or auto (0)");
   return orders;
 }
 
@@ -54,7 +54,7 @@ int ParseOrders(const std::string& text) {
 void BakeSettingsOptions::AddTo(CLI::App* cmd) {
   cmd->add_option("--orders", orders,
                   "Scattering orders computed (1 = single scattering); from 4 orders on, the rest extrapolated as a "
-                  "geometric tail (see --no-tail); or auto: until the estimated remaining error is below "
+                  "geometric tail (see --no-tail); or auto (also 0): until the estimated remaining error is below "
                   "--order-tolerance")
       ->capture_default_str();
   cmd->add_option("--order-tolerance", settings.order_tolerance,
@@ -89,7 +89,9 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
       ->capture_default_str();
   cmd->add_flag("--pack-mie", settings.pack_single_mie_in_alpha,
                 "Store single Mie's red channel in the scattering table's alpha instead of a separate table");
-  cmd->add_option("--threads", settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", settings.threads,
+                  "Worker threads (0 = all cores; at most " + std::to_string(kMaxThreads) + ")")
+      ->capture_default_str();
 }
 
 BakeSettings BakeSettingsOptions::Resolve() const {

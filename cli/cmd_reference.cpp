@@ -119,7 +119,9 @@ void AddReferenceCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", o->settings.seed, "Random seed; the results depend on it, not on --threads")
       ->capture_default_str();
-  cmd->add_option("--threads", o->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", o->settings.threads,
+                  "Worker threads (0 = all cores; at most " + std::to_string(kMaxThreads) + ")")
+      ->capture_default_str();
   cmd->add_option("--sun-transmittance", o->sun_transmittance,
                   "Sunlight attenuation at each path vertex: quadrature (exact, default) or ratio-tracking")
       ->capture_default_str();

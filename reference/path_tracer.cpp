@@ -19,6 +19,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "bake/bake.h"
 #include "bake/config.h"
 #include "core/constants.h"
 #include "core/errors.h"
@@ -383,7 +384,10 @@ void Settings::Validate() const {
     throw InputError("max order = " + std::to_string(max_order) + " must be in [0, " +
                      std::to_string(kMaxEventsPerPath) + "] (0: all orders)");
   }
-  if (threads < 0) throw InputError("threads = " + std::to_string(threads) + " must be >= 0");
+  if (threads < 0 || threads > kMaxThreads) {
+    throw InputError("threads = " + std::to_string(threads) + " must be in [0, " + std::to_string(kMaxThreads) +
+                     "] (0: all cores)");
+  }
 }
 
 RayQuery MakeRayQuery(const Query& query, double bottom_radius_m) {

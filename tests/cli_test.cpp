@@ -81,7 +81,7 @@ TEST(CliBake, BakeErrors) {
                        dir, nullptr, &err), 1);
   EXPECT_EQ(Lines(err).size(), 1u) << err;
   EXPECT_EQ(RunCommand(Skybake() + " bake no-such-atmosphere -o " + ShellQuote(dir.path() / "x"), dir), 3);
-  EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + " --orders 0", dir), 1);
+  EXPECT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + " --orders -1", dir), 1);
   // A supercompression that is not none, zstd or zstd:1..22: a usage error
   // naming the option, before anything is baked or written.
   for (const char* value : {"zstd:0", "zstd:23", "zstd:", "zlib", "zstd:3x"}) {

@@ -335,5 +335,37 @@ TEST(PipelineDefects, D13_SceneValueErrorsReadWell) {
   EXPECT_TRUE(Contains(err, "precision.scattering: unknown precision \"double\"")) << err;
 }
 
+// BakeSettings, the --orders help and its own out-of-range message call 0
+// auto: `--orders 0` bakes as `--orders auto` does.
+TEST(PipelineDefects, D13_OrdersZeroIsAuto) {
+  TempDir dir;
+  std::string out, err;
+  const std::string bake = Skybake() + " bake earth -q --json" + kSmallTables + " -o ";
+  ASSERT_EQ(RunCommand(bake + Quoted(dir.path() / "zero") + " --orders 0", dir, &out, &err), 0) << err;
+  const nlohmann::json zero = nlohmann::json::parse(out);
+  EXPECT_EQ(zero["orders"], "auto");
+  ASSERT_EQ(RunCommand(bake + Quoted(dir.path() / "auto") + " --orders auto", dir, &out, &err), 0) << err;
+  EXPECT_EQ(nlohmann::json::parse(out)["orders_used"], zero["orders_used"]);
+  EXPECT_EQ(nlohmann::json::parse(ReadText(dir.path() / "zero" / "skybake.json"))["bake"]["orders"], "auto");
+  OneLineFailure(bake + Quoted(dir.path() / "minus") + " --orders -1", dir, 1);
+}
+
+// --threads has a bound, stated in --help; beyond it a usage error.
+TEST(PipelineDefects, D13_ThreadsAreBounded) {
+  TempDir dir;
+  std::string out;
+  ASSERT_EQ(RunCommand(Skybake() + " bake --help", dir, &out), 0);
+  EXPECT_TRUE(Contains(out, "at most 1024")) << out;
+  for (const char* threads : {"100000", "1025", "-1"}) {
+    const std::string err =
+        OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --threads " + threads,
+                       dir, 1);
+    EXPECT_TRUE(Contains(err, "threads")) << err;
+  }
+  WriteText(dir.path() / "q.csv", "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,0,30,0\n");
+  OneLineFailure(Skybake() + " reference earth --in " + Quoted(dir.path() / "q.csv") + " --paths 64 --threads 100000",
+                 dir, 1);
+}
+
 }  // namespace
 }  // namespace skybake

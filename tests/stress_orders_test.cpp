@@ -177,8 +177,9 @@ TEST(Orders, CommandLineAcceptsAutoAndReportsConvergence) {
     EXPECT_EQ(testing::RunCommand(bake + " --orders '" + bad + "'", dir, &out, &err), 1) << bad;
     EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
   }
-  // Out of range: usage errors too, as every bad option value.
-  EXPECT_EQ(testing::RunCommand(bake + " --orders 0", dir, &out, &err), 1);
+  // Out of range: usage errors too, as every bad option value (0 is auto).
+  EXPECT_EQ(testing::RunCommand(bake + " --orders -1", dir, &out, &err), 1);
+  EXPECT_EQ(testing::RunCommand(bake + " --orders 101", dir, &out, &err), 1);
   EXPECT_EQ(testing::RunCommand(bake + " --orders auto --max-orders 1", dir, &out, &err), 1);
   EXPECT_EQ(testing::RunCommand(bake + " --orders auto --order-tolerance 0", dir, &out, &err), 1);
 }
