@@ -95,9 +95,21 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
 }
 
 // Where each atmosphere's set goes: `output` with {name} replaced by the
-// atmosphere's name, or, for several atmospheres and no {name}, output/name.
+// atmosphere's name (AtmosphereSourceName: "stdin" for standard input), or,
+// for several atmospheres and no {name}, output/name. Any other {...} is a
+// placeholder skybake does not know: a usage error rather than a folder
+// named after it.
 std::vector<std::string> OutputDirs(const BakeOptions& o) {
   constexpr std::string_view kName = "{name}";
+  for (std::size_t open = o.output_dir.find('{'); open != std::string::npos; open = o.output_dir.find('{', open + 1)) {
+    const std::size_t close = o.output_dir.find('}', open);
+    if (close == std::string::npos) break;
+    const std::string placeholder = o.output_dir.substr(open, close - open + 1);
+    if (placeholder.find('{', 1) == std::string::npos && placeholder != kName) {
+      throw UsageError("-o: unknown placeholder " + placeholder + " in " + o.output_dir +
+                       " (the only one is {name}, the atmosphere's name)");
+    }
+  }
   const bool pattern = o.output_dir.find(kName) != std::string::npos;
   std::vector<std::string> dirs;
   for (const std::string& atmosphere : o.atmospheres) {
@@ -179,7 +191,8 @@ void AddBakeCommand(CLI::App& app) {
                   "preset; a bare NAME is the preset where one exists, else a file); several are baked in turn")
       ->required();
   cmd->add_option("-o,--output", o->output_dir,
-                  "Output directory (created if missing); {name} is replaced by the atmosphere's name; with "
+                  "Output directory (created if missing); {name} is replaced by the atmosphere's name (the preset's, "
+                  "the file's without .toml, stdin for standard input; no other {...} placeholder exists); with "
                   "several atmospheres and no {name}, each goes to DIR/NAME")
       ->required();
   cmd->add_flag("--clean", o->clean,

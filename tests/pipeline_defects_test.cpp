@@ -367,5 +367,26 @@ TEST(PipelineDefects, D13_ThreadsAreBounded) {
                  dir, 1);
 }
 
+// {name} in -o: said in --help what it is for standard input (stdin), and
+// any other {...} refused as a usage error instead of becoming a folder.
+TEST(PipelineDefects, D13_OutputPatternsNameOnlyKnownPlaceholders) {
+  TempDir dir;
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + " bake --help", dir, &out), 0);
+  EXPECT_TRUE(Contains(out, "stdin for standard input")) << out;
+  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "{atmosphere}") + kSmallBake, dir, 1);
+  EXPECT_TRUE(Contains(err, "{atmosphere}")) << err;
+  EXPECT_FALSE(fs::exists(dir.path() / "{atmosphere}"));
+  OneLineFailure(Skybake() + " bake earth mars -o " + Quoted(dir.path() / "{name}-{Name}") + kSmallBake, dir, 1);
+  // Standard input's {name} is stdin, as --help and docs/cli.md say.
+  ASSERT_EQ(RunCommand(Skybake() + " bake - -o " + Quoted(dir.path() / "sets/{name}") + kSmallBake + " < " +
+                           Quoted(kSource / "examples/atmospheres/earth.toml"),
+                       dir, nullptr, &err),
+            0)
+      << err;
+  EXPECT_TRUE(fs::exists(dir.path() / "sets" / "stdin" / "skybake.json"));
+  EXPECT_TRUE(Contains(ReadText(kSource / "docs/cli.md"), "`stdin` for standard input"));
+}
+
 }  // namespace
 }  // namespace skybake
