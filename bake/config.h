@@ -17,14 +17,16 @@
 namespace skybake {
 
 // Parses and validates an atmosphere description. `source_name` prefixes
-// error messages (usually the file's base name). With `wavelengths_nm`, every
+// error messages (usually InputName's). With `wavelengths_nm`, every
 // per-wavelength value is taken at those wavelengths instead of the file's
 // [spectrum] (the batches of a spectral bake, bake/spectral.h); a value the
 // file gives as an array of 3 then has no meaning there and is an InputError.
 Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name,
                            std::optional<Spectrum> wavelengths_nm = std::nullopt);
 
-// How messages name an input: "standard input" for "-", else the file name.
+// How messages (and the `file` of --json errors) name an input: "standard
+// input" for "-", else the path as the user gave it, so that it finds the
+// file from where the command ran.
 std::string InputName(const std::string& path);
 
 // An atmosphere named on the command line, by one rule:

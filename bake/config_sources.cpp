@@ -92,9 +92,7 @@ Atmosphere LoadAtmosphere(const std::string& file_or_preset) {
   return ParseAtmosphere(source.text, source.name);
 }
 
-std::string InputName(const std::string& path) {
-  return path == kStandardStream ? "standard input" : std::filesystem::path(path).filename().string();
-}
+std::string InputName(const std::string& path) { return path == kStandardStream ? "standard input" : path; }
 
 std::string AtmosphereSourceName(const std::string& file_or_preset) {
   if (std::optional<std::string> preset = NamedPreset(file_or_preset)) return *preset;

@@ -199,7 +199,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   if (!job.scene_file.empty()) {
     scene.emplace();
     scene->scene = LoadScene(job.scene_file);
-    ValidateSceneForAtmosphere(scene->scene, atmosphere, std::filesystem::path(job.scene_file).filename().string());
+    ValidateSceneForAtmosphere(scene->scene, atmosphere, InputName(job.scene_file));
     if (job.formats_given) {
       throw UsageError("--format: the scene names the formats (output.formats); give one or the other");
     }

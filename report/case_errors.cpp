@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "bake/config.h"
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "formats/query_csv.h"
@@ -70,7 +71,7 @@ ReferenceSet ParseReference(const std::string& text, const std::string& source_n
 
 std::optional<ReferenceSet> LoadReference(const std::string& file, const Atmosphere& atmosphere) {
   if (!file.empty()) {
-    return ParseReference(ReadFileText(file), std::filesystem::path(file).filename().string(), atmosphere);
+    return ParseReference(ReadFileText(file), InputName(file), atmosphere);
   }
   const EmbeddedText* committed = CommittedReference(atmosphere.name);
   if (!committed) return std::nullopt;

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "bake/colour.h"
+#include "bake/config.h"
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "report/reference_files.h"
@@ -106,8 +107,7 @@ const ColourGroup& ColourErrors::Group(const std::string& name) const {
 std::optional<ReferenceSet> LoadSpectralReference(const std::string& file, const std::string& atmosphere_name) {
   const std::string expected = "a spectral reference (columns X, Y, Z; skybake reference --wavelengths N)";
   if (!file.empty()) {
-    return ParseReference(ReadFileText(file), std::filesystem::path(file).filename().string(), XyzChannels(),
-                          expected);
+    return ParseReference(ReadFileText(file), InputName(file), XyzChannels(), expected);
   }
   const EmbeddedText* committed = CommittedReference(atmosphere_name + "_spectral");
   if (!committed) return std::nullopt;

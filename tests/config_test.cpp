@@ -52,7 +52,7 @@ TEST(BadConfigs, EachFailsWithOneLineNamingFileAndProblem) {
     } catch (const InputError& error) {
       std::string message = error.what();
       EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-      EXPECT_EQ(message.rfind(name + ":", 0), 0u) << message;
+      EXPECT_EQ(message.rfind(path.string() + ":", 0), 0u) << message;
       EXPECT_NE(message.find(expected), std::string::npos) << message;
     } catch (const std::exception& error) {
       ADD_FAILURE() << "wrong exception type: " << error.what();

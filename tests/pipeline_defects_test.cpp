@@ -388,5 +388,37 @@ TEST(PipelineDefects, D13_OutputPatternsNameOnlyKnownPlaceholders) {
   EXPECT_TRUE(Contains(ReadText(kSource / "docs/cli.md"), "`stdin` for standard input"));
 }
 
+// An error about a file names it by the path the user gave, in the message
+// and in the --json error's `file`: atmosphere files, scene files and query
+// files alike (they named only the base name).
+TEST(PipelineDefects, D13_ErrorsNameTheFileByThePathGiven) {
+  TempDir dir;
+  fs::create_directories(dir.path() / "sub");
+  WriteText(dir.path() / "sub" / "bad.toml", "name = \"x\"\n[planet]\nground_radius_km = -1\n");
+  std::string out, err;
+  // A relative path stays relative.
+  EXPECT_EQ(RunCommand("cd " + Quoted(dir.path()) + " && " + Skybake() + " validate sub/bad.toml --json", dir, &out,
+                       &err),
+            2);
+  EXPECT_EQ(err.rfind("skybake: sub/bad.toml: ", 0), 0u) << err;
+  EXPECT_EQ(nlohmann::json::parse(out)["error"]["file"], "sub/bad.toml");
+  // An absolute one stays absolute.
+  EXPECT_EQ(RunCommand(Skybake() + " validate " + Quoted(dir.path() / "sub" / "bad.toml") + " --json", dir, &out, &err),
+            2);
+  EXPECT_EQ(nlohmann::json::parse(out)["error"]["file"], (dir.path() / "sub" / "bad.toml").string());
+  // A scene file, and a scene that does not fit the planet.
+  WriteText(dir.path() / "sub" / "scene.toml", "name = \"x\"\n");
+  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --scene " +
+                           Quoted(dir.path() / "sub" / "scene.toml"),
+                       dir, 2);
+  EXPECT_EQ(err.rfind("skybake: " + (dir.path() / "sub" / "scene.toml").string() + ": ", 0), 0u) << err;
+  WriteText(dir.path() / "sub" / "high.toml",
+            "name = \"x\"\n[effects]\nsky = true\n[camera]\naltitude_km = [0, 500]\n[sun]\nzenith_deg = [0, 90]\n");
+  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --scene " +
+                           Quoted(dir.path() / "sub" / "high.toml"),
+                       dir, 2);
+  EXPECT_EQ(err.rfind("skybake: " + (dir.path() / "sub" / "high.toml").string() + ": camera.altitude", 0), 0u) << err;
+}
+
 }  // namespace
 }  // namespace skybake
