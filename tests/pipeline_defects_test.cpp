@@ -420,5 +420,28 @@ TEST(PipelineDefects, D13_ErrorsNameTheFileByThePathGiven) {
   EXPECT_EQ(err.rfind("skybake: " + (dir.path() / "sub" / "high.toml").string() + ": camera.altitude", 0), 0u) << err;
 }
 
+// The docs say what the program does: render's default suns (30 and 85
+// degrees, as `render --help` states), and that a bare word names the
+// preset even where a file of that name exists (as `bake --help` says).
+TEST(PipelineDefects, D13_DocsSayWhatTheProgramDoes) {
+  TempDir dir;
+  std::string out, err;
+  ASSERT_EQ(RunCommand(Skybake() + " render --help", dir, &out), 0);
+  EXPECT_TRUE(Contains(out, "=[30,85]")) << out;
+  const std::string cli = ReadText(kSource / "docs/cli.md");
+  EXPECT_TRUE(Contains(cli, "`--sun-zenith 30,85`"));
+  EXPECT_FALSE(Contains(cli, "--sun-zenith 0,60,85"));
+
+  // A file named earth beside the command: `validate earth` still reads the preset.
+  WriteText(dir.path() / "earth", "name = \"not-the-preset\"\n");
+  ASSERT_EQ(RunCommand("cd " + Quoted(dir.path()) + " && " + Skybake() + " validate earth --json", dir, &out, &err), 0)
+      << err;
+  EXPECT_EQ(nlohmann::json::parse(out)["name"], "earth");
+  const std::string atmospheres = ReadText(kSource / "examples/atmospheres/README.md");
+  EXPECT_FALSE(Contains(atmospheres, "reads FILE when\n  it exists, otherwise the preset"));
+  EXPECT_TRUE(Contains(atmospheres, "reads the preset\n  of that name when there is one, even where a file of that "
+                                    "name exists"));
+}
+
 }  // namespace
 }  // namespace skybake
