@@ -100,6 +100,7 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
 // placeholder skybake does not know: a usage error rather than a folder
 // named after it.
 std::vector<std::string> OutputDirs(const BakeOptions& o) {
+  if (o.output_dir.empty()) throw UsageError("-o: an empty path names no folder");
   constexpr std::string_view kName = "{name}";
   for (std::size_t open = o.output_dir.find('{'); open != std::string::npos; open = o.output_dir.find('{', open + 1)) {
     const std::size_t close = o.output_dir.find('}', open);
@@ -197,7 +198,8 @@ void AddBakeCommand(CLI::App& app) {
       ->required();
   cmd->add_flag("--clean", o->clean,
                 "Remove the files of an earlier set in the output directory that the new set does not list "
-                "(without it, such files make the bake refuse; files no skybake set listed are never removed)");
+                "(without it, such files make the bake refuse before baking); files no skybake manifest there "
+                "listed (an engine's .meta files, a README) are left alone and never in the way");
   o->bake.AddTo(cmd);
   o->format_option = cmd->add_option("--format", o->formats,
                                      "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")

@@ -121,34 +121,6 @@ std::string NameList(const std::vector<std::string>& names) {
   return text;
 }
 
-// The entries of `dir` that are not in `new_files`, after checking that each
-// may be removed: IoError naming them without `clean`, or naming those no
-// earlier skybake set listed.
-std::vector<std::string> StaleFiles(const fs::path& dir, const std::vector<std::string>& new_files, bool clean) {
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return {};
-  const std::vector<std::string> stale = EntriesNotIn(dir, new_files);
-  if (stale.empty()) return stale;
-  if (!clean) {
-    throw IoError(dir.string() + ": holds files the new set would not list: " + NameList(stale) +
-                  " (--clean removes those an earlier skybake set listed; move anything else away)",
-                  ErrorLocation(dir.string()));
-  }
-  const std::vector<std::string> known = ListedFileNames(dir);
-  std::vector<std::string> foreign;
-  for (const std::string& name : stale) {
-    // A folder's name ends in '/', so it is never one of the listed files.
-    const bool ours = std::find(known.begin(), known.end(), name) != known.end() || IsTemporaryFileName(name);
-    if (!ours) foreign.push_back(name);
-  }
-  if (!foreign.empty()) {
-    throw IoError(dir.string() + ": holds files no earlier skybake set there listed, which --clean leaves alone: " +
-                  NameList(foreign) + " (move them away)",
-                  ErrorLocation(dir.string()));
-  }
-  return stale;
-}
-
 }  // namespace
 
 TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table, FileFormat format,
@@ -158,15 +130,39 @@ TableImage MakeTableFileImage(const LutSet& luts, const TableDescription& table,
   return image;
 }
 
+std::vector<std::string> SetFileNames(const LutSet& luts, const WriteOptions& options) {
+  std::vector<std::string> names;
+  for (const TableDescription& table : DescribeTables(luts)) {
+    for (FileFormat format : options.formats) names.push_back(table.name + FileExtension(format));
+  }
+  for (const ShaderFile& shader : options.shaders) names.push_back(shader.file);
+  names.push_back(kManifestFileName);
+  return names;
+}
+
+std::vector<std::string> StaleSetFiles(const fs::path& dir, const std::vector<std::string>& new_files, bool clean) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return {};
+  const std::vector<std::string> listed = ListedFileNames(dir);
+  std::vector<std::string> stale;
+  for (const std::string& name : EntriesNotIn(dir, new_files)) {
+    // A folder's name ends in '/', so it is never one of the listed files.
+    if (std::find(listed.begin(), listed.end(), name) != listed.end() || IsTemporaryFileName(name)) {
+      stale.push_back(name);
+    }
+  }
+  if (!stale.empty() && !clean) {
+    throw IoError(dir.string() + ": holds files of an earlier set that the new set would not list: " +
+                      NameList(stale) + " (--clean removes them; files no skybake set listed are left alone)",
+                  ErrorLocation(dir.string()));
+  }
+  return stale;
+}
+
 WriteReport WriteLutSet(const LutSet& luts, const fs::path& dir, const WriteOptions& options) {
   if (options.formats.empty()) throw InternalError("WriteLutSet: no file format requested");
   const std::vector<TableDescription> tables = DescribeTables(luts);
-  std::vector<std::string> new_files = {kManifestFileName};
-  for (const TableDescription& table : tables) {
-    for (FileFormat format : options.formats) new_files.push_back(table.name + FileExtension(format));
-  }
-  for (const ShaderFile& shader : options.shaders) new_files.push_back(shader.file);
-  const std::vector<std::string> stale = StaleFiles(dir, new_files, options.clean);
+  const std::vector<std::string> stale = StaleSetFiles(dir, SetFileNames(luts, options), options.clean);
 
   std::error_code ec;
   const bool created = !fs::exists(dir, ec);

@@ -39,8 +39,7 @@ struct WriteOptions {
   std::string command_line;   // recorded in the manifest
   std::vector<ShaderFile> shaders;  // written and listed under "shaders"
   // Remove the files of an earlier set in the directory that the new set does
-  // not list (those its manifest listed, and temporary files of a killed
-  // write); without it such files make WriteLutSet refuse.
+  // not list (StaleSetFiles); without it such files make WriteLutSet refuse.
   bool clean = false;
 };
 
@@ -60,10 +59,29 @@ struct WriteReport {
 // the manifest, as one staged set: it appears complete or not at all, and an
 // interrupt (core/interrupt.h) before the commit leaves the directory as it
 // was. A directory it creates is removed again on failure. IoError on
-// failure, and, before anything is written, when the directory holds a file
-// the new set does not list (see WriteOptions::clean; anything that no
-// earlier skybake set listed is never removed).
+// failure, and, before anything is written, when the directory holds files
+// of an earlier set that the new set does not list (StaleSetFiles; removed
+// after the commit with WriteOptions::clean).
 WriteReport WriteLutSet(const LutSet& luts, const std::filesystem::path& dir, const WriteOptions& options);
+
+// The plain names of the files WriteLutSet writes for `luts` with `options`:
+// each table in each format, the shader files, the manifest. A LutSet
+// without texels (atmosphere, settings, parameters, scene, colour) names the
+// same files, so that a pipeline knows them before it bakes.
+std::vector<std::string> SetFileNames(const LutSet& luts, const WriteOptions& options);
+
+// The rule for what else an output folder holds. The files in `dir` that a
+// set of `new_files` written there would leave behind from an earlier set:
+// those the manifest in `dir` lists and `new_files` do not, and temporary
+// files of a killed write. Without `clean` they are an IoError naming them
+// (a set never mixes files of two bakes); with it they are returned, for
+// WriteLutSet to remove once the new set is committed. Everything else is
+// foreign (no skybake manifest there listed it: an engine's .meta files, a
+// README, folders): left alone, and never in the way. A foreign file with
+// the name of one of `new_files` is replaced. WriteLutSet checks this before
+// it writes, the bake pipeline before it bakes.
+std::vector<std::string> StaleSetFiles(const std::filesystem::path& dir, const std::vector<std::string>& new_files,
+                                       bool clean);
 
 // The image of `table` that WriteLutSet encodes into its `format` file: the
 // pixel type `options` asks for, the storage ChooseFileStorage picks.

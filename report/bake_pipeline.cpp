@@ -183,6 +183,26 @@ json SceneSummaryJson(const SceneSummary& s) {
   return j;
 }
 
+// The names of the files the set will hold, known before the bake from a
+// set without texels (SetFileNames): its tables from the settings and the
+// scene, the runtime's files from their languages.
+std::vector<std::string> PlannedFileNames(const Atmosphere& atmosphere, const BakeSettings& settings,
+                                          const std::optional<SceneSummary>& scene,
+                                          const std::vector<ShadingLanguage>& languages, WriteOptions options) {
+  LutSet planned;
+  planned.atmosphere = atmosphere;
+  planned.settings = settings;
+  planned.parameters = MakeAtmosphereParameters(atmosphere, settings);
+  if (scene) planned.scene = scene->scene;
+  for (ShadingLanguage language : languages) {
+    for (const SnippetFile& f :
+         RuntimeSnippetFiles(language, planned.parameters, atmosphere.wavelengths_nm, atmosphere.name)) {
+      options.shaders.push_back(ShaderFile{f.file, {}, f.description});
+    }
+  }
+  return SetFileNames(planned, options);
+}
+
 }  // namespace
 
 BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, const std::filesystem::path& output_dir,
@@ -245,6 +265,10 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   // Checked before baking, created only when the set is written, so a bake
   // that fails or is interrupted leaves no empty folder behind.
   CheckOutputDirectory(output_dir);
+
+  // The files the folder holds besides are judged now, not after the bake.
+  StaleSetFiles(output_dir, PlannedFileNames(atmosphere, out.settings, scene, job.runtime_languages, write_options),
+                job.clean);
 
   // The bake. Each phase's end is a point where an interrupt leaves nothing behind.
   out.atmosphere = atmosphere.name;

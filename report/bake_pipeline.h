@@ -83,7 +83,9 @@ using BakeStepLine = std::function<void(const std::string&)>;
 // together (formats, half or --pack-mie with a scene, compare_full without
 // one, a reference without compare_full, a KTX2 supercompression without
 // KTX2 files, an unknown or no format); the scene, the
-// reference and the output directory are checked before anything is baked.
+// reference and the output directory, with the files it holds
+// (StaleSetFiles in formats/lut_files.h), are checked before anything is
+// baked.
 // `on_phase` sees each phase of the written set's bake and its writing; an
 // interrupt (core/interrupt.h) is thrown after any phase, before the commit
 // leaving nothing behind. Either callback may be empty.
