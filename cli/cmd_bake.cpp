@@ -21,6 +21,7 @@
 #include "core/errors.h"
 #include "core/file_io.h"
 #include "core/interrupt.h"
+#include "formats/manifest.h"
 #include "report/bake_pipeline.h"
 #include "shaders_runtime/snippet.h"
 
@@ -32,6 +33,8 @@ struct BakeOptions {
   std::vector<std::string> atmospheres;
   std::string output_dir;  // with several atmospheres: a folder for one each, or a pattern with {name}
   bool clean = false;
+  bool force = false;    // bake even a set that is up to date
+  std::string depfile;   // written after the bake: the set's manifest and the files it depends on
   BakeSettingsOptions bake;
   std::vector<std::string> formats = {"exr", "ktx2"};
   bool half = false;
@@ -61,6 +64,30 @@ std::vector<ShadingLanguage> ParseRuntimeLanguages(const std::vector<std::string
   return languages;
 }
 
+// Make syntax for a path in a depfile: spaces, '#' and '$' escaped.
+std::string DepfilePath(const std::filesystem::path& path) {
+  std::string escaped;
+  for (char c : std::filesystem::absolute(path).lexically_normal().string()) {
+    if (c == ' ' || c == '#') escaped += '\\';
+    if (c == '$') escaped += '$';
+    escaped += c;
+  }
+  return escaped;
+}
+
+// --depfile: one rule in Make syntax, as Ninja and Make read them (CMake's
+// DEPFILE): the set's manifest, which a bake writes last and a skipped bake
+// leaves as it is, depends on the files the bake read, the atmosphere file
+// (a preset is inside the program) and the scene file. Absolute paths, so
+// that the build's working directory does not matter.
+void WriteDepfile(const std::string& depfile, const std::string& output_dir, const report::BakeJob& job) {
+  std::string rule = DepfilePath(std::filesystem::path(output_dir) / kManifestFileName) + ":";
+  for (const std::string& input : {job.spectral_source.file, job.scene_file}) {
+    if (!input.empty()) rule += " " + DepfilePath(input);
+  }
+  WriteFileAtomically(depfile, rule + "\n");
+}
+
 // Bakes one atmosphere into `output_dir` (report/bake_pipeline.h), with the
 // phases and the summary on stderr unless --quiet; the --json report of it.
 nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, const std::string& output_dir) {
@@ -82,6 +109,7 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   job.compare_full = o.compare_full;
   job.reference_file = o.reference;
   job.clean = o.clean;
+  job.skip_up_to_date = !o.force;
   job.command_line = CommandLine();
   report::BakeStepLine print_step;
   BakeProgress print_phase;
@@ -91,6 +119,7 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   }
   const report::BakeOutcome outcome = report::BakeAndWrite(atmosphere, job, output_dir, print_step, print_phase);
   if (!o.quiet) std::fputs(report::BakeSummaryText(outcome).c_str(), stderr);
+  if (!o.depfile.empty()) WriteDepfile(o.depfile, output_dir, job);
   return report::BakeOutcomeJson(outcome);
 }
 
@@ -101,6 +130,9 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
 // named after it.
 std::vector<std::string> OutputDirs(const BakeOptions& o) {
   if (o.output_dir.empty()) throw UsageError("-o: an empty path names no folder");
+  if (!o.depfile.empty() && o.atmospheres.size() > 1) {
+    throw UsageError("--depfile: names the inputs of one set; bake one atmosphere per depfile");
+  }
   constexpr std::string_view kName = "{name}";
   for (std::size_t open = o.output_dir.find('{'); open != std::string::npos; open = o.output_dir.find('{', open + 1)) {
     const std::size_t close = o.output_dir.find('}', open);
@@ -200,6 +232,13 @@ void AddBakeCommand(CLI::App& app) {
                 "Remove the files of an earlier set in the output directory that the new set does not list "
                 "(without it, such files make the bake refuse before baking); files no skybake manifest there "
                 "listed (an engine's .meta files, a README) are left alone and never in the way");
+  cmd->add_flag("--force", o->force,
+                "Bake even when the output directory holds a set that is up to date: one whose manifest records "
+                "the same inputs (atmosphere, settings, scene, formats, version) and whose files are there at "
+                "their sizes, which is otherwise left as it is");
+  cmd->add_option("--depfile", o->depfile,
+                  "Also write FILE, a Make-syntax rule for build systems (Ninja, Make, CMake's DEPFILE): the set's "
+                  "skybake.json depends on the atmosphere and scene files read; one atmosphere only");
   o->bake.AddTo(cmd);
   o->format_option = cmd->add_option("--format", o->formats,
                                      "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")

@@ -43,7 +43,7 @@ bool IsHalf(const TableDescription& table, const WriteOptions& options) {
 // The staged writing of WriteLutSet.
 WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescription>& tables, const fs::path& dir,
                            const WriteOptions& options) {
-  ManifestWriter manifest(luts, options.command_line);
+  ManifestWriter manifest(luts, options.command_line, options.inputs_sha256);
   WriteReport report;
   // The whole set is staged and renamed at the end, so a failure or an
   // interrupt part-way leaves the previous set (files and manifest) as it was.

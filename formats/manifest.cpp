@@ -50,8 +50,8 @@ bool IsHexDigest(const std::string& s) {
 
 }  // namespace
 
-ManifestWriter::ManifestWriter(const LutSet& luts, std::string command_line)
-    : luts_(luts), command_line_(std::move(command_line)) {
+ManifestWriter::ManifestWriter(const LutSet& luts, std::string command_line, std::string inputs_sha256)
+    : luts_(luts), command_line_(std::move(command_line)), inputs_sha256_(std::move(inputs_sha256)) {
   for (const TableDescription& t : DescribeTables(luts)) {
     ordered_json channels = ordered_json::array();
     for (const TableChannel& c : t.channels) {
@@ -155,6 +155,7 @@ std::string ManifestWriter::Text() const {
       {"schema_version", kManifestSchemaVersion},
       {"generator", "skybake " SKYBAKE_VERSION},
       {"command", command_line_},
+      {"inputs_sha256", inputs_sha256_.empty() ? ordered_json(nullptr) : ordered_json(inputs_sha256_)},
       {"wavelengths_nm", luts_.colour ? ordered_json(luts_.colour->wavelengths_nm) : ordered_json({w.x, w.y, w.z})},
       {"colour", luts_.colour ? ColourToJson(luts_) : ordered_json(nullptr)},
       {"parameters", ParametersToJson(luts_.parameters)},
@@ -292,6 +293,13 @@ Manifest ReadManifest(const fs::path& dir) {
       }
     }
     for (const json& f : m.document.at("shaders")) m.shader_files.push_back(read_file(f, ""));
+    // Added within schema version 8: absent in sets written before it, null
+    // in sets not written by a bake.
+    const json inputs = m.document.value("inputs_sha256", json(nullptr));
+    if (!inputs.is_null()) {
+      m.inputs_sha256 = inputs.get<std::string>();
+      if (!IsHexDigest(m.inputs_sha256)) throw IoError(where + ": malformed inputs_sha256");
+    }
   } catch (const json::exception& e) {
     throw IoError(where + ": malformed manifest: " + e.what());
   } catch (const InputError& e) {

@@ -26,7 +26,9 @@ inline constexpr int kManifestSchemaVersion = 8;
 
 class ManifestWriter {
  public:
-  ManifestWriter(const LutSet& luts, std::string command_line);
+  // `inputs_sha256`: the hash of what determined the set (recorded as
+  // "inputs_sha256"); empty: none, null in the manifest.
+  ManifestWriter(const LutSet& luts, std::string command_line, std::string inputs_sha256);
 
   // A table file as written: its size in bytes and their SHA-256 (hex).
   void AddTableFile(const TableDescription& table, const std::string& file, const TableImage& image,
@@ -41,6 +43,7 @@ class ManifestWriter {
  private:
   const LutSet& luts_;
   std::string command_line_;
+  std::string inputs_sha256_;
   nlohmann::ordered_json tables_ = nlohmann::ordered_json::array();
   nlohmann::ordered_json shaders_ = nlohmann::ordered_json::array();
 };
@@ -61,6 +64,9 @@ struct Manifest {
   LutSet luts;                 // atmosphere, settings and parameters; textures empty
   std::vector<ManifestFile> table_files;
   std::vector<ManifestFile> shader_files;
+  // The hash of the bake's inputs; empty where the manifest records none
+  // (written before it was recorded, or not by `skybake bake`).
+  std::string inputs_sha256;
   nlohmann::json document;
 
   std::filesystem::path Directory() const { return path.parent_path(); }

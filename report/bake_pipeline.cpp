@@ -13,7 +13,9 @@
 #include "core/file_io.h"
 #include "core/interrupt.h"
 #include "formats/lut_tables.h"
+#include "formats/manifest.h"
 #include "formats/settings_record.h"
+#include "report/bake_inputs.h"
 #include "shaders_runtime/snippet.h"
 
 namespace skybake::report {
@@ -203,10 +205,29 @@ std::vector<std::string> PlannedFileNames(const Atmosphere& atmosphere, const Ba
   return SetFileNames(planned, options);
 }
 
+// `out` for a set found up to date: the manifest's tables (without texels),
+// orders and files, the settings as planned (the manifest's, with those it
+// does not record), and the check as the one phase, timed from `start`.
+void FillSkippedOutcome(Manifest set, std::chrono::steady_clock::time_point start, BakeOutcome* out) {
+  out->skipped = true;
+  out->luts = std::move(set.luts);
+  out->luts.settings = out->settings;
+  out->report.orders_used = out->luts.orders_used;
+  for (const ManifestFile& f : set.table_files) out->written.files.push_back({f.table, f.file, f.bytes});
+  for (const ManifestFile& f : set.shader_files) out->written.files.push_back({"", f.file, f.bytes});
+  std::error_code ec;
+  out->written.files.push_back({"", kManifestFileName, std::filesystem::file_size(set.path, ec)});
+  const BakeTiming check{"check the set is up to date",
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+  out->report.timings.push_back(check);
+  out->report.total_seconds = check.seconds;
+}
+
 }  // namespace
 
 BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, const std::filesystem::path& output_dir,
                          const BakeStepLine& on_step, const BakeProgress& on_phase) {
+  const auto start = std::chrono::steady_clock::now();
   // The plan: a scene narrows the atmosphere's ranges and the settings, and
   // names the formats and the tables stored as half.
   BakeOutcome out;
@@ -266,7 +287,20 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   // that fails or is interrupted leaves no empty folder behind.
   CheckOutputDirectory(output_dir);
 
-  // The files the folder holds besides are judged now, not after the bake.
+  // Incremental bakes (report/bake_inputs.h): the manifest records the
+  // inputs' hash, and a set up to date for it is left as it is. Otherwise
+  // the files the folder holds besides are judged now, not after the bake.
+  write_options.inputs_sha256 = BakeInputsSha256(full_atmosphere, job, batches ? &*batches : nullptr,
+                                                 scene ? &scene->scene : nullptr, write_options);
+  out.inputs_sha256 = write_options.inputs_sha256;
+  if (job.skip_up_to_date && !job.compare_full) {
+    if (std::optional<Manifest> set = ReadUpToDateSet(output_dir, out.inputs_sha256)) {
+      out.atmosphere = atmosphere.name;
+      if (on_step) on_step(atmosphere.name + ": " + output_dir.string() + " is up to date, not baked again");
+      FillSkippedOutcome(std::move(*set), start, &out);
+      return out;
+    }
+  }
   StaleSetFiles(output_dir, PlannedFileNames(atmosphere, out.settings, scene, job.runtime_languages, write_options),
                 job.clean);
 
@@ -331,6 +365,13 @@ std::string BakeSummaryText(const BakeOutcome& outcome) {
   const BakeReport& report = outcome.report;
   const BakeSettings& settings = outcome.settings;
   std::string out;
+  if (outcome.skipped) {
+    Append(&out,
+           "  %s records the same inputs (sha256 %.12s...) and the files it lists are there at their sizes "
+           "(checked in %.3f s); --force bakes anyway\n",
+           kManifestFileName, outcome.inputs_sha256.c_str(), report.total_seconds);
+    return out;
+  }
   Append(&out, "  %-36s %8.3f s\n", "total", report.total_seconds);
   Append(&out, "  orders used %d, ratio of the last two %.4g, extrapolated tail %.3g, ", report.orders_used,
          report.order_ratio, report.extrapolated_tail);
@@ -369,14 +410,18 @@ json BakeOutcomeJson(const BakeOutcome& outcome) {
   json j = json(SettingsJson(outcome.luts.settings, SettingsFields::kBakeReport));
   j["atmosphere"] = outcome.atmosphere;
   j["output_dir"] = outcome.output_dir.string();
+  j["skipped"] = outcome.skipped;
+  j["inputs_sha256"] = outcome.inputs_sha256;
   j["orders_used"] = report.orders_used;
-  j["order_ratio"] = report.order_ratio;
-  j["extrapolated_tail"] = report.extrapolated_tail;
-  j["remaining_error"] = report.remaining_error >= 0.0 ? json(report.remaining_error) : json(nullptr);
+  if (!outcome.skipped) {  // figures of the bake that the manifest does not record
+    j["order_ratio"] = report.order_ratio;
+    j["extrapolated_tail"] = report.extrapolated_tail;
+    j["remaining_error"] = report.remaining_error >= 0.0 ? json(report.remaining_error) : json(nullptr);
+  }
   j["pixel_type"] = outcome.half ? "half" : "float";
   j["formats"] = outcome.formats;
   j["files"] = files;
-  j["half_error"] = half_errors;
+  if (!outcome.skipped) j["half_error"] = half_errors;
   j["timings"] = timings;
   j["total_seconds"] = report.total_seconds;
   if (outcome.scene) j["scene"] = SceneSummaryJson(*outcome.scene);

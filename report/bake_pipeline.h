@@ -38,6 +38,10 @@ struct BakeJob {
   // The runtime's languages written beside the tables (shaders_runtime/snippet.h); empty: none.
   std::vector<ShadingLanguage> runtime_languages{std::begin(kShadingLanguages), std::end(kShadingLanguages)};
   bool clean = false;          // WriteOptions::clean
+  // Leave a set in the output directory that is up to date for these inputs
+  // as it is (report/bake_inputs.h) instead of baking it again; never with
+  // compare_full, which measures the bake.
+  bool skip_up_to_date = false;
   // A spectral bake (bake/spectral.h) of this many wavelengths, reading
   // `spectral_source` (the atmosphere's text) at each batch; 0: the
   // atmosphere's own three wavelengths (SpectralWavelengths refuses 1, 2 and
@@ -66,6 +70,11 @@ struct SceneSummary {
 struct BakeOutcome {
   std::string atmosphere;  // its name
   std::filesystem::path output_dir;
+  std::string inputs_sha256;  // the hash of the inputs (report/bake_inputs.h), as the manifest records it
+  // The set in output_dir was up to date and left as it was: nothing was
+  // baked or written; luts (without texels) and written are the manifest's,
+  // and the report's one phase is the check.
+  bool skipped = false;
   std::vector<std::string> formats;  // as named (the job's or the scene's)
   bool half = false;
   BakeSettings settings;  // as baked: the scene's plan applied
@@ -85,7 +94,8 @@ using BakeStepLine = std::function<void(const std::string&)>;
 // KTX2 files, an unknown or no format); the scene, the
 // reference and the output directory, with the files it holds
 // (StaleSetFiles in formats/lut_files.h), are checked before anything is
-// baked.
+// baked. With job.skip_up_to_date a set there that is up to date is left as
+// it is (BakeOutcome::skipped).
 // `on_phase` sees each phase of the written set's bake and its writing; an
 // interrupt (core/interrupt.h) is thrown after any phase, before the commit
 // leaving nothing behind. Either callback may be empty.
