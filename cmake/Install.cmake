@@ -1,5 +1,6 @@
-# `cmake --install BUILD --prefix PREFIX` puts the command-line tool and its
-# image module, the loader library (skybake::formats: LoadLutSet and the manifest, with the
+# `cmake --install BUILD --prefix PREFIX` puts the command-line tool
+# (skybake::skybake, which skybake_add_bake in cmake/skybakeAddBake.cmake runs
+# as a step of a build) and its image module, the loader library (skybake::formats: LoadLutSet and the manifest, with the
 # LutSet of skybake::bake, the CPU twin of skybake::runtime and the errors
 # of skybake::core), their headers
 # and the runtime GLSL into PREFIX, with a CMake package:
@@ -23,7 +24,8 @@ foreach(target skybake_core skybake_runtime skybake_bake skybake_formats)
   target_include_directories(${target} INTERFACE $<INSTALL_INTERFACE:${SKYBAKE_INSTALL_INCLUDEDIR}>)
 endforeach()
 
-install(TARGETS skybake RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The program, skybake::skybake in the package (skybake_add_bake runs it).
+install(TARGETS skybake EXPORT skybakeTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The image module, where plot/image_library.cpp looks beside bin/.
 install(TARGETS skybake_images LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/skybake)
 install(TARGETS skybake_core skybake_runtime skybake_bake skybake_formats EXPORT skybakeTargets
@@ -42,5 +44,5 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/skybakeConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/skybakeConfig.cmake INSTALL_DESTINATION ${SKYBAKE_INSTALL_CMAKEDIR})
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/skybakeConfigVersion.cmake COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/skybakeConfig.cmake ${PROJECT_BINARY_DIR}/skybakeConfigVersion.cmake
-              ${PROJECT_SOURCE_DIR}/cmake/OpenImageIO.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/OpenImageIO.cmake ${PROJECT_SOURCE_DIR}/cmake/skybakeAddBake.cmake
         DESTINATION ${SKYBAKE_INSTALL_CMAKEDIR})

@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config git
+  build-essential cmake ninja-build pkg-config git
   libopenexr-dev openexr
   libopenimageio-dev openimageio-tools
   libceres-dev libglm-dev libtbb-dev
