@@ -2,7 +2,8 @@
 // engines and the loader read first (schema documented in docs/manifest.md).
 // It lists every file with its format, pixel type, size, channel meanings,
 // encoding, units, parameterization and SHA-256, plus the runtime constants,
-// the bake settings, the resolved atmosphere and the command that wrote it.
+// the bake settings, the resolved atmosphere, the command that wrote it and
+// the hash of the bake's inputs (report/bake_inputs.h).
 #pragma once
 
 #include <cstdint>

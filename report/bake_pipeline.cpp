@@ -184,6 +184,20 @@ json SceneSummaryJson(const SceneSummary& s) {
   }
   return j;
 }
+// The runtime's files in each of `languages`, its constants from `parameters`.
+std::vector<ShaderFile> RuntimeShaderFiles(const std::vector<ShadingLanguage>& languages,
+                                           const glsl::AtmosphereParameters& parameters, const Atmosphere& atmosphere,
+                                           const SnippetParts& parts) {
+  std::vector<ShaderFile> files;
+  for (ShadingLanguage language : languages) {
+    for (SnippetFile& f :
+         RuntimeSnippetFiles(language, parameters, atmosphere.wavelengths_nm, atmosphere.name, parts)) {
+      files.push_back(ShaderFile{f.file, std::move(f.text), f.description});
+    }
+  }
+  return files;
+}
+
 
 // The names of the files the set will hold, known before the bake from a
 // set without texels (SetFileNames): its tables from the settings and the
@@ -196,12 +210,7 @@ std::vector<std::string> PlannedFileNames(const Atmosphere& atmosphere, const Ba
   planned.settings = settings;
   planned.parameters = MakeAtmosphereParameters(atmosphere, settings);
   if (scene) planned.scene = scene->scene;
-  for (ShadingLanguage language : languages) {
-    for (const SnippetFile& f :
-         RuntimeSnippetFiles(language, planned.parameters, atmosphere.wavelengths_nm, atmosphere.name)) {
-      options.shaders.push_back(ShaderFile{f.file, {}, f.description});
-    }
-  }
+  options.shaders = RuntimeShaderFiles(languages, planned.parameters, atmosphere, {});
   return SetFileNames(planned, options);
 }
 
@@ -210,6 +219,7 @@ std::vector<std::string> PlannedFileNames(const Atmosphere& atmosphere, const Ba
 // does not record), and the check as the one phase, timed from `start`.
 void FillSkippedOutcome(Manifest set, std::chrono::steady_clock::time_point start, BakeOutcome* out) {
   out->skipped = true;
+  out->atmosphere = out->luts.atmosphere.name;
   out->luts = std::move(set.luts);
   out->luts.settings = out->settings;
   out->report.orders_used = out->luts.orders_used;
@@ -295,7 +305,6 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   out.inputs_sha256 = write_options.inputs_sha256;
   if (job.skip_up_to_date && !job.compare_full) {
     if (std::optional<Manifest> set = ReadUpToDateSet(output_dir, out.inputs_sha256)) {
-      out.atmosphere = atmosphere.name;
       if (on_step) on_step(atmosphere.name + ": " + output_dir.string() + " is up to date, not baked again");
       FillSkippedOutcome(std::move(*set), start, &out);
       return out;
@@ -342,12 +351,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     if (reference) scene->accuracy = MeasureSceneAccuracy(*reference, scene->scene, out.luts, full);
   }
   // The runtime goes beside the tables, its constants from this bake's parameters.
-  for (ShadingLanguage language : job.runtime_languages) {
-    for (SnippetFile& f :
-         RuntimeSnippetFiles(language, out.luts.parameters, atmosphere.wavelengths_nm, atmosphere.name, parts)) {
-      write_options.shaders.push_back(ShaderFile{f.file, std::move(f.text), f.description});
-    }
-  }
+  write_options.shaders = RuntimeShaderFiles(job.runtime_languages, out.luts.parameters, atmosphere, parts);
 
   // The write, timed as one more phase.
   const auto write_start = std::chrono::steady_clock::now();
