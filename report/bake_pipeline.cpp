@@ -184,6 +184,7 @@ json SceneSummaryJson(const SceneSummary& s) {
   }
   return j;
 }
+
 // The runtime's files in each of `languages`, its constants from `parameters`.
 std::vector<ShaderFile> RuntimeShaderFiles(const std::vector<ShadingLanguage>& languages,
                                            const glsl::AtmosphereParameters& parameters, const Atmosphere& atmosphere,
@@ -197,7 +198,6 @@ std::vector<ShaderFile> RuntimeShaderFiles(const std::vector<ShadingLanguage>& l
   }
   return files;
 }
-
 
 // The names of the files the set will hold, known before the bake from a
 // set without texels (SetFileNames): its tables from the settings and the
@@ -219,8 +219,8 @@ std::vector<std::string> PlannedFileNames(const Atmosphere& atmosphere, const Ba
 // does not record), and the check as the one phase, timed from `start`.
 void FillSkippedOutcome(Manifest set, std::chrono::steady_clock::time_point start, BakeOutcome* out) {
   out->skipped = true;
-  out->atmosphere = out->luts.atmosphere.name;
   out->luts = std::move(set.luts);
+  out->atmosphere = out->luts.atmosphere.name;
   out->luts.settings = out->settings;
   out->report.orders_used = out->luts.orders_used;
   for (const ManifestFile& f : set.table_files) out->written.files.push_back({f.table, f.file, f.bytes});
