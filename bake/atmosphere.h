@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/spectral_form.h"
 #include "core/spectrum.h"
 
 namespace skybake {
@@ -59,6 +60,8 @@ struct Constituent {
   DensityProfile density;
   Spectrum scattering_per_m{0.0};  // at relative density 1
   Spectrum absorption_per_m{0.0};  // at relative density 1
+  // How the file gave them (bake/spectral_form.h); kValues when built by hand.
+  SpectralForm scattering_form, absorption_form;
   PhaseFunction phase;
 
   Spectrum Extinction() const { return scattering_per_m + absorption_per_m; }
@@ -72,6 +75,10 @@ struct Atmosphere {
   Spectrum ground_albedo{0.0};
   Spectrum wavelengths_nm{680.0, 550.0, 440.0};
   Spectrum solar_irradiance{0.0};  // at the top of the atmosphere, W m^-2 nm^-1
+  // How the file gave the albedo and the sun (bake/spectral_form.h): the
+  // canonical TOML writes these forms where they give the values above;
+  // kValues when built by hand.
+  SpectralForm ground_albedo_form, solar_irradiance_form;
   double sun_angular_radius_rad = 0.0;
   double mu_s_min = -0.2;  // cosine of the lowest sun zenith the tables cover
   std::vector<Constituent> constituents;

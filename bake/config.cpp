@@ -24,13 +24,12 @@
 
 #include <toml++/toml.h>
 
-#include "bake/physics.h"
 #include "bake/spectral_data.h"
+#include "bake/spectral_form.h"
 #include "bake/toml_input.h"
 #include "core/constants.h"
 #include "core/errors.h"
 #include "core/file_io.h"
-#include "core/interpolation.h"
 
 namespace skybake {
 
@@ -168,12 +167,6 @@ constexpr PhaseName kPhaseNames[] = {
     {"cornette-shanks", PhaseKind::kCornetteShanks},
 };
 
-// The published solar spectrum `sun.irradiance_w_m2_nm` can name.
-constexpr std::string_view kAstmG173 = "astm-g173";
-
-// The published cross-sections `{ cross_section = ... }` can name.
-constexpr std::string_view kOzone233K = "ozone-233k";
-
 // The table forms of a coefficient (see examples/atmospheres/README.md).
 enum class CoefficientForm { kRayleighLaw, kAngstrom, kRefractiveIndex, kTabulated, kCrossSection };
 struct CoefficientFormKeys {
@@ -185,13 +178,20 @@ const CoefficientFormKeys kCoefficientForms[] = {
     {CoefficientForm::kAngstrom, {"angstrom_reference", "reference_nm", "exponent"}},
     {CoefficientForm::kRefractiveIndex,
      {"refractive_index", "number_density_per_m3", "depolarization"}},
-    {CoefficientForm::kTabulated, {"wavelength_nm", "per_m"}},
+    {CoefficientForm::kTabulated, {"wavelength_nm", "per_m", "interpolation"}},
     {CoefficientForm::kCrossSection, {"cross_section", "molecules_per_m3"}},
 };
 constexpr const char* kCoefficientFormsText =
     "{ rayleigh_at_1um }, { angstrom_reference, reference_nm, exponent }, "
-    "{ refractive_index, number_density_per_m3, depolarization }, { wavelength_nm, per_m } or "
+    "{ refractive_index, number_density_per_m3, depolarization }, { wavelength_nm, per_m[, interpolation] } or "
     "{ cross_section, molecules_per_m3 }";
+
+// A per-wavelength value at the wavelengths the file is read at, and the
+// form the file gave it in.
+struct SpectralValue {
+  Spectrum values{0.0};
+  SpectralForm form;
+};
 
 // A length given as <base>_km or <base>_m, as written and in metres.
 struct Length {
@@ -204,7 +204,8 @@ class FileReader : public TomlReader {
  public:
   // With `wavelengths_nm`, the atmosphere is read at those wavelengths
   // instead of the file's [spectrum] (a spectral bake's batches); values
-  // given once per file wavelength then have no meaning and are errors.
+  // given once per file wavelength then have no meaning and are errors,
+  // but for the ground's albedo, read as the smooth reflectance through them.
   FileReader(const std::string& source, std::optional<Spectrum> wavelengths_nm)
       : TomlReader(source), wavelengths_override_(wavelengths_nm) {}
 
@@ -216,15 +217,17 @@ class FileReader : public TomlReader {
     if (const toml::node* node = root.get("description"))
       atmosphere.description = ReadString(*node, "description");
 
-    ReadPlanet(RequireTable(root, "", "planet"), atmosphere);
-
-    atmosphere.wavelengths_nm = kDefaultWavelengthsNm;
+    // The wavelengths first: the planet's albedo given at the file's three
+    // is read through them at other wavelengths.
+    file_wavelengths_nm_ = kDefaultWavelengthsNm;
     if (const toml::table* spectrum = OptionalTable(root, "", "spectrum")) {
       CheckKeys(*spectrum, "spectrum", {"wavelengths_nm"});
       if (const toml::node* node = spectrum->get("wavelengths_nm"))
-        atmosphere.wavelengths_nm = ReadArray3(*node, "spectrum.wavelengths_nm", kPositive);
+        file_wavelengths_nm_ = ReadArray3(*node, "spectrum.wavelengths_nm", kPositive);
     }
-    if (wavelengths_override_) atmosphere.wavelengths_nm = *wavelengths_override_;
+    atmosphere.wavelengths_nm = wavelengths_override_ ? *wavelengths_override_ : file_wavelengths_nm_;
+
+    ReadPlanet(RequireTable(root, "", "planet"), atmosphere);
 
     ReadSun(RequireTable(root, "", "sun"), atmosphere);
 
@@ -260,17 +263,89 @@ class FileReader : public TomlReader {
     return value;
   }
 
-  // A per-wavelength value: one number for all wavelengths, or an array of 3.
-  Spectrum ReadSpectrum(const toml::node& node, const std::string& path,
-                        const Interval& interval) const {
-    if (node.is_number()) return Spectrum(ReadNumber(node, path, interval));
+  // A per-wavelength value given as one number for all wavelengths, or as an
+  // array of 3 at the file's wavelengths, which read at other wavelengths
+  // (a spectral bake's) has no meaning: `elsewhere` lists what would.
+  SpectralValue ReadNumberOrArray(const toml::node& node, const std::string& path, const Interval& interval,
+                                  const std::string& elsewhere) const {
+    SpectralValue value;
+    if (node.is_number()) {
+      const double number = ReadNumber(node, path, interval);
+      value.form.kind = SpectralForm::Kind::kConstant;
+      value.form.parameters = {number};
+      value.values = Spectrum(number);
+      return value;
+    }
     if (!node.is_array())
       report_.Fail(path, "expected a number or an array of 3 numbers, got " + TypeName(node));
     if (wavelengths_override_) {
       report_.Fail(path, "gives a value at each of spectrum.wavelengths_nm only; a spectral bake needs it at "
-                         "any wavelength: one number, a law, a tabulated spectrum or a cross-section");
+                         "any wavelength: " + elsewhere);
     }
-    return ReadArray3(node, path, interval);
+    value.values = ReadArray3(node, path, interval);
+    return value;
+  }
+
+  // A tabulated spectrum { wavelength_nm = [...], <value_key> = [...] }: at
+  // least 2 samples, wavelengths increasing, values in `interval`; with
+  // `interpolation` allowed, that key may choose "angstrom" over "linear".
+  SpectralForm ReadTable(const toml::table& table, const std::string& path, std::string_view value_key,
+                         const Interval& interval, bool interpolation) const {
+    const std::string wavelengths_path = path + ".wavelength_nm", values_path = Join(path, value_key);
+    auto read_array = [&](std::string_view key, const std::string& key_path, const Interval& range) {
+      const toml::array* array = Require(table, path, key).as_array();
+      if (!array) report_.Fail(key_path, "expected an array of numbers");
+      std::vector<double> values;
+      for (std::size_t i = 0; i < array->size(); ++i) {
+        values.push_back(ReadNumber(*array->get(i), Index(key_path, i), range));
+      }
+      return values;
+    };
+    SpectralForm form;
+    form.kind = SpectralForm::Kind::kTabulated;
+    form.wavelength_nm = read_array("wavelength_nm", wavelengths_path, kPositive);
+    form.values = read_array(value_key, values_path, interval);
+    const std::vector<double>& nm = form.wavelength_nm;
+    if (nm.size() < 2) report_.Fail(wavelengths_path, "needs at least 2 wavelengths");
+    if (form.values.size() != nm.size()) {
+      report_.Fail(values_path, "has " + std::to_string(form.values.size()) + " values for " +
+                                    std::to_string(nm.size()) + " wavelengths");
+    }
+    for (std::size_t i = 1; i < nm.size(); ++i) {
+      if (!(nm[i] > nm[i - 1])) report_.Fail(Index(wavelengths_path, i), "must exceed the wavelength before it");
+    }
+    if (const toml::node* node = interpolation ? table.get("interpolation") : nullptr) {
+      const std::string interpolation_path = path + ".interpolation";
+      const std::string name = ReadString(*node, interpolation_path);
+      if (name == ToString(SpectralForm::Interpolation::kAngstrom)) {
+        form.interpolation = SpectralForm::Interpolation::kAngstrom;
+      } else if (name != ToString(SpectralForm::Interpolation::kLinear)) {
+        report_.Fail(interpolation_path, TomlString(name) + " is not an interpolation (expected \"linear\" or "
+                                                            "\"angstrom\")");
+      }
+    }
+    if (form.interpolation == SpectralForm::Interpolation::kAngstrom) {
+      for (std::size_t i = 0; i < form.values.size(); ++i) {
+        if (!(form.values[i] > 0.0))
+          report_.FailValue(Index(values_path, i), form.values[i],
+                            "must be > 0 with interpolation = \"angstrom\" (a power law through the samples)");
+      }
+    }
+    return form;
+  }
+
+  // A table's values at the wavelengths; a linear table must cover them.
+  Spectrum TableValues(const SpectralForm& form, const std::string& path, const Spectrum& wavelengths_nm) const {
+    const std::vector<double>& nm = form.wavelength_nm;
+    for (int c = 0; c < kWavelengthCount; ++c) {
+      const double w = wavelengths_nm[c];
+      if (form.interpolation == SpectralForm::Interpolation::kLinear && !(w >= nm.front() && w <= nm.back())) {
+        report_.Fail(path + ".wavelength_nm", "covers " + FormatNumber(nm.front()) + " to " +
+                                                  FormatNumber(nm.back()) + " nm, not the wavelength " +
+                                                  FormatNumber(w) + " nm");
+      }
+    }
+    return Evaluate(form, wavelengths_nm);
   }
 
   Length ReadLength(const toml::table& table, const std::string& path,
@@ -295,32 +370,86 @@ class FileReader : public TomlReader {
                         "must exceed " + ground.path + " = " + FormatNumber(ground.written));
     atmosphere.bottom_radius_m = ground.metres;
     atmosphere.top_radius_m = top.metres;
-    atmosphere.ground_albedo =
-        ReadSpectrum(Require(planet, "planet", "ground_albedo"), "planet.ground_albedo", kUnit);
+    const SpectralValue albedo = ReadAlbedo(Require(planet, "planet", "ground_albedo"), atmosphere.wavelengths_nm);
+    atmosphere.ground_albedo = albedo.values;
+    atmosphere.ground_albedo_form = albedo.form;
   }
 
-  // The sun's irradiance at the wavelengths: a number, 3 numbers, or
-  // "astm-g173", the 10 nm bin means of the ASTM G173-03 extraterrestrial
-  // spectrum from each wavelength up (bake/spectral_data.h).
-  Spectrum ReadSolarIrradiance(const toml::node& node, const Spectrum& wavelengths_nm) const {
-    const std::string path = "sun.irradiance_w_m2_nm";
-    if (!node.is_string()) {
-      if (!node.is_number() && !node.is_array())
-        report_.Fail(path, "expected a number, an array of 3 numbers or \"" + std::string(kAstmG173) + "\", got " +
-                               TypeName(node));
-      return ReadSpectrum(node, path, kNonNegative);
+  // The ground's albedo: a number, 3 numbers at the file's wavelengths (read
+  // at others as the smooth reflectance through them, SmoothReflectance), or
+  // a tabulated spectrum { wavelength_nm, albedo }, linear between samples.
+  SpectralValue ReadAlbedo(const toml::node& node, const Spectrum& wavelengths_nm) const {
+    const std::string path = "planet.ground_albedo";
+    SpectralValue albedo;
+    if (const toml::table* table = node.as_table()) {
+      CheckKeys(*table, path, {"wavelength_nm", "albedo"});
+      albedo.form = ReadTable(*table, path, "albedo", kUnit, false);
+      albedo.values = TableValues(albedo.form, path, wavelengths_nm);
+      return albedo;
     }
-    const std::string name = **node.as_string();
-    if (name != kAstmG173) {
-      report_.Fail(path, "unknown spectrum \"" + name + "\" (expected \"" + std::string(kAstmG173) + "\")");
-    }
-    Spectrum irradiance;
+    if (!node.is_number() && !node.is_array())
+      report_.Fail(path, "expected a number, an array of 3 numbers or a table { wavelength_nm, albedo }, got " +
+                             TypeName(node));
+    if (node.is_number()) return ReadNumberOrArray(node, path, kUnit, "");
+    const Spectrum samples = ReadArray3(node, path, kUnit);
+    albedo.values = samples;
+    if (!wavelengths_override_) return albedo;
     for (int i = 0; i < kWavelengthCount; ++i) {
-      if (!(wavelengths_nm[i] >= 280.0 && wavelengths_nm[i] + 10.0 <= 4000.0)) {
-        report_.Fail(path, "\"" + std::string(kAstmG173) + "\" covers 280 to 4000 nm; a 10 nm bin from " +
-                               FormatNumber(wavelengths_nm[i]) + " nm is outside it");
+      for (int j = 0; j < i; ++j) {
+        if (file_wavelengths_nm_[i] == file_wavelengths_nm_[j] && samples[i] != samples[j]) {
+          report_.Fail(path, "gives " + FormatNumber(samples[j]) + " and " + FormatNumber(samples[i]) +
+                                 " at the same wavelength " + FormatNumber(file_wavelengths_nm_[i]) +
+                                 " nm; a spectral bake reads no spectrum through them (give a table "
+                                 "{ wavelength_nm, albedo })");
+        }
       }
-      irradiance[i] = AstmG173ExtraterrestrialBinMean(wavelengths_nm[i]);
+    }
+    for (int c = 0; c < kWavelengthCount; ++c)
+      albedo.values[c] = SmoothReflectance(file_wavelengths_nm_, samples, wavelengths_nm[c]);
+    return albedo;
+  }
+
+  // The sun's irradiance at the wavelengths: a number, 3 numbers,
+  // "astm-g173", the 10 nm bin means of the ASTM G173-03 extraterrestrial
+  // spectrum from each wavelength up (bake/spectral_data.h), or that
+  // spectrum at another distance from the sun, { spectrum = "astm-g173",
+  // distance_au = d }, scaled by the inverse-square law 1 / d^2.
+  SpectralValue ReadSolarIrradiance(const toml::node& node, const Spectrum& wavelengths_nm) const {
+    const std::string path = "sun.irradiance_w_m2_nm";
+    const std::string spectrum_forms =
+        "a spectrum (\"" + std::string(kAstmG173) + "\", { spectrum = \"" + std::string(kAstmG173) + "\", distance_au })";
+    if (node.is_number() || node.is_array()) {
+      return ReadNumberOrArray(node, path, kNonNegative, "one number or " + spectrum_forms);
+    }
+    SpectralValue irradiance;
+    irradiance.form.kind = SpectralForm::Kind::kSolarSpectrum;
+    irradiance.form.parameters = {1.0};
+    std::string name_path = path;
+    if (const toml::table* table = node.as_table()) {
+      CheckKeys(*table, path, {"spectrum", "distance_au"});
+      name_path = path + ".spectrum";
+      irradiance.form.name = RequireString(*table, path, "spectrum");
+      irradiance.form.parameters = {ReadNumber(Require(*table, path, "distance_au"), path + ".distance_au", kPositive)};
+    } else if (node.is_string()) {
+      irradiance.form.name = **node.as_string();
+    } else {
+      report_.Fail(path, "expected a number, an array of 3 numbers or " + spectrum_forms + ", got " + TypeName(node));
+    }
+    const std::string& name = irradiance.form.name;
+    if (name != kAstmG173) {
+      report_.Fail(name_path, "unknown spectrum \"" + name + "\" (expected \"" + std::string(kAstmG173) + "\")");
+    }
+    for (int i = 0; i < kWavelengthCount; ++i) {
+      if (!AstmG173BinCovers(wavelengths_nm[i])) {
+        report_.Fail(name_path, "\"" + std::string(kAstmG173) + "\" covers 280 to 4000 nm; a 10 nm bin from " +
+                                    FormatNumber(wavelengths_nm[i]) + " nm is outside it");
+      }
+    }
+    irradiance.values = Evaluate(irradiance.form, wavelengths_nm);
+    for (int i = 0; i < kWavelengthCount; ++i) {
+      if (!std::isfinite(irradiance.values[i]))
+        report_.Fail(path, "evaluates to " + FormatNumber(irradiance.values[i]) + " at " +
+                               FormatNumber(wavelengths_nm[i]) + " nm");
     }
     return irradiance;
   }
@@ -328,8 +457,10 @@ class FileReader : public TomlReader {
   void ReadSun(const toml::table& sun, Atmosphere& atmosphere) const {
     CheckKeys(sun, "sun", {"irradiance_w_m2_nm", "angular_radius_rad", "angular_radius_deg",
                            "lowest_zenith_deg", "mu_s_min"});
-    atmosphere.solar_irradiance =
+    const SpectralValue irradiance =
         ReadSolarIrradiance(Require(sun, "sun", "irradiance_w_m2_nm"), atmosphere.wavelengths_nm);
+    atmosphere.solar_irradiance = irradiance.values;
+    atmosphere.solar_irradiance_form = irradiance.form;
     auto [radius_key, radius] = ExactlyOne(sun, "sun", {"angular_radius_rad", "angular_radius_deg"});
     atmosphere.sun_angular_radius_rad =
         radius_key == 0 ? ReadNumber(*radius, "sun.angular_radius_rad", kSunRadiusRad)
@@ -348,12 +479,18 @@ class FileReader : public TomlReader {
     CheckKeys(table, path, {"phase", "scattering_per_m", "absorption_per_m", "density"});
     Constituent constituent;
     constituent.name = name;
-    std::string scattering_path = path + ".scattering_per_m";
-    constituent.scattering_per_m = ReadCoefficient(Require(table, path, "scattering_per_m"),
-                                                   scattering_path, atmosphere.wavelengths_nm);
-    if (const toml::node* node = table.get("absorption_per_m"))
-      constituent.absorption_per_m =
-          ReadCoefficient(*node, path + ".absorption_per_m", atmosphere.wavelengths_nm);
+    const SpectralValue scattering = ReadCoefficient(Require(table, path, "scattering_per_m"),
+                                                     path + ".scattering_per_m", atmosphere.wavelengths_nm);
+    constituent.scattering_per_m = scattering.values;
+    constituent.scattering_form = scattering.form;
+    if (const toml::node* node = table.get("absorption_per_m")) {
+      const SpectralValue absorption = ReadCoefficient(*node, path + ".absorption_per_m", atmosphere.wavelengths_nm);
+      constituent.absorption_per_m = absorption.values;
+      constituent.absorption_form = absorption.form;
+    } else {
+      constituent.absorption_form.kind = SpectralForm::Kind::kConstant;
+      constituent.absorption_form.parameters = {0.0};
+    }
 
     // A pure absorber (ozone) never scatters, so its phase function would be
     // noise in the file; anything that scatters must say how.
@@ -399,45 +536,12 @@ class FileReader : public TomlReader {
     return phase;
   }
 
-  // A published spectrum as (wavelength, value) pairs, linear between them,
-  // at the three wavelengths; each must lie within the table.
-  Spectrum ReadTabulatedSpectrum(const toml::table& table, const std::string& path,
-                                 const Spectrum& wavelengths_nm) const {
-    const std::string wavelengths_path = path + ".wavelength_nm", values_path = path + ".per_m";
-    auto read_array = [&](const std::string& key, const std::string& key_path, const Interval& interval) {
-      const toml::array* array = Require(table, path, key).as_array();
-      if (!array) report_.Fail(key_path, "expected an array of numbers");
-      std::vector<double> values;
-      for (std::size_t i = 0; i < array->size(); ++i) {
-        values.push_back(ReadNumber(*array->get(i), Index(key_path, i), interval));
-      }
-      return values;
-    };
-    const std::vector<double> nm = read_array("wavelength_nm", wavelengths_path, kPositive);
-    const std::vector<double> values = read_array("per_m", values_path, kNonNegative);
-    if (nm.size() < 2) report_.Fail(wavelengths_path, "needs at least 2 wavelengths");
-    if (values.size() != nm.size()) {
-      report_.Fail(values_path, "has " + std::to_string(values.size()) + " values for " + std::to_string(nm.size()) +
-                                    " wavelengths");
+  SpectralValue ReadCoefficient(const toml::node& node, const std::string& path,
+                                const Spectrum& wavelengths_nm) const {
+    if (node.is_number() || node.is_array()) {
+      return ReadNumberOrArray(node, path, kNonNegative,
+                               "one number, a law, a tabulated spectrum or a cross-section");
     }
-    for (std::size_t i = 1; i < nm.size(); ++i) {
-      if (!(nm[i] > nm[i - 1])) report_.Fail(Index(wavelengths_path, i), "must exceed the wavelength before it");
-    }
-    Spectrum result;
-    for (int c = 0; c < kWavelengthCount; ++c) {
-      const double w = wavelengths_nm[c];
-      if (!(w >= nm.front() && w <= nm.back())) {
-        report_.Fail(wavelengths_path, "covers " + FormatNumber(nm.front()) + " to " + FormatNumber(nm.back()) +
-                                           " nm, not the wavelength " + FormatNumber(w) + " nm");
-      }
-      result[c] = PiecewiseLinear(nm, values, w);
-    }
-    return result;
-  }
-
-  Spectrum ReadCoefficient(const toml::node& node, const std::string& path,
-                           const Spectrum& wavelengths_nm) const {
-    if (node.is_number() || node.is_array()) return ReadSpectrum(node, path, kNonNegative);
     const toml::table* table = node.as_table();
     if (!table)
       report_.Fail(path, "expected a number, an array of 3 numbers or a table " +
@@ -464,70 +568,64 @@ class FileReader : public TomlReader {
       form = owner;
     }
 
-    Spectrum result;
+    SpectralForm result;
+    std::string coverage_path = path;
     switch (form->form) {
-      case CoefficientForm::kRayleighLaw: {
-        double k = ReadNumber(Require(*table, path, "rayleigh_at_1um"),
-                              path + ".rayleigh_at_1um", kNonNegative);
-        for (int i = 0; i < kWavelengthCount; ++i)
-          result[i] = RayleighLawCoefficient(k, wavelengths_nm[i]);
+      case CoefficientForm::kRayleighLaw:
+        result.kind = SpectralForm::Kind::kRayleighLaw;
+        result.parameters = {
+            ReadNumber(Require(*table, path, "rayleigh_at_1um"), path + ".rayleigh_at_1um", kNonNegative)};
         break;
-      }
-      case CoefficientForm::kAngstrom: {
-        double b = ReadNumber(Require(*table, path, "angstrom_reference"),
-                              path + ".angstrom_reference", kNonNegative);
-        double l0 = ReadNumber(Require(*table, path, "reference_nm"), path + ".reference_nm",
-                               kPositive);
-        double a = ReadNumber(Require(*table, path, "exponent"), path + ".exponent", kFinite);
-        for (int i = 0; i < kWavelengthCount; ++i)
-          result[i] = AngstromCoefficient(b, l0, a, wavelengths_nm[i]);
+      case CoefficientForm::kAngstrom:
+        result.kind = SpectralForm::Kind::kAngstrom;
+        result.parameters = {
+            ReadNumber(Require(*table, path, "angstrom_reference"), path + ".angstrom_reference", kNonNegative),
+            ReadNumber(Require(*table, path, "reference_nm"), path + ".reference_nm", kPositive),
+            ReadNumber(Require(*table, path, "exponent"), path + ".exponent", kFinite)};
         break;
-      }
-      case CoefficientForm::kRefractiveIndex: {
-        double n = ReadNumber(Require(*table, path, "refractive_index"),
-                              path + ".refractive_index", kPositive);
-        double density = ReadNumber(Require(*table, path, "number_density_per_m3"),
-                                    path + ".number_density_per_m3", kPositive);
-        double p = ReadNumber(Require(*table, path, "depolarization"), path + ".depolarization",
-                              kDepolarization);
-        for (int i = 0; i < kWavelengthCount; ++i)
-          result[i] = RayleighScatteringCoefficient(n, density, p, wavelengths_nm[i] * 1e-9);
+      case CoefficientForm::kRefractiveIndex:
+        result.kind = SpectralForm::Kind::kRefractiveIndex;
+        result.parameters = {
+            ReadNumber(Require(*table, path, "refractive_index"), path + ".refractive_index", kPositive),
+            ReadNumber(Require(*table, path, "number_density_per_m3"), path + ".number_density_per_m3", kPositive),
+            ReadNumber(Require(*table, path, "depolarization"), path + ".depolarization", kDepolarization)};
         break;
-      }
       case CoefficientForm::kTabulated:
-        result = ReadTabulatedSpectrum(*table, path, wavelengths_nm);
+        result = ReadTable(*table, path, "per_m", kNonNegative, true);
         break;
       case CoefficientForm::kCrossSection: {
         // beta = sigma(lambda) N, sigma linear between the published samples.
-        const std::string name = RequireString(*table, path, "cross_section");
-        if (name != kOzone233K) {
-          report_.Fail(path + ".cross_section",
-                       "unknown cross-section \"" + name + "\" (expected \"" + std::string(kOzone233K) + "\")");
+        result.kind = SpectralForm::Kind::kCrossSection;
+        result.name = RequireString(*table, path, "cross_section");
+        coverage_path = path + ".cross_section";
+        if (result.name != kOzone233K) {
+          report_.Fail(coverage_path, "unknown cross-section \"" + result.name + "\" (expected \"" +
+                                          std::string(kOzone233K) + "\")");
         }
-        const double molecules = ReadNumber(Require(*table, path, "molecules_per_m3"),
-                                            path + ".molecules_per_m3", kNonNegative);
+        result.parameters = {
+            ReadNumber(Require(*table, path, "molecules_per_m3"), path + ".molecules_per_m3", kNonNegative)};
         const SpectralData& sigma = OzoneCrossSection233K();
-        std::vector<double> values;
-        for (const glm::dvec3& v : sigma.values) values.push_back(v.x);
         for (int i = 0; i < kWavelengthCount; ++i) {
-          const double w = wavelengths_nm[i];
-          if (!(w >= sigma.wavelength_nm.front() && w <= sigma.wavelength_nm.back())) {
-            report_.Fail(path + ".cross_section", "\"" + name + "\" covers " +
-                                                      FormatNumber(sigma.wavelength_nm.front()) + " to " +
-                                                      FormatNumber(sigma.wavelength_nm.back()) +
-                                                      " nm, not the wavelength " + FormatNumber(w) + " nm");
+          if (!OzoneCrossSectionCovers(wavelengths_nm[i])) {
+            report_.Fail(coverage_path, "\"" + result.name + "\" covers " +
+                                            FormatNumber(sigma.wavelength_nm.front()) + " to " +
+                                            FormatNumber(sigma.wavelength_nm.back()) + " nm, not the wavelength " +
+                                            FormatNumber(wavelengths_nm[i]) + " nm");
           }
-          result[i] = molecules * PiecewiseLinear(sigma.wavelength_nm, values, w);
         }
         break;
       }
     }
+    SpectralValue value;
+    value.form = result;
+    value.values = result.kind == SpectralForm::Kind::kTabulated ? TableValues(result, path, wavelengths_nm)
+                                                                 : Evaluate(result, wavelengths_nm);
     for (int i = 0; i < kWavelengthCount; ++i) {
-      if (!std::isfinite(result[i]))
-        report_.Fail(path, "evaluates to " + FormatNumber(result[i]) + " at " +
+      if (!std::isfinite(value.values[i]))
+        report_.Fail(path, "evaluates to " + FormatNumber(value.values[i]) + " at " +
                                FormatNumber(wavelengths_nm[i]) + " nm");
     }
-    return result;
+    return value;
   }
 
   DensityProfile ReadDensity(const toml::node& node, const std::string& path) const {
@@ -583,6 +681,7 @@ class FileReader : public TomlReader {
   }
 
   std::optional<Spectrum> wavelengths_override_;
+  Spectrum file_wavelengths_nm_ = kDefaultWavelengthsNm;  // [spectrum] of the file
 };
 
 }  // namespace

@@ -20,7 +20,9 @@ namespace skybake {
 // error messages (usually InputName's). With `wavelengths_nm`, every
 // per-wavelength value is taken at those wavelengths instead of the file's
 // [spectrum] (the batches of a spectral bake, bake/spectral.h); a value the
-// file gives as an array of 3 then has no meaning there and is an InputError.
+// file gives as an array of 3 then has no meaning there and is an InputError,
+// but for planet.ground_albedo, read as the smooth reflectance spectrum
+// through its three values (SmoothReflectance, bake/spectral_form.h).
 Atmosphere ParseAtmosphere(std::string_view toml_text, const std::string& source_name,
                            std::optional<Spectrum> wavelengths_nm = std::nullopt);
 
@@ -62,10 +64,15 @@ Atmosphere LoadPreset(const std::string& name);  // InputError if unknown
 
 // The resolved atmosphere as canonical TOML in SI keys; parsing it back gives
 // the same Atmosphere (tested), so `skybake validate` output is a valid input.
+// Each per-wavelength value keeps the form the file gave it in (a law, a
+// table, a published spectrum: the Atmosphere's SpectralForms, where they
+// still give its values), so the output bakes spectrally as the file does;
+// values given as three numbers, or built by hand, are written as arrays.
 std::string ToToml(const Atmosphere& atmosphere);
 
 // The same canonical model as a JSON object with the same keys, for tools that
-// would rather not parse TOML (`skybake validate --json`).
+// would rather not parse TOML (`skybake validate --json`); its per-wavelength
+// values are the numbers at the three wavelengths, not their forms.
 std::string ToJson(const Atmosphere& atmosphere);
 
 // Throws InputError if the atmosphere is not physically meaningful (negative

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bake/spectral_form.h"
 #include "bake/toml_input.h"
 #include "core/constants.h"
 #include "core/errors.h"
@@ -50,6 +51,53 @@ std::string PresetName(std::string_view file_name) {
 
 std::string Array3(const Spectrum& value) {
   return "[" + TomlFloat(value[0]) + ", " + TomlFloat(value[1]) + ", " + TomlFloat(value[2]) + "]";
+}
+
+std::string List(const std::vector<double>& values) {
+  std::string text = "[";
+  for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + TomlFloat(values[i]);
+  return text + "]";
+}
+
+// A per-wavelength value in the form the file gave it, where that form
+// still gives `values` at `wavelengths_nm` bit for bit (an Atmosphere
+// changed after reading keeps a form that no longer does), otherwise the
+// three values. `table_key` names a table's values ("per_m", "albedo").
+std::string FormToml(const SpectralForm& form, const Spectrum& values, const Spectrum& wavelengths_nm,
+                     std::string_view table_key) {
+  using Kind = SpectralForm::Kind;
+  const Spectrum evaluated = Evaluate(form, wavelengths_nm);
+  bool holds = form.kind != Kind::kValues;
+  for (int i = 0; i < kWavelengthCount; ++i) holds = holds && evaluated[i] == values[i];
+  if (!holds) return Array3(values);
+  const std::vector<double>& p = form.parameters;
+  switch (form.kind) {
+    case Kind::kValues:
+      break;
+    case Kind::kConstant:
+      return TomlFloat(p[0]);
+    case Kind::kRayleighLaw:
+      return "{ rayleigh_at_1um = " + TomlFloat(p[0]) + " }";
+    case Kind::kAngstrom:
+      return "{ angstrom_reference = " + TomlFloat(p[0]) + ", reference_nm = " + TomlFloat(p[1]) +
+             ", exponent = " + TomlFloat(p[2]) + " }";
+    case Kind::kRefractiveIndex:
+      return "{ refractive_index = " + TomlFloat(p[0]) + ", number_density_per_m3 = " + TomlFloat(p[1]) +
+             ", depolarization = " + TomlFloat(p[2]) + " }";
+    case Kind::kTabulated: {
+      std::string text = "{ wavelength_nm = " + List(form.wavelength_nm) + ", " + std::string(table_key) + " = " +
+                         List(form.values);
+      if (form.interpolation != SpectralForm::Interpolation::kLinear)
+        text += ", interpolation = " + TomlString(ToString(form.interpolation));
+      return text + " }";
+    }
+    case Kind::kCrossSection:
+      return "{ cross_section = " + TomlString(form.name) + ", molecules_per_m3 = " + TomlFloat(p[0]) + " }";
+    case Kind::kSolarSpectrum:
+      if (p[0] == 1.0) return TomlString(form.name);
+      return "{ spectrum = " + TomlString(form.name) + ", distance_au = " + TomlFloat(p[0]) + " }";
+  }
+  return Array3(values);
 }
 
 constexpr std::string_view kPresetPrefix = "preset:";
@@ -123,11 +171,12 @@ std::string ToToml(const Atmosphere& a) {
       << "\n[planet]\n"
       << "ground_radius_m = " << TomlFloat(a.bottom_radius_m) << "\n"
       << "top_radius_m = " << TomlFloat(a.top_radius_m) << "\n"
-      << "ground_albedo = " << Array3(a.ground_albedo) << "\n"
+      << "ground_albedo = " << FormToml(a.ground_albedo_form, a.ground_albedo, a.wavelengths_nm, "albedo") << "\n"
       << "\n[spectrum]\n"
       << "wavelengths_nm = " << Array3(a.wavelengths_nm) << "\n"
       << "\n[sun]\n"
-      << "irradiance_w_m2_nm = " << Array3(a.solar_irradiance) << "\n"
+      << "irradiance_w_m2_nm = " << FormToml(a.solar_irradiance_form, a.solar_irradiance, a.wavelengths_nm, "")
+      << "\n"
       << "angular_radius_rad = " << TomlFloat(a.sun_angular_radius_rad) << "\n"
       << "mu_s_min = " << TomlFloat(a.mu_s_min);
   char zenith[64];
@@ -142,8 +191,9 @@ std::string ToToml(const Atmosphere& a) {
     if (c.phase.kind == PhaseKind::kHenyeyGreenstein || c.phase.kind == PhaseKind::kCornetteShanks)
       out << ", g = " << TomlFloat(c.phase.g);
     out << " }\n"
-        << "scattering_per_m = " << Array3(c.scattering_per_m) << "\n"
-        << "absorption_per_m = " << Array3(c.absorption_per_m) << "\n";
+        << "scattering_per_m = " << FormToml(c.scattering_form, c.scattering_per_m, a.wavelengths_nm, "per_m") << "\n"
+        << "absorption_per_m = " << FormToml(c.absorption_form, c.absorption_per_m, a.wavelengths_nm, "per_m")
+        << "\n";
     const DensityProfile& d = c.density;
     if (d.kind == DensityProfile::Kind::kLayers) {
       out << "\n[" << section << ".density]\nlayers = [\n";
@@ -155,14 +205,9 @@ std::string ToToml(const Atmosphere& a) {
       }
       out << "]\n";
     } else {
-      auto list = [](const std::vector<double>& values) {
-        std::string text = "[";
-        for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + TomlFloat(values[i]);
-        return text + "]";
-      };
       out << "\n[" << section << ".density.tabulated]\n"
-          << "altitude_m = " << list(d.altitudes_m) << "\n"
-          << "density = " << list(d.densities) << "\n";
+          << "altitude_m = " << List(d.altitudes_m) << "\n"
+          << "density = " << List(d.densities) << "\n";
     }
   }
   return out.str();

@@ -57,6 +57,8 @@ inline void ExpectIdentical(const Constituent& a, const Constituent& b) {
   EXPECT_EQ(a.name, b.name);
   ExpectSpectrumEq(a.scattering_per_m, b.scattering_per_m, "scattering_per_m");
   ExpectSpectrumEq(a.absorption_per_m, b.absorption_per_m, "absorption_per_m");
+  EXPECT_TRUE(a.scattering_form == b.scattering_form) << "scattering_form";
+  EXPECT_TRUE(a.absorption_form == b.absorption_form) << "absorption_form";
   EXPECT_TRUE(a.phase == b.phase);
   EXPECT_EQ(a.density.kind, b.density.kind);
   ASSERT_EQ(a.density.layers.size(), b.density.layers.size());
@@ -81,6 +83,8 @@ inline void ExpectIdentical(const Atmosphere& a, const Atmosphere& b) {
   ExpectSpectrumEq(a.ground_albedo, b.ground_albedo, "ground_albedo");
   ExpectSpectrumEq(a.wavelengths_nm, b.wavelengths_nm, "wavelengths_nm");
   ExpectSpectrumEq(a.solar_irradiance, b.solar_irradiance, "solar_irradiance");
+  EXPECT_TRUE(a.ground_albedo_form == b.ground_albedo_form) << "ground_albedo_form";
+  EXPECT_TRUE(a.solar_irradiance_form == b.solar_irradiance_form) << "solar_irradiance_form";
   EXPECT_EQ(a.sun_angular_radius_rad, b.sun_angular_radius_rad);
   EXPECT_EQ(a.mu_s_min, b.mu_s_min);
   ASSERT_EQ(a.constituents.size(), b.constituents.size());
