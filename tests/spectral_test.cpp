@@ -56,19 +56,37 @@ TEST(SpectralAtmosphere, FormsAreReadAtTheBatchWavelengths) {
               1e-20);
 }
 
+// A file that gives earth's ozone or sun as three numbers (Bruneton's values
+// at 680, 550, 440 nm) instead of their spectra: at other wavelengths an
+// error naming the key; at its own, read as before.
+std::string WithThreeValues(const std::string& form, const std::string& values) {
+  std::string text = Preset("earth").text;
+  const std::size_t at = text.find(form);
+  EXPECT_NE(at, std::string::npos) << form;
+  if (at != std::string::npos) text.replace(at, form.size(), values);
+  return text;
+}
+
 TEST(SpectralAtmosphere, ValuesGivenPerFileWavelengthAreAnErrorElsewhere) {
-  for (const char* preset : {"light-haze", "mars"}) {
+  struct Case {
+    std::string text, key;
+  };
+  for (const Case& c :
+       {Case{WithThreeValues("{ cross_section = \"ozone-233k\", molecules_per_m3 = 5.374e18 }",
+                             "[0.650e-6, 1.881e-6, 0.085e-6]"),
+             "constituents.ozone.absorption_per_m"},
+        Case{WithThreeValues("\"astm-g173\"", "[1.474, 1.8504, 1.91198]"), "sun.irradiance_w_m2_nm"}}) {
+    SCOPED_TRACE(c.key);
     try {
-      ParseAtmosphere(Preset(preset).text, "x.toml", Spectrum(400.0, 500.0, 600.0));
-      ADD_FAILURE() << preset << ": no error";
+      ParseAtmosphere(c.text, "x.toml", Spectrum(400.0, 500.0, 600.0));
+      ADD_FAILURE() << "no error";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("gives a value at each of spectrum.wavelengths_nm only"),
+      EXPECT_NE(std::string(e.what()).find("x.toml: " + c.key + ": gives a value at each of spectrum.wavelengths_nm only"),
                 std::string::npos)
           << e.what();
     }
+    EXPECT_NO_THROW(ParseAtmosphere(c.text, "x.toml"));
   }
-  // The same file at its own three wavelengths reads as before.
-  EXPECT_NO_THROW(LoadAtmosphere("light-haze"));
   try {
     ParseAtmosphere(Preset("earth").text, "earth.toml", Spectrum(900.0, 600.0, 400.0));
     ADD_FAILURE() << "no error";
@@ -610,8 +628,11 @@ TEST(SpectralBake, CommandLineBakesEvaluatesAndRenders) {
     int exit_code = 2;
   };
   const std::string refused = (dir.path() / "refused").string();
+  const std::filesystem::path three_values = dir.path() / "three_values.toml";
+  testing::WriteText(three_values, WithThreeValues("\"astm-g173\"", "[1.474, 1.8504, 1.91198]"));
   for (const Refusal& r :
-       {Refusal{"light-haze" + std::string(kSmallSpectralBake), "gives a value at each of spectrum.wavelengths_nm only"},
+       {Refusal{testing::ShellQuote(three_values.string()) + kSmallSpectralBake,
+                "gives a value at each of spectrum.wavelengths_nm only"},
         Refusal{"earth --pack-mie" + std::string(kSmallSpectralBake),
                 "--pack-mie: a spectral bake keeps single Mie in its own table"},
         Refusal{"earth --wavelengths 2", "a spectral bake needs at least 3 wavelengths, not 2", 1},
