@@ -161,6 +161,17 @@ std::vector<std::string> OutputDirs(const BakeOptions& o) {
   return dirs;
 }
 
+// The --json report of a batch: each atmosphere's report (or error) so far,
+// the count of failures and, for a batch that stopped, the error that
+// stopped it.
+nlohmann::json BatchJson(const nlohmann::json& bakes, int failures, const Error* stopped_by = nullptr) {
+  nlohmann::json batch = {{"bakes", bakes}, {"failed", failures}};
+  if (stopped_by) {
+    batch["error"] = {{"exit_code", static_cast<int>(stopped_by->code())}, {"message", stopped_by->what()}};
+  }
+  return batch;
+}
+
 void RunBake(const BakeOptions& o) {
   const std::string standard_input = kStandardStream;
   if (o.atmospheres.size() > 1 &&
@@ -169,29 +180,36 @@ void RunBake(const BakeOptions& o) {
   }
   CheckWavelengthsOption(o.wavelengths);
   const std::vector<std::string> dirs = OutputDirs(o);
-  InterruptScope interrupts;
   if (o.atmospheres.size() == 1) {
     nlohmann::json report = BakeOne(o, o.atmospheres[0], dirs[0]);
     if (o.json) std::printf("%s\n", report.dump(2).c_str());
     return;
   }
-  // A batch: every atmosphere is baked (an interrupt stops the rest); one
-  // summary, and the exit code of the first failure.
+  // A batch: every atmosphere is baked (an interrupt stops the rest, each
+  // set finished before it complete); one summary, and the exit code of the
+  // first failure.
   nlohmann::json bakes = nlohmann::json::array();
   std::optional<Error> first_failure;
   int failures = 0;
   for (std::size_t i = 0; i < o.atmospheres.size(); ++i) {
     const std::string& atmosphere = o.atmospheres[i];
     try {
-      ThrowIfInterrupted("not baked: " + std::to_string(o.atmospheres.size() - i) + " of " +
-                         std::to_string(o.atmospheres.size()) + " atmospheres");
+      const std::string note = std::to_string(i) + " of " + std::to_string(o.atmospheres.size()) +
+                               " atmospheres done before it (their sets complete); the folders of the rest were "
+                               "left as they were";
+      SetInterruptNote(note, [done = bakes, failures](const std::string& message) {
+        const Error stopped(ExitCode::kInterrupted, message);
+        return BatchJson(done, failures, &stopped).dump(2);
+      });
       nlohmann::json report = BakeOne(o, atmosphere, dirs[i]);
       std::fprintf(stderr, "bake %s -> %s: ok (%.3f s)\n", atmosphere.c_str(), dirs[i].c_str(),
                    report["total_seconds"].get<double>());
       report["input"] = atmosphere;
       bakes.push_back(report);
-    } catch (const InterruptedError&) {
-      throw;
+    } catch (const InterruptedError& e) {
+      if (!o.json) throw;
+      std::printf("%s\n", BatchJson(bakes, failures, &e).dump(2).c_str());
+      throw ReportedError(e);
     } catch (const Error& e) {
       std::fprintf(stderr, "bake %s -> %s: failed (exit %d): %s\n", atmosphere.c_str(), dirs[i].c_str(),
                    static_cast<int>(e.code()), e.what());
@@ -203,7 +221,7 @@ void RunBake(const BakeOptions& o) {
     }
   }
   std::fprintf(stderr, "baked %zu of %zu atmospheres\n", o.atmospheres.size() - failures, o.atmospheres.size());
-  if (o.json) std::printf("%s\n", nlohmann::json({{"bakes", bakes}, {"failed", failures}}).dump(2).c_str());
+  if (o.json) std::printf("%s\n", BatchJson(bakes, failures).dump(2).c_str());
   if (first_failure) {
     const Error summary(first_failure->code(),
                         std::to_string(failures) + " of " + std::to_string(o.atmospheres.size()) +

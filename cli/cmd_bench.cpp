@@ -29,6 +29,7 @@
 #include "cli/commands.h"
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "core/interrupt.h"
 #include "formats/settings_record.h"
 #include "report/bake_pipeline.h"
 
@@ -96,7 +97,8 @@ struct BenchConfiguration {
 };
 
 Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere,
-                    const BenchConfiguration& configuration, int runs, const std::filesystem::path& dir) {
+                    const BenchConfiguration& configuration, int runs, const std::filesystem::path& dir,
+                    const std::string& interrupt_note) {
   // The bake pipeline of `skybake bake` without the runtime: the tables
   // and the manifest, in EXR and KTX2.
   report::BakeJob job;
@@ -108,6 +110,8 @@ Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere
   job.command_line = CommandLine();
   Measurement m;
   for (int run = 0; run < runs; ++run) {
+    // Each run's set replaces the last one's whole (core/interrupt.h).
+    SetInterruptNote(interrupt_note);
     ReturnFreedMemory();
     auto start = std::chrono::steady_clock::now();
     const report::BakeOutcome outcome = report::BakeAndWrite(atmosphere, job, dir);
@@ -179,9 +183,12 @@ void RunBench(const BenchOptions& o) {
   if (o.output_dir.empty()) scratch.emplace("skybake_bench_");
   const std::filesystem::path dir = scratch ? scratch->path() : std::filesystem::path(o.output_dir);
   EnsureWritableDirectory(dir);
+  const std::string interrupt_note =
+      "the benchmark did not finish" +
+      (scratch ? std::string() : "; " + dir.string() + " holds the last set written to it, whole");
 
   ResetPeakResident();
-  Measurement base = Measure(source, atmosphere, base_configuration, o.runs, dir);
+  Measurement base = Measure(source, atmosphere, base_configuration, o.runs, dir, interrupt_note);
   const double peak_mib = PeakResidentMiB();
   const double base_total = Median(base.seconds["total"]);
 
@@ -194,7 +201,8 @@ void RunBench(const BenchOptions& o) {
       changed.settings.Validate();
       variants.emplace_back(v.name, changed);
       ResetPeakResident();
-      variant_totals.push_back(Median(Measure(source, atmosphere, changed, o.runs, dir).seconds["total"]));
+      const Measurement measured = Measure(source, atmosphere, changed, o.runs, dir, interrupt_note);
+      variant_totals.push_back(Median(measured.seconds.at("total")));
       variant_peaks.push_back(PeakResidentMiB());
     }
   }

@@ -106,7 +106,9 @@ void PrintTableFile(const json& d) {
 void WritePlots(const InfoOptions& o, json* report) {
   const LutSet luts = LoadLutSet(o.path);
   EnsureWritableDirectory(o.plot_dir);
-  const render::PlotFiles plots = render::WriteLutPlots(luts, o.plot_dir, CommandLine());
+  StagedFiles staged;  // the plots appear together or not at all
+  const render::PlotFiles plots = render::WriteLutPlots(staged, luts, o.plot_dir, CommandLine());
+  staged.Commit();
   if (!plots.png_text) std::fputs("info: no TrueType font found; the PNG plots have no text\n", stderr);
   json files = json::array();
   for (const fs::path& f : plots.files) files.push_back(f.string());

@@ -148,6 +148,9 @@ void RunRender(const RenderArguments& args) {
 
   const render::Attributes common = {{"Software", "skybake " SKYBAKE_VERSION},
                                      {"skybake.command_line", CommandLine()}};
+  // Every image, plot and the contact sheet go in one set (core/file_io.h):
+  // an interrupt or a failure leaves the folder's earlier files as they were.
+  StagedFiles staged;
   nlohmann::json images = nlohmann::json::array();
   std::vector<std::vector<render::Rgb8>> columns(args.sun_zenith_deg.size());
   std::vector<std::string> labels, exposure_lines;
@@ -178,7 +181,7 @@ void RunRender(const RenderArguments& args) {
       exr_attributes.push_back(
           {"skybake.units", colour ? "cd m^-2 (linear sRGB: Rec. 709 primaries, D65 white, from the set's CIE XYZ)"
                                    : "W m^-2 sr^-1 nm^-1 (linear radiance, R G B = the tables' wavelengths)"});
-      render::WriteLinearExr(out_dir / (stem + ".exr"), image, exr_attributes);
+      render::WriteLinearExr(staged, out_dir / (stem + ".exr"), image, exr_attributes);
       const double exposure_ev = fixed_exposure ? *fixed_exposure : render::AutoExposureEv(image);
       render::Rgb8 png = render::ToneMapToSrgb(image, render::ToneMap{exposure_ev, white});
       render::Attributes png_attributes = common;
@@ -193,7 +196,7 @@ void RunRender(const RenderArguments& args) {
                     render::ToString(view), zenith, exposure_ev, fixed_exposure ? "fixed" : "auto");
       exposure_lines.push_back(exposure_line);
       png_attributes.push_back({"ImageDescription", description});
-      render::WritePng(out_dir / (stem + ".png"), png, png_attributes);
+      render::WritePng(staged, out_dir / (stem + ".png"), png, png_attributes);
       columns[z].push_back(std::move(png));
       images.push_back({{"view", render::ToString(view)},
                         {"sun_zenith_deg", zenith},
@@ -221,11 +224,11 @@ void RunRender(const RenderArguments& args) {
       for (const render::Rgb8& image : column) sheet_columns.back().push_back(&image);
     }
     std::filesystem::path sheet = out_dir / "contact_sheet.png";
-    render::WritePng(sheet, render::ContactSheet(sheet_columns, labels), common);
+    render::WritePng(staged, sheet, render::ContactSheet(sheet_columns, labels), common);
     report["contact_sheet"] = sheet.string();
   }
   if (args.plots) {
-    render::PlotFiles plots = render::WriteLutPlots(luts, out_dir, CommandLine());
+    render::PlotFiles plots = render::WriteLutPlots(staged, luts, out_dir, CommandLine());
     nlohmann::json files = nlohmann::json::array();
     for (const auto& f : plots.files) files.push_back(f.string());
     report["plots"] = files;
@@ -233,6 +236,7 @@ void RunRender(const RenderArguments& args) {
     for (const std::string& line : plots.left_out) std::fprintf(stderr, "render: plot left out: %s\n", line.c_str());
     if (!plots.png_text && !args.quiet) std::fputs("render: no TrueType font found; the PNG plots have no text\n", stderr);
   }
+  staged.Commit();
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report["seconds"] = seconds;
   if (!args.quiet)

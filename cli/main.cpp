@@ -4,9 +4,11 @@
 // 130 interrupted.
 #include <malloc.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -51,17 +53,22 @@ void CheckFirstWord(const CLI::App& app, int argc, char** argv) {
   throw skybake::UsageError("unknown command '" + word + "' (commands: " + commands + ")");
 }
 
+// The JSON document of an error on stdout (`--json`).
+std::string ErrorJson(skybake::ExitCode code, const std::string& message, const skybake::ErrorLocation& where = {}) {
+  auto or_null = [](const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); };
+  nlohmann::json error = {{"exit_code", static_cast<int>(code)},
+                          {"message", message},
+                          {"file", or_null(where.file)},
+                          {"key", or_null(where.key)},
+                          {"line", where.line > 0 ? nlohmann::json(where.line) : nlohmann::json(nullptr)}};
+  return nlohmann::json{{"error", error}}.dump(2);
+}
+
 int Fail(bool json, skybake::ExitCode code, const std::string& message, const skybake::ErrorLocation& where = {}) {
   std::fprintf(stderr, "skybake: %s\n", message.c_str());
   if (json) {
-    auto or_null = [](const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); };
-    nlohmann::json error = {{"exit_code", static_cast<int>(code)},
-                            {"message", message},
-                            {"file", or_null(where.file)},
-                            {"key", or_null(where.key)},
-                            {"line", where.line > 0 ? nlohmann::json(where.line) : nlohmann::json(nullptr)}};
     std::fflush(stdout);
-    std::printf("%s\n", nlohmann::json{{"error", error}}.dump(2).c_str());
+    std::printf("%s\n", ErrorJson(code, message, where).c_str());
   }
   return static_cast<int>(code);
 }
@@ -82,10 +89,17 @@ void KeepFreedTablesForReuse() {
 
 int main(int argc, char** argv) {
   KeepFreedTablesForReuse();
+  const bool json = WantsJson(argc, argv);
+  // Before any thread starts, so that every thread leaves the signals to
+  // the one that acts on them (core/interrupt.h).
+  skybake::HandleInterrupts(json ? [](const std::string& message) {
+    return ErrorJson(skybake::ExitCode::kInterrupted, message);
+  } : std::function<std::string(const std::string&)>());
   CLI::App app{
       "skybake bakes physically based atmospheric-scattering data for real-time renderers.\n"
       "Exit codes: 0 ok, 1 usage, 2 invalid input, 3 I/O error, 4 internal error, 130 interrupted (SIGINT or "
-      "SIGTERM before the outputs were complete; nothing half-written is left). With --json, an error is also "
+      "SIGTERM before the outputs were complete: they are left as they were, nothing half-written; a signal "
+      "during or after their commit lets them complete, exit 0 with a note on stderr). With --json, an error is also "
       "a JSON object on stdout: {\"error\": {\"exit_code\", \"message\", \"file\", \"key\", \"line\"}}."};
   app.name("skybake");
   skybake::cli::SetCommandLine(argc, argv);
@@ -104,7 +118,6 @@ int main(int argc, char** argv) {
   skybake::cli::AddStressCommand(app);
   skybake::cli::AddReportCommand(app);
 
-  const bool json = WantsJson(argc, argv);
   using skybake::ExitCode;
   try {
     CheckFirstWord(app, argc, argv);
@@ -126,9 +139,11 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return Fail(json, ExitCode::kInternal, std::string("internal error: ") + e.what());
   }
-  // A signal recorded but never acted on arrived after the outputs were complete.
-  if (skybake::TakeInterrupt() != 0) {
-    std::fputs("skybake: interrupted after the outputs were complete; nothing was lost\n", stderr);
+  // A signal recorded but never acted on arrived during or after the commit
+  // of the outputs.
+  if (const int signal = skybake::TakeInterrupt()) {
+    std::fprintf(stderr, "skybake: interrupted by %s after the outputs were complete; nothing was lost\n",
+                 signal == SIGTERM ? "SIGTERM" : "SIGINT");
   }
   return static_cast<int>(ExitCode::kOk);
 }

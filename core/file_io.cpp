@@ -48,10 +48,12 @@ void WriteWholeFile(const fs::path& temp, const fs::path& path, std::string_view
 
 void WriteFileAtomically(const fs::path& path,
                          const std::function<void(const fs::path& temp_path)>& write) {
-  fs::path temp = TemporarySibling(path);
+  const fs::path temp = TemporarySibling(path);
+  const RegisteredTemporary registration(temp);
   try {
     write(temp);
     std::error_code ec;
+    const CommitSection commit(path);
     fs::rename(temp, path, ec);
     if (ec) throw IoError(path.string() + ": cannot write: " + ec.message());
   } catch (...) {
@@ -73,16 +75,23 @@ StagedFiles::~StagedFiles() {
 }
 
 void StagedFiles::Write(const fs::path& path, std::string_view bytes) {
+  Write(path, [&](const fs::path& temp) { WriteWholeFile(temp, path, bytes); });
+}
+
+void StagedFiles::Write(const fs::path& path, const std::function<void(const fs::path& temp_path)>& write) {
   fs::path temp = TemporarySibling(path);
   {
-    // Listed before it exists, so that the destructor removes a partial file.
+    // Listed before it exists, so that the destructor (or an interrupt)
+    // removes a partial file.
     std::lock_guard<std::mutex> lock(mutex_);
-    staged_.push_back({temp, path});
+    staged_.push_back({temp, path, RegisteredTemporary(temp)});
   }
-  WriteWholeFile(temp, path, bytes);
+  write(temp);
 }
 
 void StagedFiles::Commit() {
+  if (staged_.empty()) return;
+  const CommitSection commit(staged_.front().path);
   for (const Staged& file : staged_) {
     if (fs::is_directory(file.path)) throw IoError(file.path.string() + ": cannot write: is a directory");
   }
@@ -205,6 +214,13 @@ void CheckOutputDirectory(const fs::path& dir) {
 
 void EnsureWritableDirectory(const fs::path& dir) {
   std::error_code ec;
+  // The folders this creates, outermost first, for the interrupt rule.
+  std::vector<fs::path> created;
+  for (fs::path missing = dir; !missing.empty() && !fs::exists(missing, ec); missing = missing.parent_path()) {
+    created.insert(created.begin(), missing);
+    if (missing.parent_path() == missing) break;
+  }
+  for (const fs::path& folder : created) RegisterCreatedDirectory(folder);
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir)) {
     throw IoError(dir.string() + ": cannot create output directory" + (ec ? ": " + ec.message() : ""));
@@ -216,6 +232,7 @@ void EnsureWritableDirectory(const fs::path& dir) {
 
 ScratchDirectory::ScratchDirectory(const std::string& prefix)
     : path_(fs::temp_directory_path() / (prefix + std::to_string(::getpid()))) {
+  RegisterScratchDirectory(path_);
   EnsureWritableDirectory(path_);
 }
 

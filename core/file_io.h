@@ -9,7 +9,13 @@
 #include <string_view>
 #include <vector>
 
+#include "core/interrupt.h"
+
 namespace skybake {
+
+// Every temporary file below is registered with the interrupt rule
+// (core/interrupt.h) while it exists, and every rename into place happens
+// in a CommitSection: an interrupt leaves the earlier files or the new ones.
 
 // Calls `write` with a temporary path in the same directory as `path`, then
 // renames the temporary file over `path`. If `write` throws (or the rename
@@ -39,11 +45,17 @@ class StagedFiles {
   StagedFiles& operator=(const StagedFiles&) = delete;
   ~StagedFiles();
   void Write(const std::filesystem::path& path, std::string_view bytes);
+  // `write` makes the file at the temporary path it is given (an image
+  // library's writer, told the format: the temporary name ends in
+  // ".tmp-PID-XXXXXXXX", not in `path`'s extension).
+  void Write(const std::filesystem::path& path,
+             const std::function<void(const std::filesystem::path& temp_path)>& write);
   void Commit();
 
  private:
   struct Staged {
     std::filesystem::path temp, path;
+    RegisteredTemporary registration;
   };
   std::mutex mutex_;  // guards staged_
   std::vector<Staged> staged_;

@@ -1,35 +1,90 @@
-// Ctrl-C (SIGINT) and SIGTERM for work whose outputs must appear complete or
-// not at all.
+// One interrupt rule for every command (SIGINT and SIGTERM): an interrupt
+// either leaves the command's outputs as they were before it ran, or lets
+// them complete, and the exit code and message say which.
 //
-// While an InterruptScope lives, the first of these signals only records
-// itself; the work calls ThrowIfInterrupted() where stopping leaves nothing
-// half-written (between bake phases, before a staged set of files is
-// committed), which throws InterruptedError (exit 130). A second signal ends
-// the process at once, as without a scope. A signal recorded but never thrown
-// arrived after the outputs were complete: main() reports it and exits 0.
-// Outside any scope the signals keep their default action.
+// Every output file is written under a temporary name beside its final one
+// (core/file_io.h: WriteFileAtomically, StagedFiles), which is registered
+// here while it exists, and renamed into place in a CommitSection. With the
+// handler that main() installs (HandleInterrupts):
+//  - a signal outside a commit removes every registered temporary file,
+//    every directory the command created that is then empty and its scratch
+//    directories, prints
+//    "skybake: interrupted by SIGINT: NOTE" (the note of SetInterruptNote:
+//    what was left as it was), and exits 130 at once, whatever the command's
+//    threads are doing;
+//  - a signal during a commit is recorded and the commit completes. From the
+//    end of a commit on, signals are only recorded: the outputs are
+//    complete, and main() says so and exits 0. Work that goes on after a
+//    commit (the next atmosphere of a batch, the next run of a benchmark)
+//    calls SetInterruptNote again, which throws InterruptedError (exit 130)
+//    if a signal was recorded meanwhile and makes signals act at once again.
+// Without HandleInterrupts (a test binary) the signals keep their default
+// action and the registry only serves the handler that is not there.
 #pragma once
 
+#include <filesystem>
+#include <functional>
 #include <string>
 
 namespace skybake {
 
-class InterruptScope {
+// Installs the handler for the rest of the process. `json_document`, if
+// given, makes the document an interrupted command prints on stdout from an
+// error message ("interrupted by SIGINT: NOTE").
+void HandleInterrupts(std::function<std::string(const std::string& message)> json_document = nullptr);
+
+// Makes signals act at once again, with `note` (e.g. "nothing was written
+// to DIR") completing the message; `json_document` replaces the one on
+// stdout (a batch's report of what it finished) where --json asked for one.
+// Throws InterruptedError with `note` if a signal was recorded since the
+// last commit.
+void SetInterruptNote(const std::string& note,
+                      std::function<std::string(const std::string& message)> json_document = nullptr);
+
+// While one lives, signals are recorded, not acted on; the command's
+// outputs are complete from its end on (see above). A commit of `file` into
+// a scratch directory (RegisterScratchDirectory) commits no output: after
+// it, signals act at once again, and one recorded during it acts then.
+class CommitSection {
  public:
-  InterruptScope();
-  ~InterruptScope();
-  InterruptScope(const InterruptScope&) = delete;
-  InterruptScope& operator=(const InterruptScope&) = delete;
+  explicit CommitSection(const std::filesystem::path& file);
+  ~CommitSection();
+  CommitSection(const CommitSection&) = delete;
+  CommitSection& operator=(const CommitSection&) = delete;
+
+ private:
+  bool scratch_;
 };
 
-// The signal recorded and not yet thrown or taken (SIGINT, SIGTERM), or 0.
+// The signal recorded and not yet taken (SIGINT, SIGTERM), or 0.
 int PendingInterrupt();
 
-// Throws InterruptedError "interrupted by SIGINT: WHAT" if a signal is pending
-// (and clears it).
-void ThrowIfInterrupted(const std::string& what);
-
-// Clears and returns the pending signal (0 if none).
+// Clears and returns the recorded signal (0 if none).
 int TakeInterrupt();
+
+// A temporary file the handler removes: registered before it is created,
+// unregistered once renamed into place or removed. InternalError if more
+// than a command ever writes at once (kMaxTemporaryFiles) are registered.
+class RegisteredTemporary {
+ public:
+  static constexpr int kMaxTemporaryFiles = 1024;
+  explicit RegisteredTemporary(const std::filesystem::path& path);
+  ~RegisteredTemporary();
+  RegisteredTemporary(RegisteredTemporary&& other) noexcept;
+  RegisteredTemporary& operator=(RegisteredTemporary&&) = delete;
+  RegisteredTemporary(const RegisteredTemporary&) = delete;
+  RegisteredTemporary& operator=(const RegisteredTemporary&) = delete;
+
+ private:
+  int slot_;
+};
+
+// A directory this process created: the handler removes it if it is empty
+// by then (after the temporary files), deepest first.
+void RegisterCreatedDirectory(const std::filesystem::path& dir);
+
+// A scratch directory (core/file_io.h ScratchDirectory), nothing in it an
+// output: the handler removes it with everything in it.
+void RegisterScratchDirectory(const std::filesystem::path& dir);
 
 }  // namespace skybake

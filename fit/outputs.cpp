@@ -111,8 +111,11 @@ OutputSummary WriteFitOutputs(const Atmosphere& atmosphere, const FitSet& set, c
   EnsureWritableDirectory(options.directory);
   std::string line = options.provenance.OneLine();
   std::vector<std::string> files;
+  // One set (core/file_io.h): an interrupt or a failure leaves the
+  // folder's earlier files as they were.
+  StagedFiles staged;
   auto write = [&](const std::string& name, const std::string& text) {
-    WriteFileAtomically(options.directory / name, text);
+    staged.Write(options.directory / name, text);
     files.push_back(name);
   };
   write("sky_dome_fit.glsl", GenerateGlsl(set, line));
@@ -130,16 +133,17 @@ OutputSummary WriteFitOutputs(const Atmosphere& atmosphere, const FitSet& set, c
     for (auto [prefix, plot] : {std::pair{"fit_", ComparisonPlot(atmosphere, fit, set.options, line)},
                                 std::pair{"fit_error_", ErrorPlot(atmosphere, fit, set.options, line)}}) {
       std::string base = prefix + fit.identifier;
-      WritePlotSvg(options.directory / (base + ".svg"), plot);
+      WritePlotSvg(staged, options.directory / (base + ".svg"), plot);
       files.push_back(base + ".svg");
-      plot_text = WritePlotPng(options.directory / (base + ".png"), plot) && plot_text;
+      plot_text = WritePlotPng(staged, options.directory / (base + ".png"), plot) && plot_text;
       files.push_back(base + ".png");
     }
   }
   // The report last: it lists the files above, and its presence means they are complete.
   files.push_back("fit.json");
   OutputSummary summary = Summarize(atmosphere, set, options.dome, options.provenance, files);
-  WriteFileAtomically(options.directory / "fit.json", summary.report_json);
+  staged.Write(options.directory / "fit.json", summary.report_json);
+  staged.Commit();
   summary.plot_text = plot_text;
   return summary;
 }

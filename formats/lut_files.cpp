@@ -8,7 +8,6 @@
 
 #include "core/errors.h"
 #include "core/file_io.h"
-#include "core/interrupt.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
 #include "formats/sha256.h"
@@ -47,7 +46,6 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   WriteReport report;
   // The whole set is staged and renamed at the end, so a failure or an
   // interrupt part-way leaves the previous set (files and manifest) as it was.
-  InterruptScope interrupts;
   StagedFiles staged;
   // Each table file is encoded, hashed and written (under its temporary
   // name) by one worker, its bytes freed as soon as they are written; the
@@ -109,7 +107,6 @@ WriteReport WriteStagedSet(const LutSet& luts, const std::vector<TableDescriptio
   // Last, so a reader that finds the new manifest finds the files it lists.
   const std::string text = manifest.Text();
   staged.Write(dir / kManifestFileName, text);
-  ThrowIfInterrupted(dir.string() + " was left as it was");
   staged.Commit();
   report.files.push_back({"", kManifestFileName, text.size()});
   return report;

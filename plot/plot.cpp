@@ -416,8 +416,8 @@ std::string RenderPlotSvg(const LinePlot& plot) {
   return o.str();
 }
 
-void WritePlotSvg(const std::filesystem::path& path, const LinePlot& plot) {
-  WriteFileAtomically(path, RenderPlotSvg(plot));
+void WritePlotSvg(StagedFiles& files, const std::filesystem::path& path, const LinePlot& plot) {
+  files.Write(path, RenderPlotSvg(plot));
 }
 
 std::vector<unsigned char> RasterizePlot(const LinePlot& plot) {
@@ -429,15 +429,15 @@ std::vector<unsigned char> RasterizePlot(const LinePlot& plot) {
   return pixels;
 }
 
-void WriteSrgbPng(const std::filesystem::path& path, int width, int height, const unsigned char* rgb,
-                  const std::vector<std::pair<std::string, std::string>>& text) {
+void WriteSrgbPng(StagedFiles& files, const std::filesystem::path& path, int width, int height,
+                  const unsigned char* rgb, const std::vector<std::pair<std::string, std::string>>& text) {
   const image_module::Functions& images = ImageModule();
-  WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
+  files.Write(path, [&](const std::filesystem::path& temp) {
     ThrowIfImageError(path, images.write_srgb_png(temp.string(), width, height, rgb, text));
   });
 }
 
-bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
+bool WritePlotPng(StagedFiles& files, const std::filesystem::path& path, const LinePlot& plot) {
   using image_module::AlignX;
   const image_module::Functions& images = ImageModule();
   PlotFrame f = LayoutPlot(plot);
@@ -487,7 +487,7 @@ bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot) {
   std::vector<std::pair<std::string, std::string>> text;
   if (!plot.caption.empty()) text.push_back({"ImageDescription", plot.caption});
   if (!plot.title.empty()) text.push_back({"DocumentName", plot.title});
-  WriteSrgbPng(path, plot.width_px, plot.height_px, pixels.data(), text);
+  WriteSrgbPng(files, path, plot.width_px, plot.height_px, pixels.data(), text);
   return !font.empty();
 }
 

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/file_io.h"
+
 namespace skybake {
 
 enum class LineStyle { kSolid, kDashed, kDotted };
@@ -55,22 +57,23 @@ PlotFrame LayoutPlot(const LinePlot& plot);
 std::string PlotColor(int index);
 
 std::string RenderPlotSvg(const LinePlot& plot);
-void WritePlotSvg(const std::filesystem::path& path, const LinePlot& plot);
+// Staged into `files` (core/file_io.h), which the caller commits.
+void WritePlotSvg(StagedFiles& files, const std::filesystem::path& path, const LinePlot& plot);
 
 // Every PNG skybake writes (plots, render previews) goes through here: 8-bit
 // RGB pixels, row-major from the top, already encoded with the sRGB transfer
-// function, written atomically with an sRGB chunk (and the gAMA and cHRM
+// function, staged into `files` (core/file_io.h) with an sRGB chunk (and the gAMA and cHRM
 // chunks the PNG specification pairs with it), so viewers need not guess
 // the colour space, and `text` as text chunks. The pixels are stored as
 // given. IoError on failure.
-void WriteSrgbPng(const std::filesystem::path& path, int width, int height, const unsigned char* rgb,
-                  const std::vector<std::pair<std::string, std::string>>& text);
+void WriteSrgbPng(StagedFiles& files, const std::filesystem::path& path, int width, int height,
+                  const unsigned char* rgb, const std::vector<std::pair<std::string, std::string>>& text);
 
 // RGB pixels, row-major from the top, 8 bits per channel, without text.
 std::vector<unsigned char> RasterizePlot(const LinePlot& plot);
 // PNG through OpenImageIO, with text in the first TrueType font found of
 // DejaVu Sans, Liberation Sans, FreeSans. Returns false if none was found:
 // the PNG is then written without text (the SVG always has it).
-bool WritePlotPng(const std::filesystem::path& path, const LinePlot& plot);
+bool WritePlotPng(StagedFiles& files, const std::filesystem::path& path, const LinePlot& plot);
 
 }  // namespace skybake

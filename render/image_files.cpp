@@ -52,16 +52,17 @@ Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone) {
   return out;
 }
 
-void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes) {
+void WriteLinearExr(StagedFiles& files, const std::filesystem::path& path, const Image& image,
+                    const Attributes& attributes) {
   const image_module::Functions& images = ImageModule();
-  WriteFileAtomically(path, [&](const std::filesystem::path& temp) {
+  files.Write(path, [&](const std::filesystem::path& temp) {
     ThrowIfImageError(path,
                       images.write_linear_exr(temp.string(), image.width, image.height, image.rgb.data(), attributes));
   });
 }
 
-void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes) {
-  WriteSrgbPng(path, image.width, image.height, image.rgb.data(), attributes);
+void WritePng(StagedFiles& files, const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes) {
+  WriteSrgbPng(files, path, image.width, image.height, image.rgb.data(), attributes);
 }
 
 Rgb8 ReadPng(const std::filesystem::path& path) {

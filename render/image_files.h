@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file_io.h"
 #include "render/views.h"
 
 namespace skybake::render {
@@ -69,10 +70,12 @@ Rgb8 ToneMapToSrgb(const Image& image, const ToneMap& tone);
 // Text attributes stored in the files (e.g. the command line).
 using Attributes = std::vector<std::pair<std::string, std::string>>;
 
-// Both written atomically; IoError on failure. The PNG carries an sRGB
+// Both staged into `files` (core/file_io.h), which the caller commits;
+// IoError on failure. The PNG carries an sRGB
 // chunk (plot/plot.h WriteSrgbPng).
-void WriteLinearExr(const std::filesystem::path& path, const Image& image, const Attributes& attributes);
-void WritePng(const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes);
+void WriteLinearExr(StagedFiles& files, const std::filesystem::path& path, const Image& image,
+                    const Attributes& attributes);
+void WritePng(StagedFiles& files, const std::filesystem::path& path, const Rgb8& image, const Attributes& attributes);
 
 // Reads an 8-bit RGB PNG (tests and tools); IoError on failure.
 Rgb8 ReadPng(const std::filesystem::path& path);

@@ -50,10 +50,11 @@ ChannelLabels LabelsOf(const LutSet& luts) {
   return labels;
 }
 
-void Write(const LinePlot& plot, const std::filesystem::path& dir, const std::string& stem, PlotFiles* out) {
+void Write(StagedFiles& files, const LinePlot& plot, const std::filesystem::path& dir, const std::string& stem,
+           PlotFiles* out) {
   std::filesystem::path svg = dir / (stem + ".svg"), png = dir / (stem + ".png");
-  WritePlotSvg(svg, plot);
-  out->png_text = WritePlotPng(png, plot) && out->png_text;
+  WritePlotSvg(files, svg, plot);
+  out->png_text = WritePlotPng(files, png, plot) && out->png_text;
   out->files.push_back(svg);
   out->files.push_back(png);
 }
@@ -106,7 +107,8 @@ SunsetCurves ComputeSunsetCurves(const Twin& twin, bool channels_are_xyz) {
   return curves;
 }
 
-PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, const std::string& caption) {
+PlotFiles WriteLutPlots(StagedFiles& staged, const LutSet& luts, const std::filesystem::path& dir,
+                        const std::string& caption) {
   const Twin twin(MakeTwinTables(luts));
   const ChannelLabels labels = LabelsOf(luts);
   const glsl::AtmosphereParameters& p = twin.parameters();
@@ -138,7 +140,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
         plot.series.push_back(std::move(s));
       }
     }
-    Write(plot, dir, "lut_transmittance", &files);
+    Write(staged, plot, dir, "lut_transmittance", &files);
   }
 
   // The sky seen from 1 m above the ground, for the sun zeniths a scene's
@@ -180,7 +182,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
       }
       plot.series.push_back(std::move(s));
     }
-    Write(plot, dir, "lut_sky_radiance", &files);
+    Write(staged, plot, dir, "lut_sky_radiance", &files);
   }
 
   if (!twin.has_irradiance()) {
@@ -211,7 +213,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
       plot.series.push_back(std::move(sun));
       plot.series.push_back(std::move(sky));
     }
-    Write(plot, dir, "lut_irradiance", &files);
+    Write(staged, plot, dir, "lut_irradiance", &files);
   }
 
   std::string sunset_problem = twin.has_scattering() ? "" : MissingTable(luts, "scattering");
@@ -241,7 +243,7 @@ PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, co
       s.y = *values;
       plot.series.push_back(std::move(s));
     }
-    Write(plot, dir, "lut_sunset", &files);
+    Write(staged, plot, dir, "lut_sunset", &files);
   }
   return files;
 }

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file_io.h"
 #include "shaders_runtime/glsl_shim.h"
 
 namespace skybake {
@@ -50,8 +51,10 @@ struct SunsetCurves {
 };
 SunsetCurves ComputeSunsetCurves(const Twin& twin, bool channels_are_xyz);
 
-// Writes the plots of `luts` into `dir` (which must exist), each file
-// atomically. `caption` goes under each plot (e.g. the command line).
-PlotFiles WriteLutPlots(const LutSet& luts, const std::filesystem::path& dir, const std::string& caption);
+// Stages the plots of `luts` into `dir` (which must exist) in `files`
+// (core/file_io.h), which the caller commits. `caption` goes under each plot
+// (e.g. the command line).
+PlotFiles WriteLutPlots(StagedFiles& files, const LutSet& luts, const std::filesystem::path& dir,
+                        const std::string& caption);
 
 }  // namespace skybake::render

@@ -11,7 +11,6 @@
 #include "core/constants.h"
 #include "core/errors.h"
 #include "core/file_io.h"
-#include "core/interrupt.h"
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
 #include "formats/settings_record.h"
@@ -313,21 +312,15 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   StaleSetFiles(output_dir, PlannedFileNames(atmosphere, out.settings, scene, job.runtime_languages, write_options),
                 job.clean);
 
-  // The bake. Each phase's end is a point where an interrupt leaves nothing behind.
+  // The bake (an interrupt leaves the folder as it was until the write's
+  // commit: core/interrupt.h).
   out.atmosphere = atmosphere.name;
-  auto check_interrupt = [&](const BakeTiming&) {
-    ThrowIfInterrupted("nothing was written to " + output_dir.string());
-  };
-  auto phase_done = [&](const BakeTiming& t) {
-    if (on_phase) on_phase(t);
-    check_interrupt(t);
-  };
   auto step = [&](const std::string& line) {
     if (on_step) on_step(line);
   };
   step("baking " + atmosphere.name);
-  out.luts = batches ? BakeSpectral(job.spectral_source, *batches, out.settings, &out.report, phase_done)
-                    : Bake(atmosphere, out.settings, &out.report, phase_done);
+  out.luts = batches ? BakeSpectral(job.spectral_source, *batches, out.settings, &out.report, on_phase)
+                    : Bake(atmosphere, out.settings, &out.report, on_phase);
   SnippetParts parts;
   parts.channels_are_xyz = out.luts.colour.has_value();
   if (scene) {
@@ -341,7 +334,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     // way; its files are encoded in memory only, to count their bytes.
     step("baking " + atmosphere.name + " without the scene, for comparison");
     BakeReport full_report;
-    const LutSet full = Bake(full_atmosphere, job.settings, &full_report, check_interrupt);
+    const LutSet full = Bake(full_atmosphere, job.settings, &full_report);
     WriteOptions full_options = write_options;
     full_options.half_tables.clear();
     scene->compared = true;
@@ -358,7 +351,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   out.written = WriteLutSet(out.luts, output_dir, write_options);
   const BakeTiming write{"write files",
                          std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count()};
-  phase_done(write);
+  if (on_phase) on_phase(write);
   out.report.timings.push_back(write);
   out.report.total_seconds += write.seconds;
   if (scene) scene->scene_table_bytes = TableFileBytes(out.written);

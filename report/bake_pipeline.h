@@ -96,9 +96,9 @@ using BakeStepLine = std::function<void(const std::string&)>;
 // (StaleSetFiles in formats/lut_files.h), are checked before anything is
 // baked. With job.skip_up_to_date a set there that is up to date is left as
 // it is (BakeOutcome::skipped).
-// `on_phase` sees each phase of the written set's bake and its writing; an
-// interrupt (core/interrupt.h) is thrown after any phase, before the commit
-// leaving nothing behind. Either callback may be empty.
+// `on_phase` sees each phase of the written set's bake and its writing. The
+// set is written as one commit (core/interrupt.h: an interrupt before it
+// leaves `output_dir` as it was). Either callback may be empty.
 BakeOutcome BakeAndWrite(const Atmosphere& atmosphere, const BakeJob& job, const std::filesystem::path& output_dir,
                          const BakeStepLine& on_step = nullptr, const BakeProgress& on_phase = nullptr);
 

@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "core/file_io.h"
-#include "core/interrupt.h"
 #include "formats/settings_record.h"
 #include "report/error_stats.h"
 
@@ -243,13 +242,11 @@ LinePlot ErrorAgainstTimePlot(const ReportDocument& d) {
 
 bool WriteReportFiles(const ReportDocument& document, const std::filesystem::path& dir) {
   const LinePlot plot = ErrorAgainstTimePlot(document);
-  const bool png_has_text = WritePlotPng(dir / "error_vs_bake_time.png", plot);
-  InterruptScope interrupts;
   StagedFiles files;
+  const bool png_has_text = WritePlotPng(files, dir / "error_vs_bake_time.png", plot);
   files.Write(dir / "report.csv", ReportCsv(document));
   files.Write(dir / "report.json", ReportJson(document).dump(2) + "\n");
   files.Write(dir / "error_vs_bake_time.svg", RenderPlotSvg(plot));
-  ThrowIfInterrupted("the report in " + dir.string() + " was not written");
   files.Commit();
   return png_has_text;
 }

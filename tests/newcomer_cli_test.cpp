@@ -6,14 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
-#include "core/interrupt.h"
 #include "formats/lut_files.h"
 #include "test_atmospheres.h"
 #include "test_util.h"
@@ -196,40 +194,6 @@ TEST(NewcomerDefects, D08_AnInterruptedBakeLeavesNoFolder) {
   EXPECT_EQ(code, 130) << err;
   EXPECT_TRUE(Contains(err, "interrupted by SIGINT")) << err;
   EXPECT_FALSE(fs::exists(out));
-}
-
-TEST(NewcomerDefects, D08_AnInterruptBeforeTheCommitLeavesTheSetAsItWas) {
-  TempDir dir;
-  LutSet luts = Bake(testing::Earth(), testing::SmallBakeSettings());
-  WriteOptions options;
-  options.formats = {FileFormat::kKtx2};
-  WriteLutSet(luts, dir.path(), options);
-  const std::string manifest = ReadText(dir.path() / "skybake.json");
-  {
-    InterruptScope scope;
-    std::raise(SIGINT);  // recorded, not acted on: the write sees it before renaming anything
-    options.command_line = "another command line";
-    try {
-      WriteLutSet(luts, dir.path(), options);
-      ADD_FAILURE() << "the interrupted write went through";
-    } catch (const InterruptedError& e) {
-      EXPECT_EQ(e.code(), ExitCode::kInterrupted);
-    }
-    EXPECT_EQ(PendingInterrupt(), 0);
-  }
-  EXPECT_EQ(ReadText(dir.path() / "skybake.json"), manifest);
-  for (const auto& entry : fs::directory_iterator(dir.path())) {
-    EXPECT_FALSE(Contains(entry.path().filename().string(), ".tmp-")) << entry.path();
-  }
-  // A signal after the commit stays pending: main() reports it and exits 0, the set being complete.
-  {
-    InterruptScope scope;
-    WriteLutSet(luts, dir.path(), options);
-    std::raise(SIGINT);
-    EXPECT_EQ(PendingInterrupt(), SIGINT);
-    EXPECT_EQ(TakeInterrupt(), SIGINT);
-  }
-  EXPECT_NE(ReadText(dir.path() / "skybake.json"), manifest);
 }
 
 TEST(NewcomerDefects, D09_StressHelpStatesItsOwnDefaultsOnce) {

@@ -183,7 +183,9 @@ class PlotFiles : public ::testing::Test {
 TEST_F(PlotFiles, PngShowsTheSeriesWhereTheLayoutPutsThem) {
   LinePlot plot = SamplePlot();
   fs::path png = dir_ / "plot.png";
-  bool text = WritePlotPng(png, plot);
+  StagedFiles staged;
+  bool text = WritePlotPng(staged, png, plot);
+  staged.Commit();
   OIIO::ImageBuf image(png.string());
   ASSERT_TRUE(image.read()) << image.geterror();
   ASSERT_EQ(image.spec().width, plot.width_px);
@@ -220,9 +222,14 @@ TEST_F(PlotFiles, PngShowsTheSeriesWhereTheLayoutPutsThem) {
 
 TEST_F(PlotFiles, WritesAreAtomic) {
   fs::path missing = dir_ / "no" / "such" / "dir" / "plot.svg";
-  EXPECT_THROW(WritePlotSvg(missing, SamplePlot()), IoError);
-  EXPECT_THROW(WritePlotPng(dir_ / "no" / "plot.png", SamplePlot()), IoError);
-  WritePlotSvg(dir_ / "plot.svg", SamplePlot());
+  {
+    StagedFiles staged;
+    EXPECT_THROW(WritePlotSvg(staged, missing, SamplePlot()), IoError);
+    EXPECT_THROW(WritePlotPng(staged, dir_ / "no" / "plot.png", SamplePlot()), IoError);
+  }
+  StagedFiles staged;
+  WritePlotSvg(staged, dir_ / "plot.svg", SamplePlot());
+  staged.Commit();
   size_t files = 0;
   for (const auto& entry : fs::directory_iterator(dir_)) {
     ++files;

@@ -170,7 +170,9 @@ TEST(Render, MatchesGolden) {
   render::Rgb8 image = GoldenCandidate(60.0);
   const char* update = std::getenv("SKYBAKE_UPDATE_GOLDEN");
   if (update && std::string(update) == "1") {
-    render::WritePng(kGolden, image, {});
+    StagedFiles staged;
+    render::WritePng(staged, kGolden, image, {});
+    staged.Commit();
     GTEST_SKIP() << "golden image rewritten: " << kGolden;
   }
   render::Rgb8 golden = render::ReadPng(kGolden);

@@ -2,13 +2,11 @@
 // no temporary files: the whole set is staged and renamed at the end.
 #include <gtest/gtest.h>
 
-#include <csignal>
 #include <filesystem>
 #include <map>
 
 #include "core/errors.h"
 #include "core/file_io.h"
-#include "core/interrupt.h"
 #include "test_util.h"
 
 namespace skybake {
@@ -68,26 +66,6 @@ TEST(StagedFiles, FailedRenameKeepsTheFileItWouldReplace) {
     EXPECT_THROW(staged.Commit(), IoError);
   }
   EXPECT_EQ(Snapshot(dir.path()), (std::map<std::string, std::string>{{"a.txt", "new a"}, {"b.txt", "old b"}}));
-}
-
-TEST(InterruptScope, RecordsSigintUntilTakenAndRestoresTheHandler) {
-  static volatile std::sig_atomic_t received_signal = 0;
-  auto previous = std::signal(SIGINT, [](int signal) { received_signal = signal; });
-  received_signal = 0;
-  {
-    InterruptScope outer;
-    {
-      InterruptScope inner;  // nested scopes share the outermost's handler
-    }
-    std::raise(SIGINT);
-    EXPECT_EQ(received_signal, 0);
-    EXPECT_EQ(PendingInterrupt(), SIGINT);
-    EXPECT_THROW(ThrowIfInterrupted("test"), InterruptedError);
-    EXPECT_EQ(PendingInterrupt(), 0);
-  }
-  std::raise(SIGINT);  // the previous handler is back
-  EXPECT_EQ(received_signal, SIGINT);
-  std::signal(SIGINT, previous);
 }
 
 const std::string kTinyBake =

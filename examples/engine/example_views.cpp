@@ -112,13 +112,15 @@ void WriteViews(const Arguments& args, const LutSet& luts, const std::vector<Vie
   const render::ToneMap tone{3.3, render::WhiteBalance(luts.parameters.solar_irradiance)};
   const fs::path out_dir(args.output_dir);
   EnsureWritableDirectory(out_dir);
-  // Each file is written atomically.
+  // The images appear together or not at all.
+  StagedFiles staged;
   for (std::size_t i = 0; i < images.size(); ++i) {
     const render::Attributes attributes = {{"skybake:view", views[i].name}};
-    render::WriteLinearExr(out_dir / (std::string(views[i].name) + ".exr"), images[i], attributes);
-    render::WritePng(out_dir / (std::string(views[i].name) + ".png"), render::ToneMapToSrgb(images[i], tone),
+    render::WriteLinearExr(staged, out_dir / (std::string(views[i].name) + ".exr"), images[i], attributes);
+    render::WritePng(staged, out_dir / (std::string(views[i].name) + ".png"), render::ToneMapToSrgb(images[i], tone),
                      attributes);
   }
+  staged.Commit();
 }
 
 int RunExample(int argc, char** argv, const std::string& name, const std::string& description,
