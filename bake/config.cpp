@@ -45,7 +45,17 @@ constexpr Interval kPositive{0.0, kInf, false, false};
 constexpr Interval kNonNegative{0.0, kInf, true, false};
 constexpr Interval kUnit{0.0, 1.0, true, true};
 constexpr Interval kAsymmetry{-1.0, 1.0, false, false};
-constexpr Interval kSunRadiusRad{0.0, kPi / 2, false, false, "(0, pi/2)"};
+// The sun's angular radius from 1e-6 rad, the Sun seen from 4,650 AU (from
+// Sedna's aphelion, 937 AU, it is 5e-6 rad). Smaller discs lose the digits
+// of their arithmetic: the drawn disc's solid angle 2 pi (1 - cos a)
+// (render/views.cpp) has a relative error of 1e-4 at 1e-6 rad and is 0
+// below 1e-8 rad, the runtime's disc radiance E / (pi a^2) overflows float
+// below 1e-19 rad (1e-17 for a spectral set's sun in lux), and once a
+// underflows float (below 1e-45 rad) the bake's visible fraction of the disc
+// at the horizon, a smoothstep over +-0, divides 0 by 0: the NaN texels
+// fuzzing found at 1e-300.
+constexpr double kSunRadiusMinRad = 1e-6;
+constexpr Interval kSunRadiusRad{kSunRadiusMinRad, kPi / 2, true, false, "[1e-6, pi/2)"};
 constexpr Interval kSunRadiusDeg{0.0, 90.0, false, false};
 constexpr Interval kLowestZenithDeg{0.0, 180.0, false, true};
 constexpr Interval kMuSMin{-1.0, 1.0, true, false};
@@ -462,9 +472,14 @@ class FileReader : public TomlReader {
     atmosphere.solar_irradiance = irradiance.values;
     atmosphere.solar_irradiance_form = irradiance.form;
     auto [radius_key, radius] = ExactlyOne(sun, "sun", {"angular_radius_rad", "angular_radius_deg"});
-    atmosphere.sun_angular_radius_rad =
-        radius_key == 0 ? ReadNumber(*radius, "sun.angular_radius_rad", kSunRadiusRad)
-                        : ReadNumber(*radius, "sun.angular_radius_deg", kSunRadiusDeg) * kPi / 180.0;
+    if (radius_key == 0) {
+      atmosphere.sun_angular_radius_rad = ReadNumber(*radius, "sun.angular_radius_rad", kSunRadiusRad);
+    } else {
+      const double degrees = ReadNumber(*radius, "sun.angular_radius_deg", kSunRadiusDeg);
+      atmosphere.sun_angular_radius_rad = degrees * kPi / 180.0;
+      if (!kSunRadiusRad.Contains(atmosphere.sun_angular_radius_rad))
+        report_.FailValue("sun.angular_radius_deg", degrees, "is outside [5.73e-5, 90) (1e-6 rad to 90 deg)");
+    }
     // mu_s_min is what the tables use; lowest_zenith_deg is what people think
     // in. The writer emits mu_s_min because cos(acos(x)) need not return x.
     auto [lowest_key, lowest] = ExactlyOne(sun, "sun", {"lowest_zenith_deg", "mu_s_min"});

@@ -321,7 +321,7 @@ TEST(Validate, RejectsBrokenHandBuiltAtmospheres) {
       {[](Atmosphere& a) { a.solar_irradiance[1] = -1.0; },
        "hand: sun.irradiance_w_m2_nm[1] = -1 must be >= 0"},
       {[](Atmosphere& a) { a.sun_angular_radius_rad = 0.0; },
-       "hand: sun.angular_radius_rad = 0 is outside (0, pi/2)"},
+       "hand: sun.angular_radius_rad = 0 is outside [1e-6, pi/2)"},
       {[](Atmosphere& a) { a.mu_s_min = 1.0; }, "hand: sun.mu_s_min = 1 is outside [-1, 1)"},
       {[](Atmosphere& a) { a.constituents[1].phase.g = 1.0; },
        "hand: constituents.layered.phase.g = 1 is outside (-1, 1)"},
