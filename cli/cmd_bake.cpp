@@ -1,5 +1,5 @@
 // `skybake bake`: atmosphere → tables on disk. The pipeline is
-// report/bake_pipeline.h's; this binds the options, names each atmosphere's
+// pipeline/bake_pipeline.h's; this binds the options, names each atmosphere's
 // output folder and runs a batch.
 #include <algorithm>
 #include <cstdio>
@@ -22,7 +22,7 @@
 #include "core/file_io.h"
 #include "core/interrupt.h"
 #include "formats/manifest.h"
-#include "report/bake_pipeline.h"
+#include "pipeline/bake_pipeline.h"
 #include "shaders_runtime/snippet.h"
 
 namespace skybake::cli {
@@ -80,7 +80,7 @@ std::string DepfilePath(const std::filesystem::path& path) {
 // leaves as it is, depends on the files the bake read, the atmosphere file
 // (a preset is inside the program) and the scene file. Absolute paths, so
 // that the build's working directory does not matter.
-void WriteDepfile(const std::string& depfile, const std::string& output_dir, const report::BakeJob& job) {
+void WriteDepfile(const std::string& depfile, const std::string& output_dir, const pipeline::BakeJob& job) {
   std::string rule = DepfilePath(std::filesystem::path(output_dir) / kManifestFileName) + ":";
   for (const std::string& input : {job.spectral_source.file, job.scene_file}) {
     if (!input.empty()) rule += " " + DepfilePath(input);
@@ -88,10 +88,10 @@ void WriteDepfile(const std::string& depfile, const std::string& output_dir, con
   WriteFileAtomically(depfile, rule + "\n");
 }
 
-// Bakes one atmosphere into `output_dir` (report/bake_pipeline.h), with the
+// Bakes one atmosphere into `output_dir` (pipeline/bake_pipeline.h), with the
 // phases and the summary on stderr unless --quiet; the --json report of it.
 nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, const std::string& output_dir) {
-  report::BakeJob job;
+  pipeline::BakeJob job;
   job.spectral_source = ReadAtmosphereSource(atmosphere_arg);
   job.wavelengths = o.wavelengths;
   job.spectral_higher_orders = ParseSpectralHigherOrders(o.spectral_higher_orders);
@@ -111,16 +111,16 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
   job.clean = o.clean;
   job.skip_up_to_date = !o.force;
   job.command_line = CommandLine();
-  report::BakeStepLine print_step;
+  pipeline::BakeStepLine print_step;
   BakeProgress print_phase;
   if (!o.quiet) {
     print_step = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     print_phase = [](const BakeTiming& t) { std::fprintf(stderr, "  %-36s %8.3f s\n", t.phase.c_str(), t.seconds); };
   }
-  const report::BakeOutcome outcome = report::BakeAndWrite(atmosphere, job, output_dir, print_step, print_phase);
-  if (!o.quiet) std::fputs(report::BakeSummaryText(outcome).c_str(), stderr);
+  const pipeline::BakeOutcome outcome = pipeline::BakeAndWrite(atmosphere, job, output_dir, print_step, print_phase);
+  if (!o.quiet) std::fputs(pipeline::BakeSummaryText(outcome).c_str(), stderr);
   if (!o.depfile.empty()) WriteDepfile(o.depfile, output_dir, job);
-  return report::BakeOutcomeJson(outcome);
+  return pipeline::BakeOutcomeJson(outcome);
 }
 
 // Where each atmosphere's set goes: `output` with {name} replaced by the

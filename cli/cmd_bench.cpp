@@ -31,7 +31,7 @@
 #include "core/file_io.h"
 #include "core/interrupt.h"
 #include "formats/settings_record.h"
-#include "report/bake_pipeline.h"
+#include "pipeline/bake_pipeline.h"
 
 namespace skybake::cli {
 
@@ -101,7 +101,7 @@ Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere
                     const std::string& interrupt_note) {
   // The bake pipeline of `skybake bake` without the runtime: the tables
   // and the manifest, in EXR and KTX2.
-  report::BakeJob job;
+  pipeline::BakeJob job;
   job.settings = configuration.settings;
   job.wavelengths = configuration.wavelengths;
   job.spectral_higher_orders = configuration.spectral_higher_orders;
@@ -114,7 +114,7 @@ Measurement Measure(const AtmosphereSource& source, const Atmosphere& atmosphere
     SetInterruptNote(interrupt_note);
     ReturnFreedMemory();
     auto start = std::chrono::steady_clock::now();
-    const report::BakeOutcome outcome = report::BakeAndWrite(atmosphere, job, dir);
+    const pipeline::BakeOutcome outcome = pipeline::BakeAndWrite(atmosphere, job, dir);
     auto end = std::chrono::steady_clock::now();
     for (const BakeTiming& t : outcome.report.timings) {
       if (run == 0) m.phases.push_back(t.phase);

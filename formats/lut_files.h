@@ -37,7 +37,7 @@ struct WriteOptions {
   // KTX2 files Zstandard-supercompressed at this level (1-22), 0: stored as is.
   int ktx2_zstd_level = 0;
   std::string command_line;   // recorded in the manifest
-  std::string inputs_sha256;  // recorded in the manifest (report/bake_inputs.h); empty: none
+  std::string inputs_sha256;  // recorded in the manifest (pipeline/bake_inputs.h); empty: none
   std::vector<ShaderFile> shaders;  // written and listed under "shaders"
   // Remove the files of an earlier set in the directory that the new set does
   // not list (StaleSetFiles); without it such files make WriteLutSet refuse.

@@ -3,7 +3,7 @@
 // It lists every file with its format, pixel type, size, channel meanings,
 // encoding, units, parameterization and SHA-256, plus the runtime constants,
 // the bake settings, the resolved atmosphere, the command that wrote it and
-// the hash of the bake's inputs (report/bake_inputs.h).
+// the hash of the bake's inputs (pipeline/bake_inputs.h).
 #pragma once
 
 #include <cstdint>

@@ -8,7 +8,6 @@
 #include "core/errors.h"
 #include "formats/lut_files.h"
 #include "formats/settings_record.h"
-#include "report/bake_pipeline.h"
 #include "report/run_time_models.h"
 
 namespace skybake::report {
@@ -72,10 +71,9 @@ Written WriteTables(const LutSet& tables, const std::filesystem::path& dir, bool
   return w;
 }
 
-// A bake through the pipeline of `skybake bake` (bake_pipeline.h), without
-// the GLSL runtime and the command line, so that every configuration writes
-// the files a plain bake of it would: the tables and the manifest, float,
-// EXR and KTX2.
+// A bake and the write of its set, without the runtime and the command
+// line, so that every configuration writes the files a plain `skybake bake`
+// of it would: the tables and the manifest, float, EXR and KTX2.
 struct LadderBake {
   LutSet tables;
   BakeReport report;
@@ -83,18 +81,16 @@ struct LadderBake {
   Written files;
 };
 
+// Each timed.
 LadderBake BakeAndWriteTables(const Atmosphere& atmosphere, const BakeSettings& settings,
                               const std::filesystem::path& dir) {
-  BakeJob job;
-  job.settings = settings;
-  job.runtime_languages.clear();
-  BakeOutcome outcome = BakeAndWrite(atmosphere, job, dir);
   LadderBake b;
-  b.report = outcome.report;
-  b.files.seconds = b.report.timings.back().seconds;  // the write is the last phase
-  for (size_t i = 0; i + 1 < b.report.timings.size(); ++i) b.bake_seconds += b.report.timings[i].seconds;
-  for (const WrittenFile& f : outcome.written.files) b.files.bytes += f.bytes;
-  b.tables = std::move(outcome.luts);
+  b.tables = Bake(atmosphere, settings, &b.report);
+  b.bake_seconds = b.report.total_seconds;
+  const auto write_start = std::chrono::steady_clock::now();
+  const WriteReport written = WriteLutSet(b.tables, dir, WriteOptions{});
+  b.files.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+  for (const WrittenFile& f : written.files) b.files.bytes += f.bytes;
   return b;
 }
 

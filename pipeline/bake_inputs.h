@@ -13,9 +13,9 @@
 #include "bake/spectral.h"
 #include "formats/lut_files.h"
 #include "formats/manifest.h"
-#include "report/bake_pipeline.h"
+#include "pipeline/bake_pipeline.h"
 
-namespace skybake::report {
+namespace skybake::pipeline {
 
 // The SHA-256 (hex) of a canonical JSON document of what determines the
 // files of `job`'s set:
@@ -48,4 +48,4 @@ std::string BakeInputsSha256(const Atmosphere& atmosphere, const BakeJob& job, c
 // that cannot be read.
 std::optional<Manifest> ReadUpToDateSet(const std::filesystem::path& dir, const std::string& inputs_sha256);
 
-}  // namespace skybake::report
+}  // namespace skybake::pipeline

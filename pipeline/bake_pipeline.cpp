@@ -1,4 +1,4 @@
-#include "report/bake_pipeline.h"
+#include "pipeline/bake_pipeline.h"
 
 #include <algorithm>
 #include <chrono>
@@ -14,10 +14,10 @@
 #include "formats/lut_tables.h"
 #include "formats/manifest.h"
 #include "formats/settings_record.h"
-#include "report/bake_inputs.h"
+#include "pipeline/bake_inputs.h"
 #include "shaders_runtime/snippet.h"
 
-namespace skybake::report {
+namespace skybake::pipeline {
 
 namespace {
 
@@ -82,14 +82,14 @@ std::vector<std::string> SceneHalfTables(const Scene& scene) {
   return half;
 }
 
-std::string ErrorText(const ErrorStats& e) {
+std::string ErrorText(const report::ErrorStats& e) {
   char text[96];
   std::snprintf(text, sizeof text, "mean %.3f%% rms %.3f%% max %.3f%%", 100.0 * e.mean_relative,
                 100.0 * e.rms_relative, 100.0 * e.max_relative);
   return text;
 }
 
-json ErrorJson(const ErrorStats& e) {
+json ErrorJson(const report::ErrorStats& e) {
   return {{"mean_relative", e.mean_relative},
           {"rms_relative", e.rms_relative},
           {"max_relative", e.max_relative},
@@ -142,7 +142,7 @@ std::string SceneSummaryText(const SceneSummary& s) {
   }
   Append(&out, "    error on the %d reference cases of %s inside the scene (relative, every channel):\n",
          s.accuracy->cases, s.accuracy->reference.c_str());
-  for (const SceneQuantityErrors& q : s.accuracy->quantities) {
+  for (const report::SceneQuantityErrors& q : s.accuracy->quantities) {
     Append(&out, "      %-15s scene %s; full bake %s\n", q.quantity.c_str(), ErrorText(q.scene).c_str(),
            ErrorText(q.full).c_str());
   }
@@ -172,7 +172,7 @@ json SceneSummaryJson(const SceneSummary& s) {
                        {"full_bake_seconds", s.full_bake_seconds}};
     if (s.accuracy) {
       json quantities = json::object();
-      for (const SceneQuantityErrors& q : s.accuracy->quantities) {
+      for (const report::SceneQuantityErrors& q : s.accuracy->quantities) {
         quantities[q.quantity] = {{"scene", ErrorJson(q.scene)}, {"full", ErrorJson(q.full)}};
       }
       j["comparison"]["accuracy"] = {{"reference", s.accuracy->reference},
@@ -272,8 +272,8 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     batches = MakeSpectralBatches(SpectralWavelengths(job.wavelengths), job.spectral_higher_orders);
   if (!job.reference_file.empty() && !job.compare_full) throw UsageError("--reference: needs --compare-full");
   // Read before baking, so that a bad file fails at once.
-  std::optional<ReferenceSet> reference;
-  if (job.compare_full) reference = LoadReference(job.reference_file, atmosphere);
+  std::optional<report::ReferenceSet> reference;
+  if (job.compare_full) reference = report::LoadReference(job.reference_file, atmosphere);
   if (scene) {
     ApplyScenePlan(scene->plan, &atmosphere, &out.settings);
     scene->full_r_size = job.settings.scattering_r_size;
@@ -296,7 +296,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   // that fails or is interrupted leaves no empty folder behind.
   CheckOutputDirectory(output_dir);
 
-  // Incremental bakes (report/bake_inputs.h): the manifest records the
+  // Incremental bakes (pipeline/bake_inputs.h): the manifest records the
   // inputs' hash, and a set up to date for it is left as it is. Otherwise
   // the files the folder holds besides are judged now, not after the bake.
   write_options.inputs_sha256 = BakeInputsSha256(full_atmosphere, job, batches ? &*batches : nullptr,
@@ -341,7 +341,7 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
     scene->full_bake_seconds = full_report.total_seconds;
     scene->scene_bake_seconds = out.report.total_seconds;
     scene->full_table_bytes = TableFileBytes(full, full_options);
-    if (reference) scene->accuracy = MeasureSceneAccuracy(*reference, scene->scene, out.luts, full);
+    if (reference) scene->accuracy = report::MeasureSceneAccuracy(*reference, scene->scene, out.luts, full);
   }
   // The runtime goes beside the tables, its constants from this bake's parameters.
   write_options.shaders = RuntimeShaderFiles(job.runtime_languages, out.luts.parameters, atmosphere, parts);
@@ -425,4 +425,4 @@ json BakeOutcomeJson(const BakeOutcome& outcome) {
   return j;
 }
 
-}  // namespace skybake::report
+}  // namespace skybake::pipeline

@@ -1,4 +1,4 @@
-#include "report/bake_inputs.h"
+#include "pipeline/bake_inputs.h"
 
 #include <nlohmann/json.hpp>
 
@@ -10,7 +10,7 @@
 
 namespace fs = std::filesystem;
 
-namespace skybake::report {
+namespace skybake::pipeline {
 
 namespace {
 
@@ -99,4 +99,4 @@ std::optional<Manifest> ReadUpToDateSet(const fs::path& dir, const std::string& 
   return manifest;
 }
 
-}  // namespace skybake::report
+}  // namespace skybake::pipeline

@@ -2,9 +2,10 @@
 // plan (bake/scene.h) applied to the atmosphere and settings, the bake, the
 // storage (float, half, a scene's half tables), with --compare-full the
 // full bake it is measured against, the GLSL runtime beside the tables, and
-// the staged write (formats/lut_files.h). `skybake bake`, `skybake bench` and
-// the quality ladder of `skybake report` bake through it; BakeSummaryText and
-// BakeOutcomeJson are the forms `skybake bake` reports a bake in.
+// the staged write (formats/lut_files.h), skipped where the folder holds
+// the set of the same inputs (pipeline/bake_inputs.h). `skybake bake` and
+// `skybake bench` bake through it; BakeSummaryText and BakeOutcomeJson are
+// the forms `skybake bake` reports a bake in.
 #pragma once
 
 #include <cstdint>
@@ -24,7 +25,7 @@
 #include "report/scene_accuracy.h"
 #include "shaders_runtime/snippet.h"
 
-namespace skybake::report {
+namespace skybake::pipeline {
 
 struct BakeJob {
   BakeSettings settings;
@@ -39,7 +40,7 @@ struct BakeJob {
   std::vector<ShadingLanguage> runtime_languages{std::begin(kShadingLanguages), std::end(kShadingLanguages)};
   bool clean = false;          // WriteOptions::clean
   // Leave a set in the output directory that is up to date for these inputs
-  // as it is (report/bake_inputs.h) instead of baking it again; never with
+  // as it is (pipeline/bake_inputs.h) instead of baking it again; never with
   // compare_full, which measures the bake.
   bool skip_up_to_date = false;
   // A spectral bake (bake/spectral.h) of this many wavelengths, reading
@@ -64,13 +65,13 @@ struct SceneSummary {
   bool compared = false;
   double full_bake_seconds = 0.0, scene_bake_seconds = 0.0;
   std::uint64_t full_table_bytes = 0, scene_table_bytes = 0;
-  std::optional<SceneAccuracy> accuracy;  // with a reference for the atmosphere
+  std::optional<report::SceneAccuracy> accuracy;  // with a reference for the atmosphere
 };
 
 struct BakeOutcome {
   std::string atmosphere;  // its name
   std::filesystem::path output_dir;
-  std::string inputs_sha256;  // the hash of the inputs (report/bake_inputs.h), as the manifest records it
+  std::string inputs_sha256;  // the hash of the inputs (pipeline/bake_inputs.h), as the manifest records it
   // The set in output_dir was up to date and left as it was: nothing was
   // baked or written; luts (without texels) and written are the manifest's,
   // and the report's one phase is the check.
@@ -109,4 +110,4 @@ std::string BakeSummaryText(const BakeOutcome& outcome);
 // The report of `skybake bake --json` (tables, sizes, orders, files, timings, scene).
 nlohmann::json BakeOutcomeJson(const BakeOutcome& outcome);
 
-}  // namespace skybake::report
+}  // namespace skybake::pipeline
