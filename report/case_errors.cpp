@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include <filesystem>
-
 #include "bake/config.h"
 #include "core/errors.h"
 #include "core/file_io.h"
