@@ -99,6 +99,18 @@ def sizes(skybake):
             f"All table files: {thousands(total(full))} bytes in float, {thousands(total(half))} bytes in half.")
     replace_block("docs/files.md", "file-sizes", "sizes", text)
 
+    # The README's KTX2 tables stored as is and Zstandard-supercompressed.
+    ktx2_bytes = lambda report: sum(f["bytes"] for f in report["files"] if f["file"].endswith(".ktx2"))
+    lines = ["| KTX2 tables | stored as is | zstd (level 3) | zstd:19 |", "| --- | ---: | ---: | ---: |"]
+    for label, precision, stored in (("float", [], full), ("half (`--half`)", ["--half"], half)):
+        cells = [f"{ktx2_bytes(stored) / 1e6:.1f} MB"]
+        for level in ("zstd", "zstd:19"):
+            packed = ktx2_bytes(bake_json(skybake, WORK / "sizes" / "zstd", "--format", "ktx2", "--runtime", "none",
+                                          "--ktx2-supercompression", level, *precision))
+            cells.append(f"{packed / 1e6:.1f} MB (−{round(100 * (1 - packed / ktx2_bytes(stored)))} %)")
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    replace_block("README.md", "ktx2-zstd", "sizes", "\n".join(lines))
+
 
 def orders(skybake):
     runs = [(str(n), ["--orders", str(n)]) for n in range(1, 7)]
