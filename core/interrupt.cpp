@@ -144,12 +144,6 @@ CommitSection::~CommitSection() {
   if (pending != 0) ActOn(pending);
 }
 
-int PendingInterrupt() {
-  InterruptState& s = State();
-  std::lock_guard<std::mutex> lock(s.mutex);
-  return s.pending_signal;
-}
-
 int TakeInterrupt() {
   InterruptState& s = State();
   std::lock_guard<std::mutex> lock(s.mutex);

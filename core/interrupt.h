@@ -56,10 +56,8 @@ class CommitSection {
   bool scratch_;
 };
 
-// The signal recorded and not yet taken (SIGINT, SIGTERM), or 0.
-int PendingInterrupt();
-
-// Clears and returns the recorded signal (0 if none).
+// Clears and returns the signal recorded during or after a commit (SIGINT,
+// SIGTERM), or 0.
 int TakeInterrupt();
 
 // A temporary file the handler removes: registered before it is created,
