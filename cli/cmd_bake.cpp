@@ -129,7 +129,6 @@ nlohmann::json BakeOne(const BakeOptions& o, const std::string& atmosphere_arg, 
 // placeholder skybake does not know: a usage error rather than a folder
 // named after it.
 std::vector<std::string> OutputDirs(const BakeOptions& o) {
-  if (o.output_dir.empty()) throw UsageError("-o: an empty path names no folder");
   if (!o.depfile.empty() && o.atmospheres.size() > 1) {
     throw UsageError("--depfile: names the inputs of one set; bake one atmosphere per depfile");
   }
@@ -245,7 +244,8 @@ void AddBakeCommand(CLI::App& app) {
                   "Output directory (created if missing); {name} is replaced by the atmosphere's name (the preset's, "
                   "the file's without .toml, stdin for standard input; no other {...} placeholder exists); with "
                   "several atmospheres and no {name}, each goes to DIR/NAME")
-      ->required();
+      ->required()
+      ->check(OutputPath());
   cmd->add_flag("--clean", o->clean,
                 "Remove the files of an earlier set in the output directory that the new set does not list "
                 "(without it, such files make the bake refuse before baking); files no skybake manifest there "
@@ -256,7 +256,8 @@ void AddBakeCommand(CLI::App& app) {
                 "their sizes, which is otherwise left as it is");
   cmd->add_option("--depfile", o->depfile,
                   "Also write FILE, a Make-syntax rule for build systems (Ninja, Make, CMake's DEPFILE): the set's "
-                  "skybake.json depends on the atmosphere and scene files read; one atmosphere only");
+                  "skybake.json depends on the atmosphere and scene files read; one atmosphere only")
+      ->check(OutputPath());
   o->bake.AddTo(cmd);
   o->format_option = cmd->add_option("--format", o->formats,
                                      "File formats, comma-separated: exr, ktx2 (default exr,ktx2)")

@@ -271,7 +271,8 @@ void AddBenchCommand(CLI::App& app) {
                 "exact higher orders), and 1, 2 and all threads "
                 "(total time and peak memory)");
   cmd->add_option("-o,--output", o->output_dir,
-                  "Directory the bakes write to (default: a temporary one, removed afterwards)");
+                  "Directory the bakes write to (default: a temporary one, removed afterwards)")
+      ->check(OutputPath());
   cmd->add_flag("--json", o->json, "Print the figures as JSON instead of Markdown tables");
   cmd->callback([o] { RunBench(*o); });
 }

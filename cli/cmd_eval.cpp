@@ -10,6 +10,7 @@
 
 #include "bake/config.h"
 #include "bake/scene.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "core/errors.h"
 #include "core/file_io.h"
@@ -124,7 +125,8 @@ void AddEvalCommand(CLI::App& app) {
   cmd->add_option("--in", o->input, "Query CSV: altitude_m, view_zenith_deg, sun_zenith_deg, "
                                     "view_sun_azimuth_deg [, distance_m] [, normal_zenith_deg]")
       ->required();
-  cmd->add_option("--out", o->output, "Result CSV (default: stdout)");
+  cmd->add_option("--out", o->output, "Result CSV (default: stdout)")
+      ->check(OutputPath());
   cmd->add_flag("--clamp", o->clamp,
                 "On a scene's bake: clamp altitudes, sun angles and distances outside the scene's ranges into them "
                 "(with a warning) instead of rejecting the query");

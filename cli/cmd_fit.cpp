@@ -124,7 +124,8 @@ void AddFitCommand(CLI::App& app) {
       "of each constituent, and write GLSL + C++ evaluators, a sky-dome mesh, plots and fit.json");
   auto args = std::make_shared<FitArguments>();
   cmd->add_option("atmosphere", args->atmosphere, "Atmosphere file (.toml) or preset name")->required();
-  cmd->add_option("-o,--output", args->output_dir, "Output directory (created if needed)");
+  cmd->add_option("-o,--output", args->output_dir, "Output directory (created if needed)")
+      ->check(OutputPath());
   cmd->add_option("--constituent", args->constituents, "Fit only this constituent (repeatable)");
   cmd->add_option("--query", args->query_file,
                   "CSV with columns zenith_deg,altitude_m: print exact, fitted and Iqbal m as CSV on stdout "

@@ -207,7 +207,8 @@ void AddInfoCommand(CLI::App& app) {
   cmd->add_option("--plot", o->plot_dir,
                   "Also plot table slices of a baked directory (transmittance, sky radiance, irradiance; "
                   "lut_*.svg and .png) into this directory; a plot whose table the set leaves out (a scene's "
-                  "bake) is not drawn and is named on stderr");
+                  "bake) is not drawn and is named on stderr")
+      ->check(OutputPath());
   cmd->callback([o] { RunInfo(*o); });
 }
 

@@ -13,6 +13,7 @@
 #include "bake/config.h"
 #include "bake/spectral.h"
 #include "cli/bake_settings_options.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "core/errors.h"
@@ -103,7 +104,8 @@ void AddReferenceCommand(CLI::App& app) {
                   "Query CSV: altitude_m, view_zenith_deg, sun_zenith_deg, view_sun_azimuth_deg "
                   "[, distance_m] [, normal_zenith_deg]")
       ->required();
-  cmd->add_option("--out", o->output, "Result CSV (default: stdout)");
+  cmd->add_option("--out", o->output, "Result CSV (default: stdout)")
+      ->check(OutputPath());
   cmd->add_option("--paths", o->settings.paths,
                   "Paths per wavelength for each Monte Carlo estimate (rounded up to blocks of 64); the standard "
                   "error falls as 1/sqrt(paths)")

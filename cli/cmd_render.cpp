@@ -253,7 +253,8 @@ void AddRenderCommand(CLI::App& app) {
       "from space and an aerial-perspective strip, as linear EXR and tone-mapped sRGB PNG, plus a contact sheet");
   auto args = std::make_shared<RenderArguments>();
   cmd->add_option("lut_dir", args->lut_dir, "Directory written by `skybake bake`")->required();
-  cmd->add_option("-o,--output", args->output_dir, "Output directory (created if needed)")->required();
+  cmd->add_option("-o,--output", args->output_dir, "Output directory (created if needed)")->required()
+      ->check(OutputPath());
   cmd->add_option("--sun-zenith", args->sun_zenith_deg,
                   "Sun zenith angles in degrees (0 to 180, and at most the tables' lowest sun), comma separated")
       ->delimiter(',')

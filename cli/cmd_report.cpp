@@ -70,7 +70,8 @@ void AddReportCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "report", "Error against bake time for a ladder of quality settings, and the run-time models side by side");
   cmd->add_option("atmosphere", o->atmosphere, "Atmosphere file (.toml) or preset name")->required();
-  cmd->add_option("-o,--output", o->output_dir, "Directory for report.csv, report.json and the plot")->required();
+  cmd->add_option("-o,--output", o->output_dir, "Directory for report.csv, report.json and the plot")->required()
+      ->check(OutputPath());
   cmd->add_option("--reference", o->reference,
                   "Reference values (skybake reference over a case set with a group column); "
                   "default: the committed one, for earth only");

@@ -32,6 +32,13 @@ void SetCommandLine(int argc, char** argv) {
 
 const std::string& CommandLine() { return Storage(); }
 
+const CLI::Validator& OutputPath() {
+  static const CLI::Validator check(
+      [](const std::string& path) { return path.empty() ? std::string("an empty path names no file or folder") : ""; },
+      "PATH");
+  return check;
+}
+
 int ParseKtx2Supercompression(const std::string& value) {
   if (value == "none") return 0;
   if (value == "zstd") return ktx2::kZstdDefaultLevel;

@@ -116,6 +116,22 @@ TEST(PipelineDefects, D06_AnEmptyOutputIsAUsageErrorAtOnce) {
   EXPECT_FALSE(Contains(err, "baking")) << err;
 }
 
+// The same for every option that names an output: one line, exit 1, before any work.
+TEST(PipelineDefects, D06_EveryOutputOptionRefusesAnEmptyPathAtOnce) {
+  TempDir dir;
+  for (const std::string& command :
+       {std::string("render earth -o ''"), std::string("report earth -o ''"), std::string("fit earth -o ''"),
+        std::string("bench earth -o ''"), std::string("info earth --plot ''"),
+        std::string("eval earth --in x.csv --out ''"), std::string("reference earth --in x.csv --out ''"),
+        std::string("bake earth -o out --depfile ''")}) {
+    std::string err;
+    EXPECT_EQ(RunCommand(Skybake() + " " + command, dir, nullptr, &err), 1) << command << ": " << err;
+    EXPECT_EQ(testing::Lines(err).size(), 1u) << command << ": " << err;
+    EXPECT_TRUE(Contains(err, "an empty path")) << command << ": " << err;
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "out"));
+}
+
 // ---- incremental bakes ----
 
 TEST(IncrementalBake, ASecondBakeOfUnchangedInputsIsSkipped) {
