@@ -26,9 +26,7 @@ using testing::Skybake;
 using testing::TempDir;
 using testing::WriteText;
 
-const char* kSmall =
-    " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
-    " --sphere-samples 8 --orders 2";
+const std::string& kSmall = testing::kSmallBakeOptions;
 
 std::string Quoted(const fs::path& p) { return ShellQuote(p.string()); }
 

@@ -29,9 +29,7 @@ using testing::ShellQuote;
 using testing::Skybake;
 using testing::TempDir;
 
-const char* kSmallBake =
-    " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
-    " --sphere-samples 8 --orders 2";
+const std::string& kSmallBake = testing::kSmallBakeOptions;
 
 const std::vector<std::string> kTables = {"transmittance", "irradiance", "scattering", "single_mie_scattering"};
 

@@ -258,7 +258,9 @@ TEST(Interrupt, D02_ReportLeavesNoFolderOrCompletesTheReport) {
   fs::remove_all(out);
   TempDir run;
   const Ended ended = RunAndInterrupt(report + ShellQuote(out), run, After(0.3 * seconds));
-  if (ended.exit_code == 130) EXPECT_FALSE(fs::exists(out));
+  if (ended.exit_code == 130) {
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 // Defect 2: the other commands died of SIGINT with no message and left

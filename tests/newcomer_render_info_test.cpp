@@ -31,10 +31,7 @@ using testing::ShellQuote;
 using testing::Skybake;
 using testing::TempDir;
 
-// Table sizes and samples of a bake that takes well under a second.
-const char* const kSmallBake =
-    " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
-    " --sphere-samples 8 --orders 2";
+const std::string& kSmallBake = testing::kSmallBakeOptions;
 
 // The chunk types of a PNG file, in file order (empty if it is not a PNG).
 std::vector<std::string> PngChunks(const fs::path& path) {

@@ -32,12 +32,8 @@ using testing::Skybake;
 using testing::TempDir;
 using testing::WriteText;
 
-// Table sizes and samples of a bake that takes well under a second, and
-// such a bake, quiet.
-const std::string kSmallTables =
-    " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
-    " --sphere-samples 8";
-const std::string kSmallBake = " -q" + kSmallTables + " --orders 2";
+const std::string& kSmallTables = testing::kSmallTableOptions;
+const std::string kSmallBake = " -q" + testing::kSmallBakeOptions;
 
 const fs::path kSource = SKYBAKE_SOURCE_DIR;
 

@@ -71,6 +71,13 @@ inline std::string Skybake() {
   return ShellQuote(other != nullptr && *other != '\0' ? other : SKYBAKE_EXE);
 }
 
+// Table sizes and samples of a bake that takes well under a second, and
+// the same with two orders: the command-line tests' small bake.
+inline const std::string kSmallTableOptions =
+    " --transmittance-size 64 16 --irradiance-size 16 4 --scattering-size 8 32 8 4 --ray-samples 32"
+    " --sphere-samples 8";
+inline const std::string kSmallBakeOptions = kSmallTableOptions + " --orders 2";
+
 inline std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;
   std::istringstream in(text);
