@@ -4,7 +4,6 @@
 // 130 interrupted.
 #include <malloc.h>
 
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -141,9 +140,7 @@ int main(int argc, char** argv) {
   }
   // A signal recorded but never acted on arrived during or after the commit
   // of the outputs.
-  if (const int signal = skybake::TakeInterrupt()) {
-    std::fprintf(stderr, "skybake: interrupted by %s after the outputs were complete; nothing was lost\n",
-                 signal == SIGTERM ? "SIGTERM" : "SIGINT");
-  }
+  const std::string late_interrupt = skybake::TakeInterruptAfterCommit();
+  if (!late_interrupt.empty()) std::fprintf(stderr, "skybake: %s\n", late_interrupt.c_str());
   return static_cast<int>(ExitCode::kOk);
 }

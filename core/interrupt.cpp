@@ -1,11 +1,12 @@
 #include "core/interrupt.h"
 
 #include <pthread.h>
-#include <unistd.h>
 
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -35,7 +36,7 @@ struct InterruptState {
   int pending_signal = 0;
   std::string note = "the outputs were left as they were";
   JsonDocument json_document;
-  std::vector<fs::path> temporaries;  // a slot each; empty: free
+  std::multiset<fs::path> temporaries;
   std::vector<fs::path> created_directories;
   std::vector<fs::path> scratch_directories;
 };
@@ -62,7 +63,7 @@ void ActOn(int signal) {
   }
   for (const fs::path& temporary : s.temporaries) {
     std::error_code ignored;
-    if (!temporary.empty()) fs::remove(temporary, ignored);
+    fs::remove(temporary, ignored);
   }
   for (auto dir = s.created_directories.rbegin(); dir != s.created_directories.rend(); ++dir) {
     std::error_code ignored;
@@ -144,33 +145,29 @@ CommitSection::~CommitSection() {
   if (pending != 0) ActOn(pending);
 }
 
-int TakeInterrupt() {
+std::string TakeInterruptAfterCommit() {
   InterruptState& s = State();
   std::lock_guard<std::mutex> lock(s.mutex);
-  return std::exchange(s.pending_signal, 0);
+  const int signal = std::exchange(s.pending_signal, 0);
+  if (signal == 0) return {};
+  return std::string("interrupted by ") + SignalName(signal) + " after the outputs were complete; nothing was lost";
 }
 
-RegisteredTemporary::RegisteredTemporary(const fs::path& path) {
+RegisteredTemporary::RegisteredTemporary(const fs::path& path) : path_(path) {
   InterruptState& s = State();
   std::lock_guard<std::mutex> lock(s.mutex);
-  for (slot_ = 0; slot_ < int(s.temporaries.size()) && !s.temporaries[slot_].empty(); ++slot_) {
-  }
-  if (slot_ == kMaxTemporaryFiles) {
-    throw InternalError(path.string() + ": more than " + std::to_string(kMaxTemporaryFiles) +
-                        " temporary files at once");
-  }
-  if (slot_ == int(s.temporaries.size())) s.temporaries.emplace_back();
-  s.temporaries[slot_] = path;
+  s.temporaries.insert(path_);
 }
 
-RegisteredTemporary::RegisteredTemporary(RegisteredTemporary&& other) noexcept
-    : slot_(std::exchange(other.slot_, -1)) {}
+RegisteredTemporary::RegisteredTemporary(RegisteredTemporary&& other) noexcept : path_(std::move(other.path_)) {
+  other.path_.clear();
+}
 
 RegisteredTemporary::~RegisteredTemporary() {
-  if (slot_ < 0) return;
+  if (path_.empty()) return;
   InterruptState& s = State();
   std::lock_guard<std::mutex> lock(s.mutex);
-  s.temporaries[slot_].clear();
+  s.temporaries.erase(s.temporaries.find(path_));
 }
 
 void RegisterCreatedDirectory(const fs::path& dir) {

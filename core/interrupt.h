@@ -56,16 +56,15 @@ class CommitSection {
   bool scratch_;
 };
 
-// Clears and returns the signal recorded during or after a commit (SIGINT,
-// SIGTERM), or 0.
-int TakeInterrupt();
+// Where a signal was recorded during or after a commit, the line main()
+// prints ("interrupted by SIGINT after the outputs were complete; nothing
+// was lost"), the signal cleared; empty where none was.
+std::string TakeInterruptAfterCommit();
 
 // A temporary file the handler removes: registered before it is created,
-// unregistered once renamed into place or removed. InternalError if more
-// than a command ever writes at once (kMaxTemporaryFiles) are registered.
+// unregistered once renamed into place or removed.
 class RegisteredTemporary {
  public:
-  static constexpr int kMaxTemporaryFiles = 1024;
   explicit RegisteredTemporary(const std::filesystem::path& path);
   ~RegisteredTemporary();
   RegisteredTemporary(RegisteredTemporary&& other) noexcept;
@@ -74,7 +73,7 @@ class RegisteredTemporary {
   RegisteredTemporary& operator=(const RegisteredTemporary&) = delete;
 
  private:
-  int slot_;
+  std::filesystem::path path_;  // empty once moved from
 };
 
 // A directory this process created: the handler removes it if it is empty
