@@ -27,8 +27,15 @@ Parts (figure blocks, the page, the commands run):
            colour section as colour-errors (docs/colour.md, README.md):
            `/usr/bin/time -v skybake report earth -o build/figures/report`
            (a few minutes)
+  runtime-cost
+           runtime-cost (docs/runtime_cost.md): `skybake bake earth` into
+           build/figures/runtime-cost/earth, the peer runtime installed by
+           tests/runtime_cost/install_peer.mjs, then `skybake_runtime_cost
+           --size 1024 --runs 5` on them (SIZE and RUNS override; about 8
+           minutes); the tool is $SKYBAKE_RUNTIME_COST, else
+           build/tests/skybake_runtime_cost
 
-bench and report time the machine: run them with nothing else running.
+bench, report and runtime-cost time the machine: run them with nothing else running.
 """
 import json
 import os
@@ -240,7 +247,27 @@ def stress(skybake):
     replace_block("docs/stability.md", "stress", "stress", text)
 
 
-PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report}
+def runtime_cost(skybake):
+    work = WORK / "runtime-cost"
+    luts = work / "earth"
+    run([skybake, "bake", "earth", "-o", str(luts), "-q"])  # at once when the set is already there
+    peer = run(["node", "tests/runtime_cost/install_peer.mjs", "--work-dir", str(work / "npm")]).strip()
+    tool = os.environ.get("SKYBAKE_RUNTIME_COST", "build/tests/skybake_runtime_cost")
+    size, runs = os.environ.get("SIZE", "1024"), os.environ.get("RUNS", "5")
+    load = os.getloadavg()[0]
+    start = time.monotonic()
+    run([tool, "--luts", str(luts), "--peer", peer, "--size", size, "--runs", runs, "--json", str(work / "cost.json"),
+         "--markdown", str(work / "cost.md")])
+    wall = time.monotonic() - start
+    text = (f"`scripts/figures.sh runtime-cost` (`skybake_runtime_cost --luts build/figures/runtime-cost/earth --peer "
+            f"… --size {size} --runs {runs}`): {wall / 60:.1f} minutes, {os.cpu_count()} cores, load average "
+            f"{load:.1f} at the start (0 on an idle machine; more makes the times noisier, the ratios less so, "
+            f"since the runs alternate).\n\n" + (work / "cost.md").read_text())
+    replace_block("docs/runtime_cost.md", "runtime-cost", "runtime-cost", text)
+
+
+PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report,
+         "runtime-cost": runtime_cost}
 
 
 def main():

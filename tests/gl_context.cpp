@@ -1,6 +1,7 @@
 #include "tests/gl_context.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -39,6 +40,7 @@ struct GlFunctions {
   X(void, DeleteProgram, (GLuint))                                                                           \
   X(GLint, GetUniformLocation, (GLuint, const GLchar*))                                                      \
   X(void, Uniform1i, (GLint, GLint))                                                                         \
+  X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))                                            \
   X(void, GenTextures, (GLsizei, GLuint*))                                                                   \
   X(void, DeleteTextures, (GLsizei, const GLuint*))                                                          \
   X(void, BindTexture, (GLenum, GLuint))                                                                     \
@@ -98,6 +100,17 @@ struct GlContext::Impl {
     GLuint id;
   };
   std::vector<BoundTexture> textures;  // from SetTexture, units 1, 2, ...
+  std::vector<GLuint> programs;        // from CompileFullScreenProgram
+
+  // Binds the textures of SetTexture to their units and samplers of `program`.
+  void BindTextures(GLuint program) {
+    for (size_t t = 0; t < textures.size(); ++t) {
+      gl.ActiveTexture(GLenum(GL_TEXTURE1 + t));
+      gl.BindTexture(textures[t].target, textures[t].id);
+      gl.Uniform1i(gl.GetUniformLocation(program, textures[t].sampler.c_str()), GLint(1 + t));
+    }
+    gl.ActiveTexture(GL_TEXTURE0);
+  }
 
   void Check(const char* where) {
     GLenum error = gl.GetError();
@@ -124,13 +137,48 @@ struct GlContext::Impl {
     }
     return shader;
   }
+
+  // The program of the two shaders; throws with the driver's log if they do not compile or link.
+  GLuint Link(const std::string& vertex, const std::string& fragment) {
+    GLuint vs = Compile(GL_VERTEX_SHADER, vertex);
+    GLuint fs = 0;
+    try {
+      fs = Compile(GL_FRAGMENT_SHADER, fragment);
+    } catch (...) {
+      gl.DeleteShader(vs);
+      throw;
+    }
+    GLuint program = gl.CreateProgram();
+    gl.AttachShader(program, vs);
+    gl.AttachShader(program, fs);
+    gl.LinkProgram(program);
+    gl.DeleteShader(vs);
+    gl.DeleteShader(fs);
+    GLint linked = 0;
+    gl.GetProgramiv(program, GL_LINK_STATUS, &linked);
+    if (!linked) {
+      char log[4096] = {};
+      gl.GetProgramInfoLog(program, sizeof(log), nullptr, log);
+      gl.DeleteProgram(program);
+      throw std::runtime_error(std::string("shaders do not link:\n") + log);
+    }
+    return program;
+  }
 };
+
+// A triangle that covers the viewport, from gl_VertexID alone (no buffers).
+constexpr char kCoveringTriangle[] =
+    "void main() {\n"
+    "  vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
+    "  gl_Position = vec4(p, 0.0, 1.0);\n"
+    "}\n";
 
 GlContext::GlContext(Api api) : api_(api), impl_(std::make_unique<Impl>()) {}
 
 GlContext::~GlContext() {
   if (impl_ && impl_->context != EGL_NO_CONTEXT) {
     for (const Impl::BoundTexture& t : impl_->textures) impl_->gl.DeleteTextures(1, &t.id);
+    for (GLuint program : impl_->programs) impl_->gl.DeleteProgram(program);
     eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(impl_->display, impl_->context);
     // No eglTerminate: the headless display is shared by every context of
@@ -246,12 +294,7 @@ std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source,
 
   std::string prologue = VersionLine() + "\n" +
                          "precision highp float;\nprecision highp int;\nprecision highp sampler2D;\n";
-  // A triangle that covers the viewport, from gl_VertexID alone (no buffers).
-  std::string vertex = prologue +
-                       "void main() {\n"
-                       "  vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
-                       "  gl_Position = vec4(p, 0.0, 1.0);\n"
-                       "}\n";
+  std::string vertex = prologue + kCoveringTriangle;
   std::string fragment = prologue + "uniform sampler2D skybake_inputs;\n" +
                          "uniform int skybake_row_width;\n"
                          "uniform int skybake_inputs_per_item;\n"
@@ -265,28 +308,7 @@ std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source,
                          "}\n" +
                          "#line 1\n" + fragment_source;
 
-  GLuint vs = s.Compile(GL_VERTEX_SHADER, vertex);
-  GLuint fs = 0;
-  try {
-    fs = s.Compile(GL_FRAGMENT_SHADER, fragment);
-  } catch (...) {
-    gl.DeleteShader(vs);
-    throw;
-  }
-  GLuint program = gl.CreateProgram();
-  gl.AttachShader(program, vs);
-  gl.AttachShader(program, fs);
-  gl.LinkProgram(program);
-  gl.DeleteShader(vs);
-  gl.DeleteShader(fs);
-  GLint linked = 0;
-  gl.GetProgramiv(program, GL_LINK_STATUS, &linked);
-  if (!linked) {
-    char log[4096] = {};
-    gl.GetProgramInfoLog(program, sizeof(log), nullptr, log);
-    gl.DeleteProgram(program);
-    throw std::runtime_error(std::string("shaders do not link:\n") + log);
-  }
+  GLuint program = s.Link(vertex, fragment);
 
   // Inputs, padded to whole rows.
   std::vector<float> texels(static_cast<size_t>(width) * inputs_per_item * height * 4, 0.0f);
@@ -318,12 +340,7 @@ std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source,
     gl.Uniform1i(gl.GetUniformLocation(program, "skybake_inputs"), 0);
     gl.Uniform1i(gl.GetUniformLocation(program, "skybake_row_width"), width);
     gl.Uniform1i(gl.GetUniformLocation(program, "skybake_inputs_per_item"), inputs_per_item);
-    for (size_t t = 0; t < s.textures.size(); ++t) {
-      gl.ActiveTexture(GLenum(GL_TEXTURE1 + t));
-      gl.BindTexture(s.textures[t].target, s.textures[t].id);
-      gl.Uniform1i(gl.GetUniformLocation(program, s.textures[t].sampler.c_str()), GLint(1 + t));
-    }
-    gl.ActiveTexture(GL_TEXTURE0);
+    s.BindTextures(program);
     gl.GenVertexArrays(1, &vao);  // core profiles draw nothing without a bound VAO
     gl.BindVertexArray(vao);
     gl.Viewport(0, 0, width, height);
@@ -352,6 +369,76 @@ std::vector<Vec4> GlContext::RunFragmentPass(const std::string& fragment_source,
   return outputs;
 }
 
+unsigned GlContext::CompileFullScreenProgram(const std::string& fragment_source) {
+  const std::string prologue = VersionLine() + "\n" +
+                               "precision highp float;\nprecision highp int;\nprecision highp sampler2D;\n"
+                               "precision highp sampler3D;\n";
+  const GLuint program =
+      impl_->Link(prologue + kCoveringTriangle, prologue + "out vec4 skybake_output;\n#line 1\n" + fragment_source);
+  impl_->programs.push_back(program);
+  return program;
+}
+
+double GlContext::RenderFullScreen(unsigned program, int width, int height,
+                                   const std::vector<std::pair<std::string, Vec4>>& uniforms,
+                                   std::vector<Vec4>* pixels) {
+  Impl& s = *impl_;
+  GlFunctions& gl = s.gl;
+  if (std::find(s.programs.begin(), s.programs.end(), program) == s.programs.end())
+    throw std::runtime_error("RenderFullScreen: not a program of CompileFullScreenProgram");
+  GLuint target = 0, framebuffer = 0, vao = 0;
+  auto release = [&] {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteFramebuffers(1, &framebuffer);
+    gl.DeleteTextures(1, &target);
+    gl.DeleteVertexArrays(1, &vao);
+  };
+  double seconds = 0.0;
+  try {
+    gl.GenTextures(1, &target);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, target);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.GenFramebuffers(1, &framebuffer);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target, 0);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("RGBA32F framebuffer is incomplete");
+    gl.UseProgram(program);
+    s.BindTextures(program);
+    // A uniform the compiler found unused has location -1, which glUniform ignores.
+    for (const auto& [name, value] : uniforms)
+      gl.Uniform4f(gl.GetUniformLocation(program, name.c_str()), value[0], value[1], value[2], value[3]);
+    gl.GenVertexArrays(1, &vao);  // core profiles draw nothing without a bound VAO
+    gl.BindVertexArray(vao);
+    gl.Viewport(0, 0, width, height);
+    gl.Finish();
+    s.Check("the full-screen pass's set-up");
+    const auto start = std::chrono::steady_clock::now();
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.Finish();
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    s.Check("the full-screen pass");
+    if (pixels) {
+      std::vector<float> texels(static_cast<size_t>(width) * height * 4);
+      gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+      gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, texels.data());
+      s.Check("reading the full-screen pass back");
+      pixels->resize(static_cast<size_t>(width) * height);
+      for (size_t i = 0; i < pixels->size(); ++i)
+        for (int c = 0; c < 4; ++c) (*pixels)[i][c] = texels[i * 4 + c];
+    }
+  } catch (...) {
+    release();
+    throw;
+  }
+  release();
+  return seconds;
+}
+
 #else  // !SKYBAKE_HAVE_EGL
 
 struct GlContext::Impl {};
@@ -367,6 +454,11 @@ void GlContext::SetTexture(const std::string&, int, int, int, const float*, std:
   throw std::runtime_error("no headless GL");
 }
 std::vector<Vec4> GlContext::RunFragmentPass(const std::string&, const std::vector<Vec4>&, int) {
+  throw std::runtime_error("no headless GL");
+}
+unsigned GlContext::CompileFullScreenProgram(const std::string&) { throw std::runtime_error("no headless GL"); }
+double GlContext::RenderFullScreen(unsigned, int, int, const std::vector<std::pair<std::string, Vec4>>&,
+                                   std::vector<Vec4>*) {
   throw std::runtime_error("no headless GL");
 }
 

@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace skybake::testing {
@@ -63,6 +64,26 @@ class GlContext {
 
   std::vector<Vec4> RunFragmentPass(const std::string& fragment_source, const std::vector<Vec4>& inputs,
                                     int inputs_per_item = 1);
+
+  // Full-screen passes that are compiled once and drawn many times, for
+  // timing a shader (tests/runtime_cost.cpp). The helper puts before
+  // `fragment_source` the version line,
+  // `precision highp float; precision highp int; precision highp sampler2D; precision highp sampler3D;`
+  // and `out vec4 skybake_output;`; the caller's main() derives its pixel
+  // from gl_FragCoord and its parameters from uniforms. Returns the program,
+  // which lives as long as the context. Throws std::runtime_error with the
+  // driver's log if the shaders do not compile or link.
+  unsigned CompileFullScreenProgram(const std::string& fragment_source);
+  // Draws `program` over a width x height RGBA32F target, with the textures
+  // of SetTexture bound and each vec4 uniform of `uniforms` set by name (one
+  // the program does not use is ignored), and
+  // returns the wall seconds from the draw call until glFinish returns (the
+  // set-up before the draw is finished first and not counted). A driver that
+  // compiles a shader at its first draw (llvmpipe does) counts that compile
+  // in the first call: draw once untimed before timing. The target's texels,
+  // row by row from gl_FragCoord.y = 0.5, go to `pixels` if not null.
+  double RenderFullScreen(unsigned program, int width, int height,
+                          const std::vector<std::pair<std::string, Vec4>>& uniforms, std::vector<Vec4>* pixels);
 
  private:
   struct Impl;

@@ -1,5 +1,6 @@
 #include "examples/engine/vulkan_compute.h"
 
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -58,6 +59,7 @@ struct VulkanCompute::Impl {
     VkShaderModule module = VK_NULL_HANDLE;
     VkPipeline pipeline = VK_NULL_HANDLE;
   } cached;
+  std::vector<Pipeline> kept;  // from CreatePipeline, by index
 
   void DestroyPipeline(Pipeline* p) {
     if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
@@ -71,6 +73,12 @@ struct VulkanCompute::Impl {
   const Pipeline& PipelineFor(const std::vector<std::uint32_t>& spirv, Samplers samplers) {
     if (cached.pipeline && cached.spirv == spirv && cached.samplers == samplers) return cached;
     DestroyPipeline(&cached);
+    cached = MakePipeline(spirv, samplers);
+    return cached;
+  }
+
+  // A new pipeline for `spirv` and `samplers`.
+  Pipeline MakePipeline(const std::vector<std::uint32_t>& spirv, Samplers samplers) {
     Pipeline p;
     p.spirv = spirv;
     p.samplers = samplers;
@@ -113,14 +121,14 @@ struct VulkanCompute::Impl {
       DestroyPipeline(&p);
       throw;
     }
-    cached = std::move(p);
-    return cached;
+    return p;
   }
 
   ~Impl() {
     if (device) {
       vkDeviceWaitIdle(device);
       DestroyPipeline(&cached);
+      for (Pipeline& p : kept) DestroyPipeline(&p);
       for (Texture& t : textures) DestroyTexture(&t);
       if (sampler) vkDestroySampler(device, sampler, nullptr);
       if (pool) vkDestroyCommandPool(device, pool, nullptr);
@@ -181,9 +189,10 @@ struct VulkanCompute::Impl {
     return b;
   }
 
-  // Records commands with `record`, submits them and waits.
+  // Records commands with `record`, submits them and waits; returns the wall
+  // seconds from the submit until the queue is idle.
   template <typename Record>
-  void Submit(Record record) {
+  double Submit(Record record) {
     VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     allocate.commandPool = pool;
     allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
@@ -198,10 +207,18 @@ struct VulkanCompute::Impl {
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &commands;
+    const auto start = std::chrono::steady_clock::now();
     Check(vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
     Check(vkQueueWaitIdle(queue), "vkQueueWaitIdle");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     vkFreeCommandBuffers(device, pool, 1, &commands);
+    return seconds;
   }
+
+  // Runs pipeline `p` over `items` items (VulkanCompute::Run); returns the
+  // dispatch's seconds (Submit).
+  double Dispatch(const Pipeline& p, const std::vector<std::array<float, 4>>& inputs, std::size_t items,
+                  std::vector<std::array<float, 4>>* outputs);
 };
 
 std::unique_ptr<VulkanCompute> VulkanCompute::Create(std::string* why_not) {
@@ -340,13 +357,38 @@ std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint
   }
   if (items == 0) return {};
   if (inputs.empty()) throw std::runtime_error("a compute run needs inputs");
-  const bool combined = samplers == Samplers::kCombined;
+  std::vector<std::array<float, 4>> outputs;
+  d.Dispatch(d.PipelineFor(spirv, samplers), inputs, items, &outputs);
+  return outputs;
+}
 
-  const Impl::Pipeline& p = d.PipelineFor(spirv, samplers);
+int VulkanCompute::CreatePipeline(const std::vector<std::uint32_t>& spirv, Samplers samplers, double* seconds) {
+  Impl& d = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  d.kept.push_back(d.MakePipeline(spirv, samplers));
+  *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return int(d.kept.size()) - 1;
+}
+
+double VulkanCompute::TimeDispatch(int pipeline, const std::vector<std::array<float, 4>>& inputs, std::size_t items,
+                                   std::vector<std::array<float, 4>>* outputs) {
+  Impl& d = *impl_;
+  if (pipeline < 0 || pipeline >= int(d.kept.size())) throw std::runtime_error("no such pipeline");
+  for (const Impl::Texture& t : d.textures) {
+    if (!t.view) throw std::runtime_error("every texture binding needs a texture before a dispatch");
+  }
+  if (items == 0 || inputs.empty()) throw std::runtime_error("a timed dispatch needs items and inputs");
+  return d.Dispatch(d.kept[pipeline], inputs, items, outputs);
+}
+
+double VulkanCompute::Impl::Dispatch(const Pipeline& p, const std::vector<std::array<float, 4>>& inputs,
+                                     std::size_t items, std::vector<std::array<float, 4>>* outputs) {
+  Impl& d = *this;
+  const bool combined = p.samplers == Samplers::kCombined;
 
   // Everything created here is destroyed at the end, also on an error.
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
-  Impl::Buffer input_buffer, output_buffer;
+  Buffer input_buffer, output_buffer;
   auto release = [&] {
     if (descriptor_pool) vkDestroyDescriptorPool(d.device, descriptor_pool, nullptr);
     d.DestroyBuffer(&input_buffer);
@@ -406,7 +448,7 @@ std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint
     }
     vkUpdateDescriptorSets(d.device, uint32_t(writes.size()), writes.data(), 0, nullptr);
 
-    d.Submit([&](VkCommandBuffer commands) {
+    const double seconds = d.Submit([&](VkCommandBuffer commands) {
       vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
       vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
       vkCmdDispatch(commands, uint32_t((items + 63) / 64), 1, 1);
@@ -416,13 +458,15 @@ std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint
       vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier,
                            0, nullptr, 0, nullptr);
     });
-    std::vector<std::array<float, 4>> outputs(items);
-    void* mapped;
-    Check(vkMapMemory(d.device, output_buffer.memory, 0, output_buffer.size, 0, &mapped), "vkMapMemory");
-    std::memcpy(outputs.data(), mapped, output_buffer.size);
-    vkUnmapMemory(d.device, output_buffer.memory);
+    if (outputs) {
+      outputs->resize(items);
+      void* mapped;
+      Check(vkMapMemory(d.device, output_buffer.memory, 0, output_buffer.size, 0, &mapped), "vkMapMemory");
+      std::memcpy(outputs->data(), mapped, output_buffer.size);
+      vkUnmapMemory(d.device, output_buffer.memory);
+    }
     release();
-    return outputs;
+    return seconds;
   } catch (...) {
     release();
     throw;
@@ -443,6 +487,13 @@ void VulkanCompute::SetTexture(int, int, int, int, const float*, std::size_t) {}
 std::vector<std::array<float, 4>> VulkanCompute::Run(const std::vector<std::uint32_t>&, Samplers,
                                                     const std::vector<std::array<float, 4>>&, std::size_t) {
   return {};
+}
+int VulkanCompute::CreatePipeline(const std::vector<std::uint32_t>&, Samplers, double*) {
+  throw std::runtime_error("built without Vulkan");
+}
+double VulkanCompute::TimeDispatch(int, const std::vector<std::array<float, 4>>&, std::size_t,
+                                   std::vector<std::array<float, 4>>*) {
+  throw std::runtime_error("built without Vulkan");
 }
 std::string VulkanCompute::Description() const { return {}; }
 

@@ -64,6 +64,20 @@ class VulkanCompute {
   std::vector<std::array<float, 4>> Run(const std::vector<std::uint32_t>& spirv, Samplers samplers,
                                         const std::vector<std::array<float, 4>>& inputs, std::size_t items);
 
+  // For timing a shader (tests/runtime_cost.cpp): pipelines created once and
+  // dispatched any number of times. CreatePipeline makes the compute
+  // pipeline of `spirv` (as Run does), kept until the device goes, and
+  // returns its index, with the wall seconds of vkCreateShaderModule and
+  // vkCreateComputePipelines in `seconds`.
+  int CreatePipeline(const std::vector<std::uint32_t>& spirv, Samplers samplers, double* seconds);
+  // Runs pipeline `pipeline` as Run runs its shader and returns the wall
+  // seconds from vkQueueSubmit until vkQueueWaitIdle returns (the buffers
+  // and descriptors are made before and not counted); the outputs go to
+  // `outputs` if not null. A driver that finishes compiling at the first
+  // dispatch counts that in the first call: dispatch once untimed first.
+  double TimeDispatch(int pipeline, const std::vector<std::array<float, 4>>& inputs, std::size_t items,
+                      std::vector<std::array<float, 4>>* outputs);
+
  private:
   struct Impl;
   VulkanCompute();
