@@ -14,6 +14,9 @@ precision highp sampler3D;
 #define TransmittanceTexture sampler2D
 #define ScatteringTexture sampler3D
 #define IrradianceTexture sampler2D
+// The per-frame tables an engine renders (per_frame.glsl).
+#define SkyViewTexture sampler2D
+#define AerialPerspectiveTexture sampler3D
 // Bilinear / trilinear lookups of a table (each language's own sampling; the
 // WGSL translation samples a separate texture with a shared sampler).
 #define SampleTexture2D texture

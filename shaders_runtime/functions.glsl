@@ -159,6 +159,56 @@ vec2 GetTransmittanceTextureUvFromRMu(IN(AtmosphereParameters) atmosphere, Numbe
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+// The view zenith axis of the scattering table and of the sky view
+// (per_frame.glsl): split at the horizon into two halves, rays that hit the
+// ground in the lower one and the others in the upper one. Within its half a
+// ray's unit x in [0, 1] is its distance to the boundary it leaves through,
+// 0 looking straight up or down and 1 at the horizon: to the ground between
+// r - bottom and rho (the distance to the horizon), to the top boundary
+// between top - r and rho + H.
+Number GetUnitMuInHalf(IN(AtmosphereParameters) atmosphere, Number r, Number rho, Number mu,
+                       bool ray_r_mu_intersects_ground) {
+  if (ray_r_mu_intersects_ground) {
+    Number d = DistanceToBottomAtmosphereBoundary(atmosphere, r, mu);
+    Number d_min = r - atmosphere.bottom_radius;
+    return rho == d_min ? 0.0 : (d - d_min) / (rho - d_min);
+  }
+  Number d = DistanceToTopAtmosphereBoundary(atmosphere, r, mu);
+  Number d_min = atmosphere.top_radius - r;
+  Number d_max = rho + HorizonDistanceAtTop(atmosphere);
+  return d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+}
+
+// Its inverse: the view zenith cosine at unit x within the half, from
+// bottom^2 = r^2 + 2 r mu d + d^2 (ground) or top^2 = r^2 + 2 r mu d + d^2
+// with top^2 - r^2 = H^2 - rho^2.
+Number GetMuFromUnitMuInHalf(IN(AtmosphereParameters) atmosphere, Number r, Number rho, Number x,
+                             bool ray_r_mu_intersects_ground) {
+  if (ray_r_mu_intersects_ground) {
+    Number d_min = r - atmosphere.bottom_radius;
+    Number d = d_min + (rho - d_min) * x;
+    return d == 0.0 ? -1.0 : ClampCosine(-(rho * rho + d * d) / (2.0 * r * d));
+  }
+  Number H = HorizonDistanceAtTop(atmosphere);
+  Number d_min = atmosphere.top_radius - r;
+  Number d = d_min + (rho + H - d_min) * x;
+  return d == 0.0 ? 1.0 : ClampCosine((H * H - rho * rho - d * d) / (2.0 * r * d));
+}
+
+// The texture coordinate of unit x within its half of a mu axis of `size`
+// texels: the lower half's x runs down from the middle to 0, the upper
+// half's up to 1, each sampled at its own texel centres.
+Number GetTextureCoordFromUnitMuInHalf(Number x, bool ray_r_mu_intersects_ground, int size) {
+  Number u = 0.5 * GetTextureCoordFromUnitRange(x, size / 2);
+  return ray_r_mu_intersects_ground ? 0.5 - u : 0.5 + u;
+}
+
+// Its inverse: the half a texture coordinate lies in, and x there.
+Number GetUnitMuInHalfFromTextureCoord(Number u, int size, OUT(bool) ray_r_mu_intersects_ground) {
+  ray_r_mu_intersects_ground = u < 0.5;
+  return GetUnitRangeFromTextureCoord(ray_r_mu_intersects_ground ? 1.0 - 2.0 * u : 2.0 * u - 1.0, size / 2);
+}
+
 // A of ScatteringUnitMuSFromDistance: the distance to the top boundary from
 // the ground for the sun at scattering_mu_s_min, over its range from d_min =
 // top - bottom (the sun at the zenith) to d_max = HorizonDistanceAtTop.
@@ -467,29 +517,10 @@ Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r, Num
 // GetScattering reads again, else (0, 0).
 vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number mu_s, Number nu,
                                      bool ray_r_mu_intersects_ground, OUT(vec2) edge) {
-  Number H = HorizonDistanceAtTop(atmosphere);
   Number rho = HorizonDistance(atmosphere, r);
 
-  Number half_mu_size = Number(atmosphere.scattering_mu_size / 2);
-  Number u_mu;
-  Number x_mu;
-  if (ray_r_mu_intersects_ground) {
-    // Distance to the ground, between r - bottom (looking straight down) and
-    // rho (the horizon), mapped to the lower half.
-    Number d = DistanceToBottomAtmosphereBoundary(atmosphere, r, mu);
-    Number d_min = r - atmosphere.bottom_radius;
-    Number d_max = rho;
-    x_mu = d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min);
-    u_mu = 0.5 - 0.5 * (0.5 / half_mu_size + x_mu * (1.0 - 1.0 / half_mu_size));
-  } else {
-    // Distance to the top boundary, between top - r (straight up) and
-    // rho + H (the horizon), mapped to the upper half.
-    Number d = DistanceToTopAtmosphereBoundary(atmosphere, r, mu);
-    Number d_min = atmosphere.top_radius - r;
-    Number d_max = rho + H;
-    x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
-    u_mu = 0.5 + 0.5 * (0.5 / half_mu_size + x_mu * (1.0 - 1.0 / half_mu_size));
-  }
+  Number x_mu = GetUnitMuInHalf(atmosphere, r, rho, mu, ray_r_mu_intersects_ground);
+  Number u_mu = GetTextureCoordFromUnitMuInHalf(x_mu, ray_r_mu_intersects_ground, atmosphere.scattering_mu_size);
   Number u_r = GetScatteringTextureUR(atmosphere, r, rho, ray_r_mu_intersects_ground, x_mu);
 
   // Below the split, the position on the ray's own columns.
@@ -810,7 +841,7 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
 
 // 4D lookup: the mu_s texel columns either side of mu_s
 // (GetScatteringAtMuSColumn, two fetches each), blended linearly in
-// daylight (four fetches); for a low sun between two columns by
+// daylight by the texture unit (two fetches); for a low sun between two columns by
 // LogMonotoneCubicMix of the four columns around it (eight fetches), and
 // below the table's lowest sun by LowestSunLogFall of the two lowest
 // columns (four fetches). Below the split, each nu slice's light on the
@@ -857,15 +888,19 @@ vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) sc
   bool low_sun_below;
   Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
   GetScatteringMuSColumns(atmosphere, uvwz.y, x_low_sun, x_below, x_above, mu_s_t, low_sun_below);
-  vec4 below =
-      GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, low_sun_below);
+  if (!low_sun_below) {
+    // Daylight: linear along mu_s, which the texture unit does within a nu
+    // slice, so one fetch at mu_s_t between the two columns reads their blend.
+    return GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, mix(x_below, x_above, mu_s_t), nu_slice,
+                                    nu_t, false);
+  }
+  vec4 below = GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, true);
   vec4 above =
       GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_above, nu_slice, nu_t, x_above < x_low_sun);
   if (mu_s_t < 0.0) {
     return LowestSunContinued(below, above, atmosphere.scattering_mu_s_min,
                               GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)), mu_s);
   }
-  if (!low_sun_below) return mix(below, above, mu_s_t);
   Number column = x_below * mu_s_size - 0.5;
   Number x_first = (max(column - 1.0, 0.0) + 0.5) / mu_s_size;
   Number x_last = (min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
@@ -927,6 +962,18 @@ vec3 GetCombinedScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTex
   return vec3(scattering);
 }
 
+// The sky radiance along the ray (r, mu) to where it leaves the atmosphere
+// or meets the ground, for the sun at (mu_s, nu): the tables' light times
+// the phase functions.
+vec3 GetSkyRadianceOfRay(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                         IN(ScatteringTexture) single_mie_scattering_texture, Number r, Number mu, Number mu_s,
+                         Number nu, bool ray_r_mu_intersects_ground) {
+  vec3 single_mie_scattering;
+  vec3 scattering = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r, mu,
+                                          mu_s, nu, ray_r_mu_intersects_ground, single_mie_scattering);
+  return scattering * RayleighPhaseFunction(nu) + single_mie_scattering * MiePhaseFunction(atmosphere, nu);
+}
+
 // Sky radiance seen from `camera` along the unit vector `view_ray`, without
 // the sun disc and without ground reflection, and the transmittance to the
 // top of the atmosphere (0 if the ray hits the ground). A camera in space is
@@ -947,10 +994,8 @@ vec3 GetSkyRadiance(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture
   transmittance = ray_r_mu_intersects_ground
       ? vec3(0.0)
       : GetTransmittanceToTopAtmosphereBoundary(atmosphere, transmittance_texture, r, mu);
-  vec3 single_mie_scattering;
-  vec3 scattering = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r, mu,
-                                          mu_s, nu, ray_r_mu_intersects_ground, single_mie_scattering);
-  return scattering * RayleighPhaseFunction(nu) + single_mie_scattering * MiePhaseFunction(atmosphere, nu);
+  return GetSkyRadianceOfRay(atmosphere, scattering_texture, single_mie_scattering_texture, r, mu, mu_s, nu,
+                             ray_r_mu_intersects_ground);
 }
 #endif
 

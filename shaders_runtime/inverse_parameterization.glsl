@@ -61,28 +61,14 @@ Number GetScatteringOwnColumnSunZenith(IN(AtmosphereParameters) atmosphere, Numb
 void GetRMuMuSNuFromScatteringTextureUvwz(IN(AtmosphereParameters) atmosphere, IN(vec4) uvwz, OUT(Number) r,
                                           OUT(Number) mu, OUT(Number) mu_s, OUT(Number) nu,
                                           OUT(bool) ray_r_mu_intersects_ground) {
-  Number H = HorizonDistanceAtTop(atmosphere);
   Number rho_min = HorizonDistance(atmosphere, atmosphere.scattering_r_min);
   Number rho_max = HorizonDistance(atmosphere, atmosphere.scattering_r_max);
   Number rho = rho_min + (rho_max - rho_min) * GetUnitRangeFromTextureCoord(uvwz.w, atmosphere.scattering_r_size);
   Number bottom = atmosphere.bottom_radius;
   r = sqrt(rho * rho + bottom * bottom);
 
-  int half_mu_size = atmosphere.scattering_mu_size / 2;
-  if (uvwz.z < 0.5) {
-    Number d_min = r - bottom;
-    Number d_max = rho;
-    Number d = d_min + (d_max - d_min) * GetUnitRangeFromTextureCoord(1.0 - 2.0 * uvwz.z, half_mu_size);
-    // bottom^2 = r^2 + 2 r mu d + d^2.
-    mu = d == 0.0 ? -1.0 : ClampCosine(-(rho * rho + d * d) / (2.0 * r * d));
-    ray_r_mu_intersects_ground = true;
-  } else {
-    Number d_min = atmosphere.top_radius - r;
-    Number d_max = rho + H;
-    Number d = d_min + (d_max - d_min) * GetUnitRangeFromTextureCoord(2.0 * uvwz.z - 1.0, half_mu_size);
-    mu = d == 0.0 ? 1.0 : ClampCosine((H * H - rho * rho - d * d) / (2.0 * r * d));
-    ray_r_mu_intersects_ground = false;
-  }
+  Number x_mu = GetUnitMuInHalfFromTextureCoord(uvwz.z, atmosphere.scattering_mu_size, ray_r_mu_intersects_ground);
+  mu = GetMuFromUnitMuInHalf(atmosphere, r, rho, x_mu, ray_r_mu_intersects_ground);
 
   nu = ClampCosine(uvwz.x * 2.0 - 1.0);
   Number x_mu_s = GetUnitRangeFromTextureCoord(uvwz.y, atmosphere.scattering_mu_s_size);

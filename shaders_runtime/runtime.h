@@ -1,6 +1,6 @@
 // The GLSL runtime compiled as C++ (double precision): every function of
 // primitives.glsl and phase_functions.glsl (primitives.h), functions.glsl,
-// aerial_perspective.glsl and inverse_parameterization.glsl,
+// aerial_perspective.glsl, per_frame.glsl and inverse_parameterization.glsl,
 // in namespace skybake::glsl. The bake uses the parameterization and lookups; the CPU twin
 // (twin.h) uses the run-time functions. Each translation unit gets its own
 // internal copy, as GLSL functions cannot be declared inline.
@@ -14,6 +14,8 @@
 #define TransmittanceTexture sampler2D
 #define ScatteringTexture sampler3D
 #define IrradianceTexture sampler2D
+#define SkyViewTexture sampler2D
+#define AerialPerspectiveTexture sampler3D
 #define SampleTexture2D texture
 #define SampleTexture3D texture
 
@@ -23,6 +25,7 @@ namespace {
 #pragma GCC diagnostic ignored "-Wunused-function"
 #include "shaders_runtime/functions.glsl"
 #include "shaders_runtime/aerial_perspective.glsl"
+#include "shaders_runtime/per_frame.glsl"
 #include "shaders_runtime/inverse_parameterization.glsl"
 #pragma GCC diagnostic pop
 }  // namespace
@@ -33,5 +36,7 @@ namespace {
 #undef TransmittanceTexture
 #undef ScatteringTexture
 #undef IrradianceTexture
+#undef SkyViewTexture
+#undef AerialPerspectiveTexture
 #undef SampleTexture2D
 #undef SampleTexture3D

@@ -51,9 +51,10 @@ std::string AtmosphereConstants(ShadingLanguage language, const glsl::Atmosphere
 
 // The sources of the shipped functions.glsl, in their order of definition:
 // scalar primitives, phase functions, geometry, parameterization, lookups and
-// sky radiance, then aerial perspective and irradiance.
-inline constexpr const char* kRuntimeFunctionSources[] = {"primitives.glsl", "phase_functions.glsl",
-                                                           "functions.glsl", "aerial_perspective.glsl"};
+// sky radiance, then aerial perspective and irradiance, then the per-frame
+// tables (sky view and aerial-perspective volume).
+inline constexpr const char* kRuntimeFunctionSources[] = {"primitives.glsl", "phase_functions.glsl", "functions.glsl",
+                                                           "aerial_perspective.glsl", "per_frame.glsl"};
 
 // The shipped functions.glsl: the kRuntimeFunctionSources joined.
 std::string RuntimeFunctionsGlsl();

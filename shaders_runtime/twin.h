@@ -39,6 +39,21 @@ class Twin {
                                  const glsl::vec3& sun_direction, glsl::vec3* sky_irradiance) const;
   glsl::vec3 SolarRadiance() const;
 
+  // The per-frame tables (per_frame.glsl) for one camera and sun: the sky
+  // view, SKY_VIEW_WIDTH x SKY_VIEW_HEIGHT texels of GetSkyViewRadiance, and
+  // its lookup; a texel of the aerial-perspective volume (radiance, and its
+  // optical depth) along a froxel's ray at slice coordinate w, and the
+  // volume's lookup.
+  glsl::Texture SkyView(const glsl::vec3& camera, const glsl::vec3& sun_direction) const;
+  glsl::vec3 SkyRadianceFromSkyView(const glsl::Texture& sky_view, const glsl::vec3& camera,
+                                    const glsl::vec3& view_ray, const glsl::vec3& sun_direction,
+                                    glsl::vec3* transmittance) const;
+  glsl::vec3 AerialPerspectiveVoxel(const glsl::vec3& camera, const glsl::vec3& view_ray, double w,
+                                    const glsl::vec3& sun_direction, glsl::vec3* optical_depth) const;
+  static glsl::vec3 SkyRadianceToPointFromVolume(const glsl::Texture& radiance, const glsl::Texture& optical_depth,
+                                                 const glsl::vec2& screen_uv, double distance,
+                                                 glsl::vec3* transmittance);
+
   // Raw table lookups in the table's own coordinates.
   glsl::vec4 Scattering(double r, double mu, double mu_s, double nu, bool ray_intersects_ground) const;
   glsl::vec3 OpticalDepthToTop(double r, double mu) const;

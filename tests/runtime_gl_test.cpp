@@ -22,6 +22,7 @@
 #include "shaders_runtime/query.h"
 #include "shaders_runtime/runtime.h"
 #include "shaders_runtime/snippet.h"
+#include "shaders_runtime/twin.h"
 #include "tests/gl_context.h"
 #include "tests/runtime_queries.h"
 #include "tests/test_atmospheres.h"
@@ -87,7 +88,8 @@ TEST(RuntimeSnippet, BakeWritesItWithConstantsFromTheManifestParameters) {
   const std::filesystem::path sources = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "shaders_runtime";
   EXPECT_EQ(testing::ReadText(lut / "functions.glsl"),
             testing::ReadText(sources / "primitives.glsl") + testing::ReadText(sources / "phase_functions.glsl") +
-                testing::ReadText(sources / "functions.glsl") + testing::ReadText(sources / "aerial_perspective.glsl"));
+                testing::ReadText(sources / "functions.glsl") + testing::ReadText(sources / "aerial_perspective.glsl") +
+                testing::ReadText(sources / "per_frame.glsl"));
   // The other languages' definitions and functions are the committed translations.
   for (const char* file : {"definitions.hlsl", "functions.hlsl", "definitions.metal", "functions.metal", "functions.wgsl"}) {
     EXPECT_EQ(testing::ReadText(lut / file), testing::ReadText(sources / "generated" / file)) << file;
@@ -261,6 +263,184 @@ TEST_P(SnippetOnMesa, SpectralSetMatchesTheCppTwin) {
   parts.channels_are_xyz = true;
   ExpectGlMatchesTwin(gl.get(), luts, FragmentSource(luts, parts),
                       testing::MakeRuntimeQueries(luts.parameters.bottom_radius, luts.parameters.top_radius));
+}
+
+// The largest relative difference of `gpu` from `twin` over the values that
+// exceed 1e-6 of their channel's largest (as ExpectMatchesTwin counts them).
+double LargestRelativeDifference(const std::vector<testing::Vec4>& gpu, const std::vector<vec3>& twin) {
+  vec3 largest(0.0);
+  for (const vec3& v : twin) largest = glm::max(largest, glm::abs(v));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < twin.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      if (std::abs(twin[i][c]) <= 1e-6 * largest[c]) continue;
+      worst = std::max(worst, std::abs(gpu[i][c] - twin[i][c]) / std::abs(twin[i][c]));
+    }
+  }
+  return worst;
+}
+
+// The per-frame tables (per_frame.glsl) built and read on the driver give the
+// twin's: the sky view's texels (GetSkyViewRadiance) within the GL test's
+// tolerance for the sky radiance they hold (1e-3), the lookups of the twin's
+// tables on the driver within 1e-3. The volume's texels hold aerial
+// perspective to points beyond the query set's: 49 m segments after sunset,
+// where the one cancelling term of short segments (ExpectMatchesTwin) leaves
+// 6.6e-2 in float32 on llvmpipe, and ground 40 km away seen at a grazing
+// angle, where the table method's transmittance differs by 7.2e-3; the
+// tolerances are 1e-1 and 1e-2.
+TEST_P(SnippetOnMesa, PerFrameTablesMatchTheCppTwin) {
+  std::string why_not;
+  std::unique_ptr<GlContext> gl = GlContext::Create(GetParam(), &why_not);
+  if (!gl) GTEST_SKIP() << why_not;
+  static const LutSet luts = Bake(LoadAtmosphere("earth"), testing::RuntimeTestSettings(false));
+  SetTables(gl.get(), luts);
+  const Twin twin({luts.parameters, &luts.transmittance, &luts.scattering, &luts.single_mie_scattering,
+                   &luts.irradiance});
+  const std::string snippet = RuntimeSnippetSource(ShadingLanguage::kGlsl, luts.parameters,
+                                                   luts.atmosphere.wavelengths_nm, luts.atmosphere.name);
+  const std::string tables = R"(
+uniform sampler2D transmittance_texture;
+uniform sampler3D scattering_texture;
+uniform sampler3D single_mie_scattering_texture;
+uniform sampler2D irradiance_texture;
+uniform sampler2D sky_view_texture;
+uniform sampler3D aerial_perspective_radiance;
+uniform sampler3D aerial_perspective_optical_depth;
+)";
+  auto f = [](double v) { return float(v); };
+  auto input = [&](const vec3& v, double w) { return testing::Vec4{f(v.x), f(v.y), f(v.z), f(w)}; };
+  const double bottom = luts.parameters.bottom_radius;
+  const double degree = M_PI / 180.0;
+  for (double sun_zenith : {30.0, 93.0}) {
+    const vec3 sun(std::sin(sun_zenith * degree), 0.0, std::cos(sun_zenith * degree));
+    const vec3 camera(0.0, 0.0, bottom + 300.0);
+    SCOPED_TRACE("sun at " + std::to_string(sun_zenith) + " degrees");
+
+    // The sky view: every texel built on the driver, then the twin's table read there.
+    const glsl::Texture sky_view = twin.SkyView(camera, sun);
+    std::vector<testing::Vec4> inputs;
+    std::vector<vec3> expected;
+    for (int y = 0; y < sky_view.height; ++y) {
+      for (int x = 0; x < sky_view.width; ++x) {
+        inputs.push_back(input(camera, (x + 0.5) / sky_view.width));
+        inputs.push_back(input(sun, (y + 0.5) / sky_view.height));
+        expected.push_back(vec3(sky_view.Fetch(x, y)));
+      }
+    }
+    std::vector<testing::Vec4> built = gl->RunFragmentPass(snippet + tables + R"(
+void main() {
+  vec4 a = skybake_input(0), b = skybake_input(1);
+  skybake_output = vec4(GetSkyViewRadiance(ATMOSPHERE, scattering_texture, single_mie_scattering_texture, a.xyz,
+                                           b.xyz, vec2(a.w, b.w)), 1.0);
+}
+)", inputs, 2);
+    EXPECT_LT(LargestRelativeDifference(built, expected), 1e-3) << "sky view texels";
+    gl->SetTexture("sky_view_texture", sky_view.width, sky_view.height, 1, sky_view.texels.data(),
+                   sky_view.texels.size());
+    inputs.clear();
+    expected.clear();
+    for (int i = 0; i < 2000; ++i) {
+      const double zenith = std::fmod(i * 0.618034, 1.0) * M_PI, azimuth = (i + 0.5) / 2000.0 * 2.0 * M_PI;
+      const vec3 ray(std::sin(zenith) * std::cos(azimuth), std::sin(zenith) * std::sin(azimuth), std::cos(zenith));
+      inputs.push_back(input(camera, 0.0));
+      inputs.push_back(input(vec3(glm::vec3(ray)), 0.0));
+      inputs.push_back(input(sun, 0.0));
+      expected.push_back(twin.SkyRadianceFromSkyView(sky_view, camera, vec3(glm::vec3(ray)), sun, nullptr));
+    }
+    std::vector<testing::Vec4> read = gl->RunFragmentPass(snippet + tables + R"(
+void main() {
+  vec3 transmittance;
+  skybake_output = vec4(GetSkyRadianceFromSkyView(ATMOSPHERE, transmittance_texture, sky_view_texture,
+                                                  skybake_input(0).xyz, skybake_input(1).xyz, skybake_input(2).xyz,
+                                                  transmittance), 1.0);
+}
+)", inputs, 3);
+    EXPECT_LT(LargestRelativeDifference(read, expected), 1e-3) << "sky view lookups";
+
+    // The volume: 8 x 8 froxels of a 90-degree frustum looking at the
+    // horizon, every slice.
+    const int froxels = 8, slices = glsl::AERIAL_PERSPECTIVE_SLICES;
+    glsl::Texture radiance(froxels, froxels, slices), optical_depth(froxels, froxels, slices);
+    std::vector<vec3> expected_transmittance;
+    std::vector<vec3> rays;
+    inputs.clear();
+    expected.clear();
+    for (int z = 0; z < slices; ++z) {
+      for (int y = 0; y < froxels; ++y) {
+        for (int x = 0; x < froxels; ++x) {
+          const vec3 ray = vec3(glm::vec3(glm::normalize(vec3(1.0, 2.0 * (x + 0.5) / froxels - 1.0,
+                                                               2.0 * (y + 0.5) / froxels - 1.0))));
+          vec3 depth;
+          const vec3 value = twin.AerialPerspectiveVoxel(camera, ray, (z + 0.5) / slices, sun, &depth);
+          radiance.Store(x, y, z, glsl::vec4(value, 1.0));
+          optical_depth.Store(x, y, z, glsl::vec4(depth, 1.0));
+          inputs.push_back(input(camera, (z + 0.5) / slices));
+          inputs.push_back(input(ray, 0.0));
+          inputs.push_back(input(sun, 0.0));
+          expected.push_back(value);
+          expected_transmittance.push_back(glm::exp(-depth));
+        }
+      }
+    }
+    const std::string voxel = snippet + tables + R"(
+void main() {
+  vec3 optical_depth;
+  vec3 radiance = GetAerialPerspectiveVoxel(ATMOSPHERE, transmittance_texture, scattering_texture,
+                                            single_mie_scattering_texture, skybake_input(0).xyz,
+                                            skybake_input(1).xyz, skybake_input(0).w, skybake_input(2).xyz,
+                                            optical_depth);
+  skybake_output = vec4(OUTPUT, 1.0);
+}
+)";
+    auto with_output = [&](const char* output) {
+      std::string source = voxel;
+      source.replace(source.find("OUTPUT"), 6, output);
+      return source;
+    };
+    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(with_output("radiance"), inputs, 3), expected), 1e-1)
+        << "volume radiance";
+    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(with_output("exp(-optical_depth)"), inputs, 3),
+                                        expected_transmittance),
+              1e-2)
+        << "volume transmittance";
+    gl->SetTexture("aerial_perspective_radiance", froxels, froxels, slices, radiance.texels.data(),
+                   radiance.texels.size());
+    gl->SetTexture("aerial_perspective_optical_depth", froxels, froxels, slices, optical_depth.texels.data(),
+                   optical_depth.texels.size());
+    inputs.clear();
+    expected.clear();
+    expected_transmittance.clear();
+    for (int i = 0; i < 2000; ++i) {
+      const glsl::vec2 uv(std::fmod(i * 0.618034, 1.0), (i + 0.5) / 2000.0);
+      const double distance = float(20.0 * std::pow(5000.0, std::fmod(i * 0.414214, 1.0)));
+      vec3 transmittance;
+      expected.push_back(Twin::SkyRadianceToPointFromVolume(radiance, optical_depth, glsl::vec2(glm::vec2(uv)),
+                                                            distance, &transmittance));
+      expected_transmittance.push_back(transmittance);
+      inputs.push_back(testing::Vec4{f(uv.x), f(uv.y), f(distance), 0.0f});
+    }
+    const std::string lookup = snippet + tables + R"(
+void main() {
+  vec4 a = skybake_input(0);
+  vec3 transmittance;
+  vec3 radiance = GetSkyRadianceToPointFromVolume(aerial_perspective_radiance, aerial_perspective_optical_depth,
+                                                  a.xy, a.z, transmittance);
+  skybake_output = vec4(OUTPUT, 1.0);
+}
+)";
+    auto lookup_output = [&](const char* output) {
+      std::string source = lookup;
+      source.replace(source.find("OUTPUT"), 6, output);
+      return source;
+    };
+    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(lookup_output("radiance"), inputs, 1), expected), 1e-3)
+        << "volume lookups";
+    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(lookup_output("transmittance"), inputs, 1),
+                                        expected_transmittance),
+              1e-3)
+        << "volume lookups' transmittance";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Apis, SnippetOnMesa,

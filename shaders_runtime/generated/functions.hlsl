@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _953 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1056 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_953)
+    if (!_1056)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _816 = mu < 0.0f;
-    bool _828;
-    if (_816)
+    bool _919 = mu < 0.0f;
+    bool _931;
+    if (_919)
     {
-        _828 = (((r * r) * mu) * mu) >= c;
+        _931 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _828 = _816;
+        _931 = _919;
     }
-    return _828;
+    return _931;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _586;
+    float _689;
     if (r_mu > 0.0f)
     {
-        _586 = c / (r_mu + s);
+        _689 = c / (r_mu + s);
     }
     else
     {
-        _586 = s - r_mu;
+        _689 = s - r_mu;
     }
-    float param_1 = _586;
+    float param_1 = _689;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1045;
+    float _1160;
     if (d_max > d_min)
     {
-        _1045 = (d - d_min) / (d_max - d_min);
+        _1160 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1045 = 0.0f;
+        _1160 = 0.0f;
     }
-    float x_mu = _1045;
+    float x_mu = _1160;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -190,6 +190,66 @@ float DistanceToBottomAtmosphereBoundary(AtmosphereParameters atmosphere, float 
     float s = SafeSqrt(param);
     float param_1 = c / max(s - r_mu, 1.0000000031710768509710513471353e-30f);
     return ClampDistance(param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float mu, bool ray_r_mu_intersects_ground)
+{
+    if (ray_r_mu_intersects_ground)
+    {
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        float d_min = r - atmosphere.bottom_radius;
+        float _1212;
+        if (rho == d_min)
+        {
+            _1212 = 0.0f;
+        }
+        else
+        {
+            _1212 = (d - d_min) / (rho - d_min);
+        }
+        return _1212;
+    }
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = r;
+    float param_5 = mu;
+    float d_1 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+    float d_min_1 = atmosphere.top_radius - r;
+    AtmosphereParameters param_6 = atmosphere;
+    float d_max = rho + HorizonDistanceAtTop(param_6);
+    float _1247;
+    if (d_max > d_min_1)
+    {
+        _1247 = (d_1 - d_min_1) / (d_max - d_min_1);
+    }
+    else
+    {
+        _1247 = 0.0f;
+    }
+    return _1247;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetTextureCoordFromUnitMuInHalf(float x, bool ray_r_mu_intersects_ground, int size)
+{
+    float param = x;
+    int param_1 = size / 2;
+    float u = 0.5f * GetTextureCoordFromUnitRange(param, param_1);
+    float _1270;
+    if (ray_r_mu_intersects_ground)
+    {
+        _1270 = 0.5f - u;
+    }
+    else
+    {
+        _1270 = 0.5f + u;
+    }
+    return _1270;
 }
 #endif
 
@@ -289,39 +349,39 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1250;
+    float _1474;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1250 = ClampCosine(param_1);
+        _1474 = ClampCosine(param_1);
     }
     else
     {
-        _1250 = 1.0f;
+        _1474 = 1.0f;
     }
-    return _1250;
+    return _1474;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _832;
+    float _935;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _832 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _935 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _832 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _935 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _832;
+    return _935;
 }
 #endif
 
@@ -374,52 +434,52 @@ float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_p
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0f - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1356;
+    float2 _1580;
     if (c_end >= rho)
     {
-        _1356 = float2(-1.0f, 0.0f);
+        _1580 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1356 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
+        _1580 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float2 end = _1356;
-    bool _1384 = end.y < 0.0f;
-    bool _1394;
-    if (!_1384)
+    float2 end = _1580;
+    bool _1608 = end.y < 0.0f;
+    bool _1618;
+    if (!_1608)
     {
-        _1394 = end.x < start.x;
+        _1618 = end.x < start.x;
     }
     else
     {
-        _1394 = _1384;
+        _1618 = _1608;
     }
-    bool end_sets_last = _1394;
+    bool end_sets_last = _1618;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
     float sin_a = a * (1.0f - ((a * a) / 6.0f));
-    bool2 _1426 = end_sets_last.xx;
-    float2 last = float2(_1426.x ? end.x : start.x, _1426.y ? end.y : start.y);
+    bool2 _1650 = end_sets_last.xx;
+    float2 last = float2(_1650.x ? end.x : start.x, _1650.y ? end.y : start.y);
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1449;
+    float _1673;
     if (end_sets_last)
     {
-        float _1455;
+        float _1679;
         if (c_end >= rho)
         {
-            _1455 = 3.1415927410125732421875f;
+            _1679 = 3.1415927410125732421875f;
         }
         else
         {
-            _1455 = atan2(across, cos_alpha) + acos(cos_gamma);
+            _1679 = atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1449 = _1455;
+        _1673 = _1679;
     }
     else
     {
-        _1449 = acos(c_start);
+        _1673 = acos(c_start);
     }
-    float angle = _1449;
+    float angle = _1673;
     return angle + a;
 }
 #endif
@@ -457,17 +517,17 @@ float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
     float param_5 = 1.0f / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1192;
+    float _1416;
     if (d == 0.0f)
     {
-        _1192 = 1.0f;
+        _1416 = 1.0f;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1192 = ClampCosine(param_6);
+        _1416 = ClampCosine(param_6);
     }
-    return _1192;
+    return _1416;
 }
 #endif
 
@@ -518,15 +578,15 @@ void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, float2 edge, inout 
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1658 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _1882 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1658;
+    X_closest = _1882;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _1665 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _1889 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _1665 - X_closest;
+    X_span = _1889 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -542,9 +602,9 @@ float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, float D, float2 edg
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1615 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1839 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1615;
+    float X = _1839;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
@@ -571,9 +631,9 @@ float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, float _distance, float2
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1710 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _1934 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1710;
+    return _1934;
 }
 #endif
 
@@ -619,96 +679,61 @@ float ScatteringUnitNu(float nu)
 float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground, inout float2 edge)
 {
     AtmosphereParameters param = atmosphere;
-    float H = HorizonDistanceAtTop(param);
-    AtmosphereParameters param_1 = atmosphere;
-    float param_2 = r;
-    float rho = HorizonDistance(param_1, param_2);
-    float half_mu_size = float(atmosphere.scattering_mu_size / 2);
-    float x_mu;
-    float u_mu;
-    if (ray_r_mu_intersects_ground)
-    {
-        AtmosphereParameters param_3 = atmosphere;
-        float param_4 = r;
-        float param_5 = mu;
-        float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
-        float d_min = r - atmosphere.bottom_radius;
-        float d_max = rho;
-        float _2004;
-        if (d_max == d_min)
-        {
-            _2004 = 0.0f;
-        }
-        else
-        {
-            _2004 = (d - d_min) / (d_max - d_min);
-        }
-        x_mu = _2004;
-        u_mu = 0.5f - (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
-    }
-    else
-    {
-        AtmosphereParameters param_6 = atmosphere;
-        float param_7 = r;
-        float param_8 = mu;
-        float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
-        float d_min_1 = atmosphere.top_radius - r;
-        float d_max_1 = rho + H;
-        float _2048;
-        if (d_max_1 > d_min_1)
-        {
-            _2048 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
-        }
-        else
-        {
-            _2048 = 0.0f;
-        }
-        x_mu = _2048;
-        u_mu = 0.5f + (0.5f * ((0.5f / half_mu_size) + (x_mu * (1.0f - (1.0f / half_mu_size)))));
-    }
-    AtmosphereParameters param_9 = atmosphere;
-    float param_10 = r;
-    float param_11 = rho;
-    bool param_12 = ray_r_mu_intersects_ground;
-    float param_13 = x_mu;
-    float u_r = GetScatteringTextureUR(param_9, param_10, param_11, param_12, param_13);
-    AtmosphereParameters param_14 = atmosphere;
-    float param_15 = mu_s;
-    float u_mu_s = GetScatteringTextureUMuS(param_14, param_15);
+    float param_1 = r;
+    float rho = HorizonDistance(param, param_1);
+    AtmosphereParameters param_2 = atmosphere;
+    float param_3 = r;
+    float param_4 = rho;
+    float param_5 = mu;
+    bool param_6 = ray_r_mu_intersects_ground;
+    float x_mu = GetUnitMuInHalf(param_2, param_3, param_4, param_5, param_6);
+    float param_7 = x_mu;
+    bool param_8 = ray_r_mu_intersects_ground;
+    int param_9 = atmosphere.scattering_mu_size;
+    float u_mu = GetTextureCoordFromUnitMuInHalf(param_7, param_8, param_9);
+    AtmosphereParameters param_10 = atmosphere;
+    float param_11 = r;
+    float param_12 = rho;
+    bool param_13 = ray_r_mu_intersects_ground;
+    float param_14 = x_mu;
+    float u_r = GetScatteringTextureUR(param_10, param_11, param_12, param_13, param_14);
+    AtmosphereParameters param_15 = atmosphere;
+    float param_16 = mu_s;
+    float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = 0.0f.xx;
-    bool _2095 = atmosphere.scattering_mu_s_split > 0;
-    bool _2106;
-    if (_2095)
+    bool _2243 = atmosphere.scattering_mu_s_split > 0;
+    bool _2254;
+    if (_2243)
     {
-        _2106 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2254 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2106 = _2095;
+        _2254 = _2243;
     }
-    if (_2106)
+    if (_2254)
     {
-        float param_16 = mu;
-        float param_17 = mu_s;
-        float param_18 = nu;
-        AtmosphereParameters param_19 = atmosphere;
-        float param_20 = r;
-        float param_21 = mu;
-        float param_22 = ViewSunAzimuthCosine(param_16, param_17, param_18);
-        bool param_23 = ray_r_mu_intersects_ground;
-        float2 param_24;
-        float _2126 = ShadowEdge(param_19, param_20, param_21, param_22, param_23, param_24);
-        edge = param_24;
-        float2 param_25 = edge;
-        float param_26 = mu_s;
-        AtmosphereParameters param_27 = atmosphere;
-        float param_28 = ShadowEdgeDistance(param_25, param_26);
-        float2 param_29 = edge;
-        u_mu_s = (GetScatteringShadowEdgePosition(param_27, param_28, param_29) + 0.5f) / mu_s_size;
+        float param_17 = mu;
+        float param_18 = mu_s;
+        float param_19 = nu;
+        AtmosphereParameters param_20 = atmosphere;
+        float param_21 = r;
+        float param_22 = mu;
+        float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
+        bool param_24 = ray_r_mu_intersects_ground;
+        float2 param_25;
+        float _2274 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
+        edge = param_25;
+        float2 param_26 = edge;
+        float param_27 = mu_s;
+        AtmosphereParameters param_28 = atmosphere;
+        float param_29 = ShadowEdgeDistance(param_26, param_27);
+        float2 param_30 = edge;
+        u_mu_s = (GetScatteringShadowEdgePosition(param_28, param_29, param_30) + 0.5f) / mu_s_size;
     }
-    float param_30 = nu;
-    return float4(ScatteringUnitNu(param_30), u_mu_s, u_mu, u_r);
+    float param_31 = nu;
+    return float4(ScatteringUnitNu(param_31), u_mu_s, u_mu, u_r);
 }
 #endif
 
@@ -810,9 +835,9 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edg
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1768 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _1992 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1768 - x;
+        float error = _1992 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -842,26 +867,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _2557;
+    float4 _2705;
     if (has_a)
     {
-        _2557 = log(max(a, dark));
+        _2705 = log(max(a, dark));
     }
     else
     {
-        _2557 = (lb * 2.0f) - lc;
+        _2705 = (lb * 2.0f) - lc;
     }
-    float4 la = _2557;
-    float4 _2572;
+    float4 la = _2705;
+    float4 _2720;
     if (has_d)
     {
-        _2572 = log(max(d, dark));
+        _2720 = log(max(d, dark));
     }
     else
     {
-        _2572 = (lc * 2.0f) - lb;
+        _2720 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2572;
+    float4 ld = _2720;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -955,16 +980,16 @@ float4 GetScatteringBelowSplit(AtmosphereParameters atmosphere, Texture3D<float4
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _2476;
+    float _2624;
     if (low_sun)
     {
-        _2476 = min(t, 1.0f);
+        _2624 = min(t, 1.0f);
     }
     else
     {
-        _2476 = clamp(t, 0.0f, 1.0f);
+        _2624 = clamp(t, 0.0f, 1.0f);
     }
-    return _2476;
+    return _2624;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -992,26 +1017,26 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float2 param_6;
-    float4 _3075 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float4 _3223 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
     float2 edge = param_6;
-    float4 uvwz = _3075;
+    float4 uvwz = _3223;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = uvwz.x * (nu_size - 1.0f);
     float nu_slice = min(floor(nu_coord), nu_size - 2.0f);
     float nu_t = nu_coord - nu_slice;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float position = (uvwz.y * mu_s_size) - 0.5f;
-    bool _3109 = atmosphere.scattering_mu_s_split > 0;
-    bool _3117;
-    if (_3109)
+    bool _3257 = atmosphere.scattering_mu_s_split > 0;
+    bool _3265;
+    if (_3257)
     {
-        _3117 = position < float(atmosphere.scattering_mu_s_split);
+        _3265 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3117 = _3109;
+        _3265 = _3257;
     }
-    if (_3117)
+    if (_3265)
     {
         float past = 6.0f;
         float log_first_span = 1.0f;
@@ -1085,60 +1110,66 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float x_above = param_53;
     float mu_s_t = param_54;
     bool low_sun_below = param_55;
-    AtmosphereParameters param_56 = atmosphere;
-    float4 param_57 = uvwz;
-    float param_58 = x_below;
-    float param_59 = nu_slice;
-    float param_60 = nu_t;
-    bool param_61 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_56, scattering_texture_1, _scattering_texture_1_sampler, param_57, param_58, param_59, param_60, param_61);
-    AtmosphereParameters param_62 = atmosphere;
-    float4 param_63 = uvwz;
-    float param_64 = x_above;
-    float param_65 = nu_slice;
-    float param_66 = nu_t;
-    bool param_67 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_62, scattering_texture_1, _scattering_texture_1_sampler, param_63, param_64, param_65, param_66, param_67);
-    if (mu_s_t < 0.0f)
-    {
-        AtmosphereParameters param_68 = atmosphere;
-        float param_69 = 1.0f / (mu_s_size - 1.0f);
-        float4 param_70 = below;
-        float4 param_71 = above;
-        float param_72 = atmosphere.scattering_mu_s_min;
-        float param_73 = GetScatteringMuSFromUnitRange(param_68, param_69);
-        float param_74 = mu_s;
-        return LowestSunContinued(param_70, param_71, param_72, param_73, param_74);
-    }
     if (!low_sun_below)
     {
-        return lerp(below, above, mu_s_t.xxxx);
+        AtmosphereParameters param_56 = atmosphere;
+        float4 param_57 = uvwz;
+        float param_58 = lerp(x_below, x_above, mu_s_t);
+        float param_59 = nu_slice;
+        float param_60 = nu_t;
+        bool param_61 = false;
+        return GetScatteringAtMuSColumn(param_56, scattering_texture_1, _scattering_texture_1_sampler, param_57, param_58, param_59, param_60, param_61);
+    }
+    AtmosphereParameters param_62 = atmosphere;
+    float4 param_63 = uvwz;
+    float param_64 = x_below;
+    float param_65 = nu_slice;
+    float param_66 = nu_t;
+    bool param_67 = true;
+    float4 below = GetScatteringAtMuSColumn(param_62, scattering_texture_1, _scattering_texture_1_sampler, param_63, param_64, param_65, param_66, param_67);
+    AtmosphereParameters param_68 = atmosphere;
+    float4 param_69 = uvwz;
+    float param_70 = x_above;
+    float param_71 = nu_slice;
+    float param_72 = nu_t;
+    bool param_73 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_68, scattering_texture_1, _scattering_texture_1_sampler, param_69, param_70, param_71, param_72, param_73);
+    if (mu_s_t < 0.0f)
+    {
+        AtmosphereParameters param_74 = atmosphere;
+        float param_75 = 1.0f / (mu_s_size - 1.0f);
+        float4 param_76 = below;
+        float4 param_77 = above;
+        float param_78 = atmosphere.scattering_mu_s_min;
+        float param_79 = GetScatteringMuSFromUnitRange(param_74, param_75);
+        float param_80 = mu_s;
+        return LowestSunContinued(param_76, param_77, param_78, param_79, param_80);
     }
     float column = (x_below * mu_s_size) - 0.5f;
     float x_first = (max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size;
     float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
-    AtmosphereParameters param_75 = atmosphere;
-    float4 param_76 = uvwz;
-    float param_77 = x_first;
-    float param_78 = nu_slice;
-    float param_79 = nu_t;
-    bool param_80 = true;
-    float4 first = GetScatteringAtMuSColumn(param_75, scattering_texture_1, _scattering_texture_1_sampler, param_76, param_77, param_78, param_79, param_80);
     AtmosphereParameters param_81 = atmosphere;
     float4 param_82 = uvwz;
-    float param_83 = x_last;
+    float param_83 = x_first;
     float param_84 = nu_slice;
     float param_85 = nu_t;
-    bool param_86 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_81, scattering_texture_1, _scattering_texture_1_sampler, param_82, param_83, param_84, param_85, param_86);
-    float4 param_87 = first;
-    float4 param_88 = below;
-    float4 param_89 = above;
-    float4 param_90 = last;
-    bool param_91 = column > 0.5f;
-    bool param_92 = (column + 2.0f) < (mu_s_size - 0.5f);
-    float param_93 = mu_s_t;
-    return LogMonotoneCubicMix(param_87, param_88, param_89, param_90, param_91, param_92, param_93);
+    bool param_86 = true;
+    float4 first = GetScatteringAtMuSColumn(param_81, scattering_texture_1, _scattering_texture_1_sampler, param_82, param_83, param_84, param_85, param_86);
+    AtmosphereParameters param_87 = atmosphere;
+    float4 param_88 = uvwz;
+    float param_89 = x_last;
+    float param_90 = nu_slice;
+    float param_91 = nu_t;
+    bool param_92 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_87, scattering_texture_1, _scattering_texture_1_sampler, param_88, param_89, param_90, param_91, param_92);
+    float4 param_93 = first;
+    float4 param_94 = below;
+    float4 param_95 = above;
+    float4 param_96 = last;
+    bool param_97 = column > 0.5f;
+    bool param_98 = (column + 2.0f) < (mu_s_size - 0.5f);
+    float param_99 = mu_s_t;
+    return LogMonotoneCubicMix(param_93, param_94, param_95, param_96, param_97, param_98, param_99);
 }
 #endif
 
@@ -1154,16 +1185,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3532;
+        float3 _3689;
         if (scattering.x > 0.0f)
         {
-            _3532 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3689 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3532 = 0.0f.xxx;
+            _3689 = 0.0f.xxx;
         }
-        single_mie_scattering = _3532;
+        single_mie_scattering = _3689;
     }
     else
     {
@@ -1224,6 +1255,26 @@ float MiePhaseFunction(AtmosphereParameters atmosphere, float nu)
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+float3 GetSkyRadianceOfRay(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, Texture3D<float4> single_mie_scattering_texture_1, SamplerState _single_mie_scattering_texture_1_sampler, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = mu_s;
+    float param_4 = nu;
+    bool param_5 = ray_r_mu_intersects_ground;
+    float3 param_6;
+    float3 _3754 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 single_mie_scattering = param_6;
+    float3 scattering = _3754;
+    float param_7 = nu;
+    AtmosphereParameters param_8 = atmosphere;
+    float param_9 = nu;
+    return (scattering * RayleighPhaseFunction(param_7)) + (single_mie_scattering * MiePhaseFunction(param_8, param_9));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, Texture3D<float4> single_mie_scattering_texture_1, SamplerState _single_mie_scattering_texture_1_sampler, float3 camera, float3 view_ray, float3 sun_direction, out float3 transmittance)
 {
     AtmosphereParameters param = atmosphere;
@@ -1235,13 +1286,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _3600 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3789 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3600)
+    if (!_3789)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1250,33 +1301,219 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3620;
+    float3 _3809;
     if (ray_r_mu_intersects_ground)
     {
-        _3620 = 0.0f.xxx;
+        _3809 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3620 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _3809 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _3620;
+    transmittance = _3809;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
     float param_18 = mu_s;
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
-    float3 param_21;
-    float3 _3647 = GetCombinedScattering(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20, param_21);
-    float3 single_mie_scattering = param_21;
-    float3 scattering = _3647;
-    float param_22 = nu;
-    AtmosphereParameters param_23 = atmosphere;
-    float param_24 = nu;
-    return (scattering * RayleighPhaseFunction(param_22)) + (single_mie_scattering * MiePhaseFunction(param_23, param_24));
+    return GetSkyRadianceOfRay(param_15, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetUnitRangeFromTextureCoord(float u, int texture_size)
+{
+    return (u - (0.5f / float(texture_size))) / (1.0f - (1.0f / float(texture_size)));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetUnitMuInHalfFromTextureCoord(float u, int size, inout bool ray_r_mu_intersects_ground)
+{
+    ray_r_mu_intersects_ground = u < 0.5f;
+    float _1284;
+    if (ray_r_mu_intersects_ground)
+    {
+        _1284 = 1.0f - (2.0f * u);
+    }
+    else
+    {
+        _1284 = (2.0f * u) - 1.0f;
+    }
+    float param = _1284;
+    int param_1 = size / 2;
+    return GetUnitRangeFromTextureCoord(param, param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float SkyViewHorizonZenith(AtmosphereParameters atmosphere, float r)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    return atan2(atmosphere.bottom_radius, -HorizonDistance(param, param_1));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_direction, float2 uv, inout bool ray_r_mu_intersects_ground)
+{
+    float param = uv.y;
+    int param_1 = 108;
+    bool param_2;
+    float _4971 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    ray_r_mu_intersects_ground = param_2;
+    float x = _4971;
+    float e = (1.0f - x) * (1.0f - x);
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = length(camera);
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = ClampRadius(param_3, param_4);
+    float theta_h = SkyViewHorizonZenith(param_5, param_6);
+    float _4992;
+    if (ray_r_mu_intersects_ground)
+    {
+        _4992 = theta_h + (e * (3.1415927410125732421875f - theta_h));
+    }
+    else
+    {
+        _4992 = theta_h * (1.0f - e);
+    }
+    float theta = _4992;
+    float param_7 = uv.x;
+    int param_8 = 192;
+    float phi = 3.1415927410125732421875f * clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0f, 1.0f);
+    float3 up = normalize(camera);
+    float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
+    if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13f)
+    {
+        bool3 _5042 = (abs(up.x) < 0.89999997615814208984375f).xxx;
+        toward_sun = cross(up, float3(_5042.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5042.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5042.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
+    }
+    toward_sun = normalize(toward_sun);
+    float3 across = cross(up, toward_sun);
+    return (up * cos(theta)) + (((toward_sun * cos(phi)) + (across * sin(phi))) * sin(theta));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float3 GetSkyViewRadiance(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, Texture3D<float4> single_mie_scattering_texture_1, SamplerState _single_mie_scattering_texture_1_sampler, float3 camera, float3 sun_direction, float2 uv)
+{
+    AtmosphereParameters param = atmosphere;
+    float3 param_1 = camera;
+    float3 param_2 = sun_direction;
+    float2 param_3 = uv;
+    bool param_4;
+    float3 _5081 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    bool ray_r_mu_intersects_ground = param_4;
+    float3 view_ray = _5081;
+    float3 up = normalize(camera);
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = length(camera);
+    float param_7 = dot(up, view_ray);
+    float param_8 = dot(up, sun_direction);
+    float param_9 = dot(view_ray, sun_direction);
+    AtmosphereParameters param_10 = atmosphere;
+    float param_11 = ClampRadius(param_5, param_6);
+    float param_12 = ClampCosine(param_7);
+    float param_13 = ClampCosine(param_8);
+    float param_14 = ClampCosine(param_9);
+    bool param_15 = ray_r_mu_intersects_ground;
+    return GetSkyRadianceOfRay(param_10, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_11, param_12, param_13, param_14, param_15);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+void GetSkyViewAngles(float3 camera, float3 view_ray, float3 sun_direction, out float theta, out float phi)
+{
+    float3 up = normalize(camera);
+    float mu = dot(up, view_ray);
+    float3 horizontal = view_ray - (up * mu);
+    float3 sun_horizontal = sun_direction - (up * dot(up, sun_direction));
+    theta = atan2(length(horizontal), mu);
+    float along = dot(sun_horizontal, horizontal);
+    float side = abs(dot(cross(up, sun_horizontal), horizontal));
+    float _4957;
+    if ((along != 0.0f) || (side != 0.0f))
+    {
+        _4957 = atan2(side, along);
+    }
+    else
+    {
+        _4957 = 0.0f;
+    }
+    phi = _4957;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float2 GetSkyViewUvFromAngles(AtmosphereParameters atmosphere, float r, float theta, float phi, bool ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float theta_h = SkyViewHorizonZenith(param, param_1);
+    float _4878;
+    if (ray_r_mu_intersects_ground)
+    {
+        _4878 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
+    }
+    else
+    {
+        _4878 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
+    }
+    float x = _4878;
+    float param_2 = phi / 3.1415927410125732421875f;
+    int param_3 = 192;
+    float param_4 = x;
+    bool param_5 = ray_r_mu_intersects_ground;
+    int param_6 = 108;
+    return float2(GetTextureCoordFromUnitRange(param_2, param_3), GetTextureCoordFromUnitMuInHalf(param_4, param_5, param_6));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float3 GetSkyRadianceFromSkyView(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, Texture2D<float4> sky_view_texture_1, SamplerState _sky_view_texture_1_sampler, float3 camera, float3 view_ray, float3 sun_direction, out float3 transmittance)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = length(camera);
+    float r = ClampRadius(param, param_1);
+    float param_2 = dot(camera, view_ray) / length(camera);
+    float mu = ClampCosine(param_2);
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = r;
+    float param_5 = mu;
+    bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
+    float3 _5143;
+    if (ray_r_mu_intersects_ground)
+    {
+        _5143 = 0.0f.xxx;
+    }
+    else
+    {
+        AtmosphereParameters param_6 = atmosphere;
+        float param_7 = r;
+        float param_8 = mu;
+        _5143 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
+    }
+    transmittance = _5143;
+    float3 param_9 = camera;
+    float3 param_10 = view_ray;
+    float3 param_11 = sun_direction;
+    float param_12;
+    float param_13;
+    GetSkyViewAngles(param_9, param_10, param_11, param_12, param_13);
+    float theta = param_12;
+    float phi = param_13;
+    AtmosphereParameters param_14 = atmosphere;
+    float param_15 = r;
+    float param_16 = theta;
+    float param_17 = phi;
+    bool param_18 = ray_r_mu_intersects_ground;
+    return float3(sky_view_texture_1.SampleLevel(_sky_view_texture_1_sampler, GetSkyViewUvFromAngles(param_14, param_15, param_16, param_17, param_18), 0.0f).xyz);
 }
 #endif
 
@@ -1306,16 +1543,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _3741;
+    float _3913;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _3741 = a * exp(f * log(b / a));
+        _3913 = a * exp(f * log(b / a));
     }
     else
     {
-        _3741 = lerp(a, b, f);
+        _3913 = lerp(a, b, f);
     }
-    return _3741;
+    return _3913;
 }
 #endif
 
@@ -1381,16 +1618,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _3992;
+    float _4164;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _3992 = 1.0f - (0.5f * depth);
+        _4164 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _3992 = (1.0f - exp(-depth)) / depth;
+        _4164 = (1.0f - exp(-depth)) / depth;
     }
-    return _3992;
+    return _4164;
 }
 #endif
 
@@ -1426,10 +1663,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4072 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4244 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4072;
+        float3 extinction = _4244;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1487,10 +1724,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _3937 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4109 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _3937;
+        float3 extinction = _4109;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1563,14 +1800,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _3962;
+    float3 _4134;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _3962 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4134 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1579,9 +1816,9 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _3962 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _4134 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _3962;
+    return _4134;
 }
 #endif
 
@@ -1594,16 +1831,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3703;
+    float _3875;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _3703 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3875 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3703 = up;
+        _3875 = up;
     }
-    return _3703;
+    return _3875;
 }
 #endif
 
@@ -1626,13 +1863,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4218 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4390 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4218)
+    if (!_4390)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1672,11 +1909,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4313 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4485 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4313;
+        lit_optical_depth = _4485;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1690,11 +1927,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4347 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4519 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4347;
+        optical_depth += _4519;
     }
     if (direct < 1.0f)
     {
@@ -1713,9 +1950,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4390 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4562 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4390;
+    float3 scattering = _4562;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1736,11 +1973,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4438 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4610 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4438;
+        float3 far_optical_depth = _4610;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1760,9 +1997,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4492 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4664 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4492);
+            scattering -= (exp(-far_optical_depth) * _4664);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -1783,9 +2020,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4557 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4729 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4557;
+    float3 scattering_p = _4729;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -1805,25 +2042,76 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4601 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _4773 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4601;
+    return _4773;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float AerialPerspectiveSliceDistance(float k)
+{
+    float x = (k + 1.0f) / 32.0f;
+    return (50000.0f * x) * x;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float3 GetAerialPerspectiveVoxel(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, Texture3D<float4> single_mie_scattering_texture_1, SamplerState _single_mie_scattering_texture_1_sampler, float3 camera, float3 view_ray, float w, float3 sun_direction, out float3 optical_depth)
+{
+    float param = floor(w * 32.0f);
+    float d = AerialPerspectiveSliceDistance(param);
+    float3 _point = camera + (view_ray * d);
+    float r_point = length(_point);
+    if (r_point < atmosphere.bottom_radius)
+    {
+        _point *= (atmosphere.bottom_radius / r_point);
+    }
+    AtmosphereParameters param_1 = atmosphere;
+    float3 param_2 = camera;
+    float3 param_3 = _point;
+    float3 param_4 = sun_direction;
+    float3 param_5;
+    float3 _5237 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
+    float3 transmittance = param_5;
+    float3 radiance = _5237;
+    optical_depth = -log(max(transmittance, 1.0000000031710768509710513471353e-30f.xxx));
+    return radiance;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float3 GetSkyRadianceToPointFromVolume(Texture3D<float4> radiance_volume, SamplerState _radiance_volume_sampler, Texture3D<float4> optical_depth_volume, SamplerState _optical_depth_volume_sampler, float2 screen_uv, float _distance, out float3 transmittance)
+{
+    float slices = 32.0f;
+    float d = max(_distance, 0.0f);
+    float s = slices * sqrt(d / 50000.0f);
+    float k = clamp(floor(s) - 1.0f, 0.0f, slices - 2.0f);
+    float param = k;
+    float d_k = AerialPerspectiveSliceDistance(param);
+    float param_1 = k + 1.0f;
+    float t = clamp((d - d_k) / (AerialPerspectiveSliceDistance(param_1) - d_k), 0.0f, 1.0f);
+    float param_2 = 0.0f;
+    float near = min(d / AerialPerspectiveSliceDistance(param_2), 1.0f);
+    float3 uvw = float3(screen_uv, ((k + t) + 0.5f) / slices);
+    transmittance = exp((-float3(optical_depth_volume.SampleLevel(_optical_depth_volume_sampler, uvw, 0.0f).xyz)) * near);
+    return float3(radiance_volume.SampleLevel(_radiance_volume_sampler, uvw, 0.0f).xyz) * near;
 }
 #endif
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _2156;
+    float _2304;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _2156 = 0.100000001490116119384765625f;
+        _2304 = 0.100000001490116119384765625f;
     }
     else
     {
-        _2156 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _2304 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _2156;
+    return _2304;
 }
 #endif
 
@@ -1832,16 +2120,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2174;
+    float _2322;
     if (mu_s < knee)
     {
-        _2174 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _2322 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _2174 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _2322 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _2174;
+    return _2322;
 }
 #endif
 
@@ -1868,16 +2156,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2205;
+    float _2353;
     if (x < 0.5f)
     {
-        _2205 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _2353 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2205 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _2353 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _2205;
+    return _2353;
 }
 #endif
 
@@ -1889,16 +2177,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2499;
+    float4 _2647;
     if (t < 0.0f)
     {
-        _2499 = min(blend, a);
+        _2647 = min(blend, a);
     }
     else
     {
-        _2499 = blend;
+        _2647 = blend;
     }
-    return _2499;
+    return _2647;
 }
 #endif
 

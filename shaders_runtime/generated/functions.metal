@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _953 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1056 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_953)
+    if (!_1056)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _816 = mu < 0.0;
-    bool _828;
-    if (_816)
+    bool _919 = mu < 0.0;
+    bool _931;
+    if (_919)
     {
-        _828 = (((r * r) * mu) * mu) >= c;
+        _931 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _828 = _816;
+        _931 = _919;
     }
-    return _828;
+    return _931;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _586;
+    float _689;
     if (r_mu > 0.0)
     {
-        _586 = c / (r_mu + s);
+        _689 = c / (r_mu + s);
     }
     else
     {
-        _586 = s - r_mu;
+        _689 = s - r_mu;
     }
-    float param_1 = _586;
+    float param_1 = _689;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1045;
+    float _1160;
     if (d_max > d_min)
     {
-        _1045 = (d - d_min) / (d_max - d_min);
+        _1160 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1045 = 0.0;
+        _1160 = 0.0;
     }
-    float x_mu = _1045;
+    float x_mu = _1160;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -206,6 +206,68 @@ float DistanceToBottomAtmosphereBoundary(thread const AtmosphereParameters& atmo
     float s = SafeSqrt(param);
     float param_1 = c / fast::max(s - r_mu, 1.0000000031710768509710513471353e-30);
     return ClampDistance(param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& rho, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
+{
+    if (ray_r_mu_intersects_ground)
+    {
+        AtmosphereParameters param = atmosphere;
+        float param_1 = r;
+        float param_2 = mu;
+        float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        float d_min = r - atmosphere.bottom_radius;
+        float _1212;
+        if (rho == d_min)
+        {
+            _1212 = 0.0;
+        }
+        else
+        {
+            _1212 = (d - d_min) / (rho - d_min);
+        }
+        return _1212;
+    }
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = r;
+    float param_5 = mu;
+    float d_1 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+    float d_min_1 = atmosphere.top_radius - r;
+    AtmosphereParameters param_6 = atmosphere;
+    float d_max = rho + HorizonDistanceAtTop(param_6);
+    float _1247;
+    if (d_max > d_min_1)
+    {
+        _1247 = (d_1 - d_min_1) / (d_max - d_min_1);
+    }
+    else
+    {
+        _1247 = 0.0;
+    }
+    return _1247;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float GetTextureCoordFromUnitMuInHalf(thread const float& x, thread const bool& ray_r_mu_intersects_ground, thread const int& size)
+{
+    float param = x;
+    int param_1 = size / 2;
+    float u = 0.5 * GetTextureCoordFromUnitRange(param, param_1);
+    float _1270;
+    if (ray_r_mu_intersects_ground)
+    {
+        _1270 = 0.5 - u;
+    }
+    else
+    {
+        _1270 = 0.5 + u;
+    }
+    return _1270;
 }
 #endif
 
@@ -312,17 +374,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1250;
+    float _1474;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1250 = ClampCosine(param_1);
+        _1474 = ClampCosine(param_1);
     }
     else
     {
-        _1250 = 1.0;
+        _1474 = 1.0;
     }
-    return _1250;
+    return _1474;
 }
 #endif
 
@@ -330,22 +392,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _832;
+    float _935;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _832 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _935 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _832 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _935 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _832;
+    return _935;
 }
 #endif
 
@@ -402,51 +464,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1356;
+    float2 _1580;
     if (c_end >= rho)
     {
-        _1356 = float2(-1.0, 0.0);
+        _1580 = float2(-1.0, 0.0);
     }
     else
     {
-        _1356 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1580 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1356;
-    bool _1384 = end.y < 0.0;
-    bool _1394;
-    if (!_1384)
+    float2 end = _1580;
+    bool _1608 = end.y < 0.0;
+    bool _1618;
+    if (!_1608)
     {
-        _1394 = end.x < start.x;
+        _1618 = end.x < start.x;
     }
     else
     {
-        _1394 = _1384;
+        _1618 = _1608;
     }
-    bool end_sets_last = _1394;
+    bool end_sets_last = _1618;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1449;
+    float _1673;
     if (end_sets_last)
     {
-        float _1455;
+        float _1679;
         if (c_end >= rho)
         {
-            _1455 = 3.1415927410125732421875;
+            _1679 = 3.1415927410125732421875;
         }
         else
         {
-            _1455 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1679 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1449 = _1455;
+        _1673 = _1679;
     }
     else
     {
-        _1449 = acos(c_start);
+        _1673 = acos(c_start);
     }
-    float angle = _1449;
+    float angle = _1673;
     return angle + a;
 }
 #endif
@@ -487,17 +549,17 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_5 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1192;
+    float _1416;
     if (d == 0.0)
     {
-        _1192 = 1.0;
+        _1416 = 1.0;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1192 = ClampCosine(param_6);
+        _1416 = ClampCosine(param_6);
     }
-    return _1192;
+    return _1416;
 }
 #endif
 
@@ -552,15 +614,15 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1658 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _1882 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1658;
+    X_closest = _1882;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _1665 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _1889 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _1665 - X_closest;
+    X_span = _1889 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -577,9 +639,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1615 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1839 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1615;
+    float X = _1839;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -607,9 +669,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1710 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _1934 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1710;
+    return _1934;
 }
 #endif
 
@@ -659,96 +721,61 @@ static inline __attribute__((always_inline))
 float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground, thread float2& edge)
 {
     AtmosphereParameters param = atmosphere;
-    float H = HorizonDistanceAtTop(param);
-    AtmosphereParameters param_1 = atmosphere;
-    float param_2 = r;
-    float rho = HorizonDistance(param_1, param_2);
-    float half_mu_size = float(atmosphere.scattering_mu_size / 2);
-    float x_mu;
-    float u_mu;
-    if (ray_r_mu_intersects_ground)
-    {
-        AtmosphereParameters param_3 = atmosphere;
-        float param_4 = r;
-        float param_5 = mu;
-        float d = DistanceToBottomAtmosphereBoundary(param_3, param_4, param_5);
-        float d_min = r - atmosphere.bottom_radius;
-        float d_max = rho;
-        float _2004;
-        if (d_max == d_min)
-        {
-            _2004 = 0.0;
-        }
-        else
-        {
-            _2004 = (d - d_min) / (d_max - d_min);
-        }
-        x_mu = _2004;
-        u_mu = 0.5 - (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
-    }
-    else
-    {
-        AtmosphereParameters param_6 = atmosphere;
-        float param_7 = r;
-        float param_8 = mu;
-        float d_1 = DistanceToTopAtmosphereBoundary(param_6, param_7, param_8);
-        float d_min_1 = atmosphere.top_radius - r;
-        float d_max_1 = rho + H;
-        float _2048;
-        if (d_max_1 > d_min_1)
-        {
-            _2048 = (d_1 - d_min_1) / (d_max_1 - d_min_1);
-        }
-        else
-        {
-            _2048 = 0.0;
-        }
-        x_mu = _2048;
-        u_mu = 0.5 + (0.5 * ((0.5 / half_mu_size) + (x_mu * (1.0 - (1.0 / half_mu_size)))));
-    }
-    AtmosphereParameters param_9 = atmosphere;
-    float param_10 = r;
-    float param_11 = rho;
-    bool param_12 = ray_r_mu_intersects_ground;
-    float param_13 = x_mu;
-    float u_r = GetScatteringTextureUR(param_9, param_10, param_11, param_12, param_13);
-    AtmosphereParameters param_14 = atmosphere;
-    float param_15 = mu_s;
-    float u_mu_s = GetScatteringTextureUMuS(param_14, param_15);
+    float param_1 = r;
+    float rho = HorizonDistance(param, param_1);
+    AtmosphereParameters param_2 = atmosphere;
+    float param_3 = r;
+    float param_4 = rho;
+    float param_5 = mu;
+    bool param_6 = ray_r_mu_intersects_ground;
+    float x_mu = GetUnitMuInHalf(param_2, param_3, param_4, param_5, param_6);
+    float param_7 = x_mu;
+    bool param_8 = ray_r_mu_intersects_ground;
+    int param_9 = atmosphere.scattering_mu_size;
+    float u_mu = GetTextureCoordFromUnitMuInHalf(param_7, param_8, param_9);
+    AtmosphereParameters param_10 = atmosphere;
+    float param_11 = r;
+    float param_12 = rho;
+    bool param_13 = ray_r_mu_intersects_ground;
+    float param_14 = x_mu;
+    float u_r = GetScatteringTextureUR(param_10, param_11, param_12, param_13, param_14);
+    AtmosphereParameters param_15 = atmosphere;
+    float param_16 = mu_s;
+    float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = float2(0.0);
-    bool _2095 = atmosphere.scattering_mu_s_split > 0;
-    bool _2106;
-    if (_2095)
+    bool _2243 = atmosphere.scattering_mu_s_split > 0;
+    bool _2254;
+    if (_2243)
     {
-        _2106 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2254 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2106 = _2095;
+        _2254 = _2243;
     }
-    if (_2106)
+    if (_2254)
     {
-        float param_16 = mu;
-        float param_17 = mu_s;
-        float param_18 = nu;
-        AtmosphereParameters param_19 = atmosphere;
-        float param_20 = r;
-        float param_21 = mu;
-        float param_22 = ViewSunAzimuthCosine(param_16, param_17, param_18);
-        bool param_23 = ray_r_mu_intersects_ground;
-        float2 param_24;
-        float _2126 = ShadowEdge(param_19, param_20, param_21, param_22, param_23, param_24);
-        edge = param_24;
-        float2 param_25 = edge;
-        float param_26 = mu_s;
-        AtmosphereParameters param_27 = atmosphere;
-        float param_28 = ShadowEdgeDistance(param_25, param_26);
-        float2 param_29 = edge;
-        u_mu_s = (GetScatteringShadowEdgePosition(param_27, param_28, param_29) + 0.5) / mu_s_size;
+        float param_17 = mu;
+        float param_18 = mu_s;
+        float param_19 = nu;
+        AtmosphereParameters param_20 = atmosphere;
+        float param_21 = r;
+        float param_22 = mu;
+        float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
+        bool param_24 = ray_r_mu_intersects_ground;
+        float2 param_25;
+        float _2274 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
+        edge = param_25;
+        float2 param_26 = edge;
+        float param_27 = mu_s;
+        AtmosphereParameters param_28 = atmosphere;
+        float param_29 = ShadowEdgeDistance(param_26, param_27);
+        float2 param_30 = edge;
+        u_mu_s = (GetScatteringShadowEdgePosition(param_28, param_29, param_30) + 0.5) / mu_s_size;
     }
-    float param_30 = nu;
-    return float4(ScatteringUnitNu(param_30), u_mu_s, u_mu, u_r);
+    float param_31 = nu;
+    return float4(ScatteringUnitNu(param_31), u_mu_s, u_mu, u_r);
 }
 #endif
 
@@ -856,9 +883,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1768 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _1992 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1768 - x;
+        float error = _1992 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -890,26 +917,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _2557;
+    float4 _2705;
     if (has_a)
     {
-        _2557 = log(fast::max(a, dark));
+        _2705 = log(fast::max(a, dark));
     }
     else
     {
-        _2557 = (lb * 2.0) - lc;
+        _2705 = (lb * 2.0) - lc;
     }
-    float4 la = _2557;
-    float4 _2572;
+    float4 la = _2705;
+    float4 _2720;
     if (has_d)
     {
-        _2572 = log(fast::max(d, dark));
+        _2720 = log(fast::max(d, dark));
     }
     else
     {
-        _2572 = (lc * 2.0) - lb;
+        _2720 = (lc * 2.0) - lb;
     }
-    float4 ld = _2572;
+    float4 ld = _2720;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1005,16 +1032,16 @@ float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, te
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _2476;
+    float _2624;
     if (low_sun)
     {
-        _2476 = fast::min(t, 1.0);
+        _2624 = fast::min(t, 1.0);
     }
     else
     {
-        _2476 = fast::clamp(t, 0.0, 1.0);
+        _2624 = fast::clamp(t, 0.0, 1.0);
     }
-    return _2476;
+    return _2624;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1044,26 +1071,26 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float2 param_6;
-    float4 _3075 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float4 _3223 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
     float2 edge = param_6;
-    float4 uvwz = _3075;
+    float4 uvwz = _3223;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = uvwz.x * (nu_size - 1.0);
     float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
     float nu_t = nu_coord - nu_slice;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float position = (uvwz.y * mu_s_size) - 0.5;
-    bool _3109 = atmosphere.scattering_mu_s_split > 0;
-    bool _3117;
-    if (_3109)
+    bool _3257 = atmosphere.scattering_mu_s_split > 0;
+    bool _3265;
+    if (_3257)
     {
-        _3117 = position < float(atmosphere.scattering_mu_s_split);
+        _3265 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3117 = _3109;
+        _3265 = _3257;
     }
-    if (_3117)
+    if (_3265)
     {
         float past = 6.0;
         float log_first_span = 1.0;
@@ -1137,60 +1164,66 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float x_above = param_53;
     float mu_s_t = param_54;
     bool low_sun_below = param_55;
-    AtmosphereParameters param_56 = atmosphere;
-    float4 param_57 = uvwz;
-    float param_58 = x_below;
-    float param_59 = nu_slice;
-    float param_60 = nu_t;
-    bool param_61 = low_sun_below;
-    float4 below = GetScatteringAtMuSColumn(param_56, scattering_texture, scattering_textureSmplr, param_57, param_58, param_59, param_60, param_61);
-    AtmosphereParameters param_62 = atmosphere;
-    float4 param_63 = uvwz;
-    float param_64 = x_above;
-    float param_65 = nu_slice;
-    float param_66 = nu_t;
-    bool param_67 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_62, scattering_texture, scattering_textureSmplr, param_63, param_64, param_65, param_66, param_67);
-    if (mu_s_t < 0.0)
-    {
-        AtmosphereParameters param_68 = atmosphere;
-        float param_69 = 1.0 / (mu_s_size - 1.0);
-        float4 param_70 = below;
-        float4 param_71 = above;
-        float param_72 = atmosphere.scattering_mu_s_min;
-        float param_73 = GetScatteringMuSFromUnitRange(param_68, param_69);
-        float param_74 = mu_s;
-        return LowestSunContinued(param_70, param_71, param_72, param_73, param_74);
-    }
     if (!low_sun_below)
     {
-        return mix(below, above, float4(mu_s_t));
+        AtmosphereParameters param_56 = atmosphere;
+        float4 param_57 = uvwz;
+        float param_58 = mix(x_below, x_above, mu_s_t);
+        float param_59 = nu_slice;
+        float param_60 = nu_t;
+        bool param_61 = false;
+        return GetScatteringAtMuSColumn(param_56, scattering_texture, scattering_textureSmplr, param_57, param_58, param_59, param_60, param_61);
+    }
+    AtmosphereParameters param_62 = atmosphere;
+    float4 param_63 = uvwz;
+    float param_64 = x_below;
+    float param_65 = nu_slice;
+    float param_66 = nu_t;
+    bool param_67 = true;
+    float4 below = GetScatteringAtMuSColumn(param_62, scattering_texture, scattering_textureSmplr, param_63, param_64, param_65, param_66, param_67);
+    AtmosphereParameters param_68 = atmosphere;
+    float4 param_69 = uvwz;
+    float param_70 = x_above;
+    float param_71 = nu_slice;
+    float param_72 = nu_t;
+    bool param_73 = x_above < x_low_sun;
+    float4 above = GetScatteringAtMuSColumn(param_68, scattering_texture, scattering_textureSmplr, param_69, param_70, param_71, param_72, param_73);
+    if (mu_s_t < 0.0)
+    {
+        AtmosphereParameters param_74 = atmosphere;
+        float param_75 = 1.0 / (mu_s_size - 1.0);
+        float4 param_76 = below;
+        float4 param_77 = above;
+        float param_78 = atmosphere.scattering_mu_s_min;
+        float param_79 = GetScatteringMuSFromUnitRange(param_74, param_75);
+        float param_80 = mu_s;
+        return LowestSunContinued(param_76, param_77, param_78, param_79, param_80);
     }
     float column = (x_below * mu_s_size) - 0.5;
     float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
     float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_75 = atmosphere;
-    float4 param_76 = uvwz;
-    float param_77 = x_first;
-    float param_78 = nu_slice;
-    float param_79 = nu_t;
-    bool param_80 = true;
-    float4 first = GetScatteringAtMuSColumn(param_75, scattering_texture, scattering_textureSmplr, param_76, param_77, param_78, param_79, param_80);
     AtmosphereParameters param_81 = atmosphere;
     float4 param_82 = uvwz;
-    float param_83 = x_last;
+    float param_83 = x_first;
     float param_84 = nu_slice;
     float param_85 = nu_t;
-    bool param_86 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_81, scattering_texture, scattering_textureSmplr, param_82, param_83, param_84, param_85, param_86);
-    float4 param_87 = first;
-    float4 param_88 = below;
-    float4 param_89 = above;
-    float4 param_90 = last;
-    bool param_91 = column > 0.5;
-    bool param_92 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_93 = mu_s_t;
-    return LogMonotoneCubicMix(param_87, param_88, param_89, param_90, param_91, param_92, param_93);
+    bool param_86 = true;
+    float4 first = GetScatteringAtMuSColumn(param_81, scattering_texture, scattering_textureSmplr, param_82, param_83, param_84, param_85, param_86);
+    AtmosphereParameters param_87 = atmosphere;
+    float4 param_88 = uvwz;
+    float param_89 = x_last;
+    float param_90 = nu_slice;
+    float param_91 = nu_t;
+    bool param_92 = x_last < x_low_sun;
+    float4 last = GetScatteringAtMuSColumn(param_87, scattering_texture, scattering_textureSmplr, param_88, param_89, param_90, param_91, param_92);
+    float4 param_93 = first;
+    float4 param_94 = below;
+    float4 param_95 = above;
+    float4 param_96 = last;
+    bool param_97 = column > 0.5;
+    bool param_98 = (column + 2.0) < (mu_s_size - 0.5);
+    float param_99 = mu_s_t;
+    return LogMonotoneCubicMix(param_93, param_94, param_95, param_96, param_97, param_98, param_99);
 }
 #endif
 
@@ -1207,16 +1240,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3532;
+        float3 _3689;
         if (scattering.x > 0.0)
         {
-            _3532 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3689 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3532 = float3(0.0);
+            _3689 = float3(0.0);
         }
-        single_mie_scattering = _3532;
+        single_mie_scattering = _3689;
     }
     else
     {
@@ -1282,6 +1315,27 @@ float MiePhaseFunction(thread const AtmosphereParameters& atmosphere, thread con
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
+float3 GetSkyRadianceOfRay(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, texture3d<float> single_mie_scattering_texture, sampler single_mie_scattering_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = mu_s;
+    float param_4 = nu;
+    bool param_5 = ray_r_mu_intersects_ground;
+    float3 param_6;
+    float3 _3754 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 single_mie_scattering = param_6;
+    float3 scattering = _3754;
+    float param_7 = nu;
+    AtmosphereParameters param_8 = atmosphere;
+    float param_9 = nu;
+    return (scattering * RayleighPhaseFunction(param_7)) + (single_mie_scattering * MiePhaseFunction(param_8, param_9));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
 float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, texture3d<float> scattering_texture, sampler scattering_textureSmplr, texture3d<float> single_mie_scattering_texture, sampler single_mie_scattering_textureSmplr, thread const float3& camera, thread const float3& view_ray, thread const float3& sun_direction, thread float3& transmittance)
 {
     AtmosphereParameters param = atmosphere;
@@ -1293,13 +1347,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3600 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3789 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3600)
+    if (!_3789)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1308,33 +1362,226 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3620;
+    float3 _3809;
     if (ray_r_mu_intersects_ground)
     {
-        _3620 = float3(0.0);
+        _3809 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3620 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _3809 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _3620;
+    transmittance = _3809;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
     float param_18 = mu_s;
     float param_19 = nu;
     bool param_20 = ray_r_mu_intersects_ground;
-    float3 param_21;
-    float3 _3647 = GetCombinedScattering(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20, param_21);
-    float3 single_mie_scattering = param_21;
-    float3 scattering = _3647;
-    float param_22 = nu;
-    AtmosphereParameters param_23 = atmosphere;
-    float param_24 = nu;
-    return (scattering * RayleighPhaseFunction(param_22)) + (single_mie_scattering * MiePhaseFunction(param_23, param_24));
+    return GetSkyRadianceOfRay(param_15, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float GetUnitRangeFromTextureCoord(thread const float& u, thread const int& texture_size)
+{
+    return (u - (0.5 / float(texture_size))) / (1.0 - (1.0 / float(texture_size)));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float GetUnitMuInHalfFromTextureCoord(thread const float& u, thread const int& size, thread bool& ray_r_mu_intersects_ground)
+{
+    ray_r_mu_intersects_ground = u < 0.5;
+    float _1284;
+    if (ray_r_mu_intersects_ground)
+    {
+        _1284 = 1.0 - (2.0 * u);
+    }
+    else
+    {
+        _1284 = (2.0 * u) - 1.0;
+    }
+    float param = _1284;
+    int param_1 = size / 2;
+    return GetUnitRangeFromTextureCoord(param, param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float SkyViewHorizonZenith(thread const AtmosphereParameters& atmosphere, thread const float& r)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    return precise::atan2(atmosphere.bottom_radius, -HorizonDistance(param, param_1));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float3 GetSkyViewRay(thread const AtmosphereParameters& atmosphere, thread const float3& camera, thread const float3& sun_direction, thread const float2& uv, thread bool& ray_r_mu_intersects_ground)
+{
+    float param = uv.y;
+    int param_1 = 108;
+    bool param_2;
+    float _4971 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    ray_r_mu_intersects_ground = param_2;
+    float x = _4971;
+    float e = (1.0 - x) * (1.0 - x);
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = length(camera);
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = ClampRadius(param_3, param_4);
+    float theta_h = SkyViewHorizonZenith(param_5, param_6);
+    float _4992;
+    if (ray_r_mu_intersects_ground)
+    {
+        _4992 = theta_h + (e * (3.1415927410125732421875 - theta_h));
+    }
+    else
+    {
+        _4992 = theta_h * (1.0 - e);
+    }
+    float theta = _4992;
+    float param_7 = uv.x;
+    int param_8 = 192;
+    float phi = 3.1415927410125732421875 * fast::clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0, 1.0);
+    float3 up = fast::normalize(camera);
+    float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
+    if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13)
+    {
+        toward_sun = cross(up, select(float3(0.0, 1.0, 0.0), float3(1.0, 0.0, 0.0), bool3(abs(up.x) < 0.89999997615814208984375)));
+    }
+    toward_sun = fast::normalize(toward_sun);
+    float3 across = cross(up, toward_sun);
+    return (up * cos(theta)) + (((toward_sun * cos(phi)) + (across * sin(phi))) * sin(theta));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float3 GetSkyViewRadiance(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, texture3d<float> single_mie_scattering_texture, sampler single_mie_scattering_textureSmplr, thread const float3& camera, thread const float3& sun_direction, thread const float2& uv)
+{
+    AtmosphereParameters param = atmosphere;
+    float3 param_1 = camera;
+    float3 param_2 = sun_direction;
+    float2 param_3 = uv;
+    bool param_4;
+    float3 _5081 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    bool ray_r_mu_intersects_ground = param_4;
+    float3 view_ray = _5081;
+    float3 up = fast::normalize(camera);
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = length(camera);
+    float param_7 = dot(up, view_ray);
+    float param_8 = dot(up, sun_direction);
+    float param_9 = dot(view_ray, sun_direction);
+    AtmosphereParameters param_10 = atmosphere;
+    float param_11 = ClampRadius(param_5, param_6);
+    float param_12 = ClampCosine(param_7);
+    float param_13 = ClampCosine(param_8);
+    float param_14 = ClampCosine(param_9);
+    bool param_15 = ray_r_mu_intersects_ground;
+    return GetSkyRadianceOfRay(param_10, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_11, param_12, param_13, param_14, param_15);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+void GetSkyViewAngles(thread const float3& camera, thread const float3& view_ray, thread const float3& sun_direction, thread float& theta, thread float& phi)
+{
+    float3 up = fast::normalize(camera);
+    float mu = dot(up, view_ray);
+    float3 horizontal = view_ray - (up * mu);
+    float3 sun_horizontal = sun_direction - (up * dot(up, sun_direction));
+    theta = precise::atan2(length(horizontal), mu);
+    float along = dot(sun_horizontal, horizontal);
+    float side = abs(dot(cross(up, sun_horizontal), horizontal));
+    float _4957;
+    if ((along != 0.0) || (side != 0.0))
+    {
+        _4957 = precise::atan2(side, along);
+    }
+    else
+    {
+        _4957 = 0.0;
+    }
+    phi = _4957;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float2 GetSkyViewUvFromAngles(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& theta, thread const float& phi, thread const bool& ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float theta_h = SkyViewHorizonZenith(param, param_1);
+    float _4878;
+    if (ray_r_mu_intersects_ground)
+    {
+        _4878 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
+    }
+    else
+    {
+        _4878 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
+    }
+    float x = _4878;
+    float param_2 = phi / 3.1415927410125732421875;
+    int param_3 = 192;
+    float param_4 = x;
+    bool param_5 = ray_r_mu_intersects_ground;
+    int param_6 = 108;
+    return float2(GetTextureCoordFromUnitRange(param_2, param_3), GetTextureCoordFromUnitMuInHalf(param_4, param_5, param_6));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, texture2d<float> sky_view_texture, sampler sky_view_textureSmplr, thread const float3& camera, thread const float3& view_ray, thread const float3& sun_direction, thread float3& transmittance)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = length(camera);
+    float r = ClampRadius(param, param_1);
+    float param_2 = dot(camera, view_ray) / length(camera);
+    float mu = ClampCosine(param_2);
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = r;
+    float param_5 = mu;
+    bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
+    float3 _5143;
+    if (ray_r_mu_intersects_ground)
+    {
+        _5143 = float3(0.0);
+    }
+    else
+    {
+        AtmosphereParameters param_6 = atmosphere;
+        float param_7 = r;
+        float param_8 = mu;
+        _5143 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
+    }
+    transmittance = _5143;
+    float3 param_9 = camera;
+    float3 param_10 = view_ray;
+    float3 param_11 = sun_direction;
+    float param_12;
+    float param_13;
+    GetSkyViewAngles(param_9, param_10, param_11, param_12, param_13);
+    float theta = param_12;
+    float phi = param_13;
+    AtmosphereParameters param_14 = atmosphere;
+    float param_15 = r;
+    float param_16 = theta;
+    float param_17 = phi;
+    bool param_18 = ray_r_mu_intersects_ground;
+    return float3(sky_view_texture.sample(sky_view_textureSmplr, GetSkyViewUvFromAngles(param_14, param_15, param_16, param_17, param_18), level(0.0)).xyz);
 }
 #endif
 
@@ -1368,16 +1615,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _3741;
+    float _3913;
     if ((a > 0.0) && (b > 0.0))
     {
-        _3741 = a * exp(f * log(b / a));
+        _3913 = a * exp(f * log(b / a));
     }
     else
     {
-        _3741 = mix(a, b, f);
+        _3913 = mix(a, b, f);
     }
-    return _3741;
+    return _3913;
 }
 #endif
 
@@ -1448,16 +1695,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _3992;
+    float _4164;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _3992 = 1.0 - (0.5 * depth);
+        _4164 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _3992 = (1.0 - exp(-depth)) / depth;
+        _4164 = (1.0 - exp(-depth)) / depth;
     }
-    return _3992;
+    return _4164;
 }
 #endif
 
@@ -1494,10 +1741,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4072 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4244 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4072;
+        float3 extinction = _4244;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1556,10 +1803,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _3937 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4109 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _3937;
+        float3 extinction = _4109;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1634,14 +1881,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _3962;
+    float3 _4134;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _3962 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4134 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1650,9 +1897,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _3962 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _4134 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _3962;
+    return _4134;
 }
 #endif
 
@@ -1666,16 +1913,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3703;
+    float _3875;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _3703 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3875 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3703 = up;
+        _3875 = up;
     }
-    return _3703;
+    return _3875;
 }
 #endif
 
@@ -1699,13 +1946,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4218 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4390 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4218)
+    if (!_4390)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1745,11 +1992,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4313 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4485 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4313;
+        lit_optical_depth = _4485;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -1763,11 +2010,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4347 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4519 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4347;
+        optical_depth += _4519;
     }
     if (direct < 1.0)
     {
@@ -1786,9 +2033,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4390 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4562 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4390;
+    float3 scattering = _4562;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1809,11 +2056,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4438 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4610 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4438;
+        float3 far_optical_depth = _4610;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1833,9 +2080,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4492 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4664 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4492);
+            scattering -= (exp(-far_optical_depth) * _4664);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -1856,9 +2103,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4557 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4729 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4557;
+    float3 scattering_p = _4729;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -1879,9 +2126,63 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4601 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4773 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4601;
+    return _4773;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float AerialPerspectiveSliceDistance(thread const float& k)
+{
+    float x = (k + 1.0) / 32.0;
+    return (50000.0 * x) * x;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float3 GetAerialPerspectiveVoxel(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, texture3d<float> scattering_texture, sampler scattering_textureSmplr, texture3d<float> single_mie_scattering_texture, sampler single_mie_scattering_textureSmplr, thread const float3& camera, thread const float3& view_ray, thread const float& w, thread const float3& sun_direction, thread float3& optical_depth)
+{
+    float param = floor(w * 32.0);
+    float d = AerialPerspectiveSliceDistance(param);
+    float3 point = camera + (view_ray * d);
+    float r_point = length(point);
+    if (r_point < atmosphere.bottom_radius)
+    {
+        point *= (atmosphere.bottom_radius / r_point);
+    }
+    AtmosphereParameters param_1 = atmosphere;
+    float3 param_2 = camera;
+    float3 param_3 = point;
+    float3 param_4 = sun_direction;
+    float3 param_5;
+    float3 _5237 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
+    float3 transmittance = param_5;
+    float3 radiance = _5237;
+    optical_depth = -log(fast::max(transmittance, float3(1.0000000031710768509710513471353e-30)));
+    return radiance;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float3 GetSkyRadianceToPointFromVolume(texture3d<float> radiance_volume, sampler radiance_volumeSmplr, texture3d<float> optical_depth_volume, sampler optical_depth_volumeSmplr, thread const float2& screen_uv, thread const float& _distance, thread float3& transmittance)
+{
+    float slices = 32.0;
+    float d = fast::max(_distance, 0.0);
+    float s = slices * sqrt(d / 50000.0);
+    float k = fast::clamp(floor(s) - 1.0, 0.0, slices - 2.0);
+    float param = k;
+    float d_k = AerialPerspectiveSliceDistance(param);
+    float param_1 = k + 1.0;
+    float t = fast::clamp((d - d_k) / (AerialPerspectiveSliceDistance(param_1) - d_k), 0.0, 1.0);
+    float param_2 = 0.0;
+    float near = fast::min(d / AerialPerspectiveSliceDistance(param_2), 1.0);
+    float3 uvw = float3(screen_uv, ((k + t) + 0.5) / slices);
+    transmittance = exp((-float3(optical_depth_volume.sample(optical_depth_volumeSmplr, uvw, level(0.0)).xyz)) * near);
+    return float3(radiance_volume.sample(radiance_volumeSmplr, uvw, level(0.0)).xyz) * near;
 }
 #endif
 
@@ -1889,16 +2190,16 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _2156;
+    float _2304;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _2156 = 0.100000001490116119384765625;
+        _2304 = 0.100000001490116119384765625;
     }
     else
     {
-        _2156 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _2304 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _2156;
+    return _2304;
 }
 #endif
 
@@ -1908,16 +2209,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2174;
+    float _2322;
     if (mu_s < knee)
     {
-        _2174 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _2322 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _2174 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _2322 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _2174;
+    return _2322;
 }
 #endif
 
@@ -1946,16 +2247,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2205;
+    float _2353;
     if (x < 0.5)
     {
-        _2205 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _2353 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2205 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _2353 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _2205;
+    return _2353;
 }
 #endif
 
@@ -1968,16 +2269,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2499;
+    float4 _2647;
     if (t < 0.0)
     {
-        _2499 = fast::min(blend, a);
+        _2647 = fast::min(blend, a);
     }
     else
     {
-        _2499 = blend;
+        _2647 = blend;
     }
-    return _2499;
+    return _2647;
 }
 #endif
 

@@ -57,6 +57,14 @@ const DIRECT_SEGMENT_LENGTH: f32 = 10000f;
 
 const SEGMENT_INTERVALS: i32 = 16i;
 
+const SKY_VIEW_WIDTH: i32 = 192i;
+
+const SKY_VIEW_HEIGHT: i32 = 108i;
+
+const AERIAL_PERSPECTIVE_SLICES: i32 = 32i;
+
+const AERIAL_PERSPECTIVE_MAX_DISTANCE: f32 = 50000f;
+
 fn SampleTexture2D(table: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
     var uv_1: vec2<f32>;
 
@@ -630,160 +638,363 @@ fn GetTransmittanceTextureUvFromRMu(atmosphere_20: AtmosphereParameters, r_22: f
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringLowestSunDistance(atmosphere_22: AtmosphereParameters) -> f32 {
+fn GetUnitMuInHalf(atmosphere_22: AtmosphereParameters, r_24: f32, rho_3: f32, mu_17: f32, ray_r_mu_intersects_ground_2: bool) -> f32 {
     var atmosphere_23: AtmosphereParameters;
+    var r_25: f32;
+    var rho_4: f32;
+    var mu_18: f32;
+    var ray_r_mu_intersects_ground_3: bool;
+    var d_7: f32;
     var d_min_1: f32;
+    var local_3: f32;
+    var d_8: f32;
+    var d_min_2: f32;
     var d_max_1: f32;
-    var D: f32;
+    var local_4: f32;
 
     atmosphere_23 = atmosphere_22;
-    let _e9 = atmosphere_23;
-    let _e11 = atmosphere_23;
-    d_min_1 = (_e9.top_radius - _e11.bottom_radius);
-    let _e15 = atmosphere_23;
+    r_25 = r_24;
+    rho_4 = rho_3;
+    mu_18 = mu_17;
+    ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
+    let _e17 = ray_r_mu_intersects_ground_3;
+    if _e17 {
+        {
+            let _e18 = atmosphere_23;
+            let _e19 = r_25;
+            let _e20 = mu_18;
+            let _e21 = DistanceToBottomAtmosphereBoundary(_e18, _e19, _e20);
+            d_7 = _e21;
+            let _e23 = r_25;
+            let _e24 = atmosphere_23;
+            d_min_1 = (_e23 - _e24.bottom_radius);
+            let _e28 = rho_4;
+            let _e29 = d_min_1;
+            if (_e28 == _e29) {
+                local_3 = 0f;
+            } else {
+                let _e32 = d_7;
+                let _e33 = d_min_1;
+                let _e35 = rho_4;
+                let _e36 = d_min_1;
+                local_3 = ((_e32 - _e33) / (_e35 - _e36));
+            }
+            let _e40 = local_3;
+            return _e40;
+        }
+    }
+    let _e41 = atmosphere_23;
+    let _e42 = r_25;
+    let _e43 = mu_18;
+    let _e44 = DistanceToTopAtmosphereBoundary(_e41, _e42, _e43);
+    d_8 = _e44;
+    let _e46 = atmosphere_23;
+    let _e48 = r_25;
+    d_min_2 = (_e46.top_radius - _e48);
+    let _e51 = rho_4;
+    let _e52 = atmosphere_23;
+    let _e53 = HorizonDistanceAtTop(_e52);
+    d_max_1 = (_e51 + _e53);
+    let _e56 = d_max_1;
+    let _e57 = d_min_2;
+    if (_e56 > _e57) {
+        let _e59 = d_8;
+        let _e60 = d_min_2;
+        let _e62 = d_max_1;
+        let _e63 = d_min_2;
+        local_4 = ((_e59 - _e60) / (_e62 - _e63));
+    } else {
+        local_4 = 0f;
+    }
+    let _e68 = local_4;
+    return _e68;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetMuFromUnitMuInHalf(atmosphere_24: AtmosphereParameters, r_26: f32, rho_5: f32, x_4: f32, ray_r_mu_intersects_ground_4: bool) -> f32 {
+    var atmosphere_25: AtmosphereParameters;
+    var r_27: f32;
+    var rho_6: f32;
+    var x_5: f32;
+    var ray_r_mu_intersects_ground_5: bool;
+    var d_min_3: f32;
+    var d_9: f32;
+    var local_5: f32;
+    var H_1: f32;
+    var d_min_4: f32;
+    var d_10: f32;
+    var local_6: f32;
+
+    atmosphere_25 = atmosphere_24;
+    r_27 = r_26;
+    rho_6 = rho_5;
+    x_5 = x_4;
+    ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
+    let _e17 = ray_r_mu_intersects_ground_5;
+    if _e17 {
+        {
+            let _e18 = r_27;
+            let _e19 = atmosphere_25;
+            d_min_3 = (_e18 - _e19.bottom_radius);
+            let _e23 = d_min_3;
+            let _e24 = rho_6;
+            let _e25 = d_min_3;
+            let _e27 = x_5;
+            d_9 = (_e23 + ((_e24 - _e25) * _e27));
+            let _e31 = d_9;
+            if (_e31 == 0f) {
+                local_5 = -1f;
+            } else {
+                let _e36 = rho_6;
+                let _e37 = rho_6;
+                let _e39 = d_9;
+                let _e40 = d_9;
+                let _e45 = r_27;
+                let _e47 = d_9;
+                let _e50 = ClampCosine((-(((_e36 * _e37) + (_e39 * _e40))) / ((2f * _e45) * _e47)));
+                local_5 = _e50;
+            }
+            let _e52 = local_5;
+            return _e52;
+        }
+    }
+    let _e53 = atmosphere_25;
+    let _e54 = HorizonDistanceAtTop(_e53);
+    H_1 = _e54;
+    let _e56 = atmosphere_25;
+    let _e58 = r_27;
+    d_min_4 = (_e56.top_radius - _e58);
+    let _e61 = d_min_4;
+    let _e62 = rho_6;
+    let _e63 = H_1;
+    let _e65 = d_min_4;
+    let _e67 = x_5;
+    d_10 = (_e61 + (((_e62 + _e63) - _e65) * _e67));
+    let _e71 = d_10;
+    if (_e71 == 0f) {
+        local_6 = 1f;
+    } else {
+        let _e75 = H_1;
+        let _e76 = H_1;
+        let _e78 = rho_6;
+        let _e79 = rho_6;
+        let _e82 = d_10;
+        let _e83 = d_10;
+        let _e87 = r_27;
+        let _e89 = d_10;
+        let _e92 = ClampCosine(((((_e75 * _e76) - (_e78 * _e79)) - (_e82 * _e83)) / ((2f * _e87) * _e89)));
+        local_6 = _e92;
+    }
+    let _e94 = local_6;
+    return _e94;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetTextureCoordFromUnitMuInHalf(x_6: f32, ray_r_mu_intersects_ground_6: bool, size: i32) -> f32 {
+    var x_7: f32;
+    var ray_r_mu_intersects_ground_7: bool;
+    var size_1: i32;
+    var u_2: f32;
+    var local_7: f32;
+
+    x_7 = x_6;
+    ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
+    size_1 = size;
+    let _e14 = x_7;
+    let _e15 = size_1;
+    let _e18 = GetTextureCoordFromUnitRange(_e14, (_e15 / 2i));
+    u_2 = (0.5f * _e18);
+    let _e21 = ray_r_mu_intersects_ground_7;
+    if _e21 {
+        let _e23 = u_2;
+        local_7 = (0.5f - _e23);
+    } else {
+        let _e26 = u_2;
+        local_7 = (0.5f + _e26);
+    }
+    let _e29 = local_7;
+    return _e29;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetUnitMuInHalfFromTextureCoord(u_3: f32, size_2: i32, ray_r_mu_intersects_ground_8: ptr<function, bool>) -> f32 {
+    var u_4: f32;
+    var size_3: i32;
+    var local_8: f32;
+
+    u_4 = u_3;
+    size_3 = size_2;
+    let _e12 = u_4;
+    (*ray_r_mu_intersects_ground_8) = (_e12 < 0.5f);
+    let _e15 = (*ray_r_mu_intersects_ground_8);
+    if _e15 {
+        let _e18 = u_4;
+        local_8 = (1f - (2f * _e18));
+    } else {
+        let _e22 = u_4;
+        local_8 = ((2f * _e22) - 1f);
+    }
+    let _e27 = local_8;
+    let _e28 = size_3;
+    let _e31 = GetUnitRangeFromTextureCoord(_e27, (_e28 / 2i));
+    return _e31;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringLowestSunDistance(atmosphere_26: AtmosphereParameters) -> f32 {
+    var atmosphere_27: AtmosphereParameters;
+    var d_min_5: f32;
+    var d_max_2: f32;
+    var D: f32;
+
+    atmosphere_27 = atmosphere_26;
+    let _e9 = atmosphere_27;
+    let _e11 = atmosphere_27;
+    d_min_5 = (_e9.top_radius - _e11.bottom_radius);
+    let _e15 = atmosphere_27;
     let _e16 = HorizonDistanceAtTop(_e15);
-    d_max_1 = _e16;
-    let _e18 = atmosphere_23;
-    let _e19 = atmosphere_23;
-    let _e21 = atmosphere_23;
+    d_max_2 = _e16;
+    let _e18 = atmosphere_27;
+    let _e19 = atmosphere_27;
+    let _e21 = atmosphere_27;
     let _e23 = DistanceToTopAtmosphereBoundary(_e18, _e19.bottom_radius, _e21.scattering_mu_s_min);
     D = _e23;
     let _e25 = D;
-    let _e26 = d_min_1;
-    let _e28 = d_max_1;
-    let _e29 = d_min_1;
+    let _e26 = d_min_5;
+    let _e28 = d_max_2;
+    let _e29 = d_min_5;
     return ((_e25 - _e26) / (_e28 - _e29));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringUnitMuS(atmosphere_24: AtmosphereParameters, mu_s_3: f32) -> f32 {
-    var atmosphere_25: AtmosphereParameters;
+fn GetScatteringUnitMuS(atmosphere_28: AtmosphereParameters, mu_s_3: f32) -> f32 {
+    var atmosphere_29: AtmosphereParameters;
     var mu_s_4: f32;
-    var d_7: f32;
-    var d_min_2: f32;
-    var d_max_2: f32;
+    var d_11: f32;
+    var d_min_6: f32;
+    var d_max_3: f32;
     var a_4: f32;
 
-    atmosphere_25 = atmosphere_24;
+    atmosphere_29 = atmosphere_28;
     mu_s_4 = mu_s_3;
-    let _e11 = atmosphere_25;
-    let _e12 = atmosphere_25;
+    let _e11 = atmosphere_29;
+    let _e12 = atmosphere_29;
     let _e14 = mu_s_4;
     let _e15 = DistanceToTopAtmosphereBoundary(_e11, _e12.bottom_radius, _e14);
-    d_7 = _e15;
-    let _e17 = atmosphere_25;
-    let _e19 = atmosphere_25;
-    d_min_2 = (_e17.top_radius - _e19.bottom_radius);
-    let _e23 = atmosphere_25;
+    d_11 = _e15;
+    let _e17 = atmosphere_29;
+    let _e19 = atmosphere_29;
+    d_min_6 = (_e17.top_radius - _e19.bottom_radius);
+    let _e23 = atmosphere_29;
     let _e24 = HorizonDistanceAtTop(_e23);
-    d_max_2 = _e24;
-    let _e26 = d_7;
-    let _e27 = d_min_2;
-    let _e29 = d_max_2;
-    let _e30 = d_min_2;
+    d_max_3 = _e24;
+    let _e26 = d_11;
+    let _e27 = d_min_6;
+    let _e29 = d_max_3;
+    let _e30 = d_min_6;
     a_4 = ((_e26 - _e27) / (_e29 - _e30));
     let _e34 = a_4;
-    let _e36 = atmosphere_25;
+    let _e36 = atmosphere_29;
     let _e37 = GetScatteringLowestSunDistance(_e36);
     let _e39 = ScatteringUnitMuSFromDistance(_e34, (1f / _e37));
     return _e39;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSFromUnitRange(atmosphere_26: AtmosphereParameters, x_4: f32) -> f32 {
-    var atmosphere_27: AtmosphereParameters;
-    var x_5: f32;
+fn GetScatteringMuSFromUnitRange(atmosphere_30: AtmosphereParameters, x_8: f32) -> f32 {
+    var atmosphere_31: AtmosphereParameters;
+    var x_9: f32;
     var x_mu_s: f32;
     var bottom: f32;
-    var H_1: f32;
-    var d_min_3: f32;
-    var d_max_3: f32;
+    var H_2: f32;
+    var d_min_7: f32;
+    var d_max_4: f32;
     var A: f32;
     var a_5: f32;
-    var d_8: f32;
-    var local_3: f32;
+    var d_12: f32;
+    var local_9: f32;
 
-    atmosphere_27 = atmosphere_26;
-    x_5 = x_4;
-    let _e11 = x_5;
-    let _e12 = atmosphere_27;
-    let _e13 = atmosphere_27;
+    atmosphere_31 = atmosphere_30;
+    x_9 = x_8;
+    let _e11 = x_9;
+    let _e12 = atmosphere_31;
+    let _e13 = atmosphere_31;
     let _e15 = GetScatteringUnitMuS(_e12, _e13.scattering_mu_s_max);
     x_mu_s = (_e11 * _e15);
-    let _e18 = atmosphere_27;
+    let _e18 = atmosphere_31;
     bottom = _e18.bottom_radius;
-    let _e21 = atmosphere_27;
+    let _e21 = atmosphere_31;
     let _e22 = HorizonDistanceAtTop(_e21);
-    H_1 = _e22;
-    let _e24 = atmosphere_27;
+    H_2 = _e22;
+    let _e24 = atmosphere_31;
     let _e26 = bottom;
-    d_min_3 = (_e24.top_radius - _e26);
-    let _e29 = H_1;
-    d_max_3 = _e29;
-    let _e31 = atmosphere_27;
+    d_min_7 = (_e24.top_radius - _e26);
+    let _e29 = H_2;
+    d_max_4 = _e29;
+    let _e31 = atmosphere_31;
     let _e32 = GetScatteringLowestSunDistance(_e31);
     A = _e32;
     let _e34 = x_mu_s;
     let _e36 = A;
     let _e38 = ScatteringDistanceFromUnitMuS(_e34, (1f / _e36));
     a_5 = _e38;
-    let _e40 = d_min_3;
+    let _e40 = d_min_7;
     let _e41 = a_5;
     let _e42 = A;
-    let _e44 = d_max_3;
-    let _e45 = d_min_3;
-    d_8 = (_e40 + (min(_e41, _e42) * (_e44 - _e45)));
-    let _e50 = d_8;
+    let _e44 = d_max_4;
+    let _e45 = d_min_7;
+    d_12 = (_e40 + (min(_e41, _e42) * (_e44 - _e45)));
+    let _e50 = d_12;
     if (_e50 == 0f) {
-        local_3 = 1f;
+        local_9 = 1f;
     } else {
-        let _e54 = H_1;
-        let _e55 = H_1;
-        let _e57 = d_8;
-        let _e58 = d_8;
+        let _e54 = H_2;
+        let _e55 = H_2;
+        let _e57 = d_12;
+        let _e58 = d_12;
         let _e62 = bottom;
-        let _e64 = d_8;
+        let _e64 = d_12;
         let _e67 = ClampCosine((((_e54 * _e55) - (_e57 * _e58)) / ((2f * _e62) * _e64)));
-        local_3 = _e67;
+        local_9 = _e67;
     }
-    let _e69 = local_3;
+    let _e69 = local_9;
     return _e69;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUMuS(atmosphere_28: AtmosphereParameters, mu_s_5: f32) -> f32 {
-    var atmosphere_29: AtmosphereParameters;
+fn GetScatteringTextureUMuS(atmosphere_32: AtmosphereParameters, mu_s_5: f32) -> f32 {
+    var atmosphere_33: AtmosphereParameters;
     var mu_s_6: f32;
-    var x_6: f32;
+    var x_10: f32;
 
-    atmosphere_29 = atmosphere_28;
+    atmosphere_33 = atmosphere_32;
     mu_s_6 = mu_s_5;
-    let _e11 = atmosphere_29;
+    let _e11 = atmosphere_33;
     let _e12 = mu_s_6;
     let _e13 = GetScatteringUnitMuS(_e11, _e12);
-    let _e14 = atmosphere_29;
-    let _e15 = atmosphere_29;
+    let _e14 = atmosphere_33;
+    let _e15 = atmosphere_33;
     let _e17 = GetScatteringUnitMuS(_e14, _e15.scattering_mu_s_max);
-    x_6 = (_e13 / _e17);
-    let _e20 = x_6;
-    let _e23 = atmosphere_29;
+    x_10 = (_e13 / _e17);
+    let _e20 = x_10;
+    let _e23 = atmosphere_33;
     let _e25 = GetTextureCoordFromUnitRange(min(_e20, 1f), _e23.scattering_mu_s_size);
     return _e25;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ViewSunAzimuthCosine(mu_17: f32, mu_s_7: f32, nu_9: f32) -> f32 {
-    var mu_18: f32;
+fn ViewSunAzimuthCosine(mu_19: f32, mu_s_7: f32, nu_9: f32) -> f32 {
+    var mu_20: f32;
     var mu_s_8: f32;
     var nu_10: f32;
     var across: f32;
-    var local_4: f32;
+    var local_10: f32;
 
-    mu_18 = mu_17;
+    mu_20 = mu_19;
     mu_s_8 = mu_s_7;
     nu_10 = nu_9;
-    let _e18 = mu_18;
-    let _e19 = mu_18;
+    let _e18 = mu_20;
+    let _e19 = mu_20;
     let _e23 = mu_s_8;
     let _e24 = mu_s_8;
     let _e28 = SafeSqrt(((1f - (_e18 * _e19)) * (1f - (_e23 * _e24))));
@@ -791,73 +1002,73 @@ fn ViewSunAzimuthCosine(mu_17: f32, mu_s_7: f32, nu_9: f32) -> f32 {
     let _e30 = across;
     if (_e30 > 0f) {
         let _e33 = nu_10;
-        let _e34 = mu_18;
+        let _e34 = mu_20;
         let _e35 = mu_s_8;
         let _e38 = across;
         let _e40 = ClampCosine(((_e33 - (_e34 * _e35)) / _e38));
-        local_4 = _e40;
+        local_10 = _e40;
     } else {
-        local_4 = 1f;
+        local_10 = 1f;
     }
-    let _e43 = local_4;
+    let _e43 = local_10;
     return _e43;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_phi: f32, ray_r_mu_intersects_ground_2: bool, direction: ptr<function, vec2<f32>>) -> f32 {
-    var atmosphere_31: AtmosphereParameters;
-    var r_25: f32;
-    var mu_20: f32;
+fn ShadowEdge(atmosphere_34: AtmosphereParameters, r_28: f32, mu_21: f32, cos_phi: f32, ray_r_mu_intersects_ground_9: bool, direction: ptr<function, vec2<f32>>) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
+    var r_29: f32;
+    var mu_22: f32;
     var cos_phi_1: f32;
-    var ray_r_mu_intersects_ground_3: bool;
-    var d_9: f32;
+    var ray_r_mu_intersects_ground_10: bool;
+    var d_13: f32;
     var r_d_2: f32;
     var cos_alpha: f32;
     var across_1: f32;
-    var rho_3: f32;
+    var rho_7: f32;
     var c_end: f32;
     var c_start: f32;
     var start_1: vec2<f32>;
     var cos_gamma: f32;
     var sin_gamma: f32;
-    var local_5: vec2<f32>;
+    var local_11: vec2<f32>;
     var end: vec2<f32>;
     var end_sets_last: bool;
     var a_6: f32;
     var cos_a: f32;
     var sin_a: f32;
-    var local_6: vec2<f32>;
+    var local_12: vec2<f32>;
     var last: vec2<f32>;
-    var local_7: f32;
-    var local_8: f32;
+    var local_13: f32;
+    var local_14: f32;
     var angle: f32;
 
-    atmosphere_31 = atmosphere_30;
-    r_25 = r_24;
-    mu_20 = mu_19;
+    atmosphere_35 = atmosphere_34;
+    r_29 = r_28;
+    mu_22 = mu_21;
     cos_phi_1 = cos_phi;
-    ray_r_mu_intersects_ground_3 = ray_r_mu_intersects_ground_2;
-    let _e22 = atmosphere_31;
-    let _e23 = r_25;
-    let _e24 = mu_20;
-    let _e25 = ray_r_mu_intersects_ground_3;
+    ray_r_mu_intersects_ground_10 = ray_r_mu_intersects_ground_9;
+    let _e22 = atmosphere_35;
+    let _e23 = r_29;
+    let _e24 = mu_22;
+    let _e25 = ray_r_mu_intersects_ground_10;
     let _e26 = DistanceToNearestAtmosphereBoundary(_e22, _e23, _e24, _e25);
-    d_9 = _e26;
-    let _e28 = atmosphere_31;
-    let _e29 = r_25;
-    let _e30 = mu_20;
-    let _e31 = d_9;
+    d_13 = _e26;
+    let _e28 = atmosphere_35;
+    let _e29 = r_29;
+    let _e30 = mu_22;
+    let _e31 = d_13;
     let _e32 = RadiusAtDistance(_e28, _e29, _e30, _e31);
     r_d_2 = _e32;
-    let _e34 = r_25;
-    let _e35 = d_9;
-    let _e36 = mu_20;
+    let _e34 = r_29;
+    let _e35 = d_13;
+    let _e36 = mu_22;
     let _e39 = r_d_2;
     let _e41 = ClampCosine(((_e34 + (_e35 * _e36)) / _e39));
     cos_alpha = _e41;
-    let _e43 = d_9;
-    let _e45 = mu_20;
-    let _e46 = mu_20;
+    let _e43 = d_13;
+    let _e45 = mu_22;
+    let _e46 = mu_22;
     let _e49 = SafeSqrt((1f - (_e45 * _e46)));
     let _e51 = r_d_2;
     let _e53 = cos_phi_1;
@@ -866,30 +1077,30 @@ fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_ph
     let _e57 = across_1;
     let _e59 = cos_alpha;
     let _e60 = cos_alpha;
-    rho_3 = sqrt(((_e56 * _e57) + (_e59 * _e60)));
-    let _e65 = atmosphere_31;
+    rho_7 = sqrt(((_e56 * _e57) + (_e59 * _e60)));
+    let _e65 = atmosphere_35;
     let _e67 = r_d_2;
     let _e68 = HorizonZenithCosine(_e65.bottom_radius, _e67);
     c_end = -(_e68);
-    let _e71 = atmosphere_31;
-    let _e73 = r_25;
+    let _e71 = atmosphere_35;
+    let _e73 = r_29;
     let _e74 = HorizonZenithCosine(_e71.bottom_radius, _e73);
     c_start = _e74;
     let _e76 = c_start;
-    let _e77 = atmosphere_31;
-    let _e79 = r_25;
+    let _e77 = atmosphere_35;
+    let _e79 = r_29;
     start_1 = vec2<f32>(_e76, (_e77.bottom_radius / _e79));
     let _e83 = c_end;
-    let _e85 = rho_3;
+    let _e85 = rho_7;
     cos_gamma = (-(_e83) / _e85);
     let _e89 = cos_gamma;
     let _e90 = cos_gamma;
     let _e93 = SafeSqrt((1f - (_e89 * _e90)));
     sin_gamma = _e93;
     let _e95 = c_end;
-    let _e96 = rho_3;
+    let _e96 = rho_7;
     if (_e95 >= _e96) {
-        local_5 = vec2<f32>(-1f, 0f);
+        local_11 = vec2<f32>(-1f, 0f);
     } else {
         let _e102 = cos_alpha;
         let _e103 = cos_gamma;
@@ -899,16 +1110,16 @@ fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_ph
         let _e110 = cos_gamma;
         let _e112 = cos_alpha;
         let _e113 = sin_gamma;
-        let _e117 = rho_3;
-        local_5 = (vec2<f32>(((_e102 * _e103) - (_e105 * _e106)), ((_e109 * _e110) + (_e112 * _e113))) / vec2(_e117));
+        let _e117 = rho_7;
+        local_11 = (vec2<f32>(((_e102 * _e103) - (_e105 * _e106)), ((_e109 * _e110) + (_e112 * _e113))) / vec2(_e117));
     }
-    let _e121 = local_5;
+    let _e121 = local_11;
     end = _e121;
     let _e123 = end;
     let _e127 = end;
     let _e129 = start_1;
     end_sets_last = ((_e123.y < 0f) || (_e127.x < _e129.x));
-    let _e134 = atmosphere_31;
+    let _e134 = atmosphere_35;
     a_6 = _e134.sun_angular_radius;
     let _e139 = a_6;
     let _e141 = a_6;
@@ -922,12 +1133,12 @@ fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_ph
     let _e163 = end_sets_last;
     if _e163 {
         let _e164 = end;
-        local_6 = _e164;
+        local_12 = _e164;
     } else {
         let _e165 = start_1;
-        local_6 = _e165;
+        local_12 = _e165;
     }
-    let _e167 = local_6;
+    let _e167 = local_12;
     last = _e167;
     let _e169 = last;
     let _e171 = cos_a;
@@ -941,22 +1152,22 @@ fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_ph
     let _e188 = end_sets_last;
     if _e188 {
         let _e189 = c_end;
-        let _e190 = rho_3;
+        let _e190 = rho_7;
         if (_e189 >= _e190) {
-            local_7 = PI;
+            local_13 = PI;
         } else {
             let _e192 = across_1;
             let _e193 = cos_alpha;
             let _e195 = cos_gamma;
-            local_7 = (atan2(_e192, _e193) + acos(_e195));
+            local_13 = (atan2(_e192, _e193) + acos(_e195));
         }
-        let _e199 = local_7;
-        local_8 = _e199;
+        let _e199 = local_13;
+        local_14 = _e199;
     } else {
         let _e200 = c_start;
-        local_8 = acos(_e200);
+        local_14 = acos(_e200);
     }
-    let _e203 = local_8;
+    let _e203 = local_14;
     angle = _e203;
     let _e205 = angle;
     let _e206 = a_6;
@@ -964,24 +1175,24 @@ fn ShadowEdge(atmosphere_30: AtmosphereParameters, r_24: f32, mu_19: f32, cos_ph
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeSunZenith(atmosphere_32: AtmosphereParameters, r_26: f32, mu_21: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_4: bool) -> f32 {
-    var atmosphere_33: AtmosphereParameters;
-    var r_27: f32;
-    var mu_22: f32;
+fn ShadowEdgeSunZenith(atmosphere_36: AtmosphereParameters, r_30: f32, mu_23: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_11: bool) -> f32 {
+    var atmosphere_37: AtmosphereParameters;
+    var r_31: f32;
+    var mu_24: f32;
     var cos_phi_3: f32;
-    var ray_r_mu_intersects_ground_5: bool;
+    var ray_r_mu_intersects_ground_12: bool;
     var unused: vec2<f32>;
 
-    atmosphere_33 = atmosphere_32;
-    r_27 = r_26;
-    mu_22 = mu_21;
+    atmosphere_37 = atmosphere_36;
+    r_31 = r_30;
+    mu_24 = mu_23;
     cos_phi_3 = cos_phi_2;
-    ray_r_mu_intersects_ground_5 = ray_r_mu_intersects_ground_4;
-    let _e22 = atmosphere_33;
-    let _e23 = r_27;
-    let _e24 = mu_22;
+    ray_r_mu_intersects_ground_12 = ray_r_mu_intersects_ground_11;
+    let _e22 = atmosphere_37;
+    let _e23 = r_31;
+    let _e24 = mu_24;
     let _e25 = cos_phi_3;
-    let _e26 = ray_r_mu_intersects_ground_5;
+    let _e26 = ray_r_mu_intersects_ground_12;
     let _e29 = ShadowEdge(_e22, _e23, _e24, _e25, _e26, (&unused));
     return _e29;
 }
@@ -1034,55 +1245,55 @@ fn ShadowEdgeSunCosine(edge_4: vec2<f32>, D_1: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringSplitMuS(atmosphere_34: AtmosphereParameters) -> f32 {
-    var atmosphere_35: AtmosphereParameters;
+fn GetScatteringSplitMuS(atmosphere_38: AtmosphereParameters) -> f32 {
+    var atmosphere_39: AtmosphereParameters;
 
-    atmosphere_35 = atmosphere_34;
-    let _e13 = atmosphere_35;
-    let _e14 = atmosphere_35;
-    let _e17 = atmosphere_35;
+    atmosphere_39 = atmosphere_38;
+    let _e13 = atmosphere_39;
+    let _e14 = atmosphere_39;
+    let _e17 = atmosphere_39;
     let _e23 = GetScatteringMuSFromUnitRange(_e13, (f32(_e14.scattering_mu_s_split) / f32((_e17.scattering_mu_s_size - 1i))));
     return _e23;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeUnitSun(atmosphere_36: AtmosphereParameters, mu_s_11: f32, derivative: ptr<function, f32>) -> f32 {
-    var atmosphere_37: AtmosphereParameters;
+fn ShadowEdgeUnitSun(atmosphere_40: AtmosphereParameters, mu_s_11: f32, derivative: ptr<function, f32>) -> f32 {
+    var atmosphere_41: AtmosphereParameters;
     var mu_s_12: f32;
     var bottom_1: f32;
-    var d_10: f32;
-    var d_min_4: f32;
+    var d_14: f32;
+    var d_min_8: f32;
     var span: f32;
     var a_7: f32;
     var inverse_A_4: f32;
     var da_dtheta: f32;
 
-    atmosphere_37 = atmosphere_36;
+    atmosphere_41 = atmosphere_40;
     mu_s_12 = mu_s_11;
-    let _e16 = atmosphere_37;
+    let _e16 = atmosphere_41;
     bottom_1 = _e16.bottom_radius;
-    let _e19 = atmosphere_37;
+    let _e19 = atmosphere_41;
     let _e20 = bottom_1;
     let _e21 = mu_s_12;
     let _e22 = DistanceToTopAtmosphereBoundary(_e19, _e20, _e21);
-    d_10 = _e22;
-    let _e24 = atmosphere_37;
+    d_14 = _e22;
+    let _e24 = atmosphere_41;
     let _e26 = bottom_1;
-    d_min_4 = (_e24.top_radius - _e26);
-    let _e29 = atmosphere_37;
+    d_min_8 = (_e24.top_radius - _e26);
+    let _e29 = atmosphere_41;
     let _e30 = HorizonDistanceAtTop(_e29);
-    let _e31 = d_min_4;
+    let _e31 = d_min_8;
     span = (_e30 - _e31);
-    let _e34 = d_10;
-    let _e35 = d_min_4;
+    let _e34 = d_14;
+    let _e35 = d_min_8;
     let _e37 = span;
     a_7 = ((_e34 - _e35) / _e37);
-    let _e41 = atmosphere_37;
+    let _e41 = atmosphere_41;
     let _e42 = GetScatteringLowestSunDistance(_e41);
     inverse_A_4 = (1f / _e42);
     let _e45 = bottom_1;
-    let _e46 = d_10;
-    let _e48 = d_10;
+    let _e46 = d_14;
+    let _e48 = d_14;
     let _e49 = bottom_1;
     let _e50 = mu_s_12;
     let _e54 = span;
@@ -1102,8 +1313,8 @@ fn ShadowEdgeUnitSun(atmosphere_36: AtmosphereParameters, mu_s_11: f32, derivati
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitFrom(atmosphere_38: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
-    var atmosphere_39: AtmosphereParameters;
+fn ShadowEdgeLitUnitFrom(atmosphere_42: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
+    var atmosphere_43: AtmosphereParameters;
     var D_4: f32;
     var edge_7: vec2<f32>;
     var X_closest_1: f32;
@@ -1112,13 +1323,13 @@ fn ShadowEdgeLitUnitFrom(atmosphere_38: AtmosphereParameters, D_3: f32, edge_6: 
     var dX_dtheta: f32;
     var X: f32;
 
-    atmosphere_39 = atmosphere_38;
+    atmosphere_43 = atmosphere_42;
     D_4 = D_3;
     edge_7 = edge_6;
     X_closest_1 = X_closest;
     X_span_1 = X_span;
     log_span_1 = log_span;
-    let _e25 = atmosphere_39;
+    let _e25 = atmosphere_43;
     let _e26 = edge_7;
     let _e27 = D_4;
     let _e28 = ShadowEdgeSunCosine(_e26, _e27);
@@ -1138,23 +1349,23 @@ fn ShadowEdgeLitUnitFrom(atmosphere_38: AtmosphereParameters, D_3: f32, edge_6: 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitSpans(atmosphere_40: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
-    var atmosphere_41: AtmosphereParameters;
+fn ShadowEdgeLitUnitSpans(atmosphere_44: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
+    var atmosphere_45: AtmosphereParameters;
     var edge_9: vec2<f32>;
     var unused_1: f32;
     var split_mu_s: f32;
 
-    atmosphere_41 = atmosphere_40;
+    atmosphere_45 = atmosphere_44;
     edge_9 = edge_8;
-    let _e20 = atmosphere_41;
+    let _e20 = atmosphere_45;
     let _e21 = GetScatteringSplitMuS(_e20);
     split_mu_s = _e21;
-    let _e23 = atmosphere_41;
+    let _e23 = atmosphere_45;
     let _e24 = edge_9;
     let _e25 = ShadowEdgeSunCosine(_e24, SHADOW_EDGE_CLOSEST);
     let _e28 = ShadowEdgeUnitSun(_e23, _e25, (&unused_1));
     (*X_closest_2) = _e28;
-    let _e29 = atmosphere_41;
+    let _e29 = atmosphere_45;
     let _e30 = split_mu_s;
     let _e33 = ShadowEdgeUnitSun(_e29, _e30, (&unused_1));
     let _e34 = (*X_closest_2);
@@ -1169,8 +1380,8 @@ fn ShadowEdgeLitUnitSpans(atmosphere_40: AtmosphereParameters, edge_8: vec2<f32>
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnit(atmosphere_42: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
-    var atmosphere_43: AtmosphereParameters;
+fn ShadowEdgeLitUnit(atmosphere_46: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
+    var atmosphere_47: AtmosphereParameters;
     var distance_1: f32;
     var edge_11: vec2<f32>;
     var X_closest_3: f32;
@@ -1179,13 +1390,13 @@ fn ShadowEdgeLitUnit(atmosphere_42: AtmosphereParameters, distance_: f32, edge_1
     var split_distance_1: f32;
     var unused_2: f32;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_47 = atmosphere_46;
     distance_1 = distance_;
     edge_11 = edge_10;
-    let _e21 = atmosphere_43;
+    let _e21 = atmosphere_47;
     let _e22 = edge_11;
     ShadowEdgeLitUnitSpans(_e21, _e22, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
-    let _e32 = atmosphere_43;
+    let _e32 = atmosphere_47;
     let _e33 = distance_1;
     let _e34 = split_distance_1;
     let _e36 = edge_11;
@@ -1197,9 +1408,9 @@ fn ShadowEdgeLitUnit(atmosphere_42: AtmosphereParameters, distance_: f32, edge_1
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitDistance(atmosphere_44: AtmosphereParameters, x_7: f32, edge_12: vec2<f32>) -> f32 {
-    var atmosphere_45: AtmosphereParameters;
-    var x_8: f32;
+fn ShadowEdgeLitDistance(atmosphere_48: AtmosphereParameters, x_11: f32, edge_12: vec2<f32>) -> f32 {
+    var atmosphere_49: AtmosphereParameters;
+    var x_12: f32;
     var edge_13: vec2<f32>;
     var X_closest_4: f32;
     var X_span_4: f32;
@@ -1214,10 +1425,10 @@ fn ShadowEdgeLitDistance(atmosphere_44: AtmosphereParameters, x_7: f32, edge_12:
     var next: f32;
     var converged: bool;
 
-    atmosphere_45 = atmosphere_44;
-    x_8 = x_7;
+    atmosphere_49 = atmosphere_48;
+    x_12 = x_11;
     edge_13 = edge_12;
-    let _e21 = atmosphere_45;
+    let _e21 = atmosphere_49;
     let _e22 = edge_13;
     ShadowEdgeLitUnitSpans(_e21, _e22, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
     let _e34 = s_min;
@@ -1225,7 +1436,7 @@ fn ShadowEdgeLitDistance(atmosphere_44: AtmosphereParameters, x_7: f32, edge_12:
     s_max = (_e34 + _e35);
     let _e38 = s_min;
     let _e39 = s_max;
-    let _e40 = x_8;
+    let _e40 = x_12;
     s_2 = mix(_e38, _e39, _e40);
     loop {
         let _e45 = i;
@@ -1233,14 +1444,14 @@ fn ShadowEdgeLitDistance(atmosphere_44: AtmosphereParameters, x_7: f32, edge_12:
             break;
         }
         {
-            let _e53 = atmosphere_45;
+            let _e53 = atmosphere_49;
             let _e54 = s_2;
             let _e56 = edge_13;
             let _e57 = X_closest_4;
             let _e58 = X_span_4;
             let _e59 = log_span_4;
             let _e62 = ShadowEdgeLitUnitFrom(_e53, exp(_e54), _e56, _e57, _e58, _e59, (&slope));
-            let _e63 = x_8;
+            let _e63 = x_12;
             error = (_e62 - _e63);
             let _e66 = s_2;
             let _e67 = error;
@@ -1268,15 +1479,15 @@ fn ShadowEdgeLitDistance(atmosphere_44: AtmosphereParameters, x_7: f32, edge_12:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgePastStep(atmosphere_46: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
-    var atmosphere_47: AtmosphereParameters;
+fn ShadowEdgePastStep(atmosphere_50: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
+    var atmosphere_51: AtmosphereParameters;
     var edge_15: vec2<f32>;
     var past_lowest: f32;
 
-    atmosphere_47 = atmosphere_46;
+    atmosphere_51 = atmosphere_50;
     edge_15 = edge_14;
     let _e15 = edge_15;
-    let _e16 = atmosphere_47;
+    let _e16 = atmosphere_51;
     let _e18 = ShadowEdgeDistance(_e15, _e16.scattering_mu_s_min);
     past_lowest = -(_e18);
     let _e21 = past_lowest;
@@ -1284,24 +1495,24 @@ fn ShadowEdgePastStep(atmosphere_46: AtmosphereParameters, edge_14: vec2<f32>) -
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgePosition(atmosphere_48: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
-    var atmosphere_49: AtmosphereParameters;
+fn GetScatteringShadowEdgePosition(atmosphere_52: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
+    var atmosphere_53: AtmosphereParameters;
     var D_6: f32;
     var edge_17: vec2<f32>;
     var past: f32 = 6f;
 
-    atmosphere_49 = atmosphere_48;
+    atmosphere_53 = atmosphere_52;
     D_6 = D_5;
     edge_17 = edge_16;
     let _e20 = D_6;
     if (_e20 >= SHADOW_EDGE_CLOSEST) {
         {
             let _e22 = past;
-            let _e23 = atmosphere_49;
+            let _e23 = atmosphere_53;
             let _e24 = D_6;
             let _e25 = edge_17;
             let _e26 = ShadowEdgeLitUnit(_e23, _e24, _e25);
-            let _e27 = atmosphere_49;
+            let _e27 = atmosphere_53;
             let _e30 = past;
             return (_e22 + (_e26 * (f32(_e27.scattering_mu_s_split) - _e30)));
         }
@@ -1314,21 +1525,21 @@ fn GetScatteringShadowEdgePosition(atmosphere_48: AtmosphereParameters, D_5: f32
     }
     let _e43 = past;
     let _e46 = D_6;
-    let _e47 = atmosphere_49;
+    let _e47 = atmosphere_53;
     let _e48 = edge_17;
     let _e49 = ShadowEdgePastStep(_e47, _e48);
     return ((_e43 - 1f) + (_e46 / _e49));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgeDistance(atmosphere_50: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
-    var atmosphere_51: AtmosphereParameters;
+fn GetScatteringShadowEdgeDistance(atmosphere_54: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
+    var atmosphere_55: AtmosphereParameters;
     var position_1: f32;
     var edge_19: vec2<f32>;
     var past_1: f32 = 6f;
-    var x_9: f32;
+    var x_13: f32;
 
-    atmosphere_51 = atmosphere_50;
+    atmosphere_55 = atmosphere_54;
     position_1 = position;
     edge_19 = edge_18;
     let _e20 = position_1;
@@ -1337,11 +1548,11 @@ fn GetScatteringShadowEdgeDistance(atmosphere_50: AtmosphereParameters, position
         {
             let _e23 = position_1;
             let _e24 = past_1;
-            let _e26 = atmosphere_51;
+            let _e26 = atmosphere_55;
             let _e29 = past_1;
-            x_9 = ((_e23 - _e24) / (f32(_e26.scattering_mu_s_split) - _e29));
-            let _e33 = atmosphere_51;
-            let _e34 = x_9;
+            x_13 = ((_e23 - _e24) / (f32(_e26.scattering_mu_s_split) - _e29));
+            let _e33 = atmosphere_55;
+            let _e34 = x_13;
             let _e35 = edge_19;
             let _e36 = ShadowEdgeLitDistance(_e33, _e34, _e35);
             return _e36;
@@ -1356,18 +1567,18 @@ fn GetScatteringShadowEdgeDistance(atmosphere_50: AtmosphereParameters, position
     }
     let _e48 = position_1;
     let _e49 = past_1;
-    let _e53 = atmosphere_51;
+    let _e53 = atmosphere_55;
     let _e54 = edge_19;
     let _e55 = ShadowEdgePastStep(_e53, _e54);
     return (((_e48 - _e49) + 1f) * _e55);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4: f32, ray_r_mu_intersects_ground_6: bool, x_mu_1: f32) -> f32 {
-    var atmosphere_53: AtmosphereParameters;
-    var r_29: f32;
-    var rho_5: f32;
-    var ray_r_mu_intersects_ground_7: bool;
+fn GetScatteringTextureUR(atmosphere_56: AtmosphereParameters, r_32: f32, rho_8: f32, ray_r_mu_intersects_ground_13: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_57: AtmosphereParameters;
+    var r_33: f32;
+    var rho_9: f32;
+    var ray_r_mu_intersects_ground_14: bool;
     var x_mu_2: f32;
     var rho_min: f32;
     var rho_max: f32;
@@ -1379,31 +1590,31 @@ fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4:
     var bottom_2: f32;
     var d_below: f32;
     var d_above: f32;
-    var d_11: f32;
+    var d_15: f32;
     var t: f32;
 
-    atmosphere_53 = atmosphere_52;
-    r_29 = r_28;
-    rho_5 = rho_4;
-    ray_r_mu_intersects_ground_7 = ray_r_mu_intersects_ground_6;
+    atmosphere_57 = atmosphere_56;
+    r_33 = r_32;
+    rho_9 = rho_8;
+    ray_r_mu_intersects_ground_14 = ray_r_mu_intersects_ground_13;
     x_mu_2 = x_mu_1;
-    let _e21 = atmosphere_53;
-    let _e22 = atmosphere_53;
+    let _e21 = atmosphere_57;
+    let _e22 = atmosphere_57;
     let _e24 = HorizonDistance(_e21, _e22.scattering_r_min);
     rho_min = _e24;
-    let _e26 = atmosphere_53;
-    let _e27 = atmosphere_53;
+    let _e26 = atmosphere_57;
+    let _e27 = atmosphere_57;
     let _e29 = HorizonDistance(_e26, _e27.scattering_r_max);
     rho_max = _e29;
-    let _e31 = atmosphere_53;
+    let _e31 = atmosphere_57;
     last_row = f32((_e31.scattering_r_size - 1i));
-    let _e37 = rho_5;
+    let _e37 = rho_9;
     let _e38 = rho_min;
     let _e40 = rho_max;
     let _e41 = rho_min;
     let _e47 = last_row;
     position_2 = (clamp(((_e37 - _e38) / (_e40 - _e41)), 0f, 1f) * _e47);
-    let _e50 = ray_r_mu_intersects_ground_7;
+    let _e50 = ray_r_mu_intersects_ground_14;
     if !(_e50) {
         let _e52 = position_2;
         let _e55 = last_row;
@@ -1422,7 +1633,7 @@ fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4:
     let _e75 = row;
     let _e78 = last_row;
     rho_above = mix(_e73, _e74, ((_e75 + 1f) / _e78));
-    let _e82 = atmosphere_53;
+    let _e82 = atmosphere_57;
     bottom_2 = _e82.bottom_radius;
     let _e85 = bottom_2;
     let _e86 = rho_below;
@@ -1436,12 +1647,12 @@ fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4:
     let _e95 = rho_above;
     let _e96 = x_mu_2;
     d_above = mix(_e94, _e95, _e96);
-    let _e99 = r_29;
+    let _e99 = r_33;
     let _e100 = bottom_2;
-    let _e102 = rho_5;
+    let _e102 = rho_9;
     let _e103 = x_mu_2;
-    d_11 = mix((_e99 - _e100), _e102, _e103);
-    let _e106 = d_11;
+    d_15 = mix((_e99 - _e100), _e102, _e103);
+    let _e106 = d_15;
     let _e107 = d_below;
     let _e109 = d_above;
     let _e110 = d_below;
@@ -1453,299 +1664,233 @@ fn GetScatteringTextureUR(atmosphere_52: AtmosphereParameters, r_28: f32, rho_4:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzAndEdge(atmosphere_54: AtmosphereParameters, r_30: f32, mu_23: f32, mu_s_13: f32, nu_11: f32, ray_r_mu_intersects_ground_8: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
-    var atmosphere_55: AtmosphereParameters;
-    var r_31: f32;
-    var mu_24: f32;
+fn GetScatteringTextureUvwzAndEdge(atmosphere_58: AtmosphereParameters, r_34: f32, mu_25: f32, mu_s_13: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
+    var atmosphere_59: AtmosphereParameters;
+    var r_35: f32;
+    var mu_26: f32;
     var mu_s_14: f32;
     var nu_12: f32;
-    var ray_r_mu_intersects_ground_9: bool;
-    var H_2: f32;
-    var rho_6: f32;
-    var half_mu_size: f32;
-    var u_mu: f32;
+    var ray_r_mu_intersects_ground_16: bool;
+    var rho_10: f32;
     var x_mu_3: f32;
-    var d_12: f32;
-    var d_min_5: f32;
-    var d_max_4: f32;
-    var local_9: f32;
-    var d_13: f32;
-    var d_min_6: f32;
-    var d_max_5: f32;
-    var local_10: f32;
+    var u_mu: f32;
     var u_r: f32;
     var u_mu_s: f32;
     var mu_s_size: f32;
 
-    atmosphere_55 = atmosphere_54;
-    r_31 = r_30;
-    mu_24 = mu_23;
+    atmosphere_59 = atmosphere_58;
+    r_35 = r_34;
+    mu_26 = mu_25;
     mu_s_14 = mu_s_13;
     nu_12 = nu_11;
-    ray_r_mu_intersects_ground_9 = ray_r_mu_intersects_ground_8;
-    let _e24 = atmosphere_55;
-    let _e25 = HorizonDistanceAtTop(_e24);
-    H_2 = _e25;
-    let _e27 = atmosphere_55;
-    let _e28 = r_31;
-    let _e29 = HorizonDistance(_e27, _e28);
-    rho_6 = _e29;
-    let _e31 = atmosphere_55;
-    half_mu_size = f32((_e31.scattering_mu_size / 2i));
-    let _e39 = ray_r_mu_intersects_ground_9;
-    if _e39 {
-        {
-            let _e40 = atmosphere_55;
-            let _e41 = r_31;
-            let _e42 = mu_24;
-            let _e43 = DistanceToBottomAtmosphereBoundary(_e40, _e41, _e42);
-            d_12 = _e43;
-            let _e45 = r_31;
-            let _e46 = atmosphere_55;
-            d_min_5 = (_e45 - _e46.bottom_radius);
-            let _e50 = rho_6;
-            d_max_4 = _e50;
-            let _e52 = d_max_4;
-            let _e53 = d_min_5;
-            if (_e52 == _e53) {
-                local_9 = 0f;
-            } else {
-                let _e56 = d_12;
-                let _e57 = d_min_5;
-                let _e59 = d_max_4;
-                let _e60 = d_min_5;
-                local_9 = ((_e56 - _e57) / (_e59 - _e60));
-            }
-            let _e64 = local_9;
-            x_mu_3 = _e64;
-            let _e68 = half_mu_size;
-            let _e70 = x_mu_3;
-            let _e73 = half_mu_size;
-            u_mu = (0.5f - (0.5f * ((0.5f / _e68) + (_e70 * (1f - (1f / _e73))))));
-        }
-    } else {
-        {
-            let _e80 = atmosphere_55;
-            let _e81 = r_31;
-            let _e82 = mu_24;
-            let _e83 = DistanceToTopAtmosphereBoundary(_e80, _e81, _e82);
-            d_13 = _e83;
-            let _e85 = atmosphere_55;
-            let _e87 = r_31;
-            d_min_6 = (_e85.top_radius - _e87);
-            let _e90 = rho_6;
-            let _e91 = H_2;
-            d_max_5 = (_e90 + _e91);
-            let _e94 = d_max_5;
-            let _e95 = d_min_6;
-            if (_e94 > _e95) {
-                let _e97 = d_13;
-                let _e98 = d_min_6;
-                let _e100 = d_max_5;
-                let _e101 = d_min_6;
-                local_10 = ((_e97 - _e98) / (_e100 - _e101));
-            } else {
-                local_10 = 0f;
-            }
-            let _e106 = local_10;
-            x_mu_3 = _e106;
-            let _e110 = half_mu_size;
-            let _e112 = x_mu_3;
-            let _e115 = half_mu_size;
-            u_mu = (0.5f + (0.5f * ((0.5f / _e110) + (_e112 * (1f - (1f / _e115))))));
-        }
-    }
-    let _e122 = atmosphere_55;
-    let _e123 = r_31;
-    let _e124 = rho_6;
-    let _e125 = ray_r_mu_intersects_ground_9;
-    let _e126 = x_mu_3;
-    let _e127 = GetScatteringTextureUR(_e122, _e123, _e124, _e125, _e126);
-    u_r = _e127;
-    let _e129 = atmosphere_55;
-    let _e130 = mu_s_14;
-    let _e131 = GetScatteringTextureUMuS(_e129, _e130);
-    u_mu_s = _e131;
-    let _e133 = atmosphere_55;
-    mu_s_size = f32(_e133.scattering_mu_s_size);
+    ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
+    let _e24 = atmosphere_59;
+    let _e25 = r_35;
+    let _e26 = HorizonDistance(_e24, _e25);
+    rho_10 = _e26;
+    let _e28 = atmosphere_59;
+    let _e29 = r_35;
+    let _e30 = rho_10;
+    let _e31 = mu_26;
+    let _e32 = ray_r_mu_intersects_ground_16;
+    let _e33 = GetUnitMuInHalf(_e28, _e29, _e30, _e31, _e32);
+    x_mu_3 = _e33;
+    let _e35 = x_mu_3;
+    let _e36 = ray_r_mu_intersects_ground_16;
+    let _e37 = atmosphere_59;
+    let _e39 = GetTextureCoordFromUnitMuInHalf(_e35, _e36, _e37.scattering_mu_size);
+    u_mu = _e39;
+    let _e41 = atmosphere_59;
+    let _e42 = r_35;
+    let _e43 = rho_10;
+    let _e44 = ray_r_mu_intersects_ground_16;
+    let _e45 = x_mu_3;
+    let _e46 = GetScatteringTextureUR(_e41, _e42, _e43, _e44, _e45);
+    u_r = _e46;
+    let _e48 = atmosphere_59;
+    let _e49 = mu_s_14;
+    let _e50 = GetScatteringTextureUMuS(_e48, _e49);
+    u_mu_s = _e50;
+    let _e52 = atmosphere_59;
+    mu_s_size = f32(_e52.scattering_mu_s_size);
     (*edge_20) = vec2(0f);
-    let _e139 = atmosphere_55;
-    let _e143 = u_mu_s;
-    let _e144 = mu_s_size;
-    let _e148 = atmosphere_55;
-    if ((_e139.scattering_mu_s_split > 0i) && (((_e143 * _e144) - 0.5f) < f32(_e148.scattering_mu_s_split))) {
+    let _e58 = atmosphere_59;
+    let _e62 = u_mu_s;
+    let _e63 = mu_s_size;
+    let _e67 = atmosphere_59;
+    if ((_e58.scattering_mu_s_split > 0i) && (((_e62 * _e63) - 0.5f) < f32(_e67.scattering_mu_s_split))) {
         {
-            let _e153 = atmosphere_55;
-            let _e154 = r_31;
-            let _e155 = mu_24;
-            let _e156 = mu_24;
-            let _e157 = mu_s_14;
-            let _e158 = nu_12;
-            let _e159 = ViewSunAzimuthCosine(_e156, _e157, _e158);
-            let _e160 = ray_r_mu_intersects_ground_9;
-            let _e163 = ShadowEdge(_e153, _e154, _e155, _e159, _e160, edge_20);
-            let _e164 = atmosphere_55;
-            let _e165 = (*edge_20);
-            let _e166 = mu_s_14;
-            let _e167 = ShadowEdgeDistance(_e165, _e166);
-            let _e168 = (*edge_20);
-            let _e169 = GetScatteringShadowEdgePosition(_e164, _e167, _e168);
-            let _e172 = mu_s_size;
-            u_mu_s = ((_e169 + 0.5f) / _e172);
+            let _e72 = atmosphere_59;
+            let _e73 = r_35;
+            let _e74 = mu_26;
+            let _e75 = mu_26;
+            let _e76 = mu_s_14;
+            let _e77 = nu_12;
+            let _e78 = ViewSunAzimuthCosine(_e75, _e76, _e77);
+            let _e79 = ray_r_mu_intersects_ground_16;
+            let _e82 = ShadowEdge(_e72, _e73, _e74, _e78, _e79, edge_20);
+            let _e83 = atmosphere_59;
+            let _e84 = (*edge_20);
+            let _e85 = mu_s_14;
+            let _e86 = ShadowEdgeDistance(_e84, _e85);
+            let _e87 = (*edge_20);
+            let _e88 = GetScatteringShadowEdgePosition(_e83, _e86, _e87);
+            let _e91 = mu_s_size;
+            u_mu_s = ((_e88 + 0.5f) / _e91);
         }
     }
-    let _e174 = nu_12;
-    let _e175 = ScatteringUnitNu(_e174);
-    let _e176 = u_mu_s;
-    let _e177 = u_mu;
-    let _e178 = u_r;
-    return vec4<f32>(_e175, _e176, _e177, _e178);
+    let _e93 = nu_12;
+    let _e94 = ScatteringUnitNu(_e93);
+    let _e95 = u_mu_s;
+    let _e96 = u_mu;
+    let _e97 = u_r;
+    return vec4<f32>(_e94, _e95, _e96, _e97);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_56: AtmosphereParameters, r_32: f32, mu_25: f32, mu_s_15: f32, nu_13: f32, ray_r_mu_intersects_ground_10: bool) -> vec4<f32> {
-    var atmosphere_57: AtmosphereParameters;
-    var r_33: f32;
-    var mu_26: f32;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_60: AtmosphereParameters, r_36: f32, mu_27: f32, mu_s_15: f32, nu_13: f32, ray_r_mu_intersects_ground_17: bool) -> vec4<f32> {
+    var atmosphere_61: AtmosphereParameters;
+    var r_37: f32;
+    var mu_28: f32;
     var mu_s_16: f32;
     var nu_14: f32;
-    var ray_r_mu_intersects_ground_11: bool;
+    var ray_r_mu_intersects_ground_18: bool;
     var unused_3: vec2<f32>;
 
-    atmosphere_57 = atmosphere_56;
-    r_33 = r_32;
-    mu_26 = mu_25;
+    atmosphere_61 = atmosphere_60;
+    r_37 = r_36;
+    mu_28 = mu_27;
     mu_s_16 = mu_s_15;
     nu_14 = nu_13;
-    ray_r_mu_intersects_ground_11 = ray_r_mu_intersects_ground_10;
-    let _e24 = atmosphere_57;
-    let _e25 = r_33;
-    let _e26 = mu_26;
+    ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
+    let _e24 = atmosphere_61;
+    let _e25 = r_37;
+    let _e26 = mu_28;
     let _e27 = mu_s_16;
     let _e28 = nu_14;
-    let _e29 = ray_r_mu_intersects_ground_11;
+    let _e29 = ray_r_mu_intersects_ground_18;
     let _e32 = GetScatteringTextureUvwzAndEdge(_e24, _e25, _e26, _e27, _e28, _e29, (&unused_3));
     return _e32;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_58: AtmosphereParameters) -> f32 {
-    var atmosphere_59: AtmosphereParameters;
-    var local_11: f32;
+fn IrradianceKneeMuS(atmosphere_62: AtmosphereParameters) -> f32 {
+    var atmosphere_63: AtmosphereParameters;
+    var local_15: f32;
 
-    atmosphere_59 = atmosphere_58;
-    let _e14 = atmosphere_59;
+    atmosphere_63 = atmosphere_62;
+    let _e14 = atmosphere_63;
     if (_e14.mu_s_min < LOW_SUN_MU_S) {
-        local_11 = LOW_SUN_MU_S;
+        local_15 = LOW_SUN_MU_S;
     } else {
-        let _e18 = atmosphere_59;
-        local_11 = (0.5f * (_e18.mu_s_min + 1f));
+        let _e18 = atmosphere_63;
+        local_15 = (0.5f * (_e18.mu_s_min + 1f));
     }
-    let _e24 = local_11;
+    let _e24 = local_15;
     return _e24;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_60: AtmosphereParameters, mu_s_17: f32) -> f32 {
-    var atmosphere_61: AtmosphereParameters;
+fn GetIrradianceUnitMuS(atmosphere_64: AtmosphereParameters, mu_s_17: f32) -> f32 {
+    var atmosphere_65: AtmosphereParameters;
     var mu_s_18: f32;
     var knee: f32;
-    var local_12: f32;
+    var local_16: f32;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_65 = atmosphere_64;
     mu_s_18 = mu_s_17;
-    let _e16 = atmosphere_61;
+    let _e16 = atmosphere_65;
     let _e17 = IrradianceKneeMuS(_e16);
     knee = _e17;
     let _e19 = mu_s_18;
     let _e20 = knee;
     if (_e19 < _e20) {
         let _e23 = mu_s_18;
-        let _e24 = atmosphere_61;
+        let _e24 = atmosphere_65;
         let _e28 = knee;
-        let _e29 = atmosphere_61;
-        local_12 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
+        let _e29 = atmosphere_65;
+        local_16 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
     } else {
         let _e35 = mu_s_18;
         let _e36 = knee;
         let _e40 = knee;
-        local_12 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
+        local_16 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
     }
-    let _e45 = local_12;
+    let _e45 = local_16;
     return _e45;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_62: AtmosphereParameters, x_10: f32) -> f32 {
-    var atmosphere_63: AtmosphereParameters;
-    var x_11: f32;
+fn GetIrradianceMuSFromUnit(atmosphere_66: AtmosphereParameters, x_14: f32) -> f32 {
+    var atmosphere_67: AtmosphereParameters;
+    var x_15: f32;
     var knee_1: f32;
-    var local_13: f32;
+    var local_17: f32;
 
-    atmosphere_63 = atmosphere_62;
-    x_11 = x_10;
-    let _e16 = atmosphere_63;
+    atmosphere_67 = atmosphere_66;
+    x_15 = x_14;
+    let _e16 = atmosphere_67;
     let _e17 = IrradianceKneeMuS(_e16);
     knee_1 = _e17;
-    let _e19 = x_11;
+    let _e19 = x_15;
     if (_e19 < 0.5f) {
-        let _e22 = atmosphere_63;
-        let _e25 = x_11;
+        let _e22 = atmosphere_67;
+        let _e25 = x_15;
         let _e27 = knee_1;
-        let _e28 = atmosphere_63;
-        local_13 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
+        let _e28 = atmosphere_67;
+        local_17 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
     } else {
         let _e33 = knee_1;
-        let _e35 = x_11;
+        let _e35 = x_15;
         let _e40 = knee_1;
-        local_13 = (_e33 + (((2f * _e35) - 1f) * (1f - _e40)));
+        local_17 = (_e33 + (((2f * _e35) - 1f) * (1f - _e40)));
     }
-    let _e45 = local_13;
+    let _e45 = local_17;
     return _e45;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_64: AtmosphereParameters, r_34: f32, mu_s_19: f32) -> vec2<f32> {
-    var atmosphere_65: AtmosphereParameters;
-    var r_35: f32;
+fn GetIrradianceTextureUvFromRMuS(atmosphere_68: AtmosphereParameters, r_38: f32, mu_s_19: f32) -> vec2<f32> {
+    var atmosphere_69: AtmosphereParameters;
+    var r_39: f32;
     var mu_s_20: f32;
     var x_r_1: f32;
     var x_mu_s_1: f32;
 
-    atmosphere_65 = atmosphere_64;
-    r_35 = r_34;
+    atmosphere_69 = atmosphere_68;
+    r_39 = r_38;
     mu_s_20 = mu_s_19;
-    let _e18 = atmosphere_65;
-    let _e19 = r_35;
+    let _e18 = atmosphere_69;
+    let _e19 = r_39;
     let _e20 = HorizonDistance(_e18, _e19);
-    let _e21 = atmosphere_65;
+    let _e21 = atmosphere_69;
     let _e22 = HorizonDistanceAtTop(_e21);
     x_r_1 = (_e20 / _e22);
-    let _e25 = atmosphere_65;
+    let _e25 = atmosphere_69;
     let _e26 = mu_s_20;
     let _e27 = GetIrradianceUnitMuS(_e25, _e26);
     x_mu_s_1 = clamp(_e27, 0f, 1f);
     let _e32 = x_mu_s_1;
-    let _e33 = atmosphere_65;
+    let _e33 = atmosphere_69;
     let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_width);
     let _e36 = x_r_1;
-    let _e37 = atmosphere_65;
+    let _e37 = atmosphere_69;
     let _e39 = GetTextureCoordFromUnitRange(_e36, _e37.irradiance_height);
     return vec2<f32>(_e35, _e39);
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_66: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_36: f32, mu_27: f32) -> vec3<f32> {
-    var atmosphere_67: AtmosphereParameters;
-    var r_37: f32;
-    var mu_28: f32;
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_70: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_40: f32, mu_29: f32) -> vec3<f32> {
+    var atmosphere_71: AtmosphereParameters;
+    var r_41: f32;
+    var mu_30: f32;
     var uv_2: vec2<f32>;
 
-    atmosphere_67 = atmosphere_66;
-    r_37 = r_36;
-    mu_28 = mu_27;
-    let _e19 = atmosphere_67;
-    let _e20 = r_37;
-    let _e21 = mu_28;
+    atmosphere_71 = atmosphere_70;
+    r_41 = r_40;
+    mu_30 = mu_29;
+    let _e19 = atmosphere_71;
+    let _e20 = r_41;
+    let _e21 = mu_30;
     let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
     uv_2 = _e22;
     let _e24 = uv_2;
@@ -1753,73 +1898,73 @@ fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_66: AtmosphereParameters, t
     return vec3<f32>(_e25.xyz);
 }
 
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_68: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_38: f32, mu_29: f32) -> vec3<f32> {
-    var atmosphere_69: AtmosphereParameters;
-    var r_39: f32;
-    var mu_30: f32;
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_72: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_42: f32, mu_31: f32) -> vec3<f32> {
+    var atmosphere_73: AtmosphereParameters;
+    var r_43: f32;
+    var mu_32: f32;
 
-    atmosphere_69 = atmosphere_68;
-    r_39 = r_38;
-    mu_30 = mu_29;
-    let _e19 = atmosphere_69;
-    let _e20 = r_39;
-    let _e21 = mu_30;
+    atmosphere_73 = atmosphere_72;
+    r_43 = r_42;
+    mu_32 = mu_31;
+    let _e19 = atmosphere_73;
+    let _e20 = r_43;
+    let _e21 = mu_32;
     let _e22 = GetOpticalDepthToTopAtmosphereBoundary(_e19, transmittance_texture_1, _e20, _e21);
     return exp(-(_e22));
 }
 
-fn GetOpticalDepth(atmosphere_70: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_40: f32, mu_31: f32, d_14: f32, ray_r_mu_intersects_ground_12: bool) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
-    var r_41: f32;
-    var mu_32: f32;
-    var d_15: f32;
-    var ray_r_mu_intersects_ground_13: bool;
+fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_44: f32, mu_33: f32, d_16: f32, ray_r_mu_intersects_ground_19: bool) -> vec3<f32> {
+    var atmosphere_75: AtmosphereParameters;
+    var r_45: f32;
+    var mu_34: f32;
+    var d_17: f32;
+    var ray_r_mu_intersects_ground_20: bool;
     var r_d_3: f32;
     var mu_d: f32;
     var tau: vec3<f32>;
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_71 = atmosphere_70;
-    r_41 = r_40;
-    mu_32 = mu_31;
-    d_15 = d_14;
-    ray_r_mu_intersects_ground_13 = ray_r_mu_intersects_ground_12;
-    let _e23 = atmosphere_71;
-    let _e24 = r_41;
-    let _e25 = mu_32;
-    let _e26 = d_15;
+    atmosphere_75 = atmosphere_74;
+    r_45 = r_44;
+    mu_34 = mu_33;
+    d_17 = d_16;
+    ray_r_mu_intersects_ground_20 = ray_r_mu_intersects_ground_19;
+    let _e23 = atmosphere_75;
+    let _e24 = r_45;
+    let _e25 = mu_34;
+    let _e26 = d_17;
     let _e27 = RadiusAtDistance(_e23, _e24, _e25, _e26);
     r_d_3 = _e27;
-    let _e29 = r_41;
-    let _e30 = mu_32;
-    let _e31 = d_15;
+    let _e29 = r_45;
+    let _e30 = mu_34;
+    let _e31 = d_17;
     let _e32 = r_d_3;
     let _e33 = CosineAtDistance(_e29, _e30, _e31, _e32);
     mu_d = _e33;
-    let _e36 = ray_r_mu_intersects_ground_13;
+    let _e36 = ray_r_mu_intersects_ground_20;
     let _e37 = mu_d;
     if (_e36 || (_e37 < 0f)) {
         {
-            let _e41 = atmosphere_71;
+            let _e41 = atmosphere_75;
             let _e42 = r_d_3;
             let _e43 = mu_d;
             let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
-            let _e46 = atmosphere_71;
-            let _e47 = r_41;
-            let _e48 = mu_32;
+            let _e46 = atmosphere_75;
+            let _e47 = r_45;
+            let _e48 = mu_34;
             let _e50 = GetOpticalDepthToTopAtmosphereBoundary(_e46, transmittance_texture_2, _e47, -(_e48));
             tau = (_e45 - _e50);
         }
     } else {
-        let _e52 = mu_32;
+        let _e52 = mu_34;
         if (_e52 >= 0f) {
             {
-                let _e55 = atmosphere_71;
-                let _e56 = r_41;
-                let _e57 = mu_32;
+                let _e55 = atmosphere_75;
+                let _e56 = r_45;
+                let _e57 = mu_34;
                 let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
-                let _e59 = atmosphere_71;
+                let _e59 = atmosphere_75;
                 let _e60 = r_d_3;
                 let _e61 = mu_d;
                 let _e62 = GetOpticalDepthToTopAtmosphereBoundary(_e59, transmittance_texture_2, _e60, _e61);
@@ -1827,24 +1972,24 @@ fn GetOpticalDepth(atmosphere_70: AtmosphereParameters, transmittance_texture_2:
             }
         } else {
             {
-                let _e64 = atmosphere_71;
-                let _e65 = r_41;
-                let _e67 = mu_32;
-                let _e68 = mu_32;
+                let _e64 = atmosphere_75;
+                let _e65 = r_45;
+                let _e67 = mu_34;
+                let _e68 = mu_34;
                 let _e71 = SafeSqrt((1f - (_e67 * _e68)));
                 let _e73 = ClampRadius(_e64, (_e65 * _e71));
                 r_low = _e73;
-                let _e75 = atmosphere_71;
+                let _e75 = atmosphere_75;
                 let _e76 = r_low;
                 let _e78 = GetOpticalDepthToTopAtmosphereBoundary(_e75, transmittance_texture_2, _e76, 0f);
                 tau_low = _e78;
                 let _e80 = tau_low;
-                let _e81 = atmosphere_71;
-                let _e82 = r_41;
-                let _e83 = mu_32;
+                let _e81 = atmosphere_75;
+                let _e82 = r_45;
+                let _e83 = mu_34;
                 let _e85 = GetOpticalDepthToTopAtmosphereBoundary(_e81, transmittance_texture_2, _e82, -(_e83));
                 let _e90 = tau_low;
-                let _e91 = atmosphere_71;
+                let _e91 = atmosphere_75;
                 let _e92 = r_d_3;
                 let _e93 = mu_d;
                 let _e94 = GetOpticalDepthToTopAtmosphereBoundary(_e91, transmittance_texture_2, _e92, _e93);
@@ -1856,63 +2001,63 @@ fn GetOpticalDepth(atmosphere_70: AtmosphereParameters, transmittance_texture_2:
     return max(_e100, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_72: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_42: f32, mu_33: f32, d_16: f32, ray_r_mu_intersects_ground_14: bool) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
-    var r_43: f32;
-    var mu_34: f32;
-    var d_17: f32;
-    var ray_r_mu_intersects_ground_15: bool;
+fn GetTransmittance(atmosphere_76: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_46: f32, mu_35: f32, d_18: f32, ray_r_mu_intersects_ground_21: bool) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
+    var r_47: f32;
+    var mu_36: f32;
+    var d_19: f32;
+    var ray_r_mu_intersects_ground_22: bool;
 
-    atmosphere_73 = atmosphere_72;
-    r_43 = r_42;
-    mu_34 = mu_33;
-    d_17 = d_16;
-    ray_r_mu_intersects_ground_15 = ray_r_mu_intersects_ground_14;
-    let _e23 = atmosphere_73;
-    let _e24 = r_43;
-    let _e25 = mu_34;
-    let _e26 = d_17;
-    let _e27 = ray_r_mu_intersects_ground_15;
+    atmosphere_77 = atmosphere_76;
+    r_47 = r_46;
+    mu_36 = mu_35;
+    d_19 = d_18;
+    ray_r_mu_intersects_ground_22 = ray_r_mu_intersects_ground_21;
+    let _e23 = atmosphere_77;
+    let _e24 = r_47;
+    let _e25 = mu_36;
+    let _e26 = d_19;
+    let _e27 = ray_r_mu_intersects_ground_22;
     let _e28 = GetOpticalDepth(_e23, transmittance_texture_3, _e24, _e25, _e26, _e27);
     return exp(-(_e28));
 }
 
-fn SunVisibleFraction(atmosphere_74: AtmosphereParameters, r_44: f32, mu_s_21: f32) -> f32 {
-    var atmosphere_75: AtmosphereParameters;
-    var r_45: f32;
+fn SunVisibleFraction(atmosphere_78: AtmosphereParameters, r_48: f32, mu_s_21: f32) -> f32 {
+    var atmosphere_79: AtmosphereParameters;
+    var r_49: f32;
     var mu_s_22: f32;
     var sin_theta_h: f32;
 
-    atmosphere_75 = atmosphere_74;
-    r_45 = r_44;
+    atmosphere_79 = atmosphere_78;
+    r_49 = r_48;
     mu_s_22 = mu_s_21;
-    let _e18 = atmosphere_75;
-    let _e20 = r_45;
+    let _e18 = atmosphere_79;
+    let _e20 = r_49;
     sin_theta_h = (_e18.bottom_radius / _e20);
     let _e23 = mu_s_22;
-    let _e24 = atmosphere_75;
-    let _e26 = r_45;
+    let _e24 = atmosphere_79;
+    let _e26 = r_49;
     let _e27 = HorizonZenithCosine(_e24.bottom_radius, _e26);
     let _e28 = sin_theta_h;
-    let _e29 = atmosphere_75;
+    let _e29 = atmosphere_79;
     let _e32 = SunVisibleFractionAboveHorizon(_e23, _e27, (_e28 * _e29.sun_angular_radius));
     return _e32;
 }
 
-fn GetTransmittanceToSun(atmosphere_76: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_46: f32, mu_s_23: f32) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
-    var r_47: f32;
+fn GetTransmittanceToSun(atmosphere_80: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_50: f32, mu_s_23: f32) -> vec3<f32> {
+    var atmosphere_81: AtmosphereParameters;
+    var r_51: f32;
     var mu_s_24: f32;
 
-    atmosphere_77 = atmosphere_76;
-    r_47 = r_46;
+    atmosphere_81 = atmosphere_80;
+    r_51 = r_50;
     mu_s_24 = mu_s_23;
-    let _e19 = atmosphere_77;
-    let _e20 = r_47;
+    let _e19 = atmosphere_81;
+    let _e20 = r_51;
     let _e21 = mu_s_24;
     let _e22 = GetTransmittanceToTopAtmosphereBoundary(_e19, transmittance_texture_4, _e20, _e21);
-    let _e23 = atmosphere_77;
-    let _e24 = r_47;
+    let _e23 = atmosphere_81;
+    let _e24 = r_51;
     let _e25 = mu_s_24;
     let _e26 = SunVisibleFraction(_e23, _e24, _e25);
     return (_e22 * _e26);
@@ -1950,19 +2095,19 @@ fn SunCosineMix(a_8: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
     var t_4: f32;
     var low_sun_3: bool;
-    var local_14: f32;
+    var local_18: f32;
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
     let _e16 = low_sun_3;
     if _e16 {
         let _e17 = t_4;
-        local_14 = min(_e17, 1f);
+        local_18 = min(_e17, 1f);
     } else {
         let _e20 = t_4;
-        local_14 = clamp(_e20, 0f, 1f);
+        local_18 = clamp(_e20, 0f, 1f);
     }
-    let _e25 = local_14;
+    let _e25 = local_18;
     return _e25;
 }
 
@@ -1972,7 +2117,7 @@ fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) 
     var t_6: f32;
     var low_sun_5: bool;
     var blend: vec4<f32>;
-    var local_15: vec4<f32>;
+    var local_19: vec4<f32>;
 
     a_11 = a_10;
     b_3 = b_2;
@@ -1988,28 +2133,28 @@ fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) 
     if (_e26 < 0f) {
         let _e29 = blend;
         let _e30 = a_11;
-        local_15 = min(_e29, _e30);
+        local_19 = min(_e29, _e30);
     } else {
         let _e32 = blend;
-        local_15 = _e32;
+        local_19 = _e32;
     }
-    let _e34 = local_15;
+    let _e34 = local_19;
     return _e34;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_78: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_79: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_82: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_83: AtmosphereParameters;
     var u_mu_s_2: f32;
     var x_low_sun_1: f32;
     var mu_s_size_1: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_83 = atmosphere_82;
     u_mu_s_2 = u_mu_s_1;
     x_low_sun_1 = x_low_sun;
-    let _e22 = atmosphere_79;
+    let _e22 = atmosphere_83;
     mu_s_size_1 = f32(_e22.scattering_mu_s_size);
     let _e26 = u_mu_s_2;
     let _e27 = mu_s_size_1;
@@ -2035,20 +2180,20 @@ fn GetScatteringMuSColumns(atmosphere_78: AtmosphereParameters, u_mu_s_1: f32, x
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
+fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_20: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
     var a_13: vec4<f32>;
     var b_5: vec4<f32>;
     var c_7: vec4<f32>;
-    var d_19: vec4<f32>;
+    var d_21: vec4<f32>;
     var has_a_1: bool;
     var has_d_1: bool;
     var t_8: f32;
     var dark_1: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var lb: vec4<f32>;
     var lc: vec4<f32>;
-    var local_16: vec4<f32>;
+    var local_20: vec4<f32>;
     var la: vec4<f32>;
-    var local_17: vec4<f32>;
+    var local_21: vec4<f32>;
     var ld: vec4<f32>;
     var secant_a: vec4<f32>;
     var secant: vec4<f32>;
@@ -2067,7 +2212,7 @@ fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     a_13 = a_12;
     b_5 = b_4;
     c_7 = c_6;
-    d_19 = d_18;
+    d_21 = d_20;
     has_a_1 = has_a;
     has_d_1 = has_d;
     t_8 = t_7;
@@ -2081,25 +2226,25 @@ fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     if _e39 {
         let _e40 = a_13;
         let _e41 = dark_1;
-        local_16 = log(max(_e40, _e41));
+        local_20 = log(max(_e40, _e41));
     } else {
         let _e45 = lb;
         let _e47 = lc;
-        local_16 = ((2f * _e45) - _e47);
+        local_20 = ((2f * _e45) - _e47);
     }
-    let _e50 = local_16;
+    let _e50 = local_20;
     la = _e50;
     let _e52 = has_d_1;
     if _e52 {
-        let _e53 = d_19;
+        let _e53 = d_21;
         let _e54 = dark_1;
-        local_17 = log(max(_e53, _e54));
+        local_21 = log(max(_e53, _e54));
     } else {
         let _e58 = lc;
         let _e60 = lb;
-        local_17 = ((2f * _e58) - _e60);
+        local_21 = ((2f * _e58) - _e60);
     }
-    let _e63 = local_17;
+    let _e63 = local_21;
     ld = _e63;
     let _e65 = lb;
     let _e66 = la;
@@ -2156,7 +2301,7 @@ fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_18: ve
     let _e176 = a_13;
     let _e177 = b_5;
     let _e179 = c_7;
-    let _e180 = d_19;
+    let _e180 = d_21;
     lit = step(_e175, min(min(_e176, _e177), min(_e179, _e180)));
     let _e185 = lb;
     let _e186 = lc;
@@ -2229,7 +2374,7 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
     var mu_s_26: f32;
     var slope_2: vec4<f32>;
     var curvature_1: vec4<f32>;
-    var d_20: f32;
+    var d_22: f32;
 
     a_17 = a_16;
     b_9 = b_8;
@@ -2243,29 +2388,29 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
     LowestSunLogFall(_e24, _e25, _e26, _e27, (&slope_2), (&curvature_1));
     let _e32 = mu_s_26;
     let _e33 = mu_s_a_3;
-    d_20 = (_e32 - _e33);
+    d_22 = (_e32 - _e33);
     let _e36 = a_17;
-    let _e37 = d_20;
+    let _e37 = d_22;
     let _e38 = slope_2;
-    let _e39 = d_20;
+    let _e39 = d_22;
     let _e40 = curvature_1;
     return (_e36 * exp((_e37 * (_e38 + (_e39 * _e40)))));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringInSlice(atmosphere_80: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_12: f32, nu_slice: f32) -> vec4<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetScatteringInSlice(atmosphere_84: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_16: f32, nu_slice: f32) -> vec4<f32> {
+    var atmosphere_85: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
-    var x_13: f32;
+    var x_17: f32;
     var nu_slice_1: f32;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_85 = atmosphere_84;
     uvwz_1 = uvwz;
-    x_13 = x_12;
+    x_17 = x_16;
     nu_slice_1 = nu_slice;
     let _e21 = nu_slice_1;
-    let _e22 = x_13;
-    let _e24 = atmosphere_81;
+    let _e22 = x_17;
+    let _e24 = atmosphere_85;
     let _e28 = uvwz_1;
     let _e30 = uvwz_1;
     let _e33 = SampleTexture3D(scattering_texture, vec3<f32>(((_e21 + _e22) / f32(_e24.scattering_nu_size)), _e28.z, _e30.w));
@@ -2273,28 +2418,28 @@ fn GetScatteringInSlice(atmosphere_80: AtmosphereParameters, scattering_texture:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_82: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_14: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_83: AtmosphereParameters;
+fn GetScatteringAtMuSColumn(atmosphere_86: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_18: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_87: AtmosphereParameters;
     var uvwz_3: vec4<f32>;
-    var x_15: f32;
+    var x_19: f32;
     var nu_slice_3: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_87 = atmosphere_86;
     uvwz_3 = uvwz_2;
-    x_15 = x_14;
+    x_19 = x_18;
     nu_slice_3 = nu_slice_2;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e25 = atmosphere_83;
+    let _e25 = atmosphere_87;
     let _e26 = uvwz_3;
-    let _e27 = x_15;
+    let _e27 = x_19;
     let _e28 = nu_slice_3;
     let _e29 = GetScatteringInSlice(_e25, scattering_texture_1, _e26, _e27, _e28);
-    let _e30 = atmosphere_83;
+    let _e30 = atmosphere_87;
     let _e31 = uvwz_3;
-    let _e32 = x_15;
+    let _e32 = x_19;
     let _e33 = nu_slice_3;
     let _e36 = GetScatteringInSlice(_e30, scattering_texture_1, _e31, _e32, (_e33 + 1f));
     let _e37 = nu_t_1;
@@ -2304,28 +2449,28 @@ fn GetScatteringAtMuSColumn(atmosphere_82: AtmosphereParameters, scattering_text
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtOwnColumn(atmosphere_84: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
-    var atmosphere_85: AtmosphereParameters;
+fn GetScatteringAtOwnColumn(atmosphere_88: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
+    var atmosphere_89: AtmosphereParameters;
     var uvwz_5: vec4<f32>;
     var column_1: f32;
     var nu_slice_5: f32;
 
-    atmosphere_85 = atmosphere_84;
+    atmosphere_89 = atmosphere_88;
     uvwz_5 = uvwz_4;
     column_1 = column;
     nu_slice_5 = nu_slice_4;
-    let _e21 = atmosphere_85;
+    let _e21 = atmosphere_89;
     let _e22 = uvwz_5;
     let _e23 = column_1;
-    let _e26 = atmosphere_85;
+    let _e26 = atmosphere_89;
     let _e30 = nu_slice_5;
     let _e31 = GetScatteringInSlice(_e21, scattering_texture_2, _e22, ((_e23 + 0.5f) / f32(_e26.scattering_mu_s_size)), _e30);
     return _e31;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringBelowSplit(atmosphere_86: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
-    var atmosphere_87: AtmosphereParameters;
+fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
+    var atmosphere_91: AtmosphereParameters;
     var uvwz_7: vec4<f32>;
     var position_4: f32;
     var nu_slice_7: f32;
@@ -2340,15 +2485,15 @@ fn GetScatteringBelowSplit(atmosphere_86: AtmosphereParameters, scattering_textu
     var tiny: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var rises: vec4<f32>;
     var power: vec4<f32>;
-    var x_16: f32;
+    var x_20: f32;
     var k_4: f32;
 
-    atmosphere_87 = atmosphere_86;
+    atmosphere_91 = atmosphere_90;
     uvwz_7 = uvwz_6;
     position_4 = position_3;
     nu_slice_7 = nu_slice_6;
     log_first_span_1 = log_first_span;
-    let _e26 = atmosphere_87;
+    let _e26 = atmosphere_91;
     let _e29 = past_2;
     intervals = (f32(_e26.scattering_mu_s_split) - _e29);
     let _e32 = position_4;
@@ -2362,22 +2507,22 @@ fn GetScatteringBelowSplit(atmosphere_86: AtmosphereParameters, scattering_textu
             let _e44 = past_2;
             let _e45 = k_3;
             column_2 = (_e44 + _e45);
-            let _e48 = atmosphere_87;
+            let _e48 = atmosphere_91;
             let _e49 = uvwz_7;
             let _e50 = column_2;
             let _e53 = nu_slice_7;
             let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_3, _e49, (_e50 - 1f), _e53);
-            let _e55 = atmosphere_87;
+            let _e55 = atmosphere_91;
             let _e56 = uvwz_7;
             let _e57 = column_2;
             let _e58 = nu_slice_7;
             let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_3, _e56, _e57, _e58);
-            let _e60 = atmosphere_87;
+            let _e60 = atmosphere_91;
             let _e61 = uvwz_7;
             let _e62 = column_2;
             let _e65 = nu_slice_7;
             let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_3, _e61, (_e62 + 1f), _e65);
-            let _e67 = atmosphere_87;
+            let _e67 = atmosphere_91;
             let _e68 = uvwz_7;
             let _e69 = column_2;
             let _e72 = past_2;
@@ -2397,20 +2542,20 @@ fn GetScatteringBelowSplit(atmosphere_86: AtmosphereParameters, scattering_textu
     let _e91 = past_2;
     if (_e90 >= (_e91 - 1f)) {
         {
-            let _e95 = atmosphere_87;
+            let _e95 = atmosphere_91;
             let _e96 = uvwz_7;
             let _e97 = past_2;
             let _e100 = nu_slice_7;
             let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_3, _e96, (_e97 - 1f), _e100);
             at_edge = _e101;
-            let _e103 = atmosphere_87;
+            let _e103 = atmosphere_91;
             let _e104 = uvwz_7;
             let _e105 = past_2;
             let _e106 = nu_slice_7;
             let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_3, _e104, _e105, _e106);
             let _e108 = at_edge;
             rise_1 = (_e107 - _e108);
-            let _e111 = atmosphere_87;
+            let _e111 = atmosphere_91;
             let _e112 = uvwz_7;
             let _e113 = past_2;
             let _e116 = nu_slice_7;
@@ -2439,36 +2584,36 @@ fn GetScatteringBelowSplit(atmosphere_86: AtmosphereParameters, scattering_textu
     }
     let _e168 = past_2;
     let _e171 = position_4;
-    x_16 = ((_e168 - 1f) - _e171);
-    let _e174 = x_16;
+    x_20 = ((_e168 - 1f) - _e171);
+    let _e174 = x_20;
     let _e176 = past_2;
     k_4 = min(floor(_e174), (_e176 - 2f));
-    let _e181 = atmosphere_87;
+    let _e181 = atmosphere_91;
     let _e182 = uvwz_7;
     let _e183 = past_2;
     let _e186 = k_4;
     let _e188 = nu_slice_7;
     let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_3, _e182, ((_e183 - 1f) - _e186), _e188);
-    let _e190 = atmosphere_87;
+    let _e190 = atmosphere_91;
     let _e191 = uvwz_7;
     let _e192 = past_2;
     let _e195 = k_4;
     let _e197 = nu_slice_7;
     let _e198 = GetScatteringAtOwnColumn(_e190, scattering_texture_3, _e191, ((_e192 - 2f) - _e195), _e197);
-    let _e199 = x_16;
+    let _e199 = x_20;
     let _e200 = k_4;
     let _e203 = SunCosineMix(_e189, _e198, (_e199 - _e200), true);
     return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_48: f32, mu_35: f32, mu_s_27: f32, nu_15: f32, ray_r_mu_intersects_ground_16: bool) -> vec4<f32> {
-    var atmosphere_89: AtmosphereParameters;
-    var r_49: f32;
-    var mu_36: f32;
+fn GetScattering(atmosphere_92: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_52: f32, mu_37: f32, mu_s_27: f32, nu_15: f32, ray_r_mu_intersects_ground_23: bool) -> vec4<f32> {
+    var atmosphere_93: AtmosphereParameters;
+    var r_53: f32;
+    var mu_38: f32;
     var mu_s_28: f32;
     var nu_16: f32;
-    var ray_r_mu_intersects_ground_17: bool;
+    var ray_r_mu_intersects_ground_24: bool;
     var edge_21: vec2<f32>;
     var uvwz_8: vec4<f32>;
     var nu_size: f32;
@@ -2480,7 +2625,7 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
     var past_3: f32 = 6f;
     var log_first_span_2: f32 = 1f;
     var step_: f32;
-    var x_17: f32;
+    var x_21: f32;
     var x_below_1: f32;
     var x_above_1: f32;
     var mu_s_t_1: f32;
@@ -2494,21 +2639,21 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
     var first: vec4<f32>;
     var last_1: vec4<f32>;
 
-    atmosphere_89 = atmosphere_88;
-    r_49 = r_48;
-    mu_36 = mu_35;
+    atmosphere_93 = atmosphere_92;
+    r_53 = r_52;
+    mu_38 = mu_37;
     mu_s_28 = mu_s_27;
     nu_16 = nu_15;
-    ray_r_mu_intersects_ground_17 = ray_r_mu_intersects_ground_16;
-    let _e26 = atmosphere_89;
-    let _e27 = r_49;
-    let _e28 = mu_36;
+    ray_r_mu_intersects_ground_24 = ray_r_mu_intersects_ground_23;
+    let _e26 = atmosphere_93;
+    let _e27 = r_53;
+    let _e28 = mu_38;
     let _e29 = mu_s_28;
     let _e30 = nu_16;
-    let _e31 = ray_r_mu_intersects_ground_17;
+    let _e31 = ray_r_mu_intersects_ground_24;
     let _e34 = GetScatteringTextureUvwzAndEdge(_e26, _e27, _e28, _e29, _e30, _e31, (&edge_21));
     uvwz_8 = _e34;
-    let _e36 = atmosphere_89;
+    let _e36 = atmosphere_93;
     nu_size = f32(_e36.scattering_nu_size);
     let _e40 = uvwz_8;
     let _e42 = nu_size;
@@ -2519,14 +2664,14 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
     let _e54 = nu_coord;
     let _e55 = nu_slice_8;
     nu_t_2 = (_e54 - _e55);
-    let _e58 = atmosphere_89;
+    let _e58 = atmosphere_93;
     mu_s_size_2 = f32(_e58.scattering_mu_s_size);
     let _e62 = uvwz_8;
     let _e64 = mu_s_size_2;
     position_5 = ((_e62.y * _e64) - 0.5f);
-    let _e69 = atmosphere_89;
+    let _e69 = atmosphere_93;
     let _e73 = position_5;
-    let _e74 = atmosphere_89;
+    let _e74 = atmosphere_93;
     if ((_e69.scattering_mu_s_split > 0i) && (_e73 < f32(_e74.scattering_mu_s_split))) {
         {
             let _e84 = position_5;
@@ -2536,17 +2681,17 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
                     let _e87 = position_5;
                     if (_e87 < 0f) {
                         {
-                            let _e90 = atmosphere_89;
+                            let _e90 = atmosphere_93;
                             let _e91 = edge_21;
                             let _e92 = ShadowEdgePastStep(_e90, _e91);
                             step_ = _e92;
-                            let _e94 = atmosphere_89;
+                            let _e94 = atmosphere_93;
                             let _e95 = uvwz_8;
                             let _e97 = mu_s_size_2;
                             let _e99 = nu_slice_8;
                             let _e100 = nu_t_2;
                             let _e102 = GetScatteringAtMuSColumn(_e94, scattering_texture_4, _e95, (0.5f / _e97), _e99, _e100, true);
-                            let _e103 = atmosphere_89;
+                            let _e103 = atmosphere_93;
                             let _e104 = uvwz_8;
                             let _e106 = mu_s_size_2;
                             let _e108 = nu_slice_8;
@@ -2569,11 +2714,11 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
                     let _e131 = past_3;
                     if (_e130 >= (_e131 - 1f)) {
                         {
-                            let _e136 = atmosphere_89;
+                            let _e136 = atmosphere_93;
                             let _e139 = past_3;
-                            x_17 = (1f / (f32(_e136.scattering_mu_s_split) - _e139));
-                            let _e143 = atmosphere_89;
-                            let _e144 = x_17;
+                            x_21 = (1f / (f32(_e136.scattering_mu_s_split) - _e139));
+                            let _e143 = atmosphere_93;
+                            let _e144 = x_21;
                             let _e145 = edge_21;
                             let _e146 = ShadowEdgeLitDistance(_e143, _e144, _e145);
                             log_first_span_2 = log((_e146 / SHADOW_EDGE_CLOSEST));
@@ -2581,13 +2726,13 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
                     }
                 }
             }
-            let _e149 = atmosphere_89;
+            let _e149 = atmosphere_93;
             let _e150 = uvwz_8;
             let _e151 = position_5;
             let _e152 = nu_slice_8;
             let _e153 = log_first_span_2;
             let _e154 = GetScatteringBelowSplit(_e149, scattering_texture_4, _e150, _e151, _e152, _e153);
-            let _e155 = atmosphere_89;
+            let _e155 = atmosphere_93;
             let _e156 = uvwz_8;
             let _e157 = position_5;
             let _e158 = nu_slice_8;
@@ -2598,93 +2743,99 @@ fn GetScattering(atmosphere_88: AtmosphereParameters, scattering_texture_4: text
             return _e165;
         }
     }
-    let _e170 = atmosphere_89;
+    let _e170 = atmosphere_93;
     let _e171 = GetScatteringTextureUMuS(_e170, LOW_SUN_MU_S);
     x_low_sun_2 = _e171;
-    let _e173 = atmosphere_89;
+    let _e173 = atmosphere_93;
     let _e174 = uvwz_8;
     let _e176 = x_low_sun_2;
     GetScatteringMuSColumns(_e173, _e174.y, _e176, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e185 = atmosphere_89;
-    let _e186 = uvwz_8;
-    let _e187 = x_below_1;
-    let _e188 = nu_slice_8;
-    let _e189 = nu_t_2;
-    let _e190 = low_sun_below_1;
-    let _e191 = GetScatteringAtMuSColumn(_e185, scattering_texture_4, _e186, _e187, _e188, _e189, _e190);
-    below = _e191;
-    let _e193 = atmosphere_89;
-    let _e194 = uvwz_8;
-    let _e195 = x_above_1;
-    let _e196 = nu_slice_8;
-    let _e197 = nu_t_2;
-    let _e198 = x_above_1;
-    let _e199 = x_low_sun_2;
-    let _e201 = GetScatteringAtMuSColumn(_e193, scattering_texture_4, _e194, _e195, _e196, _e197, (_e198 < _e199));
-    above = _e201;
-    let _e203 = mu_s_t_1;
-    if (_e203 < 0f) {
+    let _e185 = low_sun_below_1;
+    if !(_e185) {
         {
-            let _e206 = below;
-            let _e207 = above;
-            let _e208 = atmosphere_89;
-            let _e210 = atmosphere_89;
-            let _e212 = mu_s_size_2;
-            let _e216 = GetScatteringMuSFromUnitRange(_e210, (1f / (_e212 - 1f)));
-            let _e217 = mu_s_28;
-            let _e218 = LowestSunContinued(_e206, _e207, _e208.scattering_mu_s_min, _e216, _e217);
-            return _e218;
+            let _e187 = atmosphere_93;
+            let _e188 = uvwz_8;
+            let _e189 = x_below_1;
+            let _e190 = x_above_1;
+            let _e191 = mu_s_t_1;
+            let _e193 = nu_slice_8;
+            let _e194 = nu_t_2;
+            let _e196 = GetScatteringAtMuSColumn(_e187, scattering_texture_4, _e188, mix(_e189, _e190, _e191), _e193, _e194, false);
+            return _e196;
         }
     }
-    let _e219 = low_sun_below_1;
-    if !(_e219) {
-        let _e221 = below;
-        let _e222 = above;
-        let _e223 = mu_s_t_1;
-        return mix(_e221, _e222, vec4(_e223));
+    let _e197 = atmosphere_93;
+    let _e198 = uvwz_8;
+    let _e199 = x_below_1;
+    let _e200 = nu_slice_8;
+    let _e201 = nu_t_2;
+    let _e203 = GetScatteringAtMuSColumn(_e197, scattering_texture_4, _e198, _e199, _e200, _e201, true);
+    below = _e203;
+    let _e205 = atmosphere_93;
+    let _e206 = uvwz_8;
+    let _e207 = x_above_1;
+    let _e208 = nu_slice_8;
+    let _e209 = nu_t_2;
+    let _e210 = x_above_1;
+    let _e211 = x_low_sun_2;
+    let _e213 = GetScatteringAtMuSColumn(_e205, scattering_texture_4, _e206, _e207, _e208, _e209, (_e210 < _e211));
+    above = _e213;
+    let _e215 = mu_s_t_1;
+    if (_e215 < 0f) {
+        {
+            let _e218 = below;
+            let _e219 = above;
+            let _e220 = atmosphere_93;
+            let _e222 = atmosphere_93;
+            let _e224 = mu_s_size_2;
+            let _e228 = GetScatteringMuSFromUnitRange(_e222, (1f / (_e224 - 1f)));
+            let _e229 = mu_s_28;
+            let _e230 = LowestSunContinued(_e218, _e219, _e220.scattering_mu_s_min, _e228, _e229);
+            return _e230;
+        }
     }
-    let _e226 = x_below_1;
-    let _e227 = mu_s_size_2;
-    column_3 = ((_e226 * _e227) - 0.5f);
-    let _e232 = column_3;
-    let _e239 = mu_s_size_2;
-    x_first = ((max((_e232 - 1f), 0f) + 0.5f) / _e239);
-    let _e242 = column_3;
-    let _e245 = mu_s_size_2;
-    let _e251 = mu_s_size_2;
-    x_last = ((min((_e242 + 2f), (_e245 - 1f)) + 0.5f) / _e251);
-    let _e254 = atmosphere_89;
-    let _e255 = uvwz_8;
-    let _e256 = x_first;
-    let _e257 = nu_slice_8;
-    let _e258 = nu_t_2;
-    let _e260 = GetScatteringAtMuSColumn(_e254, scattering_texture_4, _e255, _e256, _e257, _e258, true);
-    first = _e260;
-    let _e262 = atmosphere_89;
-    let _e263 = uvwz_8;
-    let _e264 = x_last;
-    let _e265 = nu_slice_8;
-    let _e266 = nu_t_2;
-    let _e267 = x_last;
-    let _e268 = x_low_sun_2;
-    let _e270 = GetScatteringAtMuSColumn(_e262, scattering_texture_4, _e263, _e264, _e265, _e266, (_e267 < _e268));
-    last_1 = _e270;
-    let _e272 = first;
-    let _e273 = below;
-    let _e274 = above;
-    let _e275 = last_1;
-    let _e276 = column_3;
-    let _e279 = column_3;
-    let _e282 = mu_s_size_2;
-    let _e286 = mu_s_t_1;
-    let _e287 = LogMonotoneCubicMix(_e272, _e273, _e274, _e275, (_e276 > 0.5f), ((_e279 + 2f) < (_e282 - 0.5f)), _e286);
-    return _e287;
+    let _e231 = x_below_1;
+    let _e232 = mu_s_size_2;
+    column_3 = ((_e231 * _e232) - 0.5f);
+    let _e237 = column_3;
+    let _e244 = mu_s_size_2;
+    x_first = ((max((_e237 - 1f), 0f) + 0.5f) / _e244);
+    let _e247 = column_3;
+    let _e250 = mu_s_size_2;
+    let _e256 = mu_s_size_2;
+    x_last = ((min((_e247 + 2f), (_e250 - 1f)) + 0.5f) / _e256);
+    let _e259 = atmosphere_93;
+    let _e260 = uvwz_8;
+    let _e261 = x_first;
+    let _e262 = nu_slice_8;
+    let _e263 = nu_t_2;
+    let _e265 = GetScatteringAtMuSColumn(_e259, scattering_texture_4, _e260, _e261, _e262, _e263, true);
+    first = _e265;
+    let _e267 = atmosphere_93;
+    let _e268 = uvwz_8;
+    let _e269 = x_last;
+    let _e270 = nu_slice_8;
+    let _e271 = nu_t_2;
+    let _e272 = x_last;
+    let _e273 = x_low_sun_2;
+    let _e275 = GetScatteringAtMuSColumn(_e267, scattering_texture_4, _e268, _e269, _e270, _e271, (_e272 < _e273));
+    last_1 = _e275;
+    let _e277 = first;
+    let _e278 = below;
+    let _e279 = above;
+    let _e280 = last_1;
+    let _e281 = column_3;
+    let _e284 = column_3;
+    let _e287 = mu_s_size_2;
+    let _e291 = mu_s_t_1;
+    let _e292 = LogMonotoneCubicMix(_e277, _e278, _e279, _e280, (_e281 > 0.5f), ((_e284 + 2f) < (_e287 - 0.5f)), _e291);
+    return _e292;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_90: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_50: f32, mu_s_29: f32) -> vec3<f32> {
-    var atmosphere_91: AtmosphereParameters;
-    var r_51: f32;
+fn GetIrradiance(atmosphere_94: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_54: f32, mu_s_29: f32) -> vec3<f32> {
+    var atmosphere_95: AtmosphereParameters;
+    var r_55: f32;
     var mu_s_30: f32;
     var uv_3: vec2<f32>;
     var width: f32;
@@ -2695,17 +2846,17 @@ fn GetIrradiance(atmosphere_90: AtmosphereParameters, irradiance_texture: textur
     var below_1: vec4<f32>;
     var above_1: vec4<f32>;
 
-    atmosphere_91 = atmosphere_90;
-    r_51 = r_50;
+    atmosphere_95 = atmosphere_94;
+    r_55 = r_54;
     mu_s_30 = mu_s_29;
-    let _e19 = atmosphere_91;
-    let _e20 = r_51;
+    let _e19 = atmosphere_95;
+    let _e20 = r_55;
     let _e21 = mu_s_30;
     let _e22 = GetIrradianceTextureUvFromRMuS(_e19, _e20, _e21);
     uv_3 = _e22;
-    let _e24 = atmosphere_91;
+    let _e24 = atmosphere_95;
     width = f32(_e24.irradiance_width);
-    let _e28 = atmosphere_91;
+    let _e28 = atmosphere_95;
     let _e29 = mu_s_30;
     let _e30 = GetIrradianceUnitMuS(_e28, _e29);
     let _e31 = width;
@@ -2713,7 +2864,7 @@ fn GetIrradiance(atmosphere_90: AtmosphereParameters, irradiance_texture: textur
     let _e36 = mu_s_coord_1;
     let _e39 = width;
     mu_s_column_1 = clamp(floor(_e36), 0f, (_e39 - 2f));
-    let _e44 = atmosphere_91;
+    let _e44 = atmosphere_95;
     let _e45 = mu_s_column_1;
     let _e46 = width;
     let _e50 = GetIrradianceMuSFromUnit(_e44, (_e45 / (_e46 - 1f)));
@@ -2742,22 +2893,22 @@ fn GetIrradiance(atmosphere_90: AtmosphereParameters, irradiance_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_92: AtmosphereParameters, nu_17: f32) -> f32 {
-    var atmosphere_93: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_96: AtmosphereParameters, nu_17: f32) -> f32 {
+    var atmosphere_97: AtmosphereParameters;
     var nu_18: f32;
 
-    atmosphere_93 = atmosphere_92;
+    atmosphere_97 = atmosphere_96;
     nu_18 = nu_17;
-    let _e16 = atmosphere_93;
+    let _e16 = atmosphere_97;
     if (_e16.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e19 = atmosphere_93;
+        let _e19 = atmosphere_97;
         let _e21 = nu_18;
         let _e22 = HenyeyGreensteinPhaseFunction(_e19.mie_g, _e21);
         return _e22;
     }
-    let _e23 = atmosphere_93;
+    let _e23 = atmosphere_97;
     if (_e23.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e26 = atmosphere_93;
+        let _e26 = atmosphere_97;
         let _e28 = nu_18;
         let _e29 = CornetteShanksPhaseFunction(_e26.mie_g, _e28);
         return _e29;
@@ -2766,31 +2917,31 @@ fn MiePhaseFunction(atmosphere_92: AtmosphereParameters, nu_17: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_94: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_52: f32, mu_37: f32, mu_s_31: f32, nu_19: f32, ray_r_mu_intersects_ground_18: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_95: AtmosphereParameters;
-    var r_53: f32;
-    var mu_38: f32;
+fn GetCombinedScattering(atmosphere_98: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_56: f32, mu_39: f32, mu_s_31: f32, nu_19: f32, ray_r_mu_intersects_ground_25: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_99: AtmosphereParameters;
+    var r_57: f32;
+    var mu_40: f32;
     var mu_s_32: f32;
     var nu_20: f32;
-    var ray_r_mu_intersects_ground_19: bool;
+    var ray_r_mu_intersects_ground_26: bool;
     var scattering: vec4<f32>;
-    var local_18: vec3<f32>;
+    var local_22: vec3<f32>;
 
-    atmosphere_95 = atmosphere_94;
-    r_53 = r_52;
-    mu_38 = mu_37;
+    atmosphere_99 = atmosphere_98;
+    r_57 = r_56;
+    mu_40 = mu_39;
     mu_s_32 = mu_s_31;
     nu_20 = nu_19;
-    ray_r_mu_intersects_ground_19 = ray_r_mu_intersects_ground_18;
-    let _e27 = atmosphere_95;
-    let _e28 = r_53;
-    let _e29 = mu_38;
+    ray_r_mu_intersects_ground_26 = ray_r_mu_intersects_ground_25;
+    let _e27 = atmosphere_99;
+    let _e28 = r_57;
+    let _e29 = mu_40;
     let _e30 = mu_s_32;
     let _e31 = nu_20;
-    let _e32 = ray_r_mu_intersects_ground_19;
+    let _e32 = ray_r_mu_intersects_ground_26;
     let _e33 = GetScattering(_e27, scattering_texture_5, _e28, _e29, _e30, _e31, _e32);
     scattering = _e33;
-    let _e35 = atmosphere_95;
+    let _e35 = atmosphere_99;
     if (_e35.single_mie_in_scattering_alpha == 1i) {
         {
             let _e39 = scattering;
@@ -2798,23 +2949,23 @@ fn GetCombinedScattering(atmosphere_94: AtmosphereParameters, scattering_texture
                 let _e43 = scattering;
                 let _e46 = scattering;
                 let _e49 = scattering;
-                let _e53 = atmosphere_95;
-                let _e55 = atmosphere_95;
-                local_18 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
+                let _e53 = atmosphere_99;
+                let _e55 = atmosphere_99;
+                local_22 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_18 = vec3(0f);
+                local_22 = vec3(0f);
             }
-            let _e64 = local_18;
+            let _e64 = local_22;
             (*single_mie_scattering) = _e64;
         }
     } else {
         {
-            let _e65 = atmosphere_95;
-            let _e66 = r_53;
-            let _e67 = mu_38;
+            let _e65 = atmosphere_99;
+            let _e66 = r_57;
+            let _e67 = mu_40;
             let _e68 = mu_s_32;
             let _e69 = nu_20;
-            let _e70 = ray_r_mu_intersects_ground_19;
+            let _e70 = ray_r_mu_intersects_ground_26;
             let _e71 = GetScattering(_e65, single_mie_scattering_texture, _e66, _e67, _e68, _e69, _e70);
             (*single_mie_scattering) = vec3<f32>(_e71.xyz);
         }
@@ -2824,97 +2975,122 @@ fn GetCombinedScattering(atmosphere_94: AtmosphereParameters, scattering_texture
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_96: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_97: AtmosphereParameters;
+fn GetSkyRadianceOfRay(atmosphere_100: AtmosphereParameters, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, r_58: f32, mu_41: f32, mu_s_33: f32, nu_21: f32, ray_r_mu_intersects_ground_27: bool) -> vec3<f32> {
+    var atmosphere_101: AtmosphereParameters;
+    var r_59: f32;
+    var mu_42: f32;
+    var mu_s_34: f32;
+    var nu_22: f32;
+    var ray_r_mu_intersects_ground_28: bool;
+    var single_mie_scattering_1: vec3<f32>;
+    var scattering_1: vec3<f32>;
+
+    atmosphere_101 = atmosphere_100;
+    r_59 = r_58;
+    mu_42 = mu_41;
+    mu_s_34 = mu_s_33;
+    nu_22 = nu_21;
+    ray_r_mu_intersects_ground_28 = ray_r_mu_intersects_ground_27;
+    let _e27 = atmosphere_101;
+    let _e28 = r_59;
+    let _e29 = mu_42;
+    let _e30 = mu_s_34;
+    let _e31 = nu_22;
+    let _e32 = ray_r_mu_intersects_ground_28;
+    let _e35 = GetCombinedScattering(_e27, scattering_texture_6, single_mie_scattering_texture_1, _e28, _e29, _e30, _e31, _e32, (&single_mie_scattering_1));
+    scattering_1 = _e35;
+    let _e37 = scattering_1;
+    let _e38 = nu_22;
+    let _e39 = RayleighPhaseFunction(_e38);
+    let _e41 = single_mie_scattering_1;
+    let _e42 = atmosphere_101;
+    let _e43 = nu_22;
+    let _e44 = MiePhaseFunction(_e42, _e43);
+    return ((_e37 * _e39) + (_e41 * _e44));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyRadiance(atmosphere_102: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_103: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
     var start_2: vec3<f32>;
-    var r_54: f32;
-    var mu_39: f32;
-    var mu_s_33: f32;
-    var nu_21: f32;
-    var ray_r_mu_intersects_ground_20: bool;
-    var local_19: vec3<f32>;
-    var single_mie_scattering_1: vec3<f32>;
-    var scattering_1: vec3<f32>;
+    var r_60: f32;
+    var mu_43: f32;
+    var mu_s_35: f32;
+    var nu_23: f32;
+    var ray_r_mu_intersects_ground_29: bool;
+    var local_23: vec3<f32>;
 
-    atmosphere_97 = atmosphere_96;
+    atmosphere_103 = atmosphere_102;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e29 = atmosphere_97;
+    let _e29 = atmosphere_103;
     let _e30 = camera_5;
     let _e31 = view_ray_5;
     let _e32 = sun_direction_3;
-    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_54), (&mu_39), (&mu_s_33), (&nu_21));
+    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_60), (&mu_43), (&mu_s_35), (&nu_23));
     if !(_e43) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e49 = atmosphere_97;
-    let _e50 = r_54;
-    let _e51 = mu_39;
+    let _e49 = atmosphere_103;
+    let _e50 = r_60;
+    let _e51 = mu_43;
     let _e52 = RayIntersectsGround(_e49, _e50, _e51);
-    ray_r_mu_intersects_ground_20 = _e52;
-    let _e54 = ray_r_mu_intersects_ground_20;
+    ray_r_mu_intersects_ground_29 = _e52;
+    let _e54 = ray_r_mu_intersects_ground_29;
     if _e54 {
-        local_19 = vec3(0f);
+        local_23 = vec3(0f);
     } else {
-        let _e57 = atmosphere_97;
-        let _e58 = r_54;
-        let _e59 = mu_39;
+        let _e57 = atmosphere_103;
+        let _e58 = r_60;
+        let _e59 = mu_43;
         let _e60 = GetTransmittanceToTopAtmosphereBoundary(_e57, transmittance_texture_5, _e58, _e59);
-        local_19 = _e60;
+        local_23 = _e60;
     }
-    let _e62 = local_19;
+    let _e62 = local_23;
     (*transmittance) = _e62;
-    let _e64 = atmosphere_97;
-    let _e65 = r_54;
-    let _e66 = mu_39;
-    let _e67 = mu_s_33;
-    let _e68 = nu_21;
-    let _e69 = ray_r_mu_intersects_ground_20;
-    let _e72 = GetCombinedScattering(_e64, scattering_texture_6, single_mie_scattering_texture_1, _e65, _e66, _e67, _e68, _e69, (&single_mie_scattering_1));
-    scattering_1 = _e72;
-    let _e74 = scattering_1;
-    let _e75 = nu_21;
-    let _e76 = RayleighPhaseFunction(_e75);
-    let _e78 = single_mie_scattering_1;
-    let _e79 = atmosphere_97;
-    let _e80 = nu_21;
-    let _e81 = MiePhaseFunction(_e79, _e80);
-    return ((_e74 * _e76) + (_e78 * _e81));
+    let _e63 = atmosphere_103;
+    let _e64 = r_60;
+    let _e65 = mu_43;
+    let _e66 = mu_s_35;
+    let _e67 = nu_23;
+    let _e68 = ray_r_mu_intersects_ground_29;
+    let _e69 = GetSkyRadianceOfRay(_e63, scattering_texture_7, single_mie_scattering_texture_2, _e64, _e65, _e66, _e67, _e68);
+    return _e69;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_98: AtmosphereParameters, r_55: f32, mu_40: f32) -> f32 {
-    var atmosphere_99: AtmosphereParameters;
-    var r_56: f32;
-    var mu_41: f32;
+fn DistanceInsideScatteringRadii(atmosphere_104: AtmosphereParameters, r_61: f32, mu_44: f32) -> f32 {
+    var atmosphere_105: AtmosphereParameters;
+    var r_62: f32;
+    var mu_45: f32;
     var r_max: f32;
     var r_min: f32;
     var across_2: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_20: f32;
+    var local_24: f32;
 
-    atmosphere_99 = atmosphere_98;
-    r_56 = r_55;
-    mu_41 = mu_40;
-    let _e19 = atmosphere_99;
+    atmosphere_105 = atmosphere_104;
+    r_62 = r_61;
+    mu_45 = mu_44;
+    let _e19 = atmosphere_105;
     r_max = _e19.scattering_r_max;
-    let _e22 = atmosphere_99;
+    let _e22 = atmosphere_105;
     r_min = _e22.scattering_r_min;
-    let _e25 = r_56;
-    let _e26 = r_56;
-    let _e28 = mu_41;
-    let _e29 = mu_41;
+    let _e25 = r_62;
+    let _e26 = r_62;
+    let _e28 = mu_45;
+    let _e29 = mu_45;
     across_2 = ((_e25 * _e26) * ((_e28 * _e29) - 1f));
-    let _e35 = r_56;
-    let _e37 = mu_41;
+    let _e35 = r_62;
+    let _e37 = mu_45;
     let _e39 = across_2;
     let _e40 = r_max;
     let _e41 = r_max;
@@ -2924,36 +3100,36 @@ fn DistanceInsideScatteringRadii(atmosphere_98: AtmosphereParameters, r_55: f32,
     let _e48 = r_min;
     let _e49 = r_min;
     down_discriminant = (_e47 + (_e48 * _e49));
-    let _e53 = mu_41;
+    let _e53 = mu_45;
     let _e56 = down_discriminant;
     if ((_e53 < 0f) && (_e56 >= 0f)) {
         let _e60 = up;
-        let _e61 = r_56;
-        let _e63 = mu_41;
+        let _e61 = r_62;
+        let _e63 = mu_45;
         let _e65 = down_discriminant;
-        local_20 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
+        local_24 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
     } else {
         let _e69 = up;
-        local_20 = _e69;
+        local_24 = _e69;
     }
-    let _e71 = local_20;
+    let _e71 = local_24;
     return _e71;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_100: AtmosphereParameters, i_1: i32) -> f32 {
-    var atmosphere_101: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_106: AtmosphereParameters, i_1: i32) -> f32 {
+    var atmosphere_107: AtmosphereParameters;
     var i_2: i32;
-    var x_18: f32;
+    var x_22: f32;
 
-    atmosphere_101 = atmosphere_100;
+    atmosphere_107 = atmosphere_106;
     i_2 = i_1;
     let _e18 = i_2;
-    x_18 = (f32(_e18) / 63f);
-    let _e26 = atmosphere_101;
-    let _e28 = atmosphere_101;
-    let _e31 = x_18;
-    let _e33 = x_18;
+    x_22 = (f32(_e18) / 63f);
+    let _e26 = atmosphere_107;
+    let _e28 = atmosphere_107;
+    let _e31 = x_22;
+    let _e33 = x_22;
     return (((_e26.top_radius - _e28.bottom_radius) * _e31) * _e33);
 }
 
@@ -2962,7 +3138,7 @@ fn InterpolateCoefficient(a_18: f32, b_10: f32, f: f32) -> f32 {
     var a_19: f32;
     var b_11: f32;
     var f_1: f32;
-    var local_21: f32;
+    var local_25: f32;
 
     a_19 = a_18;
     b_11 = b_10;
@@ -2974,14 +3150,14 @@ fn InterpolateCoefficient(a_18: f32, b_10: f32, f: f32) -> f32 {
         let _e28 = f_1;
         let _e29 = b_11;
         let _e30 = a_19;
-        local_21 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
+        local_25 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
     } else {
         let _e36 = a_19;
         let _e37 = b_11;
         let _e38 = f_1;
-        local_21 = mix(_e36, _e37, _e38);
+        local_25 = mix(_e36, _e37, _e38);
     }
-    let _e41 = local_21;
+    let _e41 = local_25;
     return _e41;
 }
 
@@ -3010,89 +3186,89 @@ fn InterpolateCoefficients(a_20: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_102: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_103: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_108: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_109: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_19: f32;
+    var x_23: f32;
     var i_3: i32;
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_103 = atmosphere_102;
+    atmosphere_109 = atmosphere_108;
     altitude_1 = altitude;
-    let _e20 = atmosphere_103;
-    let _e22 = atmosphere_103;
+    let _e20 = atmosphere_109;
+    let _e22 = atmosphere_109;
     height = (_e20.top_radius - _e22.bottom_radius);
     let _e26 = altitude_1;
     let _e27 = height;
-    x_19 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
-    let _e39 = x_19;
+    x_23 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
+    let _e39 = x_23;
     i_3 = min(i32(_e39), 62i);
-    let _e46 = atmosphere_103;
+    let _e46 = atmosphere_109;
     let _e47 = i_3;
     let _e48 = ProfileSampleAltitude(_e46, _e47);
     h0_ = _e48;
     let _e50 = altitude_1;
     let _e51 = h0_;
-    let _e53 = atmosphere_103;
+    let _e53 = atmosphere_109;
     let _e54 = i_3;
     let _e57 = ProfileSampleAltitude(_e53, (_e54 + 1i));
     let _e58 = h0_;
     f_4 = clamp(((_e50 - _e51) / (_e57 - _e58)), 0f, 1f);
     let _e65 = i_3;
-    let _e68 = atmosphere_103.mie_scattering_profile[_e65];
+    let _e68 = atmosphere_109.mie_scattering_profile[_e65];
     let _e69 = i_3;
-    let _e74 = atmosphere_103.mie_scattering_profile[(_e69 + 1i)];
+    let _e74 = atmosphere_109.mie_scattering_profile[(_e69 + 1i)];
     let _e75 = f_4;
     let _e76 = InterpolateCoefficients(_e68, _e74, _e75);
     (*mie_scattering) = _e76;
     let _e77 = i_3;
-    let _e80 = atmosphere_103.rayleigh_scattering_profile[_e77];
+    let _e80 = atmosphere_109.rayleigh_scattering_profile[_e77];
     let _e81 = i_3;
-    let _e86 = atmosphere_103.rayleigh_scattering_profile[(_e81 + 1i)];
+    let _e86 = atmosphere_109.rayleigh_scattering_profile[(_e81 + 1i)];
     let _e87 = f_4;
     let _e88 = InterpolateCoefficients(_e80, _e86, _e87);
     (*rayleigh_scattering) = _e88;
     let _e89 = i_3;
-    let _e92 = atmosphere_103.extinction_profile[_e89];
+    let _e92 = atmosphere_109.extinction_profile[_e89];
     let _e93 = i_3;
-    let _e98 = atmosphere_103.extinction_profile[(_e93 + 1i)];
+    let _e98 = atmosphere_109.extinction_profile[(_e93 + 1i)];
     let _e99 = f_4;
     let _e100 = InterpolateCoefficients(_e92, _e98, _e99);
     return _e100;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_104: AtmosphereParameters, r_57: f32, mu_42: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_105: AtmosphereParameters;
-    var r_58: f32;
-    var mu_43: f32;
+fn AltitudeAtDistance(atmosphere_110: AtmosphereParameters, r_63: f32, mu_46: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_111: AtmosphereParameters;
+    var r_64: f32;
+    var mu_47: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_105 = atmosphere_104;
-    r_58 = r_57;
-    mu_43 = mu_42;
+    atmosphere_111 = atmosphere_110;
+    r_64 = r_63;
+    mu_47 = mu_46;
     t_10 = t_9;
     r_t_1 = r_t;
-    let _e24 = r_58;
-    let _e25 = atmosphere_105;
+    let _e24 = r_64;
+    let _e25 = atmosphere_111;
     let _e28 = t_10;
     let _e29 = t_10;
-    let _e31 = r_58;
-    let _e33 = mu_43;
+    let _e31 = r_64;
+    let _e33 = mu_47;
     let _e37 = r_t_1;
-    let _e38 = r_58;
+    let _e38 = r_64;
     return ((_e24 - _e25.bottom_radius) + ((_e28 * (_e29 + ((2f * _e31) * _e33))) / (_e37 + _e38)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, r_59: f32, mu_44: f32, d_21: f32) -> vec3<f32> {
-    var atmosphere_107: AtmosphereParameters;
-    var r_60: f32;
-    var mu_45: f32;
-    var d_22: f32;
+fn IntegrateSegmentOpticalDepth(atmosphere_112: AtmosphereParameters, r_65: f32, mu_48: f32, d_23: f32) -> vec3<f32> {
+    var atmosphere_113: AtmosphereParameters;
+    var r_66: f32;
+    var mu_49: f32;
+    var d_24: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
@@ -3103,11 +3279,11 @@ fn IntegrateSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, r_59: f32,
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_107 = atmosphere_106;
-    r_60 = r_59;
-    mu_45 = mu_44;
-    d_22 = d_21;
-    let _e22 = d_22;
+    atmosphere_113 = atmosphere_112;
+    r_66 = r_65;
+    mu_49 = mu_48;
+    d_24 = d_23;
+    let _e22 = d_24;
     dt = (_e22 / 16f);
     loop {
         let _e35 = k_5;
@@ -3118,16 +3294,16 @@ fn IntegrateSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, r_59: f32,
             let _e41 = dt;
             let _e42 = k_5;
             t_11 = (_e41 * f32(_e42));
-            let _e46 = atmosphere_107;
-            let _e47 = r_60;
-            let _e48 = mu_45;
+            let _e46 = atmosphere_113;
+            let _e47 = r_66;
+            let _e48 = mu_49;
             let _e49 = t_11;
             let _e50 = RadiusAtDistance(_e46, _e47, _e48, _e49);
             r_t_2 = _e50;
-            let _e54 = atmosphere_107;
-            let _e55 = atmosphere_107;
-            let _e56 = r_60;
-            let _e57 = mu_45;
+            let _e54 = atmosphere_113;
+            let _e55 = atmosphere_113;
+            let _e56 = r_66;
+            let _e57 = mu_49;
             let _e58 = t_11;
             let _e59 = r_t_2;
             let _e60 = AltitudeAtDistance(_e55, _e56, _e57, _e58, _e59);
@@ -3154,67 +3330,67 @@ fn IntegrateSegmentOpticalDepth(atmosphere_106: AtmosphereParameters, r_59: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_108: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_61: f32, mu_46: f32, d_23: f32, ray_r_mu_intersects_ground_21: bool) -> vec3<f32> {
-    var atmosphere_109: AtmosphereParameters;
-    var r_62: f32;
-    var mu_47: f32;
-    var d_24: f32;
-    var ray_r_mu_intersects_ground_22: bool;
-    var local_22: vec3<f32>;
+fn LongSegmentOpticalDepth(atmosphere_114: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_67: f32, mu_50: f32, d_25: f32, ray_r_mu_intersects_ground_30: bool) -> vec3<f32> {
+    var atmosphere_115: AtmosphereParameters;
+    var r_68: f32;
+    var mu_51: f32;
+    var d_26: f32;
+    var ray_r_mu_intersects_ground_31: bool;
+    var local_26: vec3<f32>;
 
-    atmosphere_109 = atmosphere_108;
-    r_62 = r_61;
-    mu_47 = mu_46;
-    d_24 = d_23;
-    ray_r_mu_intersects_ground_22 = ray_r_mu_intersects_ground_21;
-    let _e25 = atmosphere_109;
+    atmosphere_115 = atmosphere_114;
+    r_68 = r_67;
+    mu_51 = mu_50;
+    d_26 = d_25;
+    ray_r_mu_intersects_ground_31 = ray_r_mu_intersects_ground_30;
+    let _e25 = atmosphere_115;
     if (_e25.transmittance_is_colour != 0i) {
-        let _e29 = atmosphere_109;
-        let _e30 = r_62;
-        let _e31 = mu_47;
-        let _e32 = d_24;
+        let _e29 = atmosphere_115;
+        let _e30 = r_68;
+        let _e31 = mu_51;
+        let _e32 = d_26;
         let _e33 = IntegrateSegmentOpticalDepth(_e29, _e30, _e31, _e32);
-        local_22 = _e33;
+        local_26 = _e33;
     } else {
-        let _e34 = atmosphere_109;
-        let _e35 = r_62;
-        let _e36 = mu_47;
-        let _e37 = d_24;
-        let _e38 = ray_r_mu_intersects_ground_22;
+        let _e34 = atmosphere_115;
+        let _e35 = r_68;
+        let _e36 = mu_51;
+        let _e37 = d_26;
+        let _e38 = ray_r_mu_intersects_ground_31;
         let _e39 = GetOpticalDepth(_e34, transmittance_texture_6, _e35, _e36, _e37, _e38);
-        local_22 = _e39;
+        local_26 = _e39;
     }
-    let _e41 = local_22;
+    let _e41 = local_26;
     return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_23: f32;
+    var local_27: f32;
 
     depth_1 = depth;
     let _e16 = depth_1;
     if (_e16 < 0.0001f) {
         let _e21 = depth_1;
-        local_23 = (1f - (0.5f * _e21));
+        local_27 = (1f - (0.5f * _e21));
     } else {
         let _e25 = depth_1;
         let _e29 = depth_1;
-        local_23 = ((1f - exp(-(_e25))) / _e29);
+        local_27 = ((1f - exp(-(_e25))) / _e29);
     }
-    let _e32 = local_23;
+    let _e32 = local_27;
     return _e32;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_110: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_63: f32, mu_48: f32, mu_s_34: f32, nu_22: f32, d_25: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_111: AtmosphereParameters;
-    var r_64: f32;
-    var mu_49: f32;
-    var mu_s_35: f32;
-    var nu_23: f32;
-    var d_26: f32;
+fn IntegrateSegment(atmosphere_116: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_69: f32, mu_52: f32, mu_s_36: f32, nu_24: f32, d_27: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_117: AtmosphereParameters;
+    var r_70: f32;
+    var mu_53: f32;
+    var mu_s_37: f32;
+    var nu_25: f32;
+    var d_28: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
     var previous_extinction_1: vec3<f32> = vec3(0f);
@@ -3237,13 +3413,13 @@ fn IntegrateSegment(atmosphere_110: AtmosphereParameters, transmittance_texture_
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_111 = atmosphere_110;
-    r_64 = r_63;
-    mu_49 = mu_48;
-    mu_s_35 = mu_s_34;
-    nu_23 = nu_22;
-    d_26 = d_25;
-    let _e30 = d_26;
+    atmosphere_117 = atmosphere_116;
+    r_70 = r_69;
+    mu_53 = mu_52;
+    mu_s_37 = mu_s_36;
+    nu_25 = nu_24;
+    d_28 = d_27;
+    let _e30 = d_28;
     dt_1 = (_e30 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
@@ -3257,35 +3433,35 @@ fn IntegrateSegment(atmosphere_110: AtmosphereParameters, transmittance_texture_
             let _e64 = dt_1;
             let _e65 = k_6;
             t_12 = (_e64 * f32(_e65));
-            let _e69 = atmosphere_111;
-            let _e70 = r_64;
-            let _e71 = mu_49;
+            let _e69 = atmosphere_117;
+            let _e70 = r_70;
+            let _e71 = mu_53;
             let _e72 = t_12;
             let _e73 = RadiusAtDistance(_e69, _e70, _e71, _e72);
             r_t_3 = _e73;
-            let _e75 = atmosphere_111;
-            let _e76 = r_64;
-            let _e77 = mu_49;
+            let _e75 = atmosphere_117;
+            let _e76 = r_70;
+            let _e77 = mu_53;
             let _e78 = t_12;
             let _e79 = r_t_3;
             let _e80 = AltitudeAtDistance(_e75, _e76, _e77, _e78, _e79);
             altitude_2 = _e80;
-            let _e82 = r_64;
-            let _e83 = mu_s_35;
+            let _e82 = r_70;
+            let _e83 = mu_s_37;
             let _e85 = t_12;
-            let _e86 = nu_23;
+            let _e86 = nu_25;
             let _e89 = r_t_3;
             let _e91 = ClampCosine((((_e82 * _e83) + (_e85 * _e86)) / _e89));
             mu_s_t_2 = _e91;
-            let _e95 = atmosphere_111;
+            let _e95 = atmosphere_117;
             let _e96 = altitude_2;
             let _e101 = GetCoefficientsAtAltitude(_e95, _e96, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e101;
-            let _e103 = atmosphere_111;
+            let _e103 = atmosphere_117;
             let _e104 = r_t_3;
             let _e105 = mu_s_t_2;
             let _e106 = GetOpticalDepthToTopAtmosphereBoundary(_e103, transmittance_texture_7, _e104, _e105);
-            let _e109 = atmosphere_111;
+            let _e109 = atmosphere_117;
             let _e110 = r_t_3;
             let _e111 = mu_s_t_2;
             let _e112 = SunVisibleFraction(_e109, _e110, _e111);
@@ -3354,18 +3530,18 @@ fn IntegrateSegment(atmosphere_110: AtmosphereParameters, transmittance_texture_
         }
     }
     let _e195 = (*single_rayleigh);
-    let _e196 = atmosphere_111;
+    let _e196 = atmosphere_117;
     (*single_rayleigh) = (_e195 * _e196.solar_irradiance);
     let _e199 = (*single_mie);
-    let _e200 = atmosphere_111;
+    let _e200 = atmosphere_117;
     (*single_mie) = (_e199 * _e200.solar_irradiance);
     let _e203 = optical_depth_1;
     return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_113: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_118: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_119: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -3373,13 +3549,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_65: f32;
-    var mu_50: f32;
-    var mu_s_36: f32;
-    var nu_24: f32;
-    var d_27: f32;
+    var r_71: f32;
+    var mu_54: f32;
+    var mu_s_38: f32;
+    var nu_26: f32;
+    var d_29: f32;
     var lit_1: f32;
-    var ray_r_mu_intersects_ground_23: bool;
+    var ray_r_mu_intersects_ground_32: bool;
     var r_p: f32;
     var mu_p: f32;
     var mu_s_p: f32;
@@ -3408,7 +3584,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_113 = atmosphere_112;
+    atmosphere_119 = atmosphere_118;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -3426,11 +3602,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     }
     let _e41 = camera_to_point;
     view_ray_6 = normalize(_e41);
-    let _e49 = atmosphere_113;
+    let _e49 = atmosphere_119;
     let _e50 = camera_7;
     let _e51 = view_ray_6;
     let _e52 = sun_direction_5;
-    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_65), (&mu_50), (&mu_s_36), (&nu_24));
+    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_71), (&mu_54), (&mu_s_38), (&nu_26));
     if !(_e63) {
         {
             (*transmittance_1) = vec3(1f);
@@ -3439,46 +3615,46 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     }
     let _e69 = point_1;
     let _e70 = start_3;
-    d_27 = max(length((_e69 - _e70)), 0f);
-    let _e76 = d_27;
+    d_29 = max(length((_e69 - _e70)), 0f);
+    let _e76 = d_29;
     let _e77 = shadow_length_1;
     lit_1 = max((_e76 - max(_e77, 0f)), 0f);
-    let _e84 = atmosphere_113;
-    let _e85 = r_65;
-    let _e86 = mu_50;
+    let _e84 = atmosphere_119;
+    let _e85 = r_71;
+    let _e86 = mu_54;
     let _e87 = RayIntersectsGround(_e84, _e85, _e86);
-    ray_r_mu_intersects_ground_23 = _e87;
-    let _e89 = atmosphere_113;
-    let _e90 = r_65;
-    let _e91 = mu_50;
+    ray_r_mu_intersects_ground_32 = _e87;
+    let _e89 = atmosphere_119;
+    let _e90 = r_71;
+    let _e91 = mu_54;
     let _e92 = lit_1;
     let _e93 = RadiusAtDistance(_e89, _e90, _e91, _e92);
     r_p = _e93;
-    let _e95 = r_65;
-    let _e96 = mu_50;
+    let _e95 = r_71;
+    let _e96 = mu_54;
     let _e97 = lit_1;
     let _e98 = r_p;
     let _e99 = CosineAtDistance(_e95, _e96, _e97, _e98);
     mu_p = _e99;
-    let _e101 = r_65;
-    let _e102 = mu_s_36;
+    let _e101 = r_71;
+    let _e102 = mu_s_38;
     let _e104 = lit_1;
-    let _e105 = nu_24;
+    let _e105 = nu_26;
     let _e108 = r_p;
     let _e110 = ClampCosine((((_e101 * _e102) + (_e104 * _e105)) / _e108));
     mu_s_p = _e110;
-    let _e116 = d_27;
+    let _e116 = d_29;
     direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e116));
     let _e124 = lit_1;
     lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e124));
     let _e140 = lit_direct;
     if (_e140 > 0f) {
         {
-            let _e143 = atmosphere_113;
-            let _e144 = r_65;
-            let _e145 = mu_50;
-            let _e146 = mu_s_36;
-            let _e147 = nu_24;
+            let _e143 = atmosphere_119;
+            let _e144 = r_71;
+            let _e145 = mu_54;
+            let _e146 = mu_s_38;
+            let _e147 = nu_26;
             let _e148 = lit_1;
             let _e155 = IntegrateSegment(_e143, transmittance_texture_8, _e144, _e145, _e146, _e147, _e148, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
             lit_optical_depth = _e155;
@@ -3488,16 +3664,16 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     optical_depth_2 = _e156;
     let _e158 = direct;
     let _e161 = lit_1;
-    let _e162 = d_27;
+    let _e162 = d_29;
     if ((_e158 > 0f) && (_e161 < _e162)) {
         {
             let _e168 = optical_depth_2;
-            let _e169 = atmosphere_113;
+            let _e169 = atmosphere_119;
             let _e170 = r_p;
             let _e171 = mu_p;
             let _e172 = mu_s_p;
-            let _e173 = nu_24;
-            let _e174 = d_27;
+            let _e173 = nu_26;
+            let _e174 = d_29;
             let _e175 = lit_1;
             let _e183 = IntegrateSegment(_e169, transmittance_texture_8, _e170, _e171, _e172, _e173, (_e174 - _e175), (&unused_rayleigh), (&unused_mie), (&unused_weight));
             optical_depth_2 = (_e168 + _e183);
@@ -3506,11 +3682,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     let _e185 = direct;
     if (_e185 < 1f) {
         {
-            let _e188 = atmosphere_113;
-            let _e189 = r_65;
-            let _e190 = mu_50;
-            let _e191 = d_27;
-            let _e192 = ray_r_mu_intersects_ground_23;
+            let _e188 = atmosphere_119;
+            let _e189 = r_71;
+            let _e190 = mu_54;
+            let _e191 = d_29;
+            let _e192 = ray_r_mu_intersects_ground_32;
             let _e193 = LongSegmentOpticalDepth(_e188, transmittance_texture_8, _e189, _e190, _e191, _e192);
             let _e194 = optical_depth_2;
             let _e195 = direct;
@@ -3519,35 +3695,35 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     }
     let _e198 = optical_depth_2;
     (*transmittance_1) = exp(-(_e198));
-    let _e202 = atmosphere_113;
-    let _e203 = r_65;
-    let _e204 = mu_50;
-    let _e205 = mu_s_36;
-    let _e206 = nu_24;
-    let _e207 = ray_r_mu_intersects_ground_23;
-    let _e210 = GetCombinedScattering(_e202, scattering_texture_7, single_mie_scattering_texture_2, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
+    let _e202 = atmosphere_119;
+    let _e203 = r_71;
+    let _e204 = mu_54;
+    let _e205 = mu_s_38;
+    let _e206 = nu_26;
+    let _e207 = ray_r_mu_intersects_ground_32;
+    let _e210 = GetCombinedScattering(_e202, scattering_texture_8, single_mie_scattering_texture_3, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
     scattering_3 = _e210;
     let _e212 = lit_1;
     if (_e212 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e214 = atmosphere_113;
-            let _e215 = r_65;
-            let _e216 = mu_50;
-            let _e217 = ray_r_mu_intersects_ground_23;
+            let _e214 = atmosphere_119;
+            let _e215 = r_71;
+            let _e216 = mu_54;
+            let _e217 = ray_r_mu_intersects_ground_32;
             let _e218 = DistanceToNearestAtmosphereBoundary(_e214, _e215, _e216, _e217);
             boundary = _e218;
             let _e220 = boundary;
-            let _e222 = atmosphere_113;
-            let _e223 = r_65;
-            let _e224 = mu_50;
+            let _e222 = atmosphere_119;
+            let _e223 = r_71;
+            let _e224 = mu_54;
             let _e225 = DistanceInsideScatteringRadii(_e222, _e223, _e224);
             let _e227 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e220), _e225), _e227);
-            let _e233 = atmosphere_113;
-            let _e234 = r_65;
-            let _e235 = mu_50;
-            let _e236 = mu_s_36;
-            let _e237 = nu_24;
+            let _e233 = atmosphere_119;
+            let _e234 = r_71;
+            let _e235 = mu_54;
+            let _e236 = mu_s_38;
+            let _e237 = nu_26;
             let _e238 = far;
             let _e245 = IntegrateSegment(_e233, transmittance_texture_8, _e234, _e235, _e236, _e237, _e238, (&far_rayleigh), (&far_mie), (&far_weight));
             far_optical_depth = _e245;
@@ -3555,30 +3731,30 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
             let _e248 = boundary;
             if (_e247 < _e248) {
                 {
-                    let _e250 = atmosphere_113;
-                    let _e251 = r_65;
-                    let _e252 = mu_50;
+                    let _e250 = atmosphere_119;
+                    let _e251 = r_71;
+                    let _e252 = mu_54;
                     let _e253 = far;
                     let _e254 = RadiusAtDistance(_e250, _e251, _e252, _e253);
                     r_far = _e254;
                     let _e257 = scattering_3;
                     let _e258 = far_optical_depth;
-                    let _e261 = atmosphere_113;
+                    let _e261 = atmosphere_119;
                     let _e262 = r_far;
-                    let _e263 = r_65;
-                    let _e264 = mu_50;
+                    let _e263 = r_71;
+                    let _e264 = mu_54;
                     let _e265 = far;
                     let _e266 = r_far;
                     let _e267 = CosineAtDistance(_e263, _e264, _e265, _e266);
-                    let _e268 = r_65;
-                    let _e269 = mu_s_36;
+                    let _e268 = r_71;
+                    let _e269 = mu_s_38;
                     let _e271 = far;
-                    let _e272 = nu_24;
+                    let _e272 = nu_26;
                     let _e275 = r_far;
                     let _e277 = ClampCosine((((_e268 * _e269) + (_e271 * _e272)) / _e275));
-                    let _e278 = nu_24;
-                    let _e279 = ray_r_mu_intersects_ground_23;
-                    let _e282 = GetCombinedScattering(_e261, scattering_texture_7, single_mie_scattering_texture_2, _e262, _e267, _e277, _e278, _e279, (&unused_far_mie));
+                    let _e278 = nu_26;
+                    let _e279 = ray_r_mu_intersects_ground_32;
+                    let _e282 = GetCombinedScattering(_e261, scattering_texture_8, single_mie_scattering_texture_3, _e262, _e267, _e277, _e278, _e279, (&unused_far_mie));
                     scattering_3 = (_e257 - (exp(-(_e258)) * _e282));
                 }
             }
@@ -3589,31 +3765,31 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
             multiple = ((max((_e285 - _e286), vec3(0f)) * _e291) / max(_e293, vec3(0.000000000000000000000000000001f)));
             let _e299 = single_rayleigh_1;
             let _e300 = multiple;
-            let _e302 = nu_24;
+            let _e302 = nu_26;
             let _e303 = RayleighPhaseFunction(_e302);
             let _e305 = single_mie_1;
-            let _e306 = atmosphere_113;
-            let _e307 = nu_24;
+            let _e306 = atmosphere_119;
+            let _e307 = nu_26;
             let _e308 = MiePhaseFunction(_e306, _e307);
             return (((_e299 + _e300) * _e303) + (_e305 * _e308));
         }
     }
-    let _e311 = atmosphere_113;
-    let _e312 = r_65;
-    let _e313 = mu_50;
+    let _e311 = atmosphere_119;
+    let _e312 = r_71;
+    let _e313 = mu_54;
     let _e314 = lit_1;
-    let _e315 = ray_r_mu_intersects_ground_23;
+    let _e315 = ray_r_mu_intersects_ground_32;
     let _e316 = LongSegmentOpticalDepth(_e311, transmittance_texture_8, _e312, _e313, _e314, _e315);
     let _e317 = lit_optical_depth;
     let _e318 = lit_direct;
     lit_transmittance = exp(-(mix(_e316, _e317, vec3(_e318))));
-    let _e325 = atmosphere_113;
+    let _e325 = atmosphere_119;
     let _e326 = r_p;
     let _e327 = mu_p;
     let _e328 = mu_s_p;
-    let _e329 = nu_24;
-    let _e330 = ray_r_mu_intersects_ground_23;
-    let _e333 = GetCombinedScattering(_e325, scattering_texture_7, single_mie_scattering_texture_2, _e326, _e327, _e328, _e329, _e330, (&single_mie_scattering_p));
+    let _e329 = nu_26;
+    let _e330 = ray_r_mu_intersects_ground_32;
+    let _e333 = GetCombinedScattering(_e325, scattering_texture_8, single_mie_scattering_texture_3, _e326, _e327, _e328, _e329, _e330, (&single_mie_scattering_p));
     scattering_p = _e333;
     let _e335 = scattering_3;
     let _e336 = lit_transmittance;
@@ -3628,81 +3804,81 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_112: AtmosphereParameters, transmi
     let _e353 = lit_direct;
     single_mie_scattering_2 = mix(_e351, _e352, vec3(_e353));
     let _e356 = scattering_3;
-    let _e357 = nu_24;
+    let _e357 = nu_26;
     let _e358 = RayleighPhaseFunction(_e357);
     let _e360 = single_mie_scattering_2;
-    let _e361 = atmosphere_113;
-    let _e362 = nu_24;
+    let _e361 = atmosphere_119;
+    let _e362 = nu_26;
     let _e363 = MiePhaseFunction(_e361, _e362);
     return ((_e356 * _e358) + (_e360 * _e363));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_114: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_115: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_120: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_121: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_115 = atmosphere_114;
+    atmosphere_121 = atmosphere_120;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e26 = atmosphere_115;
+    let _e26 = atmosphere_121;
     let _e27 = camera_9;
     let _e28 = point_3;
     let _e30 = sun_direction_7;
-    let _e33 = GetSkyRadianceToPointWithShadow(_e26, transmittance_texture_9, scattering_texture_8, single_mie_scattering_texture_3, _e27, _e28, 0f, _e30, transmittance_2);
+    let _e33 = GetSkyRadianceToPointWithShadow(_e26, transmittance_texture_9, scattering_texture_9, single_mie_scattering_texture_4, _e27, _e28, 0f, _e30, transmittance_2);
     return _e33;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_116: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_117: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_122: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_123: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_66: f32;
-    var mu_s_37: f32;
+    var r_72: f32;
+    var mu_s_39: f32;
 
-    atmosphere_117 = atmosphere_116;
+    atmosphere_123 = atmosphere_122;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e25 = atmosphere_117;
+    let _e25 = atmosphere_123;
     let _e26 = point_5;
     let _e28 = ClampRadius(_e25, length(_e26));
-    r_66 = _e28;
+    r_72 = _e28;
     let _e30 = point_5;
     let _e31 = sun_direction_9;
     let _e33 = point_5;
     let _e36 = ClampCosine((dot(_e30, _e31) / length(_e33)));
-    mu_s_37 = _e36;
-    let _e38 = atmosphere_117;
-    let _e39 = r_66;
-    let _e40 = mu_s_37;
+    mu_s_39 = _e36;
+    let _e38 = atmosphere_123;
+    let _e39 = r_72;
+    let _e40 = mu_s_39;
     let _e41 = GetIrradiance(_e38, irradiance_texture_1, _e39, _e40);
     let _e43 = normal_1;
     let _e44 = point_5;
     let _e46 = point_5;
     (*sky_irradiance) = ((_e41 * (1f + (dot(_e43, _e44) / length(_e46)))) * 0.5f);
-    let _e53 = atmosphere_117;
-    let _e55 = atmosphere_117;
-    let _e56 = r_66;
-    let _e57 = mu_s_37;
+    let _e53 = atmosphere_123;
+    let _e55 = atmosphere_123;
+    let _e56 = r_72;
+    let _e57 = mu_s_39;
     let _e58 = GetTransmittanceToSun(_e55, transmittance_texture_10, _e56, _e57);
     let _e60 = normal_1;
     let _e61 = sun_direction_9;
     return ((_e53.solar_irradiance * _e58) * max(dot(_e60, _e61), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_118: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_119: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_124: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_125: AtmosphereParameters;
 
-    atmosphere_119 = atmosphere_118;
-    let _e16 = atmosphere_119;
-    let _e18 = atmosphere_119;
-    let _e21 = atmosphere_119;
+    atmosphere_125 = atmosphere_124;
+    let _e16 = atmosphere_125;
+    let _e18 = atmosphere_125;
+    let _e21 = atmosphere_125;
     return (_e16.solar_irradiance / vec3(((PI * _e18.sun_angular_radius) * _e21.sun_angular_radius)));
 }
 
@@ -3714,4 +3890,407 @@ fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     let _e29 = xyz_1;
     let _e36 = xyz_1;
     return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e22), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e29), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e36));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn SkyViewHorizonZenith(atmosphere_126: AtmosphereParameters, r_73: f32) -> f32 {
+    var atmosphere_127: AtmosphereParameters;
+    var r_74: f32;
+
+    atmosphere_127 = atmosphere_126;
+    r_74 = r_73;
+    let _e20 = atmosphere_127;
+    let _e22 = atmosphere_127;
+    let _e23 = r_74;
+    let _e24 = HorizonDistance(_e22, _e23);
+    return atan2(_e20.bottom_radius, -(_e24));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyViewUvFromAngles(atmosphere_128: AtmosphereParameters, r_75: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_33: bool) -> vec2<f32> {
+    var atmosphere_129: AtmosphereParameters;
+    var r_76: f32;
+    var theta_1: f32;
+    var phi_1: f32;
+    var ray_r_mu_intersects_ground_34: bool;
+    var theta_h: f32;
+    var local_28: f32;
+    var x_24: f32;
+
+    atmosphere_129 = atmosphere_128;
+    r_76 = r_75;
+    theta_1 = theta;
+    phi_1 = phi;
+    ray_r_mu_intersects_ground_34 = ray_r_mu_intersects_ground_33;
+    let _e26 = atmosphere_129;
+    let _e27 = r_76;
+    let _e28 = SkyViewHorizonZenith(_e26, _e27);
+    theta_h = _e28;
+    let _e30 = ray_r_mu_intersects_ground_34;
+    if _e30 {
+        let _e32 = theta_1;
+        let _e33 = theta_h;
+        let _e35 = theta_h;
+        local_28 = (1f - sqrt(clamp(((_e32 - _e33) / (PI - _e35)), 0f, 1f)));
+    } else {
+        let _e44 = theta_h;
+        let _e45 = theta_1;
+        let _e47 = theta_h;
+        local_28 = (1f - sqrt(clamp(((_e44 - _e45) / _e47), 0f, 1f)));
+    }
+    let _e55 = local_28;
+    x_24 = _e55;
+    let _e57 = phi_1;
+    let _e59 = GetTextureCoordFromUnitRange((_e57 / PI), SKY_VIEW_WIDTH);
+    let _e60 = x_24;
+    let _e61 = ray_r_mu_intersects_ground_34;
+    let _e62 = GetTextureCoordFromUnitMuInHalf(_e60, _e61, SKY_VIEW_HEIGHT);
+    return vec2<f32>(_e59, _e62);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_10: vec3<f32>, theta_2: ptr<function, f32>, phi_2: ptr<function, f32>) {
+    var camera_11: vec3<f32>;
+    var view_ray_8: vec3<f32>;
+    var sun_direction_11: vec3<f32>;
+    var up_1: vec3<f32>;
+    var mu_55: f32;
+    var horizontal: vec3<f32>;
+    var sun_horizontal: vec3<f32>;
+    var along: f32;
+    var side: f32;
+    var local_29: f32;
+
+    camera_11 = camera_10;
+    view_ray_8 = view_ray_7;
+    sun_direction_11 = sun_direction_10;
+    let _e24 = camera_11;
+    up_1 = normalize(_e24);
+    let _e27 = up_1;
+    let _e28 = view_ray_8;
+    mu_55 = dot(_e27, _e28);
+    let _e31 = view_ray_8;
+    let _e32 = up_1;
+    let _e33 = mu_55;
+    horizontal = (_e31 - (_e32 * _e33));
+    let _e37 = sun_direction_11;
+    let _e38 = up_1;
+    let _e39 = up_1;
+    let _e40 = sun_direction_11;
+    sun_horizontal = (_e37 - (_e38 * dot(_e39, _e40)));
+    let _e45 = horizontal;
+    let _e47 = mu_55;
+    (*theta_2) = atan2(length(_e45), _e47);
+    let _e49 = sun_horizontal;
+    let _e50 = horizontal;
+    along = dot(_e49, _e50);
+    let _e53 = up_1;
+    let _e54 = sun_horizontal;
+    let _e56 = horizontal;
+    side = abs(dot(cross(_e53, _e54), _e56));
+    let _e60 = along;
+    let _e63 = side;
+    if ((_e60 != 0f) || (_e63 != 0f)) {
+        let _e67 = side;
+        let _e68 = along;
+        local_29 = atan2(_e67, _e68);
+    } else {
+        local_29 = 0f;
+    }
+    let _e72 = local_29;
+    (*phi_2) = _e72;
+    return;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyViewRay(atmosphere_130: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_35: ptr<function, bool>) -> vec3<f32> {
+    var atmosphere_131: AtmosphereParameters;
+    var camera_13: vec3<f32>;
+    var sun_direction_13: vec3<f32>;
+    var uv_5: vec2<f32>;
+    var x_25: f32;
+    var e: f32;
+    var theta_h_1: f32;
+    var local_30: f32;
+    var theta_3: f32;
+    var phi_3: f32;
+    var up_2: vec3<f32>;
+    var toward_sun: vec3<f32>;
+    var local_31: vec3<f32>;
+    var across_3: vec3<f32>;
+
+    atmosphere_131 = atmosphere_130;
+    camera_13 = camera_12;
+    sun_direction_13 = sun_direction_12;
+    uv_5 = uv_4;
+    let _e25 = uv_5;
+    let _e29 = GetUnitMuInHalfFromTextureCoord(_e25.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_35);
+    x_25 = _e29;
+    let _e32 = x_25;
+    let _e35 = x_25;
+    e = ((1f - _e32) * (1f - _e35));
+    let _e39 = atmosphere_131;
+    let _e40 = atmosphere_131;
+    let _e41 = camera_13;
+    let _e43 = ClampRadius(_e40, length(_e41));
+    let _e44 = SkyViewHorizonZenith(_e39, _e43);
+    theta_h_1 = _e44;
+    let _e46 = (*ray_r_mu_intersects_ground_35);
+    if _e46 {
+        let _e47 = theta_h_1;
+        let _e48 = e;
+        let _e49 = theta_h_1;
+        local_30 = (_e47 + (_e48 * (PI - _e49)));
+    } else {
+        let _e53 = theta_h_1;
+        let _e55 = e;
+        local_30 = (_e53 * (1f - _e55));
+    }
+    let _e59 = local_30;
+    theta_3 = _e59;
+    let _e61 = uv_5;
+    let _e63 = GetUnitRangeFromTextureCoord(_e61.x, SKY_VIEW_WIDTH);
+    phi_3 = (PI * clamp(_e63, 0f, 1f));
+    let _e69 = camera_13;
+    up_2 = normalize(_e69);
+    let _e72 = sun_direction_13;
+    let _e73 = up_2;
+    let _e74 = sun_direction_13;
+    let _e75 = up_2;
+    toward_sun = (_e72 - (_e73 * dot(_e74, _e75)));
+    let _e80 = toward_sun;
+    let _e81 = toward_sun;
+    if (dot(_e80, _e81) < 0.000000000001f) {
+        {
+            let _e85 = up_2;
+            let _e86 = up_2;
+            if (abs(_e86.x) < 0.9f) {
+                local_31 = vec3<f32>(1f, 0f, 0f);
+            } else {
+                local_31 = vec3<f32>(0f, 1f, 0f);
+            }
+            let _e100 = local_31;
+            toward_sun = cross(_e85, _e100);
+        }
+    }
+    let _e102 = toward_sun;
+    toward_sun = normalize(_e102);
+    let _e104 = up_2;
+    let _e105 = toward_sun;
+    across_3 = cross(_e104, _e105);
+    let _e108 = up_2;
+    let _e109 = theta_3;
+    let _e112 = toward_sun;
+    let _e113 = phi_3;
+    let _e116 = across_3;
+    let _e117 = phi_3;
+    let _e121 = theta_3;
+    return ((_e108 * cos(_e109)) + (((_e112 * cos(_e113)) + (_e116 * sin(_e117))) * sin(_e121)));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyViewRadiance(atmosphere_132: AtmosphereParameters, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
+    var atmosphere_133: AtmosphereParameters;
+    var camera_15: vec3<f32>;
+    var sun_direction_15: vec3<f32>;
+    var uv_7: vec2<f32>;
+    var ray_r_mu_intersects_ground_36: bool;
+    var view_ray_9: vec3<f32>;
+    var up_3: vec3<f32>;
+
+    atmosphere_133 = atmosphere_132;
+    camera_15 = camera_14;
+    sun_direction_15 = sun_direction_14;
+    uv_7 = uv_6;
+    let _e27 = atmosphere_133;
+    let _e28 = camera_15;
+    let _e29 = sun_direction_15;
+    let _e30 = uv_7;
+    let _e33 = GetSkyViewRay(_e27, _e28, _e29, _e30, (&ray_r_mu_intersects_ground_36));
+    view_ray_9 = _e33;
+    let _e35 = camera_15;
+    up_3 = normalize(_e35);
+    let _e38 = atmosphere_133;
+    let _e39 = atmosphere_133;
+    let _e40 = camera_15;
+    let _e42 = ClampRadius(_e39, length(_e40));
+    let _e43 = up_3;
+    let _e44 = view_ray_9;
+    let _e46 = ClampCosine(dot(_e43, _e44));
+    let _e47 = up_3;
+    let _e48 = sun_direction_15;
+    let _e50 = ClampCosine(dot(_e47, _e48));
+    let _e51 = view_ray_9;
+    let _e52 = sun_direction_15;
+    let _e54 = ClampCosine(dot(_e51, _e52));
+    let _e55 = ray_r_mu_intersects_ground_36;
+    let _e56 = GetSkyRadianceOfRay(_e38, scattering_texture_10, single_mie_scattering_texture_5, _e42, _e46, _e50, _e54, _e55);
+    return _e56;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyRadianceFromSkyView(atmosphere_134: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_135: AtmosphereParameters;
+    var camera_17: vec3<f32>;
+    var view_ray_11: vec3<f32>;
+    var sun_direction_17: vec3<f32>;
+    var r_77: f32;
+    var mu_56: f32;
+    var ray_r_mu_intersects_ground_37: bool;
+    var local_32: vec3<f32>;
+    var theta_4: f32;
+    var phi_4: f32;
+
+    atmosphere_135 = atmosphere_134;
+    camera_17 = camera_16;
+    view_ray_11 = view_ray_10;
+    sun_direction_17 = sun_direction_16;
+    let _e27 = atmosphere_135;
+    let _e28 = camera_17;
+    let _e30 = ClampRadius(_e27, length(_e28));
+    r_77 = _e30;
+    let _e32 = camera_17;
+    let _e33 = view_ray_11;
+    let _e35 = camera_17;
+    let _e38 = ClampCosine((dot(_e32, _e33) / length(_e35)));
+    mu_56 = _e38;
+    let _e40 = atmosphere_135;
+    let _e41 = r_77;
+    let _e42 = mu_56;
+    let _e43 = RayIntersectsGround(_e40, _e41, _e42);
+    ray_r_mu_intersects_ground_37 = _e43;
+    let _e45 = ray_r_mu_intersects_ground_37;
+    if _e45 {
+        local_32 = vec3(0f);
+    } else {
+        let _e48 = atmosphere_135;
+        let _e49 = r_77;
+        let _e50 = mu_56;
+        let _e51 = GetTransmittanceToTopAtmosphereBoundary(_e48, transmittance_texture_11, _e49, _e50);
+        local_32 = _e51;
+    }
+    let _e53 = local_32;
+    (*transmittance_3) = _e53;
+    let _e56 = camera_17;
+    let _e57 = view_ray_11;
+    let _e58 = sun_direction_17;
+    GetSkyViewAngles(_e56, _e57, _e58, (&theta_4), (&phi_4));
+    let _e63 = atmosphere_135;
+    let _e64 = r_77;
+    let _e65 = theta_4;
+    let _e66 = phi_4;
+    let _e67 = ray_r_mu_intersects_ground_37;
+    let _e68 = GetSkyViewUvFromAngles(_e63, _e64, _e65, _e66, _e67);
+    let _e69 = SampleTexture2D(sky_view_texture, _e68);
+    return vec3<f32>(_e69.xyz);
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn AerialPerspectiveSliceDistance(k_7: f32) -> f32 {
+    var k_8: f32;
+    var x_26: f32;
+
+    k_8 = k_7;
+    let _e20 = k_8;
+    x_26 = ((_e20 + 1f) / 32f);
+    let _e27 = x_26;
+    let _e29 = x_26;
+    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e27) * _e29);
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn GetAerialPerspectiveVoxel(atmosphere_136: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_137: AtmosphereParameters;
+    var camera_19: vec3<f32>;
+    var view_ray_13: vec3<f32>;
+    var w_1: f32;
+    var sun_direction_19: vec3<f32>;
+    var d_30: f32;
+    var point_6: vec3<f32>;
+    var r_point: f32;
+    var transmittance_4: vec3<f32>;
+    var radiance: vec3<f32>;
+
+    atmosphere_137 = atmosphere_136;
+    camera_19 = camera_18;
+    view_ray_13 = view_ray_12;
+    w_1 = w;
+    sun_direction_19 = sun_direction_18;
+    let _e32 = w_1;
+    let _e37 = AerialPerspectiveSliceDistance(floor((_e32 * 32f)));
+    d_30 = _e37;
+    let _e39 = camera_19;
+    let _e40 = view_ray_13;
+    let _e41 = d_30;
+    point_6 = (_e39 + (_e40 * _e41));
+    let _e45 = point_6;
+    r_point = length(_e45);
+    let _e48 = r_point;
+    let _e49 = atmosphere_137;
+    if (_e48 < _e49.bottom_radius) {
+        let _e52 = point_6;
+        let _e53 = atmosphere_137;
+        let _e55 = r_point;
+        point_6 = (_e52 * (_e53.bottom_radius / _e55));
+    }
+    let _e59 = atmosphere_137;
+    let _e60 = camera_19;
+    let _e61 = point_6;
+    let _e62 = sun_direction_19;
+    let _e65 = GetSkyRadianceToPoint(_e59, transmittance_texture_12, scattering_texture_11, single_mie_scattering_texture_6, _e60, _e61, _e62, (&transmittance_4));
+    radiance = _e65;
+    let _e67 = transmittance_4;
+    (*optical_depth_3) = -(log(max(_e67, vec3(0.000000000000000000000000000001f))));
+    let _e73 = radiance;
+    return _e73;
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_depth_volume: texture_3d<f32>, screen_uv: vec2<f32>, distance_2: f32, transmittance_5: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var screen_uv_1: vec2<f32>;
+    var distance_3: f32;
+    var slices: f32 = 32f;
+    var d_31: f32;
+    var s_3: f32;
+    var k_9: f32;
+    var d_k: f32;
+    var t_13: f32;
+    var near: f32;
+    var uvw_2: vec3<f32>;
+
+    screen_uv_1 = screen_uv;
+    distance_3 = distance_2;
+    let _e28 = distance_3;
+    d_31 = max(_e28, 0f);
+    let _e32 = slices;
+    let _e33 = d_31;
+    s_3 = (_e32 * sqrt((_e33 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
+    let _e38 = s_3;
+    let _e43 = slices;
+    k_9 = clamp((floor(_e38) - 1f), 0f, (_e43 - 2f));
+    let _e48 = k_9;
+    let _e49 = AerialPerspectiveSliceDistance(_e48);
+    d_k = _e49;
+    let _e51 = d_31;
+    let _e52 = d_k;
+    let _e54 = k_9;
+    let _e57 = AerialPerspectiveSliceDistance((_e54 + 1f));
+    let _e58 = d_k;
+    t_13 = clamp(((_e51 - _e52) / (_e57 - _e58)), 0f, 1f);
+    let _e65 = d_31;
+    let _e67 = AerialPerspectiveSliceDistance(0f);
+    near = min((_e65 / _e67), 1f);
+    let _e72 = screen_uv_1;
+    let _e73 = k_9;
+    let _e74 = t_13;
+    let _e78 = slices;
+    uvw_2 = vec3<f32>(_e72.x, _e72.y, (((_e73 + _e74) + 0.5f) / _e78));
+    let _e84 = uvw_2;
+    let _e85 = SampleTexture3D(optical_depth_volume, _e84);
+    let _e89 = near;
+    (*transmittance_5) = exp((-(vec3<f32>(_e85.xyz)) * _e89));
+    let _e92 = uvw_2;
+    let _e93 = SampleTexture3D(radiance_volume, _e92);
+    let _e96 = near;
+    return (vec3<f32>(_e93.xyz) * _e96);
 }

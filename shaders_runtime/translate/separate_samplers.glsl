@@ -6,11 +6,15 @@ layout(binding = 0) uniform sampler skybake_linear_sampler;
 #undef TransmittanceTexture
 #undef ScatteringTexture
 #undef IrradianceTexture
+#undef SkyViewTexture
+#undef AerialPerspectiveTexture
 #undef SampleTexture2D
 #undef SampleTexture3D
 #define TransmittanceTexture texture2D
 #define ScatteringTexture texture3D
 #define IrradianceTexture texture2D
+#define SkyViewTexture texture2D
+#define AerialPerspectiveTexture texture3D
 vec4 SampleTexture2D(texture2D table, vec2 uv) {
   return textureLod(sampler2D(table, skybake_linear_sampler), uv, 0.0);
 }
