@@ -31,7 +31,7 @@ Parts (figure blocks, the page, the commands run):
            runtime-cost (docs/runtime_cost.md): `skybake bake earth` into
            build/figures/runtime-cost/earth, the peer runtime installed by
            tests/runtime_cost/install_peer.mjs, then `skybake_runtime_cost
-           --size 1024 --runs 5` on them (SIZE and RUNS override; about 8
+           --size 1024 --runs 5` on them (SIZE and RUNS override; about 10
            minutes); the tool is $SKYBAKE_RUNTIME_COST, else
            build/tests/skybake_runtime_cost
 
@@ -256,12 +256,21 @@ def runtime_cost(skybake):
     size, runs = os.environ.get("SIZE", "1024"), os.environ.get("RUNS", "5")
     load = os.getloadavg()[0]
     start = time.monotonic()
-    run([tool, "--luts", str(luts), "--peer", peer, "--size", size, "--runs", runs, "--json", str(work / "cost.json"),
-         "--markdown", str(work / "cost.md")])
+    # Its progress and any failure on standard error, as it goes.
+    subprocess.run([tool, "--luts", str(luts), "--peer", peer, "--size", size, "--runs", runs, "--json",
+                    str(work / "cost.json"), "--markdown", str(work / "cost.md")],
+                   check=True, stdout=subprocess.DEVNULL, cwd=ROOT)
     wall = time.monotonic() - start
+    # Which runtime was measured: the commit, and whether shaders_runtime/ differed from it.
+    try:
+        commit = run(["git", "rev-parse", "--short", "HEAD"]).strip()
+        edited = run(["git", "status", "--porcelain", "--", "shaders_runtime"]).strip()
+        runtime = f"the runtime of commit {commit}" + (" with uncommitted changes in shaders_runtime/" if edited else "")
+    except (subprocess.CalledProcessError, FileNotFoundError):
+        runtime = "the runtime of a tree outside git"
     text = (f"`scripts/figures.sh runtime-cost` (`skybake_runtime_cost --luts build/figures/runtime-cost/earth --peer "
-            f"… --size {size} --runs {runs}`): {wall / 60:.1f} minutes, {os.cpu_count()} cores, load average "
-            f"{load:.1f} at the start (0 on an idle machine; more makes the times noisier, the ratios less so, "
+            f"… --size {size} --runs {runs}`) on {runtime}: {wall / 60:.1f} minutes, {os.cpu_count()} cores, load "
+            f"average {load:.1f} at the start (0 on an idle machine; more makes the times noisier, the ratios less so, "
             f"since the runs alternate).\n\n" + (work / "cost.md").read_text())
     replace_block("docs/runtime_cost.md", "runtime-cost", "runtime-cost", text)
 

@@ -13,7 +13,7 @@
 #   scripts/figures.sh report     # docs/accuracy.md, docs/images/report/ and the colour error in
 #                                 # docs/colour.md and README.md (skybake report, a few minutes)
 #   scripts/figures.sh runtime-cost  # the runtime's cost per pixel beside Bruneton's (docs/runtime_cost.md:
-#                                 # tests/runtime_cost.cpp on llvmpipe and lavapipe, about 8 minutes)
+#                                 # tests/runtime_cost.cpp on llvmpipe and lavapipe, about 10 minutes)
 #   scripts/figures.sh images     # the gallery and the engine example's images (scripts/gallery.sh,
 #                                 # scripts/engine_example_images.sh) and the sky through sunset
 #                                 # (docs/images/twilight/lut_sunset.png, skybake info --plot)

@@ -65,6 +65,10 @@ enum class Entry { kSky, kAerial, kIrradiance };
 constexpr Entry kEntries[] = {Entry::kSky, Entry::kAerial, Entry::kIrradiance};
 const char* EntryName(Entry e) { return e == Entry::kSky ? "sky" : e == Entry::kAerial ? "aerial" : "irradiance"; }
 
+// The small case of the untimed first draws and dispatches (8x8 pixels: 64
+// invocations, one workgroup).
+const Vec4 kWarmUpCase = {1.0f, 45.0f, 8.0f, 8.0f};
+
 struct Options {
   fs::path luts;
   fs::path peer;  // empty: skybake only
@@ -76,6 +80,10 @@ struct Options {
   std::vector<Entry> vulkan_entries = {std::begin(kEntries), std::end(kEntries)};
   fs::path json;
   fs::path markdown;
+
+  bool OnVulkan(Entry e) const {
+    return std::find(vulkan_entries.begin(), vulkan_entries.end(), e) != vulkan_entries.end();
+  }
 };
 
 // ---- the cases ----
@@ -412,16 +420,16 @@ void main(uint3 id : SV_DispatchThreadID) {
 #if COST_ENTRY == 1
   bool on_ground = f.y < 0.5;
   float distance = 100.0 * pow(500.0, on_ground ? 2.0 * f.y : 2.0 * f.y - 1.0);
-  float3 point;
+  float3 target;  // `point` is an HLSL keyword
   if (on_ground) {
     float angle = distance / COST_BOTTOM_RADIUS_M;
-    point = COST_BOTTOM_RADIUS_M * float3(sin(angle) * cos(azimuth), sin(angle) * sin(azimuth), cos(angle));
+    target = COST_BOTTOM_RADIUS_M * float3(sin(angle) * cos(azimuth), sin(angle) * sin(azimuth), cos(angle));
   } else {
     float zenith = radians(87.0);
-    point = camera + distance * float3(sin(zenith) * cos(azimuth), sin(zenith) * sin(azimuth), cos(zenith));
+    target = camera + distance * float3(sin(zenith) * cos(azimuth), sin(zenith) * sin(azimuth), cos(zenith));
   }
   radiance = GetSkyRadianceToPoint(atmosphere, transmittance_texture, linear_sampler, scattering_texture,
-                                   linear_sampler, single_mie_scattering_texture, linear_sampler, camera, point,
+                                   linear_sampler, single_mie_scattering_texture, linear_sampler, camera, target,
                                    sun_direction, transmittance);
 #else
   float zenith = f.y * 3.14159265358979;
@@ -464,9 +472,9 @@ int OptimizedInstructionCount(const std::vector<std::uint32_t>& spirv) {
     file.write(reinterpret_cast<const char*>(spirv.data()), std::streamsize(spirv.size() * 4));
   }
   std::string log;
-  if (testing::RunCommand(testing::ShellQuote(SKYBAKE_SPIRV_OPT) + " -O " + testing::ShellQuote(in) + " -o " +
-                              testing::ShellQuote(out),
-                          dir, nullptr, &log) != 0) {
+  if (testing::RunCommand(
+          testing::ShellQuote(SKYBAKE_SPIRV_OPT) + " -O " + testing::ShellQuote(in) + " -o " + testing::ShellQuote(out),
+          dir, nullptr, &log) != 0) {
     throw std::runtime_error("spirv-opt -O failed:\n" + log);
   }
   const std::string bytes = ReadFile(out);
@@ -476,20 +484,20 @@ int OptimizedInstructionCount(const std::vector<std::uint32_t>& spirv) {
 }
 
 struct CompiledShader {
-  std::string runtime;   // Runtime::name, or "skybake_hlsl"
+  std::string runtime;   // Runtime::name
   std::string language;  // "Vulkan GLSL 4.50" or "HLSL"
   Entry entry = Entry::kSky;
   std::vector<std::uint32_t> spirv;
   double glslang_seconds = 0.0;
   double pipeline_seconds = 0.0;
   double first_dispatch_seconds = 0.0;  // 64 invocations, right after the creation
-  int pipeline = -1;  // VulkanCompute::CreatePipeline's index
+  int pipeline = -1;                    // VulkanCompute::CreatePipeline's index
   int instructions = 0;
   int optimized_instructions = -1;
 };
 
-CompiledShader CompileForVulkan(VulkanCompute* vk, const std::string& runtime, const std::string& source,
-                                bool hlsl, Entry entry) {
+CompiledShader CompileForVulkan(VulkanCompute* vk, const std::string& runtime, const std::string& source, bool hlsl,
+                                Entry entry) {
   CompiledShader c;
   c.runtime = runtime;
   c.language = hlsl ? "HLSL" : "Vulkan GLSL 4.50";
@@ -500,11 +508,10 @@ CompiledShader CompileForVulkan(VulkanCompute* vk, const std::string& runtime, c
   c.glslang_seconds = SecondsSince(start);
   if (c.spirv.empty())
     throw std::runtime_error(runtime + " " + EntryName(entry) + " (" + c.language + ") does not compile:\n" + log);
-  c.pipeline = vk->CreatePipeline(c.spirv, hlsl ? VulkanCompute::Samplers::kSeparate
-                                                : VulkanCompute::Samplers::kCombined,
-                                  &c.pipeline_seconds);
+  c.pipeline = vk->CreatePipeline(
+      c.spirv, hlsl ? VulkanCompute::Samplers::kSeparate : VulkanCompute::Samplers::kCombined, &c.pipeline_seconds);
   // lavapipe may leave part of the compile to the first dispatch.
-  c.first_dispatch_seconds = vk->TimeDispatch(c.pipeline, {Vec4{1.0f, 45.0f, 8.0f, 8.0f}}, 64, nullptr);
+  c.first_dispatch_seconds = vk->TimeDispatch(c.pipeline, {kWarmUpCase}, 64, nullptr);
   c.instructions = InstructionCount(c.spirv);
   c.optimized_instructions = OptimizedInstructionCount(c.spirv);
   return c;
@@ -519,8 +526,8 @@ struct Statistic {
 
 struct Counts {
   Statistic fetches, calls, scalars;
-  bool all_finite = true;   // every count a finite whole number
-  bool value_finite = true;  // every pixel's radiance finite
+  bool counts_whole = true;     // every count a finite whole number
+  bool radiance_finite = true;  // every pixel's radiance and second output finite
 };
 
 Counts Summarize(const std::vector<Vec4>& pixels) {
@@ -528,11 +535,11 @@ Counts Summarize(const std::vector<Vec4>& pixels) {
   Statistic* stats[] = {&c.fetches, &c.calls, &c.scalars};
   for (const Vec4& p : pixels) {
     for (int k = 0; k < 3; ++k) {
-      if (!std::isfinite(p[k]) || p[k] < 0.0f || p[k] != std::floor(p[k])) c.all_finite = false;
+      if (!std::isfinite(p[k]) || p[k] < 0.0f || p[k] != std::floor(p[k])) c.counts_whole = false;
       stats[k]->mean += p[k];
       stats[k]->max = std::max(stats[k]->max, double(p[k]));
     }
-    if (!std::isfinite(p[3])) c.value_finite = false;
+    if (!std::isfinite(p[3])) c.radiance_finite = false;
   }
   for (Statistic* s : stats) s->mean /= double(pixels.size());
   return c;
@@ -576,9 +583,9 @@ const CompiledShader* FindShader(const Measurement& m, const std::string& runtim
 void SetTables(GlContext* gl, VulkanCompute* vk, const LutSet& luts) {
   const glsl::Texture& mie = luts.single_mie_scattering.empty() ? luts.scattering : luts.single_mie_scattering;
   const std::pair<const char*, const glsl::Texture*> tables[] = {{"transmittance_texture", &luts.transmittance},
-                                                                  {"scattering_texture", &luts.scattering},
-                                                                  {"single_mie_scattering_texture", &mie},
-                                                                  {"irradiance_texture", &luts.irradiance}};
+                                                                 {"scattering_texture", &luts.scattering},
+                                                                 {"single_mie_scattering_texture", &mie},
+                                                                 {"irradiance_texture", &luts.irradiance}};
   for (int binding = 0; binding < 4; ++binding) {
     const glsl::Texture& t = *tables[binding].second;
     if (gl) gl->SetTexture(tables[binding].first, t.width, t.height, t.depth, t.texels.data(), t.texels.size());
@@ -607,8 +614,9 @@ void CheckCountingBuild(GlContext* gl_es, const std::vector<Runtime>& runtimes, 
     for (Entry e : kEntries) {
       std::cerr << "compiling the counting build of " << runtime.name << " " << EntryName(e) << " for "
                 << gl_es->VersionLine() << "\n";
-      const unsigned program = gl_es->CompileFullScreenProgram(GlShader(runtime, e, luts.parameters.bottom_radius, true));
-      gl_es->RenderFullScreen(program, 8, 8, {{"cost_case", Vec4{1.0f, 45.0f, 8.0f, 8.0f}}}, nullptr);
+      const unsigned program =
+          gl_es->CompileFullScreenProgram(GlShader(runtime, e, luts.parameters.bottom_radius, true));
+      gl_es->RenderFullScreen(program, 8, 8, {{"cost_case", kWarmUpCase}}, nullptr);
     }
   }
 }
@@ -631,24 +639,21 @@ Measurement Measure(const Options& options, const LutSet& luts, std::vector<Runt
   // (llvmpipe and lavapipe finish compiling at the first draw).
   std::map<std::pair<size_t, Entry>, unsigned> gl_counting, gl_timing;
   std::map<std::pair<size_t, Entry>, int> vulkan;
-  const std::vector<Vec4> warm_up_case = {Vec4{1.0f, 45.0f, 8.0f, 8.0f}};
   for (size_t r = 0; r < m.runtimes.size(); ++r) {
     for (Entry e : kEntries) {
       std::cerr << "compiling " << m.runtimes[r].name << " " << EntryName(e) << "\n";
       gl_counting[{r, e}] = gl->CompileFullScreenProgram(GlShader(m.runtimes[r], e, radius, true));
       gl_timing[{r, e}] = gl->CompileFullScreenProgram(GlShader(m.runtimes[r], e, radius, false));
       for (unsigned program : {gl_counting[{r, e}], gl_timing[{r, e}]})
-        gl->RenderFullScreen(program, 8, 8, {{"cost_case", warm_up_case[0]}}, nullptr);
-      if (std::find(options.vulkan_entries.begin(), options.vulkan_entries.end(), e) == options.vulkan_entries.end())
-        continue;
+        gl->RenderFullScreen(program, 8, 8, {{"cost_case", kWarmUpCase}}, nullptr);
+      if (!options.OnVulkan(e)) continue;
       m.shaders.push_back(CompileForVulkan(vk, m.runtimes[r].name, VulkanShader(m.runtimes[r], e, radius), false, e));
       vulkan[{r, e}] = m.shaders.back().pipeline;
     }
   }
   if (options.hlsl) {
     for (Entry e : {Entry::kSky, Entry::kAerial}) {
-      if (std::find(options.vulkan_entries.begin(), options.vulkan_entries.end(), e) == options.vulkan_entries.end())
-        continue;
+      if (!options.OnVulkan(e)) continue;
       std::cerr << "compiling skybake HLSL " << EntryName(e) << "\n";
       m.shaders.push_back(CompileForVulkan(vk, "skybake", HlslShader(luts, e), true, e));
     }
@@ -694,11 +699,11 @@ std::vector<std::string> Check(const Measurement& m) {
       const RuntimeResult& result = c.runtimes[r];
       const std::string where = m.runtimes[r].name + ", " + c.c.name + ": ";
       const Counts& counts = result.counts;
-      if (!counts.all_finite) failures.push_back(where + "a count is not a whole number");
+      if (!counts.counts_whole) failures.push_back(where + "a count is not a whole number");
       if (!(counts.fetches.mean > 0.0)) failures.push_back(where + "no texture fetches");
       if (!(counts.calls.mean > 0.0)) failures.push_back(where + "no transcendental functions");
       if (!(counts.scalars.mean >= counts.calls.mean)) failures.push_back(where + "fewer scalars than calls");
-      if (r == 0 && !counts.value_finite) failures.push_back(where + "radiance is NaN or infinite");
+      if (r == 0 && !counts.radiance_finite) failures.push_back(where + "radiance is NaN or infinite");
       for (const std::vector<double>* times : {&result.gl_seconds, &result.vulkan_seconds}) {
         for (double t : *times)
           if (!(t > 0.0) || !std::isfinite(t)) failures.push_back(where + "a time is not positive");
@@ -756,8 +761,7 @@ nlohmann::ordered_json ToJson(const Measurement& m, const Options& options) {
         jc[m.runtimes[r].name]["vulkan_seconds"] = result.vulkan_seconds;
         jc[m.runtimes[r].name]["vulkan_median_seconds"] = Median(result.vulkan_seconds);
         if (r > 0) {
-          jc[m.runtimes[r].name]["vulkan_ratio"] =
-              Median(c.runtimes[0].vulkan_seconds) / Median(result.vulkan_seconds);
+          jc[m.runtimes[r].name]["vulkan_ratio"] = Median(c.runtimes[0].vulkan_seconds) / Median(result.vulkan_seconds);
         }
       }
     }
@@ -804,8 +808,7 @@ std::string Markdown(const Measurement& m) {
       for (const CaseResult& c : m.cases) {
         if (c.c.entry == e && IsDaylight(c.c.sun_zenith_deg) == daylight) {
           g.cases.push_back(&c);
-          if (std::find(suns.begin(), suns.end(), c.c.sun_zenith_deg) == suns.end())
-            suns.push_back(c.c.sun_zenith_deg);
+          if (std::find(suns.begin(), suns.end(), c.c.sun_zenith_deg) == suns.end()) suns.push_back(c.c.sun_zenith_deg);
         }
       }
       if (g.cases.empty()) continue;
@@ -837,7 +840,8 @@ std::string Markdown(const Measurement& m) {
          "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const Group& g : groups) {
     auto count_cell = [&](size_t r, const Statistic Counts::*statistic) {
-      std::vector<double> maxima = values(g, [&](const CaseResult& c) { return (c.runtimes[r].counts.*statistic).max; });
+      std::vector<double> maxima =
+          values(g, [&](const CaseResult& c) { return (c.runtimes[r].counts.*statistic).max; });
       return Range(values(g, [&](const CaseResult& c) { return (c.runtimes[r].counts.*statistic).mean; }), "%.1f") +
              " (" + Format("%.0f", *std::max_element(maxima.begin(), maxima.end())) + ")";
     };
@@ -849,14 +853,16 @@ std::string Markdown(const Measurement& m) {
       std::string cell;
       for (size_t r = 1; r < m.runtimes.size(); ++r) {
         cell += (r > 1 ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
-                  const auto& times = [&](size_t k) { return vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds; };
-                  return Median(times(0)) / Median(times(r));
+                  auto median = [&](size_t k) {
+                    return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds);
+                  };
+                  return median(0) / median(r);
                 }));
       }
       return cell;
     };
-    out << "| " << g.name << " | " << count_cell(0, &Counts::fetches) << " | " << peer_cells(&Counts::fetches)
-        << " | " << count_cell(0, &Counts::calls) << " | " << peer_cells(&Counts::calls) << " | "
+    out << "| " << g.name << " | " << count_cell(0, &Counts::fetches) << " | " << peer_cells(&Counts::fetches) << " | "
+        << count_cell(0, &Counts::calls) << " | " << peer_cells(&Counts::calls) << " | "
         << instructions("skybake", "Vulkan GLSL 4.50", g.entry) << " | "
         << (peer ? instructions("peer_separate", "Vulkan GLSL 4.50", g.entry) + " / " +
                        instructions("peer_combined", "Vulkan GLSL 4.50", g.entry)
@@ -897,8 +903,8 @@ std::string Markdown(const Measurement& m) {
   for (const CompiledShader& s : m.shaders) {
     out << "| " << s.runtime << " | " << s.language << " | " << EntryName(s.entry) << " | "
         << Format("%.2f", s.glslang_seconds) << " | " << Format("%.2f", s.pipeline_seconds) << " | "
-        << Format("%.3f", s.first_dispatch_seconds) << " | " << s.instructions << " | " << (s.optimized_instructions < 0 ? "—" : std::to_string(s.optimized_instructions))
-        << " |\n";
+        << Format("%.3f", s.first_dispatch_seconds) << " | " << s.instructions << " | "
+        << (s.optimized_instructions < 0 ? "—" : std::to_string(s.optimized_instructions)) << " |\n";
   }
   out << "\nDrivers: " << m.gl_driver << " (counted and timed; the counting build also compiles and runs on "
       << m.gl_es_driver << "); " << m.vulkan_driver << ".\n";
@@ -921,19 +927,26 @@ Options ParseOptions(int argc, char** argv) {
     }
     if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
     const std::string value = argv[++i];
-    if (arg == "--luts") o.luts = value;
-    else if (arg == "--peer") o.peer = value;
-    else if (arg == "--size") o.size = std::stoi(value);
-    else if (arg == "--runs") o.runs = std::stoi(value);
-    else if (arg == "--json") o.json = value;
-    else if (arg == "--markdown") o.markdown = value;
+    if (arg == "--luts")
+      o.luts = value;
+    else if (arg == "--peer")
+      o.peer = value;
+    else if (arg == "--size")
+      o.size = std::stoi(value);
+    else if (arg == "--runs")
+      o.runs = std::stoi(value);
+    else if (arg == "--json")
+      o.json = value;
+    else if (arg == "--markdown")
+      o.markdown = value;
     else if (arg == "--vulkan-entries") {
       o.vulkan_entries.clear();
       std::istringstream in(value);
       for (std::string name; std::getline(in, name, ',');) {
         const Entry* e = std::find_if(std::begin(kEntries), std::end(kEntries),
                                       [&](Entry entry) { return name == EntryName(entry); });
-        if (e == std::end(kEntries)) throw std::invalid_argument("--vulkan-entries: not sky, aerial or irradiance: " + name);
+        if (e == std::end(kEntries))
+          throw std::invalid_argument("--vulkan-entries: not sky, aerial or irradiance: " + name);
         o.vulkan_entries.push_back(*e);
       }
     } else if (arg == "--suns") {
