@@ -90,7 +90,7 @@ void BakeSettings::Validate() const {
 }
 
 namespace {
-// The split of the scattering tables' sun axis (functions.glsl, "The sun
+// The split of the scattering tables' sun axis (shadow_edge.glsl, "The sun
 // axis after sunset"): the lowest column whose sun is at most 83 degrees
 // from the zenith (on Earth's default table 82.6 degrees), where the sun
 // is up for every point of every ray and the light changes slowly with it,

@@ -199,7 +199,7 @@ glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere
 // on: the tables' r, mu and nu rows unless settings.scattering_range
 // restricts them, and mu_s columns at the same suns for every ray (the
 // scattering density J, light arriving at a point, has no shadow edge to
-// follow; functions.glsl, "The sun axis after sunset").
+// follow; shadow_edge.glsl, "The sun axis after sunset").
 glsl::AtmosphereParameters AtmosphereGrid(const Atmosphere& atmosphere, const BakeSettings& settings);
 
 // Fills the coefficient profiles of `parameters` (definitions.glsl) from the

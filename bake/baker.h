@@ -171,7 +171,7 @@ class Baker {
   bool TableRestricted() const { return settings_.scattering_range.has_value(); }
   // Whether the table's grid is the one the orders are computed on: not
   // where it is restricted, nor where its mu_s columns below the split are
-  // each ray's own (functions.glsl, "The sun axis after sunset").
+  // each ray's own (shadow_edge.glsl, "The sun axis after sunset").
   bool TableOnAtmosphereGrid() const { return !TableRestricted() && params_.scattering_mu_s_split == 0; }
   // Whether the orders are gathered on another grid than the table's, so
   // that the table's higher orders come from one gather of their summed

@@ -1,5 +1,5 @@
 // The suns of a scattering grid's own columns below its split
-// (functions.glsl, "The sun axis after sunset"), solved once per grid for
+// (shadow_edge.glsl, "The sun axis after sunset"), solved once per grid for
 // the bake's passes over its texels.
 #pragma once
 
@@ -19,7 +19,7 @@
 namespace skybake::detail {
 
 // Per ray of a scattering grid with a split, the sun cosines of its own
-// columns below it (functions.glsl, "The sun axis after sunset") per nu
+// columns below it (shadow_edge.glsl, "The sun axis after sunset") per nu
 // slice, as GetScatteringTexel gives them, solved once for the grid:
 // GetScatteringOwnColumnSunZenith's fixed point, each column's from the
 // edge of the column above it (which lies close to its own), with each lit

@@ -198,7 +198,7 @@ double RhoSpan(const Atmosphere& atmosphere, double low, double high) {
 // the objects, at the end of the sunlit part of a partly shadowed segment
 // (which can dip below both ends) and, for segments shorter than
 // DIRECT_SEGMENT_LENGTH, that far along the ray as long as it stays inside
-// the table's radii (functions.glsl); with the sun as seen from there: the
+// the table's radii (aerial_perspective.glsl); with the sun as seen from there: the
 // scene's suns, moved by up to the central angle of the longest of these
 // distances (a camera in space sees every sun). Restricts plan's tables to
 // those altitudes and suns.

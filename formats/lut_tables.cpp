@@ -25,7 +25,7 @@ std::string Nm(double nm) {
   return buffer;
 }
 
-// Shared wording of the texture-coordinate mappings (functions.glsl has the code).
+// Shared wording of the texture-coordinate mappings (the runtime's GLSL, shaders_runtime/, has the code).
 constexpr const char* kTexelCentres = "; u = 0.5 / n + x * (1 - 1 / n) puts x = 0 and 1 on the first and last texel centres";
 constexpr const char* kRhoOverH =
     "x = rho / H, rho = sqrt(r^2 - bottom_radius^2), H = sqrt(top_radius^2 - bottom_radius^2)";
@@ -158,7 +158,7 @@ std::vector<TableDescription> DescribeTables(const LutSet& luts) {
            std::string(kTexelCentres) +
            "; from column scattering_mu_s_split up. Below it (where it is above 0) every ray (r, mu) and sun azimuth "
            "has its own columns, placed from the sun zenith angle E past which no point of the ray sees the sun "
-           "(GetScatteringShadowEdgePosition in functions.glsl): 6 at and past E (the last at E, the others evenly to "
+           "(GetScatteringShadowEdgePosition in shadow_edge.glsl): 6 at and past E (the last at E, the others evenly to "
            "max(theta(scattering_mu_s_min), E + 2 degrees)), the others from D = E - theta = 0.05 degrees (D_min) to "
            "the split's sun at even steps of 0.3 (X(E - D) - X(E - D_min)) / (X(theta_split) - X(E - D_min)) + 0.7 "
            "ln(D / D_min) / ln((E - theta_split) / D_min), X = (1 - a / A) / (1 + a)"},

@@ -16,7 +16,7 @@ namespace skybake {
 // One texture axis and the physical coordinate it samples.
 struct TableAxis {
   std::string axis;        // "x", "y", "z"
-  std::string coordinate;  // "mu", "r", "mu_s", "nu" (names as in functions.glsl)
+  std::string coordinate;  // "mu", "r", "mu_s", "nu" (names as in the runtime's GLSL)
   int size = 0;            // texels (for the packed scattering x axis: the size of this coordinate)
   double range_min = 0.0, range_max = 0.0;
   std::string units;    // "m" for r, "1" for cosines

@@ -24,11 +24,12 @@ ordered_json SizeToJson(int width, int height, int depth, bool is_3d) {
   return is_3d ? ordered_json::array({width, height, depth}) : ordered_json::array({width, height});
 }
 
-// The constants the texture-coordinate mappings use, named as in functions.glsl.
+// The constants the texture-coordinate mappings use, named as in the runtime's GLSL.
 ordered_json ParameterizationToJson(const glsl::AtmosphereParameters& p) {
   return ordered_json{
-      {"functions", "shaders_runtime/functions.glsl: GetTransmittanceTextureUvFromRMu, "
-                    "GetIrradianceTextureUvFromRMuS, GetScatteringTextureUvwzFromRMuMuSNu"},
+      {"functions", "shaders_runtime/: GetTransmittanceTextureUvFromRMu (geometry.glsl), "
+                    "GetIrradianceTextureUvFromRMuS (table_mappings.glsl), "
+                    "GetScatteringTextureUvwzFromRMuMuSNu (lookups.glsl)"},
       {"bottom_radius", p.bottom_radius},
       {"top_radius", p.top_radius},
       {"H", glsl::HorizonDistanceAtTop(p)},

@@ -2,7 +2,7 @@
 // evaluated straight from the Atmosphere description, concentric shells with
 // an extinction majorant each for delta tracking, and optical depths by
 // adaptive Gauss-Kronrod quadrature. Of the table path it shares only the
-// Atmosphere and the ray-sphere primitives of shaders_runtime/functions.glsl.
+// Atmosphere and the ray-sphere primitives of shaders_runtime/geometry.glsl.
 //
 // Rays are given as (r, mu): the distance of the origin to the planet centre
 // and the cosine of the angle between the ray and the origin's zenith; the

@@ -1,5 +1,5 @@
 // The runtime's texture() calls per evaluation, counted, not estimated:
-// functions.glsl compiled a further time with samplers that count their
+// the runtime's sources compiled a further time with samplers that count their
 // calls (texture lookups are the one thing the GLSL shim stands in for).
 #include <glm/geometric.hpp>
 
@@ -37,7 +37,11 @@ vec4 texture(const CountingSampler3D& s, const vec3& uvw) {
 #define SampleTexture3D texture
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
-#include "shaders_runtime/functions.glsl"
+#include "shaders_runtime/geometry.glsl"
+#include "shaders_runtime/table_mappings.glsl"
+#include "shaders_runtime/shadow_edge.glsl"
+#include "shaders_runtime/lookups.glsl"
+#include "shaders_runtime/sky.glsl"
 #include "shaders_runtime/aerial_perspective.glsl"
 #pragma GCC diagnostic pop
 #undef IN

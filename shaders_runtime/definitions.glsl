@@ -1,4 +1,4 @@
-// skybake GLSL runtime: types shared by the functions in functions.glsl.
+// skybake GLSL runtime: types shared by the runtime's functions.
 // The C++ twin defines the same names in shaders_runtime/glsl_shim.h, so the
 // function bodies compile unchanged as GLSL and as C++.
 #ifdef GL_ES
@@ -30,7 +30,7 @@ const int PHASE_HENYEY_GREENSTEIN = 1;
 const int PHASE_CORNETTE_SHANKS = 2;
 
 // Coefficient profiles for integrating along short segments (aerial
-// perspective near the horizon, functions.glsl): samples at the altitudes
+// perspective near the horizon, aerial_perspective.glsl): samples at the altitudes
 // (top_radius - bottom_radius) * (i / (ALTITUDE_PROFILE_SIZE - 1))^2, dense
 // near the ground where the aerosols' scale height is short.
 const int ALTITUDE_PROFILE_SIZE = 64;
@@ -76,7 +76,7 @@ struct AtmosphereParameters {
   Number scattering_mu_s_max;
   // The first mu_s column of the scattering tables that lies at the same
   // sun for every ray; below it each ray has its own columns, placed from
-  // its shadow edge (functions.glsl, "The sun axis after sunset"). 0: every
+  // its shadow edge (shadow_edge.glsl, "The sun axis after sunset"). 0: every
   // column is the same for every ray.
   int scattering_mu_s_split;
   int irradiance_width;   // mu_s

@@ -1,5 +1,5 @@
 // The GLSL subset in C++: types, built-in functions and texture sampling with
-// the names functions.glsl uses, in double precision. Included only through
+// the names the runtime's GLSL uses, in double precision. Included only through
 // runtime.h. Texture sampling follows OpenGL's GL_LINEAR filtering with
 // GL_CLAMP_TO_EDGE: texel centres at (i + 0.5) / size.
 #pragma once

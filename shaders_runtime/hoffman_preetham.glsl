@@ -3,10 +3,10 @@
 // run-time models skybake compares (docs/report.md). No tables: a handful of
 // exp() per pixel.
 //
-// Compiled twice, like functions.glsl: as GLSL after definitions.glsl (it
+// Compiled twice, like the runtime's sources: as GLSL after definitions.glsl (it
 // uses Number, IN(), PI) and phase_functions.glsl, and as C++ in double
 // precision through shaders_runtime/hoffman_preetham.h. It does not depend on
-// functions.glsl.
+// the sky runtime's other sources.
 //
 // The model. Two constituents of constant density: air (Rayleigh phase) and
 // haze (Henyey-Greenstein phase), with the scattering and extinction

@@ -1,6 +1,6 @@
 // Hoffman & Preetham's analytic model (hoffman_preetham.glsl) compiled as C++
 // in double precision, in namespace skybake::glsl. A separate header from
-// runtime.h: the model shares only the phase functions with functions.glsl
+// runtime.h: the model shares only the phase functions with the sky runtime
 // (phase_functions.glsl, through primitives.h), and a translation unit may
 // include both. As with runtime.h, each translation unit
 // gets its own internal copy (GLSL functions cannot be declared inline), so

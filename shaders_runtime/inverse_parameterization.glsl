@@ -1,4 +1,4 @@
-// Inverses of the table parameterizations in functions.glsl: from a texel's
+// Inverses of the table parameterizations (table_mappings.glsl, lookups.glsl): from a texel's
 // texture coordinates back to the physical (r, mu, mu_s, nu) it stands for.
 // The bake evaluates these at texel centres; engines never need them, so this
 // file is not part of the shipped snippet. Round trips are tested.

@@ -1,6 +1,6 @@
 // skybake GLSL runtime: phase functions, per steradian, of the cosine nu of the
 // scattering angle; each integrates to 1 over the sphere. The one definition
-// used by the sky runtime (functions.glsl), the dome model
+// used by the sky runtime (sky.glsl), the dome model
 // (hoffman_preetham.glsl) and, compiled as C++ (primitives.h), by the
 // bake in double and in float. Literals are written Number(...) for the float
 // instantiation (see primitives.glsl).

@@ -1,5 +1,6 @@
 // The GLSL runtime compiled as C++ (double precision): every function of
-// primitives.glsl and phase_functions.glsl (primitives.h), functions.glsl,
+// primitives.glsl and phase_functions.glsl (primitives.h), the sources of
+// functions.glsl (kRuntimeFunctionSources, shaders_runtime/snippet.h),
 // aerial_perspective.glsl, per_frame.glsl and inverse_parameterization.glsl,
 // in namespace skybake::glsl. The bake uses the parameterization and lookups; the CPU twin
 // (twin.h) uses the run-time functions. Each translation unit gets its own
@@ -23,7 +24,11 @@ namespace skybake::glsl {
 namespace {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
-#include "shaders_runtime/functions.glsl"
+#include "shaders_runtime/geometry.glsl"
+#include "shaders_runtime/table_mappings.glsl"
+#include "shaders_runtime/shadow_edge.glsl"
+#include "shaders_runtime/lookups.glsl"
+#include "shaders_runtime/sky.glsl"
 #include "shaders_runtime/aerial_perspective.glsl"
 #include "shaders_runtime/per_frame.glsl"
 #include "shaders_runtime/inverse_parameterization.glsl"

@@ -22,7 +22,7 @@ struct SnippetFile {
   std::string description;
 };
 
-// The parts of functions.glsl a bake ships: a scene that leaves out a table
+// The parts of the runtime's functions a bake ships: a scene that leaves out a table
 // leaves out the functions that read it (SKYBAKE_HAS_* #defines).
 struct SnippetParts {
   bool scattering = true;          // sky radiance (GetSkyRadiance and the 4D lookups)
@@ -50,11 +50,14 @@ std::string AtmosphereConstants(ShadingLanguage language, const glsl::Atmosphere
                                 const SnippetParts& parts = {});
 
 // The sources of the shipped functions.glsl, in their order of definition:
-// scalar primitives, phase functions, geometry, parameterization, lookups and
-// sky radiance, then aerial perspective and irradiance, then the per-frame
-// tables (sky view and aerial-perspective volume).
-inline constexpr const char* kRuntimeFunctionSources[] = {"primitives.glsl", "phase_functions.glsl", "functions.glsl",
-                                                           "aerial_perspective.glsl", "per_frame.glsl"};
+// scalar primitives, phase functions, ray geometry, the tables' coordinates,
+// the sun axis after sunset, the lookups, the sky's entry points, aerial
+// perspective and irradiance, and the per-frame tables (sky view and
+// aerial-perspective volume).
+inline constexpr const char* kRuntimeFunctionSources[] = {
+    "primitives.glsl", "phase_functions.glsl", "geometry.glsl",
+    "table_mappings.glsl", "shadow_edge.glsl", "lookups.glsl",
+    "sky.glsl", "aerial_perspective.glsl", "per_frame.glsl"};
 
 // The shipped functions.glsl: the kRuntimeFunctionSources joined.
 std::string RuntimeFunctionsGlsl();

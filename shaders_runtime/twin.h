@@ -1,5 +1,5 @@
-// The CPU twin of the GLSL runtime: the run-time functions of
-// functions.glsl, compiled from the same source, sampling tables held in
+// The CPU twin of the GLSL runtime: its run-time functions, compiled from
+// the same sources, sampling tables held in
 // memory. It is the reference behaviour for the GLSL snippet and what
 // `skybake eval` answers with.
 #pragma once

@@ -1,4 +1,4 @@
-// Aerial perspective (GetSkyRadianceToPoint in shaders_runtime/functions.glsl,
+// Aerial perspective (GetSkyRadianceToPoint in shaders_runtime/aerial_perspective.glsl,
 // through the CPU twin) for short segments near the horizon, against the
 // independent Monte Carlo reference, and its shadow length for light shafts.
 //

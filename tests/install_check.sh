@@ -15,7 +15,7 @@ fail() { echo "install_check: $*"; exit 1; }
 cmake --install "$build" --prefix "$work/prefix" >"$work/install.log"
 for f in bin/skybake include/skybake/formats/lut_files.h include/skybake/core/version.h \
          lib/cmake/skybake/skybakeConfig.cmake lib/cmake/skybake/skybakeAddBake.cmake \
-         share/skybake/shaders_runtime/functions.glsl; do
+         share/skybake/shaders_runtime/lookups.glsl; do
   [ -e "$work/prefix/$f" ] || fail "$f was not installed"
 done
 # Ninja where it is installed (scripts/setup.sh installs it), else Makefiles:

@@ -86,10 +86,12 @@ TEST(RuntimeSnippet, BakeWritesItWithConstantsFromTheManifestParameters) {
                                               "definitions.metal", "atmosphere_constants.metal", "functions.metal",
                                               "atmosphere_constants.wgsl", "functions.wgsl"}));
   const std::filesystem::path sources = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "shaders_runtime";
-  EXPECT_EQ(testing::ReadText(lut / "functions.glsl"),
-            testing::ReadText(sources / "primitives.glsl") + testing::ReadText(sources / "phase_functions.glsl") +
-                testing::ReadText(sources / "functions.glsl") + testing::ReadText(sources / "aerial_perspective.glsl") +
-                testing::ReadText(sources / "per_frame.glsl"));
+  std::string joined;
+  for (const char* file : {"primitives.glsl", "phase_functions.glsl", "geometry.glsl", "table_mappings.glsl",
+                           "shadow_edge.glsl", "lookups.glsl", "sky.glsl", "aerial_perspective.glsl", "per_frame.glsl"}) {
+    joined += testing::ReadText(sources / file);
+  }
+  EXPECT_EQ(testing::ReadText(lut / "functions.glsl"), joined);
   // The other languages' definitions and functions are the committed translations.
   for (const char* file : {"definitions.hlsl", "functions.hlsl", "definitions.metal", "functions.metal", "functions.wgsl"}) {
     EXPECT_EQ(testing::ReadText(lut / file), testing::ReadText(sources / "generated" / file)) << file;

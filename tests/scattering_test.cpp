@@ -275,7 +275,7 @@ TEST(SingleScattering, LowSunLookupsBetweenTexelsFollowTheFall) {
   // On columns at the same suns for every ray, next to a column where the
   // ray is (nearly) all in the Earth's shadow, the lookup fell too early, by
   // up to 100 % of a small value, and read 0.191 RMS; on the ray's own
-  // columns, which follow its edge (functions.glsl, "The sun axis after
+  // columns, which follow its edge (shadow_edge.glsl, "The sun axis after
   // sunset"), 0.013.
   EXPECT_LT(lookup_rms, 0.03);
 }

@@ -1,4 +1,4 @@
-// The scattering tables' sun axis after sunset (functions.glsl, "The sun
+// The scattering tables' sun axis after sunset (shadow_edge.glsl, "The sun
 // axis after sunset"): each ray's shadow edge, the own columns the bake
 // places from it, and single scattering alone read through them against an
 // independent quadrature, in twilight and in daylight, on Earth and on

@@ -349,17 +349,17 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1474;
+    float _1587;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1474 = ClampCosine(param_1);
+        _1587 = ClampCosine(param_1);
     }
     else
     {
-        _1474 = 1.0f;
+        _1587 = 1.0f;
     }
-    return _1474;
+    return _1587;
 }
 #endif
 
@@ -434,52 +434,52 @@ float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_p
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0f - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1580;
+    float2 _1693;
     if (c_end >= rho)
     {
-        _1580 = float2(-1.0f, 0.0f);
+        _1693 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1580 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
+        _1693 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float2 end = _1580;
-    bool _1608 = end.y < 0.0f;
-    bool _1618;
-    if (!_1608)
+    float2 end = _1693;
+    bool _1721 = end.y < 0.0f;
+    bool _1731;
+    if (!_1721)
     {
-        _1618 = end.x < start.x;
+        _1731 = end.x < start.x;
     }
     else
     {
-        _1618 = _1608;
+        _1731 = _1721;
     }
-    bool end_sets_last = _1618;
+    bool end_sets_last = _1731;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
     float sin_a = a * (1.0f - ((a * a) / 6.0f));
-    bool2 _1650 = end_sets_last.xx;
-    float2 last = float2(_1650.x ? end.x : start.x, _1650.y ? end.y : start.y);
+    bool2 _1763 = end_sets_last.xx;
+    float2 last = float2(_1763.x ? end.x : start.x, _1763.y ? end.y : start.y);
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1673;
+    float _1786;
     if (end_sets_last)
     {
-        float _1679;
+        float _1792;
         if (c_end >= rho)
         {
-            _1679 = 3.1415927410125732421875f;
+            _1792 = 3.1415927410125732421875f;
         }
         else
         {
-            _1679 = atan2(across, cos_alpha) + acos(cos_gamma);
+            _1792 = atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1673 = _1679;
+        _1786 = _1792;
     }
     else
     {
-        _1673 = acos(c_start);
+        _1786 = acos(c_start);
     }
-    float angle = _1673;
+    float angle = _1786;
     return angle + a;
 }
 #endif
@@ -578,15 +578,15 @@ void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, float2 edge, inout 
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1882 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _1995 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1882;
+    X_closest = _1995;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _1889 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _2002 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _1889 - X_closest;
+    X_span = _2002 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -602,9 +602,9 @@ float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, float D, float2 edg
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1839 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1952 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1839;
+    float X = _1952;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
@@ -631,9 +631,9 @@ float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, float _distance, float2
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1934 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _2047 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1934;
+    return _2047;
 }
 #endif
 
@@ -702,17 +702,17 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r,
     float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = 0.0f.xx;
-    bool _2243 = atmosphere.scattering_mu_s_split > 0;
-    bool _2254;
-    if (_2243)
+    bool _2356 = atmosphere.scattering_mu_s_split > 0;
+    bool _2367;
+    if (_2356)
     {
-        _2254 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2367 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2254 = _2243;
+        _2367 = _2356;
     }
-    if (_2254)
+    if (_2367)
     {
         float param_17 = mu;
         float param_18 = mu_s;
@@ -723,7 +723,7 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r,
         float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
         bool param_24 = ray_r_mu_intersects_ground;
         float2 param_25;
-        float _2274 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
+        float _2387 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
         edge = param_25;
         float2 param_26 = edge;
         float param_27 = mu_s;
@@ -835,9 +835,9 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edg
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1992 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _2105 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1992 - x;
+        float error = _2105 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -867,26 +867,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _2705;
+    float4 _2711;
     if (has_a)
     {
-        _2705 = log(max(a, dark));
+        _2711 = log(max(a, dark));
     }
     else
     {
-        _2705 = (lb * 2.0f) - lc;
+        _2711 = (lb * 2.0f) - lc;
     }
-    float4 la = _2705;
-    float4 _2720;
+    float4 la = _2711;
+    float4 _2726;
     if (has_d)
     {
-        _2720 = log(max(d, dark));
+        _2726 = log(max(d, dark));
     }
     else
     {
-        _2720 = (lc * 2.0f) - lb;
+        _2726 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2720;
+    float4 ld = _2726;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1000,7 +1000,17 @@ void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, floa
     float mu_s_column = clamp(floor(mu_s_coord), 0.0f, mu_s_size - 2.0f);
     x_below = (mu_s_column + 0.5f) / mu_s_size;
     x_above = (mu_s_column + 1.5f) / mu_s_size;
-    low_sun_below = x_below < x_low_sun;
+    bool _2684 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
+    bool _2690;
+    if (_2684)
+    {
+        _2690 = x_below < x_low_sun;
+    }
+    else
+    {
+        _2690 = _2684;
+    }
+    low_sun_below = _2690;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -1017,26 +1027,26 @@ float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scatteri
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float2 param_6;
-    float4 _3223 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float4 _3229 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
     float2 edge = param_6;
-    float4 uvwz = _3223;
+    float4 uvwz = _3229;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = uvwz.x * (nu_size - 1.0f);
     float nu_slice = min(floor(nu_coord), nu_size - 2.0f);
     float nu_t = nu_coord - nu_slice;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float position = (uvwz.y * mu_s_size) - 0.5f;
-    bool _3257 = atmosphere.scattering_mu_s_split > 0;
-    bool _3265;
-    if (_3257)
+    bool _3263 = atmosphere.scattering_mu_s_split > 0;
+    bool _3271;
+    if (_3263)
     {
-        _3265 = position < float(atmosphere.scattering_mu_s_split);
+        _3271 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3265 = _3257;
+        _3271 = _3263;
     }
-    if (_3265)
+    if (_3271)
     {
         float past = 6.0f;
         float log_first_span = 1.0f;
@@ -1185,16 +1195,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3689;
+        float3 _3695;
         if (scattering.x > 0.0f)
         {
-            _3689 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3695 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3689 = 0.0f.xxx;
+            _3695 = 0.0f.xxx;
         }
-        single_mie_scattering = _3689;
+        single_mie_scattering = _3695;
     }
     else
     {
@@ -1264,9 +1274,9 @@ float3 GetSkyRadianceOfRay(AtmosphereParameters atmosphere, Texture3D<float4> sc
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3754 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3760 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3754;
+    float3 scattering = _3760;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1286,13 +1296,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _3789 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3795 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3789)
+    if (!_3795)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1301,19 +1311,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3809;
+    float3 _3815;
     if (ray_r_mu_intersects_ground)
     {
-        _3809 = 0.0f.xxx;
+        _3815 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3809 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _3815 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _3809;
+    transmittance = _3815;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1365,25 +1375,25 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _4971 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _4977 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _4971;
+    float x = _4977;
     float e = (1.0f - x) * (1.0f - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _4992;
+    float _4998;
     if (ray_r_mu_intersects_ground)
     {
-        _4992 = theta_h + (e * (3.1415927410125732421875f - theta_h));
+        _4998 = theta_h + (e * (3.1415927410125732421875f - theta_h));
     }
     else
     {
-        _4992 = theta_h * (1.0f - e);
+        _4998 = theta_h * (1.0f - e);
     }
-    float theta = _4992;
+    float theta = _4998;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875f * clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0f, 1.0f);
@@ -1391,8 +1401,8 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
     if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13f)
     {
-        bool3 _5042 = (abs(up.x) < 0.89999997615814208984375f).xxx;
-        toward_sun = cross(up, float3(_5042.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5042.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5042.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
+        bool3 _5048 = (abs(up.x) < 0.89999997615814208984375f).xxx;
+        toward_sun = cross(up, float3(_5048.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5048.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5048.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
     }
     toward_sun = normalize(toward_sun);
     float3 across = cross(up, toward_sun);
@@ -1408,9 +1418,9 @@ float3 GetSkyViewRadiance(AtmosphereParameters atmosphere, Texture3D<float4> sca
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5081 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5087 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5081;
+    float3 view_ray = _5087;
     float3 up = normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1437,16 +1447,16 @@ void GetSkyViewAngles(float3 camera, float3 view_ray, float3 sun_direction, out 
     theta = atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _4957;
+    float _4963;
     if ((along != 0.0f) || (side != 0.0f))
     {
-        _4957 = atan2(side, along);
+        _4963 = atan2(side, along);
     }
     else
     {
-        _4957 = 0.0f;
+        _4963 = 0.0f;
     }
-    phi = _4957;
+    phi = _4963;
 }
 #endif
 
@@ -1456,16 +1466,16 @@ float2 GetSkyViewUvFromAngles(AtmosphereParameters atmosphere, float r, float th
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _4878;
+    float _4884;
     if (ray_r_mu_intersects_ground)
     {
-        _4878 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
+        _4884 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
     }
     else
     {
-        _4878 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
+        _4884 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
     }
-    float x = _4878;
+    float x = _4884;
     float param_2 = phi / 3.1415927410125732421875f;
     int param_3 = 192;
     float param_4 = x;
@@ -1487,19 +1497,19 @@ float3 GetSkyRadianceFromSkyView(AtmosphereParameters atmosphere, Texture2D<floa
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5143;
+    float3 _5149;
     if (ray_r_mu_intersects_ground)
     {
-        _5143 = 0.0f.xxx;
+        _5149 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5143 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
+        _5149 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
     }
-    transmittance = _5143;
+    transmittance = _5149;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1543,16 +1553,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _3913;
+    float _3919;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _3913 = a * exp(f * log(b / a));
+        _3919 = a * exp(f * log(b / a));
     }
     else
     {
-        _3913 = lerp(a, b, f);
+        _3919 = lerp(a, b, f);
     }
-    return _3913;
+    return _3919;
 }
 #endif
 
@@ -1618,16 +1628,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _4164;
+    float _4170;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _4164 = 1.0f - (0.5f * depth);
+        _4170 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _4164 = (1.0f - exp(-depth)) / depth;
+        _4170 = (1.0f - exp(-depth)) / depth;
     }
-    return _4164;
+    return _4170;
 }
 #endif
 
@@ -1663,10 +1673,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4244 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4250 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4244;
+        float3 extinction = _4250;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1724,10 +1734,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4109 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4115 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4109;
+        float3 extinction = _4115;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1800,14 +1810,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _4134;
+    float3 _4140;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4134 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4140 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1816,9 +1826,9 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4134 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _4140 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _4134;
+    return _4140;
 }
 #endif
 
@@ -1831,16 +1841,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3875;
+    float _3881;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _3875 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3881 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3875 = up;
+        _3881 = up;
     }
-    return _3875;
+    return _3881;
 }
 #endif
 
@@ -1863,13 +1873,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4390 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4396 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4390)
+    if (!_4396)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1909,11 +1919,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4485 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4491 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4485;
+        lit_optical_depth = _4491;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1927,11 +1937,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4519 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4525 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4519;
+        optical_depth += _4525;
     }
     if (direct < 1.0f)
     {
@@ -1950,9 +1960,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4562 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4568 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4562;
+    float3 scattering = _4568;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1973,11 +1983,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4610 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4616 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4610;
+        float3 far_optical_depth = _4616;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -1997,9 +2007,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4664 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4670 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4664);
+            scattering -= (exp(-far_optical_depth) * _4670);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -2020,9 +2030,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4729 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4735 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4729;
+    float3 scattering_p = _4735;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -2042,9 +2052,9 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4773 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _4779 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4773;
+    return _4779;
 }
 #endif
 
@@ -2072,9 +2082,9 @@ float3 GetAerialPerspectiveVoxel(AtmosphereParameters atmosphere, Texture2D<floa
     float3 param_3 = _point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5237 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
+    float3 _5243 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5237;
+    float3 radiance = _5243;
     optical_depth = -log(max(transmittance, 1.0000000031710768509710513471353e-30f.xxx));
     return radiance;
 }
@@ -2102,16 +2112,16 @@ float3 GetSkyRadianceToPointFromVolume(Texture3D<float4> radiance_volume, Sample
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _2304;
+    float _1465;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _2304 = 0.100000001490116119384765625f;
+        _1465 = 0.100000001490116119384765625f;
     }
     else
     {
-        _2304 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1465 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _2304;
+    return _1465;
 }
 #endif
 
@@ -2120,16 +2130,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2322;
+    float _1483;
     if (mu_s < knee)
     {
-        _2322 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1483 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _2322 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1483 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _2322;
+    return _1483;
 }
 #endif
 
@@ -2156,16 +2166,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2353;
+    float _1514;
     if (x < 0.5f)
     {
-        _2353 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1514 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2353 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1514 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _2353;
+    return _1514;
 }
 #endif
 

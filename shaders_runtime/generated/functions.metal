@@ -374,17 +374,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1474;
+    float _1587;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1474 = ClampCosine(param_1);
+        _1587 = ClampCosine(param_1);
     }
     else
     {
-        _1474 = 1.0;
+        _1587 = 1.0;
     }
-    return _1474;
+    return _1587;
 }
 #endif
 
@@ -464,51 +464,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1580;
+    float2 _1693;
     if (c_end >= rho)
     {
-        _1580 = float2(-1.0, 0.0);
+        _1693 = float2(-1.0, 0.0);
     }
     else
     {
-        _1580 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1693 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1580;
-    bool _1608 = end.y < 0.0;
-    bool _1618;
-    if (!_1608)
+    float2 end = _1693;
+    bool _1721 = end.y < 0.0;
+    bool _1731;
+    if (!_1721)
     {
-        _1618 = end.x < start.x;
+        _1731 = end.x < start.x;
     }
     else
     {
-        _1618 = _1608;
+        _1731 = _1721;
     }
-    bool end_sets_last = _1618;
+    bool end_sets_last = _1731;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1673;
+    float _1786;
     if (end_sets_last)
     {
-        float _1679;
+        float _1792;
         if (c_end >= rho)
         {
-            _1679 = 3.1415927410125732421875;
+            _1792 = 3.1415927410125732421875;
         }
         else
         {
-            _1679 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1792 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1673 = _1679;
+        _1786 = _1792;
     }
     else
     {
-        _1673 = acos(c_start);
+        _1786 = acos(c_start);
     }
-    float angle = _1673;
+    float angle = _1786;
     return angle + a;
 }
 #endif
@@ -614,15 +614,15 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1882 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _1995 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1882;
+    X_closest = _1995;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _1889 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _2002 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _1889 - X_closest;
+    X_span = _2002 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -639,9 +639,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1839 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1952 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1839;
+    float X = _1952;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -669,9 +669,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _1934 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _2047 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _1934;
+    return _2047;
 }
 #endif
 
@@ -744,17 +744,17 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
     float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = float2(0.0);
-    bool _2243 = atmosphere.scattering_mu_s_split > 0;
-    bool _2254;
-    if (_2243)
+    bool _2356 = atmosphere.scattering_mu_s_split > 0;
+    bool _2367;
+    if (_2356)
     {
-        _2254 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2367 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2254 = _2243;
+        _2367 = _2356;
     }
-    if (_2254)
+    if (_2367)
     {
         float param_17 = mu;
         float param_18 = mu_s;
@@ -765,7 +765,7 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
         float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
         bool param_24 = ray_r_mu_intersects_ground;
         float2 param_25;
-        float _2274 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
+        float _2387 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
         edge = param_25;
         float2 param_26 = edge;
         float param_27 = mu_s;
@@ -883,9 +883,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _1992 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _2105 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _1992 - x;
+        float error = _2105 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -917,26 +917,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _2705;
+    float4 _2711;
     if (has_a)
     {
-        _2705 = log(fast::max(a, dark));
+        _2711 = log(fast::max(a, dark));
     }
     else
     {
-        _2705 = (lb * 2.0) - lc;
+        _2711 = (lb * 2.0) - lc;
     }
-    float4 la = _2705;
-    float4 _2720;
+    float4 la = _2711;
+    float4 _2726;
     if (has_d)
     {
-        _2720 = log(fast::max(d, dark));
+        _2726 = log(fast::max(d, dark));
     }
     else
     {
-        _2720 = (lc * 2.0) - lb;
+        _2726 = (lc * 2.0) - lb;
     }
-    float4 ld = _2720;
+    float4 ld = _2726;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1053,7 +1053,17 @@ void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thre
     float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
     x_below = (mu_s_column + 0.5) / mu_s_size;
     x_above = (mu_s_column + 1.5) / mu_s_size;
-    low_sun_below = x_below < x_low_sun;
+    bool _2684 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
+    bool _2690;
+    if (_2684)
+    {
+        _2690 = x_below < x_low_sun;
+    }
+    else
+    {
+        _2690 = _2684;
+    }
+    low_sun_below = _2690;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -1071,26 +1081,26 @@ float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<fl
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float2 param_6;
-    float4 _3223 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float4 _3229 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
     float2 edge = param_6;
-    float4 uvwz = _3223;
+    float4 uvwz = _3229;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = uvwz.x * (nu_size - 1.0);
     float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
     float nu_t = nu_coord - nu_slice;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     float position = (uvwz.y * mu_s_size) - 0.5;
-    bool _3257 = atmosphere.scattering_mu_s_split > 0;
-    bool _3265;
-    if (_3257)
+    bool _3263 = atmosphere.scattering_mu_s_split > 0;
+    bool _3271;
+    if (_3263)
     {
-        _3265 = position < float(atmosphere.scattering_mu_s_split);
+        _3271 = position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3265 = _3257;
+        _3271 = _3263;
     }
-    if (_3265)
+    if (_3271)
     {
         float past = 6.0;
         float log_first_span = 1.0;
@@ -1240,16 +1250,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3689;
+        float3 _3695;
         if (scattering.x > 0.0)
         {
-            _3689 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3695 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3689 = float3(0.0);
+            _3695 = float3(0.0);
         }
-        single_mie_scattering = _3689;
+        single_mie_scattering = _3695;
     }
     else
     {
@@ -1324,9 +1334,9 @@ float3 GetSkyRadianceOfRay(thread const AtmosphereParameters& atmosphere, textur
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3754 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3760 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3754;
+    float3 scattering = _3760;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1347,13 +1357,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3789 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3795 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3789)
+    if (!_3795)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1362,19 +1372,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3809;
+    float3 _3815;
     if (ray_r_mu_intersects_ground)
     {
-        _3809 = float3(0.0);
+        _3815 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3809 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _3815 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _3809;
+    transmittance = _3815;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1430,25 +1440,25 @@ float3 GetSkyViewRay(thread const AtmosphereParameters& atmosphere, thread const
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _4971 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _4977 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _4971;
+    float x = _4977;
     float e = (1.0 - x) * (1.0 - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _4992;
+    float _4998;
     if (ray_r_mu_intersects_ground)
     {
-        _4992 = theta_h + (e * (3.1415927410125732421875 - theta_h));
+        _4998 = theta_h + (e * (3.1415927410125732421875 - theta_h));
     }
     else
     {
-        _4992 = theta_h * (1.0 - e);
+        _4998 = theta_h * (1.0 - e);
     }
-    float theta = _4992;
+    float theta = _4998;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875 * fast::clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0, 1.0);
@@ -1473,9 +1483,9 @@ float3 GetSkyViewRadiance(thread const AtmosphereParameters& atmosphere, texture
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5081 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5087 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5081;
+    float3 view_ray = _5087;
     float3 up = fast::normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1503,16 +1513,16 @@ void GetSkyViewAngles(thread const float3& camera, thread const float3& view_ray
     theta = precise::atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _4957;
+    float _4963;
     if ((along != 0.0) || (side != 0.0))
     {
-        _4957 = precise::atan2(side, along);
+        _4963 = precise::atan2(side, along);
     }
     else
     {
-        _4957 = 0.0;
+        _4963 = 0.0;
     }
-    phi = _4957;
+    phi = _4963;
 }
 #endif
 
@@ -1523,16 +1533,16 @@ float2 GetSkyViewUvFromAngles(thread const AtmosphereParameters& atmosphere, thr
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _4878;
+    float _4884;
     if (ray_r_mu_intersects_ground)
     {
-        _4878 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
+        _4884 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
     }
     else
     {
-        _4878 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
+        _4884 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
     }
-    float x = _4878;
+    float x = _4884;
     float param_2 = phi / 3.1415927410125732421875;
     int param_3 = 192;
     float param_4 = x;
@@ -1555,19 +1565,19 @@ float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, 
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5143;
+    float3 _5149;
     if (ray_r_mu_intersects_ground)
     {
-        _5143 = float3(0.0);
+        _5149 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5143 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
+        _5149 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
     }
-    transmittance = _5143;
+    transmittance = _5149;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1615,16 +1625,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _3913;
+    float _3919;
     if ((a > 0.0) && (b > 0.0))
     {
-        _3913 = a * exp(f * log(b / a));
+        _3919 = a * exp(f * log(b / a));
     }
     else
     {
-        _3913 = mix(a, b, f);
+        _3919 = mix(a, b, f);
     }
-    return _3913;
+    return _3919;
 }
 #endif
 
@@ -1695,16 +1705,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _4164;
+    float _4170;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _4164 = 1.0 - (0.5 * depth);
+        _4170 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _4164 = (1.0 - exp(-depth)) / depth;
+        _4170 = (1.0 - exp(-depth)) / depth;
     }
-    return _4164;
+    return _4170;
 }
 #endif
 
@@ -1741,10 +1751,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4244 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4250 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4244;
+        float3 extinction = _4250;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1803,10 +1813,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4109 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4115 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4109;
+        float3 extinction = _4115;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1881,14 +1891,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _4134;
+    float3 _4140;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4134 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4140 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1897,9 +1907,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4134 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _4140 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _4134;
+    return _4140;
 }
 #endif
 
@@ -1913,16 +1923,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3875;
+    float _3881;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _3875 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3881 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3875 = up;
+        _3881 = up;
     }
-    return _3875;
+    return _3881;
 }
 #endif
 
@@ -1946,13 +1956,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4390 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4396 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4390)
+    if (!_4396)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1992,11 +2002,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4485 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4491 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4485;
+        lit_optical_depth = _4491;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -2010,11 +2020,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4519 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4525 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4519;
+        optical_depth += _4525;
     }
     if (direct < 1.0)
     {
@@ -2033,9 +2043,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4562 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4568 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4562;
+    float3 scattering = _4568;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -2056,11 +2066,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4610 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4616 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4610;
+        float3 far_optical_depth = _4616;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -2080,9 +2090,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4664 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4670 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4664);
+            scattering -= (exp(-far_optical_depth) * _4670);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -2103,9 +2113,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4729 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4735 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4729;
+    float3 scattering_p = _4735;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -2126,9 +2136,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4773 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4779 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4773;
+    return _4779;
 }
 #endif
 
@@ -2158,9 +2168,9 @@ float3 GetAerialPerspectiveVoxel(thread const AtmosphereParameters& atmosphere, 
     float3 param_3 = point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5237 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
+    float3 _5243 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5237;
+    float3 radiance = _5243;
     optical_depth = -log(fast::max(transmittance, float3(1.0000000031710768509710513471353e-30)));
     return radiance;
 }
@@ -2190,16 +2200,16 @@ float3 GetSkyRadianceToPointFromVolume(texture3d<float> radiance_volume, sampler
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _2304;
+    float _1465;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _2304 = 0.100000001490116119384765625;
+        _1465 = 0.100000001490116119384765625;
     }
     else
     {
-        _2304 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1465 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _2304;
+    return _1465;
 }
 #endif
 
@@ -2209,16 +2219,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2322;
+    float _1483;
     if (mu_s < knee)
     {
-        _2322 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1483 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _2322 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1483 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _2322;
+    return _1483;
 }
 #endif
 
@@ -2247,16 +2257,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _2353;
+    float _1514;
     if (x < 0.5)
     {
-        _2353 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1514 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _2353 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1514 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _2353;
+    return _1514;
 }
 #endif
 

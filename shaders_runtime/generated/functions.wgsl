@@ -43,6 +43,8 @@ const ALTITUDE_PROFILE_SIZE: i32 = 64i;
 
 const SCATTERING_MU_S_HIGH_SUN_SHARE: f32 = 0.5f;
 
+const LOW_SUN_MU_S: f32 = 0.1f;
+
 const SHADOW_EDGE_PAST_COLUMNS: i32 = 6i;
 
 const SHADOW_EDGE_TABLES_WEIGHT: f32 = 0.3f;
@@ -50,8 +52,6 @@ const SHADOW_EDGE_TABLES_WEIGHT: f32 = 0.3f;
 const SHADOW_EDGE_CLOSEST: f32 = 0.0008726646f;
 
 const SHADOW_EDGE_LEAST_PAST_SPAN: f32 = 0.034906585f;
-
-const LOW_SUN_MU_S: f32 = 0.1f;
 
 const DIRECT_SEGMENT_LENGTH: f32 = 10000f;
 
@@ -982,42 +982,148 @@ fn GetScatteringTextureUMuS(atmosphere_32: AtmosphereParameters, mu_s_5: f32) ->
     return _e25;
 }
 
-// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ViewSunAzimuthCosine(mu_19: f32, mu_s_7: f32, nu_9: f32) -> f32 {
-    var mu_20: f32;
-    var mu_s_8: f32;
-    var nu_10: f32;
-    var across: f32;
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn IrradianceKneeMuS(atmosphere_34: AtmosphereParameters) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
     var local_10: f32;
 
-    mu_20 = mu_19;
-    mu_s_8 = mu_s_7;
-    nu_10 = nu_9;
-    let _e18 = mu_20;
-    let _e19 = mu_20;
-    let _e23 = mu_s_8;
-    let _e24 = mu_s_8;
-    let _e28 = SafeSqrt(((1f - (_e18 * _e19)) * (1f - (_e23 * _e24))));
-    across = _e28;
-    let _e30 = across;
-    if (_e30 > 0f) {
-        let _e33 = nu_10;
-        let _e34 = mu_20;
-        let _e35 = mu_s_8;
-        let _e38 = across;
-        let _e40 = ClampCosine(((_e33 - (_e34 * _e35)) / _e38));
-        local_10 = _e40;
+    atmosphere_35 = atmosphere_34;
+    let _e10 = atmosphere_35;
+    if (_e10.mu_s_min < LOW_SUN_MU_S) {
+        local_10 = LOW_SUN_MU_S;
     } else {
-        local_10 = 1f;
+        let _e14 = atmosphere_35;
+        local_10 = (0.5f * (_e14.mu_s_min + 1f));
     }
-    let _e43 = local_10;
-    return _e43;
+    let _e20 = local_10;
+    return _e20;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceUnitMuS(atmosphere_36: AtmosphereParameters, mu_s_7: f32) -> f32 {
+    var atmosphere_37: AtmosphereParameters;
+    var mu_s_8: f32;
+    var knee: f32;
+    var local_11: f32;
+
+    atmosphere_37 = atmosphere_36;
+    mu_s_8 = mu_s_7;
+    let _e12 = atmosphere_37;
+    let _e13 = IrradianceKneeMuS(_e12);
+    knee = _e13;
+    let _e15 = mu_s_8;
+    let _e16 = knee;
+    if (_e15 < _e16) {
+        let _e19 = mu_s_8;
+        let _e20 = atmosphere_37;
+        let _e24 = knee;
+        let _e25 = atmosphere_37;
+        local_11 = ((0.5f * (_e19 - _e20.mu_s_min)) / (_e24 - _e25.mu_s_min));
+    } else {
+        let _e31 = mu_s_8;
+        let _e32 = knee;
+        let _e36 = knee;
+        local_11 = (0.5f + ((0.5f * (_e31 - _e32)) / (1f - _e36)));
+    }
+    let _e41 = local_11;
+    return _e41;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceMuSFromUnit(atmosphere_38: AtmosphereParameters, x_11: f32) -> f32 {
+    var atmosphere_39: AtmosphereParameters;
+    var x_12: f32;
+    var knee_1: f32;
+    var local_12: f32;
+
+    atmosphere_39 = atmosphere_38;
+    x_12 = x_11;
+    let _e12 = atmosphere_39;
+    let _e13 = IrradianceKneeMuS(_e12);
+    knee_1 = _e13;
+    let _e15 = x_12;
+    if (_e15 < 0.5f) {
+        let _e18 = atmosphere_39;
+        let _e21 = x_12;
+        let _e23 = knee_1;
+        let _e24 = atmosphere_39;
+        local_12 = (_e18.mu_s_min + ((2f * _e21) * (_e23 - _e24.mu_s_min)));
+    } else {
+        let _e29 = knee_1;
+        let _e31 = x_12;
+        let _e36 = knee_1;
+        local_12 = (_e29 + (((2f * _e31) - 1f) * (1f - _e36)));
+    }
+    let _e41 = local_12;
+    return _e41;
+}
+
+// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
+fn GetIrradianceTextureUvFromRMuS(atmosphere_40: AtmosphereParameters, r_28: f32, mu_s_9: f32) -> vec2<f32> {
+    var atmosphere_41: AtmosphereParameters;
+    var r_29: f32;
+    var mu_s_10: f32;
+    var x_r_1: f32;
+    var x_mu_s_1: f32;
+
+    atmosphere_41 = atmosphere_40;
+    r_29 = r_28;
+    mu_s_10 = mu_s_9;
+    let _e14 = atmosphere_41;
+    let _e15 = r_29;
+    let _e16 = HorizonDistance(_e14, _e15);
+    let _e17 = atmosphere_41;
+    let _e18 = HorizonDistanceAtTop(_e17);
+    x_r_1 = (_e16 / _e18);
+    let _e21 = atmosphere_41;
+    let _e22 = mu_s_10;
+    let _e23 = GetIrradianceUnitMuS(_e21, _e22);
+    x_mu_s_1 = clamp(_e23, 0f, 1f);
+    let _e28 = x_mu_s_1;
+    let _e29 = atmosphere_41;
+    let _e31 = GetTextureCoordFromUnitRange(_e28, _e29.irradiance_width);
+    let _e32 = x_r_1;
+    let _e33 = atmosphere_41;
+    let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_height);
+    return vec2<f32>(_e31, _e35);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdge(atmosphere_34: AtmosphereParameters, r_28: f32, mu_21: f32, cos_phi: f32, ray_r_mu_intersects_ground_9: bool, direction: ptr<function, vec2<f32>>) -> f32 {
-    var atmosphere_35: AtmosphereParameters;
-    var r_29: f32;
+fn ViewSunAzimuthCosine(mu_19: f32, mu_s_11: f32, nu_9: f32) -> f32 {
+    var mu_20: f32;
+    var mu_s_12: f32;
+    var nu_10: f32;
+    var across: f32;
+    var local_13: f32;
+
+    mu_20 = mu_19;
+    mu_s_12 = mu_s_11;
+    nu_10 = nu_9;
+    let _e19 = mu_20;
+    let _e20 = mu_20;
+    let _e24 = mu_s_12;
+    let _e25 = mu_s_12;
+    let _e29 = SafeSqrt(((1f - (_e19 * _e20)) * (1f - (_e24 * _e25))));
+    across = _e29;
+    let _e31 = across;
+    if (_e31 > 0f) {
+        let _e34 = nu_10;
+        let _e35 = mu_20;
+        let _e36 = mu_s_12;
+        let _e39 = across;
+        let _e41 = ClampCosine(((_e34 - (_e35 * _e36)) / _e39));
+        local_13 = _e41;
+    } else {
+        local_13 = 1f;
+    }
+    let _e44 = local_13;
+    return _e44;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn ShadowEdge(atmosphere_42: AtmosphereParameters, r_30: f32, mu_21: f32, cos_phi: f32, ray_r_mu_intersects_ground_9: bool, direction: ptr<function, vec2<f32>>) -> f32 {
+    var atmosphere_43: AtmosphereParameters;
+    var r_31: f32;
     var mu_22: f32;
     var cos_phi_1: f32;
     var ray_r_mu_intersects_ground_10: bool;
@@ -1031,170 +1137,170 @@ fn ShadowEdge(atmosphere_34: AtmosphereParameters, r_28: f32, mu_21: f32, cos_ph
     var start_1: vec2<f32>;
     var cos_gamma: f32;
     var sin_gamma: f32;
-    var local_11: vec2<f32>;
+    var local_14: vec2<f32>;
     var end: vec2<f32>;
     var end_sets_last: bool;
     var a_6: f32;
     var cos_a: f32;
     var sin_a: f32;
-    var local_12: vec2<f32>;
+    var local_15: vec2<f32>;
     var last: vec2<f32>;
-    var local_13: f32;
-    var local_14: f32;
+    var local_16: f32;
+    var local_17: f32;
     var angle: f32;
 
-    atmosphere_35 = atmosphere_34;
-    r_29 = r_28;
+    atmosphere_43 = atmosphere_42;
+    r_31 = r_30;
     mu_22 = mu_21;
     cos_phi_1 = cos_phi;
     ray_r_mu_intersects_ground_10 = ray_r_mu_intersects_ground_9;
-    let _e22 = atmosphere_35;
-    let _e23 = r_29;
-    let _e24 = mu_22;
-    let _e25 = ray_r_mu_intersects_ground_10;
-    let _e26 = DistanceToNearestAtmosphereBoundary(_e22, _e23, _e24, _e25);
-    d_13 = _e26;
-    let _e28 = atmosphere_35;
-    let _e29 = r_29;
-    let _e30 = mu_22;
-    let _e31 = d_13;
-    let _e32 = RadiusAtDistance(_e28, _e29, _e30, _e31);
-    r_d_2 = _e32;
-    let _e34 = r_29;
-    let _e35 = d_13;
-    let _e36 = mu_22;
-    let _e39 = r_d_2;
-    let _e41 = ClampCosine(((_e34 + (_e35 * _e36)) / _e39));
-    cos_alpha = _e41;
-    let _e43 = d_13;
-    let _e45 = mu_22;
+    let _e23 = atmosphere_43;
+    let _e24 = r_31;
+    let _e25 = mu_22;
+    let _e26 = ray_r_mu_intersects_ground_10;
+    let _e27 = DistanceToNearestAtmosphereBoundary(_e23, _e24, _e25, _e26);
+    d_13 = _e27;
+    let _e29 = atmosphere_43;
+    let _e30 = r_31;
+    let _e31 = mu_22;
+    let _e32 = d_13;
+    let _e33 = RadiusAtDistance(_e29, _e30, _e31, _e32);
+    r_d_2 = _e33;
+    let _e35 = r_31;
+    let _e36 = d_13;
+    let _e37 = mu_22;
+    let _e40 = r_d_2;
+    let _e42 = ClampCosine(((_e35 + (_e36 * _e37)) / _e40));
+    cos_alpha = _e42;
+    let _e44 = d_13;
     let _e46 = mu_22;
-    let _e49 = SafeSqrt((1f - (_e45 * _e46)));
-    let _e51 = r_d_2;
-    let _e53 = cos_phi_1;
-    across_1 = (((_e43 * _e49) / _e51) * _e53);
-    let _e56 = across_1;
+    let _e47 = mu_22;
+    let _e50 = SafeSqrt((1f - (_e46 * _e47)));
+    let _e52 = r_d_2;
+    let _e54 = cos_phi_1;
+    across_1 = (((_e44 * _e50) / _e52) * _e54);
     let _e57 = across_1;
-    let _e59 = cos_alpha;
+    let _e58 = across_1;
     let _e60 = cos_alpha;
-    rho_7 = sqrt(((_e56 * _e57) + (_e59 * _e60)));
-    let _e65 = atmosphere_35;
-    let _e67 = r_d_2;
-    let _e68 = HorizonZenithCosine(_e65.bottom_radius, _e67);
-    c_end = -(_e68);
-    let _e71 = atmosphere_35;
-    let _e73 = r_29;
-    let _e74 = HorizonZenithCosine(_e71.bottom_radius, _e73);
-    c_start = _e74;
-    let _e76 = c_start;
-    let _e77 = atmosphere_35;
-    let _e79 = r_29;
-    start_1 = vec2<f32>(_e76, (_e77.bottom_radius / _e79));
-    let _e83 = c_end;
-    let _e85 = rho_7;
-    cos_gamma = (-(_e83) / _e85);
-    let _e89 = cos_gamma;
+    let _e61 = cos_alpha;
+    rho_7 = sqrt(((_e57 * _e58) + (_e60 * _e61)));
+    let _e66 = atmosphere_43;
+    let _e68 = r_d_2;
+    let _e69 = HorizonZenithCosine(_e66.bottom_radius, _e68);
+    c_end = -(_e69);
+    let _e72 = atmosphere_43;
+    let _e74 = r_31;
+    let _e75 = HorizonZenithCosine(_e72.bottom_radius, _e74);
+    c_start = _e75;
+    let _e77 = c_start;
+    let _e78 = atmosphere_43;
+    let _e80 = r_31;
+    start_1 = vec2<f32>(_e77, (_e78.bottom_radius / _e80));
+    let _e84 = c_end;
+    let _e86 = rho_7;
+    cos_gamma = (-(_e84) / _e86);
     let _e90 = cos_gamma;
-    let _e93 = SafeSqrt((1f - (_e89 * _e90)));
-    sin_gamma = _e93;
-    let _e95 = c_end;
-    let _e96 = rho_7;
-    if (_e95 >= _e96) {
-        local_11 = vec2<f32>(-1f, 0f);
+    let _e91 = cos_gamma;
+    let _e94 = SafeSqrt((1f - (_e90 * _e91)));
+    sin_gamma = _e94;
+    let _e96 = c_end;
+    let _e97 = rho_7;
+    if (_e96 >= _e97) {
+        local_14 = vec2<f32>(-1f, 0f);
     } else {
-        let _e102 = cos_alpha;
-        let _e103 = cos_gamma;
-        let _e105 = across_1;
-        let _e106 = sin_gamma;
-        let _e109 = across_1;
-        let _e110 = cos_gamma;
-        let _e112 = cos_alpha;
-        let _e113 = sin_gamma;
-        let _e117 = rho_7;
-        local_11 = (vec2<f32>(((_e102 * _e103) - (_e105 * _e106)), ((_e109 * _e110) + (_e112 * _e113))) / vec2(_e117));
+        let _e103 = cos_alpha;
+        let _e104 = cos_gamma;
+        let _e106 = across_1;
+        let _e107 = sin_gamma;
+        let _e110 = across_1;
+        let _e111 = cos_gamma;
+        let _e113 = cos_alpha;
+        let _e114 = sin_gamma;
+        let _e118 = rho_7;
+        local_14 = (vec2<f32>(((_e103 * _e104) - (_e106 * _e107)), ((_e110 * _e111) + (_e113 * _e114))) / vec2(_e118));
     }
-    let _e121 = local_11;
-    end = _e121;
-    let _e123 = end;
-    let _e127 = end;
-    let _e129 = start_1;
-    end_sets_last = ((_e123.y < 0f) || (_e127.x < _e129.x));
-    let _e134 = atmosphere_35;
-    a_6 = _e134.sun_angular_radius;
-    let _e139 = a_6;
-    let _e141 = a_6;
-    let _e144 = a_6;
+    let _e122 = local_14;
+    end = _e122;
+    let _e124 = end;
+    let _e128 = end;
+    let _e130 = start_1;
+    end_sets_last = ((_e124.y < 0f) || (_e128.x < _e130.x));
+    let _e135 = atmosphere_43;
+    a_6 = _e135.sun_angular_radius;
+    let _e140 = a_6;
+    let _e142 = a_6;
     let _e145 = a_6;
-    cos_a = (1f - (((0.5f * _e139) * _e141) * (1f - ((_e144 * _e145) / 12f))));
-    let _e153 = a_6;
-    let _e155 = a_6;
+    let _e146 = a_6;
+    cos_a = (1f - (((0.5f * _e140) * _e142) * (1f - ((_e145 * _e146) / 12f))));
+    let _e154 = a_6;
     let _e156 = a_6;
-    sin_a = (_e153 * (1f - ((_e155 * _e156) / 6f)));
-    let _e163 = end_sets_last;
-    if _e163 {
-        let _e164 = end;
-        local_12 = _e164;
+    let _e157 = a_6;
+    sin_a = (_e154 * (1f - ((_e156 * _e157) / 6f)));
+    let _e164 = end_sets_last;
+    if _e164 {
+        let _e165 = end;
+        local_15 = _e165;
     } else {
-        let _e165 = start_1;
-        local_12 = _e165;
+        let _e166 = start_1;
+        local_15 = _e166;
     }
-    let _e167 = local_12;
-    last = _e167;
-    let _e169 = last;
-    let _e171 = cos_a;
-    let _e173 = last;
-    let _e175 = sin_a;
-    let _e178 = last;
-    let _e180 = cos_a;
-    let _e182 = last;
-    let _e184 = sin_a;
-    (*direction) = vec2<f32>(((_e169.x * _e171) - (_e173.y * _e175)), ((_e178.y * _e180) + (_e182.x * _e184)));
-    let _e188 = end_sets_last;
-    if _e188 {
-        let _e189 = c_end;
-        let _e190 = rho_7;
-        if (_e189 >= _e190) {
-            local_13 = PI;
+    let _e168 = local_15;
+    last = _e168;
+    let _e170 = last;
+    let _e172 = cos_a;
+    let _e174 = last;
+    let _e176 = sin_a;
+    let _e179 = last;
+    let _e181 = cos_a;
+    let _e183 = last;
+    let _e185 = sin_a;
+    (*direction) = vec2<f32>(((_e170.x * _e172) - (_e174.y * _e176)), ((_e179.y * _e181) + (_e183.x * _e185)));
+    let _e189 = end_sets_last;
+    if _e189 {
+        let _e190 = c_end;
+        let _e191 = rho_7;
+        if (_e190 >= _e191) {
+            local_16 = PI;
         } else {
-            let _e192 = across_1;
-            let _e193 = cos_alpha;
-            let _e195 = cos_gamma;
-            local_13 = (atan2(_e192, _e193) + acos(_e195));
+            let _e193 = across_1;
+            let _e194 = cos_alpha;
+            let _e196 = cos_gamma;
+            local_16 = (atan2(_e193, _e194) + acos(_e196));
         }
-        let _e199 = local_13;
-        local_14 = _e199;
+        let _e200 = local_16;
+        local_17 = _e200;
     } else {
-        let _e200 = c_start;
-        local_14 = acos(_e200);
+        let _e201 = c_start;
+        local_17 = acos(_e201);
     }
-    let _e203 = local_14;
-    angle = _e203;
-    let _e205 = angle;
-    let _e206 = a_6;
-    return (_e205 + _e206);
+    let _e204 = local_17;
+    angle = _e204;
+    let _e206 = angle;
+    let _e207 = a_6;
+    return (_e206 + _e207);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeSunZenith(atmosphere_36: AtmosphereParameters, r_30: f32, mu_23: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_11: bool) -> f32 {
-    var atmosphere_37: AtmosphereParameters;
-    var r_31: f32;
+fn ShadowEdgeSunZenith(atmosphere_44: AtmosphereParameters, r_32: f32, mu_23: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_11: bool) -> f32 {
+    var atmosphere_45: AtmosphereParameters;
+    var r_33: f32;
     var mu_24: f32;
     var cos_phi_3: f32;
     var ray_r_mu_intersects_ground_12: bool;
     var unused: vec2<f32>;
 
-    atmosphere_37 = atmosphere_36;
-    r_31 = r_30;
+    atmosphere_45 = atmosphere_44;
+    r_33 = r_32;
     mu_24 = mu_23;
     cos_phi_3 = cos_phi_2;
     ray_r_mu_intersects_ground_12 = ray_r_mu_intersects_ground_11;
-    let _e22 = atmosphere_37;
-    let _e23 = r_31;
-    let _e24 = mu_24;
-    let _e25 = cos_phi_3;
-    let _e26 = ray_r_mu_intersects_ground_12;
-    let _e29 = ShadowEdge(_e22, _e23, _e24, _e25, _e26, (&unused));
-    return _e29;
+    let _e23 = atmosphere_45;
+    let _e24 = r_33;
+    let _e25 = mu_24;
+    let _e26 = cos_phi_3;
+    let _e27 = ray_r_mu_intersects_ground_12;
+    let _e30 = ShadowEdge(_e23, _e24, _e25, _e26, _e27, (&unused));
+    return _e30;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1202,32 +1308,32 @@ fn ShadowEdgeDirection(edge: f32) -> vec2<f32> {
     var edge_1: f32;
 
     edge_1 = edge;
-    let _e13 = edge_1;
-    let _e15 = edge_1;
-    return vec2<f32>(cos(_e13), sin(_e15));
+    let _e14 = edge_1;
+    let _e16 = edge_1;
+    return vec2<f32>(cos(_e14), sin(_e16));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeDistance(edge_2: vec2<f32>, mu_s_9: f32) -> f32 {
+fn ShadowEdgeDistance(edge_2: vec2<f32>, mu_s_13: f32) -> f32 {
     var edge_3: vec2<f32>;
-    var mu_s_10: f32;
+    var mu_s_14: f32;
     var sin_theta: f32;
 
     edge_3 = edge_2;
-    mu_s_10 = mu_s_9;
-    let _e16 = mu_s_10;
-    let _e17 = mu_s_10;
-    let _e20 = SafeSqrt((1f - (_e16 * _e17)));
-    sin_theta = _e20;
-    let _e22 = edge_3;
-    let _e24 = mu_s_10;
-    let _e26 = edge_3;
-    let _e28 = sin_theta;
-    let _e31 = edge_3;
-    let _e33 = mu_s_10;
-    let _e35 = edge_3;
-    let _e37 = sin_theta;
-    return atan2(((_e22.y * _e24) - (_e26.x * _e28)), ((_e31.x * _e33) + (_e35.y * _e37)));
+    mu_s_14 = mu_s_13;
+    let _e17 = mu_s_14;
+    let _e18 = mu_s_14;
+    let _e21 = SafeSqrt((1f - (_e17 * _e18)));
+    sin_theta = _e21;
+    let _e23 = edge_3;
+    let _e25 = mu_s_14;
+    let _e27 = edge_3;
+    let _e29 = sin_theta;
+    let _e32 = edge_3;
+    let _e34 = mu_s_14;
+    let _e36 = edge_3;
+    let _e38 = sin_theta;
+    return atan2(((_e23.y * _e25) - (_e27.x * _e29)), ((_e32.x * _e34) + (_e36.y * _e38)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1237,29 +1343,29 @@ fn ShadowEdgeSunCosine(edge_4: vec2<f32>, D_1: f32) -> f32 {
 
     edge_5 = edge_4;
     D_2 = D_1;
-    let _e15 = edge_5;
-    let _e17 = D_2;
-    let _e20 = edge_5;
-    let _e22 = D_2;
-    return ((_e15.x * cos(_e17)) + (_e20.y * sin(_e22)));
+    let _e16 = edge_5;
+    let _e18 = D_2;
+    let _e21 = edge_5;
+    let _e23 = D_2;
+    return ((_e16.x * cos(_e18)) + (_e21.y * sin(_e23)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringSplitMuS(atmosphere_38: AtmosphereParameters) -> f32 {
-    var atmosphere_39: AtmosphereParameters;
+fn GetScatteringSplitMuS(atmosphere_46: AtmosphereParameters) -> f32 {
+    var atmosphere_47: AtmosphereParameters;
 
-    atmosphere_39 = atmosphere_38;
-    let _e13 = atmosphere_39;
-    let _e14 = atmosphere_39;
-    let _e17 = atmosphere_39;
-    let _e23 = GetScatteringMuSFromUnitRange(_e13, (f32(_e14.scattering_mu_s_split) / f32((_e17.scattering_mu_s_size - 1i))));
-    return _e23;
+    atmosphere_47 = atmosphere_46;
+    let _e14 = atmosphere_47;
+    let _e15 = atmosphere_47;
+    let _e18 = atmosphere_47;
+    let _e24 = GetScatteringMuSFromUnitRange(_e14, (f32(_e15.scattering_mu_s_split) / f32((_e18.scattering_mu_s_size - 1i))));
+    return _e24;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeUnitSun(atmosphere_40: AtmosphereParameters, mu_s_11: f32, derivative: ptr<function, f32>) -> f32 {
-    var atmosphere_41: AtmosphereParameters;
-    var mu_s_12: f32;
+fn ShadowEdgeUnitSun(atmosphere_48: AtmosphereParameters, mu_s_15: f32, derivative: ptr<function, f32>) -> f32 {
+    var atmosphere_49: AtmosphereParameters;
+    var mu_s_16: f32;
     var bottom_1: f32;
     var d_14: f32;
     var d_min_8: f32;
@@ -1268,53 +1374,53 @@ fn ShadowEdgeUnitSun(atmosphere_40: AtmosphereParameters, mu_s_11: f32, derivati
     var inverse_A_4: f32;
     var da_dtheta: f32;
 
-    atmosphere_41 = atmosphere_40;
-    mu_s_12 = mu_s_11;
-    let _e16 = atmosphere_41;
-    bottom_1 = _e16.bottom_radius;
-    let _e19 = atmosphere_41;
-    let _e20 = bottom_1;
-    let _e21 = mu_s_12;
-    let _e22 = DistanceToTopAtmosphereBoundary(_e19, _e20, _e21);
-    d_14 = _e22;
-    let _e24 = atmosphere_41;
-    let _e26 = bottom_1;
-    d_min_8 = (_e24.top_radius - _e26);
-    let _e29 = atmosphere_41;
-    let _e30 = HorizonDistanceAtTop(_e29);
-    let _e31 = d_min_8;
-    span = (_e30 - _e31);
-    let _e34 = d_14;
-    let _e35 = d_min_8;
-    let _e37 = span;
-    a_7 = ((_e34 - _e35) / _e37);
-    let _e41 = atmosphere_41;
-    let _e42 = GetScatteringLowestSunDistance(_e41);
-    inverse_A_4 = (1f / _e42);
-    let _e45 = bottom_1;
-    let _e46 = d_14;
-    let _e48 = d_14;
-    let _e49 = bottom_1;
-    let _e50 = mu_s_12;
-    let _e54 = span;
-    let _e57 = mu_s_12;
-    let _e58 = mu_s_12;
-    let _e61 = SafeSqrt((1f - (_e57 * _e58)));
-    da_dtheta = ((((_e45 * _e46) / (_e48 + (_e49 * _e50))) / _e54) * _e61);
-    let _e64 = inverse_A_4;
-    let _e69 = a_7;
-    let _e72 = a_7;
-    let _e76 = da_dtheta;
-    (*derivative) = ((-((_e64 + 1f)) / ((1f + _e69) * (1f + _e72))) * _e76);
-    let _e79 = a_7;
-    let _e80 = inverse_A_4;
-    let _e84 = a_7;
-    return ((1f - (_e79 * _e80)) / (1f + _e84));
+    atmosphere_49 = atmosphere_48;
+    mu_s_16 = mu_s_15;
+    let _e17 = atmosphere_49;
+    bottom_1 = _e17.bottom_radius;
+    let _e20 = atmosphere_49;
+    let _e21 = bottom_1;
+    let _e22 = mu_s_16;
+    let _e23 = DistanceToTopAtmosphereBoundary(_e20, _e21, _e22);
+    d_14 = _e23;
+    let _e25 = atmosphere_49;
+    let _e27 = bottom_1;
+    d_min_8 = (_e25.top_radius - _e27);
+    let _e30 = atmosphere_49;
+    let _e31 = HorizonDistanceAtTop(_e30);
+    let _e32 = d_min_8;
+    span = (_e31 - _e32);
+    let _e35 = d_14;
+    let _e36 = d_min_8;
+    let _e38 = span;
+    a_7 = ((_e35 - _e36) / _e38);
+    let _e42 = atmosphere_49;
+    let _e43 = GetScatteringLowestSunDistance(_e42);
+    inverse_A_4 = (1f / _e43);
+    let _e46 = bottom_1;
+    let _e47 = d_14;
+    let _e49 = d_14;
+    let _e50 = bottom_1;
+    let _e51 = mu_s_16;
+    let _e55 = span;
+    let _e58 = mu_s_16;
+    let _e59 = mu_s_16;
+    let _e62 = SafeSqrt((1f - (_e58 * _e59)));
+    da_dtheta = ((((_e46 * _e47) / (_e49 + (_e50 * _e51))) / _e55) * _e62);
+    let _e65 = inverse_A_4;
+    let _e70 = a_7;
+    let _e73 = a_7;
+    let _e77 = da_dtheta;
+    (*derivative) = ((-((_e65 + 1f)) / ((1f + _e70) * (1f + _e73))) * _e77);
+    let _e80 = a_7;
+    let _e81 = inverse_A_4;
+    let _e85 = a_7;
+    return ((1f - (_e80 * _e81)) / (1f + _e85));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitFrom(atmosphere_42: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
-    var atmosphere_43: AtmosphereParameters;
+fn ShadowEdgeLitUnitFrom(atmosphere_50: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
+    var atmosphere_51: AtmosphereParameters;
     var D_4: f32;
     var edge_7: vec2<f32>;
     var X_closest_1: f32;
@@ -1323,65 +1429,65 @@ fn ShadowEdgeLitUnitFrom(atmosphere_42: AtmosphereParameters, D_3: f32, edge_6: 
     var dX_dtheta: f32;
     var X: f32;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_51 = atmosphere_50;
     D_4 = D_3;
     edge_7 = edge_6;
     X_closest_1 = X_closest;
     X_span_1 = X_span;
     log_span_1 = log_span;
-    let _e25 = atmosphere_43;
-    let _e26 = edge_7;
-    let _e27 = D_4;
-    let _e28 = ShadowEdgeSunCosine(_e26, _e27);
-    let _e31 = ShadowEdgeUnitSun(_e25, _e28, (&dX_dtheta));
-    X = _e31;
-    let _e35 = dX_dtheta;
-    let _e37 = D_4;
-    let _e39 = X_span_1;
-    let _e44 = log_span_1;
-    (*derivative_1) = ((((-0.3f * _e35) * _e37) / _e39) + (0.7f / _e44));
-    let _e47 = X;
-    let _e48 = X_closest_1;
-    let _e51 = X_span_1;
-    let _e56 = D_4;
-    let _e60 = log_span_1;
-    return (((SHADOW_EDGE_TABLES_WEIGHT * (_e47 - _e48)) / _e51) + ((0.7f * log((_e56 / SHADOW_EDGE_CLOSEST))) / _e60));
+    let _e26 = atmosphere_51;
+    let _e27 = edge_7;
+    let _e28 = D_4;
+    let _e29 = ShadowEdgeSunCosine(_e27, _e28);
+    let _e32 = ShadowEdgeUnitSun(_e26, _e29, (&dX_dtheta));
+    X = _e32;
+    let _e36 = dX_dtheta;
+    let _e38 = D_4;
+    let _e40 = X_span_1;
+    let _e45 = log_span_1;
+    (*derivative_1) = ((((-0.3f * _e36) * _e38) / _e40) + (0.7f / _e45));
+    let _e48 = X;
+    let _e49 = X_closest_1;
+    let _e52 = X_span_1;
+    let _e57 = D_4;
+    let _e61 = log_span_1;
+    return (((SHADOW_EDGE_TABLES_WEIGHT * (_e48 - _e49)) / _e52) + ((0.7f * log((_e57 / SHADOW_EDGE_CLOSEST))) / _e61));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitSpans(atmosphere_44: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
-    var atmosphere_45: AtmosphereParameters;
+fn ShadowEdgeLitUnitSpans(atmosphere_52: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
+    var atmosphere_53: AtmosphereParameters;
     var edge_9: vec2<f32>;
     var unused_1: f32;
     var split_mu_s: f32;
 
-    atmosphere_45 = atmosphere_44;
+    atmosphere_53 = atmosphere_52;
     edge_9 = edge_8;
-    let _e20 = atmosphere_45;
-    let _e21 = GetScatteringSplitMuS(_e20);
-    split_mu_s = _e21;
-    let _e23 = atmosphere_45;
-    let _e24 = edge_9;
-    let _e25 = ShadowEdgeSunCosine(_e24, SHADOW_EDGE_CLOSEST);
-    let _e28 = ShadowEdgeUnitSun(_e23, _e25, (&unused_1));
-    (*X_closest_2) = _e28;
-    let _e29 = atmosphere_45;
-    let _e30 = split_mu_s;
-    let _e33 = ShadowEdgeUnitSun(_e29, _e30, (&unused_1));
-    let _e34 = (*X_closest_2);
-    (*X_span_2) = (_e33 - _e34);
-    let _e36 = edge_9;
-    let _e37 = split_mu_s;
-    let _e38 = ShadowEdgeDistance(_e36, _e37);
-    (*split_distance) = _e38;
-    let _e39 = (*split_distance);
-    (*log_span_2) = log((_e39 / SHADOW_EDGE_CLOSEST));
+    let _e21 = atmosphere_53;
+    let _e22 = GetScatteringSplitMuS(_e21);
+    split_mu_s = _e22;
+    let _e24 = atmosphere_53;
+    let _e25 = edge_9;
+    let _e26 = ShadowEdgeSunCosine(_e25, SHADOW_EDGE_CLOSEST);
+    let _e29 = ShadowEdgeUnitSun(_e24, _e26, (&unused_1));
+    (*X_closest_2) = _e29;
+    let _e30 = atmosphere_53;
+    let _e31 = split_mu_s;
+    let _e34 = ShadowEdgeUnitSun(_e30, _e31, (&unused_1));
+    let _e35 = (*X_closest_2);
+    (*X_span_2) = (_e34 - _e35);
+    let _e37 = edge_9;
+    let _e38 = split_mu_s;
+    let _e39 = ShadowEdgeDistance(_e37, _e38);
+    (*split_distance) = _e39;
+    let _e40 = (*split_distance);
+    (*log_span_2) = log((_e40 / SHADOW_EDGE_CLOSEST));
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnit(atmosphere_46: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
-    var atmosphere_47: AtmosphereParameters;
+fn ShadowEdgeLitUnit(atmosphere_54: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
+    var atmosphere_55: AtmosphereParameters;
     var distance_1: f32;
     var edge_11: vec2<f32>;
     var X_closest_3: f32;
@@ -1390,27 +1496,27 @@ fn ShadowEdgeLitUnit(atmosphere_46: AtmosphereParameters, distance_: f32, edge_1
     var split_distance_1: f32;
     var unused_2: f32;
 
-    atmosphere_47 = atmosphere_46;
+    atmosphere_55 = atmosphere_54;
     distance_1 = distance_;
     edge_11 = edge_10;
-    let _e21 = atmosphere_47;
-    let _e22 = edge_11;
-    ShadowEdgeLitUnitSpans(_e21, _e22, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
-    let _e32 = atmosphere_47;
-    let _e33 = distance_1;
-    let _e34 = split_distance_1;
-    let _e36 = edge_11;
-    let _e37 = X_closest_3;
-    let _e38 = X_span_3;
-    let _e39 = log_span_3;
-    let _e42 = ShadowEdgeLitUnitFrom(_e32, clamp(_e33, SHADOW_EDGE_CLOSEST, _e34), _e36, _e37, _e38, _e39, (&unused_2));
-    return _e42;
+    let _e22 = atmosphere_55;
+    let _e23 = edge_11;
+    ShadowEdgeLitUnitSpans(_e22, _e23, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
+    let _e33 = atmosphere_55;
+    let _e34 = distance_1;
+    let _e35 = split_distance_1;
+    let _e37 = edge_11;
+    let _e38 = X_closest_3;
+    let _e39 = X_span_3;
+    let _e40 = log_span_3;
+    let _e43 = ShadowEdgeLitUnitFrom(_e33, clamp(_e34, SHADOW_EDGE_CLOSEST, _e35), _e37, _e38, _e39, _e40, (&unused_2));
+    return _e43;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitDistance(atmosphere_48: AtmosphereParameters, x_11: f32, edge_12: vec2<f32>) -> f32 {
-    var atmosphere_49: AtmosphereParameters;
-    var x_12: f32;
+fn ShadowEdgeLitDistance(atmosphere_56: AtmosphereParameters, x_13: f32, edge_12: vec2<f32>) -> f32 {
+    var atmosphere_57: AtmosphereParameters;
+    var x_14: f32;
     var edge_13: vec2<f32>;
     var X_closest_4: f32;
     var X_span_4: f32;
@@ -1425,158 +1531,158 @@ fn ShadowEdgeLitDistance(atmosphere_48: AtmosphereParameters, x_11: f32, edge_12
     var next: f32;
     var converged: bool;
 
-    atmosphere_49 = atmosphere_48;
-    x_12 = x_11;
+    atmosphere_57 = atmosphere_56;
+    x_14 = x_13;
     edge_13 = edge_12;
-    let _e21 = atmosphere_49;
-    let _e22 = edge_13;
-    ShadowEdgeLitUnitSpans(_e21, _e22, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
-    let _e34 = s_min;
-    let _e35 = log_span_4;
-    s_max = (_e34 + _e35);
-    let _e38 = s_min;
-    let _e39 = s_max;
-    let _e40 = x_12;
-    s_2 = mix(_e38, _e39, _e40);
+    let _e22 = atmosphere_57;
+    let _e23 = edge_13;
+    ShadowEdgeLitUnitSpans(_e22, _e23, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
+    let _e35 = s_min;
+    let _e36 = log_span_4;
+    s_max = (_e35 + _e36);
+    let _e39 = s_min;
+    let _e40 = s_max;
+    let _e41 = x_14;
+    s_2 = mix(_e39, _e40, _e41);
     loop {
-        let _e45 = i;
-        if !((_e45 < 12i)) {
+        let _e46 = i;
+        if !((_e46 < 12i)) {
             break;
         }
         {
-            let _e53 = atmosphere_49;
-            let _e54 = s_2;
-            let _e56 = edge_13;
-            let _e57 = X_closest_4;
-            let _e58 = X_span_4;
-            let _e59 = log_span_4;
-            let _e62 = ShadowEdgeLitUnitFrom(_e53, exp(_e54), _e56, _e57, _e58, _e59, (&slope));
-            let _e63 = x_12;
-            error = (_e62 - _e63);
-            let _e66 = s_2;
-            let _e67 = error;
-            let _e68 = slope;
-            let _e71 = s_min;
-            let _e72 = s_max;
-            next = clamp((_e66 - (_e67 / _e68)), _e71, _e72);
-            let _e75 = next;
-            let _e76 = s_2;
-            converged = (abs((_e75 - _e76)) < 0.00000000001f);
-            let _e82 = next;
-            s_2 = _e82;
-            let _e83 = converged;
-            if _e83 {
+            let _e54 = atmosphere_57;
+            let _e55 = s_2;
+            let _e57 = edge_13;
+            let _e58 = X_closest_4;
+            let _e59 = X_span_4;
+            let _e60 = log_span_4;
+            let _e63 = ShadowEdgeLitUnitFrom(_e54, exp(_e55), _e57, _e58, _e59, _e60, (&slope));
+            let _e64 = x_14;
+            error = (_e63 - _e64);
+            let _e67 = s_2;
+            let _e68 = error;
+            let _e69 = slope;
+            let _e72 = s_min;
+            let _e73 = s_max;
+            next = clamp((_e67 - (_e68 / _e69)), _e72, _e73);
+            let _e76 = next;
+            let _e77 = s_2;
+            converged = (abs((_e76 - _e77)) < 0.00000000001f);
+            let _e83 = next;
+            s_2 = _e83;
+            let _e84 = converged;
+            if _e84 {
                 break;
             }
         }
         continuing {
-            let _e49 = i;
-            i = (_e49 + 1i);
+            let _e50 = i;
+            i = (_e50 + 1i);
         }
     }
-    let _e84 = s_2;
-    return exp(_e84);
+    let _e85 = s_2;
+    return exp(_e85);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgePastStep(atmosphere_50: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
-    var atmosphere_51: AtmosphereParameters;
+fn ShadowEdgePastStep(atmosphere_58: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
+    var atmosphere_59: AtmosphereParameters;
     var edge_15: vec2<f32>;
     var past_lowest: f32;
 
-    atmosphere_51 = atmosphere_50;
+    atmosphere_59 = atmosphere_58;
     edge_15 = edge_14;
-    let _e15 = edge_15;
-    let _e16 = atmosphere_51;
-    let _e18 = ShadowEdgeDistance(_e15, _e16.scattering_mu_s_min);
-    past_lowest = -(_e18);
-    let _e21 = past_lowest;
-    return (max(_e21, SHADOW_EDGE_LEAST_PAST_SPAN) / 5f);
+    let _e16 = edge_15;
+    let _e17 = atmosphere_59;
+    let _e19 = ShadowEdgeDistance(_e16, _e17.scattering_mu_s_min);
+    past_lowest = -(_e19);
+    let _e22 = past_lowest;
+    return (max(_e22, SHADOW_EDGE_LEAST_PAST_SPAN) / 5f);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgePosition(atmosphere_52: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
-    var atmosphere_53: AtmosphereParameters;
+fn GetScatteringShadowEdgePosition(atmosphere_60: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
+    var atmosphere_61: AtmosphereParameters;
     var D_6: f32;
     var edge_17: vec2<f32>;
     var past: f32 = 6f;
 
-    atmosphere_53 = atmosphere_52;
+    atmosphere_61 = atmosphere_60;
     D_6 = D_5;
     edge_17 = edge_16;
-    let _e20 = D_6;
-    if (_e20 >= SHADOW_EDGE_CLOSEST) {
+    let _e21 = D_6;
+    if (_e21 >= SHADOW_EDGE_CLOSEST) {
         {
-            let _e22 = past;
-            let _e23 = atmosphere_53;
-            let _e24 = D_6;
-            let _e25 = edge_17;
-            let _e26 = ShadowEdgeLitUnit(_e23, _e24, _e25);
-            let _e27 = atmosphere_53;
-            let _e30 = past;
-            return (_e22 + (_e26 * (f32(_e27.scattering_mu_s_split) - _e30)));
+            let _e23 = past;
+            let _e24 = atmosphere_61;
+            let _e25 = D_6;
+            let _e26 = edge_17;
+            let _e27 = ShadowEdgeLitUnit(_e24, _e25, _e26);
+            let _e28 = atmosphere_61;
+            let _e31 = past;
+            return (_e23 + (_e27 * (f32(_e28.scattering_mu_s_split) - _e31)));
         }
     }
-    let _e34 = D_6;
-    if (_e34 >= 0f) {
-        let _e37 = past;
-        let _e40 = D_6;
-        return ((_e37 - 1f) + (_e40 / SHADOW_EDGE_CLOSEST));
+    let _e35 = D_6;
+    if (_e35 >= 0f) {
+        let _e38 = past;
+        let _e41 = D_6;
+        return ((_e38 - 1f) + (_e41 / SHADOW_EDGE_CLOSEST));
     }
-    let _e43 = past;
-    let _e46 = D_6;
-    let _e47 = atmosphere_53;
-    let _e48 = edge_17;
-    let _e49 = ShadowEdgePastStep(_e47, _e48);
-    return ((_e43 - 1f) + (_e46 / _e49));
+    let _e44 = past;
+    let _e47 = D_6;
+    let _e48 = atmosphere_61;
+    let _e49 = edge_17;
+    let _e50 = ShadowEdgePastStep(_e48, _e49);
+    return ((_e44 - 1f) + (_e47 / _e50));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgeDistance(atmosphere_54: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
-    var atmosphere_55: AtmosphereParameters;
+fn GetScatteringShadowEdgeDistance(atmosphere_62: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
+    var atmosphere_63: AtmosphereParameters;
     var position_1: f32;
     var edge_19: vec2<f32>;
     var past_1: f32 = 6f;
-    var x_13: f32;
+    var x_15: f32;
 
-    atmosphere_55 = atmosphere_54;
+    atmosphere_63 = atmosphere_62;
     position_1 = position;
     edge_19 = edge_18;
-    let _e20 = position_1;
-    let _e21 = past_1;
-    if (_e20 >= _e21) {
+    let _e21 = position_1;
+    let _e22 = past_1;
+    if (_e21 >= _e22) {
         {
-            let _e23 = position_1;
-            let _e24 = past_1;
-            let _e26 = atmosphere_55;
-            let _e29 = past_1;
-            x_13 = ((_e23 - _e24) / (f32(_e26.scattering_mu_s_split) - _e29));
-            let _e33 = atmosphere_55;
-            let _e34 = x_13;
-            let _e35 = edge_19;
-            let _e36 = ShadowEdgeLitDistance(_e33, _e34, _e35);
-            return _e36;
+            let _e24 = position_1;
+            let _e25 = past_1;
+            let _e27 = atmosphere_63;
+            let _e30 = past_1;
+            x_15 = ((_e24 - _e25) / (f32(_e27.scattering_mu_s_split) - _e30));
+            let _e34 = atmosphere_63;
+            let _e35 = x_15;
+            let _e36 = edge_19;
+            let _e37 = ShadowEdgeLitDistance(_e34, _e35, _e36);
+            return _e37;
         }
     }
-    let _e37 = position_1;
-    let _e38 = past_1;
-    if (_e37 >= (_e38 - 1f)) {
-        let _e42 = position_1;
-        let _e43 = past_1;
-        return (((_e42 - _e43) + 1f) * SHADOW_EDGE_CLOSEST);
+    let _e38 = position_1;
+    let _e39 = past_1;
+    if (_e38 >= (_e39 - 1f)) {
+        let _e43 = position_1;
+        let _e44 = past_1;
+        return (((_e43 - _e44) + 1f) * SHADOW_EDGE_CLOSEST);
     }
-    let _e48 = position_1;
-    let _e49 = past_1;
-    let _e53 = atmosphere_55;
-    let _e54 = edge_19;
-    let _e55 = ShadowEdgePastStep(_e53, _e54);
-    return (((_e48 - _e49) + 1f) * _e55);
+    let _e49 = position_1;
+    let _e50 = past_1;
+    let _e54 = atmosphere_63;
+    let _e55 = edge_19;
+    let _e56 = ShadowEdgePastStep(_e54, _e55);
+    return (((_e49 - _e50) + 1f) * _e56);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_56: AtmosphereParameters, r_32: f32, rho_8: f32, ray_r_mu_intersects_ground_13: bool, x_mu_1: f32) -> f32 {
-    var atmosphere_57: AtmosphereParameters;
-    var r_33: f32;
+fn GetScatteringTextureUR(atmosphere_64: AtmosphereParameters, r_34: f32, rho_8: f32, ray_r_mu_intersects_ground_13: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_65: AtmosphereParameters;
+    var r_35: f32;
     var rho_9: f32;
     var ray_r_mu_intersects_ground_14: bool;
     var x_mu_2: f32;
@@ -1593,82 +1699,82 @@ fn GetScatteringTextureUR(atmosphere_56: AtmosphereParameters, r_32: f32, rho_8:
     var d_15: f32;
     var t: f32;
 
-    atmosphere_57 = atmosphere_56;
-    r_33 = r_32;
+    atmosphere_65 = atmosphere_64;
+    r_35 = r_34;
     rho_9 = rho_8;
     ray_r_mu_intersects_ground_14 = ray_r_mu_intersects_ground_13;
     x_mu_2 = x_mu_1;
-    let _e21 = atmosphere_57;
-    let _e22 = atmosphere_57;
-    let _e24 = HorizonDistance(_e21, _e22.scattering_r_min);
-    rho_min = _e24;
-    let _e26 = atmosphere_57;
-    let _e27 = atmosphere_57;
-    let _e29 = HorizonDistance(_e26, _e27.scattering_r_max);
-    rho_max = _e29;
-    let _e31 = atmosphere_57;
-    last_row = f32((_e31.scattering_r_size - 1i));
-    let _e37 = rho_9;
-    let _e38 = rho_min;
-    let _e40 = rho_max;
-    let _e41 = rho_min;
-    let _e47 = last_row;
-    position_2 = (clamp(((_e37 - _e38) / (_e40 - _e41)), 0f, 1f) * _e47);
-    let _e50 = ray_r_mu_intersects_ground_14;
-    if !(_e50) {
-        let _e52 = position_2;
-        let _e55 = last_row;
-        return ((_e52 + 0.5f) / (_e55 + 1f));
+    let _e22 = atmosphere_65;
+    let _e23 = atmosphere_65;
+    let _e25 = HorizonDistance(_e22, _e23.scattering_r_min);
+    rho_min = _e25;
+    let _e27 = atmosphere_65;
+    let _e28 = atmosphere_65;
+    let _e30 = HorizonDistance(_e27, _e28.scattering_r_max);
+    rho_max = _e30;
+    let _e32 = atmosphere_65;
+    last_row = f32((_e32.scattering_r_size - 1i));
+    let _e38 = rho_9;
+    let _e39 = rho_min;
+    let _e41 = rho_max;
+    let _e42 = rho_min;
+    let _e48 = last_row;
+    position_2 = (clamp(((_e38 - _e39) / (_e41 - _e42)), 0f, 1f) * _e48);
+    let _e51 = ray_r_mu_intersects_ground_14;
+    if !(_e51) {
+        let _e53 = position_2;
+        let _e56 = last_row;
+        return ((_e53 + 0.5f) / (_e56 + 1f));
     }
-    let _e59 = position_2;
-    let _e61 = last_row;
-    row = min(floor(_e59), (_e61 - 1f));
-    let _e66 = rho_min;
-    let _e67 = rho_max;
-    let _e68 = row;
-    let _e69 = last_row;
-    rho_below = mix(_e66, _e67, (_e68 / _e69));
-    let _e73 = rho_min;
-    let _e74 = rho_max;
-    let _e75 = row;
-    let _e78 = last_row;
-    rho_above = mix(_e73, _e74, ((_e75 + 1f) / _e78));
-    let _e82 = atmosphere_57;
-    bottom_2 = _e82.bottom_radius;
-    let _e85 = bottom_2;
-    let _e86 = rho_below;
-    let _e87 = HeightFromHorizonDistance(_e85, _e86);
-    let _e88 = rho_below;
-    let _e89 = x_mu_2;
-    d_below = mix(_e87, _e88, _e89);
-    let _e92 = bottom_2;
-    let _e93 = rho_above;
-    let _e94 = HeightFromHorizonDistance(_e92, _e93);
-    let _e95 = rho_above;
-    let _e96 = x_mu_2;
-    d_above = mix(_e94, _e95, _e96);
-    let _e99 = r_33;
-    let _e100 = bottom_2;
-    let _e102 = rho_9;
-    let _e103 = x_mu_2;
-    d_15 = mix((_e99 - _e100), _e102, _e103);
-    let _e106 = d_15;
-    let _e107 = d_below;
-    let _e109 = d_above;
-    let _e110 = d_below;
-    t = clamp(((_e106 - _e107) / (_e109 - _e110)), 0f, 1f);
-    let _e117 = row;
-    let _e118 = t;
-    let _e122 = last_row;
-    return (((_e117 + _e118) + 0.5f) / (_e122 + 1f));
+    let _e60 = position_2;
+    let _e62 = last_row;
+    row = min(floor(_e60), (_e62 - 1f));
+    let _e67 = rho_min;
+    let _e68 = rho_max;
+    let _e69 = row;
+    let _e70 = last_row;
+    rho_below = mix(_e67, _e68, (_e69 / _e70));
+    let _e74 = rho_min;
+    let _e75 = rho_max;
+    let _e76 = row;
+    let _e79 = last_row;
+    rho_above = mix(_e74, _e75, ((_e76 + 1f) / _e79));
+    let _e83 = atmosphere_65;
+    bottom_2 = _e83.bottom_radius;
+    let _e86 = bottom_2;
+    let _e87 = rho_below;
+    let _e88 = HeightFromHorizonDistance(_e86, _e87);
+    let _e89 = rho_below;
+    let _e90 = x_mu_2;
+    d_below = mix(_e88, _e89, _e90);
+    let _e93 = bottom_2;
+    let _e94 = rho_above;
+    let _e95 = HeightFromHorizonDistance(_e93, _e94);
+    let _e96 = rho_above;
+    let _e97 = x_mu_2;
+    d_above = mix(_e95, _e96, _e97);
+    let _e100 = r_35;
+    let _e101 = bottom_2;
+    let _e103 = rho_9;
+    let _e104 = x_mu_2;
+    d_15 = mix((_e100 - _e101), _e103, _e104);
+    let _e107 = d_15;
+    let _e108 = d_below;
+    let _e110 = d_above;
+    let _e111 = d_below;
+    t = clamp(((_e107 - _e108) / (_e110 - _e111)), 0f, 1f);
+    let _e118 = row;
+    let _e119 = t;
+    let _e123 = last_row;
+    return (((_e118 + _e119) + 0.5f) / (_e123 + 1f));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzAndEdge(atmosphere_58: AtmosphereParameters, r_34: f32, mu_25: f32, mu_s_13: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
-    var atmosphere_59: AtmosphereParameters;
-    var r_35: f32;
+fn GetScatteringTextureUvwzAndEdge(atmosphere_66: AtmosphereParameters, r_36: f32, mu_25: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
+    var atmosphere_67: AtmosphereParameters;
+    var r_37: f32;
     var mu_26: f32;
-    var mu_s_14: f32;
+    var mu_s_18: f32;
     var nu_12: f32;
     var ray_r_mu_intersects_ground_16: bool;
     var rho_10: f32;
@@ -1678,205 +1784,99 @@ fn GetScatteringTextureUvwzAndEdge(atmosphere_58: AtmosphereParameters, r_34: f3
     var u_mu_s: f32;
     var mu_s_size: f32;
 
-    atmosphere_59 = atmosphere_58;
-    r_35 = r_34;
+    atmosphere_67 = atmosphere_66;
+    r_37 = r_36;
     mu_26 = mu_25;
-    mu_s_14 = mu_s_13;
+    mu_s_18 = mu_s_17;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e24 = atmosphere_59;
-    let _e25 = r_35;
-    let _e26 = HorizonDistance(_e24, _e25);
-    rho_10 = _e26;
-    let _e28 = atmosphere_59;
-    let _e29 = r_35;
-    let _e30 = rho_10;
-    let _e31 = mu_26;
-    let _e32 = ray_r_mu_intersects_ground_16;
-    let _e33 = GetUnitMuInHalf(_e28, _e29, _e30, _e31, _e32);
-    x_mu_3 = _e33;
-    let _e35 = x_mu_3;
-    let _e36 = ray_r_mu_intersects_ground_16;
-    let _e37 = atmosphere_59;
-    let _e39 = GetTextureCoordFromUnitMuInHalf(_e35, _e36, _e37.scattering_mu_size);
-    u_mu = _e39;
-    let _e41 = atmosphere_59;
-    let _e42 = r_35;
-    let _e43 = rho_10;
-    let _e44 = ray_r_mu_intersects_ground_16;
-    let _e45 = x_mu_3;
-    let _e46 = GetScatteringTextureUR(_e41, _e42, _e43, _e44, _e45);
-    u_r = _e46;
-    let _e48 = atmosphere_59;
-    let _e49 = mu_s_14;
-    let _e50 = GetScatteringTextureUMuS(_e48, _e49);
-    u_mu_s = _e50;
-    let _e52 = atmosphere_59;
-    mu_s_size = f32(_e52.scattering_mu_s_size);
+    let _e25 = atmosphere_67;
+    let _e26 = r_37;
+    let _e27 = HorizonDistance(_e25, _e26);
+    rho_10 = _e27;
+    let _e29 = atmosphere_67;
+    let _e30 = r_37;
+    let _e31 = rho_10;
+    let _e32 = mu_26;
+    let _e33 = ray_r_mu_intersects_ground_16;
+    let _e34 = GetUnitMuInHalf(_e29, _e30, _e31, _e32, _e33);
+    x_mu_3 = _e34;
+    let _e36 = x_mu_3;
+    let _e37 = ray_r_mu_intersects_ground_16;
+    let _e38 = atmosphere_67;
+    let _e40 = GetTextureCoordFromUnitMuInHalf(_e36, _e37, _e38.scattering_mu_size);
+    u_mu = _e40;
+    let _e42 = atmosphere_67;
+    let _e43 = r_37;
+    let _e44 = rho_10;
+    let _e45 = ray_r_mu_intersects_ground_16;
+    let _e46 = x_mu_3;
+    let _e47 = GetScatteringTextureUR(_e42, _e43, _e44, _e45, _e46);
+    u_r = _e47;
+    let _e49 = atmosphere_67;
+    let _e50 = mu_s_18;
+    let _e51 = GetScatteringTextureUMuS(_e49, _e50);
+    u_mu_s = _e51;
+    let _e53 = atmosphere_67;
+    mu_s_size = f32(_e53.scattering_mu_s_size);
     (*edge_20) = vec2(0f);
-    let _e58 = atmosphere_59;
-    let _e62 = u_mu_s;
-    let _e63 = mu_s_size;
-    let _e67 = atmosphere_59;
-    if ((_e58.scattering_mu_s_split > 0i) && (((_e62 * _e63) - 0.5f) < f32(_e67.scattering_mu_s_split))) {
+    let _e59 = atmosphere_67;
+    let _e63 = u_mu_s;
+    let _e64 = mu_s_size;
+    let _e68 = atmosphere_67;
+    if ((_e59.scattering_mu_s_split > 0i) && (((_e63 * _e64) - 0.5f) < f32(_e68.scattering_mu_s_split))) {
         {
-            let _e72 = atmosphere_59;
-            let _e73 = r_35;
-            let _e74 = mu_26;
+            let _e73 = atmosphere_67;
+            let _e74 = r_37;
             let _e75 = mu_26;
-            let _e76 = mu_s_14;
-            let _e77 = nu_12;
-            let _e78 = ViewSunAzimuthCosine(_e75, _e76, _e77);
-            let _e79 = ray_r_mu_intersects_ground_16;
-            let _e82 = ShadowEdge(_e72, _e73, _e74, _e78, _e79, edge_20);
-            let _e83 = atmosphere_59;
-            let _e84 = (*edge_20);
-            let _e85 = mu_s_14;
-            let _e86 = ShadowEdgeDistance(_e84, _e85);
-            let _e87 = (*edge_20);
-            let _e88 = GetScatteringShadowEdgePosition(_e83, _e86, _e87);
-            let _e91 = mu_s_size;
-            u_mu_s = ((_e88 + 0.5f) / _e91);
+            let _e76 = mu_26;
+            let _e77 = mu_s_18;
+            let _e78 = nu_12;
+            let _e79 = ViewSunAzimuthCosine(_e76, _e77, _e78);
+            let _e80 = ray_r_mu_intersects_ground_16;
+            let _e83 = ShadowEdge(_e73, _e74, _e75, _e79, _e80, edge_20);
+            let _e84 = atmosphere_67;
+            let _e85 = (*edge_20);
+            let _e86 = mu_s_18;
+            let _e87 = ShadowEdgeDistance(_e85, _e86);
+            let _e88 = (*edge_20);
+            let _e89 = GetScatteringShadowEdgePosition(_e84, _e87, _e88);
+            let _e92 = mu_s_size;
+            u_mu_s = ((_e89 + 0.5f) / _e92);
         }
     }
-    let _e93 = nu_12;
-    let _e94 = ScatteringUnitNu(_e93);
-    let _e95 = u_mu_s;
-    let _e96 = u_mu;
-    let _e97 = u_r;
-    return vec4<f32>(_e94, _e95, _e96, _e97);
+    let _e94 = nu_12;
+    let _e95 = ScatteringUnitNu(_e94);
+    let _e96 = u_mu_s;
+    let _e97 = u_mu;
+    let _e98 = u_r;
+    return vec4<f32>(_e95, _e96, _e97, _e98);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_60: AtmosphereParameters, r_36: f32, mu_27: f32, mu_s_15: f32, nu_13: f32, ray_r_mu_intersects_ground_17: bool) -> vec4<f32> {
-    var atmosphere_61: AtmosphereParameters;
-    var r_37: f32;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_68: AtmosphereParameters, r_38: f32, mu_27: f32, mu_s_19: f32, nu_13: f32, ray_r_mu_intersects_ground_17: bool) -> vec4<f32> {
+    var atmosphere_69: AtmosphereParameters;
+    var r_39: f32;
     var mu_28: f32;
-    var mu_s_16: f32;
+    var mu_s_20: f32;
     var nu_14: f32;
     var ray_r_mu_intersects_ground_18: bool;
     var unused_3: vec2<f32>;
 
-    atmosphere_61 = atmosphere_60;
-    r_37 = r_36;
-    mu_28 = mu_27;
-    mu_s_16 = mu_s_15;
-    nu_14 = nu_13;
-    ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
-    let _e24 = atmosphere_61;
-    let _e25 = r_37;
-    let _e26 = mu_28;
-    let _e27 = mu_s_16;
-    let _e28 = nu_14;
-    let _e29 = ray_r_mu_intersects_ground_18;
-    let _e32 = GetScatteringTextureUvwzAndEdge(_e24, _e25, _e26, _e27, _e28, _e29, (&unused_3));
-    return _e32;
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_62: AtmosphereParameters) -> f32 {
-    var atmosphere_63: AtmosphereParameters;
-    var local_15: f32;
-
-    atmosphere_63 = atmosphere_62;
-    let _e14 = atmosphere_63;
-    if (_e14.mu_s_min < LOW_SUN_MU_S) {
-        local_15 = LOW_SUN_MU_S;
-    } else {
-        let _e18 = atmosphere_63;
-        local_15 = (0.5f * (_e18.mu_s_min + 1f));
-    }
-    let _e24 = local_15;
-    return _e24;
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_64: AtmosphereParameters, mu_s_17: f32) -> f32 {
-    var atmosphere_65: AtmosphereParameters;
-    var mu_s_18: f32;
-    var knee: f32;
-    var local_16: f32;
-
-    atmosphere_65 = atmosphere_64;
-    mu_s_18 = mu_s_17;
-    let _e16 = atmosphere_65;
-    let _e17 = IrradianceKneeMuS(_e16);
-    knee = _e17;
-    let _e19 = mu_s_18;
-    let _e20 = knee;
-    if (_e19 < _e20) {
-        let _e23 = mu_s_18;
-        let _e24 = atmosphere_65;
-        let _e28 = knee;
-        let _e29 = atmosphere_65;
-        local_16 = ((0.5f * (_e23 - _e24.mu_s_min)) / (_e28 - _e29.mu_s_min));
-    } else {
-        let _e35 = mu_s_18;
-        let _e36 = knee;
-        let _e40 = knee;
-        local_16 = (0.5f + ((0.5f * (_e35 - _e36)) / (1f - _e40)));
-    }
-    let _e45 = local_16;
-    return _e45;
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_66: AtmosphereParameters, x_14: f32) -> f32 {
-    var atmosphere_67: AtmosphereParameters;
-    var x_15: f32;
-    var knee_1: f32;
-    var local_17: f32;
-
-    atmosphere_67 = atmosphere_66;
-    x_15 = x_14;
-    let _e16 = atmosphere_67;
-    let _e17 = IrradianceKneeMuS(_e16);
-    knee_1 = _e17;
-    let _e19 = x_15;
-    if (_e19 < 0.5f) {
-        let _e22 = atmosphere_67;
-        let _e25 = x_15;
-        let _e27 = knee_1;
-        let _e28 = atmosphere_67;
-        local_17 = (_e22.mu_s_min + ((2f * _e25) * (_e27 - _e28.mu_s_min)));
-    } else {
-        let _e33 = knee_1;
-        let _e35 = x_15;
-        let _e40 = knee_1;
-        local_17 = (_e33 + (((2f * _e35) - 1f) * (1f - _e40)));
-    }
-    let _e45 = local_17;
-    return _e45;
-}
-
-// skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_68: AtmosphereParameters, r_38: f32, mu_s_19: f32) -> vec2<f32> {
-    var atmosphere_69: AtmosphereParameters;
-    var r_39: f32;
-    var mu_s_20: f32;
-    var x_r_1: f32;
-    var x_mu_s_1: f32;
-
     atmosphere_69 = atmosphere_68;
     r_39 = r_38;
+    mu_28 = mu_27;
     mu_s_20 = mu_s_19;
-    let _e18 = atmosphere_69;
-    let _e19 = r_39;
-    let _e20 = HorizonDistance(_e18, _e19);
-    let _e21 = atmosphere_69;
-    let _e22 = HorizonDistanceAtTop(_e21);
-    x_r_1 = (_e20 / _e22);
+    nu_14 = nu_13;
+    ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
     let _e25 = atmosphere_69;
-    let _e26 = mu_s_20;
-    let _e27 = GetIrradianceUnitMuS(_e25, _e26);
-    x_mu_s_1 = clamp(_e27, 0f, 1f);
-    let _e32 = x_mu_s_1;
-    let _e33 = atmosphere_69;
-    let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_width);
-    let _e36 = x_r_1;
-    let _e37 = atmosphere_69;
-    let _e39 = GetTextureCoordFromUnitRange(_e36, _e37.irradiance_height);
-    return vec2<f32>(_e35, _e39);
+    let _e26 = r_39;
+    let _e27 = mu_28;
+    let _e28 = mu_s_20;
+    let _e29 = nu_14;
+    let _e30 = ray_r_mu_intersects_ground_18;
+    let _e33 = GetScatteringTextureUvwzAndEdge(_e25, _e26, _e27, _e28, _e29, _e30, (&unused_3));
+    return _e33;
 }
 
 fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_70: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_40: f32, mu_29: f32) -> vec3<f32> {
@@ -2168,14 +2168,15 @@ fn GetScatteringMuSColumns(atmosphere_82: AtmosphereParameters, u_mu_s_1: f32, x
     let _e45 = mu_s_column;
     let _e48 = mu_s_size_1;
     (*x_above) = ((_e45 + 1.5f) / _e48);
-    let _e50 = (*x_below);
-    let _e51 = x_low_sun_1;
-    (*low_sun_below) = (_e50 < _e51);
-    let _e53 = mu_s_coord;
-    let _e54 = mu_s_column;
-    let _e56 = (*low_sun_below);
-    let _e57 = SunCosinePosition((_e53 - _e54), _e56);
-    (*mu_s_t) = _e57;
+    let _e50 = atmosphere_83;
+    let _e53 = (*x_below);
+    let _e54 = x_low_sun_1;
+    (*low_sun_below) = ((_e50.scattering_mu_s_min < LOW_SUN_MU_S) && (_e53 < _e54));
+    let _e57 = mu_s_coord;
+    let _e58 = mu_s_column;
+    let _e60 = (*low_sun_below);
+    let _e61 = SunCosinePosition((_e57 - _e58), _e60);
+    (*mu_s_t) = _e61;
     return;
 }
 
