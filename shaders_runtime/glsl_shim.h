@@ -25,6 +25,7 @@ using Number = double;
 using vec2 = glm::dvec2;
 using vec3 = glm::dvec3;
 using vec4 = glm::dvec4;
+using bvec4 = glm::bvec4;
 
 using glm::clamp;
 using glm::dot;

@@ -315,75 +315,136 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
                       x - k, true);
 }
 
-// 4D lookup: the mu_s texel columns either side of mu_s
-// (GetScatteringAtMuSColumn, two fetches each), blended linearly in
-// daylight by the texture unit (two fetches); for a low sun between two columns by
-// LogMonotoneCubicMix of the four columns around it (eight fetches), and
-// below the table's lowest sun by LowestSunLogFall of the two lowest
-// columns (four fetches). Below the split, each nu slice's light on the
-// ray's own columns (GetScatteringBelowSplit, up to four fetches each),
-// geometric between the two slices, and past the ray's first column
-// LowestSunLogFall of its first two (four fetches).
-vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
-                   Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
+// Where a lookup of the scattering tables reads and how it blends, for one
+// ray and sun: found once (GetScatteringLookup) and applied to each table
+// (GetScatteringFromLookup), so that the single Mie table costs fetches and
+// blends but none of the coordinates' arithmetic.
+const int SCATTERING_DAYLIGHT = 0;          // linear along mu_s: one fetch per nu slice at x.x
+const int SCATTERING_LOW_SUN = 1;           // LogMonotoneCubicMix of the columns at x, at t
+const int SCATTERING_BELOW_TABLE = 2;       // LowestSunContinued of the columns at x.x and x.y
+const int SCATTERING_OWN_COLUMNS = 3;       // GetScatteringBelowSplit in each nu slice, at position
+struct ScatteringLookup {
+  int kind;
+  vec4 uvwz;         // GetScatteringTextureUvwzAndEdge
+  Number nu_slice;   // the lower of the two nu slices, and the position between them
+  Number nu_t;
+  vec4 x;            // the mu_s columns' coordinates within a slice
+  bvec4 low_sun;     // per column: its two nu slices blended geometrically
+  bool has_first;    // SCATTERING_LOW_SUN: whether x.x and x.w are columns of their own
+  bool has_last;
+  Number t;          // SCATTERING_LOW_SUN: between x.y and x.z
+  Number mu_s_a;     // SCATTERING_BELOW_TABLE: the sun cosines of x.x and x.y, and the sun's
+  Number mu_s_b;
+  Number mu_s;
+  Number position;        // SCATTERING_OWN_COLUMNS
+  Number log_first_span;
+};
+
+ScatteringLookup GetScatteringLookup(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number mu_s,
+                                     Number nu, bool ray_r_mu_intersects_ground) {
+  ScatteringLookup lookup;
   vec2 edge;
-  vec4 uvwz = GetScatteringTextureUvwzAndEdge(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground, edge);
+  lookup.uvwz = GetScatteringTextureUvwzAndEdge(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground, edge);
   Number nu_size = Number(atmosphere.scattering_nu_size);
-  Number nu_coord = uvwz.x * (nu_size - 1.0);
-  Number nu_slice = min(floor(nu_coord), nu_size - 2.0);
-  Number nu_t = nu_coord - nu_slice;
+  Number nu_coord = lookup.uvwz.x * (nu_size - 1.0);
+  lookup.nu_slice = min(floor(nu_coord), nu_size - 2.0);
+  lookup.nu_t = nu_coord - lookup.nu_slice;
+  lookup.low_sun = bvec4(true);
+  lookup.has_first = false;
+  lookup.has_last = false;
+  lookup.t = 0.0;
+  lookup.mu_s_a = 0.0;
+  lookup.mu_s_b = 0.0;
+  lookup.mu_s = mu_s;
+  lookup.log_first_span = 1.0;
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
-  Number position = uvwz.y * mu_s_size - 0.5;
-  if (atmosphere.scattering_mu_s_split > 0 && position < Number(atmosphere.scattering_mu_s_split)) {
+  lookup.position = lookup.uvwz.y * mu_s_size - 0.5;
+  if (atmosphere.scattering_mu_s_split > 0 && lookup.position < Number(atmosphere.scattering_mu_s_split)) {
     Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
-    Number log_first_span = 1.0;
-    if (position < past) {
-      if (position < 0.0) {
-        // Past the first column (the tables' lowest sun, or
-        // SHADOW_EDGE_LEAST_PAST_SPAN past the edge): ln L continued from
-        // the first two (LowestSunLogFall), as below the tables' lowest sun.
-        Number step = ShadowEdgePastStep(atmosphere, edge);
-        return LowestSunContinued(
-            GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 0.5 / mu_s_size, nu_slice, nu_t, true),
-            GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, 1.5 / mu_s_size, nu_slice, nu_t, true),
-            ShadowEdgeSunCosine(edge, -(past - 1.0) * step), ShadowEdgeSunCosine(edge, -(past - 2.0) * step), mu_s);
-      }
-      if (position >= past - 1.0) {
-        Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
-        log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge) / SHADOW_EDGE_CLOSEST);
-      }
+    lookup.kind = SCATTERING_OWN_COLUMNS;
+    lookup.x = vec4(0.0);
+    if (lookup.position < 0.0) {
+      // Past the first column (the tables' lowest sun, or
+      // SHADOW_EDGE_LEAST_PAST_SPAN past the edge): ln L continued from
+      // the first two (LowestSunLogFall), as below the tables' lowest sun.
+      Number step = ShadowEdgePastStep(atmosphere, edge);
+      lookup.kind = SCATTERING_BELOW_TABLE;
+      lookup.x = vec4(0.5, 1.5, 0.0, 0.0) / mu_s_size;
+      lookup.mu_s_a = ShadowEdgeSunCosine(edge, -(past - 1.0) * step);
+      lookup.mu_s_b = ShadowEdgeSunCosine(edge, -(past - 2.0) * step);
+    } else if (lookup.position >= past - 1.0 && lookup.position < past) {
+      Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
+      lookup.log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge) / SHADOW_EDGE_CLOSEST);
     }
-    return SunCosineMix(
-        GetScatteringBelowSplit(atmosphere, scattering_texture, uvwz, position, nu_slice, log_first_span),
-        GetScatteringBelowSplit(atmosphere, scattering_texture, uvwz, position, nu_slice + 1.0, log_first_span),
-        nu_t, true);
+    return lookup;
   }
   Number x_below;
   Number x_above;
-  Number mu_s_t;
   bool low_sun_below;
   Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
-  GetScatteringMuSColumns(atmosphere, uvwz.y, x_low_sun, x_below, x_above, mu_s_t, low_sun_below);
+  GetScatteringMuSColumns(atmosphere, lookup.uvwz.y, x_low_sun, x_below, x_above, lookup.t, low_sun_below);
   if (!low_sun_below) {
     // Daylight: linear along mu_s, which the texture unit does within a nu
-    // slice, so one fetch at mu_s_t between the two columns reads their blend.
-    return GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, mix(x_below, x_above, mu_s_t), nu_slice,
-                                    nu_t, false);
+    // slice, so one fetch at t between the two columns reads their blend.
+    lookup.kind = SCATTERING_DAYLIGHT;
+    lookup.x = vec4(mix(x_below, x_above, lookup.t), 0.0, 0.0, 0.0);
+    lookup.low_sun = bvec4(false);
+    return lookup;
   }
-  vec4 below = GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_below, nu_slice, nu_t, true);
-  vec4 above =
-      GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_above, nu_slice, nu_t, x_above < x_low_sun);
-  if (mu_s_t < 0.0) {
-    return LowestSunContinued(below, above, atmosphere.scattering_mu_s_min,
-                              GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0)), mu_s);
+  if (lookup.t < 0.0) {
+    lookup.kind = SCATTERING_BELOW_TABLE;
+    lookup.x = vec4(x_below, x_above, 0.0, 0.0);
+    lookup.low_sun = bvec4(true, x_above < x_low_sun, true, true);
+    lookup.mu_s_a = atmosphere.scattering_mu_s_min;
+    lookup.mu_s_b = GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0));
+    return lookup;
   }
   Number column = x_below * mu_s_size - 0.5;
-  Number x_first = (max(column - 1.0, 0.0) + 0.5) / mu_s_size;
   Number x_last = (min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-  vec4 first = GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_first, nu_slice, nu_t, true);
-  vec4 last =
-      GetScatteringAtMuSColumn(atmosphere, scattering_texture, uvwz, x_last, nu_slice, nu_t, x_last < x_low_sun);
-  return LogMonotoneCubicMix(first, below, above, last, column > 0.5, column + 2.0 < mu_s_size - 0.5, mu_s_t);
+  lookup.kind = SCATTERING_LOW_SUN;
+  lookup.x = vec4((max(column - 1.0, 0.0) + 0.5) / mu_s_size, x_below, x_above, x_last);
+  lookup.low_sun = bvec4(true, true, x_above < x_low_sun, x_last < x_low_sun);
+  lookup.has_first = column > 0.5;
+  lookup.has_last = column + 2.0 < mu_s_size - 0.5;
+  return lookup;
+}
+
+// The lookup applied to one table: in daylight two fetches (the texture unit
+// blends the two mu_s columns); for a low sun between two columns
+// LogMonotoneCubicMix of the four around it (eight fetches); below the
+// table's lowest sun, or past a ray's first own column, LowestSunLogFall of
+// the two lowest (four fetches); below the split, each nu slice's light on
+// the ray's own columns (GetScatteringBelowSplit, up to four fetches each),
+// geometric between the two slices.
+vec4 GetScatteringFromLookup(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                             IN(ScatteringLookup) lookup) {
+  if (lookup.kind == SCATTERING_OWN_COLUMNS) {
+    return SunCosineMix(GetScatteringBelowSplit(atmosphere, scattering_texture, lookup.uvwz, lookup.position,
+                                                lookup.nu_slice, lookup.log_first_span),
+                        GetScatteringBelowSplit(atmosphere, scattering_texture, lookup.uvwz, lookup.position,
+                                                lookup.nu_slice + 1.0, lookup.log_first_span),
+                        lookup.nu_t, true);
+  }
+  vec4 a = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.x, lookup.nu_slice,
+                                    lookup.nu_t, lookup.low_sun.x);
+  if (lookup.kind == SCATTERING_DAYLIGHT) return a;
+  vec4 b = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.y, lookup.nu_slice,
+                                    lookup.nu_t, lookup.low_sun.y);
+  if (lookup.kind == SCATTERING_BELOW_TABLE) {
+    return LowestSunContinued(a, b, lookup.mu_s_a, lookup.mu_s_b, lookup.mu_s);
+  }
+  vec4 c = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.z, lookup.nu_slice,
+                                    lookup.nu_t, lookup.low_sun.z);
+  vec4 d = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.w, lookup.nu_slice,
+                                    lookup.nu_t, lookup.low_sun.w);
+  return LogMonotoneCubicMix(a, b, c, d, lookup.has_first, lookup.has_last, lookup.t);
+}
+
+// The 4D lookup of one table.
+vec4 GetScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                   Number r, Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
+  return GetScatteringFromLookup(atmosphere, scattering_texture,
+                                 GetScatteringLookup(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground));
 }
 #endif
 

@@ -20,7 +20,8 @@ vec3 GetCombinedScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTex
                            IN(ScatteringTexture) single_mie_scattering_texture, Number r, Number mu,
                            Number mu_s, Number nu, bool ray_r_mu_intersects_ground,
                            OUT(vec3) single_mie_scattering) {
-  vec4 scattering = GetScattering(atmosphere, scattering_texture, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
+  ScatteringLookup lookup = GetScatteringLookup(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
+  vec4 scattering = GetScatteringFromLookup(atmosphere, scattering_texture, lookup);
   if (atmosphere.single_mie_in_scattering_alpha == 1) {
     // Only the red channel of single Mie was stored; rebuild the others from the
     // main table's colour (Bruneton 2017, Section "Combined scattering").
@@ -29,8 +30,7 @@ vec3 GetCombinedScattering(IN(AtmosphereParameters) atmosphere, IN(ScatteringTex
                                                              atmosphere.mie_to_rayleigh_scattering_ratio.r)
         : vec3(0.0);
   } else {
-    single_mie_scattering = vec3(GetScattering(atmosphere, single_mie_scattering_texture, r, mu, mu_s, nu,
-                                               ray_r_mu_intersects_ground));
+    single_mie_scattering = vec3(GetScatteringFromLookup(atmosphere, single_mie_scattering_texture, lookup));
   }
   return vec3(scattering);
 }

@@ -29,3 +29,21 @@ struct AtmosphereParameters
     float3 mie_scattering_profile[64];
     float3 rayleigh_scattering_profile[64];
 };
+
+struct ScatteringLookup
+{
+    int kind;
+    float4 uvwz;
+    float nu_slice;
+    float nu_t;
+    float4 x;
+    bool4 low_sun;
+    bool has_first;
+    bool has_last;
+    float t;
+    float mu_s_a;
+    float mu_s_b;
+    float mu_s;
+    float position;
+    float log_first_span;
+};

@@ -77,3 +77,21 @@ struct AtmosphereParameters
     spvUnsafeArray<float3, 64> mie_scattering_profile;
     spvUnsafeArray<float3, 64> rayleigh_scattering_profile;
 };
+
+struct ScatteringLookup
+{
+    int kind;
+    float4 uvwz;
+    float nu_slice;
+    float nu_t;
+    float4 x;
+    short4 low_sun;
+    short has_first;
+    short has_last;
+    float t;
+    float mu_s_a;
+    float mu_s_b;
+    float mu_s;
+    float position;
+    float log_first_span;
+};

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1056 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1064 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1056)
+    if (!_1064)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _919 = mu < 0.0f;
-    bool _931;
-    if (_919)
+    bool _927 = mu < 0.0f;
+    bool _939;
+    if (_927)
     {
-        _931 = (((r * r) * mu) * mu) >= c;
+        _939 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _931 = _919;
+        _939 = _927;
     }
-    return _931;
+    return _939;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _689;
+    float _697;
     if (r_mu > 0.0f)
     {
-        _689 = c / (r_mu + s);
+        _697 = c / (r_mu + s);
     }
     else
     {
-        _689 = s - r_mu;
+        _697 = s - r_mu;
     }
-    float param_1 = _689;
+    float param_1 = _697;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1160;
+    float _1168;
     if (d_max > d_min)
     {
-        _1160 = (d - d_min) / (d_max - d_min);
+        _1168 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1160 = 0.0f;
+        _1168 = 0.0f;
     }
-    float x_mu = _1160;
+    float x_mu = _1168;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -203,16 +203,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1212;
+        float _1220;
         if (rho == d_min)
         {
-            _1212 = 0.0f;
+            _1220 = 0.0f;
         }
         else
         {
-            _1212 = (d - d_min) / (rho - d_min);
+            _1220 = (d - d_min) / (rho - d_min);
         }
-        return _1212;
+        return _1220;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -221,16 +221,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1247;
+    float _1255;
     if (d_max > d_min_1)
     {
-        _1247 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1255 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1247 = 0.0f;
+        _1255 = 0.0f;
     }
-    return _1247;
+    return _1255;
 }
 #endif
 
@@ -240,16 +240,16 @@ float GetTextureCoordFromUnitMuInHalf(float x, bool ray_r_mu_intersects_ground, 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5f * GetTextureCoordFromUnitRange(param, param_1);
-    float _1270;
+    float _1278;
     if (ray_r_mu_intersects_ground)
     {
-        _1270 = 0.5f - u;
+        _1278 = 0.5f - u;
     }
     else
     {
-        _1270 = 0.5f + u;
+        _1278 = 0.5f + u;
     }
-    return _1270;
+    return _1278;
 }
 #endif
 
@@ -349,39 +349,39 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1587;
+    float _1595;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1587 = ClampCosine(param_1);
+        _1595 = ClampCosine(param_1);
     }
     else
     {
-        _1587 = 1.0f;
+        _1595 = 1.0f;
     }
-    return _1587;
+    return _1595;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _935;
+    float _943;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _935 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _943 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _935 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _943 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _935;
+    return _943;
 }
 #endif
 
@@ -434,52 +434,52 @@ float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_p
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0f - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1693;
+    float2 _1701;
     if (c_end >= rho)
     {
-        _1693 = float2(-1.0f, 0.0f);
+        _1701 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1693 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
+        _1701 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float2 end = _1693;
-    bool _1721 = end.y < 0.0f;
-    bool _1731;
-    if (!_1721)
+    float2 end = _1701;
+    bool _1729 = end.y < 0.0f;
+    bool _1739;
+    if (!_1729)
     {
-        _1731 = end.x < start.x;
+        _1739 = end.x < start.x;
     }
     else
     {
-        _1731 = _1721;
+        _1739 = _1729;
     }
-    bool end_sets_last = _1731;
+    bool end_sets_last = _1739;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
     float sin_a = a * (1.0f - ((a * a) / 6.0f));
-    bool2 _1763 = end_sets_last.xx;
-    float2 last = float2(_1763.x ? end.x : start.x, _1763.y ? end.y : start.y);
+    bool2 _1771 = end_sets_last.xx;
+    float2 last = float2(_1771.x ? end.x : start.x, _1771.y ? end.y : start.y);
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1786;
+    float _1794;
     if (end_sets_last)
     {
-        float _1792;
+        float _1800;
         if (c_end >= rho)
         {
-            _1792 = 3.1415927410125732421875f;
+            _1800 = 3.1415927410125732421875f;
         }
         else
         {
-            _1792 = atan2(across, cos_alpha) + acos(cos_gamma);
+            _1800 = atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1786 = _1792;
+        _1794 = _1800;
     }
     else
     {
-        _1786 = acos(c_start);
+        _1794 = acos(c_start);
     }
-    float angle = _1786;
+    float angle = _1794;
     return angle + a;
 }
 #endif
@@ -517,17 +517,17 @@ float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
     float param_5 = 1.0f / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1416;
+    float _1424;
     if (d == 0.0f)
     {
-        _1416 = 1.0f;
+        _1424 = 1.0f;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1416 = ClampCosine(param_6);
+        _1424 = ClampCosine(param_6);
     }
-    return _1416;
+    return _1424;
 }
 #endif
 
@@ -578,15 +578,15 @@ void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, float2 edge, inout 
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1995 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _2003 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1995;
+    X_closest = _2003;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _2002 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _2010 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _2002 - X_closest;
+    X_span = _2010 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -602,9 +602,9 @@ float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, float D, float2 edg
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1952 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1960 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1952;
+    float X = _1960;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
@@ -631,9 +631,9 @@ float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, float _distance, float2
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _2047 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _2055 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _2047;
+    return _2055;
 }
 #endif
 
@@ -702,17 +702,17 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r,
     float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = 0.0f.xx;
-    bool _2356 = atmosphere.scattering_mu_s_split > 0;
-    bool _2367;
-    if (_2356)
+    bool _2364 = atmosphere.scattering_mu_s_split > 0;
+    bool _2375;
+    if (_2364)
     {
-        _2367 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2375 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2367 = _2356;
+        _2375 = _2364;
     }
-    if (_2367)
+    if (_2375)
     {
         float param_17 = mu;
         float param_18 = mu_s;
@@ -723,7 +723,7 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r,
         float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
         bool param_24 = ray_r_mu_intersects_ground;
         float2 param_25;
-        float _2387 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
+        float _2395 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
         edge = param_25;
         float2 param_26 = edge;
         float param_27 = mu_s;
@@ -734,78 +734,6 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r,
     }
     float param_31 = nu;
     return float4(ScatteringUnitNu(param_31), u_mu_s, u_mu, u_r);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-float4 GetScatteringInSlice(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float4 uvwz, float x, float nu_slice)
-{
-    return scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3((nu_slice + x) / float(atmosphere.scattering_nu_size), uvwz.z, uvwz.w), 0.0f);
-}
-#endif
-
-float4 SunCosineMix(float4 a, float4 b, float t, bool low_sun)
-{
-    if (!low_sun)
-    {
-        return lerp(a, b, t.xxxx);
-    }
-    float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
-    return exp(lerp(log(max(a, dark)), log(max(b, dark)), t.xxxx)) * step(dark, max(a, b));
-}
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-float4 GetScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float4 uvwz, float x, float nu_slice, float nu_t, bool low_sun)
-{
-    AtmosphereParameters param = atmosphere;
-    float4 param_1 = uvwz;
-    float param_2 = x;
-    float param_3 = nu_slice;
-    AtmosphereParameters param_4 = atmosphere;
-    float4 param_5 = uvwz;
-    float param_6 = x;
-    float param_7 = nu_slice + 1.0f;
-    float4 param_8 = GetScatteringInSlice(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3);
-    float4 param_9 = GetScatteringInSlice(param_4, scattering_texture_1, _scattering_texture_1_sampler, param_5, param_6, param_7);
-    float param_10 = nu_t;
-    bool param_11 = low_sun;
-    return SunCosineMix(param_8, param_9, param_10, param_11);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-void LowestSunLogFall(float4 a, float4 b, float mu_s_a, float mu_s_b, out float4 slope, out float4 curvature)
-{
-    float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
-    float4 rise = ((log(max(b, dark)) - log(max(a, dark))) * step(dark, a)) * (1.0f.xxxx - step(b, a));
-    if (mu_s_b < 0.0f)
-    {
-        float4 k = rise / ((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b)).xxxx;
-        slope = k * ((-2.0f) * mu_s_a);
-        curvature = -k;
-    }
-    else
-    {
-        slope = rise / (mu_s_b - mu_s_a).xxxx;
-        curvature = 0.0f.xxxx;
-    }
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-float4 LowestSunContinued(float4 a, float4 b, float mu_s_a, float mu_s_b, float mu_s)
-{
-    float4 param = a;
-    float4 param_1 = b;
-    float param_2 = mu_s_a;
-    float param_3 = mu_s_b;
-    float4 param_4;
-    float4 param_5;
-    LowestSunLogFall(param, param_1, param_2, param_3, param_4, param_5);
-    float4 slope = param_4;
-    float4 curvature = param_5;
-    float d = mu_s - mu_s_a;
-    return a * exp((slope + (curvature * d)) * d);
 }
 #endif
 
@@ -835,9 +763,9 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edg
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _2105 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _2113 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _2105 - x;
+        float error = _2113 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -847,6 +775,176 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edg
         }
     }
     return exp(s);
+}
+#endif
+
+float SunCosinePosition(float t, bool low_sun)
+{
+    float _2632;
+    if (low_sun)
+    {
+        _2632 = min(t, 1.0f);
+    }
+    else
+    {
+        _2632 = clamp(t, 0.0f, 1.0f);
+    }
+    return _2632;
+}
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, float x_low_sun, inout float x_below, out float x_above, out float mu_s_t, inout bool low_sun_below)
+{
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    float mu_s_coord = (u_mu_s * mu_s_size) - 0.5f;
+    float mu_s_column = clamp(floor(mu_s_coord), 0.0f, mu_s_size - 2.0f);
+    x_below = (mu_s_column + 0.5f) / mu_s_size;
+    x_above = (mu_s_column + 1.5f) / mu_s_size;
+    bool _2692 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
+    bool _2698;
+    if (_2692)
+    {
+        _2698 = x_below < x_low_sun;
+    }
+    else
+    {
+        _2698 = _2692;
+    }
+    low_sun_below = _2698;
+    float param = mu_s_coord - mu_s_column;
+    bool param_1 = low_sun_below;
+    mu_s_t = SunCosinePosition(param, param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = mu_s;
+    float param_4 = nu;
+    bool param_5 = ray_r_mu_intersects_ground;
+    float2 param_6;
+    float4 _3237 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float2 edge = param_6;
+    ScatteringLookup lookup;
+    lookup.uvwz = _3237;
+    float nu_size = float(atmosphere.scattering_nu_size);
+    float nu_coord = lookup.uvwz.x * (nu_size - 1.0f);
+    lookup.nu_slice = min(floor(nu_coord), nu_size - 2.0f);
+    lookup.nu_t = nu_coord - lookup.nu_slice;
+    lookup.low_sun = bool4(true, true, true, true);
+    lookup.has_first = false;
+    lookup.has_last = false;
+    lookup.t = 0.0f;
+    lookup.mu_s_a = 0.0f;
+    lookup.mu_s_b = 0.0f;
+    lookup.mu_s = mu_s;
+    lookup.log_first_span = 1.0f;
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5f;
+    bool _3289 = atmosphere.scattering_mu_s_split > 0;
+    bool _3298;
+    if (_3289)
+    {
+        _3298 = lookup.position < float(atmosphere.scattering_mu_s_split);
+    }
+    else
+    {
+        _3298 = _3289;
+    }
+    if (_3298)
+    {
+        float past = 6.0f;
+        lookup.kind = 3;
+        lookup.x = 0.0f.xxxx;
+        if (lookup.position < 0.0f)
+        {
+            AtmosphereParameters param_7 = atmosphere;
+            float2 param_8 = edge;
+            float _step = ShadowEdgePastStep(param_7, param_8);
+            lookup.kind = 2;
+            lookup.x = float4(0.5f, 1.5f, 0.0f, 0.0f) / mu_s_size.xxxx;
+            float2 param_9 = edge;
+            float param_10 = (-(past - 1.0f)) * _step;
+            lookup.mu_s_a = ShadowEdgeSunCosine(param_9, param_10);
+            float2 param_11 = edge;
+            float param_12 = (-(past - 2.0f)) * _step;
+            lookup.mu_s_b = ShadowEdgeSunCosine(param_11, param_12);
+        }
+        else
+        {
+            bool _3346 = lookup.position >= (past - 1.0f);
+            bool _3353;
+            if (_3346)
+            {
+                _3353 = lookup.position < past;
+            }
+            else
+            {
+                _3353 = _3346;
+            }
+            if (_3353)
+            {
+                float x = 1.0f / (float(atmosphere.scattering_mu_s_split) - past);
+                AtmosphereParameters param_13 = atmosphere;
+                float param_14 = x;
+                float2 param_15 = edge;
+                lookup.log_first_span = log(ShadowEdgeLitDistance(param_13, param_14, param_15) / 0.0008726646192371845245361328125f);
+            }
+        }
+        return lookup;
+    }
+    AtmosphereParameters param_16 = atmosphere;
+    float param_17 = 0.100000001490116119384765625f;
+    float x_low_sun = GetScatteringTextureUMuS(param_16, param_17);
+    AtmosphereParameters param_18 = atmosphere;
+    float param_19 = lookup.uvwz.y;
+    float param_20 = x_low_sun;
+    float param_21;
+    float param_22;
+    float param_23;
+    bool param_24;
+    GetScatteringMuSColumns(param_18, param_19, param_20, param_21, param_22, param_23, param_24);
+    float x_below = param_21;
+    float x_above = param_22;
+    lookup.t = param_23;
+    bool low_sun_below = param_24;
+    if (!low_sun_below)
+    {
+        lookup.kind = 0;
+        lookup.x = float4(lerp(x_below, x_above, lookup.t), 0.0f, 0.0f, 0.0f);
+        lookup.low_sun = bool4(false, false, false, false);
+        return lookup;
+    }
+    if (lookup.t < 0.0f)
+    {
+        lookup.kind = 2;
+        lookup.x = float4(x_below, x_above, 0.0f, 0.0f);
+        lookup.low_sun = bool4(true, x_above < x_low_sun, true, true);
+        lookup.mu_s_a = atmosphere.scattering_mu_s_min;
+        AtmosphereParameters param_25 = atmosphere;
+        float param_26 = 1.0f / (mu_s_size - 1.0f);
+        lookup.mu_s_b = GetScatteringMuSFromUnitRange(param_25, param_26);
+        return lookup;
+    }
+    float column = (x_below * mu_s_size) - 0.5f;
+    float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
+    lookup.kind = 1;
+    lookup.x = float4((max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size, x_below, x_above, x_last);
+    lookup.low_sun = bool4(true, true, x_above < x_low_sun, x_last < x_low_sun);
+    lookup.has_first = column > 0.5f;
+    lookup.has_last = (column + 2.0f) < (mu_s_size - 0.5f);
+    return lookup;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float4 GetScatteringInSlice(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float4 uvwz, float x, float nu_slice)
+{
+    return scattering_texture_1.SampleLevel(_scattering_texture_1_sampler, float3((nu_slice + x) / float(atmosphere.scattering_nu_size), uvwz.z, uvwz.w), 0.0f);
 }
 #endif
 
@@ -867,26 +965,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _2711;
+    float4 _2719;
     if (has_a)
     {
-        _2711 = log(max(a, dark));
+        _2719 = log(max(a, dark));
     }
     else
     {
-        _2711 = (lb * 2.0f) - lc;
+        _2719 = (lb * 2.0f) - lc;
     }
-    float4 la = _2711;
-    float4 _2726;
+    float4 la = _2719;
+    float4 _2734;
     if (has_d)
     {
-        _2726 = log(max(d, dark));
+        _2734 = log(max(d, dark));
     }
     else
     {
-        _2726 = (lc * 2.0f) - lb;
+        _2734 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2726;
+    float4 ld = _2734;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -903,6 +1001,16 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     return exp(lerp(lerp(lb, lc, t.xxxx), cubic, lit)) * step(dark, max(b, c));
 }
 #endif
+
+float4 SunCosineMix(float4 a, float4 b, float t, bool low_sun)
+{
+    if (!low_sun)
+    {
+        return lerp(a, b, t.xxxx);
+    }
+    float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
+    return exp(lerp(log(max(a, dark)), log(max(b, dark)), t.xxxx)) * step(dark, max(a, b));
+}
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float4 GetScatteringBelowSplit(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float4 uvwz, float position, float nu_slice, float log_first_span)
@@ -978,208 +1086,131 @@ float4 GetScatteringBelowSplit(AtmosphereParameters atmosphere, Texture3D<float4
 }
 #endif
 
-float SunCosinePosition(float t, bool low_sun)
-{
-    float _2624;
-    if (low_sun)
-    {
-        _2624 = min(t, 1.0f);
-    }
-    else
-    {
-        _2624 = clamp(t, 0.0f, 1.0f);
-    }
-    return _2624;
-}
-
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, float x_low_sun, inout float x_below, out float x_above, out float mu_s_t, inout bool low_sun_below)
+float4 GetScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float4 uvwz, float x, float nu_slice, float nu_t, bool low_sun)
 {
-    float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    float mu_s_coord = (u_mu_s * mu_s_size) - 0.5f;
-    float mu_s_column = clamp(floor(mu_s_coord), 0.0f, mu_s_size - 2.0f);
-    x_below = (mu_s_column + 0.5f) / mu_s_size;
-    x_above = (mu_s_column + 1.5f) / mu_s_size;
-    bool _2684 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
-    bool _2690;
-    if (_2684)
-    {
-        _2690 = x_below < x_low_sun;
-    }
-    else
-    {
-        _2690 = _2684;
-    }
-    low_sun_below = _2690;
-    float param = mu_s_coord - mu_s_column;
-    bool param_1 = low_sun_below;
-    mu_s_t = SunCosinePosition(param, param_1);
+    AtmosphereParameters param = atmosphere;
+    float4 param_1 = uvwz;
+    float param_2 = x;
+    float param_3 = nu_slice;
+    AtmosphereParameters param_4 = atmosphere;
+    float4 param_5 = uvwz;
+    float param_6 = x;
+    float param_7 = nu_slice + 1.0f;
+    float4 param_8 = GetScatteringInSlice(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3);
+    float4 param_9 = GetScatteringInSlice(param_4, scattering_texture_1, _scattering_texture_1_sampler, param_5, param_6, param_7);
+    float param_10 = nu_t;
+    bool param_11 = low_sun;
+    return SunCosineMix(param_8, param_9, param_10, param_11);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float4 GetScattering(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground)
+void LowestSunLogFall(float4 a, float4 b, float mu_s_a, float mu_s_b, out float4 slope, out float4 curvature)
 {
-    AtmosphereParameters param = atmosphere;
-    float param_1 = r;
-    float param_2 = mu;
-    float param_3 = mu_s;
-    float param_4 = nu;
-    bool param_5 = ray_r_mu_intersects_ground;
-    float2 param_6;
-    float4 _3229 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
-    float2 edge = param_6;
-    float4 uvwz = _3229;
-    float nu_size = float(atmosphere.scattering_nu_size);
-    float nu_coord = uvwz.x * (nu_size - 1.0f);
-    float nu_slice = min(floor(nu_coord), nu_size - 2.0f);
-    float nu_t = nu_coord - nu_slice;
-    float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    float position = (uvwz.y * mu_s_size) - 0.5f;
-    bool _3263 = atmosphere.scattering_mu_s_split > 0;
-    bool _3271;
-    if (_3263)
+    float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
+    float4 rise = ((log(max(b, dark)) - log(max(a, dark))) * step(dark, a)) * (1.0f.xxxx - step(b, a));
+    if (mu_s_b < 0.0f)
     {
-        _3271 = position < float(atmosphere.scattering_mu_s_split);
+        float4 k = rise / ((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b)).xxxx;
+        slope = k * ((-2.0f) * mu_s_a);
+        curvature = -k;
     }
     else
     {
-        _3271 = _3263;
+        slope = rise / (mu_s_b - mu_s_a).xxxx;
+        curvature = 0.0f.xxxx;
     }
-    if (_3271)
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float4 LowestSunContinued(float4 a, float4 b, float mu_s_a, float mu_s_b, float mu_s)
+{
+    float4 param = a;
+    float4 param_1 = b;
+    float param_2 = mu_s_a;
+    float param_3 = mu_s_b;
+    float4 param_4;
+    float4 param_5;
+    LowestSunLogFall(param, param_1, param_2, param_3, param_4, param_5);
+    float4 slope = param_4;
+    float4 curvature = param_5;
+    float d = mu_s - mu_s_a;
+    return a * exp((slope + (curvature * d)) * d);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float4 GetScatteringFromLookup(AtmosphereParameters atmosphere, Texture3D<float4> scattering_texture_1, SamplerState _scattering_texture_1_sampler, ScatteringLookup lookup)
+{
+    if (lookup.kind == 3)
     {
-        float past = 6.0f;
-        float log_first_span = 1.0f;
-        if (position < past)
-        {
-            if (position < 0.0f)
-            {
-                AtmosphereParameters param_7 = atmosphere;
-                float2 param_8 = edge;
-                float _step = ShadowEdgePastStep(param_7, param_8);
-                AtmosphereParameters param_9 = atmosphere;
-                float4 param_10 = uvwz;
-                float param_11 = 0.5f / mu_s_size;
-                float param_12 = nu_slice;
-                float param_13 = nu_t;
-                bool param_14 = true;
-                AtmosphereParameters param_15 = atmosphere;
-                float4 param_16 = uvwz;
-                float param_17 = 1.5f / mu_s_size;
-                float param_18 = nu_slice;
-                float param_19 = nu_t;
-                bool param_20 = true;
-                float2 param_21 = edge;
-                float param_22 = (-(past - 1.0f)) * _step;
-                float2 param_23 = edge;
-                float param_24 = (-(past - 2.0f)) * _step;
-                float4 param_25 = GetScatteringAtMuSColumn(param_9, scattering_texture_1, _scattering_texture_1_sampler, param_10, param_11, param_12, param_13, param_14);
-                float4 param_26 = GetScatteringAtMuSColumn(param_15, scattering_texture_1, _scattering_texture_1_sampler, param_16, param_17, param_18, param_19, param_20);
-                float param_27 = ShadowEdgeSunCosine(param_21, param_22);
-                float param_28 = ShadowEdgeSunCosine(param_23, param_24);
-                float param_29 = mu_s;
-                return LowestSunContinued(param_25, param_26, param_27, param_28, param_29);
-            }
-            if (position >= (past - 1.0f))
-            {
-                float x = 1.0f / (float(atmosphere.scattering_mu_s_split) - past);
-                AtmosphereParameters param_30 = atmosphere;
-                float param_31 = x;
-                float2 param_32 = edge;
-                log_first_span = log(ShadowEdgeLitDistance(param_30, param_31, param_32) / 0.0008726646192371845245361328125f);
-            }
-        }
-        AtmosphereParameters param_33 = atmosphere;
-        float4 param_34 = uvwz;
-        float param_35 = position;
-        float param_36 = nu_slice;
-        float param_37 = log_first_span;
-        AtmosphereParameters param_38 = atmosphere;
-        float4 param_39 = uvwz;
-        float param_40 = position;
-        float param_41 = nu_slice + 1.0f;
-        float param_42 = log_first_span;
-        float4 param_43 = GetScatteringBelowSplit(param_33, scattering_texture_1, _scattering_texture_1_sampler, param_34, param_35, param_36, param_37);
-        float4 param_44 = GetScatteringBelowSplit(param_38, scattering_texture_1, _scattering_texture_1_sampler, param_39, param_40, param_41, param_42);
-        float param_45 = nu_t;
-        bool param_46 = true;
-        return SunCosineMix(param_43, param_44, param_45, param_46);
+        AtmosphereParameters param = atmosphere;
+        float4 param_1 = lookup.uvwz;
+        float param_2 = lookup.position;
+        float param_3 = lookup.nu_slice;
+        float param_4 = lookup.log_first_span;
+        AtmosphereParameters param_5 = atmosphere;
+        float4 param_6 = lookup.uvwz;
+        float param_7 = lookup.position;
+        float param_8 = lookup.nu_slice + 1.0f;
+        float param_9 = lookup.log_first_span;
+        float4 param_10 = GetScatteringBelowSplit(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4);
+        float4 param_11 = GetScatteringBelowSplit(param_5, scattering_texture_1, _scattering_texture_1_sampler, param_6, param_7, param_8, param_9);
+        float param_12 = lookup.nu_t;
+        bool param_13 = true;
+        return SunCosineMix(param_10, param_11, param_12, param_13);
     }
-    AtmosphereParameters param_47 = atmosphere;
-    float param_48 = 0.100000001490116119384765625f;
-    float x_low_sun = GetScatteringTextureUMuS(param_47, param_48);
-    AtmosphereParameters param_49 = atmosphere;
-    float param_50 = uvwz.y;
-    float param_51 = x_low_sun;
-    float param_52;
-    float param_53;
-    float param_54;
-    bool param_55;
-    GetScatteringMuSColumns(param_49, param_50, param_51, param_52, param_53, param_54, param_55);
-    float x_below = param_52;
-    float x_above = param_53;
-    float mu_s_t = param_54;
-    bool low_sun_below = param_55;
-    if (!low_sun_below)
+    AtmosphereParameters param_14 = atmosphere;
+    float4 param_15 = lookup.uvwz;
+    float param_16 = lookup.x.x;
+    float param_17 = lookup.nu_slice;
+    float param_18 = lookup.nu_t;
+    bool param_19 = lookup.low_sun.x;
+    float4 a = GetScatteringAtMuSColumn(param_14, scattering_texture_1, _scattering_texture_1_sampler, param_15, param_16, param_17, param_18, param_19);
+    if (lookup.kind == 0)
     {
-        AtmosphereParameters param_56 = atmosphere;
-        float4 param_57 = uvwz;
-        float param_58 = lerp(x_below, x_above, mu_s_t);
-        float param_59 = nu_slice;
-        float param_60 = nu_t;
-        bool param_61 = false;
-        return GetScatteringAtMuSColumn(param_56, scattering_texture_1, _scattering_texture_1_sampler, param_57, param_58, param_59, param_60, param_61);
+        return a;
     }
-    AtmosphereParameters param_62 = atmosphere;
-    float4 param_63 = uvwz;
-    float param_64 = x_below;
-    float param_65 = nu_slice;
-    float param_66 = nu_t;
-    bool param_67 = true;
-    float4 below = GetScatteringAtMuSColumn(param_62, scattering_texture_1, _scattering_texture_1_sampler, param_63, param_64, param_65, param_66, param_67);
-    AtmosphereParameters param_68 = atmosphere;
-    float4 param_69 = uvwz;
-    float param_70 = x_above;
-    float param_71 = nu_slice;
-    float param_72 = nu_t;
-    bool param_73 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_68, scattering_texture_1, _scattering_texture_1_sampler, param_69, param_70, param_71, param_72, param_73);
-    if (mu_s_t < 0.0f)
+    AtmosphereParameters param_20 = atmosphere;
+    float4 param_21 = lookup.uvwz;
+    float param_22 = lookup.x.y;
+    float param_23 = lookup.nu_slice;
+    float param_24 = lookup.nu_t;
+    bool param_25 = lookup.low_sun.y;
+    float4 b = GetScatteringAtMuSColumn(param_20, scattering_texture_1, _scattering_texture_1_sampler, param_21, param_22, param_23, param_24, param_25);
+    if (lookup.kind == 2)
     {
-        AtmosphereParameters param_74 = atmosphere;
-        float param_75 = 1.0f / (mu_s_size - 1.0f);
-        float4 param_76 = below;
-        float4 param_77 = above;
-        float param_78 = atmosphere.scattering_mu_s_min;
-        float param_79 = GetScatteringMuSFromUnitRange(param_74, param_75);
-        float param_80 = mu_s;
-        return LowestSunContinued(param_76, param_77, param_78, param_79, param_80);
+        float4 param_26 = a;
+        float4 param_27 = b;
+        float param_28 = lookup.mu_s_a;
+        float param_29 = lookup.mu_s_b;
+        float param_30 = lookup.mu_s;
+        return LowestSunContinued(param_26, param_27, param_28, param_29, param_30);
     }
-    float column = (x_below * mu_s_size) - 0.5f;
-    float x_first = (max(column - 1.0f, 0.0f) + 0.5f) / mu_s_size;
-    float x_last = (min(column + 2.0f, mu_s_size - 1.0f) + 0.5f) / mu_s_size;
-    AtmosphereParameters param_81 = atmosphere;
-    float4 param_82 = uvwz;
-    float param_83 = x_first;
-    float param_84 = nu_slice;
-    float param_85 = nu_t;
-    bool param_86 = true;
-    float4 first = GetScatteringAtMuSColumn(param_81, scattering_texture_1, _scattering_texture_1_sampler, param_82, param_83, param_84, param_85, param_86);
-    AtmosphereParameters param_87 = atmosphere;
-    float4 param_88 = uvwz;
-    float param_89 = x_last;
-    float param_90 = nu_slice;
-    float param_91 = nu_t;
-    bool param_92 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_87, scattering_texture_1, _scattering_texture_1_sampler, param_88, param_89, param_90, param_91, param_92);
-    float4 param_93 = first;
-    float4 param_94 = below;
-    float4 param_95 = above;
-    float4 param_96 = last;
-    bool param_97 = column > 0.5f;
-    bool param_98 = (column + 2.0f) < (mu_s_size - 0.5f);
-    float param_99 = mu_s_t;
-    return LogMonotoneCubicMix(param_93, param_94, param_95, param_96, param_97, param_98, param_99);
+    AtmosphereParameters param_31 = atmosphere;
+    float4 param_32 = lookup.uvwz;
+    float param_33 = lookup.x.z;
+    float param_34 = lookup.nu_slice;
+    float param_35 = lookup.nu_t;
+    bool param_36 = lookup.low_sun.z;
+    float4 c = GetScatteringAtMuSColumn(param_31, scattering_texture_1, _scattering_texture_1_sampler, param_32, param_33, param_34, param_35, param_36);
+    AtmosphereParameters param_37 = atmosphere;
+    float4 param_38 = lookup.uvwz;
+    float param_39 = lookup.x.w;
+    float param_40 = lookup.nu_slice;
+    float param_41 = lookup.nu_t;
+    bool param_42 = lookup.low_sun.w;
+    float4 d = GetScatteringAtMuSColumn(param_37, scattering_texture_1, _scattering_texture_1_sampler, param_38, param_39, param_40, param_41, param_42);
+    float4 param_43 = a;
+    float4 param_44 = b;
+    float4 param_45 = c;
+    float4 param_46 = d;
+    bool param_47 = lookup.has_first;
+    bool param_48 = lookup.has_last;
+    float param_49 = lookup.t;
+    return LogMonotoneCubicMix(param_43, param_44, param_45, param_46, param_47, param_48, param_49);
 }
 #endif
 
@@ -1192,29 +1223,28 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float param_3 = mu_s;
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
-    float4 scattering = GetScattering(param, scattering_texture_1, _scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    ScatteringLookup lookup = GetScatteringLookup(param, param_1, param_2, param_3, param_4, param_5);
+    AtmosphereParameters param_6 = atmosphere;
+    ScatteringLookup param_7 = lookup;
+    float4 scattering = GetScatteringFromLookup(param_6, scattering_texture_1, _scattering_texture_1_sampler, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3695;
+        float3 _3791;
         if (scattering.x > 0.0f)
         {
-            _3695 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3791 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3695 = 0.0f.xxx;
+            _3791 = 0.0f.xxx;
         }
-        single_mie_scattering = _3695;
+        single_mie_scattering = _3791;
     }
     else
     {
-        AtmosphereParameters param_6 = atmosphere;
-        float param_7 = r;
-        float param_8 = mu;
-        float param_9 = mu_s;
-        float param_10 = nu;
-        bool param_11 = ray_r_mu_intersects_ground;
-        single_mie_scattering = float3(GetScattering(param_6, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_7, param_8, param_9, param_10, param_11).xyz);
+        AtmosphereParameters param_8 = atmosphere;
+        ScatteringLookup param_9 = lookup;
+        single_mie_scattering = float3(GetScatteringFromLookup(param_8, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_9).xyz);
     }
     return float3(scattering.xyz);
 }
@@ -1274,9 +1304,9 @@ float3 GetSkyRadianceOfRay(AtmosphereParameters atmosphere, Texture3D<float4> sc
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3760 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3847 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3760;
+    float3 scattering = _3847;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1296,13 +1326,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _3795 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3882 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3795)
+    if (!_3882)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1311,19 +1341,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3815;
+    float3 _3902;
     if (ray_r_mu_intersects_ground)
     {
-        _3815 = 0.0f.xxx;
+        _3902 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3815 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _3902 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _3815;
+    transmittance = _3902;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1345,16 +1375,16 @@ float GetUnitRangeFromTextureCoord(float u, int texture_size)
 float GetUnitMuInHalfFromTextureCoord(float u, int size, inout bool ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5f;
-    float _1284;
+    float _1292;
     if (ray_r_mu_intersects_ground)
     {
-        _1284 = 1.0f - (2.0f * u);
+        _1292 = 1.0f - (2.0f * u);
     }
     else
     {
-        _1284 = (2.0f * u) - 1.0f;
+        _1292 = (2.0f * u) - 1.0f;
     }
-    float param = _1284;
+    float param = _1292;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1375,25 +1405,25 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _4977 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5063 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _4977;
+    float x = _5063;
     float e = (1.0f - x) * (1.0f - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _4998;
+    float _5084;
     if (ray_r_mu_intersects_ground)
     {
-        _4998 = theta_h + (e * (3.1415927410125732421875f - theta_h));
+        _5084 = theta_h + (e * (3.1415927410125732421875f - theta_h));
     }
     else
     {
-        _4998 = theta_h * (1.0f - e);
+        _5084 = theta_h * (1.0f - e);
     }
-    float theta = _4998;
+    float theta = _5084;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875f * clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0f, 1.0f);
@@ -1401,8 +1431,8 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
     if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13f)
     {
-        bool3 _5048 = (abs(up.x) < 0.89999997615814208984375f).xxx;
-        toward_sun = cross(up, float3(_5048.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5048.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5048.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
+        bool3 _5134 = (abs(up.x) < 0.89999997615814208984375f).xxx;
+        toward_sun = cross(up, float3(_5134.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5134.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5134.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
     }
     toward_sun = normalize(toward_sun);
     float3 across = cross(up, toward_sun);
@@ -1418,9 +1448,9 @@ float3 GetSkyViewRadiance(AtmosphereParameters atmosphere, Texture3D<float4> sca
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5087 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5173 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5087;
+    float3 view_ray = _5173;
     float3 up = normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1447,16 +1477,16 @@ void GetSkyViewAngles(float3 camera, float3 view_ray, float3 sun_direction, out 
     theta = atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _4963;
+    float _5049;
     if ((along != 0.0f) || (side != 0.0f))
     {
-        _4963 = atan2(side, along);
+        _5049 = atan2(side, along);
     }
     else
     {
-        _4963 = 0.0f;
+        _5049 = 0.0f;
     }
-    phi = _4963;
+    phi = _5049;
 }
 #endif
 
@@ -1466,16 +1496,16 @@ float2 GetSkyViewUvFromAngles(AtmosphereParameters atmosphere, float r, float th
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _4884;
+    float _4970;
     if (ray_r_mu_intersects_ground)
     {
-        _4884 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
+        _4970 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
     }
     else
     {
-        _4884 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
+        _4970 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
     }
-    float x = _4884;
+    float x = _4970;
     float param_2 = phi / 3.1415927410125732421875f;
     int param_3 = 192;
     float param_4 = x;
@@ -1497,19 +1527,19 @@ float3 GetSkyRadianceFromSkyView(AtmosphereParameters atmosphere, Texture2D<floa
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5149;
+    float3 _5235;
     if (ray_r_mu_intersects_ground)
     {
-        _5149 = 0.0f.xxx;
+        _5235 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5149 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
+        _5235 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
     }
-    transmittance = _5149;
+    transmittance = _5235;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1553,16 +1583,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _3919;
+    float _4006;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _3919 = a * exp(f * log(b / a));
+        _4006 = a * exp(f * log(b / a));
     }
     else
     {
-        _3919 = lerp(a, b, f);
+        _4006 = lerp(a, b, f);
     }
-    return _3919;
+    return _4006;
 }
 #endif
 
@@ -1628,16 +1658,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _4170;
+    float _4256;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _4170 = 1.0f - (0.5f * depth);
+        _4256 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _4170 = (1.0f - exp(-depth)) / depth;
+        _4256 = (1.0f - exp(-depth)) / depth;
     }
-    return _4170;
+    return _4256;
 }
 #endif
 
@@ -1673,10 +1703,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4250 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4336 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4250;
+        float3 extinction = _4336;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1734,10 +1764,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4115 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4202 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4115;
+        float3 extinction = _4202;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1810,14 +1840,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _4140;
+    float3 _4226;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4140 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4226 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1826,9 +1856,9 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4140 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _4226 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _4140;
+    return _4226;
 }
 #endif
 
@@ -1841,16 +1871,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3881;
+    float _3968;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _3881 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3968 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3881 = up;
+        _3968 = up;
     }
-    return _3881;
+    return _3968;
 }
 #endif
 
@@ -1873,13 +1903,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4396 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4482 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4396)
+    if (!_4482)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1919,11 +1949,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4491 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4577 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4491;
+        lit_optical_depth = _4577;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1937,11 +1967,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4525 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4611 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4525;
+        optical_depth += _4611;
     }
     if (direct < 1.0f)
     {
@@ -1960,9 +1990,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4568 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4654 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4568;
+    float3 scattering = _4654;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -1983,11 +2013,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4616 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4702 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4616;
+        float3 far_optical_depth = _4702;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -2007,9 +2037,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4670 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4756 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4670);
+            scattering -= (exp(-far_optical_depth) * _4756);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -2030,9 +2060,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4735 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4821 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4735;
+    float3 scattering_p = _4821;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -2052,9 +2082,9 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4779 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _4865 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4779;
+    return _4865;
 }
 #endif
 
@@ -2082,9 +2112,9 @@ float3 GetAerialPerspectiveVoxel(AtmosphereParameters atmosphere, Texture2D<floa
     float3 param_3 = _point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5243 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
+    float3 _5329 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5243;
+    float3 radiance = _5329;
     optical_depth = -log(max(transmittance, 1.0000000031710768509710513471353e-30f.xxx));
     return radiance;
 }
@@ -2112,16 +2142,16 @@ float3 GetSkyRadianceToPointFromVolume(Texture3D<float4> radiance_volume, Sample
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1465;
+    float _1473;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1465 = 0.100000001490116119384765625f;
+        _1473 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1465 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1473 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1465;
+    return _1473;
 }
 #endif
 
@@ -2130,16 +2160,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1483;
+    float _1491;
     if (mu_s < knee)
     {
-        _1483 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1491 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1483 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1491 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1483;
+    return _1491;
 }
 #endif
 
@@ -2166,16 +2196,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1514;
+    float _1522;
     if (x < 0.5f)
     {
-        _1514 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1522 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1514 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1522 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1514;
+    return _1522;
 }
 #endif
 
@@ -2187,16 +2217,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2647;
+    float4 _2655;
     if (t < 0.0f)
     {
-        _2647 = min(blend, a);
+        _2655 = min(blend, a);
     }
     else
     {
-        _2647 = blend;
+        _2655 = blend;
     }
-    return _2647;
+    return _2655;
 }
 #endif
 

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1056 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1064 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1056)
+    if (!_1064)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _919 = mu < 0.0;
-    bool _931;
-    if (_919)
+    bool _927 = mu < 0.0;
+    bool _939;
+    if (_927)
     {
-        _931 = (((r * r) * mu) * mu) >= c;
+        _939 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _931 = _919;
+        _939 = _927;
     }
-    return _931;
+    return _939;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _689;
+    float _697;
     if (r_mu > 0.0)
     {
-        _689 = c / (r_mu + s);
+        _697 = c / (r_mu + s);
     }
     else
     {
-        _689 = s - r_mu;
+        _697 = s - r_mu;
     }
-    float param_1 = _689;
+    float param_1 = _697;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1160;
+    float _1168;
     if (d_max > d_min)
     {
-        _1160 = (d - d_min) / (d_max - d_min);
+        _1168 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1160 = 0.0;
+        _1168 = 0.0;
     }
-    float x_mu = _1160;
+    float x_mu = _1168;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -220,16 +220,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1212;
+        float _1220;
         if (rho == d_min)
         {
-            _1212 = 0.0;
+            _1220 = 0.0;
         }
         else
         {
-            _1212 = (d - d_min) / (rho - d_min);
+            _1220 = (d - d_min) / (rho - d_min);
         }
-        return _1212;
+        return _1220;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -238,16 +238,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1247;
+    float _1255;
     if (d_max > d_min_1)
     {
-        _1247 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1255 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1247 = 0.0;
+        _1255 = 0.0;
     }
-    return _1247;
+    return _1255;
 }
 #endif
 
@@ -258,16 +258,16 @@ float GetTextureCoordFromUnitMuInHalf(thread const float& x, thread const bool& 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5 * GetTextureCoordFromUnitRange(param, param_1);
-    float _1270;
+    float _1278;
     if (ray_r_mu_intersects_ground)
     {
-        _1270 = 0.5 - u;
+        _1278 = 0.5 - u;
     }
     else
     {
-        _1270 = 0.5 + u;
+        _1278 = 0.5 + u;
     }
-    return _1270;
+    return _1278;
 }
 #endif
 
@@ -374,17 +374,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1587;
+    float _1595;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1587 = ClampCosine(param_1);
+        _1595 = ClampCosine(param_1);
     }
     else
     {
-        _1587 = 1.0;
+        _1595 = 1.0;
     }
-    return _1587;
+    return _1595;
 }
 #endif
 
@@ -392,22 +392,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _935;
+    float _943;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _935 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _943 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _935 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _943 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _935;
+    return _943;
 }
 #endif
 
@@ -464,51 +464,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1693;
+    float2 _1701;
     if (c_end >= rho)
     {
-        _1693 = float2(-1.0, 0.0);
+        _1701 = float2(-1.0, 0.0);
     }
     else
     {
-        _1693 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1701 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1693;
-    bool _1721 = end.y < 0.0;
-    bool _1731;
-    if (!_1721)
+    float2 end = _1701;
+    bool _1729 = end.y < 0.0;
+    bool _1739;
+    if (!_1729)
     {
-        _1731 = end.x < start.x;
+        _1739 = end.x < start.x;
     }
     else
     {
-        _1731 = _1721;
+        _1739 = _1729;
     }
-    bool end_sets_last = _1731;
+    bool end_sets_last = _1739;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1786;
+    float _1794;
     if (end_sets_last)
     {
-        float _1792;
+        float _1800;
         if (c_end >= rho)
         {
-            _1792 = 3.1415927410125732421875;
+            _1800 = 3.1415927410125732421875;
         }
         else
         {
-            _1792 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1800 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1786 = _1792;
+        _1794 = _1800;
     }
     else
     {
-        _1786 = acos(c_start);
+        _1794 = acos(c_start);
     }
-    float angle = _1786;
+    float angle = _1794;
     return angle + a;
 }
 #endif
@@ -549,17 +549,17 @@ float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmospher
     float param_5 = 1.0 / A;
     float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
     float d = d_min + (fast::min(a, A) * (d_max - d_min));
-    float _1416;
+    float _1424;
     if (d == 0.0)
     {
-        _1416 = 1.0;
+        _1424 = 1.0;
     }
     else
     {
         float param_6 = ((H * H) - (d * d)) / ((2.0 * bottom) * d);
-        _1416 = ClampCosine(param_6);
+        _1424 = ClampCosine(param_6);
     }
-    return _1416;
+    return _1424;
 }
 #endif
 
@@ -614,15 +614,15 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _1995 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _2003 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _1995;
+    X_closest = _2003;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _2002 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _2010 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _2002 - X_closest;
+    X_span = _2010 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -639,9 +639,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1952 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1960 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1952;
+    float X = _1960;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -669,9 +669,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _2047 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _2055 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _2047;
+    return _2055;
 }
 #endif
 
@@ -744,17 +744,17 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
     float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = float2(0.0);
-    bool _2356 = atmosphere.scattering_mu_s_split > 0;
-    bool _2367;
-    if (_2356)
+    bool _2364 = atmosphere.scattering_mu_s_split > 0;
+    bool _2375;
+    if (_2364)
     {
-        _2367 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2375 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2367 = _2356;
+        _2375 = _2364;
     }
-    if (_2367)
+    if (_2375)
     {
         float param_17 = mu;
         float param_18 = mu_s;
@@ -765,7 +765,7 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
         float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
         bool param_24 = ray_r_mu_intersects_ground;
         float2 param_25;
-        float _2387 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
+        float _2395 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
         edge = param_25;
         float2 param_26 = edge;
         float param_27 = mu_s;
@@ -776,83 +776,6 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
     }
     float param_31 = nu;
     return float4(ScatteringUnitNu(param_31), u_mu_s, u_mu, u_r);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
-float4 GetScatteringInSlice(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice)
-{
-    return scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / float(atmosphere.scattering_nu_size), uvwz.z, uvwz.w), level(0.0));
-}
-#endif
-
-static inline __attribute__((always_inline))
-float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
-{
-    if (!low_sun)
-    {
-        return mix(a, b, float4(t));
-    }
-    float4 dark = float4(1.0000000031710768509710513471353e-30);
-    return exp(mix(log(fast::max(a, dark)), log(fast::max(b, dark)), float4(t))) * step(dark, fast::max(a, b));
-}
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
-float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
-{
-    AtmosphereParameters param = atmosphere;
-    float4 param_1 = uvwz;
-    float param_2 = x;
-    float param_3 = nu_slice;
-    AtmosphereParameters param_4 = atmosphere;
-    float4 param_5 = uvwz;
-    float param_6 = x;
-    float param_7 = nu_slice + 1.0;
-    float4 param_8 = GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
-    float4 param_9 = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
-    float param_10 = nu_t;
-    bool param_11 = low_sun;
-    return SunCosineMix(param_8, param_9, param_10, param_11);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
-void LowestSunLogFall(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread float4& slope, thread float4& curvature)
-{
-    float4 dark = float4(1.0000000031710768509710513471353e-30);
-    float4 rise = ((log(fast::max(b, dark)) - log(fast::max(a, dark))) * step(dark, a)) * (float4(1.0) - step(b, a));
-    if (mu_s_b < 0.0)
-    {
-        float4 k = rise / float4((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b));
-        slope = k * ((-2.0) * mu_s_a);
-        curvature = -k;
-    }
-    else
-    {
-        slope = rise / float4(mu_s_b - mu_s_a);
-        curvature = float4(0.0);
-    }
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
-float4 LowestSunContinued(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread const float& mu_s)
-{
-    float4 param = a;
-    float4 param_1 = b;
-    float param_2 = mu_s_a;
-    float param_3 = mu_s_b;
-    float4 param_4;
-    float4 param_5;
-    LowestSunLogFall(param, param_1, param_2, param_3, param_4, param_5);
-    float4 slope = param_4;
-    float4 curvature = param_5;
-    float d = mu_s - mu_s_a;
-    return a * exp((slope + (curvature * d)) * d);
 }
 #endif
 
@@ -883,9 +806,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _2105 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _2113 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _2105 - x;
+        float error = _2113 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -895,6 +818,180 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         }
     }
     return exp(s);
+}
+#endif
+
+static inline __attribute__((always_inline))
+float SunCosinePosition(thread const float& t, thread const bool& low_sun)
+{
+    float _2632;
+    if (low_sun)
+    {
+        _2632 = fast::min(t, 1.0);
+    }
+    else
+    {
+        _2632 = fast::clamp(t, 0.0, 1.0);
+    }
+    return _2632;
+}
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thread const float& u_mu_s, thread const float& x_low_sun, thread float& x_below, thread float& x_above, thread float& mu_s_t, thread bool& low_sun_below)
+{
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    float mu_s_coord = (u_mu_s * mu_s_size) - 0.5;
+    float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
+    x_below = (mu_s_column + 0.5) / mu_s_size;
+    x_above = (mu_s_column + 1.5) / mu_s_size;
+    bool _2692 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
+    bool _2698;
+    if (_2692)
+    {
+        _2698 = x_below < x_low_sun;
+    }
+    else
+    {
+        _2698 = _2692;
+    }
+    low_sun_below = _2698;
+    float param = mu_s_coord - mu_s_column;
+    bool param_1 = low_sun_below;
+    mu_s_t = SunCosinePosition(param, param_1);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = mu_s;
+    float param_4 = nu;
+    bool param_5 = ray_r_mu_intersects_ground;
+    float2 param_6;
+    float4 _3237 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float2 edge = param_6;
+    ScatteringLookup lookup;
+    lookup.uvwz = _3237;
+    float nu_size = float(atmosphere.scattering_nu_size);
+    float nu_coord = lookup.uvwz.x * (nu_size - 1.0);
+    lookup.nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
+    lookup.nu_t = nu_coord - lookup.nu_slice;
+    lookup.low_sun = short4(bool4(true));
+    lookup.has_first = short(false);
+    lookup.has_last = short(false);
+    lookup.t = 0.0;
+    lookup.mu_s_a = 0.0;
+    lookup.mu_s_b = 0.0;
+    lookup.mu_s = mu_s;
+    lookup.log_first_span = 1.0;
+    float mu_s_size = float(atmosphere.scattering_mu_s_size);
+    lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5;
+    bool _3289 = atmosphere.scattering_mu_s_split > 0;
+    bool _3298;
+    if (_3289)
+    {
+        _3298 = lookup.position < float(atmosphere.scattering_mu_s_split);
+    }
+    else
+    {
+        _3298 = _3289;
+    }
+    if (_3298)
+    {
+        float past = 6.0;
+        lookup.kind = 3;
+        lookup.x = float4(0.0);
+        if (lookup.position < 0.0)
+        {
+            AtmosphereParameters param_7 = atmosphere;
+            float2 param_8 = edge;
+            float _step = ShadowEdgePastStep(param_7, param_8);
+            lookup.kind = 2;
+            lookup.x = float4(0.5, 1.5, 0.0, 0.0) / float4(mu_s_size);
+            float2 param_9 = edge;
+            float param_10 = (-(past - 1.0)) * _step;
+            lookup.mu_s_a = ShadowEdgeSunCosine(param_9, param_10);
+            float2 param_11 = edge;
+            float param_12 = (-(past - 2.0)) * _step;
+            lookup.mu_s_b = ShadowEdgeSunCosine(param_11, param_12);
+        }
+        else
+        {
+            bool _3346 = lookup.position >= (past - 1.0);
+            bool _3353;
+            if (_3346)
+            {
+                _3353 = lookup.position < past;
+            }
+            else
+            {
+                _3353 = _3346;
+            }
+            if (_3353)
+            {
+                float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
+                AtmosphereParameters param_13 = atmosphere;
+                float param_14 = x;
+                float2 param_15 = edge;
+                lookup.log_first_span = log(ShadowEdgeLitDistance(param_13, param_14, param_15) / 0.0008726646192371845245361328125);
+            }
+        }
+        return lookup;
+    }
+    AtmosphereParameters param_16 = atmosphere;
+    float param_17 = 0.100000001490116119384765625;
+    float x_low_sun = GetScatteringTextureUMuS(param_16, param_17);
+    AtmosphereParameters param_18 = atmosphere;
+    float param_19 = lookup.uvwz.y;
+    float param_20 = x_low_sun;
+    float param_21;
+    float param_22;
+    float param_23;
+    bool param_24;
+    GetScatteringMuSColumns(param_18, param_19, param_20, param_21, param_22, param_23, param_24);
+    float x_below = param_21;
+    float x_above = param_22;
+    lookup.t = param_23;
+    bool low_sun_below = param_24;
+    if (!low_sun_below)
+    {
+        lookup.kind = 0;
+        lookup.x = float4(mix(x_below, x_above, lookup.t), 0.0, 0.0, 0.0);
+        lookup.low_sun = short4(bool4(false));
+        return lookup;
+    }
+    if (lookup.t < 0.0)
+    {
+        lookup.kind = 2;
+        lookup.x = float4(x_below, x_above, 0.0, 0.0);
+        lookup.low_sun = short4(bool4(true, x_above < x_low_sun, true, true));
+        lookup.mu_s_a = atmosphere.scattering_mu_s_min;
+        AtmosphereParameters param_25 = atmosphere;
+        float param_26 = 1.0 / (mu_s_size - 1.0);
+        lookup.mu_s_b = GetScatteringMuSFromUnitRange(param_25, param_26);
+        return lookup;
+    }
+    float column = (x_below * mu_s_size) - 0.5;
+    float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
+    lookup.kind = 1;
+    lookup.x = float4((fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size, x_below, x_above, x_last);
+    lookup.low_sun = short4(bool4(true, true, x_above < x_low_sun, x_last < x_low_sun));
+    lookup.has_first = short(column > 0.5);
+    lookup.has_last = short((column + 2.0) < (mu_s_size - 0.5));
+    return lookup;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 GetScatteringInSlice(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice)
+{
+    return scattering_texture.sample(scattering_textureSmplr, float3((nu_slice + x) / float(atmosphere.scattering_nu_size), uvwz.z, uvwz.w), level(0.0));
 }
 #endif
 
@@ -917,26 +1014,26 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float4 dark = float4(1.0000000031710768509710513471353e-30);
     float4 lb = log(fast::max(b, dark));
     float4 lc = log(fast::max(c, dark));
-    float4 _2711;
+    float4 _2719;
     if (has_a)
     {
-        _2711 = log(fast::max(a, dark));
+        _2719 = log(fast::max(a, dark));
     }
     else
     {
-        _2711 = (lb * 2.0) - lc;
+        _2719 = (lb * 2.0) - lc;
     }
-    float4 la = _2711;
-    float4 _2726;
+    float4 la = _2719;
+    float4 _2734;
     if (has_d)
     {
-        _2726 = log(fast::max(d, dark));
+        _2734 = log(fast::max(d, dark));
     }
     else
     {
-        _2726 = (lc * 2.0) - lb;
+        _2734 = (lc * 2.0) - lb;
     }
-    float4 ld = _2726;
+    float4 ld = _2734;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -953,6 +1050,17 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     return exp(mix(mix(lb, lc, float4(t)), cubic, lit)) * step(dark, fast::max(b, c));
 }
 #endif
+
+static inline __attribute__((always_inline))
+float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
+{
+    if (!low_sun)
+    {
+        return mix(a, b, float4(t));
+    }
+    float4 dark = float4(1.0000000031710768509710513471353e-30);
+    return exp(mix(log(fast::max(a, dark)), log(fast::max(b, dark)), float4(t))) * step(dark, fast::max(a, b));
+}
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
@@ -1029,211 +1137,135 @@ float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, te
 }
 #endif
 
-static inline __attribute__((always_inline))
-float SunCosinePosition(thread const float& t, thread const bool& low_sun)
-{
-    float _2624;
-    if (low_sun)
-    {
-        _2624 = fast::min(t, 1.0);
-    }
-    else
-    {
-        _2624 = fast::clamp(t, 0.0, 1.0);
-    }
-    return _2624;
-}
-
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thread const float& u_mu_s, thread const float& x_low_sun, thread float& x_below, thread float& x_above, thread float& mu_s_t, thread bool& low_sun_below)
+float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
 {
-    float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    float mu_s_coord = (u_mu_s * mu_s_size) - 0.5;
-    float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
-    x_below = (mu_s_column + 0.5) / mu_s_size;
-    x_above = (mu_s_column + 1.5) / mu_s_size;
-    bool _2684 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
-    bool _2690;
-    if (_2684)
-    {
-        _2690 = x_below < x_low_sun;
-    }
-    else
-    {
-        _2690 = _2684;
-    }
-    low_sun_below = _2690;
-    float param = mu_s_coord - mu_s_column;
-    bool param_1 = low_sun_below;
-    mu_s_t = SunCosinePosition(param, param_1);
+    AtmosphereParameters param = atmosphere;
+    float4 param_1 = uvwz;
+    float param_2 = x;
+    float param_3 = nu_slice;
+    AtmosphereParameters param_4 = atmosphere;
+    float4 param_5 = uvwz;
+    float param_6 = x;
+    float param_7 = nu_slice + 1.0;
+    float4 param_8 = GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
+    float4 param_9 = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
+    float param_10 = nu_t;
+    bool param_11 = low_sun;
+    return SunCosineMix(param_8, param_9, param_10, param_11);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScattering(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const bool& ray_r_mu_intersects_ground)
+void LowestSunLogFall(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread float4& slope, thread float4& curvature)
 {
-    AtmosphereParameters param = atmosphere;
-    float param_1 = r;
-    float param_2 = mu;
-    float param_3 = mu_s;
-    float param_4 = nu;
-    bool param_5 = ray_r_mu_intersects_ground;
-    float2 param_6;
-    float4 _3229 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
-    float2 edge = param_6;
-    float4 uvwz = _3229;
-    float nu_size = float(atmosphere.scattering_nu_size);
-    float nu_coord = uvwz.x * (nu_size - 1.0);
-    float nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
-    float nu_t = nu_coord - nu_slice;
-    float mu_s_size = float(atmosphere.scattering_mu_s_size);
-    float position = (uvwz.y * mu_s_size) - 0.5;
-    bool _3263 = atmosphere.scattering_mu_s_split > 0;
-    bool _3271;
-    if (_3263)
+    float4 dark = float4(1.0000000031710768509710513471353e-30);
+    float4 rise = ((log(fast::max(b, dark)) - log(fast::max(a, dark))) * step(dark, a)) * (float4(1.0) - step(b, a));
+    if (mu_s_b < 0.0)
     {
-        _3271 = position < float(atmosphere.scattering_mu_s_split);
+        float4 k = rise / float4((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b));
+        slope = k * ((-2.0) * mu_s_a);
+        curvature = -k;
     }
     else
     {
-        _3271 = _3263;
+        slope = rise / float4(mu_s_b - mu_s_a);
+        curvature = float4(0.0);
     }
-    if (_3271)
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 LowestSunContinued(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread const float& mu_s)
+{
+    float4 param = a;
+    float4 param_1 = b;
+    float param_2 = mu_s_a;
+    float param_3 = mu_s_b;
+    float4 param_4;
+    float4 param_5;
+    LowestSunLogFall(param, param_1, param_2, param_3, param_4, param_5);
+    float4 slope = param_4;
+    float4 curvature = param_5;
+    float d = mu_s - mu_s_a;
+    return a * exp((slope + (curvature * d)) * d);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+static inline __attribute__((always_inline))
+float4 GetScatteringFromLookup(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const ScatteringLookup& lookup)
+{
+    if (lookup.kind == 3)
     {
-        float past = 6.0;
-        float log_first_span = 1.0;
-        if (position < past)
-        {
-            if (position < 0.0)
-            {
-                AtmosphereParameters param_7 = atmosphere;
-                float2 param_8 = edge;
-                float _step = ShadowEdgePastStep(param_7, param_8);
-                AtmosphereParameters param_9 = atmosphere;
-                float4 param_10 = uvwz;
-                float param_11 = 0.5 / mu_s_size;
-                float param_12 = nu_slice;
-                float param_13 = nu_t;
-                bool param_14 = true;
-                AtmosphereParameters param_15 = atmosphere;
-                float4 param_16 = uvwz;
-                float param_17 = 1.5 / mu_s_size;
-                float param_18 = nu_slice;
-                float param_19 = nu_t;
-                bool param_20 = true;
-                float2 param_21 = edge;
-                float param_22 = (-(past - 1.0)) * _step;
-                float2 param_23 = edge;
-                float param_24 = (-(past - 2.0)) * _step;
-                float4 param_25 = GetScatteringAtMuSColumn(param_9, scattering_texture, scattering_textureSmplr, param_10, param_11, param_12, param_13, param_14);
-                float4 param_26 = GetScatteringAtMuSColumn(param_15, scattering_texture, scattering_textureSmplr, param_16, param_17, param_18, param_19, param_20);
-                float param_27 = ShadowEdgeSunCosine(param_21, param_22);
-                float param_28 = ShadowEdgeSunCosine(param_23, param_24);
-                float param_29 = mu_s;
-                return LowestSunContinued(param_25, param_26, param_27, param_28, param_29);
-            }
-            if (position >= (past - 1.0))
-            {
-                float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
-                AtmosphereParameters param_30 = atmosphere;
-                float param_31 = x;
-                float2 param_32 = edge;
-                log_first_span = log(ShadowEdgeLitDistance(param_30, param_31, param_32) / 0.0008726646192371845245361328125);
-            }
-        }
-        AtmosphereParameters param_33 = atmosphere;
-        float4 param_34 = uvwz;
-        float param_35 = position;
-        float param_36 = nu_slice;
-        float param_37 = log_first_span;
-        AtmosphereParameters param_38 = atmosphere;
-        float4 param_39 = uvwz;
-        float param_40 = position;
-        float param_41 = nu_slice + 1.0;
-        float param_42 = log_first_span;
-        float4 param_43 = GetScatteringBelowSplit(param_33, scattering_texture, scattering_textureSmplr, param_34, param_35, param_36, param_37);
-        float4 param_44 = GetScatteringBelowSplit(param_38, scattering_texture, scattering_textureSmplr, param_39, param_40, param_41, param_42);
-        float param_45 = nu_t;
-        bool param_46 = true;
-        return SunCosineMix(param_43, param_44, param_45, param_46);
+        AtmosphereParameters param = atmosphere;
+        float4 param_1 = lookup.uvwz;
+        float param_2 = lookup.position;
+        float param_3 = lookup.nu_slice;
+        float param_4 = lookup.log_first_span;
+        AtmosphereParameters param_5 = atmosphere;
+        float4 param_6 = lookup.uvwz;
+        float param_7 = lookup.position;
+        float param_8 = lookup.nu_slice + 1.0;
+        float param_9 = lookup.log_first_span;
+        float4 param_10 = GetScatteringBelowSplit(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4);
+        float4 param_11 = GetScatteringBelowSplit(param_5, scattering_texture, scattering_textureSmplr, param_6, param_7, param_8, param_9);
+        float param_12 = lookup.nu_t;
+        bool param_13 = true;
+        return SunCosineMix(param_10, param_11, param_12, param_13);
     }
-    AtmosphereParameters param_47 = atmosphere;
-    float param_48 = 0.100000001490116119384765625;
-    float x_low_sun = GetScatteringTextureUMuS(param_47, param_48);
-    AtmosphereParameters param_49 = atmosphere;
-    float param_50 = uvwz.y;
-    float param_51 = x_low_sun;
-    float param_52;
-    float param_53;
-    float param_54;
-    bool param_55;
-    GetScatteringMuSColumns(param_49, param_50, param_51, param_52, param_53, param_54, param_55);
-    float x_below = param_52;
-    float x_above = param_53;
-    float mu_s_t = param_54;
-    bool low_sun_below = param_55;
-    if (!low_sun_below)
+    AtmosphereParameters param_14 = atmosphere;
+    float4 param_15 = lookup.uvwz;
+    float param_16 = lookup.x.x;
+    float param_17 = lookup.nu_slice;
+    float param_18 = lookup.nu_t;
+    bool param_19 = bool(lookup.low_sun.x);
+    float4 a = GetScatteringAtMuSColumn(param_14, scattering_texture, scattering_textureSmplr, param_15, param_16, param_17, param_18, param_19);
+    if (lookup.kind == 0)
     {
-        AtmosphereParameters param_56 = atmosphere;
-        float4 param_57 = uvwz;
-        float param_58 = mix(x_below, x_above, mu_s_t);
-        float param_59 = nu_slice;
-        float param_60 = nu_t;
-        bool param_61 = false;
-        return GetScatteringAtMuSColumn(param_56, scattering_texture, scattering_textureSmplr, param_57, param_58, param_59, param_60, param_61);
+        return a;
     }
-    AtmosphereParameters param_62 = atmosphere;
-    float4 param_63 = uvwz;
-    float param_64 = x_below;
-    float param_65 = nu_slice;
-    float param_66 = nu_t;
-    bool param_67 = true;
-    float4 below = GetScatteringAtMuSColumn(param_62, scattering_texture, scattering_textureSmplr, param_63, param_64, param_65, param_66, param_67);
-    AtmosphereParameters param_68 = atmosphere;
-    float4 param_69 = uvwz;
-    float param_70 = x_above;
-    float param_71 = nu_slice;
-    float param_72 = nu_t;
-    bool param_73 = x_above < x_low_sun;
-    float4 above = GetScatteringAtMuSColumn(param_68, scattering_texture, scattering_textureSmplr, param_69, param_70, param_71, param_72, param_73);
-    if (mu_s_t < 0.0)
+    AtmosphereParameters param_20 = atmosphere;
+    float4 param_21 = lookup.uvwz;
+    float param_22 = lookup.x.y;
+    float param_23 = lookup.nu_slice;
+    float param_24 = lookup.nu_t;
+    bool param_25 = bool(lookup.low_sun.y);
+    float4 b = GetScatteringAtMuSColumn(param_20, scattering_texture, scattering_textureSmplr, param_21, param_22, param_23, param_24, param_25);
+    if (lookup.kind == 2)
     {
-        AtmosphereParameters param_74 = atmosphere;
-        float param_75 = 1.0 / (mu_s_size - 1.0);
-        float4 param_76 = below;
-        float4 param_77 = above;
-        float param_78 = atmosphere.scattering_mu_s_min;
-        float param_79 = GetScatteringMuSFromUnitRange(param_74, param_75);
-        float param_80 = mu_s;
-        return LowestSunContinued(param_76, param_77, param_78, param_79, param_80);
+        float4 param_26 = a;
+        float4 param_27 = b;
+        float param_28 = lookup.mu_s_a;
+        float param_29 = lookup.mu_s_b;
+        float param_30 = lookup.mu_s;
+        return LowestSunContinued(param_26, param_27, param_28, param_29, param_30);
     }
-    float column = (x_below * mu_s_size) - 0.5;
-    float x_first = (fast::max(column - 1.0, 0.0) + 0.5) / mu_s_size;
-    float x_last = (fast::min(column + 2.0, mu_s_size - 1.0) + 0.5) / mu_s_size;
-    AtmosphereParameters param_81 = atmosphere;
-    float4 param_82 = uvwz;
-    float param_83 = x_first;
-    float param_84 = nu_slice;
-    float param_85 = nu_t;
-    bool param_86 = true;
-    float4 first = GetScatteringAtMuSColumn(param_81, scattering_texture, scattering_textureSmplr, param_82, param_83, param_84, param_85, param_86);
-    AtmosphereParameters param_87 = atmosphere;
-    float4 param_88 = uvwz;
-    float param_89 = x_last;
-    float param_90 = nu_slice;
-    float param_91 = nu_t;
-    bool param_92 = x_last < x_low_sun;
-    float4 last = GetScatteringAtMuSColumn(param_87, scattering_texture, scattering_textureSmplr, param_88, param_89, param_90, param_91, param_92);
-    float4 param_93 = first;
-    float4 param_94 = below;
-    float4 param_95 = above;
-    float4 param_96 = last;
-    bool param_97 = column > 0.5;
-    bool param_98 = (column + 2.0) < (mu_s_size - 0.5);
-    float param_99 = mu_s_t;
-    return LogMonotoneCubicMix(param_93, param_94, param_95, param_96, param_97, param_98, param_99);
+    AtmosphereParameters param_31 = atmosphere;
+    float4 param_32 = lookup.uvwz;
+    float param_33 = lookup.x.z;
+    float param_34 = lookup.nu_slice;
+    float param_35 = lookup.nu_t;
+    bool param_36 = bool(lookup.low_sun.z);
+    float4 c = GetScatteringAtMuSColumn(param_31, scattering_texture, scattering_textureSmplr, param_32, param_33, param_34, param_35, param_36);
+    AtmosphereParameters param_37 = atmosphere;
+    float4 param_38 = lookup.uvwz;
+    float param_39 = lookup.x.w;
+    float param_40 = lookup.nu_slice;
+    float param_41 = lookup.nu_t;
+    bool param_42 = bool(lookup.low_sun.w);
+    float4 d = GetScatteringAtMuSColumn(param_37, scattering_texture, scattering_textureSmplr, param_38, param_39, param_40, param_41, param_42);
+    float4 param_43 = a;
+    float4 param_44 = b;
+    float4 param_45 = c;
+    float4 param_46 = d;
+    bool param_47 = bool(lookup.has_first);
+    bool param_48 = bool(lookup.has_last);
+    float param_49 = lookup.t;
+    return LogMonotoneCubicMix(param_43, param_44, param_45, param_46, param_47, param_48, param_49);
 }
 #endif
 
@@ -1247,29 +1279,28 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float param_3 = mu_s;
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
-    float4 scattering = GetScattering(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    ScatteringLookup lookup = GetScatteringLookup(param, param_1, param_2, param_3, param_4, param_5);
+    AtmosphereParameters param_6 = atmosphere;
+    ScatteringLookup param_7 = lookup;
+    float4 scattering = GetScatteringFromLookup(param_6, scattering_texture, scattering_textureSmplr, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3695;
+        float3 _3791;
         if (scattering.x > 0.0)
         {
-            _3695 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3791 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3695 = float3(0.0);
+            _3791 = float3(0.0);
         }
-        single_mie_scattering = _3695;
+        single_mie_scattering = _3791;
     }
     else
     {
-        AtmosphereParameters param_6 = atmosphere;
-        float param_7 = r;
-        float param_8 = mu;
-        float param_9 = mu_s;
-        float param_10 = nu;
-        bool param_11 = ray_r_mu_intersects_ground;
-        single_mie_scattering = float3(GetScattering(param_6, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_7, param_8, param_9, param_10, param_11).xyz);
+        AtmosphereParameters param_8 = atmosphere;
+        ScatteringLookup param_9 = lookup;
+        single_mie_scattering = float3(GetScatteringFromLookup(param_8, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_9).xyz);
     }
     return float3(scattering.xyz);
 }
@@ -1334,9 +1365,9 @@ float3 GetSkyRadianceOfRay(thread const AtmosphereParameters& atmosphere, textur
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3760 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3847 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3760;
+    float3 scattering = _3847;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1357,13 +1388,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3795 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3882 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3795)
+    if (!_3882)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1372,19 +1403,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3815;
+    float3 _3902;
     if (ray_r_mu_intersects_ground)
     {
-        _3815 = float3(0.0);
+        _3902 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3815 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _3902 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _3815;
+    transmittance = _3902;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1408,16 +1439,16 @@ static inline __attribute__((always_inline))
 float GetUnitMuInHalfFromTextureCoord(thread const float& u, thread const int& size, thread bool& ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5;
-    float _1284;
+    float _1292;
     if (ray_r_mu_intersects_ground)
     {
-        _1284 = 1.0 - (2.0 * u);
+        _1292 = 1.0 - (2.0 * u);
     }
     else
     {
-        _1284 = (2.0 * u) - 1.0;
+        _1292 = (2.0 * u) - 1.0;
     }
-    float param = _1284;
+    float param = _1292;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1440,25 +1471,25 @@ float3 GetSkyViewRay(thread const AtmosphereParameters& atmosphere, thread const
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _4977 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5063 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _4977;
+    float x = _5063;
     float e = (1.0 - x) * (1.0 - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _4998;
+    float _5084;
     if (ray_r_mu_intersects_ground)
     {
-        _4998 = theta_h + (e * (3.1415927410125732421875 - theta_h));
+        _5084 = theta_h + (e * (3.1415927410125732421875 - theta_h));
     }
     else
     {
-        _4998 = theta_h * (1.0 - e);
+        _5084 = theta_h * (1.0 - e);
     }
-    float theta = _4998;
+    float theta = _5084;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875 * fast::clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0, 1.0);
@@ -1483,9 +1514,9 @@ float3 GetSkyViewRadiance(thread const AtmosphereParameters& atmosphere, texture
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5087 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5173 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5087;
+    float3 view_ray = _5173;
     float3 up = fast::normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1513,16 +1544,16 @@ void GetSkyViewAngles(thread const float3& camera, thread const float3& view_ray
     theta = precise::atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _4963;
+    float _5049;
     if ((along != 0.0) || (side != 0.0))
     {
-        _4963 = precise::atan2(side, along);
+        _5049 = precise::atan2(side, along);
     }
     else
     {
-        _4963 = 0.0;
+        _5049 = 0.0;
     }
-    phi = _4963;
+    phi = _5049;
 }
 #endif
 
@@ -1533,16 +1564,16 @@ float2 GetSkyViewUvFromAngles(thread const AtmosphereParameters& atmosphere, thr
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _4884;
+    float _4970;
     if (ray_r_mu_intersects_ground)
     {
-        _4884 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
+        _4970 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
     }
     else
     {
-        _4884 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
+        _4970 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
     }
-    float x = _4884;
+    float x = _4970;
     float param_2 = phi / 3.1415927410125732421875;
     int param_3 = 192;
     float param_4 = x;
@@ -1565,19 +1596,19 @@ float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, 
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5149;
+    float3 _5235;
     if (ray_r_mu_intersects_ground)
     {
-        _5149 = float3(0.0);
+        _5235 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5149 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
+        _5235 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
     }
-    transmittance = _5149;
+    transmittance = _5235;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1625,16 +1656,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _3919;
+    float _4006;
     if ((a > 0.0) && (b > 0.0))
     {
-        _3919 = a * exp(f * log(b / a));
+        _4006 = a * exp(f * log(b / a));
     }
     else
     {
-        _3919 = mix(a, b, f);
+        _4006 = mix(a, b, f);
     }
-    return _3919;
+    return _4006;
 }
 #endif
 
@@ -1705,16 +1736,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _4170;
+    float _4256;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _4170 = 1.0 - (0.5 * depth);
+        _4256 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _4170 = (1.0 - exp(-depth)) / depth;
+        _4256 = (1.0 - exp(-depth)) / depth;
     }
-    return _4170;
+    return _4256;
 }
 #endif
 
@@ -1751,10 +1782,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4250 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4336 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4250;
+        float3 extinction = _4336;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1813,10 +1844,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4115 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4202 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4115;
+        float3 extinction = _4202;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1891,14 +1922,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _4140;
+    float3 _4226;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4140 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4226 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1907,9 +1938,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4140 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _4226 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _4140;
+    return _4226;
 }
 #endif
 
@@ -1923,16 +1954,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3881;
+    float _3968;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _3881 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _3968 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3881 = up;
+        _3968 = up;
     }
-    return _3881;
+    return _3968;
 }
 #endif
 
@@ -1956,13 +1987,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4396 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4482 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4396)
+    if (!_4482)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -2002,11 +2033,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4491 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4577 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4491;
+        lit_optical_depth = _4577;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -2020,11 +2051,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4525 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4611 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4525;
+        optical_depth += _4611;
     }
     if (direct < 1.0)
     {
@@ -2043,9 +2074,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4568 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4654 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4568;
+    float3 scattering = _4654;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -2066,11 +2097,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4616 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4702 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4616;
+        float3 far_optical_depth = _4702;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -2090,9 +2121,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4670 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4756 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4670);
+            scattering -= (exp(-far_optical_depth) * _4756);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -2113,9 +2144,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4735 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4821 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4735;
+    float3 scattering_p = _4821;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -2136,9 +2167,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4779 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4865 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4779;
+    return _4865;
 }
 #endif
 
@@ -2168,9 +2199,9 @@ float3 GetAerialPerspectiveVoxel(thread const AtmosphereParameters& atmosphere, 
     float3 param_3 = point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5243 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
+    float3 _5329 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5243;
+    float3 radiance = _5329;
     optical_depth = -log(fast::max(transmittance, float3(1.0000000031710768509710513471353e-30)));
     return radiance;
 }
@@ -2200,16 +2231,16 @@ float3 GetSkyRadianceToPointFromVolume(texture3d<float> radiance_volume, sampler
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1465;
+    float _1473;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1465 = 0.100000001490116119384765625;
+        _1473 = 0.100000001490116119384765625;
     }
     else
     {
-        _1465 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1473 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1465;
+    return _1473;
 }
 #endif
 
@@ -2219,16 +2250,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1483;
+    float _1491;
     if (mu_s < knee)
     {
-        _1483 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1491 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1483 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1491 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1483;
+    return _1491;
 }
 #endif
 
@@ -2257,16 +2288,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1514;
+    float _1522;
     if (x < 0.5)
     {
-        _1514 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1522 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1514 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1522 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1514;
+    return _1522;
 }
 #endif
 
@@ -2279,16 +2310,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2647;
+    float4 _2655;
     if (t < 0.0)
     {
-        _2647 = fast::min(blend, a);
+        _2655 = fast::min(blend, a);
     }
     else
     {
-        _2647 = blend;
+        _2655 = blend;
     }
-    return _2647;
+    return _2655;
 }
 #endif
 

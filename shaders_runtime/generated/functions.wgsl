@@ -31,6 +31,23 @@ struct AtmosphereParameters {
     rayleigh_scattering_profile: array<vec3<f32>, 64>,
 }
 
+struct ScatteringLookup {
+    kind: i32,
+    uvwz: vec4<f32>,
+    nu_slice: f32,
+    nu_t: f32,
+    x: vec4<f32>,
+    low_sun: vec4<bool>,
+    has_first: bool,
+    has_last: bool,
+    t: f32,
+    mu_s_a: f32,
+    mu_s_b: f32,
+    mu_s: f32,
+    position: f32,
+    log_first_span: f32,
+}
+
 const PI: f32 = 3.1415927f;
 
 const PHASE_NONE: i32 = 0i;
@@ -52,6 +69,14 @@ const SHADOW_EDGE_TABLES_WEIGHT: f32 = 0.3f;
 const SHADOW_EDGE_CLOSEST: f32 = 0.0008726646f;
 
 const SHADOW_EDGE_LEAST_PAST_SPAN: f32 = 0.034906585f;
+
+const SCATTERING_DAYLIGHT: i32 = 0i;
+
+const SCATTERING_LOW_SUN: i32 = 1i;
+
+const SCATTERING_BELOW_TABLE: i32 = 2i;
+
+const SCATTERING_OWN_COLUMNS: i32 = 3i;
 
 const DIRECT_SEGMENT_LENGTH: f32 = 10000f;
 
@@ -2608,37 +2633,27 @@ fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_textu
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_92: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, r_52: f32, mu_37: f32, mu_s_27: f32, nu_15: f32, ray_r_mu_intersects_ground_23: bool) -> vec4<f32> {
+fn GetScatteringLookup(atmosphere_92: AtmosphereParameters, r_52: f32, mu_37: f32, mu_s_27: f32, nu_15: f32, ray_r_mu_intersects_ground_23: bool) -> ScatteringLookup {
     var atmosphere_93: AtmosphereParameters;
     var r_53: f32;
     var mu_38: f32;
     var mu_s_28: f32;
     var nu_16: f32;
     var ray_r_mu_intersects_ground_24: bool;
+    var lookup: ScatteringLookup;
     var edge_21: vec2<f32>;
-    var uvwz_8: vec4<f32>;
     var nu_size: f32;
     var nu_coord: f32;
-    var nu_slice_8: f32;
-    var nu_t_2: f32;
     var mu_s_size_2: f32;
-    var position_5: f32;
     var past_3: f32 = 6f;
-    var log_first_span_2: f32 = 1f;
     var step_: f32;
     var x_21: f32;
     var x_below_1: f32;
     var x_above_1: f32;
-    var mu_s_t_1: f32;
     var low_sun_below_1: bool;
     var x_low_sun_2: f32;
-    var below: vec4<f32>;
-    var above: vec4<f32>;
     var column_3: f32;
-    var x_first: f32;
     var x_last: f32;
-    var first: vec4<f32>;
-    var last_1: vec4<f32>;
 
     atmosphere_93 = atmosphere_92;
     r_53 = r_52;
@@ -2646,431 +2661,515 @@ fn GetScattering(atmosphere_92: AtmosphereParameters, scattering_texture_4: text
     mu_s_28 = mu_s_27;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_24 = ray_r_mu_intersects_ground_23;
-    let _e26 = atmosphere_93;
-    let _e27 = r_53;
-    let _e28 = mu_38;
-    let _e29 = mu_s_28;
-    let _e30 = nu_16;
-    let _e31 = ray_r_mu_intersects_ground_24;
-    let _e34 = GetScatteringTextureUvwzAndEdge(_e26, _e27, _e28, _e29, _e30, _e31, (&edge_21));
-    uvwz_8 = _e34;
-    let _e36 = atmosphere_93;
-    nu_size = f32(_e36.scattering_nu_size);
-    let _e40 = uvwz_8;
-    let _e42 = nu_size;
-    nu_coord = (_e40.x * (_e42 - 1f));
-    let _e47 = nu_coord;
-    let _e49 = nu_size;
-    nu_slice_8 = min(floor(_e47), (_e49 - 2f));
-    let _e54 = nu_coord;
-    let _e55 = nu_slice_8;
-    nu_t_2 = (_e54 - _e55);
-    let _e58 = atmosphere_93;
-    mu_s_size_2 = f32(_e58.scattering_mu_s_size);
-    let _e62 = uvwz_8;
-    let _e64 = mu_s_size_2;
-    position_5 = ((_e62.y * _e64) - 0.5f);
-    let _e69 = atmosphere_93;
-    let _e73 = position_5;
-    let _e74 = atmosphere_93;
-    if ((_e69.scattering_mu_s_split > 0i) && (_e73 < f32(_e74.scattering_mu_s_split))) {
+    let _e31 = atmosphere_93;
+    let _e32 = r_53;
+    let _e33 = mu_38;
+    let _e34 = mu_s_28;
+    let _e35 = nu_16;
+    let _e36 = ray_r_mu_intersects_ground_24;
+    let _e39 = GetScatteringTextureUvwzAndEdge(_e31, _e32, _e33, _e34, _e35, _e36, (&edge_21));
+    lookup.uvwz = _e39;
+    let _e40 = atmosphere_93;
+    nu_size = f32(_e40.scattering_nu_size);
+    let _e44 = lookup;
+    let _e47 = nu_size;
+    nu_coord = (_e44.uvwz.x * (_e47 - 1f));
+    let _e53 = nu_coord;
+    let _e55 = nu_size;
+    lookup.nu_slice = min(floor(_e53), (_e55 - 2f));
+    let _e60 = nu_coord;
+    let _e61 = lookup;
+    lookup.nu_t = (_e60 - _e61.nu_slice);
+    lookup.low_sun = vec4(true);
+    lookup.has_first = false;
+    lookup.has_last = false;
+    lookup.t = 0f;
+    lookup.mu_s_a = 0f;
+    lookup.mu_s_b = 0f;
+    let _e78 = mu_s_28;
+    lookup.mu_s = _e78;
+    lookup.log_first_span = 1f;
+    let _e81 = atmosphere_93;
+    mu_s_size_2 = f32(_e81.scattering_mu_s_size);
+    let _e86 = lookup;
+    let _e89 = mu_s_size_2;
+    lookup.position = ((_e86.uvwz.y * _e89) - 0.5f);
+    let _e93 = atmosphere_93;
+    let _e97 = lookup;
+    let _e99 = atmosphere_93;
+    if ((_e93.scattering_mu_s_split > 0i) && (_e97.position < f32(_e99.scattering_mu_s_split))) {
         {
-            let _e84 = position_5;
-            let _e85 = past_3;
-            if (_e84 < _e85) {
+            lookup.kind = SCATTERING_OWN_COLUMNS;
+            lookup.x = vec4(0f);
+            let _e111 = lookup;
+            if (_e111.position < 0f) {
                 {
-                    let _e87 = position_5;
-                    if (_e87 < 0f) {
-                        {
-                            let _e90 = atmosphere_93;
-                            let _e91 = edge_21;
-                            let _e92 = ShadowEdgePastStep(_e90, _e91);
-                            step_ = _e92;
-                            let _e94 = atmosphere_93;
-                            let _e95 = uvwz_8;
-                            let _e97 = mu_s_size_2;
-                            let _e99 = nu_slice_8;
-                            let _e100 = nu_t_2;
-                            let _e102 = GetScatteringAtMuSColumn(_e94, scattering_texture_4, _e95, (0.5f / _e97), _e99, _e100, true);
-                            let _e103 = atmosphere_93;
-                            let _e104 = uvwz_8;
-                            let _e106 = mu_s_size_2;
-                            let _e108 = nu_slice_8;
-                            let _e109 = nu_t_2;
-                            let _e111 = GetScatteringAtMuSColumn(_e103, scattering_texture_4, _e104, (1.5f / _e106), _e108, _e109, true);
-                            let _e112 = edge_21;
-                            let _e113 = past_3;
-                            let _e117 = step_;
-                            let _e119 = ShadowEdgeSunCosine(_e112, (-((_e113 - 1f)) * _e117));
-                            let _e120 = edge_21;
-                            let _e121 = past_3;
-                            let _e125 = step_;
-                            let _e127 = ShadowEdgeSunCosine(_e120, (-((_e121 - 2f)) * _e125));
-                            let _e128 = mu_s_28;
-                            let _e129 = LowestSunContinued(_e102, _e111, _e119, _e127, _e128);
-                            return _e129;
-                        }
-                    }
-                    let _e130 = position_5;
+                    let _e115 = atmosphere_93;
+                    let _e116 = edge_21;
+                    let _e117 = ShadowEdgePastStep(_e115, _e116);
+                    step_ = _e117;
+                    lookup.kind = SCATTERING_BELOW_TABLE;
+                    let _e126 = mu_s_size_2;
+                    lookup.x = (vec4<f32>(0.5f, 1.5f, 0f, 0f) / vec4(_e126));
+                    let _e130 = edge_21;
                     let _e131 = past_3;
-                    if (_e130 >= (_e131 - 1f)) {
-                        {
-                            let _e136 = atmosphere_93;
-                            let _e139 = past_3;
-                            x_21 = (1f / (f32(_e136.scattering_mu_s_split) - _e139));
-                            let _e143 = atmosphere_93;
-                            let _e144 = x_21;
-                            let _e145 = edge_21;
-                            let _e146 = ShadowEdgeLitDistance(_e143, _e144, _e145);
-                            log_first_span_2 = log((_e146 / SHADOW_EDGE_CLOSEST));
-                        }
+                    let _e135 = step_;
+                    let _e137 = ShadowEdgeSunCosine(_e130, (-((_e131 - 1f)) * _e135));
+                    lookup.mu_s_a = _e137;
+                    let _e139 = edge_21;
+                    let _e140 = past_3;
+                    let _e144 = step_;
+                    let _e146 = ShadowEdgeSunCosine(_e139, (-((_e140 - 2f)) * _e144));
+                    lookup.mu_s_b = _e146;
+                }
+            } else {
+                let _e147 = lookup;
+                let _e149 = past_3;
+                let _e153 = lookup;
+                let _e155 = past_3;
+                if ((_e147.position >= (_e149 - 1f)) && (_e153.position < _e155)) {
+                    {
+                        let _e159 = atmosphere_93;
+                        let _e162 = past_3;
+                        x_21 = (1f / (f32(_e159.scattering_mu_s_split) - _e162));
+                        let _e167 = atmosphere_93;
+                        let _e168 = x_21;
+                        let _e169 = edge_21;
+                        let _e170 = ShadowEdgeLitDistance(_e167, _e168, _e169);
+                        lookup.log_first_span = log((_e170 / SHADOW_EDGE_CLOSEST));
                     }
                 }
             }
-            let _e149 = atmosphere_93;
-            let _e150 = uvwz_8;
-            let _e151 = position_5;
-            let _e152 = nu_slice_8;
-            let _e153 = log_first_span_2;
-            let _e154 = GetScatteringBelowSplit(_e149, scattering_texture_4, _e150, _e151, _e152, _e153);
-            let _e155 = atmosphere_93;
-            let _e156 = uvwz_8;
-            let _e157 = position_5;
-            let _e158 = nu_slice_8;
-            let _e161 = log_first_span_2;
-            let _e162 = GetScatteringBelowSplit(_e155, scattering_texture_4, _e156, _e157, (_e158 + 1f), _e161);
-            let _e163 = nu_t_2;
-            let _e165 = SunCosineMix(_e154, _e162, _e163, true);
-            return _e165;
+            let _e173 = lookup;
+            return _e173;
         }
     }
-    let _e170 = atmosphere_93;
-    let _e171 = GetScatteringTextureUMuS(_e170, LOW_SUN_MU_S);
-    x_low_sun_2 = _e171;
-    let _e173 = atmosphere_93;
-    let _e174 = uvwz_8;
-    let _e176 = x_low_sun_2;
-    GetScatteringMuSColumns(_e173, _e174.y, _e176, (&x_below_1), (&x_above_1), (&mu_s_t_1), (&low_sun_below_1));
-    let _e185 = low_sun_below_1;
-    if !(_e185) {
+    let _e177 = atmosphere_93;
+    let _e178 = GetScatteringTextureUMuS(_e177, LOW_SUN_MU_S);
+    x_low_sun_2 = _e178;
+    let _e180 = atmosphere_93;
+    let _e181 = lookup;
+    let _e184 = x_low_sun_2;
+    let _e187 = lookup;
+    GetScatteringMuSColumns(_e180, _e181.uvwz.y, _e184, (&x_below_1), (&x_above_1), (&lookup.t), (&low_sun_below_1));
+    let _e195 = low_sun_below_1;
+    if !(_e195) {
         {
-            let _e187 = atmosphere_93;
-            let _e188 = uvwz_8;
-            let _e189 = x_below_1;
-            let _e190 = x_above_1;
-            let _e191 = mu_s_t_1;
-            let _e193 = nu_slice_8;
-            let _e194 = nu_t_2;
-            let _e196 = GetScatteringAtMuSColumn(_e187, scattering_texture_4, _e188, mix(_e189, _e190, _e191), _e193, _e194, false);
-            return _e196;
+            lookup.kind = SCATTERING_DAYLIGHT;
+            let _e199 = x_below_1;
+            let _e200 = x_above_1;
+            let _e201 = lookup;
+            lookup.x = vec4<f32>(mix(_e199, _e200, _e201.t), 0f, 0f, 0f);
+            lookup.low_sun = vec4(false);
+            let _e211 = lookup;
+            return _e211;
         }
     }
-    let _e197 = atmosphere_93;
-    let _e198 = uvwz_8;
-    let _e199 = x_below_1;
-    let _e200 = nu_slice_8;
-    let _e201 = nu_t_2;
-    let _e203 = GetScatteringAtMuSColumn(_e197, scattering_texture_4, _e198, _e199, _e200, _e201, true);
-    below = _e203;
-    let _e205 = atmosphere_93;
-    let _e206 = uvwz_8;
-    let _e207 = x_above_1;
-    let _e208 = nu_slice_8;
-    let _e209 = nu_t_2;
-    let _e210 = x_above_1;
-    let _e211 = x_low_sun_2;
-    let _e213 = GetScatteringAtMuSColumn(_e205, scattering_texture_4, _e206, _e207, _e208, _e209, (_e210 < _e211));
-    above = _e213;
-    let _e215 = mu_s_t_1;
-    if (_e215 < 0f) {
+    let _e212 = lookup;
+    if (_e212.t < 0f) {
         {
-            let _e218 = below;
-            let _e219 = above;
-            let _e220 = atmosphere_93;
-            let _e222 = atmosphere_93;
-            let _e224 = mu_s_size_2;
-            let _e228 = GetScatteringMuSFromUnitRange(_e222, (1f / (_e224 - 1f)));
-            let _e229 = mu_s_28;
-            let _e230 = LowestSunContinued(_e218, _e219, _e220.scattering_mu_s_min, _e228, _e229);
-            return _e230;
+            lookup.kind = SCATTERING_BELOW_TABLE;
+            let _e218 = x_below_1;
+            let _e219 = x_above_1;
+            lookup.x = vec4<f32>(_e218, _e219, 0f, 0f);
+            let _e225 = x_above_1;
+            let _e226 = x_low_sun_2;
+            lookup.low_sun = vec4<bool>(true, (_e225 < _e226), true, true);
+            let _e232 = atmosphere_93;
+            lookup.mu_s_a = _e232.scattering_mu_s_min;
+            let _e235 = atmosphere_93;
+            let _e237 = mu_s_size_2;
+            let _e241 = GetScatteringMuSFromUnitRange(_e235, (1f / (_e237 - 1f)));
+            lookup.mu_s_b = _e241;
+            let _e242 = lookup;
+            return _e242;
         }
     }
-    let _e231 = x_below_1;
-    let _e232 = mu_s_size_2;
-    column_3 = ((_e231 * _e232) - 0.5f);
-    let _e237 = column_3;
+    let _e243 = x_below_1;
     let _e244 = mu_s_size_2;
-    x_first = ((max((_e237 - 1f), 0f) + 0.5f) / _e244);
-    let _e247 = column_3;
-    let _e250 = mu_s_size_2;
-    let _e256 = mu_s_size_2;
-    x_last = ((min((_e247 + 2f), (_e250 - 1f)) + 0.5f) / _e256);
-    let _e259 = atmosphere_93;
-    let _e260 = uvwz_8;
-    let _e261 = x_first;
-    let _e262 = nu_slice_8;
-    let _e263 = nu_t_2;
-    let _e265 = GetScatteringAtMuSColumn(_e259, scattering_texture_4, _e260, _e261, _e262, _e263, true);
-    first = _e265;
-    let _e267 = atmosphere_93;
-    let _e268 = uvwz_8;
-    let _e269 = x_last;
-    let _e270 = nu_slice_8;
-    let _e271 = nu_t_2;
-    let _e272 = x_last;
-    let _e273 = x_low_sun_2;
-    let _e275 = GetScatteringAtMuSColumn(_e267, scattering_texture_4, _e268, _e269, _e270, _e271, (_e272 < _e273));
-    last_1 = _e275;
-    let _e277 = first;
-    let _e278 = below;
-    let _e279 = above;
-    let _e280 = last_1;
-    let _e281 = column_3;
-    let _e284 = column_3;
-    let _e287 = mu_s_size_2;
-    let _e291 = mu_s_t_1;
-    let _e292 = LogMonotoneCubicMix(_e277, _e278, _e279, _e280, (_e281 > 0.5f), ((_e284 + 2f) < (_e287 - 0.5f)), _e291);
-    return _e292;
+    column_3 = ((_e243 * _e244) - 0.5f);
+    let _e249 = column_3;
+    let _e252 = mu_s_size_2;
+    let _e258 = mu_s_size_2;
+    x_last = ((min((_e249 + 2f), (_e252 - 1f)) + 0.5f) / _e258);
+    lookup.kind = SCATTERING_LOW_SUN;
+    let _e263 = column_3;
+    let _e270 = mu_s_size_2;
+    let _e272 = x_below_1;
+    let _e273 = x_above_1;
+    let _e274 = x_last;
+    lookup.x = vec4<f32>(((max((_e263 - 1f), 0f) + 0.5f) / _e270), _e272, _e273, _e274);
+    let _e279 = x_above_1;
+    let _e280 = x_low_sun_2;
+    let _e282 = x_last;
+    let _e283 = x_low_sun_2;
+    lookup.low_sun = vec4<bool>(true, true, (_e279 < _e280), (_e282 < _e283));
+    let _e287 = column_3;
+    lookup.has_first = (_e287 > 0.5f);
+    let _e291 = column_3;
+    let _e294 = mu_s_size_2;
+    lookup.has_last = ((_e291 + 2f) < (_e294 - 0.5f));
+    let _e298 = lookup;
+    return _e298;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, lookup_1: ScatteringLookup) -> vec4<f32> {
+    var atmosphere_95: AtmosphereParameters;
+    var lookup_2: ScatteringLookup;
+    var a_18: vec4<f32>;
+    var b_10: vec4<f32>;
+    var c_8: vec4<f32>;
+    var d_23: vec4<f32>;
+
+    atmosphere_95 = atmosphere_94;
+    lookup_2 = lookup_1;
+    let _e21 = lookup_2;
+    if (_e21.kind == SCATTERING_OWN_COLUMNS) {
+        {
+            let _e24 = atmosphere_95;
+            let _e25 = lookup_2;
+            let _e27 = lookup_2;
+            let _e29 = lookup_2;
+            let _e31 = lookup_2;
+            let _e33 = GetScatteringBelowSplit(_e24, scattering_texture_4, _e25.uvwz, _e27.position, _e29.nu_slice, _e31.log_first_span);
+            let _e34 = atmosphere_95;
+            let _e35 = lookup_2;
+            let _e37 = lookup_2;
+            let _e39 = lookup_2;
+            let _e43 = lookup_2;
+            let _e45 = GetScatteringBelowSplit(_e34, scattering_texture_4, _e35.uvwz, _e37.position, (_e39.nu_slice + 1f), _e43.log_first_span);
+            let _e46 = lookup_2;
+            let _e49 = SunCosineMix(_e33, _e45, _e46.nu_t, true);
+            return _e49;
+        }
+    }
+    let _e50 = atmosphere_95;
+    let _e51 = lookup_2;
+    let _e53 = lookup_2;
+    let _e56 = lookup_2;
+    let _e58 = lookup_2;
+    let _e60 = lookup_2;
+    let _e63 = GetScatteringAtMuSColumn(_e50, scattering_texture_4, _e51.uvwz, _e53.x.x, _e56.nu_slice, _e58.nu_t, _e60.low_sun.x);
+    a_18 = _e63;
+    let _e65 = lookup_2;
+    if (_e65.kind == SCATTERING_DAYLIGHT) {
+        let _e68 = a_18;
+        return _e68;
+    }
+    let _e69 = atmosphere_95;
+    let _e70 = lookup_2;
+    let _e72 = lookup_2;
+    let _e75 = lookup_2;
+    let _e77 = lookup_2;
+    let _e79 = lookup_2;
+    let _e82 = GetScatteringAtMuSColumn(_e69, scattering_texture_4, _e70.uvwz, _e72.x.y, _e75.nu_slice, _e77.nu_t, _e79.low_sun.y);
+    b_10 = _e82;
+    let _e84 = lookup_2;
+    if (_e84.kind == SCATTERING_BELOW_TABLE) {
+        {
+            let _e87 = a_18;
+            let _e88 = b_10;
+            let _e89 = lookup_2;
+            let _e91 = lookup_2;
+            let _e93 = lookup_2;
+            let _e95 = LowestSunContinued(_e87, _e88, _e89.mu_s_a, _e91.mu_s_b, _e93.mu_s);
+            return _e95;
+        }
+    }
+    let _e96 = atmosphere_95;
+    let _e97 = lookup_2;
+    let _e99 = lookup_2;
+    let _e102 = lookup_2;
+    let _e104 = lookup_2;
+    let _e106 = lookup_2;
+    let _e109 = GetScatteringAtMuSColumn(_e96, scattering_texture_4, _e97.uvwz, _e99.x.z, _e102.nu_slice, _e104.nu_t, _e106.low_sun.z);
+    c_8 = _e109;
+    let _e111 = atmosphere_95;
+    let _e112 = lookup_2;
+    let _e114 = lookup_2;
+    let _e117 = lookup_2;
+    let _e119 = lookup_2;
+    let _e121 = lookup_2;
+    let _e124 = GetScatteringAtMuSColumn(_e111, scattering_texture_4, _e112.uvwz, _e114.x.w, _e117.nu_slice, _e119.nu_t, _e121.low_sun.w);
+    d_23 = _e124;
+    let _e126 = a_18;
+    let _e127 = b_10;
+    let _e128 = c_8;
+    let _e129 = d_23;
+    let _e130 = lookup_2;
+    let _e132 = lookup_2;
+    let _e134 = lookup_2;
+    let _e136 = LogMonotoneCubicMix(_e126, _e127, _e128, _e129, _e130.has_first, _e132.has_last, _e134.t);
+    return _e136;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScattering(atmosphere_96: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, r_54: f32, mu_39: f32, mu_s_29: f32, nu_17: f32, ray_r_mu_intersects_ground_25: bool) -> vec4<f32> {
+    var atmosphere_97: AtmosphereParameters;
+    var r_55: f32;
+    var mu_40: f32;
+    var mu_s_30: f32;
+    var nu_18: f32;
+    var ray_r_mu_intersects_ground_26: bool;
+
+    atmosphere_97 = atmosphere_96;
+    r_55 = r_54;
+    mu_40 = mu_39;
+    mu_s_30 = mu_s_29;
+    nu_18 = nu_17;
+    ray_r_mu_intersects_ground_26 = ray_r_mu_intersects_ground_25;
+    let _e29 = atmosphere_97;
+    let _e30 = atmosphere_97;
+    let _e31 = r_55;
+    let _e32 = mu_40;
+    let _e33 = mu_s_30;
+    let _e34 = nu_18;
+    let _e35 = ray_r_mu_intersects_ground_26;
+    let _e36 = GetScatteringLookup(_e30, _e31, _e32, _e33, _e34, _e35);
+    let _e37 = GetScatteringFromLookup(_e29, scattering_texture_5, _e36);
+    return _e37;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_94: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_54: f32, mu_s_29: f32) -> vec3<f32> {
-    var atmosphere_95: AtmosphereParameters;
-    var r_55: f32;
-    var mu_s_30: f32;
+fn GetIrradiance(atmosphere_98: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_56: f32, mu_s_31: f32) -> vec3<f32> {
+    var atmosphere_99: AtmosphereParameters;
+    var r_57: f32;
+    var mu_s_32: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
     var mu_s_column_1: f32;
     var mu_s_below: f32;
     var low_sun_8: bool;
-    var below_1: vec4<f32>;
-    var above_1: vec4<f32>;
+    var below: vec4<f32>;
+    var above: vec4<f32>;
 
-    atmosphere_95 = atmosphere_94;
-    r_55 = r_54;
-    mu_s_30 = mu_s_29;
-    let _e19 = atmosphere_95;
-    let _e20 = r_55;
-    let _e21 = mu_s_30;
-    let _e22 = GetIrradianceTextureUvFromRMuS(_e19, _e20, _e21);
-    uv_3 = _e22;
-    let _e24 = atmosphere_95;
-    width = f32(_e24.irradiance_width);
-    let _e28 = atmosphere_95;
-    let _e29 = mu_s_30;
-    let _e30 = GetIrradianceUnitMuS(_e28, _e29);
-    let _e31 = width;
-    mu_s_coord_1 = (_e30 * (_e31 - 1f));
-    let _e36 = mu_s_coord_1;
-    let _e39 = width;
-    mu_s_column_1 = clamp(floor(_e36), 0f, (_e39 - 2f));
-    let _e44 = atmosphere_95;
-    let _e45 = mu_s_column_1;
-    let _e46 = width;
-    let _e50 = GetIrradianceMuSFromUnit(_e44, (_e45 / (_e46 - 1f)));
-    mu_s_below = _e50;
-    let _e52 = mu_s_below;
-    low_sun_8 = (_e52 < LOW_SUN_MU_S);
-    let _e55 = mu_s_column_1;
-    let _e58 = width;
-    let _e60 = uv_3;
-    let _e63 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e55 + 0.5f) / _e58), _e60.y));
-    below_1 = _e63;
-    let _e65 = mu_s_column_1;
-    let _e68 = width;
-    let _e70 = uv_3;
-    let _e73 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e65 + 1.5f) / _e68), _e70.y));
-    above_1 = _e73;
-    let _e75 = below_1;
-    let _e76 = above_1;
-    let _e77 = mu_s_coord_1;
-    let _e78 = mu_s_column_1;
-    let _e80 = low_sun_8;
-    let _e81 = SunCosinePosition((_e77 - _e78), _e80);
-    let _e82 = low_sun_8;
-    let _e83 = SunBelowTableMix(_e75, _e76, _e81, _e82);
-    return vec3<f32>(_e83.xyz);
+    atmosphere_99 = atmosphere_98;
+    r_57 = r_56;
+    mu_s_32 = mu_s_31;
+    let _e23 = atmosphere_99;
+    let _e24 = r_57;
+    let _e25 = mu_s_32;
+    let _e26 = GetIrradianceTextureUvFromRMuS(_e23, _e24, _e25);
+    uv_3 = _e26;
+    let _e28 = atmosphere_99;
+    width = f32(_e28.irradiance_width);
+    let _e32 = atmosphere_99;
+    let _e33 = mu_s_32;
+    let _e34 = GetIrradianceUnitMuS(_e32, _e33);
+    let _e35 = width;
+    mu_s_coord_1 = (_e34 * (_e35 - 1f));
+    let _e40 = mu_s_coord_1;
+    let _e43 = width;
+    mu_s_column_1 = clamp(floor(_e40), 0f, (_e43 - 2f));
+    let _e48 = atmosphere_99;
+    let _e49 = mu_s_column_1;
+    let _e50 = width;
+    let _e54 = GetIrradianceMuSFromUnit(_e48, (_e49 / (_e50 - 1f)));
+    mu_s_below = _e54;
+    let _e56 = mu_s_below;
+    low_sun_8 = (_e56 < LOW_SUN_MU_S);
+    let _e59 = mu_s_column_1;
+    let _e62 = width;
+    let _e64 = uv_3;
+    let _e67 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e59 + 0.5f) / _e62), _e64.y));
+    below = _e67;
+    let _e69 = mu_s_column_1;
+    let _e72 = width;
+    let _e74 = uv_3;
+    let _e77 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e69 + 1.5f) / _e72), _e74.y));
+    above = _e77;
+    let _e79 = below;
+    let _e80 = above;
+    let _e81 = mu_s_coord_1;
+    let _e82 = mu_s_column_1;
+    let _e84 = low_sun_8;
+    let _e85 = SunCosinePosition((_e81 - _e82), _e84);
+    let _e86 = low_sun_8;
+    let _e87 = SunBelowTableMix(_e79, _e80, _e85, _e86);
+    return vec3<f32>(_e87.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_96: AtmosphereParameters, nu_17: f32) -> f32 {
-    var atmosphere_97: AtmosphereParameters;
-    var nu_18: f32;
+fn MiePhaseFunction(atmosphere_100: AtmosphereParameters, nu_19: f32) -> f32 {
+    var atmosphere_101: AtmosphereParameters;
+    var nu_20: f32;
 
-    atmosphere_97 = atmosphere_96;
-    nu_18 = nu_17;
-    let _e16 = atmosphere_97;
-    if (_e16.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e19 = atmosphere_97;
-        let _e21 = nu_18;
-        let _e22 = HenyeyGreensteinPhaseFunction(_e19.mie_g, _e21);
-        return _e22;
+    atmosphere_101 = atmosphere_100;
+    nu_20 = nu_19;
+    let _e20 = atmosphere_101;
+    if (_e20.mie_phase == PHASE_HENYEY_GREENSTEIN) {
+        let _e23 = atmosphere_101;
+        let _e25 = nu_20;
+        let _e26 = HenyeyGreensteinPhaseFunction(_e23.mie_g, _e25);
+        return _e26;
     }
-    let _e23 = atmosphere_97;
-    if (_e23.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e26 = atmosphere_97;
-        let _e28 = nu_18;
-        let _e29 = CornetteShanksPhaseFunction(_e26.mie_g, _e28);
-        return _e29;
+    let _e27 = atmosphere_101;
+    if (_e27.mie_phase == PHASE_CORNETTE_SHANKS) {
+        let _e30 = atmosphere_101;
+        let _e32 = nu_20;
+        let _e33 = CornetteShanksPhaseFunction(_e30.mie_g, _e32);
+        return _e33;
     }
     return 0f;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_98: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_56: f32, mu_39: f32, mu_s_31: f32, nu_19: f32, ray_r_mu_intersects_ground_25: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_99: AtmosphereParameters;
-    var r_57: f32;
-    var mu_40: f32;
-    var mu_s_32: f32;
-    var nu_20: f32;
-    var ray_r_mu_intersects_ground_26: bool;
-    var scattering: vec4<f32>;
-    var local_22: vec3<f32>;
-
-    atmosphere_99 = atmosphere_98;
-    r_57 = r_56;
-    mu_40 = mu_39;
-    mu_s_32 = mu_s_31;
-    nu_20 = nu_19;
-    ray_r_mu_intersects_ground_26 = ray_r_mu_intersects_ground_25;
-    let _e27 = atmosphere_99;
-    let _e28 = r_57;
-    let _e29 = mu_40;
-    let _e30 = mu_s_32;
-    let _e31 = nu_20;
-    let _e32 = ray_r_mu_intersects_ground_26;
-    let _e33 = GetScattering(_e27, scattering_texture_5, _e28, _e29, _e30, _e31, _e32);
-    scattering = _e33;
-    let _e35 = atmosphere_99;
-    if (_e35.single_mie_in_scattering_alpha == 1i) {
-        {
-            let _e39 = scattering;
-            if (_e39.x > 0f) {
-                let _e43 = scattering;
-                let _e46 = scattering;
-                let _e49 = scattering;
-                let _e53 = atmosphere_99;
-                let _e55 = atmosphere_99;
-                local_22 = (((vec3<f32>(_e43.xyz) * _e46.w) / vec3(_e49.x)) * (_e53.mie_to_rayleigh_scattering_ratio / vec3(_e55.mie_to_rayleigh_scattering_ratio.x)));
-            } else {
-                local_22 = vec3(0f);
-            }
-            let _e64 = local_22;
-            (*single_mie_scattering) = _e64;
-        }
-    } else {
-        {
-            let _e65 = atmosphere_99;
-            let _e66 = r_57;
-            let _e67 = mu_40;
-            let _e68 = mu_s_32;
-            let _e69 = nu_20;
-            let _e70 = ray_r_mu_intersects_ground_26;
-            let _e71 = GetScattering(_e65, single_mie_scattering_texture, _e66, _e67, _e68, _e69, _e70);
-            (*single_mie_scattering) = vec3<f32>(_e71.xyz);
-        }
-    }
-    let _e74 = scattering;
-    return vec3<f32>(_e74.xyz);
-}
-
-// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceOfRay(atmosphere_100: AtmosphereParameters, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, r_58: f32, mu_41: f32, mu_s_33: f32, nu_21: f32, ray_r_mu_intersects_ground_27: bool) -> vec3<f32> {
-    var atmosphere_101: AtmosphereParameters;
+fn GetCombinedScattering(atmosphere_102: AtmosphereParameters, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_58: f32, mu_41: f32, mu_s_33: f32, nu_21: f32, ray_r_mu_intersects_ground_27: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_103: AtmosphereParameters;
     var r_59: f32;
     var mu_42: f32;
     var mu_s_34: f32;
     var nu_22: f32;
     var ray_r_mu_intersects_ground_28: bool;
-    var single_mie_scattering_1: vec3<f32>;
-    var scattering_1: vec3<f32>;
+    var lookup_3: ScatteringLookup;
+    var scattering: vec4<f32>;
+    var local_22: vec3<f32>;
 
-    atmosphere_101 = atmosphere_100;
+    atmosphere_103 = atmosphere_102;
     r_59 = r_58;
     mu_42 = mu_41;
     mu_s_34 = mu_s_33;
     nu_22 = nu_21;
     ray_r_mu_intersects_ground_28 = ray_r_mu_intersects_ground_27;
-    let _e27 = atmosphere_101;
-    let _e28 = r_59;
-    let _e29 = mu_42;
-    let _e30 = mu_s_34;
-    let _e31 = nu_22;
-    let _e32 = ray_r_mu_intersects_ground_28;
-    let _e35 = GetCombinedScattering(_e27, scattering_texture_6, single_mie_scattering_texture_1, _e28, _e29, _e30, _e31, _e32, (&single_mie_scattering_1));
-    scattering_1 = _e35;
-    let _e37 = scattering_1;
-    let _e38 = nu_22;
-    let _e39 = RayleighPhaseFunction(_e38);
-    let _e41 = single_mie_scattering_1;
-    let _e42 = atmosphere_101;
-    let _e43 = nu_22;
-    let _e44 = MiePhaseFunction(_e42, _e43);
-    return ((_e37 * _e39) + (_e41 * _e44));
+    let _e31 = atmosphere_103;
+    let _e32 = r_59;
+    let _e33 = mu_42;
+    let _e34 = mu_s_34;
+    let _e35 = nu_22;
+    let _e36 = ray_r_mu_intersects_ground_28;
+    let _e37 = GetScatteringLookup(_e31, _e32, _e33, _e34, _e35, _e36);
+    lookup_3 = _e37;
+    let _e39 = atmosphere_103;
+    let _e40 = lookup_3;
+    let _e41 = GetScatteringFromLookup(_e39, scattering_texture_6, _e40);
+    scattering = _e41;
+    let _e43 = atmosphere_103;
+    if (_e43.single_mie_in_scattering_alpha == 1i) {
+        {
+            let _e47 = scattering;
+            if (_e47.x > 0f) {
+                let _e51 = scattering;
+                let _e54 = scattering;
+                let _e57 = scattering;
+                let _e61 = atmosphere_103;
+                let _e63 = atmosphere_103;
+                local_22 = (((vec3<f32>(_e51.xyz) * _e54.w) / vec3(_e57.x)) * (_e61.mie_to_rayleigh_scattering_ratio / vec3(_e63.mie_to_rayleigh_scattering_ratio.x)));
+            } else {
+                local_22 = vec3(0f);
+            }
+            let _e72 = local_22;
+            (*single_mie_scattering) = _e72;
+        }
+    } else {
+        {
+            let _e73 = atmosphere_103;
+            let _e74 = lookup_3;
+            let _e75 = GetScatteringFromLookup(_e73, single_mie_scattering_texture, _e74);
+            (*single_mie_scattering) = vec3<f32>(_e75.xyz);
+        }
+    }
+    let _e78 = scattering;
+    return vec3<f32>(_e78.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_102: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_103: AtmosphereParameters;
+fn GetSkyRadianceOfRay(atmosphere_104: AtmosphereParameters, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, r_60: f32, mu_43: f32, mu_s_35: f32, nu_23: f32, ray_r_mu_intersects_ground_29: bool) -> vec3<f32> {
+    var atmosphere_105: AtmosphereParameters;
+    var r_61: f32;
+    var mu_44: f32;
+    var mu_s_36: f32;
+    var nu_24: f32;
+    var ray_r_mu_intersects_ground_30: bool;
+    var single_mie_scattering_1: vec3<f32>;
+    var scattering_1: vec3<f32>;
+
+    atmosphere_105 = atmosphere_104;
+    r_61 = r_60;
+    mu_44 = mu_43;
+    mu_s_36 = mu_s_35;
+    nu_24 = nu_23;
+    ray_r_mu_intersects_ground_30 = ray_r_mu_intersects_ground_29;
+    let _e31 = atmosphere_105;
+    let _e32 = r_61;
+    let _e33 = mu_44;
+    let _e34 = mu_s_36;
+    let _e35 = nu_24;
+    let _e36 = ray_r_mu_intersects_ground_30;
+    let _e39 = GetCombinedScattering(_e31, scattering_texture_7, single_mie_scattering_texture_1, _e32, _e33, _e34, _e35, _e36, (&single_mie_scattering_1));
+    scattering_1 = _e39;
+    let _e41 = scattering_1;
+    let _e42 = nu_24;
+    let _e43 = RayleighPhaseFunction(_e42);
+    let _e45 = single_mie_scattering_1;
+    let _e46 = atmosphere_105;
+    let _e47 = nu_24;
+    let _e48 = MiePhaseFunction(_e46, _e47);
+    return ((_e41 * _e43) + (_e45 * _e48));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyRadiance(atmosphere_106: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_107: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
     var start_2: vec3<f32>;
-    var r_60: f32;
-    var mu_43: f32;
-    var mu_s_35: f32;
-    var nu_23: f32;
-    var ray_r_mu_intersects_ground_29: bool;
+    var r_62: f32;
+    var mu_45: f32;
+    var mu_s_37: f32;
+    var nu_25: f32;
+    var ray_r_mu_intersects_ground_31: bool;
     var local_23: vec3<f32>;
 
-    atmosphere_103 = atmosphere_102;
+    atmosphere_107 = atmosphere_106;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e29 = atmosphere_103;
-    let _e30 = camera_5;
-    let _e31 = view_ray_5;
-    let _e32 = sun_direction_3;
-    let _e43 = GetViewRayStart(_e29, _e30, _e31, _e32, (&start_2), (&r_60), (&mu_43), (&mu_s_35), (&nu_23));
-    if !(_e43) {
+    let _e33 = atmosphere_107;
+    let _e34 = camera_5;
+    let _e35 = view_ray_5;
+    let _e36 = sun_direction_3;
+    let _e47 = GetViewRayStart(_e33, _e34, _e35, _e36, (&start_2), (&r_62), (&mu_45), (&mu_s_37), (&nu_25));
+    if !(_e47) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e49 = atmosphere_103;
-    let _e50 = r_60;
-    let _e51 = mu_43;
-    let _e52 = RayIntersectsGround(_e49, _e50, _e51);
-    ray_r_mu_intersects_ground_29 = _e52;
-    let _e54 = ray_r_mu_intersects_ground_29;
-    if _e54 {
+    let _e53 = atmosphere_107;
+    let _e54 = r_62;
+    let _e55 = mu_45;
+    let _e56 = RayIntersectsGround(_e53, _e54, _e55);
+    ray_r_mu_intersects_ground_31 = _e56;
+    let _e58 = ray_r_mu_intersects_ground_31;
+    if _e58 {
         local_23 = vec3(0f);
     } else {
-        let _e57 = atmosphere_103;
-        let _e58 = r_60;
-        let _e59 = mu_43;
-        let _e60 = GetTransmittanceToTopAtmosphereBoundary(_e57, transmittance_texture_5, _e58, _e59);
-        local_23 = _e60;
+        let _e61 = atmosphere_107;
+        let _e62 = r_62;
+        let _e63 = mu_45;
+        let _e64 = GetTransmittanceToTopAtmosphereBoundary(_e61, transmittance_texture_5, _e62, _e63);
+        local_23 = _e64;
     }
-    let _e62 = local_23;
-    (*transmittance) = _e62;
-    let _e63 = atmosphere_103;
-    let _e64 = r_60;
-    let _e65 = mu_43;
-    let _e66 = mu_s_35;
-    let _e67 = nu_23;
-    let _e68 = ray_r_mu_intersects_ground_29;
-    let _e69 = GetSkyRadianceOfRay(_e63, scattering_texture_7, single_mie_scattering_texture_2, _e64, _e65, _e66, _e67, _e68);
-    return _e69;
+    let _e66 = local_23;
+    (*transmittance) = _e66;
+    let _e67 = atmosphere_107;
+    let _e68 = r_62;
+    let _e69 = mu_45;
+    let _e70 = mu_s_37;
+    let _e71 = nu_25;
+    let _e72 = ray_r_mu_intersects_ground_31;
+    let _e73 = GetSkyRadianceOfRay(_e67, scattering_texture_8, single_mie_scattering_texture_2, _e68, _e69, _e70, _e71, _e72);
+    return _e73;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_104: AtmosphereParameters, r_61: f32, mu_44: f32) -> f32 {
-    var atmosphere_105: AtmosphereParameters;
-    var r_62: f32;
-    var mu_45: f32;
+fn DistanceInsideScatteringRadii(atmosphere_108: AtmosphereParameters, r_63: f32, mu_46: f32) -> f32 {
+    var atmosphere_109: AtmosphereParameters;
+    var r_64: f32;
+    var mu_47: f32;
     var r_max: f32;
     var r_min: f32;
     var across_2: f32;
@@ -3078,117 +3177,117 @@ fn DistanceInsideScatteringRadii(atmosphere_104: AtmosphereParameters, r_61: f32
     var down_discriminant: f32;
     var local_24: f32;
 
-    atmosphere_105 = atmosphere_104;
-    r_62 = r_61;
-    mu_45 = mu_44;
-    let _e19 = atmosphere_105;
-    r_max = _e19.scattering_r_max;
-    let _e22 = atmosphere_105;
-    r_min = _e22.scattering_r_min;
-    let _e25 = r_62;
-    let _e26 = r_62;
-    let _e28 = mu_45;
-    let _e29 = mu_45;
-    across_2 = ((_e25 * _e26) * ((_e28 * _e29) - 1f));
-    let _e35 = r_62;
-    let _e37 = mu_45;
-    let _e39 = across_2;
-    let _e40 = r_max;
-    let _e41 = r_max;
-    let _e44 = SafeSqrt((_e39 + (_e40 * _e41)));
-    up = ((-(_e35) * _e37) + _e44);
-    let _e47 = across_2;
-    let _e48 = r_min;
-    let _e49 = r_min;
-    down_discriminant = (_e47 + (_e48 * _e49));
-    let _e53 = mu_45;
-    let _e56 = down_discriminant;
-    if ((_e53 < 0f) && (_e56 >= 0f)) {
-        let _e60 = up;
-        let _e61 = r_62;
-        let _e63 = mu_45;
-        let _e65 = down_discriminant;
-        local_24 = min(_e60, ((-(_e61) * _e63) - sqrt(_e65)));
+    atmosphere_109 = atmosphere_108;
+    r_64 = r_63;
+    mu_47 = mu_46;
+    let _e23 = atmosphere_109;
+    r_max = _e23.scattering_r_max;
+    let _e26 = atmosphere_109;
+    r_min = _e26.scattering_r_min;
+    let _e29 = r_64;
+    let _e30 = r_64;
+    let _e32 = mu_47;
+    let _e33 = mu_47;
+    across_2 = ((_e29 * _e30) * ((_e32 * _e33) - 1f));
+    let _e39 = r_64;
+    let _e41 = mu_47;
+    let _e43 = across_2;
+    let _e44 = r_max;
+    let _e45 = r_max;
+    let _e48 = SafeSqrt((_e43 + (_e44 * _e45)));
+    up = ((-(_e39) * _e41) + _e48);
+    let _e51 = across_2;
+    let _e52 = r_min;
+    let _e53 = r_min;
+    down_discriminant = (_e51 + (_e52 * _e53));
+    let _e57 = mu_47;
+    let _e60 = down_discriminant;
+    if ((_e57 < 0f) && (_e60 >= 0f)) {
+        let _e64 = up;
+        let _e65 = r_64;
+        let _e67 = mu_47;
+        let _e69 = down_discriminant;
+        local_24 = min(_e64, ((-(_e65) * _e67) - sqrt(_e69)));
     } else {
-        let _e69 = up;
-        local_24 = _e69;
+        let _e73 = up;
+        local_24 = _e73;
     }
-    let _e71 = local_24;
-    return _e71;
+    let _e75 = local_24;
+    return _e75;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_106: AtmosphereParameters, i_1: i32) -> f32 {
-    var atmosphere_107: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_110: AtmosphereParameters, i_1: i32) -> f32 {
+    var atmosphere_111: AtmosphereParameters;
     var i_2: i32;
     var x_22: f32;
 
-    atmosphere_107 = atmosphere_106;
+    atmosphere_111 = atmosphere_110;
     i_2 = i_1;
-    let _e18 = i_2;
-    x_22 = (f32(_e18) / 63f);
-    let _e26 = atmosphere_107;
-    let _e28 = atmosphere_107;
-    let _e31 = x_22;
-    let _e33 = x_22;
-    return (((_e26.top_radius - _e28.bottom_radius) * _e31) * _e33);
+    let _e22 = i_2;
+    x_22 = (f32(_e22) / 63f);
+    let _e30 = atmosphere_111;
+    let _e32 = atmosphere_111;
+    let _e35 = x_22;
+    let _e37 = x_22;
+    return (((_e30.top_radius - _e32.bottom_radius) * _e35) * _e37);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_18: f32, b_10: f32, f: f32) -> f32 {
-    var a_19: f32;
-    var b_11: f32;
+fn InterpolateCoefficient(a_19: f32, b_11: f32, f: f32) -> f32 {
+    var a_20: f32;
+    var b_12: f32;
     var f_1: f32;
     var local_25: f32;
 
-    a_19 = a_18;
-    b_11 = b_10;
+    a_20 = a_19;
+    b_12 = b_11;
     f_1 = f;
-    let _e20 = a_19;
-    let _e23 = b_11;
-    if ((_e20 > 0f) && (_e23 > 0f)) {
-        let _e27 = a_19;
-        let _e28 = f_1;
-        let _e29 = b_11;
-        let _e30 = a_19;
-        local_25 = (_e27 * exp((_e28 * log((_e29 / _e30)))));
+    let _e24 = a_20;
+    let _e27 = b_12;
+    if ((_e24 > 0f) && (_e27 > 0f)) {
+        let _e31 = a_20;
+        let _e32 = f_1;
+        let _e33 = b_12;
+        let _e34 = a_20;
+        local_25 = (_e31 * exp((_e32 * log((_e33 / _e34)))));
     } else {
-        let _e36 = a_19;
-        let _e37 = b_11;
-        let _e38 = f_1;
-        local_25 = mix(_e36, _e37, _e38);
+        let _e40 = a_20;
+        let _e41 = b_12;
+        let _e42 = f_1;
+        local_25 = mix(_e40, _e41, _e42);
     }
-    let _e41 = local_25;
-    return _e41;
+    let _e45 = local_25;
+    return _e45;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_20: vec3<f32>, b_12: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_21: vec3<f32>;
-    var b_13: vec3<f32>;
+fn InterpolateCoefficients(a_21: vec3<f32>, b_13: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_22: vec3<f32>;
+    var b_14: vec3<f32>;
     var f_3: f32;
 
-    a_21 = a_20;
-    b_13 = b_12;
+    a_22 = a_21;
+    b_14 = b_13;
     f_3 = f_2;
-    let _e20 = a_21;
-    let _e22 = b_13;
-    let _e24 = f_3;
-    let _e25 = InterpolateCoefficient(_e20.x, _e22.x, _e24);
-    let _e26 = a_21;
-    let _e28 = b_13;
-    let _e30 = f_3;
-    let _e31 = InterpolateCoefficient(_e26.y, _e28.y, _e30);
-    let _e32 = a_21;
-    let _e34 = b_13;
-    let _e36 = f_3;
-    let _e37 = InterpolateCoefficient(_e32.z, _e34.z, _e36);
-    return vec3<f32>(_e25, _e31, _e37);
+    let _e24 = a_22;
+    let _e26 = b_14;
+    let _e28 = f_3;
+    let _e29 = InterpolateCoefficient(_e24.x, _e26.x, _e28);
+    let _e30 = a_22;
+    let _e32 = b_14;
+    let _e34 = f_3;
+    let _e35 = InterpolateCoefficient(_e30.y, _e32.y, _e34);
+    let _e36 = a_22;
+    let _e38 = b_14;
+    let _e40 = f_3;
+    let _e41 = InterpolateCoefficient(_e36.z, _e38.z, _e40);
+    return vec3<f32>(_e29, _e35, _e41);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_108: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_109: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_112: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_113: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
     var x_23: f32;
@@ -3196,80 +3295,80 @@ fn GetCoefficientsAtAltitude(atmosphere_108: AtmosphereParameters, altitude: f32
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_109 = atmosphere_108;
+    atmosphere_113 = atmosphere_112;
     altitude_1 = altitude;
-    let _e20 = atmosphere_109;
-    let _e22 = atmosphere_109;
-    height = (_e20.top_radius - _e22.bottom_radius);
-    let _e26 = altitude_1;
-    let _e27 = height;
-    x_23 = (sqrt(clamp((_e26 / _e27), 0f, 1f)) * 63f);
-    let _e39 = x_23;
-    i_3 = min(i32(_e39), 62i);
-    let _e46 = atmosphere_109;
-    let _e47 = i_3;
-    let _e48 = ProfileSampleAltitude(_e46, _e47);
-    h0_ = _e48;
-    let _e50 = altitude_1;
-    let _e51 = h0_;
-    let _e53 = atmosphere_109;
-    let _e54 = i_3;
-    let _e57 = ProfileSampleAltitude(_e53, (_e54 + 1i));
-    let _e58 = h0_;
-    f_4 = clamp(((_e50 - _e51) / (_e57 - _e58)), 0f, 1f);
-    let _e65 = i_3;
-    let _e68 = atmosphere_109.mie_scattering_profile[_e65];
+    let _e24 = atmosphere_113;
+    let _e26 = atmosphere_113;
+    height = (_e24.top_radius - _e26.bottom_radius);
+    let _e30 = altitude_1;
+    let _e31 = height;
+    x_23 = (sqrt(clamp((_e30 / _e31), 0f, 1f)) * 63f);
+    let _e43 = x_23;
+    i_3 = min(i32(_e43), 62i);
+    let _e50 = atmosphere_113;
+    let _e51 = i_3;
+    let _e52 = ProfileSampleAltitude(_e50, _e51);
+    h0_ = _e52;
+    let _e54 = altitude_1;
+    let _e55 = h0_;
+    let _e57 = atmosphere_113;
+    let _e58 = i_3;
+    let _e61 = ProfileSampleAltitude(_e57, (_e58 + 1i));
+    let _e62 = h0_;
+    f_4 = clamp(((_e54 - _e55) / (_e61 - _e62)), 0f, 1f);
     let _e69 = i_3;
-    let _e74 = atmosphere_109.mie_scattering_profile[(_e69 + 1i)];
-    let _e75 = f_4;
-    let _e76 = InterpolateCoefficients(_e68, _e74, _e75);
-    (*mie_scattering) = _e76;
-    let _e77 = i_3;
-    let _e80 = atmosphere_109.rayleigh_scattering_profile[_e77];
+    let _e72 = atmosphere_113.mie_scattering_profile[_e69];
+    let _e73 = i_3;
+    let _e78 = atmosphere_113.mie_scattering_profile[(_e73 + 1i)];
+    let _e79 = f_4;
+    let _e80 = InterpolateCoefficients(_e72, _e78, _e79);
+    (*mie_scattering) = _e80;
     let _e81 = i_3;
-    let _e86 = atmosphere_109.rayleigh_scattering_profile[(_e81 + 1i)];
-    let _e87 = f_4;
-    let _e88 = InterpolateCoefficients(_e80, _e86, _e87);
-    (*rayleigh_scattering) = _e88;
-    let _e89 = i_3;
-    let _e92 = atmosphere_109.extinction_profile[_e89];
+    let _e84 = atmosphere_113.rayleigh_scattering_profile[_e81];
+    let _e85 = i_3;
+    let _e90 = atmosphere_113.rayleigh_scattering_profile[(_e85 + 1i)];
+    let _e91 = f_4;
+    let _e92 = InterpolateCoefficients(_e84, _e90, _e91);
+    (*rayleigh_scattering) = _e92;
     let _e93 = i_3;
-    let _e98 = atmosphere_109.extinction_profile[(_e93 + 1i)];
-    let _e99 = f_4;
-    let _e100 = InterpolateCoefficients(_e92, _e98, _e99);
-    return _e100;
+    let _e96 = atmosphere_113.extinction_profile[_e93];
+    let _e97 = i_3;
+    let _e102 = atmosphere_113.extinction_profile[(_e97 + 1i)];
+    let _e103 = f_4;
+    let _e104 = InterpolateCoefficients(_e96, _e102, _e103);
+    return _e104;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_110: AtmosphereParameters, r_63: f32, mu_46: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_111: AtmosphereParameters;
-    var r_64: f32;
-    var mu_47: f32;
+fn AltitudeAtDistance(atmosphere_114: AtmosphereParameters, r_65: f32, mu_48: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_115: AtmosphereParameters;
+    var r_66: f32;
+    var mu_49: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_111 = atmosphere_110;
-    r_64 = r_63;
-    mu_47 = mu_46;
+    atmosphere_115 = atmosphere_114;
+    r_66 = r_65;
+    mu_49 = mu_48;
     t_10 = t_9;
     r_t_1 = r_t;
-    let _e24 = r_64;
-    let _e25 = atmosphere_111;
-    let _e28 = t_10;
-    let _e29 = t_10;
-    let _e31 = r_64;
-    let _e33 = mu_47;
-    let _e37 = r_t_1;
-    let _e38 = r_64;
-    return ((_e24 - _e25.bottom_radius) + ((_e28 * (_e29 + ((2f * _e31) * _e33))) / (_e37 + _e38)));
+    let _e28 = r_66;
+    let _e29 = atmosphere_115;
+    let _e32 = t_10;
+    let _e33 = t_10;
+    let _e35 = r_66;
+    let _e37 = mu_49;
+    let _e41 = r_t_1;
+    let _e42 = r_66;
+    return ((_e28 - _e29.bottom_radius) + ((_e32 * (_e33 + ((2f * _e35) * _e37))) / (_e41 + _e42)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_112: AtmosphereParameters, r_65: f32, mu_48: f32, d_23: f32) -> vec3<f32> {
-    var atmosphere_113: AtmosphereParameters;
-    var r_66: f32;
-    var mu_49: f32;
-    var d_24: f32;
+fn IntegrateSegmentOpticalDepth(atmosphere_116: AtmosphereParameters, r_67: f32, mu_50: f32, d_24: f32) -> vec3<f32> {
+    var atmosphere_117: AtmosphereParameters;
+    var r_68: f32;
+    var mu_51: f32;
+    var d_25: f32;
     var dt: f32;
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
@@ -3280,89 +3379,89 @@ fn IntegrateSegmentOpticalDepth(atmosphere_112: AtmosphereParameters, r_65: f32,
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_113 = atmosphere_112;
-    r_66 = r_65;
-    mu_49 = mu_48;
-    d_24 = d_23;
-    let _e22 = d_24;
-    dt = (_e22 / 16f);
+    atmosphere_117 = atmosphere_116;
+    r_68 = r_67;
+    mu_51 = mu_50;
+    d_25 = d_24;
+    let _e26 = d_25;
+    dt = (_e26 / 16f);
     loop {
-        let _e35 = k_5;
-        if !((_e35 <= SEGMENT_INTERVALS)) {
+        let _e39 = k_5;
+        if !((_e39 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e41 = dt;
-            let _e42 = k_5;
-            t_11 = (_e41 * f32(_e42));
-            let _e46 = atmosphere_113;
-            let _e47 = r_66;
-            let _e48 = mu_49;
-            let _e49 = t_11;
-            let _e50 = RadiusAtDistance(_e46, _e47, _e48, _e49);
-            r_t_2 = _e50;
-            let _e54 = atmosphere_113;
-            let _e55 = atmosphere_113;
-            let _e56 = r_66;
-            let _e57 = mu_49;
-            let _e58 = t_11;
-            let _e59 = r_t_2;
-            let _e60 = AltitudeAtDistance(_e55, _e56, _e57, _e58, _e59);
-            let _e65 = GetCoefficientsAtAltitude(_e54, _e60, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e65;
-            let _e67 = k_5;
-            if (_e67 > 0i) {
-                let _e70 = optical_depth;
-                let _e71 = previous_extinction;
-                let _e72 = extinction;
-                let _e75 = dt;
-                optical_depth = (_e70 + ((_e71 + _e72) * (0.5f * _e75)));
+            let _e45 = dt;
+            let _e46 = k_5;
+            t_11 = (_e45 * f32(_e46));
+            let _e50 = atmosphere_117;
+            let _e51 = r_68;
+            let _e52 = mu_51;
+            let _e53 = t_11;
+            let _e54 = RadiusAtDistance(_e50, _e51, _e52, _e53);
+            r_t_2 = _e54;
+            let _e58 = atmosphere_117;
+            let _e59 = atmosphere_117;
+            let _e60 = r_68;
+            let _e61 = mu_51;
+            let _e62 = t_11;
+            let _e63 = r_t_2;
+            let _e64 = AltitudeAtDistance(_e59, _e60, _e61, _e62, _e63);
+            let _e69 = GetCoefficientsAtAltitude(_e58, _e64, (&mie_scattering_1), (&rayleigh_scattering_1));
+            extinction = _e69;
+            let _e71 = k_5;
+            if (_e71 > 0i) {
+                let _e74 = optical_depth;
+                let _e75 = previous_extinction;
+                let _e76 = extinction;
+                let _e79 = dt;
+                optical_depth = (_e74 + ((_e75 + _e76) * (0.5f * _e79)));
             }
-            let _e79 = extinction;
-            previous_extinction = _e79;
+            let _e83 = extinction;
+            previous_extinction = _e83;
         }
         continuing {
-            let _e38 = k_5;
-            k_5 = (_e38 + 1i);
+            let _e42 = k_5;
+            k_5 = (_e42 + 1i);
         }
     }
-    let _e80 = optical_depth;
-    return _e80;
+    let _e84 = optical_depth;
+    return _e84;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_114: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_67: f32, mu_50: f32, d_25: f32, ray_r_mu_intersects_ground_30: bool) -> vec3<f32> {
-    var atmosphere_115: AtmosphereParameters;
-    var r_68: f32;
-    var mu_51: f32;
-    var d_26: f32;
-    var ray_r_mu_intersects_ground_31: bool;
+fn LongSegmentOpticalDepth(atmosphere_118: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_69: f32, mu_52: f32, d_26: f32, ray_r_mu_intersects_ground_32: bool) -> vec3<f32> {
+    var atmosphere_119: AtmosphereParameters;
+    var r_70: f32;
+    var mu_53: f32;
+    var d_27: f32;
+    var ray_r_mu_intersects_ground_33: bool;
     var local_26: vec3<f32>;
 
-    atmosphere_115 = atmosphere_114;
-    r_68 = r_67;
-    mu_51 = mu_50;
-    d_26 = d_25;
-    ray_r_mu_intersects_ground_31 = ray_r_mu_intersects_ground_30;
-    let _e25 = atmosphere_115;
-    if (_e25.transmittance_is_colour != 0i) {
-        let _e29 = atmosphere_115;
-        let _e30 = r_68;
-        let _e31 = mu_51;
-        let _e32 = d_26;
-        let _e33 = IntegrateSegmentOpticalDepth(_e29, _e30, _e31, _e32);
-        local_26 = _e33;
+    atmosphere_119 = atmosphere_118;
+    r_70 = r_69;
+    mu_53 = mu_52;
+    d_27 = d_26;
+    ray_r_mu_intersects_ground_33 = ray_r_mu_intersects_ground_32;
+    let _e29 = atmosphere_119;
+    if (_e29.transmittance_is_colour != 0i) {
+        let _e33 = atmosphere_119;
+        let _e34 = r_70;
+        let _e35 = mu_53;
+        let _e36 = d_27;
+        let _e37 = IntegrateSegmentOpticalDepth(_e33, _e34, _e35, _e36);
+        local_26 = _e37;
     } else {
-        let _e34 = atmosphere_115;
-        let _e35 = r_68;
-        let _e36 = mu_51;
-        let _e37 = d_26;
-        let _e38 = ray_r_mu_intersects_ground_31;
-        let _e39 = GetOpticalDepth(_e34, transmittance_texture_6, _e35, _e36, _e37, _e38);
-        local_26 = _e39;
+        let _e38 = atmosphere_119;
+        let _e39 = r_70;
+        let _e40 = mu_53;
+        let _e41 = d_27;
+        let _e42 = ray_r_mu_intersects_ground_33;
+        let _e43 = GetOpticalDepth(_e38, transmittance_texture_6, _e39, _e40, _e41, _e42);
+        local_26 = _e43;
     }
-    let _e41 = local_26;
-    return _e41;
+    let _e45 = local_26;
+    return _e45;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3371,27 +3470,27 @@ fn MeanAttenuation(depth: f32) -> f32 {
     var local_27: f32;
 
     depth_1 = depth;
-    let _e16 = depth_1;
-    if (_e16 < 0.0001f) {
-        let _e21 = depth_1;
-        local_27 = (1f - (0.5f * _e21));
-    } else {
+    let _e20 = depth_1;
+    if (_e20 < 0.0001f) {
         let _e25 = depth_1;
+        local_27 = (1f - (0.5f * _e25));
+    } else {
         let _e29 = depth_1;
-        local_27 = ((1f - exp(-(_e25))) / _e29);
+        let _e33 = depth_1;
+        local_27 = ((1f - exp(-(_e29))) / _e33);
     }
-    let _e32 = local_27;
-    return _e32;
+    let _e36 = local_27;
+    return _e36;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_116: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_69: f32, mu_52: f32, mu_s_36: f32, nu_24: f32, d_27: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_117: AtmosphereParameters;
-    var r_70: f32;
-    var mu_53: f32;
-    var mu_s_37: f32;
-    var nu_25: f32;
-    var d_28: f32;
+fn IntegrateSegment(atmosphere_120: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_38: f32, nu_26: f32, d_28: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_121: AtmosphereParameters;
+    var r_72: f32;
+    var mu_55: f32;
+    var mu_s_39: f32;
+    var nu_27: f32;
+    var d_29: f32;
     var dt_1: f32;
     var optical_depth_1: vec3<f32> = vec3(0f);
     var previous_extinction_1: vec3<f32> = vec3(0f);
@@ -3402,7 +3501,7 @@ fn IntegrateSegment(atmosphere_116: AtmosphereParameters, transmittance_texture_
     var t_12: f32;
     var r_t_3: f32;
     var altitude_2: f32;
-    var mu_s_t_2: f32;
+    var mu_s_t_1: f32;
     var mie_scattering_2: vec3<f32>;
     var rayleigh_scattering_2: vec3<f32>;
     var extinction_1: vec3<f32>;
@@ -3414,135 +3513,135 @@ fn IntegrateSegment(atmosphere_116: AtmosphereParameters, transmittance_texture_
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_117 = atmosphere_116;
-    r_70 = r_69;
-    mu_53 = mu_52;
-    mu_s_37 = mu_s_36;
-    nu_25 = nu_24;
-    d_28 = d_27;
-    let _e30 = d_28;
-    dt_1 = (_e30 / 16f);
+    atmosphere_121 = atmosphere_120;
+    r_72 = r_71;
+    mu_55 = mu_54;
+    mu_s_39 = mu_s_38;
+    nu_27 = nu_26;
+    d_29 = d_28;
+    let _e34 = d_29;
+    dt_1 = (_e34 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
     (*scattering_weight) = vec3(0f);
     loop {
-        let _e58 = k_6;
-        if !((_e58 <= SEGMENT_INTERVALS)) {
+        let _e62 = k_6;
+        if !((_e62 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e64 = dt_1;
-            let _e65 = k_6;
-            t_12 = (_e64 * f32(_e65));
-            let _e69 = atmosphere_117;
-            let _e70 = r_70;
-            let _e71 = mu_53;
-            let _e72 = t_12;
-            let _e73 = RadiusAtDistance(_e69, _e70, _e71, _e72);
-            r_t_3 = _e73;
-            let _e75 = atmosphere_117;
-            let _e76 = r_70;
-            let _e77 = mu_53;
-            let _e78 = t_12;
-            let _e79 = r_t_3;
-            let _e80 = AltitudeAtDistance(_e75, _e76, _e77, _e78, _e79);
-            altitude_2 = _e80;
-            let _e82 = r_70;
-            let _e83 = mu_s_37;
-            let _e85 = t_12;
-            let _e86 = nu_25;
-            let _e89 = r_t_3;
-            let _e91 = ClampCosine((((_e82 * _e83) + (_e85 * _e86)) / _e89));
-            mu_s_t_2 = _e91;
-            let _e95 = atmosphere_117;
-            let _e96 = altitude_2;
-            let _e101 = GetCoefficientsAtAltitude(_e95, _e96, (&mie_scattering_2), (&rayleigh_scattering_2));
-            extinction_1 = _e101;
-            let _e103 = atmosphere_117;
-            let _e104 = r_t_3;
-            let _e105 = mu_s_t_2;
-            let _e106 = GetOpticalDepthToTopAtmosphereBoundary(_e103, transmittance_texture_7, _e104, _e105);
-            let _e109 = atmosphere_117;
-            let _e110 = r_t_3;
-            let _e111 = mu_s_t_2;
-            let _e112 = SunVisibleFraction(_e109, _e110, _e111);
-            sunlight = (exp(-(_e106)) * _e112);
-            let _e115 = rayleigh_scattering_2;
-            let _e116 = sunlight;
-            rayleigh = (_e115 * _e116);
-            let _e119 = mie_scattering_2;
+            let _e68 = dt_1;
+            let _e69 = k_6;
+            t_12 = (_e68 * f32(_e69));
+            let _e73 = atmosphere_121;
+            let _e74 = r_72;
+            let _e75 = mu_55;
+            let _e76 = t_12;
+            let _e77 = RadiusAtDistance(_e73, _e74, _e75, _e76);
+            r_t_3 = _e77;
+            let _e79 = atmosphere_121;
+            let _e80 = r_72;
+            let _e81 = mu_55;
+            let _e82 = t_12;
+            let _e83 = r_t_3;
+            let _e84 = AltitudeAtDistance(_e79, _e80, _e81, _e82, _e83);
+            altitude_2 = _e84;
+            let _e86 = r_72;
+            let _e87 = mu_s_39;
+            let _e89 = t_12;
+            let _e90 = nu_27;
+            let _e93 = r_t_3;
+            let _e95 = ClampCosine((((_e86 * _e87) + (_e89 * _e90)) / _e93));
+            mu_s_t_1 = _e95;
+            let _e99 = atmosphere_121;
+            let _e100 = altitude_2;
+            let _e105 = GetCoefficientsAtAltitude(_e99, _e100, (&mie_scattering_2), (&rayleigh_scattering_2));
+            extinction_1 = _e105;
+            let _e107 = atmosphere_121;
+            let _e108 = r_t_3;
+            let _e109 = mu_s_t_1;
+            let _e110 = GetOpticalDepthToTopAtmosphereBoundary(_e107, transmittance_texture_7, _e108, _e109);
+            let _e113 = atmosphere_121;
+            let _e114 = r_t_3;
+            let _e115 = mu_s_t_1;
+            let _e116 = SunVisibleFraction(_e113, _e114, _e115);
+            sunlight = (exp(-(_e110)) * _e116);
+            let _e119 = rayleigh_scattering_2;
             let _e120 = sunlight;
-            mie = (_e119 * _e120);
-            let _e123 = rayleigh_scattering_2;
-            let _e124 = mie_scattering_2;
-            scattering_2 = (_e123 + _e124);
-            let _e127 = k_6;
-            if (_e127 > 0i) {
+            rayleigh = (_e119 * _e120);
+            let _e123 = mie_scattering_2;
+            let _e124 = sunlight;
+            mie = (_e123 * _e124);
+            let _e127 = rayleigh_scattering_2;
+            let _e128 = mie_scattering_2;
+            scattering_2 = (_e127 + _e128);
+            let _e131 = k_6;
+            if (_e131 > 0i) {
                 {
-                    let _e130 = previous_extinction_1;
-                    let _e131 = extinction_1;
-                    let _e134 = dt_1;
-                    interval_depth = ((_e130 + _e131) * (0.5f * _e134));
-                    let _e138 = optical_depth_1;
-                    start_transmittance = exp(-(_e138));
-                    let _e142 = start_transmittance;
-                    let _e143 = interval_depth;
-                    let _e145 = MeanAttenuation(_e143.x);
-                    let _e146 = interval_depth;
-                    let _e148 = MeanAttenuation(_e146.y);
-                    let _e149 = interval_depth;
-                    let _e151 = MeanAttenuation(_e149.z);
-                    mean_transmittance = (_e142 * vec3<f32>(_e145, _e148, _e151));
-                    let _e155 = (*single_rayleigh);
-                    let _e156 = previous_rayleigh;
-                    let _e157 = rayleigh;
-                    let _e160 = dt_1;
-                    let _e163 = mean_transmittance;
-                    (*single_rayleigh) = (_e155 + (((_e156 + _e157) * (0.5f * _e160)) * _e163));
-                    let _e166 = (*single_mie);
-                    let _e167 = previous_mie;
-                    let _e168 = mie;
-                    let _e171 = dt_1;
-                    let _e174 = mean_transmittance;
-                    (*single_mie) = (_e166 + (((_e167 + _e168) * (0.5f * _e171)) * _e174));
-                    let _e177 = (*scattering_weight);
-                    let _e178 = previous_scattering;
-                    let _e179 = scattering_2;
-                    let _e182 = dt_1;
-                    let _e185 = mean_transmittance;
-                    (*scattering_weight) = (_e177 + (((_e178 + _e179) * (0.5f * _e182)) * _e185));
-                    let _e188 = optical_depth_1;
-                    let _e189 = interval_depth;
-                    optical_depth_1 = (_e188 + _e189);
+                    let _e134 = previous_extinction_1;
+                    let _e135 = extinction_1;
+                    let _e138 = dt_1;
+                    interval_depth = ((_e134 + _e135) * (0.5f * _e138));
+                    let _e142 = optical_depth_1;
+                    start_transmittance = exp(-(_e142));
+                    let _e146 = start_transmittance;
+                    let _e147 = interval_depth;
+                    let _e149 = MeanAttenuation(_e147.x);
+                    let _e150 = interval_depth;
+                    let _e152 = MeanAttenuation(_e150.y);
+                    let _e153 = interval_depth;
+                    let _e155 = MeanAttenuation(_e153.z);
+                    mean_transmittance = (_e146 * vec3<f32>(_e149, _e152, _e155));
+                    let _e159 = (*single_rayleigh);
+                    let _e160 = previous_rayleigh;
+                    let _e161 = rayleigh;
+                    let _e164 = dt_1;
+                    let _e167 = mean_transmittance;
+                    (*single_rayleigh) = (_e159 + (((_e160 + _e161) * (0.5f * _e164)) * _e167));
+                    let _e170 = (*single_mie);
+                    let _e171 = previous_mie;
+                    let _e172 = mie;
+                    let _e175 = dt_1;
+                    let _e178 = mean_transmittance;
+                    (*single_mie) = (_e170 + (((_e171 + _e172) * (0.5f * _e175)) * _e178));
+                    let _e181 = (*scattering_weight);
+                    let _e182 = previous_scattering;
+                    let _e183 = scattering_2;
+                    let _e186 = dt_1;
+                    let _e189 = mean_transmittance;
+                    (*scattering_weight) = (_e181 + (((_e182 + _e183) * (0.5f * _e186)) * _e189));
+                    let _e192 = optical_depth_1;
+                    let _e193 = interval_depth;
+                    optical_depth_1 = (_e192 + _e193);
                 }
             }
-            let _e191 = extinction_1;
-            previous_extinction_1 = _e191;
-            let _e192 = rayleigh;
-            previous_rayleigh = _e192;
-            let _e193 = mie;
-            previous_mie = _e193;
-            let _e194 = scattering_2;
-            previous_scattering = _e194;
+            let _e195 = extinction_1;
+            previous_extinction_1 = _e195;
+            let _e196 = rayleigh;
+            previous_rayleigh = _e196;
+            let _e197 = mie;
+            previous_mie = _e197;
+            let _e198 = scattering_2;
+            previous_scattering = _e198;
         }
         continuing {
-            let _e61 = k_6;
-            k_6 = (_e61 + 1i);
+            let _e65 = k_6;
+            k_6 = (_e65 + 1i);
         }
     }
-    let _e195 = (*single_rayleigh);
-    let _e196 = atmosphere_117;
-    (*single_rayleigh) = (_e195 * _e196.solar_irradiance);
-    let _e199 = (*single_mie);
-    let _e200 = atmosphere_117;
-    (*single_mie) = (_e199 * _e200.solar_irradiance);
-    let _e203 = optical_depth_1;
-    return _e203;
+    let _e199 = (*single_rayleigh);
+    let _e200 = atmosphere_121;
+    (*single_rayleigh) = (_e199 * _e200.solar_irradiance);
+    let _e203 = (*single_mie);
+    let _e204 = atmosphere_121;
+    (*single_mie) = (_e203 * _e204.solar_irradiance);
+    let _e207 = optical_depth_1;
+    return _e207;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_118: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_119: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_123: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -3550,13 +3649,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_118: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_71: f32;
-    var mu_54: f32;
-    var mu_s_38: f32;
-    var nu_26: f32;
-    var d_29: f32;
+    var r_73: f32;
+    var mu_56: f32;
+    var mu_s_40: f32;
+    var nu_28: f32;
+    var d_30: f32;
     var lit_1: f32;
-    var ray_r_mu_intersects_ground_32: bool;
+    var ray_r_mu_intersects_ground_34: bool;
     var r_p: f32;
     var mu_p: f32;
     var mu_s_p: f32;
@@ -3585,368 +3684,368 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_118: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_119 = atmosphere_118;
+    atmosphere_123 = atmosphere_122;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
     sun_direction_5 = sun_direction_4;
-    let _e28 = point_1;
-    let _e29 = camera_7;
-    camera_to_point = (_e28 - _e29);
-    let _e32 = camera_to_point;
-    let _e33 = camera_to_point;
-    if (dot(_e32, _e33) == 0f) {
+    let _e32 = point_1;
+    let _e33 = camera_7;
+    camera_to_point = (_e32 - _e33);
+    let _e36 = camera_to_point;
+    let _e37 = camera_to_point;
+    if (dot(_e36, _e37) == 0f) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e41 = camera_to_point;
-    view_ray_6 = normalize(_e41);
-    let _e49 = atmosphere_119;
-    let _e50 = camera_7;
-    let _e51 = view_ray_6;
-    let _e52 = sun_direction_5;
-    let _e63 = GetViewRayStart(_e49, _e50, _e51, _e52, (&start_3), (&r_71), (&mu_54), (&mu_s_38), (&nu_26));
-    if !(_e63) {
+    let _e45 = camera_to_point;
+    view_ray_6 = normalize(_e45);
+    let _e53 = atmosphere_123;
+    let _e54 = camera_7;
+    let _e55 = view_ray_6;
+    let _e56 = sun_direction_5;
+    let _e67 = GetViewRayStart(_e53, _e54, _e55, _e56, (&start_3), (&r_73), (&mu_56), (&mu_s_40), (&nu_28));
+    if !(_e67) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e69 = point_1;
-    let _e70 = start_3;
-    d_29 = max(length((_e69 - _e70)), 0f);
-    let _e76 = d_29;
-    let _e77 = shadow_length_1;
-    lit_1 = max((_e76 - max(_e77, 0f)), 0f);
-    let _e84 = atmosphere_119;
-    let _e85 = r_71;
-    let _e86 = mu_54;
-    let _e87 = RayIntersectsGround(_e84, _e85, _e86);
-    ray_r_mu_intersects_ground_32 = _e87;
-    let _e89 = atmosphere_119;
-    let _e90 = r_71;
-    let _e91 = mu_54;
-    let _e92 = lit_1;
-    let _e93 = RadiusAtDistance(_e89, _e90, _e91, _e92);
-    r_p = _e93;
-    let _e95 = r_71;
-    let _e96 = mu_54;
-    let _e97 = lit_1;
-    let _e98 = r_p;
-    let _e99 = CosineAtDistance(_e95, _e96, _e97, _e98);
-    mu_p = _e99;
-    let _e101 = r_71;
-    let _e102 = mu_s_38;
-    let _e104 = lit_1;
-    let _e105 = nu_26;
-    let _e108 = r_p;
-    let _e110 = ClampCosine((((_e101 * _e102) + (_e104 * _e105)) / _e108));
-    mu_s_p = _e110;
-    let _e116 = d_29;
-    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e116));
-    let _e124 = lit_1;
-    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e124));
-    let _e140 = lit_direct;
-    if (_e140 > 0f) {
+    let _e73 = point_1;
+    let _e74 = start_3;
+    d_30 = max(length((_e73 - _e74)), 0f);
+    let _e80 = d_30;
+    let _e81 = shadow_length_1;
+    lit_1 = max((_e80 - max(_e81, 0f)), 0f);
+    let _e88 = atmosphere_123;
+    let _e89 = r_73;
+    let _e90 = mu_56;
+    let _e91 = RayIntersectsGround(_e88, _e89, _e90);
+    ray_r_mu_intersects_ground_34 = _e91;
+    let _e93 = atmosphere_123;
+    let _e94 = r_73;
+    let _e95 = mu_56;
+    let _e96 = lit_1;
+    let _e97 = RadiusAtDistance(_e93, _e94, _e95, _e96);
+    r_p = _e97;
+    let _e99 = r_73;
+    let _e100 = mu_56;
+    let _e101 = lit_1;
+    let _e102 = r_p;
+    let _e103 = CosineAtDistance(_e99, _e100, _e101, _e102);
+    mu_p = _e103;
+    let _e105 = r_73;
+    let _e106 = mu_s_40;
+    let _e108 = lit_1;
+    let _e109 = nu_28;
+    let _e112 = r_p;
+    let _e114 = ClampCosine((((_e105 * _e106) + (_e108 * _e109)) / _e112));
+    mu_s_p = _e114;
+    let _e120 = d_30;
+    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e120));
+    let _e128 = lit_1;
+    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e128));
+    let _e144 = lit_direct;
+    if (_e144 > 0f) {
         {
-            let _e143 = atmosphere_119;
-            let _e144 = r_71;
-            let _e145 = mu_54;
-            let _e146 = mu_s_38;
-            let _e147 = nu_26;
-            let _e148 = lit_1;
-            let _e155 = IntegrateSegment(_e143, transmittance_texture_8, _e144, _e145, _e146, _e147, _e148, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
-            lit_optical_depth = _e155;
+            let _e147 = atmosphere_123;
+            let _e148 = r_73;
+            let _e149 = mu_56;
+            let _e150 = mu_s_40;
+            let _e151 = nu_28;
+            let _e152 = lit_1;
+            let _e159 = IntegrateSegment(_e147, transmittance_texture_8, _e148, _e149, _e150, _e151, _e152, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
+            lit_optical_depth = _e159;
         }
     }
-    let _e156 = lit_optical_depth;
-    optical_depth_2 = _e156;
-    let _e158 = direct;
-    let _e161 = lit_1;
-    let _e162 = d_29;
-    if ((_e158 > 0f) && (_e161 < _e162)) {
+    let _e160 = lit_optical_depth;
+    optical_depth_2 = _e160;
+    let _e162 = direct;
+    let _e165 = lit_1;
+    let _e166 = d_30;
+    if ((_e162 > 0f) && (_e165 < _e166)) {
         {
-            let _e168 = optical_depth_2;
-            let _e169 = atmosphere_119;
-            let _e170 = r_p;
-            let _e171 = mu_p;
-            let _e172 = mu_s_p;
-            let _e173 = nu_26;
-            let _e174 = d_29;
-            let _e175 = lit_1;
-            let _e183 = IntegrateSegment(_e169, transmittance_texture_8, _e170, _e171, _e172, _e173, (_e174 - _e175), (&unused_rayleigh), (&unused_mie), (&unused_weight));
-            optical_depth_2 = (_e168 + _e183);
+            let _e172 = optical_depth_2;
+            let _e173 = atmosphere_123;
+            let _e174 = r_p;
+            let _e175 = mu_p;
+            let _e176 = mu_s_p;
+            let _e177 = nu_28;
+            let _e178 = d_30;
+            let _e179 = lit_1;
+            let _e187 = IntegrateSegment(_e173, transmittance_texture_8, _e174, _e175, _e176, _e177, (_e178 - _e179), (&unused_rayleigh), (&unused_mie), (&unused_weight));
+            optical_depth_2 = (_e172 + _e187);
         }
     }
-    let _e185 = direct;
-    if (_e185 < 1f) {
+    let _e189 = direct;
+    if (_e189 < 1f) {
         {
-            let _e188 = atmosphere_119;
-            let _e189 = r_71;
-            let _e190 = mu_54;
-            let _e191 = d_29;
-            let _e192 = ray_r_mu_intersects_ground_32;
-            let _e193 = LongSegmentOpticalDepth(_e188, transmittance_texture_8, _e189, _e190, _e191, _e192);
-            let _e194 = optical_depth_2;
-            let _e195 = direct;
-            optical_depth_2 = mix(_e193, _e194, vec3(_e195));
+            let _e192 = atmosphere_123;
+            let _e193 = r_73;
+            let _e194 = mu_56;
+            let _e195 = d_30;
+            let _e196 = ray_r_mu_intersects_ground_34;
+            let _e197 = LongSegmentOpticalDepth(_e192, transmittance_texture_8, _e193, _e194, _e195, _e196);
+            let _e198 = optical_depth_2;
+            let _e199 = direct;
+            optical_depth_2 = mix(_e197, _e198, vec3(_e199));
         }
     }
-    let _e198 = optical_depth_2;
-    (*transmittance_1) = exp(-(_e198));
-    let _e202 = atmosphere_119;
-    let _e203 = r_71;
-    let _e204 = mu_54;
-    let _e205 = mu_s_38;
-    let _e206 = nu_26;
-    let _e207 = ray_r_mu_intersects_ground_32;
-    let _e210 = GetCombinedScattering(_e202, scattering_texture_8, single_mie_scattering_texture_3, _e203, _e204, _e205, _e206, _e207, (&single_mie_scattering_2));
-    scattering_3 = _e210;
-    let _e212 = lit_1;
-    if (_e212 < DIRECT_SEGMENT_LENGTH) {
+    let _e202 = optical_depth_2;
+    (*transmittance_1) = exp(-(_e202));
+    let _e206 = atmosphere_123;
+    let _e207 = r_73;
+    let _e208 = mu_56;
+    let _e209 = mu_s_40;
+    let _e210 = nu_28;
+    let _e211 = ray_r_mu_intersects_ground_34;
+    let _e214 = GetCombinedScattering(_e206, scattering_texture_9, single_mie_scattering_texture_3, _e207, _e208, _e209, _e210, _e211, (&single_mie_scattering_2));
+    scattering_3 = _e214;
+    let _e216 = lit_1;
+    if (_e216 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e214 = atmosphere_119;
-            let _e215 = r_71;
-            let _e216 = mu_54;
-            let _e217 = ray_r_mu_intersects_ground_32;
-            let _e218 = DistanceToNearestAtmosphereBoundary(_e214, _e215, _e216, _e217);
-            boundary = _e218;
-            let _e220 = boundary;
-            let _e222 = atmosphere_119;
-            let _e223 = r_71;
-            let _e224 = mu_54;
-            let _e225 = DistanceInsideScatteringRadii(_e222, _e223, _e224);
-            let _e227 = lit_1;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e220), _e225), _e227);
-            let _e233 = atmosphere_119;
-            let _e234 = r_71;
-            let _e235 = mu_54;
-            let _e236 = mu_s_38;
-            let _e237 = nu_26;
-            let _e238 = far;
-            let _e245 = IntegrateSegment(_e233, transmittance_texture_8, _e234, _e235, _e236, _e237, _e238, (&far_rayleigh), (&far_mie), (&far_weight));
-            far_optical_depth = _e245;
-            let _e247 = far;
-            let _e248 = boundary;
-            if (_e247 < _e248) {
+            let _e218 = atmosphere_123;
+            let _e219 = r_73;
+            let _e220 = mu_56;
+            let _e221 = ray_r_mu_intersects_ground_34;
+            let _e222 = DistanceToNearestAtmosphereBoundary(_e218, _e219, _e220, _e221);
+            boundary = _e222;
+            let _e224 = boundary;
+            let _e226 = atmosphere_123;
+            let _e227 = r_73;
+            let _e228 = mu_56;
+            let _e229 = DistanceInsideScatteringRadii(_e226, _e227, _e228);
+            let _e231 = lit_1;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e224), _e229), _e231);
+            let _e237 = atmosphere_123;
+            let _e238 = r_73;
+            let _e239 = mu_56;
+            let _e240 = mu_s_40;
+            let _e241 = nu_28;
+            let _e242 = far;
+            let _e249 = IntegrateSegment(_e237, transmittance_texture_8, _e238, _e239, _e240, _e241, _e242, (&far_rayleigh), (&far_mie), (&far_weight));
+            far_optical_depth = _e249;
+            let _e251 = far;
+            let _e252 = boundary;
+            if (_e251 < _e252) {
                 {
-                    let _e250 = atmosphere_119;
-                    let _e251 = r_71;
-                    let _e252 = mu_54;
-                    let _e253 = far;
-                    let _e254 = RadiusAtDistance(_e250, _e251, _e252, _e253);
-                    r_far = _e254;
-                    let _e257 = scattering_3;
-                    let _e258 = far_optical_depth;
-                    let _e261 = atmosphere_119;
-                    let _e262 = r_far;
-                    let _e263 = r_71;
-                    let _e264 = mu_54;
-                    let _e265 = far;
+                    let _e254 = atmosphere_123;
+                    let _e255 = r_73;
+                    let _e256 = mu_56;
+                    let _e257 = far;
+                    let _e258 = RadiusAtDistance(_e254, _e255, _e256, _e257);
+                    r_far = _e258;
+                    let _e261 = scattering_3;
+                    let _e262 = far_optical_depth;
+                    let _e265 = atmosphere_123;
                     let _e266 = r_far;
-                    let _e267 = CosineAtDistance(_e263, _e264, _e265, _e266);
-                    let _e268 = r_71;
-                    let _e269 = mu_s_38;
-                    let _e271 = far;
-                    let _e272 = nu_26;
-                    let _e275 = r_far;
-                    let _e277 = ClampCosine((((_e268 * _e269) + (_e271 * _e272)) / _e275));
-                    let _e278 = nu_26;
-                    let _e279 = ray_r_mu_intersects_ground_32;
-                    let _e282 = GetCombinedScattering(_e261, scattering_texture_8, single_mie_scattering_texture_3, _e262, _e267, _e277, _e278, _e279, (&unused_far_mie));
-                    scattering_3 = (_e257 - (exp(-(_e258)) * _e282));
+                    let _e267 = r_73;
+                    let _e268 = mu_56;
+                    let _e269 = far;
+                    let _e270 = r_far;
+                    let _e271 = CosineAtDistance(_e267, _e268, _e269, _e270);
+                    let _e272 = r_73;
+                    let _e273 = mu_s_40;
+                    let _e275 = far;
+                    let _e276 = nu_28;
+                    let _e279 = r_far;
+                    let _e281 = ClampCosine((((_e272 * _e273) + (_e275 * _e276)) / _e279));
+                    let _e282 = nu_28;
+                    let _e283 = ray_r_mu_intersects_ground_34;
+                    let _e286 = GetCombinedScattering(_e265, scattering_texture_9, single_mie_scattering_texture_3, _e266, _e271, _e281, _e282, _e283, (&unused_far_mie));
+                    scattering_3 = (_e261 - (exp(-(_e262)) * _e286));
                 }
             }
-            let _e285 = scattering_3;
-            let _e286 = far_rayleigh;
-            let _e291 = lit_weight;
-            let _e293 = far_weight;
-            multiple = ((max((_e285 - _e286), vec3(0f)) * _e291) / max(_e293, vec3(0.000000000000000000000000000001f)));
-            let _e299 = single_rayleigh_1;
-            let _e300 = multiple;
-            let _e302 = nu_26;
-            let _e303 = RayleighPhaseFunction(_e302);
-            let _e305 = single_mie_1;
-            let _e306 = atmosphere_119;
-            let _e307 = nu_26;
-            let _e308 = MiePhaseFunction(_e306, _e307);
-            return (((_e299 + _e300) * _e303) + (_e305 * _e308));
+            let _e289 = scattering_3;
+            let _e290 = far_rayleigh;
+            let _e295 = lit_weight;
+            let _e297 = far_weight;
+            multiple = ((max((_e289 - _e290), vec3(0f)) * _e295) / max(_e297, vec3(0.000000000000000000000000000001f)));
+            let _e303 = single_rayleigh_1;
+            let _e304 = multiple;
+            let _e306 = nu_28;
+            let _e307 = RayleighPhaseFunction(_e306);
+            let _e309 = single_mie_1;
+            let _e310 = atmosphere_123;
+            let _e311 = nu_28;
+            let _e312 = MiePhaseFunction(_e310, _e311);
+            return (((_e303 + _e304) * _e307) + (_e309 * _e312));
         }
     }
-    let _e311 = atmosphere_119;
-    let _e312 = r_71;
-    let _e313 = mu_54;
-    let _e314 = lit_1;
-    let _e315 = ray_r_mu_intersects_ground_32;
-    let _e316 = LongSegmentOpticalDepth(_e311, transmittance_texture_8, _e312, _e313, _e314, _e315);
-    let _e317 = lit_optical_depth;
-    let _e318 = lit_direct;
-    lit_transmittance = exp(-(mix(_e316, _e317, vec3(_e318))));
-    let _e325 = atmosphere_119;
-    let _e326 = r_p;
-    let _e327 = mu_p;
-    let _e328 = mu_s_p;
-    let _e329 = nu_26;
-    let _e330 = ray_r_mu_intersects_ground_32;
-    let _e333 = GetCombinedScattering(_e325, scattering_texture_8, single_mie_scattering_texture_3, _e326, _e327, _e328, _e329, _e330, (&single_mie_scattering_p));
-    scattering_p = _e333;
-    let _e335 = scattering_3;
-    let _e336 = lit_transmittance;
-    let _e337 = scattering_p;
-    scattering_3 = max((_e335 - (_e336 * _e337)), vec3(0f));
-    let _e343 = single_mie_scattering_2;
-    let _e344 = lit_transmittance;
-    let _e345 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e343 - (_e344 * _e345)), vec3(0f));
-    let _e351 = single_mie_scattering_2;
-    let _e352 = single_mie_1;
-    let _e353 = lit_direct;
-    single_mie_scattering_2 = mix(_e351, _e352, vec3(_e353));
-    let _e356 = scattering_3;
-    let _e357 = nu_26;
-    let _e358 = RayleighPhaseFunction(_e357);
-    let _e360 = single_mie_scattering_2;
-    let _e361 = atmosphere_119;
-    let _e362 = nu_26;
-    let _e363 = MiePhaseFunction(_e361, _e362);
-    return ((_e356 * _e358) + (_e360 * _e363));
+    let _e315 = atmosphere_123;
+    let _e316 = r_73;
+    let _e317 = mu_56;
+    let _e318 = lit_1;
+    let _e319 = ray_r_mu_intersects_ground_34;
+    let _e320 = LongSegmentOpticalDepth(_e315, transmittance_texture_8, _e316, _e317, _e318, _e319);
+    let _e321 = lit_optical_depth;
+    let _e322 = lit_direct;
+    lit_transmittance = exp(-(mix(_e320, _e321, vec3(_e322))));
+    let _e329 = atmosphere_123;
+    let _e330 = r_p;
+    let _e331 = mu_p;
+    let _e332 = mu_s_p;
+    let _e333 = nu_28;
+    let _e334 = ray_r_mu_intersects_ground_34;
+    let _e337 = GetCombinedScattering(_e329, scattering_texture_9, single_mie_scattering_texture_3, _e330, _e331, _e332, _e333, _e334, (&single_mie_scattering_p));
+    scattering_p = _e337;
+    let _e339 = scattering_3;
+    let _e340 = lit_transmittance;
+    let _e341 = scattering_p;
+    scattering_3 = max((_e339 - (_e340 * _e341)), vec3(0f));
+    let _e347 = single_mie_scattering_2;
+    let _e348 = lit_transmittance;
+    let _e349 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e347 - (_e348 * _e349)), vec3(0f));
+    let _e355 = single_mie_scattering_2;
+    let _e356 = single_mie_1;
+    let _e357 = lit_direct;
+    single_mie_scattering_2 = mix(_e355, _e356, vec3(_e357));
+    let _e360 = scattering_3;
+    let _e361 = nu_28;
+    let _e362 = RayleighPhaseFunction(_e361);
+    let _e364 = single_mie_scattering_2;
+    let _e365 = atmosphere_123;
+    let _e366 = nu_28;
+    let _e367 = MiePhaseFunction(_e365, _e366);
+    return ((_e360 * _e362) + (_e364 * _e367));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_120: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_121: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_124: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_125: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_121 = atmosphere_120;
+    atmosphere_125 = atmosphere_124;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e26 = atmosphere_121;
-    let _e27 = camera_9;
-    let _e28 = point_3;
-    let _e30 = sun_direction_7;
-    let _e33 = GetSkyRadianceToPointWithShadow(_e26, transmittance_texture_9, scattering_texture_9, single_mie_scattering_texture_4, _e27, _e28, 0f, _e30, transmittance_2);
-    return _e33;
+    let _e30 = atmosphere_125;
+    let _e31 = camera_9;
+    let _e32 = point_3;
+    let _e34 = sun_direction_7;
+    let _e37 = GetSkyRadianceToPointWithShadow(_e30, transmittance_texture_9, scattering_texture_10, single_mie_scattering_texture_4, _e31, _e32, 0f, _e34, transmittance_2);
+    return _e37;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_122: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_123: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_126: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_127: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_72: f32;
-    var mu_s_39: f32;
+    var r_74: f32;
+    var mu_s_41: f32;
 
-    atmosphere_123 = atmosphere_122;
+    atmosphere_127 = atmosphere_126;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e25 = atmosphere_123;
-    let _e26 = point_5;
-    let _e28 = ClampRadius(_e25, length(_e26));
-    r_72 = _e28;
+    let _e29 = atmosphere_127;
     let _e30 = point_5;
-    let _e31 = sun_direction_9;
-    let _e33 = point_5;
-    let _e36 = ClampCosine((dot(_e30, _e31) / length(_e33)));
-    mu_s_39 = _e36;
-    let _e38 = atmosphere_123;
-    let _e39 = r_72;
-    let _e40 = mu_s_39;
-    let _e41 = GetIrradiance(_e38, irradiance_texture_1, _e39, _e40);
-    let _e43 = normal_1;
-    let _e44 = point_5;
-    let _e46 = point_5;
-    (*sky_irradiance) = ((_e41 * (1f + (dot(_e43, _e44) / length(_e46)))) * 0.5f);
-    let _e53 = atmosphere_123;
-    let _e55 = atmosphere_123;
-    let _e56 = r_72;
-    let _e57 = mu_s_39;
-    let _e58 = GetTransmittanceToSun(_e55, transmittance_texture_10, _e56, _e57);
-    let _e60 = normal_1;
-    let _e61 = sun_direction_9;
-    return ((_e53.solar_irradiance * _e58) * max(dot(_e60, _e61), 0f));
+    let _e32 = ClampRadius(_e29, length(_e30));
+    r_74 = _e32;
+    let _e34 = point_5;
+    let _e35 = sun_direction_9;
+    let _e37 = point_5;
+    let _e40 = ClampCosine((dot(_e34, _e35) / length(_e37)));
+    mu_s_41 = _e40;
+    let _e42 = atmosphere_127;
+    let _e43 = r_74;
+    let _e44 = mu_s_41;
+    let _e45 = GetIrradiance(_e42, irradiance_texture_1, _e43, _e44);
+    let _e47 = normal_1;
+    let _e48 = point_5;
+    let _e50 = point_5;
+    (*sky_irradiance) = ((_e45 * (1f + (dot(_e47, _e48) / length(_e50)))) * 0.5f);
+    let _e57 = atmosphere_127;
+    let _e59 = atmosphere_127;
+    let _e60 = r_74;
+    let _e61 = mu_s_41;
+    let _e62 = GetTransmittanceToSun(_e59, transmittance_texture_10, _e60, _e61);
+    let _e64 = normal_1;
+    let _e65 = sun_direction_9;
+    return ((_e57.solar_irradiance * _e62) * max(dot(_e64, _e65), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_124: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_125: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_128: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_129: AtmosphereParameters;
 
-    atmosphere_125 = atmosphere_124;
-    let _e16 = atmosphere_125;
-    let _e18 = atmosphere_125;
-    let _e21 = atmosphere_125;
-    return (_e16.solar_irradiance / vec3(((PI * _e18.sun_angular_radius) * _e21.sun_angular_radius)));
+    atmosphere_129 = atmosphere_128;
+    let _e20 = atmosphere_129;
+    let _e22 = atmosphere_129;
+    let _e25 = atmosphere_129;
+    return (_e20.solar_irradiance / vec3(((PI * _e22.sun_angular_radius) * _e25.sun_angular_radius)));
 }
 
 fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     var xyz_1: vec3<f32>;
 
     xyz_1 = xyz;
-    let _e22 = xyz_1;
-    let _e29 = xyz_1;
-    let _e36 = xyz_1;
-    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e22), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e29), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e36));
+    let _e26 = xyz_1;
+    let _e33 = xyz_1;
+    let _e40 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e26), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e33), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e40));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn SkyViewHorizonZenith(atmosphere_126: AtmosphereParameters, r_73: f32) -> f32 {
-    var atmosphere_127: AtmosphereParameters;
-    var r_74: f32;
-
-    atmosphere_127 = atmosphere_126;
-    r_74 = r_73;
-    let _e20 = atmosphere_127;
-    let _e22 = atmosphere_127;
-    let _e23 = r_74;
-    let _e24 = HorizonDistance(_e22, _e23);
-    return atan2(_e20.bottom_radius, -(_e24));
-}
-
-// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewUvFromAngles(atmosphere_128: AtmosphereParameters, r_75: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_33: bool) -> vec2<f32> {
-    var atmosphere_129: AtmosphereParameters;
+fn SkyViewHorizonZenith(atmosphere_130: AtmosphereParameters, r_75: f32) -> f32 {
+    var atmosphere_131: AtmosphereParameters;
     var r_76: f32;
+
+    atmosphere_131 = atmosphere_130;
+    r_76 = r_75;
+    let _e24 = atmosphere_131;
+    let _e26 = atmosphere_131;
+    let _e27 = r_76;
+    let _e28 = HorizonDistance(_e26, _e27);
+    return atan2(_e24.bottom_radius, -(_e28));
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetSkyViewUvFromAngles(atmosphere_132: AtmosphereParameters, r_77: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
+    var atmosphere_133: AtmosphereParameters;
+    var r_78: f32;
     var theta_1: f32;
     var phi_1: f32;
-    var ray_r_mu_intersects_ground_34: bool;
+    var ray_r_mu_intersects_ground_36: bool;
     var theta_h: f32;
     var local_28: f32;
     var x_24: f32;
 
-    atmosphere_129 = atmosphere_128;
-    r_76 = r_75;
+    atmosphere_133 = atmosphere_132;
+    r_78 = r_77;
     theta_1 = theta;
     phi_1 = phi;
-    ray_r_mu_intersects_ground_34 = ray_r_mu_intersects_ground_33;
-    let _e26 = atmosphere_129;
-    let _e27 = r_76;
-    let _e28 = SkyViewHorizonZenith(_e26, _e27);
-    theta_h = _e28;
-    let _e30 = ray_r_mu_intersects_ground_34;
-    if _e30 {
-        let _e32 = theta_1;
-        let _e33 = theta_h;
-        let _e35 = theta_h;
-        local_28 = (1f - sqrt(clamp(((_e32 - _e33) / (PI - _e35)), 0f, 1f)));
+    ray_r_mu_intersects_ground_36 = ray_r_mu_intersects_ground_35;
+    let _e30 = atmosphere_133;
+    let _e31 = r_78;
+    let _e32 = SkyViewHorizonZenith(_e30, _e31);
+    theta_h = _e32;
+    let _e34 = ray_r_mu_intersects_ground_36;
+    if _e34 {
+        let _e36 = theta_1;
+        let _e37 = theta_h;
+        let _e39 = theta_h;
+        local_28 = (1f - sqrt(clamp(((_e36 - _e37) / (PI - _e39)), 0f, 1f)));
     } else {
-        let _e44 = theta_h;
-        let _e45 = theta_1;
-        let _e47 = theta_h;
-        local_28 = (1f - sqrt(clamp(((_e44 - _e45) / _e47), 0f, 1f)));
+        let _e48 = theta_h;
+        let _e49 = theta_1;
+        let _e51 = theta_h;
+        local_28 = (1f - sqrt(clamp(((_e48 - _e49) / _e51), 0f, 1f)));
     }
-    let _e55 = local_28;
-    x_24 = _e55;
-    let _e57 = phi_1;
-    let _e59 = GetTextureCoordFromUnitRange((_e57 / PI), SKY_VIEW_WIDTH);
-    let _e60 = x_24;
-    let _e61 = ray_r_mu_intersects_ground_34;
-    let _e62 = GetTextureCoordFromUnitMuInHalf(_e60, _e61, SKY_VIEW_HEIGHT);
-    return vec2<f32>(_e59, _e62);
+    let _e59 = local_28;
+    x_24 = _e59;
+    let _e61 = phi_1;
+    let _e63 = GetTextureCoordFromUnitRange((_e61 / PI), SKY_VIEW_WIDTH);
+    let _e64 = x_24;
+    let _e65 = ray_r_mu_intersects_ground_36;
+    let _e66 = GetTextureCoordFromUnitMuInHalf(_e64, _e65, SKY_VIEW_HEIGHT);
+    return vec2<f32>(_e63, _e66);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -3955,7 +4054,7 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     var view_ray_8: vec3<f32>;
     var sun_direction_11: vec3<f32>;
     var up_1: vec3<f32>;
-    var mu_55: f32;
+    var mu_57: f32;
     var horizontal: vec3<f32>;
     var sun_horizontal: vec3<f32>;
     var along: f32;
@@ -3965,47 +4064,47 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     camera_11 = camera_10;
     view_ray_8 = view_ray_7;
     sun_direction_11 = sun_direction_10;
-    let _e24 = camera_11;
-    up_1 = normalize(_e24);
-    let _e27 = up_1;
-    let _e28 = view_ray_8;
-    mu_55 = dot(_e27, _e28);
-    let _e31 = view_ray_8;
-    let _e32 = up_1;
-    let _e33 = mu_55;
-    horizontal = (_e31 - (_e32 * _e33));
-    let _e37 = sun_direction_11;
-    let _e38 = up_1;
-    let _e39 = up_1;
-    let _e40 = sun_direction_11;
-    sun_horizontal = (_e37 - (_e38 * dot(_e39, _e40)));
-    let _e45 = horizontal;
-    let _e47 = mu_55;
-    (*theta_2) = atan2(length(_e45), _e47);
-    let _e49 = sun_horizontal;
-    let _e50 = horizontal;
-    along = dot(_e49, _e50);
-    let _e53 = up_1;
-    let _e54 = sun_horizontal;
-    let _e56 = horizontal;
-    side = abs(dot(cross(_e53, _e54), _e56));
-    let _e60 = along;
-    let _e63 = side;
-    if ((_e60 != 0f) || (_e63 != 0f)) {
-        let _e67 = side;
-        let _e68 = along;
-        local_29 = atan2(_e67, _e68);
+    let _e28 = camera_11;
+    up_1 = normalize(_e28);
+    let _e31 = up_1;
+    let _e32 = view_ray_8;
+    mu_57 = dot(_e31, _e32);
+    let _e35 = view_ray_8;
+    let _e36 = up_1;
+    let _e37 = mu_57;
+    horizontal = (_e35 - (_e36 * _e37));
+    let _e41 = sun_direction_11;
+    let _e42 = up_1;
+    let _e43 = up_1;
+    let _e44 = sun_direction_11;
+    sun_horizontal = (_e41 - (_e42 * dot(_e43, _e44)));
+    let _e49 = horizontal;
+    let _e51 = mu_57;
+    (*theta_2) = atan2(length(_e49), _e51);
+    let _e53 = sun_horizontal;
+    let _e54 = horizontal;
+    along = dot(_e53, _e54);
+    let _e57 = up_1;
+    let _e58 = sun_horizontal;
+    let _e60 = horizontal;
+    side = abs(dot(cross(_e57, _e58), _e60));
+    let _e64 = along;
+    let _e67 = side;
+    if ((_e64 != 0f) || (_e67 != 0f)) {
+        let _e71 = side;
+        let _e72 = along;
+        local_29 = atan2(_e71, _e72);
     } else {
         local_29 = 0f;
     }
-    let _e72 = local_29;
-    (*phi_2) = _e72;
+    let _e76 = local_29;
+    (*phi_2) = _e76;
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRay(atmosphere_130: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_35: ptr<function, bool>) -> vec3<f32> {
-    var atmosphere_131: AtmosphereParameters;
+fn GetSkyViewRay(atmosphere_134: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
+    var atmosphere_135: AtmosphereParameters;
     var camera_13: vec3<f32>;
     var sun_direction_13: vec3<f32>;
     var uv_5: vec2<f32>;
@@ -4020,170 +4119,170 @@ fn GetSkyViewRay(atmosphere_130: AtmosphereParameters, camera_12: vec3<f32>, sun
     var local_31: vec3<f32>;
     var across_3: vec3<f32>;
 
-    atmosphere_131 = atmosphere_130;
+    atmosphere_135 = atmosphere_134;
     camera_13 = camera_12;
     sun_direction_13 = sun_direction_12;
     uv_5 = uv_4;
-    let _e25 = uv_5;
-    let _e29 = GetUnitMuInHalfFromTextureCoord(_e25.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_35);
-    x_25 = _e29;
-    let _e32 = x_25;
-    let _e35 = x_25;
-    e = ((1f - _e32) * (1f - _e35));
-    let _e39 = atmosphere_131;
-    let _e40 = atmosphere_131;
-    let _e41 = camera_13;
-    let _e43 = ClampRadius(_e40, length(_e41));
-    let _e44 = SkyViewHorizonZenith(_e39, _e43);
-    theta_h_1 = _e44;
-    let _e46 = (*ray_r_mu_intersects_ground_35);
-    if _e46 {
-        let _e47 = theta_h_1;
-        let _e48 = e;
-        let _e49 = theta_h_1;
-        local_30 = (_e47 + (_e48 * (PI - _e49)));
-    } else {
+    let _e29 = uv_5;
+    let _e33 = GetUnitMuInHalfFromTextureCoord(_e29.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
+    x_25 = _e33;
+    let _e36 = x_25;
+    let _e39 = x_25;
+    e = ((1f - _e36) * (1f - _e39));
+    let _e43 = atmosphere_135;
+    let _e44 = atmosphere_135;
+    let _e45 = camera_13;
+    let _e47 = ClampRadius(_e44, length(_e45));
+    let _e48 = SkyViewHorizonZenith(_e43, _e47);
+    theta_h_1 = _e48;
+    let _e50 = (*ray_r_mu_intersects_ground_37);
+    if _e50 {
+        let _e51 = theta_h_1;
+        let _e52 = e;
         let _e53 = theta_h_1;
-        let _e55 = e;
-        local_30 = (_e53 * (1f - _e55));
+        local_30 = (_e51 + (_e52 * (PI - _e53)));
+    } else {
+        let _e57 = theta_h_1;
+        let _e59 = e;
+        local_30 = (_e57 * (1f - _e59));
     }
-    let _e59 = local_30;
-    theta_3 = _e59;
-    let _e61 = uv_5;
-    let _e63 = GetUnitRangeFromTextureCoord(_e61.x, SKY_VIEW_WIDTH);
-    phi_3 = (PI * clamp(_e63, 0f, 1f));
-    let _e69 = camera_13;
-    up_2 = normalize(_e69);
-    let _e72 = sun_direction_13;
-    let _e73 = up_2;
-    let _e74 = sun_direction_13;
-    let _e75 = up_2;
-    toward_sun = (_e72 - (_e73 * dot(_e74, _e75)));
-    let _e80 = toward_sun;
-    let _e81 = toward_sun;
-    if (dot(_e80, _e81) < 0.000000000001f) {
+    let _e63 = local_30;
+    theta_3 = _e63;
+    let _e65 = uv_5;
+    let _e67 = GetUnitRangeFromTextureCoord(_e65.x, SKY_VIEW_WIDTH);
+    phi_3 = (PI * clamp(_e67, 0f, 1f));
+    let _e73 = camera_13;
+    up_2 = normalize(_e73);
+    let _e76 = sun_direction_13;
+    let _e77 = up_2;
+    let _e78 = sun_direction_13;
+    let _e79 = up_2;
+    toward_sun = (_e76 - (_e77 * dot(_e78, _e79)));
+    let _e84 = toward_sun;
+    let _e85 = toward_sun;
+    if (dot(_e84, _e85) < 0.000000000001f) {
         {
-            let _e85 = up_2;
-            let _e86 = up_2;
-            if (abs(_e86.x) < 0.9f) {
+            let _e89 = up_2;
+            let _e90 = up_2;
+            if (abs(_e90.x) < 0.9f) {
                 local_31 = vec3<f32>(1f, 0f, 0f);
             } else {
                 local_31 = vec3<f32>(0f, 1f, 0f);
             }
-            let _e100 = local_31;
-            toward_sun = cross(_e85, _e100);
+            let _e104 = local_31;
+            toward_sun = cross(_e89, _e104);
         }
     }
-    let _e102 = toward_sun;
-    toward_sun = normalize(_e102);
-    let _e104 = up_2;
-    let _e105 = toward_sun;
-    across_3 = cross(_e104, _e105);
+    let _e106 = toward_sun;
+    toward_sun = normalize(_e106);
     let _e108 = up_2;
-    let _e109 = theta_3;
-    let _e112 = toward_sun;
-    let _e113 = phi_3;
-    let _e116 = across_3;
+    let _e109 = toward_sun;
+    across_3 = cross(_e108, _e109);
+    let _e112 = up_2;
+    let _e113 = theta_3;
+    let _e116 = toward_sun;
     let _e117 = phi_3;
-    let _e121 = theta_3;
-    return ((_e108 * cos(_e109)) + (((_e112 * cos(_e113)) + (_e116 * sin(_e117))) * sin(_e121)));
+    let _e120 = across_3;
+    let _e121 = phi_3;
+    let _e125 = theta_3;
+    return ((_e112 * cos(_e113)) + (((_e116 * cos(_e117)) + (_e120 * sin(_e121))) * sin(_e125)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRadiance(atmosphere_132: AtmosphereParameters, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
-    var atmosphere_133: AtmosphereParameters;
+fn GetSkyViewRadiance(atmosphere_136: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
+    var atmosphere_137: AtmosphereParameters;
     var camera_15: vec3<f32>;
     var sun_direction_15: vec3<f32>;
     var uv_7: vec2<f32>;
-    var ray_r_mu_intersects_ground_36: bool;
+    var ray_r_mu_intersects_ground_38: bool;
     var view_ray_9: vec3<f32>;
     var up_3: vec3<f32>;
 
-    atmosphere_133 = atmosphere_132;
+    atmosphere_137 = atmosphere_136;
     camera_15 = camera_14;
     sun_direction_15 = sun_direction_14;
     uv_7 = uv_6;
-    let _e27 = atmosphere_133;
-    let _e28 = camera_15;
-    let _e29 = sun_direction_15;
-    let _e30 = uv_7;
-    let _e33 = GetSkyViewRay(_e27, _e28, _e29, _e30, (&ray_r_mu_intersects_ground_36));
-    view_ray_9 = _e33;
-    let _e35 = camera_15;
-    up_3 = normalize(_e35);
-    let _e38 = atmosphere_133;
-    let _e39 = atmosphere_133;
-    let _e40 = camera_15;
-    let _e42 = ClampRadius(_e39, length(_e40));
-    let _e43 = up_3;
-    let _e44 = view_ray_9;
-    let _e46 = ClampCosine(dot(_e43, _e44));
+    let _e31 = atmosphere_137;
+    let _e32 = camera_15;
+    let _e33 = sun_direction_15;
+    let _e34 = uv_7;
+    let _e37 = GetSkyViewRay(_e31, _e32, _e33, _e34, (&ray_r_mu_intersects_ground_38));
+    view_ray_9 = _e37;
+    let _e39 = camera_15;
+    up_3 = normalize(_e39);
+    let _e42 = atmosphere_137;
+    let _e43 = atmosphere_137;
+    let _e44 = camera_15;
+    let _e46 = ClampRadius(_e43, length(_e44));
     let _e47 = up_3;
-    let _e48 = sun_direction_15;
+    let _e48 = view_ray_9;
     let _e50 = ClampCosine(dot(_e47, _e48));
-    let _e51 = view_ray_9;
+    let _e51 = up_3;
     let _e52 = sun_direction_15;
     let _e54 = ClampCosine(dot(_e51, _e52));
-    let _e55 = ray_r_mu_intersects_ground_36;
-    let _e56 = GetSkyRadianceOfRay(_e38, scattering_texture_10, single_mie_scattering_texture_5, _e42, _e46, _e50, _e54, _e55);
-    return _e56;
+    let _e55 = view_ray_9;
+    let _e56 = sun_direction_15;
+    let _e58 = ClampCosine(dot(_e55, _e56));
+    let _e59 = ray_r_mu_intersects_ground_38;
+    let _e60 = GetSkyRadianceOfRay(_e42, scattering_texture_11, single_mie_scattering_texture_5, _e46, _e50, _e54, _e58, _e59);
+    return _e60;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceFromSkyView(atmosphere_134: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_135: AtmosphereParameters;
+fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_139: AtmosphereParameters;
     var camera_17: vec3<f32>;
     var view_ray_11: vec3<f32>;
     var sun_direction_17: vec3<f32>;
-    var r_77: f32;
-    var mu_56: f32;
-    var ray_r_mu_intersects_ground_37: bool;
+    var r_79: f32;
+    var mu_58: f32;
+    var ray_r_mu_intersects_ground_39: bool;
     var local_32: vec3<f32>;
     var theta_4: f32;
     var phi_4: f32;
 
-    atmosphere_135 = atmosphere_134;
+    atmosphere_139 = atmosphere_138;
     camera_17 = camera_16;
     view_ray_11 = view_ray_10;
     sun_direction_17 = sun_direction_16;
-    let _e27 = atmosphere_135;
-    let _e28 = camera_17;
-    let _e30 = ClampRadius(_e27, length(_e28));
-    r_77 = _e30;
+    let _e31 = atmosphere_139;
     let _e32 = camera_17;
-    let _e33 = view_ray_11;
-    let _e35 = camera_17;
-    let _e38 = ClampCosine((dot(_e32, _e33) / length(_e35)));
-    mu_56 = _e38;
-    let _e40 = atmosphere_135;
-    let _e41 = r_77;
-    let _e42 = mu_56;
-    let _e43 = RayIntersectsGround(_e40, _e41, _e42);
-    ray_r_mu_intersects_ground_37 = _e43;
-    let _e45 = ray_r_mu_intersects_ground_37;
-    if _e45 {
+    let _e34 = ClampRadius(_e31, length(_e32));
+    r_79 = _e34;
+    let _e36 = camera_17;
+    let _e37 = view_ray_11;
+    let _e39 = camera_17;
+    let _e42 = ClampCosine((dot(_e36, _e37) / length(_e39)));
+    mu_58 = _e42;
+    let _e44 = atmosphere_139;
+    let _e45 = r_79;
+    let _e46 = mu_58;
+    let _e47 = RayIntersectsGround(_e44, _e45, _e46);
+    ray_r_mu_intersects_ground_39 = _e47;
+    let _e49 = ray_r_mu_intersects_ground_39;
+    if _e49 {
         local_32 = vec3(0f);
     } else {
-        let _e48 = atmosphere_135;
-        let _e49 = r_77;
-        let _e50 = mu_56;
-        let _e51 = GetTransmittanceToTopAtmosphereBoundary(_e48, transmittance_texture_11, _e49, _e50);
-        local_32 = _e51;
+        let _e52 = atmosphere_139;
+        let _e53 = r_79;
+        let _e54 = mu_58;
+        let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_11, _e53, _e54);
+        local_32 = _e55;
     }
-    let _e53 = local_32;
-    (*transmittance_3) = _e53;
-    let _e56 = camera_17;
-    let _e57 = view_ray_11;
-    let _e58 = sun_direction_17;
-    GetSkyViewAngles(_e56, _e57, _e58, (&theta_4), (&phi_4));
-    let _e63 = atmosphere_135;
-    let _e64 = r_77;
-    let _e65 = theta_4;
-    let _e66 = phi_4;
-    let _e67 = ray_r_mu_intersects_ground_37;
-    let _e68 = GetSkyViewUvFromAngles(_e63, _e64, _e65, _e66, _e67);
-    let _e69 = SampleTexture2D(sky_view_texture, _e68);
-    return vec3<f32>(_e69.xyz);
+    let _e57 = local_32;
+    (*transmittance_3) = _e57;
+    let _e60 = camera_17;
+    let _e61 = view_ray_11;
+    let _e62 = sun_direction_17;
+    GetSkyViewAngles(_e60, _e61, _e62, (&theta_4), (&phi_4));
+    let _e67 = atmosphere_139;
+    let _e68 = r_79;
+    let _e69 = theta_4;
+    let _e70 = phi_4;
+    let _e71 = ray_r_mu_intersects_ground_39;
+    let _e72 = GetSkyViewUvFromAngles(_e67, _e68, _e69, _e70, _e71);
+    let _e73 = SampleTexture2D(sky_view_texture, _e72);
+    return vec3<f32>(_e73.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4192,58 +4291,58 @@ fn AerialPerspectiveSliceDistance(k_7: f32) -> f32 {
     var x_26: f32;
 
     k_8 = k_7;
-    let _e20 = k_8;
-    x_26 = ((_e20 + 1f) / 32f);
-    let _e27 = x_26;
-    let _e29 = x_26;
-    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e27) * _e29);
+    let _e24 = k_8;
+    x_26 = ((_e24 + 1f) / 32f);
+    let _e31 = x_26;
+    let _e33 = x_26;
+    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e31) * _e33);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetAerialPerspectiveVoxel(atmosphere_136: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_137: AtmosphereParameters;
+fn GetAerialPerspectiveVoxel(atmosphere_140: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_141: AtmosphereParameters;
     var camera_19: vec3<f32>;
     var view_ray_13: vec3<f32>;
     var w_1: f32;
     var sun_direction_19: vec3<f32>;
-    var d_30: f32;
+    var d_31: f32;
     var point_6: vec3<f32>;
     var r_point: f32;
     var transmittance_4: vec3<f32>;
     var radiance: vec3<f32>;
 
-    atmosphere_137 = atmosphere_136;
+    atmosphere_141 = atmosphere_140;
     camera_19 = camera_18;
     view_ray_13 = view_ray_12;
     w_1 = w;
     sun_direction_19 = sun_direction_18;
-    let _e32 = w_1;
-    let _e37 = AerialPerspectiveSliceDistance(floor((_e32 * 32f)));
-    d_30 = _e37;
-    let _e39 = camera_19;
-    let _e40 = view_ray_13;
-    let _e41 = d_30;
-    point_6 = (_e39 + (_e40 * _e41));
-    let _e45 = point_6;
-    r_point = length(_e45);
-    let _e48 = r_point;
-    let _e49 = atmosphere_137;
-    if (_e48 < _e49.bottom_radius) {
-        let _e52 = point_6;
-        let _e53 = atmosphere_137;
-        let _e55 = r_point;
-        point_6 = (_e52 * (_e53.bottom_radius / _e55));
+    let _e36 = w_1;
+    let _e41 = AerialPerspectiveSliceDistance(floor((_e36 * 32f)));
+    d_31 = _e41;
+    let _e43 = camera_19;
+    let _e44 = view_ray_13;
+    let _e45 = d_31;
+    point_6 = (_e43 + (_e44 * _e45));
+    let _e49 = point_6;
+    r_point = length(_e49);
+    let _e52 = r_point;
+    let _e53 = atmosphere_141;
+    if (_e52 < _e53.bottom_radius) {
+        let _e56 = point_6;
+        let _e57 = atmosphere_141;
+        let _e59 = r_point;
+        point_6 = (_e56 * (_e57.bottom_radius / _e59));
     }
-    let _e59 = atmosphere_137;
-    let _e60 = camera_19;
-    let _e61 = point_6;
-    let _e62 = sun_direction_19;
-    let _e65 = GetSkyRadianceToPoint(_e59, transmittance_texture_12, scattering_texture_11, single_mie_scattering_texture_6, _e60, _e61, _e62, (&transmittance_4));
-    radiance = _e65;
-    let _e67 = transmittance_4;
-    (*optical_depth_3) = -(log(max(_e67, vec3(0.000000000000000000000000000001f))));
-    let _e73 = radiance;
-    return _e73;
+    let _e63 = atmosphere_141;
+    let _e64 = camera_19;
+    let _e65 = point_6;
+    let _e66 = sun_direction_19;
+    let _e69 = GetSkyRadianceToPoint(_e63, transmittance_texture_12, scattering_texture_12, single_mie_scattering_texture_6, _e64, _e65, _e66, (&transmittance_4));
+    radiance = _e69;
+    let _e71 = transmittance_4;
+    (*optical_depth_3) = -(log(max(_e71, vec3(0.000000000000000000000000000001f))));
+    let _e77 = radiance;
+    return _e77;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4251,7 +4350,7 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     var screen_uv_1: vec2<f32>;
     var distance_3: f32;
     var slices: f32 = 32f;
-    var d_31: f32;
+    var d_32: f32;
     var s_3: f32;
     var k_9: f32;
     var d_k: f32;
@@ -4261,37 +4360,37 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
 
     screen_uv_1 = screen_uv;
     distance_3 = distance_2;
-    let _e28 = distance_3;
-    d_31 = max(_e28, 0f);
-    let _e32 = slices;
-    let _e33 = d_31;
-    s_3 = (_e32 * sqrt((_e33 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
-    let _e38 = s_3;
-    let _e43 = slices;
-    k_9 = clamp((floor(_e38) - 1f), 0f, (_e43 - 2f));
-    let _e48 = k_9;
-    let _e49 = AerialPerspectiveSliceDistance(_e48);
-    d_k = _e49;
-    let _e51 = d_31;
-    let _e52 = d_k;
-    let _e54 = k_9;
-    let _e57 = AerialPerspectiveSliceDistance((_e54 + 1f));
-    let _e58 = d_k;
-    t_13 = clamp(((_e51 - _e52) / (_e57 - _e58)), 0f, 1f);
-    let _e65 = d_31;
-    let _e67 = AerialPerspectiveSliceDistance(0f);
-    near = min((_e65 / _e67), 1f);
-    let _e72 = screen_uv_1;
-    let _e73 = k_9;
-    let _e74 = t_13;
-    let _e78 = slices;
-    uvw_2 = vec3<f32>(_e72.x, _e72.y, (((_e73 + _e74) + 0.5f) / _e78));
-    let _e84 = uvw_2;
-    let _e85 = SampleTexture3D(optical_depth_volume, _e84);
-    let _e89 = near;
-    (*transmittance_5) = exp((-(vec3<f32>(_e85.xyz)) * _e89));
-    let _e92 = uvw_2;
-    let _e93 = SampleTexture3D(radiance_volume, _e92);
-    let _e96 = near;
-    return (vec3<f32>(_e93.xyz) * _e96);
+    let _e32 = distance_3;
+    d_32 = max(_e32, 0f);
+    let _e36 = slices;
+    let _e37 = d_32;
+    s_3 = (_e36 * sqrt((_e37 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
+    let _e42 = s_3;
+    let _e47 = slices;
+    k_9 = clamp((floor(_e42) - 1f), 0f, (_e47 - 2f));
+    let _e52 = k_9;
+    let _e53 = AerialPerspectiveSliceDistance(_e52);
+    d_k = _e53;
+    let _e55 = d_32;
+    let _e56 = d_k;
+    let _e58 = k_9;
+    let _e61 = AerialPerspectiveSliceDistance((_e58 + 1f));
+    let _e62 = d_k;
+    t_13 = clamp(((_e55 - _e56) / (_e61 - _e62)), 0f, 1f);
+    let _e69 = d_32;
+    let _e71 = AerialPerspectiveSliceDistance(0f);
+    near = min((_e69 / _e71), 1f);
+    let _e76 = screen_uv_1;
+    let _e77 = k_9;
+    let _e78 = t_13;
+    let _e82 = slices;
+    uvw_2 = vec3<f32>(_e76.x, _e76.y, (((_e77 + _e78) + 0.5f) / _e82));
+    let _e88 = uvw_2;
+    let _e89 = SampleTexture3D(optical_depth_volume, _e88);
+    let _e93 = near;
+    (*transmittance_5) = exp((-(vec3<f32>(_e89.xyz)) * _e93));
+    let _e96 = uvw_2;
+    let _e97 = SampleTexture3D(radiance_volume, _e96);
+    let _e100 = near;
+    return (vec3<f32>(_e97.xyz) * _e100);
 }
