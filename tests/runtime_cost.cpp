@@ -48,6 +48,7 @@
 
 #include "examples/engine/vulkan_compute.h"
 #include "formats/lut_files.h"
+#include "shaders_runtime/runtime.h"
 #include "shaders_runtime/snippet.h"
 #include "tests/gl_context.h"
 #include "tests/test_util.h"
@@ -212,6 +213,35 @@ vec3 CostIrradiance(vec3 point, vec3 normal, vec3 sun_direction, out vec3 sky_ir
 }
 )";
 
+// The entry points' adapters for skybake's per-frame path
+// (shaders_runtime/per_frame.glsl): the sky read from a sky view, aerial
+// perspective from a volume (at a screen position taken from the ray's
+// direction), irradiance as the direct lookup (it has no per-frame table).
+// The per-frame tables are the set's own tables under their names (a 2D and
+// a 3D table, read at the same coordinates): only the cost is measured, and
+// the tables of a frame, smaller than these, would be read faster if at all
+// differently.
+constexpr char kSkybakePerFrameAdapters[] = R"(
+#define sky_view_texture transmittance_texture
+#define aerial_perspective_radiance scattering_texture
+#define aerial_perspective_optical_depth single_mie_scattering_texture
+const float COST_LENGTH_UNIT = 1.0;  // positions in metres
+vec3 CostSky(vec3 camera, vec3 view_ray, vec3 sun_direction, out vec3 transmittance) {
+  return GetSkyRadianceFromSkyView(ATMOSPHERE, transmittance_texture, sky_view_texture, camera, view_ray,
+                                   sun_direction, transmittance);
+}
+vec3 CostAerial(vec3 camera, vec3 point, vec3 sun_direction, out vec3 transmittance) {
+  vec3 to_point = point - camera;
+  vec2 screen_uv = normalize(to_point).xy * 0.5 + 0.5;
+  return GetSkyRadianceToPointFromVolume(aerial_perspective_radiance, aerial_perspective_optical_depth,
+                                         screen_uv, length(to_point), transmittance);
+}
+vec3 CostIrradiance(vec3 point, vec3 normal, vec3 sun_direction, out vec3 sky_irradiance) {
+  return GetSunAndSkyIrradiance(ATMOSPHERE, transmittance_texture, irradiance_texture, point, normal,
+                                sun_direction, sky_irradiance);
+}
+)";
+
 // The peer's adapters: its ATMOSPHERE is in kilometres (three-atmosphere's
 // METER_TO_LENGTH_UNIT), and its GetSkyRadiance and GetSkyRadianceToPoint
 // take a shadow length (0: no light shafts).
@@ -237,13 +267,13 @@ std::string ReadFile(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-Runtime SkybakeRuntime(const LutSet& luts) {
+Runtime SkybakeRuntime(const LutSet& luts, bool per_frame) {
   SnippetParts parts;
   parts.channels_are_xyz = luts.colour.has_value();
-  return {"skybake", "skybake",
+  return {per_frame ? "skybake_per_frame" : "skybake", per_frame ? "skybake, per-frame tables" : "skybake",
           RuntimeSnippetSource(ShadingLanguage::kGlsl, luts.parameters, luts.atmosphere.wavelengths_nm,
                                luts.atmosphere.name, parts) +
-              kSkybakeAdapters};
+              (per_frame ? kSkybakePerFrameAdapters : kSkybakeAdapters)};
 }
 
 // Bruneton's runtime from `peer_dir` with what it leaves to its host: the
@@ -563,8 +593,11 @@ struct CaseResult {
   std::vector<RuntimeResult> runtimes;  // as Measurement::runtimes
 };
 
+// The index of the peer's first runtime in Measurement::runtimes.
+constexpr size_t kFirstPeer = 2;
+
 struct Measurement {
-  std::vector<Runtime> runtimes;  // skybake first
+  std::vector<Runtime> runtimes;  // skybake, its per-frame path, then the peer's two (kFirstPeer)
   std::string gl_driver, gl_es_driver, vulkan_driver;
   std::vector<CompiledShader> shaders;
   std::vector<CaseResult> cases;
@@ -598,7 +631,7 @@ Vec4 ViewCase(const Case& c, int size) {
 }
 
 std::vector<Runtime> Runtimes(const Options& options, const LutSet& luts) {
-  std::vector<Runtime> runtimes = {SkybakeRuntime(luts)};
+  std::vector<Runtime> runtimes = {SkybakeRuntime(luts, false), SkybakeRuntime(luts, true)};
   if (!options.peer.empty()) {
     runtimes.push_back(PeerRuntime(options.peer, luts, false));
     runtimes.push_back(PeerRuntime(options.peer, luts, true));
@@ -792,7 +825,7 @@ std::string RatioRange(const std::vector<double>& values) {
 }
 
 std::string Markdown(const Measurement& m) {
-  const bool peer = m.runtimes.size() > 1;
+  const bool peer = m.runtimes.size() > kFirstPeer;
   struct Group {
     std::string name;
     std::vector<const CaseResult*> cases;
@@ -846,13 +879,15 @@ std::string Markdown(const Measurement& m) {
              " (" + Format("%.0f", *std::max_element(maxima.begin(), maxima.end())) + ")";
     };
     auto peer_cells = [&](const Statistic Counts::*statistic) {
-      return peer ? count_cell(1, statistic) + " / " + count_cell(2, statistic) : std::string("—");
+      return peer ? count_cell(kFirstPeer, statistic) + " / " + count_cell(kFirstPeer + 1, statistic)
+                  : std::string("—");
     };
+    // The ratios of skybake's medians to the peer's (separate / combined).
     auto ratio_cell = [&](bool vulkan) {
       if (!peer) return std::string("—");
       std::string cell;
-      for (size_t r = 1; r < m.runtimes.size(); ++r) {
-        cell += (r > 1 ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
+      for (size_t r = kFirstPeer; r < m.runtimes.size(); ++r) {
+        cell += (r > kFirstPeer ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
                   auto median = [&](size_t k) {
                     return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds);
                   };
@@ -869,9 +904,77 @@ std::string Markdown(const Measurement& m) {
                  : "—")
         << " | " << ratio_cell(false) << " | " << ratio_cell(true) << " |\n";
   }
+  out << "\nThe per-frame path (shaders_runtime/per_frame.glsl: the sky from a sky view, aerial perspective from "
+         "a volume; irradiance has no per-frame table), per pixel as above, and its time per pixel against the "
+         "direct lookup's and the peer's (separate / combined):\n\n"
+         "| case group | texture fetches | transcendental calls | SPIR-V instructions after `spirv-opt -O` "
+         "| GL, ratio to the direct lookup | GL, ratio to the peer | Vulkan, ratio to the direct lookup "
+         "| Vulkan, ratio to the peer |\n"
+         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const Group& g : groups) {
+    auto count_cell = [&](const Statistic Counts::*statistic) {
+      std::vector<double> maxima =
+          values(g, [&](const CaseResult& c) { return (c.runtimes[1].counts.*statistic).max; });
+      return Range(values(g, [&](const CaseResult& c) { return (c.runtimes[1].counts.*statistic).mean; }), "%.1f") +
+             " (" + Format("%.0f", *std::max_element(maxima.begin(), maxima.end())) + ")";
+    };
+    auto peer_ratio = [&](bool vulkan) {
+      if (!peer) return std::string("—");
+      std::string cell;
+      for (size_t r = kFirstPeer; r < m.runtimes.size(); ++r) {
+        cell += (r > kFirstPeer ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
+                  auto median = [&](size_t k) {
+                    return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds);
+                  };
+                  return median(1) / median(r);
+                }));
+      }
+      return cell;
+    };
+    auto direct_ratio = [&](bool vulkan) {
+      return RatioRange(values(g, [&](const CaseResult& c) {
+        auto median = [&](size_t k) { return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds); };
+        return median(1) / median(0);
+      }));
+    };
+    out << "| " << g.name << " | " << count_cell(&Counts::fetches) << " | " << count_cell(&Counts::calls) << " | "
+        << instructions("skybake_per_frame", "Vulkan GLSL 4.50", g.entry) << " | " << direct_ratio(false) << " | "
+        << peer_ratio(false) << " | " << direct_ratio(true) << " | " << peer_ratio(true) << " |\n";
+  }
+
+  // What building the per-frame tables costs each frame: one direct lookup
+  // per texel, at the direct lookups' time per pixel measured above (the
+  // sky from 1 m, aerial perspective from 300 m).
+  const double sky_view_texels = double(glsl::SKY_VIEW_WIDTH) * glsl::SKY_VIEW_HEIGHT;
+  const double volume_texels = 32.0 * 32.0 * glsl::AERIAL_PERSPECTIVE_SLICES;
+  out << "\nBuilding the per-frame tables each frame: " << Format("%.0f", sky_view_texels) << " sky lookups ("
+      << glsl::SKY_VIEW_WIDTH << "×" << glsl::SKY_VIEW_HEIGHT << ") and " << Format("%.0f", volume_texels)
+      << " aerial-perspective lookups (32×32 froxels, " << glsl::AERIAL_PERSPECTIVE_SLICES
+      << " slices); at the direct lookups' median time per pixel above (sky from 1 m, aerial perspective from "
+         "300 m), per frame:\n\n| sun | GL ms | Vulkan ms |\n| --- | ---: | ---: |\n";
+  for (double sun : [&] {
+         std::vector<double> suns;
+         for (const CaseResult& c : m.cases)
+           if (std::find(suns.begin(), suns.end(), c.c.sun_zenith_deg) == suns.end()) suns.push_back(c.c.sun_zenith_deg);
+         return suns;
+       }()) {
+    double gl_ms = 0.0, vulkan_ms = 0.0;
+    bool vulkan_timed = true;
+    for (const CaseResult& c : m.cases) {
+      if (c.c.sun_zenith_deg != sun) continue;
+      const bool sky = c.c.entry == Entry::kSky && c.c.altitude_m == 1.0, aerial = c.c.entry == Entry::kAerial;
+      if (!sky && !aerial) continue;
+      const double texels = (sky ? sky_view_texels : volume_texels) / (double(m.size) * m.size);
+      gl_ms += 1e3 * Median(c.runtimes[0].gl_seconds) * texels;
+      if (c.runtimes[0].vulkan_seconds.empty()) vulkan_timed = false;
+      else vulkan_ms += 1e3 * Median(c.runtimes[0].vulkan_seconds) * texels;
+    }
+    out << "| " << Degrees(sun) << " | " << Format("%.2f", gl_ms) << " | "
+        << (vulkan_timed ? Format("%.2f", vulkan_ms) : std::string("—")) << " |\n";
+  }
 
   out << "\nEach case (counts: mean and largest; scalar components of the transcendental calls, a vec3 `exp` "
-         "being 3; times: medians in milliseconds), skybake / peer separate / peer combined:\n\n"
+         "being 3; times: medians in milliseconds), skybake / its per-frame path / peer separate / peer combined:\n\n"
          "| case | fetches | transcendental calls | their scalar components | GL ms | Vulkan ms |\n"
          "| --- | ---: | ---: | ---: | ---: | ---: |\n";
   for (const CaseResult& c : m.cases) {
