@@ -330,7 +330,7 @@ class MuSCoordinate {
     const double top = grid.top_radius, bottom = grid.bottom_radius;
     const double d_min = top - bottom, d_max = glsl::HorizonDistanceAtTop(grid);
     bottom_ = float(bottom), c_ = float((top - bottom) * (top + bottom)), d_min_ = float(d_min);
-    inverse_span_ = float(1.0 / (d_max - d_min)), inverse_a_ = float(1.0 / glsl::GetScatteringLowestSunDistance(grid));
+    inverse_span_ = float(1.0 / (d_max - d_min)), inverse_a_ = float(glsl::GetScatteringSunAxis(grid).inverse_A);
     last_ = float(grid.scattering_mu_s_size - 1), last_left_ = grid.scattering_mu_s_size - 2;
     scale_ = float((grid.scattering_mu_s_size - 1) / glsl::GetScatteringUnitMuS(grid, grid.scattering_mu_s_max));
   }

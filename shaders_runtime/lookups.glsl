@@ -32,8 +32,9 @@ Number GetScatteringTextureUR(IN(AtmosphereParameters) atmosphere, Number r, Num
 // y is mu, z is r. Returns (u_nu, u_mu_s, u_mu, u_r) in [0, 1]; below the
 // split also the ray's shadow edge (ShadowEdge's direction), which
 // GetScattering reads again, else (0, 0).
-vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number mu_s, Number nu,
-                                     bool ray_r_mu_intersects_ground, OUT(vec2) edge) {
+vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis, Number r,
+                                     Number mu, Number mu_s, Number nu, bool ray_r_mu_intersects_ground,
+                                     OUT(vec2) edge) {
   Number rho = HorizonDistance(atmosphere, r);
 
   Number x_mu = GetUnitMuInHalf(atmosphere, r, rho, mu, ray_r_mu_intersects_ground);
@@ -41,7 +42,7 @@ vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, Number
   Number u_r = GetScatteringTextureUR(atmosphere, r, rho, ray_r_mu_intersects_ground, x_mu);
 
   // Below the split, the position on the ray's own columns.
-  Number u_mu_s = GetScatteringTextureUMuS(atmosphere, mu_s);
+  Number u_mu_s = GetScatteringTextureUMuSOnAxis(atmosphere, sun_axis, mu_s);
   Number mu_s_size = Number(atmosphere.scattering_mu_s_size);
   edge = vec2(0.0);
   if (atmosphere.scattering_mu_s_split > 0 && u_mu_s * mu_s_size - 0.5 < Number(atmosphere.scattering_mu_s_split)) {
@@ -54,7 +55,8 @@ vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, Number
 vec4 GetScatteringTextureUvwzFromRMuMuSNu(IN(AtmosphereParameters) atmosphere, Number r, Number mu,
                                           Number mu_s, Number nu, bool ray_r_mu_intersects_ground) {
   vec2 unused;
-  return GetScatteringTextureUvwzAndEdge(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground, unused);
+  return GetScatteringTextureUvwzAndEdge(atmosphere, GetScatteringSunAxis(atmosphere), r, mu, mu_s, nu,
+                                         ray_r_mu_intersects_ground, unused);
 }
 #endif
 
@@ -344,7 +346,9 @@ ScatteringLookup GetScatteringLookup(IN(AtmosphereParameters) atmosphere, Number
                                      Number nu, bool ray_r_mu_intersects_ground) {
   ScatteringLookup lookup;
   vec2 edge;
-  lookup.uvwz = GetScatteringTextureUvwzAndEdge(atmosphere, r, mu, mu_s, nu, ray_r_mu_intersects_ground, edge);
+  ScatteringSunAxis sun_axis = GetScatteringSunAxis(atmosphere);
+  lookup.uvwz =
+      GetScatteringTextureUvwzAndEdge(atmosphere, sun_axis, r, mu, mu_s, nu, ray_r_mu_intersects_ground, edge);
   Number nu_size = Number(atmosphere.scattering_nu_size);
   Number nu_coord = lookup.uvwz.x * (nu_size - 1.0);
   lookup.nu_slice = min(floor(nu_coord), nu_size - 2.0);
@@ -381,7 +385,7 @@ ScatteringLookup GetScatteringLookup(IN(AtmosphereParameters) atmosphere, Number
   Number x_below;
   Number x_above;
   bool low_sun_below;
-  Number x_low_sun = GetScatteringTextureUMuS(atmosphere, LOW_SUN_MU_S);
+  Number x_low_sun = GetScatteringTextureUMuSOnAxis(atmosphere, sun_axis, LOW_SUN_MU_S);
   GetScatteringMuSColumns(atmosphere, lookup.uvwz.y, x_low_sun, x_below, x_above, lookup.t, low_sun_below);
   if (!low_sun_below) {
     // Daylight: linear along mu_s, which the texture unit does within a nu
@@ -396,7 +400,7 @@ ScatteringLookup GetScatteringLookup(IN(AtmosphereParameters) atmosphere, Number
     lookup.x = vec4(x_below, x_above, 0.0, 0.0);
     lookup.low_sun = bvec4(true, x_above < x_low_sun, true, true);
     lookup.mu_s_a = atmosphere.scattering_mu_s_min;
-    lookup.mu_s_b = GetScatteringMuSFromUnitRange(atmosphere, 1.0 / (mu_s_size - 1.0));
+    lookup.mu_s_b = GetScatteringMuSFromUnitRangeOnAxis(atmosphere, sun_axis, 1.0 / (mu_s_size - 1.0));
     return lookup;
   }
   Number column = x_below * mu_s_size - 0.5;

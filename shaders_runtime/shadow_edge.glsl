@@ -126,9 +126,10 @@ Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number mu_s, OUT(N
   Number bottom = atmosphere.bottom_radius;
   Number d = DistanceToTopAtmosphereBoundary(atmosphere, bottom, mu_s);
   Number d_min = atmosphere.top_radius - bottom;
-  Number span = HorizonDistanceAtTop(atmosphere) - d_min;
+  ScatteringSunAxis sun_axis = GetScatteringSunAxis(atmosphere);
+  Number span = sun_axis.H - d_min;
   Number a = (d - d_min) / span;
-  Number inverse_A = 1.0 / GetScatteringLowestSunDistance(atmosphere);
+  Number inverse_A = sun_axis.inverse_A;
   Number da_dtheta = bottom * d / (d + bottom * mu_s) / span * SafeSqrt(1.0 - mu_s * mu_s);
   derivative = -(inverse_A + 1.0) / ((1.0 + a) * (1.0 + a)) * da_dtheta;
   return (1.0 - a * inverse_A) / (1.0 + a);

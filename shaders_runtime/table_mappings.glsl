@@ -52,48 +52,72 @@ Number GetUnitMuInHalfFromTextureCoord(Number u, int size, OUT(bool) ray_r_mu_in
   return GetUnitRangeFromTextureCoord(ray_r_mu_intersects_ground ? 1.0 - 2.0 * u : 2.0 * u - 1.0, size / 2);
 }
 
-// A of ScatteringUnitMuSFromDistance: the distance to the top boundary from
-// the ground for the sun at scattering_mu_s_min, over its range from d_min =
-// top - bottom (the sun at the zenith) to d_max = HorizonDistanceAtTop.
-Number GetScatteringLowestSunDistance(IN(AtmosphereParameters) atmosphere) {
-  Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
-  Number d_max = HorizonDistanceAtTop(atmosphere);
-  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.scattering_mu_s_min);
-  return (D - d_min) / (d_max - d_min);
-}
+// The constants of the scattering table's mu_s axis, found once per lookup:
+// H (HorizonDistanceAtTop), A of ScatteringUnitMuSFromDistance (the
+// distance to the top boundary from the ground for the sun at
+// scattering_mu_s_min, over its range from d_min = top - bottom, the sun at
+// the zenith, to d_max = H) and 1 / A, and the unit mu_s of
+// scattering_mu_s_max (GetScatteringUnitMuSOnAxis), which maps to 1.
+struct ScatteringSunAxis {
+  Number H;
+  Number A;
+  Number inverse_A;
+  Number unit_max;
+};
 
 // mu_s through the distance to the top boundary from the ground, rescaled so
-// that scattering_mu_s_min maps to 0 and more texels go to low suns, then
-// stretched so that scattering_mu_s_max maps to 1. (Independent of r: the
-// bake maps the sun's cosine along a ray with it alone.)
-Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
+// that scattering_mu_s_min maps to 0 and more texels go to low suns (before
+// the stretch by unit_max). Independent of r: the bake maps the sun's cosine
+// along a ray with it alone. Reads the axis's H and inverse_A only.
+Number GetScatteringUnitMuSOnAxis(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) axis, Number mu_s) {
   Number d = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, mu_s);
   Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
-  Number d_max = HorizonDistanceAtTop(atmosphere);
-  Number a = (d - d_min) / (d_max - d_min);
-  return ScatteringUnitMuSFromDistance(a, 1.0 / GetScatteringLowestSunDistance(atmosphere));
+  Number a = (d - d_min) / (axis.H - d_min);
+  return ScatteringUnitMuSFromDistance(a, axis.inverse_A);
 }
 
-// The inverse of GetScatteringUnitMuS stretched to [0, 1]: the sun cosine
-// at x in [0, 1] along the table's mu_s axis (x = column / (size - 1) at a
-// texel column): a by ScatteringDistanceFromUnitMuS, then d, and mu_s from
+ScatteringSunAxis GetScatteringSunAxis(IN(AtmosphereParameters) atmosphere) {
+  ScatteringSunAxis axis;
+  Number d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+  axis.H = HorizonDistanceAtTop(atmosphere);
+  Number D = DistanceToTopAtmosphereBoundary(atmosphere, atmosphere.bottom_radius, atmosphere.scattering_mu_s_min);
+  axis.A = (D - d_min) / (axis.H - d_min);
+  axis.inverse_A = 1.0 / axis.A;
+  axis.unit_max = 0.0;
+  axis.unit_max = GetScatteringUnitMuSOnAxis(atmosphere, axis, atmosphere.scattering_mu_s_max);
+  return axis;
+}
+
+Number GetScatteringUnitMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
+  return GetScatteringUnitMuSOnAxis(atmosphere, GetScatteringSunAxis(atmosphere), mu_s);
+}
+
+// The inverse of the unit mu_s stretched to [0, 1]: the sun cosine at x in
+// [0, 1] along the table's mu_s axis (x = column / (size - 1) at a texel
+// column): a by ScatteringDistanceFromUnitMuS, then d, and mu_s from
 // top^2 = bottom^2 + 2 bottom mu_s d + d^2.
-Number GetScatteringMuSFromUnitRange(IN(AtmosphereParameters) atmosphere, Number x) {
-  Number x_mu_s = x * GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
+Number GetScatteringMuSFromUnitRangeOnAxis(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) axis,
+                                           Number x) {
   Number bottom = atmosphere.bottom_radius;
-  Number H = HorizonDistanceAtTop(atmosphere);
   Number d_min = atmosphere.top_radius - bottom;
-  Number d_max = H;
-  Number A = GetScatteringLowestSunDistance(atmosphere);
-  Number a = ScatteringDistanceFromUnitMuS(x_mu_s, 1.0 / A);
-  Number d = d_min + min(a, A) * (d_max - d_min);
-  return d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * bottom * d));
+  Number a = ScatteringDistanceFromUnitMuS(x * axis.unit_max, axis.inverse_A);
+  Number d = d_min + min(a, axis.A) * (axis.H - d_min);
+  return d == 0.0 ? 1.0 : ClampCosine((axis.H * axis.H - d * d) / (2.0 * bottom * d));
+}
+
+Number GetScatteringMuSFromUnitRange(IN(AtmosphereParameters) atmosphere, Number x) {
+  return GetScatteringMuSFromUnitRangeOnAxis(atmosphere, GetScatteringSunAxis(atmosphere), x);
+}
+
+// The texture coordinate along mu_s within a nu slice.
+Number GetScatteringTextureUMuSOnAxis(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) axis,
+                                      Number mu_s) {
+  Number x = GetScatteringUnitMuSOnAxis(atmosphere, axis, mu_s) / axis.unit_max;
+  return GetTextureCoordFromUnitRange(min(x, 1.0), atmosphere.scattering_mu_s_size);
 }
 
 Number GetScatteringTextureUMuS(IN(AtmosphereParameters) atmosphere, Number mu_s) {
-  Number x = GetScatteringUnitMuS(atmosphere, mu_s) /
-             GetScatteringUnitMuS(atmosphere, atmosphere.scattering_mu_s_max);
-  return GetTextureCoordFromUnitRange(min(x, 1.0), atmosphere.scattering_mu_s_size);
+  return GetScatteringTextureUMuSOnAxis(atmosphere, GetScatteringSunAxis(atmosphere), mu_s);
 }
 #endif
 

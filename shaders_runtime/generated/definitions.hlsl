@@ -30,6 +30,14 @@ struct AtmosphereParameters
     float3 rayleigh_scattering_profile[64];
 };
 
+struct ScatteringSunAxis
+{
+    float H;
+    float A;
+    float inverse_A;
+    float unit_max;
+};
+
 struct ScatteringLookup
 {
     int kind;

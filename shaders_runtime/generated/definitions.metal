@@ -78,6 +78,14 @@ struct AtmosphereParameters
     spvUnsafeArray<float3, 64> rayleigh_scattering_profile;
 };
 
+struct ScatteringSunAxis
+{
+    float H;
+    float A;
+    float inverse_A;
+    float unit_max;
+};
+
 struct ScatteringLookup
 {
     int kind;

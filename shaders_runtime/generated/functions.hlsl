@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1064 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1076 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1064)
+    if (!_1076)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _927 = mu < 0.0f;
-    bool _939;
-    if (_927)
+    bool _939 = mu < 0.0f;
+    bool _951;
+    if (_939)
     {
-        _939 = (((r * r) * mu) * mu) >= c;
+        _951 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _939 = _927;
+        _951 = _939;
     }
-    return _939;
+    return _951;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _697;
+    float _709;
     if (r_mu > 0.0f)
     {
-        _697 = c / (r_mu + s);
+        _709 = c / (r_mu + s);
     }
     else
     {
-        _697 = s - r_mu;
+        _709 = s - r_mu;
     }
-    float param_1 = _697;
+    float param_1 = _709;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1168;
+    float _1180;
     if (d_max > d_min)
     {
-        _1168 = (d - d_min) / (d_max - d_min);
+        _1180 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1168 = 0.0f;
+        _1180 = 0.0f;
     }
-    float x_mu = _1168;
+    float x_mu = _1180;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -182,6 +182,50 @@ float3 GetTransmittanceToTopAtmosphereBoundary(AtmosphereParameters atmosphere, 
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
+float ScatteringUnitMuSFromDistance(float a, float inverse_A)
+{
+    return (1.0f - (a * inverse_A)) / (1.0f + (0.5f * a));
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetScatteringUnitMuSOnAxis(AtmosphereParameters atmosphere, ScatteringSunAxis axis, float mu_s)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = atmosphere.bottom_radius;
+    float param_2 = mu_s;
+    float d = DistanceToTopAtmosphereBoundary(param, param_1, param_2);
+    float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+    float a = (d - d_min) / (axis.H - d_min);
+    float param_3 = a;
+    float param_4 = axis.inverse_A;
+    return ScatteringUnitMuSFromDistance(param_3, param_4);
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+ScatteringSunAxis GetScatteringSunAxis(AtmosphereParameters atmosphere)
+{
+    float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
+    AtmosphereParameters param = atmosphere;
+    ScatteringSunAxis axis;
+    axis.H = HorizonDistanceAtTop(param);
+    AtmosphereParameters param_1 = atmosphere;
+    float param_2 = atmosphere.bottom_radius;
+    float param_3 = atmosphere.scattering_mu_s_min;
+    float D = DistanceToTopAtmosphereBoundary(param_1, param_2, param_3);
+    axis.A = (D - d_min) / (axis.H - d_min);
+    axis.inverse_A = 1.0f / axis.A;
+    axis.unit_max = 0.0f;
+    AtmosphereParameters param_4 = atmosphere;
+    ScatteringSunAxis param_5 = axis;
+    float param_6 = atmosphere.scattering_mu_s_max;
+    axis.unit_max = GetScatteringUnitMuSOnAxis(param_4, param_5, param_6);
+    return axis;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToBottomAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu)
 {
     float r_mu = r * mu;
@@ -203,16 +247,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1220;
+        float _1232;
         if (rho == d_min)
         {
-            _1220 = 0.0f;
+            _1232 = 0.0f;
         }
         else
         {
-            _1220 = (d - d_min) / (rho - d_min);
+            _1232 = (d - d_min) / (rho - d_min);
         }
-        return _1220;
+        return _1232;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -221,16 +265,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1255;
+    float _1267;
     if (d_max > d_min_1)
     {
-        _1255 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1267 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1255 = 0.0f;
+        _1267 = 0.0f;
     }
-    return _1255;
+    return _1267;
 }
 #endif
 
@@ -240,16 +284,16 @@ float GetTextureCoordFromUnitMuInHalf(float x, bool ray_r_mu_intersects_ground, 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5f * GetTextureCoordFromUnitRange(param, param_1);
-    float _1278;
+    float _1290;
     if (ray_r_mu_intersects_ground)
     {
-        _1278 = 0.5f - u;
+        _1290 = 0.5f - u;
     }
     else
     {
-        _1278 = 0.5f + u;
+        _1290 = 0.5f + u;
     }
-    return _1278;
+    return _1290;
 }
 #endif
 
@@ -292,55 +336,15 @@ float GetScatteringTextureUR(AtmosphereParameters atmosphere, float r, float rho
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float GetScatteringLowestSunDistance(AtmosphereParameters atmosphere)
-{
-    float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
-    AtmosphereParameters param = atmosphere;
-    float d_max = HorizonDistanceAtTop(param);
-    AtmosphereParameters param_1 = atmosphere;
-    float param_2 = atmosphere.bottom_radius;
-    float param_3 = atmosphere.scattering_mu_s_min;
-    float D = DistanceToTopAtmosphereBoundary(param_1, param_2, param_3);
-    return (D - d_min) / (d_max - d_min);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-float ScatteringUnitMuSFromDistance(float a, float inverse_A)
-{
-    return (1.0f - (a * inverse_A)) / (1.0f + (0.5f * a));
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-float GetScatteringUnitMuS(AtmosphereParameters atmosphere, float mu_s)
+float GetScatteringTextureUMuSOnAxis(AtmosphereParameters atmosphere, ScatteringSunAxis axis, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
-    float param_1 = atmosphere.bottom_radius;
+    ScatteringSunAxis param_1 = axis;
     float param_2 = mu_s;
-    float d = DistanceToTopAtmosphereBoundary(param, param_1, param_2);
-    float d_min = atmosphere.top_radius - atmosphere.bottom_radius;
-    AtmosphereParameters param_3 = atmosphere;
-    float d_max = HorizonDistanceAtTop(param_3);
-    float a = (d - d_min) / (d_max - d_min);
-    AtmosphereParameters param_4 = atmosphere;
-    float param_5 = a;
-    float param_6 = 1.0f / GetScatteringLowestSunDistance(param_4);
-    return ScatteringUnitMuSFromDistance(param_5, param_6);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-float GetScatteringTextureUMuS(AtmosphereParameters atmosphere, float mu_s)
-{
-    AtmosphereParameters param = atmosphere;
-    float param_1 = mu_s;
-    AtmosphereParameters param_2 = atmosphere;
-    float param_3 = atmosphere.scattering_mu_s_max;
-    float x = GetScatteringUnitMuS(param, param_1) / GetScatteringUnitMuS(param_2, param_3);
-    float param_4 = min(x, 1.0f);
-    int param_5 = atmosphere.scattering_mu_s_size;
-    return GetTextureCoordFromUnitRange(param_4, param_5);
+    float x = GetScatteringUnitMuSOnAxis(param, param_1, param_2) / axis.unit_max;
+    float param_3 = min(x, 1.0f);
+    int param_4 = atmosphere.scattering_mu_s_size;
+    return GetTextureCoordFromUnitRange(param_3, param_4);
 }
 #endif
 
@@ -349,39 +353,39 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1595;
+    float _1619;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1595 = ClampCosine(param_1);
+        _1619 = ClampCosine(param_1);
     }
     else
     {
-        _1595 = 1.0f;
+        _1619 = 1.0f;
     }
-    return _1595;
+    return _1619;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _943;
+    float _955;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _943 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _955 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _943 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _955 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _943;
+    return _955;
 }
 #endif
 
@@ -434,52 +438,52 @@ float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_p
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0f - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1701;
+    float2 _1725;
     if (c_end >= rho)
     {
-        _1701 = float2(-1.0f, 0.0f);
+        _1725 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1701 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
+        _1725 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float2 end = _1701;
-    bool _1729 = end.y < 0.0f;
-    bool _1739;
-    if (!_1729)
+    float2 end = _1725;
+    bool _1753 = end.y < 0.0f;
+    bool _1763;
+    if (!_1753)
     {
-        _1739 = end.x < start.x;
+        _1763 = end.x < start.x;
     }
     else
     {
-        _1739 = _1729;
+        _1763 = _1753;
     }
-    bool end_sets_last = _1739;
+    bool end_sets_last = _1763;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
     float sin_a = a * (1.0f - ((a * a) / 6.0f));
-    bool2 _1771 = end_sets_last.xx;
-    float2 last = float2(_1771.x ? end.x : start.x, _1771.y ? end.y : start.y);
+    bool2 _1794 = end_sets_last.xx;
+    float2 last = float2(_1794.x ? end.x : start.x, _1794.y ? end.y : start.y);
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1794;
+    float _1817;
     if (end_sets_last)
     {
-        float _1800;
+        float _1823;
         if (c_end >= rho)
         {
-            _1800 = 3.1415927410125732421875f;
+            _1823 = 3.1415927410125732421875f;
         }
         else
         {
-            _1800 = atan2(across, cos_alpha) + acos(cos_gamma);
+            _1823 = atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1794 = _1800;
+        _1817 = _1823;
     }
     else
     {
-        _1794 = acos(c_start);
+        _1817 = acos(c_start);
     }
-    float angle = _1794;
+    float angle = _1817;
     return angle + a;
 }
 #endif
@@ -501,33 +505,36 @@ float ScatteringDistanceFromUnitMuS(float x, float inverse_A)
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
+float GetScatteringMuSFromUnitRangeOnAxis(AtmosphereParameters atmosphere, ScatteringSunAxis axis, float x)
 {
-    AtmosphereParameters param = atmosphere;
-    float param_1 = atmosphere.scattering_mu_s_max;
-    float x_mu_s = x * GetScatteringUnitMuS(param, param_1);
     float bottom = atmosphere.bottom_radius;
-    AtmosphereParameters param_2 = atmosphere;
-    float H = HorizonDistanceAtTop(param_2);
     float d_min = atmosphere.top_radius - bottom;
-    float d_max = H;
-    AtmosphereParameters param_3 = atmosphere;
-    float A = GetScatteringLowestSunDistance(param_3);
-    float param_4 = x_mu_s;
-    float param_5 = 1.0f / A;
-    float a = ScatteringDistanceFromUnitMuS(param_4, param_5);
-    float d = d_min + (min(a, A) * (d_max - d_min));
-    float _1424;
+    float param = x * axis.unit_max;
+    float param_1 = axis.inverse_A;
+    float a = ScatteringDistanceFromUnitMuS(param, param_1);
+    float d = d_min + (min(a, axis.A) * (axis.H - d_min));
+    float _1437;
     if (d == 0.0f)
     {
-        _1424 = 1.0f;
+        _1437 = 1.0f;
     }
     else
     {
-        float param_6 = ((H * H) - (d * d)) / ((2.0f * bottom) * d);
-        _1424 = ClampCosine(param_6);
+        float param_2 = ((axis.H * axis.H) - (d * d)) / ((2.0f * bottom) * d);
+        _1437 = ClampCosine(param_2);
     }
-    return _1424;
+    return _1437;
+}
+#endif
+
+#if SKYBAKE_HAS_SCATTERING_TEXTURE
+float GetScatteringMuSFromUnitRange(AtmosphereParameters atmosphere, float x)
+{
+    AtmosphereParameters param = atmosphere;
+    AtmosphereParameters param_1 = atmosphere;
+    ScatteringSunAxis param_2 = GetScatteringSunAxis(param);
+    float param_3 = x;
+    return GetScatteringMuSFromUnitRangeOnAxis(param_1, param_2, param_3);
 }
 #endif
 
@@ -557,12 +564,12 @@ float ShadowEdgeUnitSun(AtmosphereParameters atmosphere, float mu_s, out float d
     float d = DistanceToTopAtmosphereBoundary(param, param_1, param_2);
     float d_min = atmosphere.top_radius - bottom;
     AtmosphereParameters param_3 = atmosphere;
-    float span = HorizonDistanceAtTop(param_3) - d_min;
+    ScatteringSunAxis sun_axis = GetScatteringSunAxis(param_3);
+    float span = sun_axis.H - d_min;
     float a = (d - d_min) / span;
-    AtmosphereParameters param_4 = atmosphere;
-    float inverse_A = 1.0f / GetScatteringLowestSunDistance(param_4);
-    float param_5 = 1.0f - (mu_s * mu_s);
-    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * SafeSqrt(param_5);
+    float inverse_A = sun_axis.inverse_A;
+    float param_4 = 1.0f - (mu_s * mu_s);
+    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * SafeSqrt(param_4);
     derivative = ((-(inverse_A + 1.0f)) / ((1.0f + a) * (1.0f + a))) * da_dtheta;
     return (1.0f - (a * inverse_A)) / (1.0f + a);
 }
@@ -578,15 +585,15 @@ void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, float2 edge, inout 
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = ShadowEdgeSunCosine(param_1, param_2);
     float param_5;
-    float _2003 = ShadowEdgeUnitSun(param_3, param_4, param_5);
+    float _2027 = ShadowEdgeUnitSun(param_3, param_4, param_5);
     float unused = param_5;
-    X_closest = _2003;
+    X_closest = _2027;
     AtmosphereParameters param_6 = atmosphere;
     float param_7 = split_mu_s;
     float param_8;
-    float _2010 = ShadowEdgeUnitSun(param_6, param_7, param_8);
+    float _2034 = ShadowEdgeUnitSun(param_6, param_7, param_8);
     unused = param_8;
-    X_span = _2010 - X_closest;
+    X_span = _2034 - X_closest;
     float2 param_9 = edge;
     float param_10 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_9, param_10);
@@ -602,9 +609,9 @@ float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, float D, float2 edg
     AtmosphereParameters param_2 = atmosphere;
     float param_3 = ShadowEdgeSunCosine(param, param_1);
     float param_4;
-    float _1960 = ShadowEdgeUnitSun(param_2, param_3, param_4);
+    float _1984 = ShadowEdgeUnitSun(param_2, param_3, param_4);
     float dX_dtheta = param_4;
-    float X = _1960;
+    float X = _1984;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
@@ -631,9 +638,9 @@ float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, float _distance, float2
     float param_10 = X_span;
     float param_11 = log_span;
     float param_12;
-    float _2055 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+    float _2079 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
     float unused = param_12;
-    return _2055;
+    return _2079;
 }
 #endif
 
@@ -676,7 +683,7 @@ float ScatteringUnitNu(float nu)
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
-float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground, inout float2 edge)
+float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, ScatteringSunAxis sun_axis, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground, inout float2 edge)
 {
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
@@ -698,42 +705,43 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, float r,
     float param_14 = x_mu;
     float u_r = GetScatteringTextureUR(param_10, param_11, param_12, param_13, param_14);
     AtmosphereParameters param_15 = atmosphere;
-    float param_16 = mu_s;
-    float u_mu_s = GetScatteringTextureUMuS(param_15, param_16);
+    ScatteringSunAxis param_16 = sun_axis;
+    float param_17 = mu_s;
+    float u_mu_s = GetScatteringTextureUMuSOnAxis(param_15, param_16, param_17);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = 0.0f.xx;
-    bool _2364 = atmosphere.scattering_mu_s_split > 0;
-    bool _2375;
-    if (_2364)
+    bool _2389 = atmosphere.scattering_mu_s_split > 0;
+    bool _2400;
+    if (_2389)
     {
-        _2375 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2400 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2375 = _2364;
+        _2400 = _2389;
     }
-    if (_2375)
+    if (_2400)
     {
-        float param_17 = mu;
-        float param_18 = mu_s;
-        float param_19 = nu;
-        AtmosphereParameters param_20 = atmosphere;
-        float param_21 = r;
-        float param_22 = mu;
-        float param_23 = ViewSunAzimuthCosine(param_17, param_18, param_19);
-        bool param_24 = ray_r_mu_intersects_ground;
-        float2 param_25;
-        float _2395 = ShadowEdge(param_20, param_21, param_22, param_23, param_24, param_25);
-        edge = param_25;
-        float2 param_26 = edge;
-        float param_27 = mu_s;
-        AtmosphereParameters param_28 = atmosphere;
-        float param_29 = ShadowEdgeDistance(param_26, param_27);
-        float2 param_30 = edge;
-        u_mu_s = (GetScatteringShadowEdgePosition(param_28, param_29, param_30) + 0.5f) / mu_s_size;
+        float param_18 = mu;
+        float param_19 = mu_s;
+        float param_20 = nu;
+        AtmosphereParameters param_21 = atmosphere;
+        float param_22 = r;
+        float param_23 = mu;
+        float param_24 = ViewSunAzimuthCosine(param_18, param_19, param_20);
+        bool param_25 = ray_r_mu_intersects_ground;
+        float2 param_26;
+        float _2420 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
+        edge = param_26;
+        float2 param_27 = edge;
+        float param_28 = mu_s;
+        AtmosphereParameters param_29 = atmosphere;
+        float param_30 = ShadowEdgeDistance(param_27, param_28);
+        float2 param_31 = edge;
+        u_mu_s = (GetScatteringShadowEdgePosition(param_29, param_30, param_31) + 0.5f) / mu_s_size;
     }
-    float param_31 = nu;
-    return float4(ScatteringUnitNu(param_31), u_mu_s, u_mu, u_r);
+    float param_32 = nu;
+    return float4(ScatteringUnitNu(param_32), u_mu_s, u_mu, u_r);
 }
 #endif
 
@@ -763,9 +771,9 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edg
         float param_9 = X_closest;
         float param_10 = X_span;
         float param_11 = log_span;
-        float _2113 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
+        float _2136 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
         float slope = param_12;
-        float error = _2113 - x;
+        float error = _2136 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -780,16 +788,16 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, float x, float2 edg
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _2632;
+    float _2657;
     if (low_sun)
     {
-        _2632 = min(t, 1.0f);
+        _2657 = min(t, 1.0f);
     }
     else
     {
-        _2632 = clamp(t, 0.0f, 1.0f);
+        _2657 = clamp(t, 0.0f, 1.0f);
     }
-    return _2632;
+    return _2657;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -800,17 +808,17 @@ void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, floa
     float mu_s_column = clamp(floor(mu_s_coord), 0.0f, mu_s_size - 2.0f);
     x_below = (mu_s_column + 0.5f) / mu_s_size;
     x_above = (mu_s_column + 1.5f) / mu_s_size;
-    bool _2692 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
-    bool _2698;
-    if (_2692)
+    bool _2717 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
+    bool _2723;
+    if (_2717)
     {
-        _2698 = x_below < x_low_sun;
+        _2723 = x_below < x_low_sun;
     }
     else
     {
-        _2698 = _2692;
+        _2723 = _2717;
     }
-    low_sun_below = _2698;
+    low_sun_below = _2723;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -821,16 +829,19 @@ void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, floa
 ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, float mu, float mu_s, float nu, bool ray_r_mu_intersects_ground)
 {
     AtmosphereParameters param = atmosphere;
-    float param_1 = r;
-    float param_2 = mu;
-    float param_3 = mu_s;
-    float param_4 = nu;
-    bool param_5 = ray_r_mu_intersects_ground;
-    float2 param_6;
-    float4 _3237 = GetScatteringTextureUvwzAndEdge(param, param_1, param_2, param_3, param_4, param_5, param_6);
-    float2 edge = param_6;
+    ScatteringSunAxis sun_axis = GetScatteringSunAxis(param);
+    AtmosphereParameters param_1 = atmosphere;
+    ScatteringSunAxis param_2 = sun_axis;
+    float param_3 = r;
+    float param_4 = mu;
+    float param_5 = mu_s;
+    float param_6 = nu;
+    bool param_7 = ray_r_mu_intersects_ground;
+    float2 param_8;
+    float4 _3268 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    float2 edge = param_8;
     ScatteringLookup lookup;
-    lookup.uvwz = _3237;
+    lookup.uvwz = _3268;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = lookup.uvwz.x * (nu_size - 1.0f);
     lookup.nu_slice = min(floor(nu_coord), nu_size - 2.0f);
@@ -845,73 +856,74 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
     lookup.log_first_span = 1.0f;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5f;
-    bool _3289 = atmosphere.scattering_mu_s_split > 0;
-    bool _3298;
-    if (_3289)
+    bool _3320 = atmosphere.scattering_mu_s_split > 0;
+    bool _3329;
+    if (_3320)
     {
-        _3298 = lookup.position < float(atmosphere.scattering_mu_s_split);
+        _3329 = lookup.position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3298 = _3289;
+        _3329 = _3320;
     }
-    if (_3298)
+    if (_3329)
     {
         float past = 6.0f;
         lookup.kind = 3;
         lookup.x = 0.0f.xxxx;
         if (lookup.position < 0.0f)
         {
-            AtmosphereParameters param_7 = atmosphere;
-            float2 param_8 = edge;
-            float _step = ShadowEdgePastStep(param_7, param_8);
+            AtmosphereParameters param_9 = atmosphere;
+            float2 param_10 = edge;
+            float _step = ShadowEdgePastStep(param_9, param_10);
             lookup.kind = 2;
             lookup.x = float4(0.5f, 1.5f, 0.0f, 0.0f) / mu_s_size.xxxx;
-            float2 param_9 = edge;
-            float param_10 = (-(past - 1.0f)) * _step;
-            lookup.mu_s_a = ShadowEdgeSunCosine(param_9, param_10);
             float2 param_11 = edge;
-            float param_12 = (-(past - 2.0f)) * _step;
-            lookup.mu_s_b = ShadowEdgeSunCosine(param_11, param_12);
+            float param_12 = (-(past - 1.0f)) * _step;
+            lookup.mu_s_a = ShadowEdgeSunCosine(param_11, param_12);
+            float2 param_13 = edge;
+            float param_14 = (-(past - 2.0f)) * _step;
+            lookup.mu_s_b = ShadowEdgeSunCosine(param_13, param_14);
         }
         else
         {
-            bool _3346 = lookup.position >= (past - 1.0f);
-            bool _3353;
-            if (_3346)
+            bool _3377 = lookup.position >= (past - 1.0f);
+            bool _3384;
+            if (_3377)
             {
-                _3353 = lookup.position < past;
+                _3384 = lookup.position < past;
             }
             else
             {
-                _3353 = _3346;
+                _3384 = _3377;
             }
-            if (_3353)
+            if (_3384)
             {
                 float x = 1.0f / (float(atmosphere.scattering_mu_s_split) - past);
-                AtmosphereParameters param_13 = atmosphere;
-                float param_14 = x;
-                float2 param_15 = edge;
-                lookup.log_first_span = log(ShadowEdgeLitDistance(param_13, param_14, param_15) / 0.0008726646192371845245361328125f);
+                AtmosphereParameters param_15 = atmosphere;
+                float param_16 = x;
+                float2 param_17 = edge;
+                lookup.log_first_span = log(ShadowEdgeLitDistance(param_15, param_16, param_17) / 0.0008726646192371845245361328125f);
             }
         }
         return lookup;
     }
-    AtmosphereParameters param_16 = atmosphere;
-    float param_17 = 0.100000001490116119384765625f;
-    float x_low_sun = GetScatteringTextureUMuS(param_16, param_17);
     AtmosphereParameters param_18 = atmosphere;
-    float param_19 = lookup.uvwz.y;
-    float param_20 = x_low_sun;
-    float param_21;
-    float param_22;
-    float param_23;
-    bool param_24;
-    GetScatteringMuSColumns(param_18, param_19, param_20, param_21, param_22, param_23, param_24);
-    float x_below = param_21;
-    float x_above = param_22;
-    lookup.t = param_23;
-    bool low_sun_below = param_24;
+    ScatteringSunAxis param_19 = sun_axis;
+    float param_20 = 0.100000001490116119384765625f;
+    float x_low_sun = GetScatteringTextureUMuSOnAxis(param_18, param_19, param_20);
+    AtmosphereParameters param_21 = atmosphere;
+    float param_22 = lookup.uvwz.y;
+    float param_23 = x_low_sun;
+    float param_24;
+    float param_25;
+    float param_26;
+    bool param_27;
+    GetScatteringMuSColumns(param_21, param_22, param_23, param_24, param_25, param_26, param_27);
+    float x_below = param_24;
+    float x_above = param_25;
+    lookup.t = param_26;
+    bool low_sun_below = param_27;
     if (!low_sun_below)
     {
         lookup.kind = 0;
@@ -925,9 +937,10 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
         lookup.x = float4(x_below, x_above, 0.0f, 0.0f);
         lookup.low_sun = bool4(true, x_above < x_low_sun, true, true);
         lookup.mu_s_a = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_25 = atmosphere;
-        float param_26 = 1.0f / (mu_s_size - 1.0f);
-        lookup.mu_s_b = GetScatteringMuSFromUnitRange(param_25, param_26);
+        AtmosphereParameters param_28 = atmosphere;
+        ScatteringSunAxis param_29 = sun_axis;
+        float param_30 = 1.0f / (mu_s_size - 1.0f);
+        lookup.mu_s_b = GetScatteringMuSFromUnitRangeOnAxis(param_28, param_29, param_30);
         return lookup;
     }
     float column = (x_below * mu_s_size) - 0.5f;
@@ -965,26 +978,26 @@ float4 LogMonotoneCubicMix(float4 a, float4 b, float4 c, float4 d, bool has_a, b
     float4 dark = 1.0000000031710768509710513471353e-30f.xxxx;
     float4 lb = log(max(b, dark));
     float4 lc = log(max(c, dark));
-    float4 _2719;
+    float4 _2744;
     if (has_a)
     {
-        _2719 = log(max(a, dark));
+        _2744 = log(max(a, dark));
     }
     else
     {
-        _2719 = (lb * 2.0f) - lc;
+        _2744 = (lb * 2.0f) - lc;
     }
-    float4 la = _2719;
-    float4 _2734;
+    float4 la = _2744;
+    float4 _2759;
     if (has_d)
     {
-        _2734 = log(max(d, dark));
+        _2759 = log(max(d, dark));
     }
     else
     {
-        _2734 = (lc * 2.0f) - lb;
+        _2759 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2734;
+    float4 ld = _2759;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1229,16 +1242,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScatteringFromLookup(param_6, scattering_texture_1, _scattering_texture_1_sampler, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3791;
+        float3 _3826;
         if (scattering.x > 0.0f)
         {
-            _3791 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3826 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3791 = 0.0f.xxx;
+            _3826 = 0.0f.xxx;
         }
-        single_mie_scattering = _3791;
+        single_mie_scattering = _3826;
     }
     else
     {
@@ -1304,9 +1317,9 @@ float3 GetSkyRadianceOfRay(AtmosphereParameters atmosphere, Texture3D<float4> sc
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3847 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3882 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3847;
+    float3 scattering = _3882;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1326,13 +1339,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _3882 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3917 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3882)
+    if (!_3917)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1341,19 +1354,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3902;
+    float3 _3937;
     if (ray_r_mu_intersects_ground)
     {
-        _3902 = 0.0f.xxx;
+        _3937 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3902 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _3937 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _3902;
+    transmittance = _3937;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1375,16 +1388,16 @@ float GetUnitRangeFromTextureCoord(float u, int texture_size)
 float GetUnitMuInHalfFromTextureCoord(float u, int size, inout bool ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5f;
-    float _1292;
+    float _1304;
     if (ray_r_mu_intersects_ground)
     {
-        _1292 = 1.0f - (2.0f * u);
+        _1304 = 1.0f - (2.0f * u);
     }
     else
     {
-        _1292 = (2.0f * u) - 1.0f;
+        _1304 = (2.0f * u) - 1.0f;
     }
-    float param = _1292;
+    float param = _1304;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1405,25 +1418,25 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _5063 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5098 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _5063;
+    float x = _5098;
     float e = (1.0f - x) * (1.0f - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _5084;
+    float _5119;
     if (ray_r_mu_intersects_ground)
     {
-        _5084 = theta_h + (e * (3.1415927410125732421875f - theta_h));
+        _5119 = theta_h + (e * (3.1415927410125732421875f - theta_h));
     }
     else
     {
-        _5084 = theta_h * (1.0f - e);
+        _5119 = theta_h * (1.0f - e);
     }
-    float theta = _5084;
+    float theta = _5119;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875f * clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0f, 1.0f);
@@ -1431,8 +1444,8 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
     if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13f)
     {
-        bool3 _5134 = (abs(up.x) < 0.89999997615814208984375f).xxx;
-        toward_sun = cross(up, float3(_5134.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5134.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5134.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
+        bool3 _5169 = (abs(up.x) < 0.89999997615814208984375f).xxx;
+        toward_sun = cross(up, float3(_5169.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5169.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5169.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
     }
     toward_sun = normalize(toward_sun);
     float3 across = cross(up, toward_sun);
@@ -1448,9 +1461,9 @@ float3 GetSkyViewRadiance(AtmosphereParameters atmosphere, Texture3D<float4> sca
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5173 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5208 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5173;
+    float3 view_ray = _5208;
     float3 up = normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1477,16 +1490,16 @@ void GetSkyViewAngles(float3 camera, float3 view_ray, float3 sun_direction, out 
     theta = atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _5049;
+    float _5084;
     if ((along != 0.0f) || (side != 0.0f))
     {
-        _5049 = atan2(side, along);
+        _5084 = atan2(side, along);
     }
     else
     {
-        _5049 = 0.0f;
+        _5084 = 0.0f;
     }
-    phi = _5049;
+    phi = _5084;
 }
 #endif
 
@@ -1496,16 +1509,16 @@ float2 GetSkyViewUvFromAngles(AtmosphereParameters atmosphere, float r, float th
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _4970;
+    float _5005;
     if (ray_r_mu_intersects_ground)
     {
-        _4970 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
+        _5005 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
     }
     else
     {
-        _4970 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
+        _5005 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
     }
-    float x = _4970;
+    float x = _5005;
     float param_2 = phi / 3.1415927410125732421875f;
     int param_3 = 192;
     float param_4 = x;
@@ -1527,19 +1540,19 @@ float3 GetSkyRadianceFromSkyView(AtmosphereParameters atmosphere, Texture2D<floa
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5235;
+    float3 _5270;
     if (ray_r_mu_intersects_ground)
     {
-        _5235 = 0.0f.xxx;
+        _5270 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5235 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
+        _5270 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
     }
-    transmittance = _5235;
+    transmittance = _5270;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1583,16 +1596,16 @@ float ProfileSampleAltitude(AtmosphereParameters atmosphere, int i)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float InterpolateCoefficient(float a, float b, float f)
 {
-    float _4006;
+    float _4041;
     if ((a > 0.0f) && (b > 0.0f))
     {
-        _4006 = a * exp(f * log(b / a));
+        _4041 = a * exp(f * log(b / a));
     }
     else
     {
-        _4006 = lerp(a, b, f);
+        _4041 = lerp(a, b, f);
     }
-    return _4006;
+    return _4041;
 }
 #endif
 
@@ -1658,16 +1671,16 @@ float SunVisibleFraction(AtmosphereParameters atmosphere, float r, float mu_s)
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float MeanAttenuation(float depth)
 {
-    float _4256;
+    float _4291;
     if (depth < 9.9999997473787516355514526367188e-05f)
     {
-        _4256 = 1.0f - (0.5f * depth);
+        _4291 = 1.0f - (0.5f * depth);
     }
     else
     {
-        _4256 = (1.0f - exp(-depth)) / depth;
+        _4291 = (1.0f - exp(-depth)) / depth;
     }
-    return _4256;
+    return _4291;
 }
 #endif
 
@@ -1703,10 +1716,10 @@ float3 IntegrateSegment(AtmosphereParameters atmosphere, Texture2D<float4> trans
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4336 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4371 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4336;
+        float3 extinction = _4371;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1764,10 +1777,10 @@ float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, fl
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4202 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4237 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4202;
+        float3 extinction = _4237;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
@@ -1840,14 +1853,14 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
 {
-    float3 _4226;
+    float3 _4261;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4226 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4261 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1856,9 +1869,9 @@ float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4226 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
+        _4261 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
     }
-    return _4226;
+    return _4261;
 }
 #endif
 
@@ -1871,16 +1884,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _3968;
+    float _4003;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _3968 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _4003 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _3968 = up;
+        _4003 = up;
     }
-    return _3968;
+    return _4003;
 }
 #endif
 
@@ -1903,13 +1916,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4482 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4517 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4482)
+    if (!_4517)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1949,11 +1962,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4577 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4612 = IntegrateSegment(param_21, transmittance_texture_1, _transmittance_texture_1_sampler, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4577;
+        lit_optical_depth = _4612;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0f) && (lit < d))
@@ -1967,11 +1980,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4611 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4646 = IntegrateSegment(param_30, transmittance_texture_1, _transmittance_texture_1_sampler, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4611;
+        optical_depth += _4646;
     }
     if (direct < 1.0f)
     {
@@ -1990,9 +2003,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4654 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4689 = GetCombinedScattering(param_44, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4654;
+    float3 scattering = _4689;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -2013,11 +2026,11 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4702 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4737 = IntegrateSegment(param_58, transmittance_texture_1, _transmittance_texture_1_sampler, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4702;
+        float3 far_optical_depth = _4737;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -2037,9 +2050,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4756 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4791 = GetCombinedScattering(param_76, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4756);
+            scattering -= (exp(-far_optical_depth) * _4791);
         }
         float3 multiple = (max(scattering - far_rayleigh, 0.0f.xxx) * lit_weight) / max(far_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_83 = nu;
@@ -2060,9 +2073,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4821 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4856 = GetCombinedScattering(param_91, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4821;
+    float3 scattering_p = _4856;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, single_mie, lit_direct.xxx);
@@ -2082,9 +2095,9 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4865 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _4900 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4865;
+    return _4900;
 }
 #endif
 
@@ -2112,9 +2125,9 @@ float3 GetAerialPerspectiveVoxel(AtmosphereParameters atmosphere, Texture2D<floa
     float3 param_3 = _point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5329 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
+    float3 _5364 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5329;
+    float3 radiance = _5364;
     optical_depth = -log(max(transmittance, 1.0000000031710768509710513471353e-30f.xxx));
     return radiance;
 }
@@ -2142,16 +2155,16 @@ float3 GetSkyRadianceToPointFromVolume(Texture3D<float4> radiance_volume, Sample
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1473;
+    float _1497;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1473 = 0.100000001490116119384765625f;
+        _1497 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1473 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1497 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1473;
+    return _1497;
 }
 #endif
 
@@ -2160,16 +2173,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1491;
+    float _1515;
     if (mu_s < knee)
     {
-        _1491 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1515 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1491 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1515 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1491;
+    return _1515;
 }
 #endif
 
@@ -2196,16 +2209,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1522;
+    float _1546;
     if (x < 0.5f)
     {
-        _1522 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1546 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1522 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1546 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1522;
+    return _1546;
 }
 #endif
 
@@ -2217,16 +2230,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2655;
+    float4 _2680;
     if (t < 0.0f)
     {
-        _2655 = min(blend, a);
+        _2680 = min(blend, a);
     }
     else
     {
-        _2655 = blend;
+        _2680 = blend;
     }
-    return _2655;
+    return _2680;
 }
 #endif
 

@@ -31,6 +31,13 @@ struct AtmosphereParameters {
     rayleigh_scattering_profile: array<vec3<f32>, 64>,
 }
 
+struct ScatteringSunAxis {
+    H: f32,
+    A: f32,
+    inverse_A: f32,
+    unit_max: f32,
+}
+
 struct ScatteringLookup {
     kind: i32,
     uvwz: vec4<f32>,
@@ -866,158 +873,197 @@ fn GetUnitMuInHalfFromTextureCoord(u_3: f32, size_2: i32, ray_r_mu_intersects_gr
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringLowestSunDistance(atmosphere_26: AtmosphereParameters) -> f32 {
+fn GetScatteringUnitMuSOnAxis(atmosphere_26: AtmosphereParameters, axis: ScatteringSunAxis, mu_s_3: f32) -> f32 {
     var atmosphere_27: AtmosphereParameters;
-    var d_min_5: f32;
-    var d_max_2: f32;
-    var D: f32;
-
-    atmosphere_27 = atmosphere_26;
-    let _e9 = atmosphere_27;
-    let _e11 = atmosphere_27;
-    d_min_5 = (_e9.top_radius - _e11.bottom_radius);
-    let _e15 = atmosphere_27;
-    let _e16 = HorizonDistanceAtTop(_e15);
-    d_max_2 = _e16;
-    let _e18 = atmosphere_27;
-    let _e19 = atmosphere_27;
-    let _e21 = atmosphere_27;
-    let _e23 = DistanceToTopAtmosphereBoundary(_e18, _e19.bottom_radius, _e21.scattering_mu_s_min);
-    D = _e23;
-    let _e25 = D;
-    let _e26 = d_min_5;
-    let _e28 = d_max_2;
-    let _e29 = d_min_5;
-    return ((_e25 - _e26) / (_e28 - _e29));
-}
-
-// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringUnitMuS(atmosphere_28: AtmosphereParameters, mu_s_3: f32) -> f32 {
-    var atmosphere_29: AtmosphereParameters;
+    var axis_1: ScatteringSunAxis;
     var mu_s_4: f32;
     var d_11: f32;
-    var d_min_6: f32;
-    var d_max_3: f32;
+    var d_min_5: f32;
     var a_4: f32;
 
-    atmosphere_29 = atmosphere_28;
+    atmosphere_27 = atmosphere_26;
+    axis_1 = axis;
     mu_s_4 = mu_s_3;
-    let _e11 = atmosphere_29;
-    let _e12 = atmosphere_29;
-    let _e14 = mu_s_4;
-    let _e15 = DistanceToTopAtmosphereBoundary(_e11, _e12.bottom_radius, _e14);
-    d_11 = _e15;
-    let _e17 = atmosphere_29;
-    let _e19 = atmosphere_29;
-    d_min_6 = (_e17.top_radius - _e19.bottom_radius);
-    let _e23 = atmosphere_29;
-    let _e24 = HorizonDistanceAtTop(_e23);
-    d_max_3 = _e24;
-    let _e26 = d_11;
-    let _e27 = d_min_6;
-    let _e29 = d_max_3;
-    let _e30 = d_min_6;
-    a_4 = ((_e26 - _e27) / (_e29 - _e30));
+    let _e13 = atmosphere_27;
+    let _e14 = atmosphere_27;
+    let _e16 = mu_s_4;
+    let _e17 = DistanceToTopAtmosphereBoundary(_e13, _e14.bottom_radius, _e16);
+    d_11 = _e17;
+    let _e19 = atmosphere_27;
+    let _e21 = atmosphere_27;
+    d_min_5 = (_e19.top_radius - _e21.bottom_radius);
+    let _e25 = d_11;
+    let _e26 = d_min_5;
+    let _e28 = axis_1;
+    let _e30 = d_min_5;
+    a_4 = ((_e25 - _e26) / (_e28.H - _e30));
     let _e34 = a_4;
-    let _e36 = atmosphere_29;
-    let _e37 = GetScatteringLowestSunDistance(_e36);
-    let _e39 = ScatteringUnitMuSFromDistance(_e34, (1f / _e37));
-    return _e39;
+    let _e35 = axis_1;
+    let _e37 = ScatteringUnitMuSFromDistance(_e34, _e35.inverse_A);
+    return _e37;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSFromUnitRange(atmosphere_30: AtmosphereParameters, x_8: f32) -> f32 {
+fn GetScatteringSunAxis(atmosphere_28: AtmosphereParameters) -> ScatteringSunAxis {
+    var atmosphere_29: AtmosphereParameters;
+    var axis_2: ScatteringSunAxis;
+    var d_min_6: f32;
+    var D: f32;
+
+    atmosphere_29 = atmosphere_28;
+    let _e10 = atmosphere_29;
+    let _e12 = atmosphere_29;
+    d_min_6 = (_e10.top_radius - _e12.bottom_radius);
+    let _e17 = atmosphere_29;
+    let _e18 = HorizonDistanceAtTop(_e17);
+    axis_2.H = _e18;
+    let _e19 = atmosphere_29;
+    let _e20 = atmosphere_29;
+    let _e22 = atmosphere_29;
+    let _e24 = DistanceToTopAtmosphereBoundary(_e19, _e20.bottom_radius, _e22.scattering_mu_s_min);
+    D = _e24;
+    let _e27 = D;
+    let _e28 = d_min_6;
+    let _e30 = axis_2;
+    let _e32 = d_min_6;
+    axis_2.A = ((_e27 - _e28) / (_e30.H - _e32));
+    let _e37 = axis_2;
+    axis_2.inverse_A = (1f / _e37.A);
+    axis_2.unit_max = 0f;
+    let _e43 = atmosphere_29;
+    let _e44 = axis_2;
+    let _e45 = atmosphere_29;
+    let _e47 = GetScatteringUnitMuSOnAxis(_e43, _e44, _e45.scattering_mu_s_max);
+    axis_2.unit_max = _e47;
+    let _e48 = axis_2;
+    return _e48;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringUnitMuS(atmosphere_30: AtmosphereParameters, mu_s_5: f32) -> f32 {
     var atmosphere_31: AtmosphereParameters;
+    var mu_s_6: f32;
+
+    atmosphere_31 = atmosphere_30;
+    mu_s_6 = mu_s_5;
+    let _e11 = atmosphere_31;
+    let _e12 = atmosphere_31;
+    let _e13 = GetScatteringSunAxis(_e12);
+    let _e14 = mu_s_6;
+    let _e15 = GetScatteringUnitMuSOnAxis(_e11, _e13, _e14);
+    return _e15;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringMuSFromUnitRangeOnAxis(atmosphere_32: AtmosphereParameters, axis_3: ScatteringSunAxis, x_8: f32) -> f32 {
+    var atmosphere_33: AtmosphereParameters;
+    var axis_4: ScatteringSunAxis;
     var x_9: f32;
-    var x_mu_s: f32;
     var bottom: f32;
-    var H_2: f32;
     var d_min_7: f32;
-    var d_max_4: f32;
-    var A: f32;
     var a_5: f32;
     var d_12: f32;
     var local_9: f32;
 
-    atmosphere_31 = atmosphere_30;
+    atmosphere_33 = atmosphere_32;
+    axis_4 = axis_3;
     x_9 = x_8;
-    let _e11 = x_9;
-    let _e12 = atmosphere_31;
-    let _e13 = atmosphere_31;
-    let _e15 = GetScatteringUnitMuS(_e12, _e13.scattering_mu_s_max);
-    x_mu_s = (_e11 * _e15);
-    let _e18 = atmosphere_31;
-    bottom = _e18.bottom_radius;
-    let _e21 = atmosphere_31;
-    let _e22 = HorizonDistanceAtTop(_e21);
-    H_2 = _e22;
-    let _e24 = atmosphere_31;
-    let _e26 = bottom;
-    d_min_7 = (_e24.top_radius - _e26);
-    let _e29 = H_2;
-    d_max_4 = _e29;
-    let _e31 = atmosphere_31;
-    let _e32 = GetScatteringLowestSunDistance(_e31);
-    A = _e32;
-    let _e34 = x_mu_s;
-    let _e36 = A;
-    let _e38 = ScatteringDistanceFromUnitMuS(_e34, (1f / _e36));
-    a_5 = _e38;
-    let _e40 = d_min_7;
-    let _e41 = a_5;
-    let _e42 = A;
-    let _e44 = d_max_4;
-    let _e45 = d_min_7;
-    d_12 = (_e40 + (min(_e41, _e42) * (_e44 - _e45)));
-    let _e50 = d_12;
-    if (_e50 == 0f) {
+    let _e13 = atmosphere_33;
+    bottom = _e13.bottom_radius;
+    let _e16 = atmosphere_33;
+    let _e18 = bottom;
+    d_min_7 = (_e16.top_radius - _e18);
+    let _e21 = x_9;
+    let _e22 = axis_4;
+    let _e25 = axis_4;
+    let _e27 = ScatteringDistanceFromUnitMuS((_e21 * _e22.unit_max), _e25.inverse_A);
+    a_5 = _e27;
+    let _e29 = d_min_7;
+    let _e30 = a_5;
+    let _e31 = axis_4;
+    let _e34 = axis_4;
+    let _e36 = d_min_7;
+    d_12 = (_e29 + (min(_e30, _e31.A) * (_e34.H - _e36)));
+    let _e41 = d_12;
+    if (_e41 == 0f) {
         local_9 = 1f;
     } else {
-        let _e54 = H_2;
-        let _e55 = H_2;
+        let _e45 = axis_4;
+        let _e47 = axis_4;
+        let _e50 = d_12;
+        let _e51 = d_12;
+        let _e55 = bottom;
         let _e57 = d_12;
-        let _e58 = d_12;
-        let _e62 = bottom;
-        let _e64 = d_12;
-        let _e67 = ClampCosine((((_e54 * _e55) - (_e57 * _e58)) / ((2f * _e62) * _e64)));
-        local_9 = _e67;
+        let _e60 = ClampCosine((((_e45.H * _e47.H) - (_e50 * _e51)) / ((2f * _e55) * _e57)));
+        local_9 = _e60;
     }
-    let _e69 = local_9;
-    return _e69;
+    let _e62 = local_9;
+    return _e62;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUMuS(atmosphere_32: AtmosphereParameters, mu_s_5: f32) -> f32 {
-    var atmosphere_33: AtmosphereParameters;
-    var mu_s_6: f32;
-    var x_10: f32;
+fn GetScatteringMuSFromUnitRange(atmosphere_34: AtmosphereParameters, x_10: f32) -> f32 {
+    var atmosphere_35: AtmosphereParameters;
+    var x_11: f32;
 
-    atmosphere_33 = atmosphere_32;
-    mu_s_6 = mu_s_5;
-    let _e11 = atmosphere_33;
-    let _e12 = mu_s_6;
-    let _e13 = GetScatteringUnitMuS(_e11, _e12);
-    let _e14 = atmosphere_33;
-    let _e15 = atmosphere_33;
-    let _e17 = GetScatteringUnitMuS(_e14, _e15.scattering_mu_s_max);
-    x_10 = (_e13 / _e17);
-    let _e20 = x_10;
-    let _e23 = atmosphere_33;
-    let _e25 = GetTextureCoordFromUnitRange(min(_e20, 1f), _e23.scattering_mu_s_size);
-    return _e25;
+    atmosphere_35 = atmosphere_34;
+    x_11 = x_10;
+    let _e11 = atmosphere_35;
+    let _e12 = atmosphere_35;
+    let _e13 = GetScatteringSunAxis(_e12);
+    let _e14 = x_11;
+    let _e15 = GetScatteringMuSFromUnitRangeOnAxis(_e11, _e13, _e14);
+    return _e15;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringTextureUMuSOnAxis(atmosphere_36: AtmosphereParameters, axis_5: ScatteringSunAxis, mu_s_7: f32) -> f32 {
+    var atmosphere_37: AtmosphereParameters;
+    var axis_6: ScatteringSunAxis;
+    var mu_s_8: f32;
+    var x_12: f32;
+
+    atmosphere_37 = atmosphere_36;
+    axis_6 = axis_5;
+    mu_s_8 = mu_s_7;
+    let _e13 = atmosphere_37;
+    let _e14 = axis_6;
+    let _e15 = mu_s_8;
+    let _e16 = GetScatteringUnitMuSOnAxis(_e13, _e14, _e15);
+    let _e17 = axis_6;
+    x_12 = (_e16 / _e17.unit_max);
+    let _e21 = x_12;
+    let _e24 = atmosphere_37;
+    let _e26 = GetTextureCoordFromUnitRange(min(_e21, 1f), _e24.scattering_mu_s_size);
+    return _e26;
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn GetScatteringTextureUMuS(atmosphere_38: AtmosphereParameters, mu_s_9: f32) -> f32 {
+    var atmosphere_39: AtmosphereParameters;
+    var mu_s_10: f32;
+
+    atmosphere_39 = atmosphere_38;
+    mu_s_10 = mu_s_9;
+    let _e11 = atmosphere_39;
+    let _e12 = atmosphere_39;
+    let _e13 = GetScatteringSunAxis(_e12);
+    let _e14 = mu_s_10;
+    let _e15 = GetScatteringTextureUMuSOnAxis(_e11, _e13, _e14);
+    return _e15;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn IrradianceKneeMuS(atmosphere_34: AtmosphereParameters) -> f32 {
-    var atmosphere_35: AtmosphereParameters;
+fn IrradianceKneeMuS(atmosphere_40: AtmosphereParameters) -> f32 {
+    var atmosphere_41: AtmosphereParameters;
     var local_10: f32;
 
-    atmosphere_35 = atmosphere_34;
-    let _e10 = atmosphere_35;
+    atmosphere_41 = atmosphere_40;
+    let _e10 = atmosphere_41;
     if (_e10.mu_s_min < LOW_SUN_MU_S) {
         local_10 = LOW_SUN_MU_S;
     } else {
-        let _e14 = atmosphere_35;
+        let _e14 = atmosphere_41;
         local_10 = (0.5f * (_e14.mu_s_min + 1f));
     }
     let _e20 = local_10;
@@ -1025,27 +1071,27 @@ fn IrradianceKneeMuS(atmosphere_34: AtmosphereParameters) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceUnitMuS(atmosphere_36: AtmosphereParameters, mu_s_7: f32) -> f32 {
-    var atmosphere_37: AtmosphereParameters;
-    var mu_s_8: f32;
+fn GetIrradianceUnitMuS(atmosphere_42: AtmosphereParameters, mu_s_11: f32) -> f32 {
+    var atmosphere_43: AtmosphereParameters;
+    var mu_s_12: f32;
     var knee: f32;
     var local_11: f32;
 
-    atmosphere_37 = atmosphere_36;
-    mu_s_8 = mu_s_7;
-    let _e12 = atmosphere_37;
+    atmosphere_43 = atmosphere_42;
+    mu_s_12 = mu_s_11;
+    let _e12 = atmosphere_43;
     let _e13 = IrradianceKneeMuS(_e12);
     knee = _e13;
-    let _e15 = mu_s_8;
+    let _e15 = mu_s_12;
     let _e16 = knee;
     if (_e15 < _e16) {
-        let _e19 = mu_s_8;
-        let _e20 = atmosphere_37;
+        let _e19 = mu_s_12;
+        let _e20 = atmosphere_43;
         let _e24 = knee;
-        let _e25 = atmosphere_37;
+        let _e25 = atmosphere_43;
         local_11 = ((0.5f * (_e19 - _e20.mu_s_min)) / (_e24 - _e25.mu_s_min));
     } else {
-        let _e31 = mu_s_8;
+        let _e31 = mu_s_12;
         let _e32 = knee;
         let _e36 = knee;
         local_11 = (0.5f + ((0.5f * (_e31 - _e32)) / (1f - _e36)));
@@ -1055,27 +1101,27 @@ fn GetIrradianceUnitMuS(atmosphere_36: AtmosphereParameters, mu_s_7: f32) -> f32
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceMuSFromUnit(atmosphere_38: AtmosphereParameters, x_11: f32) -> f32 {
-    var atmosphere_39: AtmosphereParameters;
-    var x_12: f32;
+fn GetIrradianceMuSFromUnit(atmosphere_44: AtmosphereParameters, x_13: f32) -> f32 {
+    var atmosphere_45: AtmosphereParameters;
+    var x_14: f32;
     var knee_1: f32;
     var local_12: f32;
 
-    atmosphere_39 = atmosphere_38;
-    x_12 = x_11;
-    let _e12 = atmosphere_39;
+    atmosphere_45 = atmosphere_44;
+    x_14 = x_13;
+    let _e12 = atmosphere_45;
     let _e13 = IrradianceKneeMuS(_e12);
     knee_1 = _e13;
-    let _e15 = x_12;
+    let _e15 = x_14;
     if (_e15 < 0.5f) {
-        let _e18 = atmosphere_39;
-        let _e21 = x_12;
+        let _e18 = atmosphere_45;
+        let _e21 = x_14;
         let _e23 = knee_1;
-        let _e24 = atmosphere_39;
+        let _e24 = atmosphere_45;
         local_12 = (_e18.mu_s_min + ((2f * _e21) * (_e23 - _e24.mu_s_min)));
     } else {
         let _e29 = knee_1;
-        let _e31 = x_12;
+        let _e31 = x_14;
         let _e36 = knee_1;
         local_12 = (_e29 + (((2f * _e31) - 1f) * (1f - _e36)));
     }
@@ -1084,57 +1130,57 @@ fn GetIrradianceMuSFromUnit(atmosphere_38: AtmosphereParameters, x_11: f32) -> f
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradianceTextureUvFromRMuS(atmosphere_40: AtmosphereParameters, r_28: f32, mu_s_9: f32) -> vec2<f32> {
-    var atmosphere_41: AtmosphereParameters;
+fn GetIrradianceTextureUvFromRMuS(atmosphere_46: AtmosphereParameters, r_28: f32, mu_s_13: f32) -> vec2<f32> {
+    var atmosphere_47: AtmosphereParameters;
     var r_29: f32;
-    var mu_s_10: f32;
+    var mu_s_14: f32;
     var x_r_1: f32;
-    var x_mu_s_1: f32;
+    var x_mu_s: f32;
 
-    atmosphere_41 = atmosphere_40;
+    atmosphere_47 = atmosphere_46;
     r_29 = r_28;
-    mu_s_10 = mu_s_9;
-    let _e14 = atmosphere_41;
+    mu_s_14 = mu_s_13;
+    let _e14 = atmosphere_47;
     let _e15 = r_29;
     let _e16 = HorizonDistance(_e14, _e15);
-    let _e17 = atmosphere_41;
+    let _e17 = atmosphere_47;
     let _e18 = HorizonDistanceAtTop(_e17);
     x_r_1 = (_e16 / _e18);
-    let _e21 = atmosphere_41;
-    let _e22 = mu_s_10;
+    let _e21 = atmosphere_47;
+    let _e22 = mu_s_14;
     let _e23 = GetIrradianceUnitMuS(_e21, _e22);
-    x_mu_s_1 = clamp(_e23, 0f, 1f);
-    let _e28 = x_mu_s_1;
-    let _e29 = atmosphere_41;
+    x_mu_s = clamp(_e23, 0f, 1f);
+    let _e28 = x_mu_s;
+    let _e29 = atmosphere_47;
     let _e31 = GetTextureCoordFromUnitRange(_e28, _e29.irradiance_width);
     let _e32 = x_r_1;
-    let _e33 = atmosphere_41;
+    let _e33 = atmosphere_47;
     let _e35 = GetTextureCoordFromUnitRange(_e32, _e33.irradiance_height);
     return vec2<f32>(_e31, _e35);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ViewSunAzimuthCosine(mu_19: f32, mu_s_11: f32, nu_9: f32) -> f32 {
+fn ViewSunAzimuthCosine(mu_19: f32, mu_s_15: f32, nu_9: f32) -> f32 {
     var mu_20: f32;
-    var mu_s_12: f32;
+    var mu_s_16: f32;
     var nu_10: f32;
     var across: f32;
     var local_13: f32;
 
     mu_20 = mu_19;
-    mu_s_12 = mu_s_11;
+    mu_s_16 = mu_s_15;
     nu_10 = nu_9;
     let _e19 = mu_20;
     let _e20 = mu_20;
-    let _e24 = mu_s_12;
-    let _e25 = mu_s_12;
+    let _e24 = mu_s_16;
+    let _e25 = mu_s_16;
     let _e29 = SafeSqrt(((1f - (_e19 * _e20)) * (1f - (_e24 * _e25))));
     across = _e29;
     let _e31 = across;
     if (_e31 > 0f) {
         let _e34 = nu_10;
         let _e35 = mu_20;
-        let _e36 = mu_s_12;
+        let _e36 = mu_s_16;
         let _e39 = across;
         let _e41 = ClampCosine(((_e34 - (_e35 * _e36)) / _e39));
         local_13 = _e41;
@@ -1146,8 +1192,8 @@ fn ViewSunAzimuthCosine(mu_19: f32, mu_s_11: f32, nu_9: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdge(atmosphere_42: AtmosphereParameters, r_30: f32, mu_21: f32, cos_phi: f32, ray_r_mu_intersects_ground_9: bool, direction: ptr<function, vec2<f32>>) -> f32 {
-    var atmosphere_43: AtmosphereParameters;
+fn ShadowEdge(atmosphere_48: AtmosphereParameters, r_30: f32, mu_21: f32, cos_phi: f32, ray_r_mu_intersects_ground_9: bool, direction: ptr<function, vec2<f32>>) -> f32 {
+    var atmosphere_49: AtmosphereParameters;
     var r_31: f32;
     var mu_22: f32;
     var cos_phi_1: f32;
@@ -1174,18 +1220,18 @@ fn ShadowEdge(atmosphere_42: AtmosphereParameters, r_30: f32, mu_21: f32, cos_ph
     var local_17: f32;
     var angle: f32;
 
-    atmosphere_43 = atmosphere_42;
+    atmosphere_49 = atmosphere_48;
     r_31 = r_30;
     mu_22 = mu_21;
     cos_phi_1 = cos_phi;
     ray_r_mu_intersects_ground_10 = ray_r_mu_intersects_ground_9;
-    let _e23 = atmosphere_43;
+    let _e23 = atmosphere_49;
     let _e24 = r_31;
     let _e25 = mu_22;
     let _e26 = ray_r_mu_intersects_ground_10;
     let _e27 = DistanceToNearestAtmosphereBoundary(_e23, _e24, _e25, _e26);
     d_13 = _e27;
-    let _e29 = atmosphere_43;
+    let _e29 = atmosphere_49;
     let _e30 = r_31;
     let _e31 = mu_22;
     let _e32 = d_13;
@@ -1209,16 +1255,16 @@ fn ShadowEdge(atmosphere_42: AtmosphereParameters, r_30: f32, mu_21: f32, cos_ph
     let _e60 = cos_alpha;
     let _e61 = cos_alpha;
     rho_7 = sqrt(((_e57 * _e58) + (_e60 * _e61)));
-    let _e66 = atmosphere_43;
+    let _e66 = atmosphere_49;
     let _e68 = r_d_2;
     let _e69 = HorizonZenithCosine(_e66.bottom_radius, _e68);
     c_end = -(_e69);
-    let _e72 = atmosphere_43;
+    let _e72 = atmosphere_49;
     let _e74 = r_31;
     let _e75 = HorizonZenithCosine(_e72.bottom_radius, _e74);
     c_start = _e75;
     let _e77 = c_start;
-    let _e78 = atmosphere_43;
+    let _e78 = atmosphere_49;
     let _e80 = r_31;
     start_1 = vec2<f32>(_e77, (_e78.bottom_radius / _e80));
     let _e84 = c_end;
@@ -1250,7 +1296,7 @@ fn ShadowEdge(atmosphere_42: AtmosphereParameters, r_30: f32, mu_21: f32, cos_ph
     let _e128 = end;
     let _e130 = start_1;
     end_sets_last = ((_e124.y < 0f) || (_e128.x < _e130.x));
-    let _e135 = atmosphere_43;
+    let _e135 = atmosphere_49;
     a_6 = _e135.sun_angular_radius;
     let _e140 = a_6;
     let _e142 = a_6;
@@ -1306,20 +1352,20 @@ fn ShadowEdge(atmosphere_42: AtmosphereParameters, r_30: f32, mu_21: f32, cos_ph
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeSunZenith(atmosphere_44: AtmosphereParameters, r_32: f32, mu_23: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_11: bool) -> f32 {
-    var atmosphere_45: AtmosphereParameters;
+fn ShadowEdgeSunZenith(atmosphere_50: AtmosphereParameters, r_32: f32, mu_23: f32, cos_phi_2: f32, ray_r_mu_intersects_ground_11: bool) -> f32 {
+    var atmosphere_51: AtmosphereParameters;
     var r_33: f32;
     var mu_24: f32;
     var cos_phi_3: f32;
     var ray_r_mu_intersects_ground_12: bool;
     var unused: vec2<f32>;
 
-    atmosphere_45 = atmosphere_44;
+    atmosphere_51 = atmosphere_50;
     r_33 = r_32;
     mu_24 = mu_23;
     cos_phi_3 = cos_phi_2;
     ray_r_mu_intersects_ground_12 = ray_r_mu_intersects_ground_11;
-    let _e23 = atmosphere_45;
+    let _e23 = atmosphere_51;
     let _e24 = r_33;
     let _e25 = mu_24;
     let _e26 = cos_phi_3;
@@ -1339,23 +1385,23 @@ fn ShadowEdgeDirection(edge: f32) -> vec2<f32> {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeDistance(edge_2: vec2<f32>, mu_s_13: f32) -> f32 {
+fn ShadowEdgeDistance(edge_2: vec2<f32>, mu_s_17: f32) -> f32 {
     var edge_3: vec2<f32>;
-    var mu_s_14: f32;
+    var mu_s_18: f32;
     var sin_theta: f32;
 
     edge_3 = edge_2;
-    mu_s_14 = mu_s_13;
-    let _e17 = mu_s_14;
-    let _e18 = mu_s_14;
+    mu_s_18 = mu_s_17;
+    let _e17 = mu_s_18;
+    let _e18 = mu_s_18;
     let _e21 = SafeSqrt((1f - (_e17 * _e18)));
     sin_theta = _e21;
     let _e23 = edge_3;
-    let _e25 = mu_s_14;
+    let _e25 = mu_s_18;
     let _e27 = edge_3;
     let _e29 = sin_theta;
     let _e32 = edge_3;
-    let _e34 = mu_s_14;
+    let _e34 = mu_s_18;
     let _e36 = edge_3;
     let _e38 = sin_theta;
     return atan2(((_e23.y * _e25) - (_e27.x * _e29)), ((_e32.x * _e34) + (_e36.y * _e38)));
@@ -1376,76 +1422,78 @@ fn ShadowEdgeSunCosine(edge_4: vec2<f32>, D_1: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringSplitMuS(atmosphere_46: AtmosphereParameters) -> f32 {
-    var atmosphere_47: AtmosphereParameters;
+fn GetScatteringSplitMuS(atmosphere_52: AtmosphereParameters) -> f32 {
+    var atmosphere_53: AtmosphereParameters;
 
-    atmosphere_47 = atmosphere_46;
-    let _e14 = atmosphere_47;
-    let _e15 = atmosphere_47;
-    let _e18 = atmosphere_47;
+    atmosphere_53 = atmosphere_52;
+    let _e14 = atmosphere_53;
+    let _e15 = atmosphere_53;
+    let _e18 = atmosphere_53;
     let _e24 = GetScatteringMuSFromUnitRange(_e14, (f32(_e15.scattering_mu_s_split) / f32((_e18.scattering_mu_s_size - 1i))));
     return _e24;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeUnitSun(atmosphere_48: AtmosphereParameters, mu_s_15: f32, derivative: ptr<function, f32>) -> f32 {
-    var atmosphere_49: AtmosphereParameters;
-    var mu_s_16: f32;
+fn ShadowEdgeUnitSun(atmosphere_54: AtmosphereParameters, mu_s_19: f32, derivative: ptr<function, f32>) -> f32 {
+    var atmosphere_55: AtmosphereParameters;
+    var mu_s_20: f32;
     var bottom_1: f32;
     var d_14: f32;
     var d_min_8: f32;
+    var sun_axis: ScatteringSunAxis;
     var span: f32;
     var a_7: f32;
     var inverse_A_4: f32;
     var da_dtheta: f32;
 
-    atmosphere_49 = atmosphere_48;
-    mu_s_16 = mu_s_15;
-    let _e17 = atmosphere_49;
+    atmosphere_55 = atmosphere_54;
+    mu_s_20 = mu_s_19;
+    let _e17 = atmosphere_55;
     bottom_1 = _e17.bottom_radius;
-    let _e20 = atmosphere_49;
+    let _e20 = atmosphere_55;
     let _e21 = bottom_1;
-    let _e22 = mu_s_16;
+    let _e22 = mu_s_20;
     let _e23 = DistanceToTopAtmosphereBoundary(_e20, _e21, _e22);
     d_14 = _e23;
-    let _e25 = atmosphere_49;
+    let _e25 = atmosphere_55;
     let _e27 = bottom_1;
     d_min_8 = (_e25.top_radius - _e27);
-    let _e30 = atmosphere_49;
-    let _e31 = HorizonDistanceAtTop(_e30);
-    let _e32 = d_min_8;
-    span = (_e31 - _e32);
-    let _e35 = d_14;
-    let _e36 = d_min_8;
-    let _e38 = span;
-    a_7 = ((_e35 - _e36) / _e38);
-    let _e42 = atmosphere_49;
-    let _e43 = GetScatteringLowestSunDistance(_e42);
-    inverse_A_4 = (1f / _e43);
-    let _e46 = bottom_1;
-    let _e47 = d_14;
-    let _e49 = d_14;
-    let _e50 = bottom_1;
-    let _e51 = mu_s_16;
-    let _e55 = span;
-    let _e58 = mu_s_16;
-    let _e59 = mu_s_16;
-    let _e62 = SafeSqrt((1f - (_e58 * _e59)));
-    da_dtheta = ((((_e46 * _e47) / (_e49 + (_e50 * _e51))) / _e55) * _e62);
-    let _e65 = inverse_A_4;
-    let _e70 = a_7;
-    let _e73 = a_7;
-    let _e77 = da_dtheta;
-    (*derivative) = ((-((_e65 + 1f)) / ((1f + _e70) * (1f + _e73))) * _e77);
-    let _e80 = a_7;
-    let _e81 = inverse_A_4;
-    let _e85 = a_7;
-    return ((1f - (_e80 * _e81)) / (1f + _e85));
+    let _e30 = atmosphere_55;
+    let _e31 = GetScatteringSunAxis(_e30);
+    sun_axis = _e31;
+    let _e33 = sun_axis;
+    let _e35 = d_min_8;
+    span = (_e33.H - _e35);
+    let _e38 = d_14;
+    let _e39 = d_min_8;
+    let _e41 = span;
+    a_7 = ((_e38 - _e39) / _e41);
+    let _e44 = sun_axis;
+    inverse_A_4 = _e44.inverse_A;
+    let _e47 = bottom_1;
+    let _e48 = d_14;
+    let _e50 = d_14;
+    let _e51 = bottom_1;
+    let _e52 = mu_s_20;
+    let _e56 = span;
+    let _e59 = mu_s_20;
+    let _e60 = mu_s_20;
+    let _e63 = SafeSqrt((1f - (_e59 * _e60)));
+    da_dtheta = ((((_e47 * _e48) / (_e50 + (_e51 * _e52))) / _e56) * _e63);
+    let _e66 = inverse_A_4;
+    let _e71 = a_7;
+    let _e74 = a_7;
+    let _e78 = da_dtheta;
+    (*derivative) = ((-((_e66 + 1f)) / ((1f + _e71) * (1f + _e74))) * _e78);
+    let _e81 = a_7;
+    let _e82 = inverse_A_4;
+    let _e86 = a_7;
+    return ((1f - (_e81 * _e82)) / (1f + _e86));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitFrom(atmosphere_50: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
-    var atmosphere_51: AtmosphereParameters;
+fn ShadowEdgeLitUnitFrom(atmosphere_56: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
+    var atmosphere_57: AtmosphereParameters;
     var D_4: f32;
     var edge_7: vec2<f32>;
     var X_closest_1: f32;
@@ -1454,13 +1502,13 @@ fn ShadowEdgeLitUnitFrom(atmosphere_50: AtmosphereParameters, D_3: f32, edge_6: 
     var dX_dtheta: f32;
     var X: f32;
 
-    atmosphere_51 = atmosphere_50;
+    atmosphere_57 = atmosphere_56;
     D_4 = D_3;
     edge_7 = edge_6;
     X_closest_1 = X_closest;
     X_span_1 = X_span;
     log_span_1 = log_span;
-    let _e26 = atmosphere_51;
+    let _e26 = atmosphere_57;
     let _e27 = edge_7;
     let _e28 = D_4;
     let _e29 = ShadowEdgeSunCosine(_e27, _e28);
@@ -1480,23 +1528,23 @@ fn ShadowEdgeLitUnitFrom(atmosphere_50: AtmosphereParameters, D_3: f32, edge_6: 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitSpans(atmosphere_52: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
-    var atmosphere_53: AtmosphereParameters;
+fn ShadowEdgeLitUnitSpans(atmosphere_58: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
+    var atmosphere_59: AtmosphereParameters;
     var edge_9: vec2<f32>;
     var unused_1: f32;
     var split_mu_s: f32;
 
-    atmosphere_53 = atmosphere_52;
+    atmosphere_59 = atmosphere_58;
     edge_9 = edge_8;
-    let _e21 = atmosphere_53;
+    let _e21 = atmosphere_59;
     let _e22 = GetScatteringSplitMuS(_e21);
     split_mu_s = _e22;
-    let _e24 = atmosphere_53;
+    let _e24 = atmosphere_59;
     let _e25 = edge_9;
     let _e26 = ShadowEdgeSunCosine(_e25, SHADOW_EDGE_CLOSEST);
     let _e29 = ShadowEdgeUnitSun(_e24, _e26, (&unused_1));
     (*X_closest_2) = _e29;
-    let _e30 = atmosphere_53;
+    let _e30 = atmosphere_59;
     let _e31 = split_mu_s;
     let _e34 = ShadowEdgeUnitSun(_e30, _e31, (&unused_1));
     let _e35 = (*X_closest_2);
@@ -1511,8 +1559,8 @@ fn ShadowEdgeLitUnitSpans(atmosphere_52: AtmosphereParameters, edge_8: vec2<f32>
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnit(atmosphere_54: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
-    var atmosphere_55: AtmosphereParameters;
+fn ShadowEdgeLitUnit(atmosphere_60: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
+    var atmosphere_61: AtmosphereParameters;
     var distance_1: f32;
     var edge_11: vec2<f32>;
     var X_closest_3: f32;
@@ -1521,13 +1569,13 @@ fn ShadowEdgeLitUnit(atmosphere_54: AtmosphereParameters, distance_: f32, edge_1
     var split_distance_1: f32;
     var unused_2: f32;
 
-    atmosphere_55 = atmosphere_54;
+    atmosphere_61 = atmosphere_60;
     distance_1 = distance_;
     edge_11 = edge_10;
-    let _e22 = atmosphere_55;
+    let _e22 = atmosphere_61;
     let _e23 = edge_11;
     ShadowEdgeLitUnitSpans(_e22, _e23, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
-    let _e33 = atmosphere_55;
+    let _e33 = atmosphere_61;
     let _e34 = distance_1;
     let _e35 = split_distance_1;
     let _e37 = edge_11;
@@ -1539,9 +1587,9 @@ fn ShadowEdgeLitUnit(atmosphere_54: AtmosphereParameters, distance_: f32, edge_1
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitDistance(atmosphere_56: AtmosphereParameters, x_13: f32, edge_12: vec2<f32>) -> f32 {
-    var atmosphere_57: AtmosphereParameters;
-    var x_14: f32;
+fn ShadowEdgeLitDistance(atmosphere_62: AtmosphereParameters, x_15: f32, edge_12: vec2<f32>) -> f32 {
+    var atmosphere_63: AtmosphereParameters;
+    var x_16: f32;
     var edge_13: vec2<f32>;
     var X_closest_4: f32;
     var X_span_4: f32;
@@ -1556,10 +1604,10 @@ fn ShadowEdgeLitDistance(atmosphere_56: AtmosphereParameters, x_13: f32, edge_12
     var next: f32;
     var converged: bool;
 
-    atmosphere_57 = atmosphere_56;
-    x_14 = x_13;
+    atmosphere_63 = atmosphere_62;
+    x_16 = x_15;
     edge_13 = edge_12;
-    let _e22 = atmosphere_57;
+    let _e22 = atmosphere_63;
     let _e23 = edge_13;
     ShadowEdgeLitUnitSpans(_e22, _e23, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
     let _e35 = s_min;
@@ -1567,7 +1615,7 @@ fn ShadowEdgeLitDistance(atmosphere_56: AtmosphereParameters, x_13: f32, edge_12
     s_max = (_e35 + _e36);
     let _e39 = s_min;
     let _e40 = s_max;
-    let _e41 = x_14;
+    let _e41 = x_16;
     s_2 = mix(_e39, _e40, _e41);
     loop {
         let _e46 = i;
@@ -1575,14 +1623,14 @@ fn ShadowEdgeLitDistance(atmosphere_56: AtmosphereParameters, x_13: f32, edge_12
             break;
         }
         {
-            let _e54 = atmosphere_57;
+            let _e54 = atmosphere_63;
             let _e55 = s_2;
             let _e57 = edge_13;
             let _e58 = X_closest_4;
             let _e59 = X_span_4;
             let _e60 = log_span_4;
             let _e63 = ShadowEdgeLitUnitFrom(_e54, exp(_e55), _e57, _e58, _e59, _e60, (&slope));
-            let _e64 = x_14;
+            let _e64 = x_16;
             error = (_e63 - _e64);
             let _e67 = s_2;
             let _e68 = error;
@@ -1610,15 +1658,15 @@ fn ShadowEdgeLitDistance(atmosphere_56: AtmosphereParameters, x_13: f32, edge_12
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgePastStep(atmosphere_58: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
-    var atmosphere_59: AtmosphereParameters;
+fn ShadowEdgePastStep(atmosphere_64: AtmosphereParameters, edge_14: vec2<f32>) -> f32 {
+    var atmosphere_65: AtmosphereParameters;
     var edge_15: vec2<f32>;
     var past_lowest: f32;
 
-    atmosphere_59 = atmosphere_58;
+    atmosphere_65 = atmosphere_64;
     edge_15 = edge_14;
     let _e16 = edge_15;
-    let _e17 = atmosphere_59;
+    let _e17 = atmosphere_65;
     let _e19 = ShadowEdgeDistance(_e16, _e17.scattering_mu_s_min);
     past_lowest = -(_e19);
     let _e22 = past_lowest;
@@ -1626,24 +1674,24 @@ fn ShadowEdgePastStep(atmosphere_58: AtmosphereParameters, edge_14: vec2<f32>) -
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgePosition(atmosphere_60: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
-    var atmosphere_61: AtmosphereParameters;
+fn GetScatteringShadowEdgePosition(atmosphere_66: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
+    var atmosphere_67: AtmosphereParameters;
     var D_6: f32;
     var edge_17: vec2<f32>;
     var past: f32 = 6f;
 
-    atmosphere_61 = atmosphere_60;
+    atmosphere_67 = atmosphere_66;
     D_6 = D_5;
     edge_17 = edge_16;
     let _e21 = D_6;
     if (_e21 >= SHADOW_EDGE_CLOSEST) {
         {
             let _e23 = past;
-            let _e24 = atmosphere_61;
+            let _e24 = atmosphere_67;
             let _e25 = D_6;
             let _e26 = edge_17;
             let _e27 = ShadowEdgeLitUnit(_e24, _e25, _e26);
-            let _e28 = atmosphere_61;
+            let _e28 = atmosphere_67;
             let _e31 = past;
             return (_e23 + (_e27 * (f32(_e28.scattering_mu_s_split) - _e31)));
         }
@@ -1656,21 +1704,21 @@ fn GetScatteringShadowEdgePosition(atmosphere_60: AtmosphereParameters, D_5: f32
     }
     let _e44 = past;
     let _e47 = D_6;
-    let _e48 = atmosphere_61;
+    let _e48 = atmosphere_67;
     let _e49 = edge_17;
     let _e50 = ShadowEdgePastStep(_e48, _e49);
     return ((_e44 - 1f) + (_e47 / _e50));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgeDistance(atmosphere_62: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
-    var atmosphere_63: AtmosphereParameters;
+fn GetScatteringShadowEdgeDistance(atmosphere_68: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
+    var atmosphere_69: AtmosphereParameters;
     var position_1: f32;
     var edge_19: vec2<f32>;
     var past_1: f32 = 6f;
-    var x_15: f32;
+    var x_17: f32;
 
-    atmosphere_63 = atmosphere_62;
+    atmosphere_69 = atmosphere_68;
     position_1 = position;
     edge_19 = edge_18;
     let _e21 = position_1;
@@ -1679,11 +1727,11 @@ fn GetScatteringShadowEdgeDistance(atmosphere_62: AtmosphereParameters, position
         {
             let _e24 = position_1;
             let _e25 = past_1;
-            let _e27 = atmosphere_63;
+            let _e27 = atmosphere_69;
             let _e30 = past_1;
-            x_15 = ((_e24 - _e25) / (f32(_e27.scattering_mu_s_split) - _e30));
-            let _e34 = atmosphere_63;
-            let _e35 = x_15;
+            x_17 = ((_e24 - _e25) / (f32(_e27.scattering_mu_s_split) - _e30));
+            let _e34 = atmosphere_69;
+            let _e35 = x_17;
             let _e36 = edge_19;
             let _e37 = ShadowEdgeLitDistance(_e34, _e35, _e36);
             return _e37;
@@ -1698,15 +1746,15 @@ fn GetScatteringShadowEdgeDistance(atmosphere_62: AtmosphereParameters, position
     }
     let _e49 = position_1;
     let _e50 = past_1;
-    let _e54 = atmosphere_63;
+    let _e54 = atmosphere_69;
     let _e55 = edge_19;
     let _e56 = ShadowEdgePastStep(_e54, _e55);
     return (((_e49 - _e50) + 1f) * _e56);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUR(atmosphere_64: AtmosphereParameters, r_34: f32, rho_8: f32, ray_r_mu_intersects_ground_13: bool, x_mu_1: f32) -> f32 {
-    var atmosphere_65: AtmosphereParameters;
+fn GetScatteringTextureUR(atmosphere_70: AtmosphereParameters, r_34: f32, rho_8: f32, ray_r_mu_intersects_ground_13: bool, x_mu_1: f32) -> f32 {
+    var atmosphere_71: AtmosphereParameters;
     var r_35: f32;
     var rho_9: f32;
     var ray_r_mu_intersects_ground_14: bool;
@@ -1724,20 +1772,20 @@ fn GetScatteringTextureUR(atmosphere_64: AtmosphereParameters, r_34: f32, rho_8:
     var d_15: f32;
     var t: f32;
 
-    atmosphere_65 = atmosphere_64;
+    atmosphere_71 = atmosphere_70;
     r_35 = r_34;
     rho_9 = rho_8;
     ray_r_mu_intersects_ground_14 = ray_r_mu_intersects_ground_13;
     x_mu_2 = x_mu_1;
-    let _e22 = atmosphere_65;
-    let _e23 = atmosphere_65;
+    let _e22 = atmosphere_71;
+    let _e23 = atmosphere_71;
     let _e25 = HorizonDistance(_e22, _e23.scattering_r_min);
     rho_min = _e25;
-    let _e27 = atmosphere_65;
-    let _e28 = atmosphere_65;
+    let _e27 = atmosphere_71;
+    let _e28 = atmosphere_71;
     let _e30 = HorizonDistance(_e27, _e28.scattering_r_max);
     rho_max = _e30;
-    let _e32 = atmosphere_65;
+    let _e32 = atmosphere_71;
     last_row = f32((_e32.scattering_r_size - 1i));
     let _e38 = rho_9;
     let _e39 = rho_min;
@@ -1764,7 +1812,7 @@ fn GetScatteringTextureUR(atmosphere_64: AtmosphereParameters, r_34: f32, rho_8:
     let _e76 = row;
     let _e79 = last_row;
     rho_above = mix(_e74, _e75, ((_e76 + 1f) / _e79));
-    let _e83 = atmosphere_65;
+    let _e83 = atmosphere_71;
     bottom_2 = _e83.bottom_radius;
     let _e86 = bottom_2;
     let _e87 = rho_below;
@@ -1795,11 +1843,12 @@ fn GetScatteringTextureUR(atmosphere_64: AtmosphereParameters, r_34: f32, rho_8:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzAndEdge(atmosphere_66: AtmosphereParameters, r_36: f32, mu_25: f32, mu_s_17: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
-    var atmosphere_67: AtmosphereParameters;
+fn GetScatteringTextureUvwzAndEdge(atmosphere_72: AtmosphereParameters, sun_axis_1: ScatteringSunAxis, r_36: f32, mu_25: f32, mu_s_21: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
+    var atmosphere_73: AtmosphereParameters;
+    var sun_axis_2: ScatteringSunAxis;
     var r_37: f32;
     var mu_26: f32;
-    var mu_s_18: f32;
+    var mu_s_22: f32;
     var nu_12: f32;
     var ray_r_mu_intersects_ground_16: bool;
     var rho_10: f32;
@@ -1809,111 +1858,115 @@ fn GetScatteringTextureUvwzAndEdge(atmosphere_66: AtmosphereParameters, r_36: f3
     var u_mu_s: f32;
     var mu_s_size: f32;
 
-    atmosphere_67 = atmosphere_66;
+    atmosphere_73 = atmosphere_72;
+    sun_axis_2 = sun_axis_1;
     r_37 = r_36;
     mu_26 = mu_25;
-    mu_s_18 = mu_s_17;
+    mu_s_22 = mu_s_21;
     nu_12 = nu_11;
     ray_r_mu_intersects_ground_16 = ray_r_mu_intersects_ground_15;
-    let _e25 = atmosphere_67;
-    let _e26 = r_37;
-    let _e27 = HorizonDistance(_e25, _e26);
-    rho_10 = _e27;
-    let _e29 = atmosphere_67;
-    let _e30 = r_37;
-    let _e31 = rho_10;
-    let _e32 = mu_26;
-    let _e33 = ray_r_mu_intersects_ground_16;
-    let _e34 = GetUnitMuInHalf(_e29, _e30, _e31, _e32, _e33);
-    x_mu_3 = _e34;
-    let _e36 = x_mu_3;
-    let _e37 = ray_r_mu_intersects_ground_16;
-    let _e38 = atmosphere_67;
-    let _e40 = GetTextureCoordFromUnitMuInHalf(_e36, _e37, _e38.scattering_mu_size);
-    u_mu = _e40;
-    let _e42 = atmosphere_67;
-    let _e43 = r_37;
-    let _e44 = rho_10;
-    let _e45 = ray_r_mu_intersects_ground_16;
-    let _e46 = x_mu_3;
-    let _e47 = GetScatteringTextureUR(_e42, _e43, _e44, _e45, _e46);
-    u_r = _e47;
-    let _e49 = atmosphere_67;
-    let _e50 = mu_s_18;
-    let _e51 = GetScatteringTextureUMuS(_e49, _e50);
-    u_mu_s = _e51;
-    let _e53 = atmosphere_67;
-    mu_s_size = f32(_e53.scattering_mu_s_size);
+    let _e27 = atmosphere_73;
+    let _e28 = r_37;
+    let _e29 = HorizonDistance(_e27, _e28);
+    rho_10 = _e29;
+    let _e31 = atmosphere_73;
+    let _e32 = r_37;
+    let _e33 = rho_10;
+    let _e34 = mu_26;
+    let _e35 = ray_r_mu_intersects_ground_16;
+    let _e36 = GetUnitMuInHalf(_e31, _e32, _e33, _e34, _e35);
+    x_mu_3 = _e36;
+    let _e38 = x_mu_3;
+    let _e39 = ray_r_mu_intersects_ground_16;
+    let _e40 = atmosphere_73;
+    let _e42 = GetTextureCoordFromUnitMuInHalf(_e38, _e39, _e40.scattering_mu_size);
+    u_mu = _e42;
+    let _e44 = atmosphere_73;
+    let _e45 = r_37;
+    let _e46 = rho_10;
+    let _e47 = ray_r_mu_intersects_ground_16;
+    let _e48 = x_mu_3;
+    let _e49 = GetScatteringTextureUR(_e44, _e45, _e46, _e47, _e48);
+    u_r = _e49;
+    let _e51 = atmosphere_73;
+    let _e52 = sun_axis_2;
+    let _e53 = mu_s_22;
+    let _e54 = GetScatteringTextureUMuSOnAxis(_e51, _e52, _e53);
+    u_mu_s = _e54;
+    let _e56 = atmosphere_73;
+    mu_s_size = f32(_e56.scattering_mu_s_size);
     (*edge_20) = vec2(0f);
-    let _e59 = atmosphere_67;
-    let _e63 = u_mu_s;
-    let _e64 = mu_s_size;
-    let _e68 = atmosphere_67;
-    if ((_e59.scattering_mu_s_split > 0i) && (((_e63 * _e64) - 0.5f) < f32(_e68.scattering_mu_s_split))) {
+    let _e62 = atmosphere_73;
+    let _e66 = u_mu_s;
+    let _e67 = mu_s_size;
+    let _e71 = atmosphere_73;
+    if ((_e62.scattering_mu_s_split > 0i) && (((_e66 * _e67) - 0.5f) < f32(_e71.scattering_mu_s_split))) {
         {
-            let _e73 = atmosphere_67;
-            let _e74 = r_37;
-            let _e75 = mu_26;
-            let _e76 = mu_26;
-            let _e77 = mu_s_18;
-            let _e78 = nu_12;
-            let _e79 = ViewSunAzimuthCosine(_e76, _e77, _e78);
-            let _e80 = ray_r_mu_intersects_ground_16;
-            let _e83 = ShadowEdge(_e73, _e74, _e75, _e79, _e80, edge_20);
-            let _e84 = atmosphere_67;
-            let _e85 = (*edge_20);
-            let _e86 = mu_s_18;
-            let _e87 = ShadowEdgeDistance(_e85, _e86);
+            let _e76 = atmosphere_73;
+            let _e77 = r_37;
+            let _e78 = mu_26;
+            let _e79 = mu_26;
+            let _e80 = mu_s_22;
+            let _e81 = nu_12;
+            let _e82 = ViewSunAzimuthCosine(_e79, _e80, _e81);
+            let _e83 = ray_r_mu_intersects_ground_16;
+            let _e86 = ShadowEdge(_e76, _e77, _e78, _e82, _e83, edge_20);
+            let _e87 = atmosphere_73;
             let _e88 = (*edge_20);
-            let _e89 = GetScatteringShadowEdgePosition(_e84, _e87, _e88);
-            let _e92 = mu_s_size;
-            u_mu_s = ((_e89 + 0.5f) / _e92);
+            let _e89 = mu_s_22;
+            let _e90 = ShadowEdgeDistance(_e88, _e89);
+            let _e91 = (*edge_20);
+            let _e92 = GetScatteringShadowEdgePosition(_e87, _e90, _e91);
+            let _e95 = mu_s_size;
+            u_mu_s = ((_e92 + 0.5f) / _e95);
         }
     }
-    let _e94 = nu_12;
-    let _e95 = ScatteringUnitNu(_e94);
-    let _e96 = u_mu_s;
-    let _e97 = u_mu;
-    let _e98 = u_r;
-    return vec4<f32>(_e95, _e96, _e97, _e98);
+    let _e97 = nu_12;
+    let _e98 = ScatteringUnitNu(_e97);
+    let _e99 = u_mu_s;
+    let _e100 = u_mu;
+    let _e101 = u_r;
+    return vec4<f32>(_e98, _e99, _e100, _e101);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_68: AtmosphereParameters, r_38: f32, mu_27: f32, mu_s_19: f32, nu_13: f32, ray_r_mu_intersects_ground_17: bool) -> vec4<f32> {
-    var atmosphere_69: AtmosphereParameters;
+fn GetScatteringTextureUvwzFromRMuMuSNu(atmosphere_74: AtmosphereParameters, r_38: f32, mu_27: f32, mu_s_23: f32, nu_13: f32, ray_r_mu_intersects_ground_17: bool) -> vec4<f32> {
+    var atmosphere_75: AtmosphereParameters;
     var r_39: f32;
     var mu_28: f32;
-    var mu_s_20: f32;
+    var mu_s_24: f32;
     var nu_14: f32;
     var ray_r_mu_intersects_ground_18: bool;
     var unused_3: vec2<f32>;
 
-    atmosphere_69 = atmosphere_68;
+    atmosphere_75 = atmosphere_74;
     r_39 = r_38;
     mu_28 = mu_27;
-    mu_s_20 = mu_s_19;
+    mu_s_24 = mu_s_23;
     nu_14 = nu_13;
     ray_r_mu_intersects_ground_18 = ray_r_mu_intersects_ground_17;
-    let _e25 = atmosphere_69;
-    let _e26 = r_39;
-    let _e27 = mu_28;
-    let _e28 = mu_s_20;
-    let _e29 = nu_14;
-    let _e30 = ray_r_mu_intersects_ground_18;
-    let _e33 = GetScatteringTextureUvwzAndEdge(_e25, _e26, _e27, _e28, _e29, _e30, (&unused_3));
-    return _e33;
+    let _e25 = atmosphere_75;
+    let _e26 = atmosphere_75;
+    let _e27 = GetScatteringSunAxis(_e26);
+    let _e28 = r_39;
+    let _e29 = mu_28;
+    let _e30 = mu_s_24;
+    let _e31 = nu_14;
+    let _e32 = ray_r_mu_intersects_ground_18;
+    let _e35 = GetScatteringTextureUvwzAndEdge(_e25, _e27, _e28, _e29, _e30, _e31, _e32, (&unused_3));
+    return _e35;
 }
 
-fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_70: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_40: f32, mu_29: f32) -> vec3<f32> {
-    var atmosphere_71: AtmosphereParameters;
+fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_76: AtmosphereParameters, transmittance_texture: texture_2d<f32>, r_40: f32, mu_29: f32) -> vec3<f32> {
+    var atmosphere_77: AtmosphereParameters;
     var r_41: f32;
     var mu_30: f32;
     var uv_2: vec2<f32>;
 
-    atmosphere_71 = atmosphere_70;
+    atmosphere_77 = atmosphere_76;
     r_41 = r_40;
     mu_30 = mu_29;
-    let _e19 = atmosphere_71;
+    let _e19 = atmosphere_77;
     let _e20 = r_41;
     let _e21 = mu_30;
     let _e22 = GetTransmittanceTextureUvFromRMu(_e19, _e20, _e21);
@@ -1923,23 +1976,23 @@ fn GetOpticalDepthToTopAtmosphereBoundary(atmosphere_70: AtmosphereParameters, t
     return vec3<f32>(_e25.xyz);
 }
 
-fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_72: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_42: f32, mu_31: f32) -> vec3<f32> {
-    var atmosphere_73: AtmosphereParameters;
+fn GetTransmittanceToTopAtmosphereBoundary(atmosphere_78: AtmosphereParameters, transmittance_texture_1: texture_2d<f32>, r_42: f32, mu_31: f32) -> vec3<f32> {
+    var atmosphere_79: AtmosphereParameters;
     var r_43: f32;
     var mu_32: f32;
 
-    atmosphere_73 = atmosphere_72;
+    atmosphere_79 = atmosphere_78;
     r_43 = r_42;
     mu_32 = mu_31;
-    let _e19 = atmosphere_73;
+    let _e19 = atmosphere_79;
     let _e20 = r_43;
     let _e21 = mu_32;
     let _e22 = GetOpticalDepthToTopAtmosphereBoundary(_e19, transmittance_texture_1, _e20, _e21);
     return exp(-(_e22));
 }
 
-fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_44: f32, mu_33: f32, d_16: f32, ray_r_mu_intersects_ground_19: bool) -> vec3<f32> {
-    var atmosphere_75: AtmosphereParameters;
+fn GetOpticalDepth(atmosphere_80: AtmosphereParameters, transmittance_texture_2: texture_2d<f32>, r_44: f32, mu_33: f32, d_16: f32, ray_r_mu_intersects_ground_19: bool) -> vec3<f32> {
+    var atmosphere_81: AtmosphereParameters;
     var r_45: f32;
     var mu_34: f32;
     var d_17: f32;
@@ -1950,12 +2003,12 @@ fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2:
     var r_low: f32;
     var tau_low: vec3<f32>;
 
-    atmosphere_75 = atmosphere_74;
+    atmosphere_81 = atmosphere_80;
     r_45 = r_44;
     mu_34 = mu_33;
     d_17 = d_16;
     ray_r_mu_intersects_ground_20 = ray_r_mu_intersects_ground_19;
-    let _e23 = atmosphere_75;
+    let _e23 = atmosphere_81;
     let _e24 = r_45;
     let _e25 = mu_34;
     let _e26 = d_17;
@@ -1971,11 +2024,11 @@ fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2:
     let _e37 = mu_d;
     if (_e36 || (_e37 < 0f)) {
         {
-            let _e41 = atmosphere_75;
+            let _e41 = atmosphere_81;
             let _e42 = r_d_3;
             let _e43 = mu_d;
             let _e45 = GetOpticalDepthToTopAtmosphereBoundary(_e41, transmittance_texture_2, _e42, -(_e43));
-            let _e46 = atmosphere_75;
+            let _e46 = atmosphere_81;
             let _e47 = r_45;
             let _e48 = mu_34;
             let _e50 = GetOpticalDepthToTopAtmosphereBoundary(_e46, transmittance_texture_2, _e47, -(_e48));
@@ -1985,11 +2038,11 @@ fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2:
         let _e52 = mu_34;
         if (_e52 >= 0f) {
             {
-                let _e55 = atmosphere_75;
+                let _e55 = atmosphere_81;
                 let _e56 = r_45;
                 let _e57 = mu_34;
                 let _e58 = GetOpticalDepthToTopAtmosphereBoundary(_e55, transmittance_texture_2, _e56, _e57);
-                let _e59 = atmosphere_75;
+                let _e59 = atmosphere_81;
                 let _e60 = r_d_3;
                 let _e61 = mu_d;
                 let _e62 = GetOpticalDepthToTopAtmosphereBoundary(_e59, transmittance_texture_2, _e60, _e61);
@@ -1997,24 +2050,24 @@ fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2:
             }
         } else {
             {
-                let _e64 = atmosphere_75;
+                let _e64 = atmosphere_81;
                 let _e65 = r_45;
                 let _e67 = mu_34;
                 let _e68 = mu_34;
                 let _e71 = SafeSqrt((1f - (_e67 * _e68)));
                 let _e73 = ClampRadius(_e64, (_e65 * _e71));
                 r_low = _e73;
-                let _e75 = atmosphere_75;
+                let _e75 = atmosphere_81;
                 let _e76 = r_low;
                 let _e78 = GetOpticalDepthToTopAtmosphereBoundary(_e75, transmittance_texture_2, _e76, 0f);
                 tau_low = _e78;
                 let _e80 = tau_low;
-                let _e81 = atmosphere_75;
+                let _e81 = atmosphere_81;
                 let _e82 = r_45;
                 let _e83 = mu_34;
                 let _e85 = GetOpticalDepthToTopAtmosphereBoundary(_e81, transmittance_texture_2, _e82, -(_e83));
                 let _e90 = tau_low;
-                let _e91 = atmosphere_75;
+                let _e91 = atmosphere_81;
                 let _e92 = r_d_3;
                 let _e93 = mu_d;
                 let _e94 = GetOpticalDepthToTopAtmosphereBoundary(_e91, transmittance_texture_2, _e92, _e93);
@@ -2026,19 +2079,19 @@ fn GetOpticalDepth(atmosphere_74: AtmosphereParameters, transmittance_texture_2:
     return max(_e100, vec3(0f));
 }
 
-fn GetTransmittance(atmosphere_76: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_46: f32, mu_35: f32, d_18: f32, ray_r_mu_intersects_ground_21: bool) -> vec3<f32> {
-    var atmosphere_77: AtmosphereParameters;
+fn GetTransmittance(atmosphere_82: AtmosphereParameters, transmittance_texture_3: texture_2d<f32>, r_46: f32, mu_35: f32, d_18: f32, ray_r_mu_intersects_ground_21: bool) -> vec3<f32> {
+    var atmosphere_83: AtmosphereParameters;
     var r_47: f32;
     var mu_36: f32;
     var d_19: f32;
     var ray_r_mu_intersects_ground_22: bool;
 
-    atmosphere_77 = atmosphere_76;
+    atmosphere_83 = atmosphere_82;
     r_47 = r_46;
     mu_36 = mu_35;
     d_19 = d_18;
     ray_r_mu_intersects_ground_22 = ray_r_mu_intersects_ground_21;
-    let _e23 = atmosphere_77;
+    let _e23 = atmosphere_83;
     let _e24 = r_47;
     let _e25 = mu_36;
     let _e26 = d_19;
@@ -2047,43 +2100,43 @@ fn GetTransmittance(atmosphere_76: AtmosphereParameters, transmittance_texture_3
     return exp(-(_e28));
 }
 
-fn SunVisibleFraction(atmosphere_78: AtmosphereParameters, r_48: f32, mu_s_21: f32) -> f32 {
-    var atmosphere_79: AtmosphereParameters;
+fn SunVisibleFraction(atmosphere_84: AtmosphereParameters, r_48: f32, mu_s_25: f32) -> f32 {
+    var atmosphere_85: AtmosphereParameters;
     var r_49: f32;
-    var mu_s_22: f32;
+    var mu_s_26: f32;
     var sin_theta_h: f32;
 
-    atmosphere_79 = atmosphere_78;
+    atmosphere_85 = atmosphere_84;
     r_49 = r_48;
-    mu_s_22 = mu_s_21;
-    let _e18 = atmosphere_79;
+    mu_s_26 = mu_s_25;
+    let _e18 = atmosphere_85;
     let _e20 = r_49;
     sin_theta_h = (_e18.bottom_radius / _e20);
-    let _e23 = mu_s_22;
-    let _e24 = atmosphere_79;
+    let _e23 = mu_s_26;
+    let _e24 = atmosphere_85;
     let _e26 = r_49;
     let _e27 = HorizonZenithCosine(_e24.bottom_radius, _e26);
     let _e28 = sin_theta_h;
-    let _e29 = atmosphere_79;
+    let _e29 = atmosphere_85;
     let _e32 = SunVisibleFractionAboveHorizon(_e23, _e27, (_e28 * _e29.sun_angular_radius));
     return _e32;
 }
 
-fn GetTransmittanceToSun(atmosphere_80: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_50: f32, mu_s_23: f32) -> vec3<f32> {
-    var atmosphere_81: AtmosphereParameters;
+fn GetTransmittanceToSun(atmosphere_86: AtmosphereParameters, transmittance_texture_4: texture_2d<f32>, r_50: f32, mu_s_27: f32) -> vec3<f32> {
+    var atmosphere_87: AtmosphereParameters;
     var r_51: f32;
-    var mu_s_24: f32;
+    var mu_s_28: f32;
 
-    atmosphere_81 = atmosphere_80;
+    atmosphere_87 = atmosphere_86;
     r_51 = r_50;
-    mu_s_24 = mu_s_23;
-    let _e19 = atmosphere_81;
+    mu_s_28 = mu_s_27;
+    let _e19 = atmosphere_87;
     let _e20 = r_51;
-    let _e21 = mu_s_24;
+    let _e21 = mu_s_28;
     let _e22 = GetTransmittanceToTopAtmosphereBoundary(_e19, transmittance_texture_4, _e20, _e21);
-    let _e23 = atmosphere_81;
+    let _e23 = atmosphere_87;
     let _e24 = r_51;
-    let _e25 = mu_s_24;
+    let _e25 = mu_s_28;
     let _e26 = SunVisibleFraction(_e23, _e24, _e25);
     return (_e22 * _e26);
 }
@@ -2168,18 +2221,18 @@ fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringMuSColumns(atmosphere_82: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
-    var atmosphere_83: AtmosphereParameters;
+fn GetScatteringMuSColumns(atmosphere_88: AtmosphereParameters, u_mu_s_1: f32, x_low_sun: f32, x_below: ptr<function, f32>, x_above: ptr<function, f32>, mu_s_t: ptr<function, f32>, low_sun_below: ptr<function, bool>) {
+    var atmosphere_89: AtmosphereParameters;
     var u_mu_s_2: f32;
     var x_low_sun_1: f32;
     var mu_s_size_1: f32;
     var mu_s_coord: f32;
     var mu_s_column: f32;
 
-    atmosphere_83 = atmosphere_82;
+    atmosphere_89 = atmosphere_88;
     u_mu_s_2 = u_mu_s_1;
     x_low_sun_1 = x_low_sun;
-    let _e22 = atmosphere_83;
+    let _e22 = atmosphere_89;
     mu_s_size_1 = f32(_e22.scattering_mu_s_size);
     let _e26 = u_mu_s_2;
     let _e27 = mu_s_size_1;
@@ -2193,7 +2246,7 @@ fn GetScatteringMuSColumns(atmosphere_82: AtmosphereParameters, u_mu_s_1: f32, x
     let _e45 = mu_s_column;
     let _e48 = mu_s_size_1;
     (*x_above) = ((_e45 + 1.5f) / _e48);
-    let _e50 = atmosphere_83;
+    let _e50 = atmosphere_89;
     let _e53 = (*x_below);
     let _e54 = x_low_sun_1;
     (*low_sun_below) = ((_e50.scattering_mu_s_min < LOW_SUN_MU_S) && (_e53 < _e54));
@@ -2392,12 +2445,12 @@ fn LowestSunLogFall(a_14: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_25: f32) -> vec4<f32> {
+fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_29: f32) -> vec4<f32> {
     var a_17: vec4<f32>;
     var b_9: vec4<f32>;
     var mu_s_a_3: f32;
     var mu_s_b_3: f32;
-    var mu_s_26: f32;
+    var mu_s_30: f32;
     var slope_2: vec4<f32>;
     var curvature_1: vec4<f32>;
     var d_22: f32;
@@ -2406,13 +2459,13 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
     b_9 = b_8;
     mu_s_a_3 = mu_s_a_2;
     mu_s_b_3 = mu_s_b_2;
-    mu_s_26 = mu_s_25;
+    mu_s_30 = mu_s_29;
     let _e24 = a_17;
     let _e25 = b_9;
     let _e26 = mu_s_a_3;
     let _e27 = mu_s_b_3;
     LowestSunLogFall(_e24, _e25, _e26, _e27, (&slope_2), (&curvature_1));
-    let _e32 = mu_s_26;
+    let _e32 = mu_s_30;
     let _e33 = mu_s_a_3;
     d_22 = (_e32 - _e33);
     let _e36 = a_17;
@@ -2424,19 +2477,19 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringInSlice(atmosphere_84: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_16: f32, nu_slice: f32) -> vec4<f32> {
-    var atmosphere_85: AtmosphereParameters;
+fn GetScatteringInSlice(atmosphere_90: AtmosphereParameters, scattering_texture: texture_3d<f32>, uvwz: vec4<f32>, x_18: f32, nu_slice: f32) -> vec4<f32> {
+    var atmosphere_91: AtmosphereParameters;
     var uvwz_1: vec4<f32>;
-    var x_17: f32;
+    var x_19: f32;
     var nu_slice_1: f32;
 
-    atmosphere_85 = atmosphere_84;
+    atmosphere_91 = atmosphere_90;
     uvwz_1 = uvwz;
-    x_17 = x_16;
+    x_19 = x_18;
     nu_slice_1 = nu_slice;
     let _e21 = nu_slice_1;
-    let _e22 = x_17;
-    let _e24 = atmosphere_85;
+    let _e22 = x_19;
+    let _e24 = atmosphere_91;
     let _e28 = uvwz_1;
     let _e30 = uvwz_1;
     let _e33 = SampleTexture3D(scattering_texture, vec3<f32>(((_e21 + _e22) / f32(_e24.scattering_nu_size)), _e28.z, _e30.w));
@@ -2444,28 +2497,28 @@ fn GetScatteringInSlice(atmosphere_84: AtmosphereParameters, scattering_texture:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_86: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_18: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
-    var atmosphere_87: AtmosphereParameters;
+fn GetScatteringAtMuSColumn(atmosphere_92: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_20: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+    var atmosphere_93: AtmosphereParameters;
     var uvwz_3: vec4<f32>;
-    var x_19: f32;
+    var x_21: f32;
     var nu_slice_3: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
 
-    atmosphere_87 = atmosphere_86;
+    atmosphere_93 = atmosphere_92;
     uvwz_3 = uvwz_2;
-    x_19 = x_18;
+    x_21 = x_20;
     nu_slice_3 = nu_slice_2;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e25 = atmosphere_87;
+    let _e25 = atmosphere_93;
     let _e26 = uvwz_3;
-    let _e27 = x_19;
+    let _e27 = x_21;
     let _e28 = nu_slice_3;
     let _e29 = GetScatteringInSlice(_e25, scattering_texture_1, _e26, _e27, _e28);
-    let _e30 = atmosphere_87;
+    let _e30 = atmosphere_93;
     let _e31 = uvwz_3;
-    let _e32 = x_19;
+    let _e32 = x_21;
     let _e33 = nu_slice_3;
     let _e36 = GetScatteringInSlice(_e30, scattering_texture_1, _e31, _e32, (_e33 + 1f));
     let _e37 = nu_t_1;
@@ -2475,28 +2528,28 @@ fn GetScatteringAtMuSColumn(atmosphere_86: AtmosphereParameters, scattering_text
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtOwnColumn(atmosphere_88: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
-    var atmosphere_89: AtmosphereParameters;
+fn GetScatteringAtOwnColumn(atmosphere_94: AtmosphereParameters, scattering_texture_2: texture_3d<f32>, uvwz_4: vec4<f32>, column: f32, nu_slice_4: f32) -> vec4<f32> {
+    var atmosphere_95: AtmosphereParameters;
     var uvwz_5: vec4<f32>;
     var column_1: f32;
     var nu_slice_5: f32;
 
-    atmosphere_89 = atmosphere_88;
+    atmosphere_95 = atmosphere_94;
     uvwz_5 = uvwz_4;
     column_1 = column;
     nu_slice_5 = nu_slice_4;
-    let _e21 = atmosphere_89;
+    let _e21 = atmosphere_95;
     let _e22 = uvwz_5;
     let _e23 = column_1;
-    let _e26 = atmosphere_89;
+    let _e26 = atmosphere_95;
     let _e30 = nu_slice_5;
     let _e31 = GetScatteringInSlice(_e21, scattering_texture_2, _e22, ((_e23 + 0.5f) / f32(_e26.scattering_mu_s_size)), _e30);
     return _e31;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
-    var atmosphere_91: AtmosphereParameters;
+fn GetScatteringBelowSplit(atmosphere_96: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
+    var atmosphere_97: AtmosphereParameters;
     var uvwz_7: vec4<f32>;
     var position_4: f32;
     var nu_slice_7: f32;
@@ -2511,15 +2564,15 @@ fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_textu
     var tiny: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var rises: vec4<f32>;
     var power: vec4<f32>;
-    var x_20: f32;
+    var x_22: f32;
     var k_4: f32;
 
-    atmosphere_91 = atmosphere_90;
+    atmosphere_97 = atmosphere_96;
     uvwz_7 = uvwz_6;
     position_4 = position_3;
     nu_slice_7 = nu_slice_6;
     log_first_span_1 = log_first_span;
-    let _e26 = atmosphere_91;
+    let _e26 = atmosphere_97;
     let _e29 = past_2;
     intervals = (f32(_e26.scattering_mu_s_split) - _e29);
     let _e32 = position_4;
@@ -2533,22 +2586,22 @@ fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_textu
             let _e44 = past_2;
             let _e45 = k_3;
             column_2 = (_e44 + _e45);
-            let _e48 = atmosphere_91;
+            let _e48 = atmosphere_97;
             let _e49 = uvwz_7;
             let _e50 = column_2;
             let _e53 = nu_slice_7;
             let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_3, _e49, (_e50 - 1f), _e53);
-            let _e55 = atmosphere_91;
+            let _e55 = atmosphere_97;
             let _e56 = uvwz_7;
             let _e57 = column_2;
             let _e58 = nu_slice_7;
             let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_3, _e56, _e57, _e58);
-            let _e60 = atmosphere_91;
+            let _e60 = atmosphere_97;
             let _e61 = uvwz_7;
             let _e62 = column_2;
             let _e65 = nu_slice_7;
             let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_3, _e61, (_e62 + 1f), _e65);
-            let _e67 = atmosphere_91;
+            let _e67 = atmosphere_97;
             let _e68 = uvwz_7;
             let _e69 = column_2;
             let _e72 = past_2;
@@ -2568,20 +2621,20 @@ fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_textu
     let _e91 = past_2;
     if (_e90 >= (_e91 - 1f)) {
         {
-            let _e95 = atmosphere_91;
+            let _e95 = atmosphere_97;
             let _e96 = uvwz_7;
             let _e97 = past_2;
             let _e100 = nu_slice_7;
             let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_3, _e96, (_e97 - 1f), _e100);
             at_edge = _e101;
-            let _e103 = atmosphere_91;
+            let _e103 = atmosphere_97;
             let _e104 = uvwz_7;
             let _e105 = past_2;
             let _e106 = nu_slice_7;
             let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_3, _e104, _e105, _e106);
             let _e108 = at_edge;
             rise_1 = (_e107 - _e108);
-            let _e111 = atmosphere_91;
+            let _e111 = atmosphere_97;
             let _e112 = uvwz_7;
             let _e113 = past_2;
             let _e116 = nu_slice_7;
@@ -2610,44 +2663,45 @@ fn GetScatteringBelowSplit(atmosphere_90: AtmosphereParameters, scattering_textu
     }
     let _e168 = past_2;
     let _e171 = position_4;
-    x_20 = ((_e168 - 1f) - _e171);
-    let _e174 = x_20;
+    x_22 = ((_e168 - 1f) - _e171);
+    let _e174 = x_22;
     let _e176 = past_2;
     k_4 = min(floor(_e174), (_e176 - 2f));
-    let _e181 = atmosphere_91;
+    let _e181 = atmosphere_97;
     let _e182 = uvwz_7;
     let _e183 = past_2;
     let _e186 = k_4;
     let _e188 = nu_slice_7;
     let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_3, _e182, ((_e183 - 1f) - _e186), _e188);
-    let _e190 = atmosphere_91;
+    let _e190 = atmosphere_97;
     let _e191 = uvwz_7;
     let _e192 = past_2;
     let _e195 = k_4;
     let _e197 = nu_slice_7;
     let _e198 = GetScatteringAtOwnColumn(_e190, scattering_texture_3, _e191, ((_e192 - 2f) - _e195), _e197);
-    let _e199 = x_20;
+    let _e199 = x_22;
     let _e200 = k_4;
     let _e203 = SunCosineMix(_e189, _e198, (_e199 - _e200), true);
     return _e203;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringLookup(atmosphere_92: AtmosphereParameters, r_52: f32, mu_37: f32, mu_s_27: f32, nu_15: f32, ray_r_mu_intersects_ground_23: bool) -> ScatteringLookup {
-    var atmosphere_93: AtmosphereParameters;
+fn GetScatteringLookup(atmosphere_98: AtmosphereParameters, r_52: f32, mu_37: f32, mu_s_31: f32, nu_15: f32, ray_r_mu_intersects_ground_23: bool) -> ScatteringLookup {
+    var atmosphere_99: AtmosphereParameters;
     var r_53: f32;
     var mu_38: f32;
-    var mu_s_28: f32;
+    var mu_s_32: f32;
     var nu_16: f32;
     var ray_r_mu_intersects_ground_24: bool;
     var lookup: ScatteringLookup;
     var edge_21: vec2<f32>;
+    var sun_axis_3: ScatteringSunAxis;
     var nu_size: f32;
     var nu_coord: f32;
     var mu_s_size_2: f32;
     var past_3: f32 = 6f;
     var step_: f32;
-    var x_21: f32;
+    var x_23: f32;
     var x_below_1: f32;
     var x_above_1: f32;
     var low_sun_below_1: bool;
@@ -2655,185 +2709,191 @@ fn GetScatteringLookup(atmosphere_92: AtmosphereParameters, r_52: f32, mu_37: f3
     var column_3: f32;
     var x_last: f32;
 
-    atmosphere_93 = atmosphere_92;
+    atmosphere_99 = atmosphere_98;
     r_53 = r_52;
     mu_38 = mu_37;
-    mu_s_28 = mu_s_27;
+    mu_s_32 = mu_s_31;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_24 = ray_r_mu_intersects_ground_23;
-    let _e31 = atmosphere_93;
-    let _e32 = r_53;
-    let _e33 = mu_38;
-    let _e34 = mu_s_28;
-    let _e35 = nu_16;
-    let _e36 = ray_r_mu_intersects_ground_24;
-    let _e39 = GetScatteringTextureUvwzAndEdge(_e31, _e32, _e33, _e34, _e35, _e36, (&edge_21));
-    lookup.uvwz = _e39;
-    let _e40 = atmosphere_93;
-    nu_size = f32(_e40.scattering_nu_size);
-    let _e44 = lookup;
-    let _e47 = nu_size;
-    nu_coord = (_e44.uvwz.x * (_e47 - 1f));
-    let _e53 = nu_coord;
-    let _e55 = nu_size;
-    lookup.nu_slice = min(floor(_e53), (_e55 - 2f));
-    let _e60 = nu_coord;
-    let _e61 = lookup;
-    lookup.nu_t = (_e60 - _e61.nu_slice);
+    let _e30 = atmosphere_99;
+    let _e31 = GetScatteringSunAxis(_e30);
+    sun_axis_3 = _e31;
+    let _e34 = atmosphere_99;
+    let _e35 = sun_axis_3;
+    let _e36 = r_53;
+    let _e37 = mu_38;
+    let _e38 = mu_s_32;
+    let _e39 = nu_16;
+    let _e40 = ray_r_mu_intersects_ground_24;
+    let _e43 = GetScatteringTextureUvwzAndEdge(_e34, _e35, _e36, _e37, _e38, _e39, _e40, (&edge_21));
+    lookup.uvwz = _e43;
+    let _e44 = atmosphere_99;
+    nu_size = f32(_e44.scattering_nu_size);
+    let _e48 = lookup;
+    let _e51 = nu_size;
+    nu_coord = (_e48.uvwz.x * (_e51 - 1f));
+    let _e57 = nu_coord;
+    let _e59 = nu_size;
+    lookup.nu_slice = min(floor(_e57), (_e59 - 2f));
+    let _e64 = nu_coord;
+    let _e65 = lookup;
+    lookup.nu_t = (_e64 - _e65.nu_slice);
     lookup.low_sun = vec4(true);
     lookup.has_first = false;
     lookup.has_last = false;
     lookup.t = 0f;
     lookup.mu_s_a = 0f;
     lookup.mu_s_b = 0f;
-    let _e78 = mu_s_28;
-    lookup.mu_s = _e78;
+    let _e82 = mu_s_32;
+    lookup.mu_s = _e82;
     lookup.log_first_span = 1f;
-    let _e81 = atmosphere_93;
-    mu_s_size_2 = f32(_e81.scattering_mu_s_size);
-    let _e86 = lookup;
-    let _e89 = mu_s_size_2;
-    lookup.position = ((_e86.uvwz.y * _e89) - 0.5f);
-    let _e93 = atmosphere_93;
-    let _e97 = lookup;
-    let _e99 = atmosphere_93;
-    if ((_e93.scattering_mu_s_split > 0i) && (_e97.position < f32(_e99.scattering_mu_s_split))) {
+    let _e85 = atmosphere_99;
+    mu_s_size_2 = f32(_e85.scattering_mu_s_size);
+    let _e90 = lookup;
+    let _e93 = mu_s_size_2;
+    lookup.position = ((_e90.uvwz.y * _e93) - 0.5f);
+    let _e97 = atmosphere_99;
+    let _e101 = lookup;
+    let _e103 = atmosphere_99;
+    if ((_e97.scattering_mu_s_split > 0i) && (_e101.position < f32(_e103.scattering_mu_s_split))) {
         {
             lookup.kind = SCATTERING_OWN_COLUMNS;
             lookup.x = vec4(0f);
-            let _e111 = lookup;
-            if (_e111.position < 0f) {
+            let _e115 = lookup;
+            if (_e115.position < 0f) {
                 {
-                    let _e115 = atmosphere_93;
-                    let _e116 = edge_21;
-                    let _e117 = ShadowEdgePastStep(_e115, _e116);
-                    step_ = _e117;
+                    let _e119 = atmosphere_99;
+                    let _e120 = edge_21;
+                    let _e121 = ShadowEdgePastStep(_e119, _e120);
+                    step_ = _e121;
                     lookup.kind = SCATTERING_BELOW_TABLE;
-                    let _e126 = mu_s_size_2;
-                    lookup.x = (vec4<f32>(0.5f, 1.5f, 0f, 0f) / vec4(_e126));
-                    let _e130 = edge_21;
-                    let _e131 = past_3;
-                    let _e135 = step_;
-                    let _e137 = ShadowEdgeSunCosine(_e130, (-((_e131 - 1f)) * _e135));
-                    lookup.mu_s_a = _e137;
-                    let _e139 = edge_21;
-                    let _e140 = past_3;
-                    let _e144 = step_;
-                    let _e146 = ShadowEdgeSunCosine(_e139, (-((_e140 - 2f)) * _e144));
-                    lookup.mu_s_b = _e146;
+                    let _e130 = mu_s_size_2;
+                    lookup.x = (vec4<f32>(0.5f, 1.5f, 0f, 0f) / vec4(_e130));
+                    let _e134 = edge_21;
+                    let _e135 = past_3;
+                    let _e139 = step_;
+                    let _e141 = ShadowEdgeSunCosine(_e134, (-((_e135 - 1f)) * _e139));
+                    lookup.mu_s_a = _e141;
+                    let _e143 = edge_21;
+                    let _e144 = past_3;
+                    let _e148 = step_;
+                    let _e150 = ShadowEdgeSunCosine(_e143, (-((_e144 - 2f)) * _e148));
+                    lookup.mu_s_b = _e150;
                 }
             } else {
-                let _e147 = lookup;
-                let _e149 = past_3;
-                let _e153 = lookup;
-                let _e155 = past_3;
-                if ((_e147.position >= (_e149 - 1f)) && (_e153.position < _e155)) {
+                let _e151 = lookup;
+                let _e153 = past_3;
+                let _e157 = lookup;
+                let _e159 = past_3;
+                if ((_e151.position >= (_e153 - 1f)) && (_e157.position < _e159)) {
                     {
-                        let _e159 = atmosphere_93;
-                        let _e162 = past_3;
-                        x_21 = (1f / (f32(_e159.scattering_mu_s_split) - _e162));
-                        let _e167 = atmosphere_93;
-                        let _e168 = x_21;
-                        let _e169 = edge_21;
-                        let _e170 = ShadowEdgeLitDistance(_e167, _e168, _e169);
-                        lookup.log_first_span = log((_e170 / SHADOW_EDGE_CLOSEST));
+                        let _e163 = atmosphere_99;
+                        let _e166 = past_3;
+                        x_23 = (1f / (f32(_e163.scattering_mu_s_split) - _e166));
+                        let _e171 = atmosphere_99;
+                        let _e172 = x_23;
+                        let _e173 = edge_21;
+                        let _e174 = ShadowEdgeLitDistance(_e171, _e172, _e173);
+                        lookup.log_first_span = log((_e174 / SHADOW_EDGE_CLOSEST));
                     }
                 }
             }
-            let _e173 = lookup;
-            return _e173;
+            let _e177 = lookup;
+            return _e177;
         }
     }
-    let _e177 = atmosphere_93;
-    let _e178 = GetScatteringTextureUMuS(_e177, LOW_SUN_MU_S);
-    x_low_sun_2 = _e178;
-    let _e180 = atmosphere_93;
-    let _e181 = lookup;
-    let _e184 = x_low_sun_2;
-    let _e187 = lookup;
-    GetScatteringMuSColumns(_e180, _e181.uvwz.y, _e184, (&x_below_1), (&x_above_1), (&lookup.t), (&low_sun_below_1));
-    let _e195 = low_sun_below_1;
-    if !(_e195) {
+    let _e181 = atmosphere_99;
+    let _e182 = sun_axis_3;
+    let _e183 = GetScatteringTextureUMuSOnAxis(_e181, _e182, LOW_SUN_MU_S);
+    x_low_sun_2 = _e183;
+    let _e185 = atmosphere_99;
+    let _e186 = lookup;
+    let _e189 = x_low_sun_2;
+    let _e192 = lookup;
+    GetScatteringMuSColumns(_e185, _e186.uvwz.y, _e189, (&x_below_1), (&x_above_1), (&lookup.t), (&low_sun_below_1));
+    let _e200 = low_sun_below_1;
+    if !(_e200) {
         {
             lookup.kind = SCATTERING_DAYLIGHT;
-            let _e199 = x_below_1;
-            let _e200 = x_above_1;
-            let _e201 = lookup;
-            lookup.x = vec4<f32>(mix(_e199, _e200, _e201.t), 0f, 0f, 0f);
+            let _e204 = x_below_1;
+            let _e205 = x_above_1;
+            let _e206 = lookup;
+            lookup.x = vec4<f32>(mix(_e204, _e205, _e206.t), 0f, 0f, 0f);
             lookup.low_sun = vec4(false);
-            let _e211 = lookup;
-            return _e211;
+            let _e216 = lookup;
+            return _e216;
         }
     }
-    let _e212 = lookup;
-    if (_e212.t < 0f) {
+    let _e217 = lookup;
+    if (_e217.t < 0f) {
         {
             lookup.kind = SCATTERING_BELOW_TABLE;
-            let _e218 = x_below_1;
-            let _e219 = x_above_1;
-            lookup.x = vec4<f32>(_e218, _e219, 0f, 0f);
-            let _e225 = x_above_1;
-            let _e226 = x_low_sun_2;
-            lookup.low_sun = vec4<bool>(true, (_e225 < _e226), true, true);
-            let _e232 = atmosphere_93;
-            lookup.mu_s_a = _e232.scattering_mu_s_min;
-            let _e235 = atmosphere_93;
-            let _e237 = mu_s_size_2;
-            let _e241 = GetScatteringMuSFromUnitRange(_e235, (1f / (_e237 - 1f)));
-            lookup.mu_s_b = _e241;
-            let _e242 = lookup;
-            return _e242;
+            let _e223 = x_below_1;
+            let _e224 = x_above_1;
+            lookup.x = vec4<f32>(_e223, _e224, 0f, 0f);
+            let _e230 = x_above_1;
+            let _e231 = x_low_sun_2;
+            lookup.low_sun = vec4<bool>(true, (_e230 < _e231), true, true);
+            let _e237 = atmosphere_99;
+            lookup.mu_s_a = _e237.scattering_mu_s_min;
+            let _e240 = atmosphere_99;
+            let _e241 = sun_axis_3;
+            let _e243 = mu_s_size_2;
+            let _e247 = GetScatteringMuSFromUnitRangeOnAxis(_e240, _e241, (1f / (_e243 - 1f)));
+            lookup.mu_s_b = _e247;
+            let _e248 = lookup;
+            return _e248;
         }
     }
-    let _e243 = x_below_1;
-    let _e244 = mu_s_size_2;
-    column_3 = ((_e243 * _e244) - 0.5f);
-    let _e249 = column_3;
-    let _e252 = mu_s_size_2;
+    let _e249 = x_below_1;
+    let _e250 = mu_s_size_2;
+    column_3 = ((_e249 * _e250) - 0.5f);
+    let _e255 = column_3;
     let _e258 = mu_s_size_2;
-    x_last = ((min((_e249 + 2f), (_e252 - 1f)) + 0.5f) / _e258);
+    let _e264 = mu_s_size_2;
+    x_last = ((min((_e255 + 2f), (_e258 - 1f)) + 0.5f) / _e264);
     lookup.kind = SCATTERING_LOW_SUN;
-    let _e263 = column_3;
-    let _e270 = mu_s_size_2;
-    let _e272 = x_below_1;
-    let _e273 = x_above_1;
-    let _e274 = x_last;
-    lookup.x = vec4<f32>(((max((_e263 - 1f), 0f) + 0.5f) / _e270), _e272, _e273, _e274);
+    let _e269 = column_3;
+    let _e276 = mu_s_size_2;
+    let _e278 = x_below_1;
     let _e279 = x_above_1;
-    let _e280 = x_low_sun_2;
-    let _e282 = x_last;
-    let _e283 = x_low_sun_2;
-    lookup.low_sun = vec4<bool>(true, true, (_e279 < _e280), (_e282 < _e283));
-    let _e287 = column_3;
-    lookup.has_first = (_e287 > 0.5f);
-    let _e291 = column_3;
-    let _e294 = mu_s_size_2;
-    lookup.has_last = ((_e291 + 2f) < (_e294 - 0.5f));
-    let _e298 = lookup;
-    return _e298;
+    let _e280 = x_last;
+    lookup.x = vec4<f32>(((max((_e269 - 1f), 0f) + 0.5f) / _e276), _e278, _e279, _e280);
+    let _e285 = x_above_1;
+    let _e286 = x_low_sun_2;
+    let _e288 = x_last;
+    let _e289 = x_low_sun_2;
+    lookup.low_sun = vec4<bool>(true, true, (_e285 < _e286), (_e288 < _e289));
+    let _e293 = column_3;
+    lookup.has_first = (_e293 > 0.5f);
+    let _e297 = column_3;
+    let _e300 = mu_s_size_2;
+    lookup.has_last = ((_e297 + 2f) < (_e300 - 0.5f));
+    let _e304 = lookup;
+    return _e304;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, lookup_1: ScatteringLookup) -> vec4<f32> {
-    var atmosphere_95: AtmosphereParameters;
+fn GetScatteringFromLookup(atmosphere_100: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, lookup_1: ScatteringLookup) -> vec4<f32> {
+    var atmosphere_101: AtmosphereParameters;
     var lookup_2: ScatteringLookup;
     var a_18: vec4<f32>;
     var b_10: vec4<f32>;
     var c_8: vec4<f32>;
     var d_23: vec4<f32>;
 
-    atmosphere_95 = atmosphere_94;
+    atmosphere_101 = atmosphere_100;
     lookup_2 = lookup_1;
     let _e21 = lookup_2;
     if (_e21.kind == SCATTERING_OWN_COLUMNS) {
         {
-            let _e24 = atmosphere_95;
+            let _e24 = atmosphere_101;
             let _e25 = lookup_2;
             let _e27 = lookup_2;
             let _e29 = lookup_2;
             let _e31 = lookup_2;
             let _e33 = GetScatteringBelowSplit(_e24, scattering_texture_4, _e25.uvwz, _e27.position, _e29.nu_slice, _e31.log_first_span);
-            let _e34 = atmosphere_95;
+            let _e34 = atmosphere_101;
             let _e35 = lookup_2;
             let _e37 = lookup_2;
             let _e39 = lookup_2;
@@ -2844,7 +2904,7 @@ fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_textu
             return _e49;
         }
     }
-    let _e50 = atmosphere_95;
+    let _e50 = atmosphere_101;
     let _e51 = lookup_2;
     let _e53 = lookup_2;
     let _e56 = lookup_2;
@@ -2857,7 +2917,7 @@ fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_textu
         let _e68 = a_18;
         return _e68;
     }
-    let _e69 = atmosphere_95;
+    let _e69 = atmosphere_101;
     let _e70 = lookup_2;
     let _e72 = lookup_2;
     let _e75 = lookup_2;
@@ -2877,7 +2937,7 @@ fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_textu
             return _e95;
         }
     }
-    let _e96 = atmosphere_95;
+    let _e96 = atmosphere_101;
     let _e97 = lookup_2;
     let _e99 = lookup_2;
     let _e102 = lookup_2;
@@ -2885,7 +2945,7 @@ fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_textu
     let _e106 = lookup_2;
     let _e109 = GetScatteringAtMuSColumn(_e96, scattering_texture_4, _e97.uvwz, _e99.x.z, _e102.nu_slice, _e104.nu_t, _e106.low_sun.z);
     c_8 = _e109;
-    let _e111 = atmosphere_95;
+    let _e111 = atmosphere_101;
     let _e112 = lookup_2;
     let _e114 = lookup_2;
     let _e117 = lookup_2;
@@ -2905,25 +2965,25 @@ fn GetScatteringFromLookup(atmosphere_94: AtmosphereParameters, scattering_textu
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScattering(atmosphere_96: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, r_54: f32, mu_39: f32, mu_s_29: f32, nu_17: f32, ray_r_mu_intersects_ground_25: bool) -> vec4<f32> {
-    var atmosphere_97: AtmosphereParameters;
+fn GetScattering(atmosphere_102: AtmosphereParameters, scattering_texture_5: texture_3d<f32>, r_54: f32, mu_39: f32, mu_s_33: f32, nu_17: f32, ray_r_mu_intersects_ground_25: bool) -> vec4<f32> {
+    var atmosphere_103: AtmosphereParameters;
     var r_55: f32;
     var mu_40: f32;
-    var mu_s_30: f32;
+    var mu_s_34: f32;
     var nu_18: f32;
     var ray_r_mu_intersects_ground_26: bool;
 
-    atmosphere_97 = atmosphere_96;
+    atmosphere_103 = atmosphere_102;
     r_55 = r_54;
     mu_40 = mu_39;
-    mu_s_30 = mu_s_29;
+    mu_s_34 = mu_s_33;
     nu_18 = nu_17;
     ray_r_mu_intersects_ground_26 = ray_r_mu_intersects_ground_25;
-    let _e29 = atmosphere_97;
-    let _e30 = atmosphere_97;
+    let _e29 = atmosphere_103;
+    let _e30 = atmosphere_103;
     let _e31 = r_55;
     let _e32 = mu_40;
-    let _e33 = mu_s_30;
+    let _e33 = mu_s_34;
     let _e34 = nu_18;
     let _e35 = ray_r_mu_intersects_ground_26;
     let _e36 = GetScatteringLookup(_e30, _e31, _e32, _e33, _e34, _e35);
@@ -2932,10 +2992,10 @@ fn GetScattering(atmosphere_96: AtmosphereParameters, scattering_texture_5: text
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetIrradiance(atmosphere_98: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_56: f32, mu_s_31: f32) -> vec3<f32> {
-    var atmosphere_99: AtmosphereParameters;
+fn GetIrradiance(atmosphere_104: AtmosphereParameters, irradiance_texture: texture_2d<f32>, r_56: f32, mu_s_35: f32) -> vec3<f32> {
+    var atmosphere_105: AtmosphereParameters;
     var r_57: f32;
-    var mu_s_32: f32;
+    var mu_s_36: f32;
     var uv_3: vec2<f32>;
     var width: f32;
     var mu_s_coord_1: f32;
@@ -2945,25 +3005,25 @@ fn GetIrradiance(atmosphere_98: AtmosphereParameters, irradiance_texture: textur
     var below: vec4<f32>;
     var above: vec4<f32>;
 
-    atmosphere_99 = atmosphere_98;
+    atmosphere_105 = atmosphere_104;
     r_57 = r_56;
-    mu_s_32 = mu_s_31;
-    let _e23 = atmosphere_99;
+    mu_s_36 = mu_s_35;
+    let _e23 = atmosphere_105;
     let _e24 = r_57;
-    let _e25 = mu_s_32;
+    let _e25 = mu_s_36;
     let _e26 = GetIrradianceTextureUvFromRMuS(_e23, _e24, _e25);
     uv_3 = _e26;
-    let _e28 = atmosphere_99;
+    let _e28 = atmosphere_105;
     width = f32(_e28.irradiance_width);
-    let _e32 = atmosphere_99;
-    let _e33 = mu_s_32;
+    let _e32 = atmosphere_105;
+    let _e33 = mu_s_36;
     let _e34 = GetIrradianceUnitMuS(_e32, _e33);
     let _e35 = width;
     mu_s_coord_1 = (_e34 * (_e35 - 1f));
     let _e40 = mu_s_coord_1;
     let _e43 = width;
     mu_s_column_1 = clamp(floor(_e40), 0f, (_e43 - 2f));
-    let _e48 = atmosphere_99;
+    let _e48 = atmosphere_105;
     let _e49 = mu_s_column_1;
     let _e50 = width;
     let _e54 = GetIrradianceMuSFromUnit(_e48, (_e49 / (_e50 - 1f)));
@@ -2992,22 +3052,22 @@ fn GetIrradiance(atmosphere_98: AtmosphereParameters, irradiance_texture: textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn MiePhaseFunction(atmosphere_100: AtmosphereParameters, nu_19: f32) -> f32 {
-    var atmosphere_101: AtmosphereParameters;
+fn MiePhaseFunction(atmosphere_106: AtmosphereParameters, nu_19: f32) -> f32 {
+    var atmosphere_107: AtmosphereParameters;
     var nu_20: f32;
 
-    atmosphere_101 = atmosphere_100;
+    atmosphere_107 = atmosphere_106;
     nu_20 = nu_19;
-    let _e20 = atmosphere_101;
+    let _e20 = atmosphere_107;
     if (_e20.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e23 = atmosphere_101;
+        let _e23 = atmosphere_107;
         let _e25 = nu_20;
         let _e26 = HenyeyGreensteinPhaseFunction(_e23.mie_g, _e25);
         return _e26;
     }
-    let _e27 = atmosphere_101;
+    let _e27 = atmosphere_107;
     if (_e27.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e30 = atmosphere_101;
+        let _e30 = atmosphere_107;
         let _e32 = nu_20;
         let _e33 = CornetteShanksPhaseFunction(_e30.mie_g, _e32);
         return _e33;
@@ -3016,36 +3076,36 @@ fn MiePhaseFunction(atmosphere_100: AtmosphereParameters, nu_19: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetCombinedScattering(atmosphere_102: AtmosphereParameters, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_58: f32, mu_41: f32, mu_s_33: f32, nu_21: f32, ray_r_mu_intersects_ground_27: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_103: AtmosphereParameters;
+fn GetCombinedScattering(atmosphere_108: AtmosphereParameters, scattering_texture_6: texture_3d<f32>, single_mie_scattering_texture: texture_3d<f32>, r_58: f32, mu_41: f32, mu_s_37: f32, nu_21: f32, ray_r_mu_intersects_ground_27: bool, single_mie_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_109: AtmosphereParameters;
     var r_59: f32;
     var mu_42: f32;
-    var mu_s_34: f32;
+    var mu_s_38: f32;
     var nu_22: f32;
     var ray_r_mu_intersects_ground_28: bool;
     var lookup_3: ScatteringLookup;
     var scattering: vec4<f32>;
     var local_22: vec3<f32>;
 
-    atmosphere_103 = atmosphere_102;
+    atmosphere_109 = atmosphere_108;
     r_59 = r_58;
     mu_42 = mu_41;
-    mu_s_34 = mu_s_33;
+    mu_s_38 = mu_s_37;
     nu_22 = nu_21;
     ray_r_mu_intersects_ground_28 = ray_r_mu_intersects_ground_27;
-    let _e31 = atmosphere_103;
+    let _e31 = atmosphere_109;
     let _e32 = r_59;
     let _e33 = mu_42;
-    let _e34 = mu_s_34;
+    let _e34 = mu_s_38;
     let _e35 = nu_22;
     let _e36 = ray_r_mu_intersects_ground_28;
     let _e37 = GetScatteringLookup(_e31, _e32, _e33, _e34, _e35, _e36);
     lookup_3 = _e37;
-    let _e39 = atmosphere_103;
+    let _e39 = atmosphere_109;
     let _e40 = lookup_3;
     let _e41 = GetScatteringFromLookup(_e39, scattering_texture_6, _e40);
     scattering = _e41;
-    let _e43 = atmosphere_103;
+    let _e43 = atmosphere_109;
     if (_e43.single_mie_in_scattering_alpha == 1i) {
         {
             let _e47 = scattering;
@@ -3053,8 +3113,8 @@ fn GetCombinedScattering(atmosphere_102: AtmosphereParameters, scattering_textur
                 let _e51 = scattering;
                 let _e54 = scattering;
                 let _e57 = scattering;
-                let _e61 = atmosphere_103;
-                let _e63 = atmosphere_103;
+                let _e61 = atmosphere_109;
+                let _e63 = atmosphere_109;
                 local_22 = (((vec3<f32>(_e51.xyz) * _e54.w) / vec3(_e57.x)) * (_e61.mie_to_rayleigh_scattering_ratio / vec3(_e63.mie_to_rayleigh_scattering_ratio.x)));
             } else {
                 local_22 = vec3(0f);
@@ -3064,7 +3124,7 @@ fn GetCombinedScattering(atmosphere_102: AtmosphereParameters, scattering_textur
         }
     } else {
         {
-            let _e73 = atmosphere_103;
+            let _e73 = atmosphere_109;
             let _e74 = lookup_3;
             let _e75 = GetScatteringFromLookup(_e73, single_mie_scattering_texture, _e74);
             (*single_mie_scattering) = vec3<f32>(_e75.xyz);
@@ -3075,26 +3135,26 @@ fn GetCombinedScattering(atmosphere_102: AtmosphereParameters, scattering_textur
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceOfRay(atmosphere_104: AtmosphereParameters, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, r_60: f32, mu_43: f32, mu_s_35: f32, nu_23: f32, ray_r_mu_intersects_ground_29: bool) -> vec3<f32> {
-    var atmosphere_105: AtmosphereParameters;
+fn GetSkyRadianceOfRay(atmosphere_110: AtmosphereParameters, scattering_texture_7: texture_3d<f32>, single_mie_scattering_texture_1: texture_3d<f32>, r_60: f32, mu_43: f32, mu_s_39: f32, nu_23: f32, ray_r_mu_intersects_ground_29: bool) -> vec3<f32> {
+    var atmosphere_111: AtmosphereParameters;
     var r_61: f32;
     var mu_44: f32;
-    var mu_s_36: f32;
+    var mu_s_40: f32;
     var nu_24: f32;
     var ray_r_mu_intersects_ground_30: bool;
     var single_mie_scattering_1: vec3<f32>;
     var scattering_1: vec3<f32>;
 
-    atmosphere_105 = atmosphere_104;
+    atmosphere_111 = atmosphere_110;
     r_61 = r_60;
     mu_44 = mu_43;
-    mu_s_36 = mu_s_35;
+    mu_s_40 = mu_s_39;
     nu_24 = nu_23;
     ray_r_mu_intersects_ground_30 = ray_r_mu_intersects_ground_29;
-    let _e31 = atmosphere_105;
+    let _e31 = atmosphere_111;
     let _e32 = r_61;
     let _e33 = mu_44;
-    let _e34 = mu_s_36;
+    let _e34 = mu_s_40;
     let _e35 = nu_24;
     let _e36 = ray_r_mu_intersects_ground_30;
     let _e39 = GetCombinedScattering(_e31, scattering_texture_7, single_mie_scattering_texture_1, _e32, _e33, _e34, _e35, _e36, (&single_mie_scattering_1));
@@ -3103,42 +3163,42 @@ fn GetSkyRadianceOfRay(atmosphere_104: AtmosphereParameters, scattering_texture_
     let _e42 = nu_24;
     let _e43 = RayleighPhaseFunction(_e42);
     let _e45 = single_mie_scattering_1;
-    let _e46 = atmosphere_105;
+    let _e46 = atmosphere_111;
     let _e47 = nu_24;
     let _e48 = MiePhaseFunction(_e46, _e47);
     return ((_e41 * _e43) + (_e45 * _e48));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadiance(atmosphere_106: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_107: AtmosphereParameters;
+fn GetSkyRadiance(atmosphere_112: AtmosphereParameters, transmittance_texture_5: texture_2d<f32>, scattering_texture_8: texture_3d<f32>, single_mie_scattering_texture_2: texture_3d<f32>, camera_4: vec3<f32>, view_ray_4: vec3<f32>, sun_direction_2: vec3<f32>, transmittance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_113: AtmosphereParameters;
     var camera_5: vec3<f32>;
     var view_ray_5: vec3<f32>;
     var sun_direction_3: vec3<f32>;
     var start_2: vec3<f32>;
     var r_62: f32;
     var mu_45: f32;
-    var mu_s_37: f32;
+    var mu_s_41: f32;
     var nu_25: f32;
     var ray_r_mu_intersects_ground_31: bool;
     var local_23: vec3<f32>;
 
-    atmosphere_107 = atmosphere_106;
+    atmosphere_113 = atmosphere_112;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e33 = atmosphere_107;
+    let _e33 = atmosphere_113;
     let _e34 = camera_5;
     let _e35 = view_ray_5;
     let _e36 = sun_direction_3;
-    let _e47 = GetViewRayStart(_e33, _e34, _e35, _e36, (&start_2), (&r_62), (&mu_45), (&mu_s_37), (&nu_25));
+    let _e47 = GetViewRayStart(_e33, _e34, _e35, _e36, (&start_2), (&r_62), (&mu_45), (&mu_s_41), (&nu_25));
     if !(_e47) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e53 = atmosphere_107;
+    let _e53 = atmosphere_113;
     let _e54 = r_62;
     let _e55 = mu_45;
     let _e56 = RayIntersectsGround(_e53, _e54, _e55);
@@ -3147,7 +3207,7 @@ fn GetSkyRadiance(atmosphere_106: AtmosphereParameters, transmittance_texture_5:
     if _e58 {
         local_23 = vec3(0f);
     } else {
-        let _e61 = atmosphere_107;
+        let _e61 = atmosphere_113;
         let _e62 = r_62;
         let _e63 = mu_45;
         let _e64 = GetTransmittanceToTopAtmosphereBoundary(_e61, transmittance_texture_5, _e62, _e63);
@@ -3155,10 +3215,10 @@ fn GetSkyRadiance(atmosphere_106: AtmosphereParameters, transmittance_texture_5:
     }
     let _e66 = local_23;
     (*transmittance) = _e66;
-    let _e67 = atmosphere_107;
+    let _e67 = atmosphere_113;
     let _e68 = r_62;
     let _e69 = mu_45;
-    let _e70 = mu_s_37;
+    let _e70 = mu_s_41;
     let _e71 = nu_25;
     let _e72 = ray_r_mu_intersects_ground_31;
     let _e73 = GetSkyRadianceOfRay(_e67, scattering_texture_8, single_mie_scattering_texture_2, _e68, _e69, _e70, _e71, _e72);
@@ -3166,8 +3226,8 @@ fn GetSkyRadiance(atmosphere_106: AtmosphereParameters, transmittance_texture_5:
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn DistanceInsideScatteringRadii(atmosphere_108: AtmosphereParameters, r_63: f32, mu_46: f32) -> f32 {
-    var atmosphere_109: AtmosphereParameters;
+fn DistanceInsideScatteringRadii(atmosphere_114: AtmosphereParameters, r_63: f32, mu_46: f32) -> f32 {
+    var atmosphere_115: AtmosphereParameters;
     var r_64: f32;
     var mu_47: f32;
     var r_max: f32;
@@ -3177,12 +3237,12 @@ fn DistanceInsideScatteringRadii(atmosphere_108: AtmosphereParameters, r_63: f32
     var down_discriminant: f32;
     var local_24: f32;
 
-    atmosphere_109 = atmosphere_108;
+    atmosphere_115 = atmosphere_114;
     r_64 = r_63;
     mu_47 = mu_46;
-    let _e23 = atmosphere_109;
+    let _e23 = atmosphere_115;
     r_max = _e23.scattering_r_max;
-    let _e26 = atmosphere_109;
+    let _e26 = atmosphere_115;
     r_min = _e26.scattering_r_min;
     let _e29 = r_64;
     let _e30 = r_64;
@@ -3217,19 +3277,19 @@ fn DistanceInsideScatteringRadii(atmosphere_108: AtmosphereParameters, r_63: f32
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ProfileSampleAltitude(atmosphere_110: AtmosphereParameters, i_1: i32) -> f32 {
-    var atmosphere_111: AtmosphereParameters;
+fn ProfileSampleAltitude(atmosphere_116: AtmosphereParameters, i_1: i32) -> f32 {
+    var atmosphere_117: AtmosphereParameters;
     var i_2: i32;
-    var x_22: f32;
+    var x_24: f32;
 
-    atmosphere_111 = atmosphere_110;
+    atmosphere_117 = atmosphere_116;
     i_2 = i_1;
     let _e22 = i_2;
-    x_22 = (f32(_e22) / 63f);
-    let _e30 = atmosphere_111;
-    let _e32 = atmosphere_111;
-    let _e35 = x_22;
-    let _e37 = x_22;
+    x_24 = (f32(_e22) / 63f);
+    let _e30 = atmosphere_117;
+    let _e32 = atmosphere_117;
+    let _e35 = x_24;
+    let _e37 = x_24;
     return (((_e30.top_radius - _e32.bottom_radius) * _e35) * _e37);
 }
 
@@ -3286,74 +3346,74 @@ fn InterpolateCoefficients(a_21: vec3<f32>, b_13: vec3<f32>, f_2: f32) -> vec3<f
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetCoefficientsAtAltitude(atmosphere_112: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_113: AtmosphereParameters;
+fn GetCoefficientsAtAltitude(atmosphere_118: AtmosphereParameters, altitude: f32, mie_scattering: ptr<function, vec3<f32>>, rayleigh_scattering: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_119: AtmosphereParameters;
     var altitude_1: f32;
     var height: f32;
-    var x_23: f32;
+    var x_25: f32;
     var i_3: i32;
     var h0_: f32;
     var f_4: f32;
 
-    atmosphere_113 = atmosphere_112;
+    atmosphere_119 = atmosphere_118;
     altitude_1 = altitude;
-    let _e24 = atmosphere_113;
-    let _e26 = atmosphere_113;
+    let _e24 = atmosphere_119;
+    let _e26 = atmosphere_119;
     height = (_e24.top_radius - _e26.bottom_radius);
     let _e30 = altitude_1;
     let _e31 = height;
-    x_23 = (sqrt(clamp((_e30 / _e31), 0f, 1f)) * 63f);
-    let _e43 = x_23;
+    x_25 = (sqrt(clamp((_e30 / _e31), 0f, 1f)) * 63f);
+    let _e43 = x_25;
     i_3 = min(i32(_e43), 62i);
-    let _e50 = atmosphere_113;
+    let _e50 = atmosphere_119;
     let _e51 = i_3;
     let _e52 = ProfileSampleAltitude(_e50, _e51);
     h0_ = _e52;
     let _e54 = altitude_1;
     let _e55 = h0_;
-    let _e57 = atmosphere_113;
+    let _e57 = atmosphere_119;
     let _e58 = i_3;
     let _e61 = ProfileSampleAltitude(_e57, (_e58 + 1i));
     let _e62 = h0_;
     f_4 = clamp(((_e54 - _e55) / (_e61 - _e62)), 0f, 1f);
     let _e69 = i_3;
-    let _e72 = atmosphere_113.mie_scattering_profile[_e69];
+    let _e72 = atmosphere_119.mie_scattering_profile[_e69];
     let _e73 = i_3;
-    let _e78 = atmosphere_113.mie_scattering_profile[(_e73 + 1i)];
+    let _e78 = atmosphere_119.mie_scattering_profile[(_e73 + 1i)];
     let _e79 = f_4;
     let _e80 = InterpolateCoefficients(_e72, _e78, _e79);
     (*mie_scattering) = _e80;
     let _e81 = i_3;
-    let _e84 = atmosphere_113.rayleigh_scattering_profile[_e81];
+    let _e84 = atmosphere_119.rayleigh_scattering_profile[_e81];
     let _e85 = i_3;
-    let _e90 = atmosphere_113.rayleigh_scattering_profile[(_e85 + 1i)];
+    let _e90 = atmosphere_119.rayleigh_scattering_profile[(_e85 + 1i)];
     let _e91 = f_4;
     let _e92 = InterpolateCoefficients(_e84, _e90, _e91);
     (*rayleigh_scattering) = _e92;
     let _e93 = i_3;
-    let _e96 = atmosphere_113.extinction_profile[_e93];
+    let _e96 = atmosphere_119.extinction_profile[_e93];
     let _e97 = i_3;
-    let _e102 = atmosphere_113.extinction_profile[(_e97 + 1i)];
+    let _e102 = atmosphere_119.extinction_profile[(_e97 + 1i)];
     let _e103 = f_4;
     let _e104 = InterpolateCoefficients(_e96, _e102, _e103);
     return _e104;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_114: AtmosphereParameters, r_65: f32, mu_48: f32, t_9: f32, r_t: f32) -> f32 {
-    var atmosphere_115: AtmosphereParameters;
+fn AltitudeAtDistance(atmosphere_120: AtmosphereParameters, r_65: f32, mu_48: f32, t_9: f32, r_t: f32) -> f32 {
+    var atmosphere_121: AtmosphereParameters;
     var r_66: f32;
     var mu_49: f32;
     var t_10: f32;
     var r_t_1: f32;
 
-    atmosphere_115 = atmosphere_114;
+    atmosphere_121 = atmosphere_120;
     r_66 = r_65;
     mu_49 = mu_48;
     t_10 = t_9;
     r_t_1 = r_t;
     let _e28 = r_66;
-    let _e29 = atmosphere_115;
+    let _e29 = atmosphere_121;
     let _e32 = t_10;
     let _e33 = t_10;
     let _e35 = r_66;
@@ -3364,8 +3424,8 @@ fn AltitudeAtDistance(atmosphere_114: AtmosphereParameters, r_65: f32, mu_48: f3
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_116: AtmosphereParameters, r_67: f32, mu_50: f32, d_24: f32) -> vec3<f32> {
-    var atmosphere_117: AtmosphereParameters;
+fn IntegrateSegmentOpticalDepth(atmosphere_122: AtmosphereParameters, r_67: f32, mu_50: f32, d_24: f32) -> vec3<f32> {
+    var atmosphere_123: AtmosphereParameters;
     var r_68: f32;
     var mu_51: f32;
     var d_25: f32;
@@ -3379,7 +3439,7 @@ fn IntegrateSegmentOpticalDepth(atmosphere_116: AtmosphereParameters, r_67: f32,
     var rayleigh_scattering_1: vec3<f32>;
     var extinction: vec3<f32>;
 
-    atmosphere_117 = atmosphere_116;
+    atmosphere_123 = atmosphere_122;
     r_68 = r_67;
     mu_51 = mu_50;
     d_25 = d_24;
@@ -3394,14 +3454,14 @@ fn IntegrateSegmentOpticalDepth(atmosphere_116: AtmosphereParameters, r_67: f32,
             let _e45 = dt;
             let _e46 = k_5;
             t_11 = (_e45 * f32(_e46));
-            let _e50 = atmosphere_117;
+            let _e50 = atmosphere_123;
             let _e51 = r_68;
             let _e52 = mu_51;
             let _e53 = t_11;
             let _e54 = RadiusAtDistance(_e50, _e51, _e52, _e53);
             r_t_2 = _e54;
-            let _e58 = atmosphere_117;
-            let _e59 = atmosphere_117;
+            let _e58 = atmosphere_123;
+            let _e59 = atmosphere_123;
             let _e60 = r_68;
             let _e61 = mu_51;
             let _e62 = t_11;
@@ -3430,29 +3490,29 @@ fn IntegrateSegmentOpticalDepth(atmosphere_116: AtmosphereParameters, r_67: f32,
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_118: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_69: f32, mu_52: f32, d_26: f32, ray_r_mu_intersects_ground_32: bool) -> vec3<f32> {
-    var atmosphere_119: AtmosphereParameters;
+fn LongSegmentOpticalDepth(atmosphere_124: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_69: f32, mu_52: f32, d_26: f32, ray_r_mu_intersects_ground_32: bool) -> vec3<f32> {
+    var atmosphere_125: AtmosphereParameters;
     var r_70: f32;
     var mu_53: f32;
     var d_27: f32;
     var ray_r_mu_intersects_ground_33: bool;
     var local_26: vec3<f32>;
 
-    atmosphere_119 = atmosphere_118;
+    atmosphere_125 = atmosphere_124;
     r_70 = r_69;
     mu_53 = mu_52;
     d_27 = d_26;
     ray_r_mu_intersects_ground_33 = ray_r_mu_intersects_ground_32;
-    let _e29 = atmosphere_119;
+    let _e29 = atmosphere_125;
     if (_e29.transmittance_is_colour != 0i) {
-        let _e33 = atmosphere_119;
+        let _e33 = atmosphere_125;
         let _e34 = r_70;
         let _e35 = mu_53;
         let _e36 = d_27;
         let _e37 = IntegrateSegmentOpticalDepth(_e33, _e34, _e35, _e36);
         local_26 = _e37;
     } else {
-        let _e38 = atmosphere_119;
+        let _e38 = atmosphere_125;
         let _e39 = r_70;
         let _e40 = mu_53;
         let _e41 = d_27;
@@ -3484,11 +3544,11 @@ fn MeanAttenuation(depth: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_120: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_38: f32, nu_26: f32, d_28: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_121: AtmosphereParameters;
+fn IntegrateSegment(atmosphere_126: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_42: f32, nu_26: f32, d_28: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_127: AtmosphereParameters;
     var r_72: f32;
     var mu_55: f32;
-    var mu_s_39: f32;
+    var mu_s_43: f32;
     var nu_27: f32;
     var d_29: f32;
     var dt_1: f32;
@@ -3513,10 +3573,10 @@ fn IntegrateSegment(atmosphere_120: AtmosphereParameters, transmittance_texture_
     var start_transmittance: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_121 = atmosphere_120;
+    atmosphere_127 = atmosphere_126;
     r_72 = r_71;
     mu_55 = mu_54;
-    mu_s_39 = mu_s_38;
+    mu_s_43 = mu_s_42;
     nu_27 = nu_26;
     d_29 = d_28;
     let _e34 = d_29;
@@ -3533,13 +3593,13 @@ fn IntegrateSegment(atmosphere_120: AtmosphereParameters, transmittance_texture_
             let _e68 = dt_1;
             let _e69 = k_6;
             t_12 = (_e68 * f32(_e69));
-            let _e73 = atmosphere_121;
+            let _e73 = atmosphere_127;
             let _e74 = r_72;
             let _e75 = mu_55;
             let _e76 = t_12;
             let _e77 = RadiusAtDistance(_e73, _e74, _e75, _e76);
             r_t_3 = _e77;
-            let _e79 = atmosphere_121;
+            let _e79 = atmosphere_127;
             let _e80 = r_72;
             let _e81 = mu_55;
             let _e82 = t_12;
@@ -3547,21 +3607,21 @@ fn IntegrateSegment(atmosphere_120: AtmosphereParameters, transmittance_texture_
             let _e84 = AltitudeAtDistance(_e79, _e80, _e81, _e82, _e83);
             altitude_2 = _e84;
             let _e86 = r_72;
-            let _e87 = mu_s_39;
+            let _e87 = mu_s_43;
             let _e89 = t_12;
             let _e90 = nu_27;
             let _e93 = r_t_3;
             let _e95 = ClampCosine((((_e86 * _e87) + (_e89 * _e90)) / _e93));
             mu_s_t_1 = _e95;
-            let _e99 = atmosphere_121;
+            let _e99 = atmosphere_127;
             let _e100 = altitude_2;
             let _e105 = GetCoefficientsAtAltitude(_e99, _e100, (&mie_scattering_2), (&rayleigh_scattering_2));
             extinction_1 = _e105;
-            let _e107 = atmosphere_121;
+            let _e107 = atmosphere_127;
             let _e108 = r_t_3;
             let _e109 = mu_s_t_1;
             let _e110 = GetOpticalDepthToTopAtmosphereBoundary(_e107, transmittance_texture_7, _e108, _e109);
-            let _e113 = atmosphere_121;
+            let _e113 = atmosphere_127;
             let _e114 = r_t_3;
             let _e115 = mu_s_t_1;
             let _e116 = SunVisibleFraction(_e113, _e114, _e115);
@@ -3630,18 +3690,18 @@ fn IntegrateSegment(atmosphere_120: AtmosphereParameters, transmittance_texture_
         }
     }
     let _e199 = (*single_rayleigh);
-    let _e200 = atmosphere_121;
+    let _e200 = atmosphere_127;
     (*single_rayleigh) = (_e199 * _e200.solar_irradiance);
     let _e203 = (*single_mie);
-    let _e204 = atmosphere_121;
+    let _e204 = atmosphere_127;
     (*single_mie) = (_e203 * _e204.solar_irradiance);
     let _e207 = optical_depth_1;
     return _e207;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_123: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_129: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -3651,7 +3711,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     var start_3: vec3<f32>;
     var r_73: f32;
     var mu_56: f32;
-    var mu_s_40: f32;
+    var mu_s_44: f32;
     var nu_28: f32;
     var d_30: f32;
     var lit_1: f32;
@@ -3684,7 +3744,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_123 = atmosphere_122;
+    atmosphere_129 = atmosphere_128;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -3702,11 +3762,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     }
     let _e45 = camera_to_point;
     view_ray_6 = normalize(_e45);
-    let _e53 = atmosphere_123;
+    let _e53 = atmosphere_129;
     let _e54 = camera_7;
     let _e55 = view_ray_6;
     let _e56 = sun_direction_5;
-    let _e67 = GetViewRayStart(_e53, _e54, _e55, _e56, (&start_3), (&r_73), (&mu_56), (&mu_s_40), (&nu_28));
+    let _e67 = GetViewRayStart(_e53, _e54, _e55, _e56, (&start_3), (&r_73), (&mu_56), (&mu_s_44), (&nu_28));
     if !(_e67) {
         {
             (*transmittance_1) = vec3(1f);
@@ -3719,12 +3779,12 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e80 = d_30;
     let _e81 = shadow_length_1;
     lit_1 = max((_e80 - max(_e81, 0f)), 0f);
-    let _e88 = atmosphere_123;
+    let _e88 = atmosphere_129;
     let _e89 = r_73;
     let _e90 = mu_56;
     let _e91 = RayIntersectsGround(_e88, _e89, _e90);
     ray_r_mu_intersects_ground_34 = _e91;
-    let _e93 = atmosphere_123;
+    let _e93 = atmosphere_129;
     let _e94 = r_73;
     let _e95 = mu_56;
     let _e96 = lit_1;
@@ -3737,7 +3797,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e103 = CosineAtDistance(_e99, _e100, _e101, _e102);
     mu_p = _e103;
     let _e105 = r_73;
-    let _e106 = mu_s_40;
+    let _e106 = mu_s_44;
     let _e108 = lit_1;
     let _e109 = nu_28;
     let _e112 = r_p;
@@ -3750,10 +3810,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e144 = lit_direct;
     if (_e144 > 0f) {
         {
-            let _e147 = atmosphere_123;
+            let _e147 = atmosphere_129;
             let _e148 = r_73;
             let _e149 = mu_56;
-            let _e150 = mu_s_40;
+            let _e150 = mu_s_44;
             let _e151 = nu_28;
             let _e152 = lit_1;
             let _e159 = IntegrateSegment(_e147, transmittance_texture_8, _e148, _e149, _e150, _e151, _e152, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
@@ -3768,7 +3828,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     if ((_e162 > 0f) && (_e165 < _e166)) {
         {
             let _e172 = optical_depth_2;
-            let _e173 = atmosphere_123;
+            let _e173 = atmosphere_129;
             let _e174 = r_p;
             let _e175 = mu_p;
             let _e176 = mu_s_p;
@@ -3782,7 +3842,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e189 = direct;
     if (_e189 < 1f) {
         {
-            let _e192 = atmosphere_123;
+            let _e192 = atmosphere_129;
             let _e193 = r_73;
             let _e194 = mu_56;
             let _e195 = d_30;
@@ -3795,10 +3855,10 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     }
     let _e202 = optical_depth_2;
     (*transmittance_1) = exp(-(_e202));
-    let _e206 = atmosphere_123;
+    let _e206 = atmosphere_129;
     let _e207 = r_73;
     let _e208 = mu_56;
-    let _e209 = mu_s_40;
+    let _e209 = mu_s_44;
     let _e210 = nu_28;
     let _e211 = ray_r_mu_intersects_ground_34;
     let _e214 = GetCombinedScattering(_e206, scattering_texture_9, single_mie_scattering_texture_3, _e207, _e208, _e209, _e210, _e211, (&single_mie_scattering_2));
@@ -3806,23 +3866,23 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e216 = lit_1;
     if (_e216 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e218 = atmosphere_123;
+            let _e218 = atmosphere_129;
             let _e219 = r_73;
             let _e220 = mu_56;
             let _e221 = ray_r_mu_intersects_ground_34;
             let _e222 = DistanceToNearestAtmosphereBoundary(_e218, _e219, _e220, _e221);
             boundary = _e222;
             let _e224 = boundary;
-            let _e226 = atmosphere_123;
+            let _e226 = atmosphere_129;
             let _e227 = r_73;
             let _e228 = mu_56;
             let _e229 = DistanceInsideScatteringRadii(_e226, _e227, _e228);
             let _e231 = lit_1;
             far = max(min(min(DIRECT_SEGMENT_LENGTH, _e224), _e229), _e231);
-            let _e237 = atmosphere_123;
+            let _e237 = atmosphere_129;
             let _e238 = r_73;
             let _e239 = mu_56;
-            let _e240 = mu_s_40;
+            let _e240 = mu_s_44;
             let _e241 = nu_28;
             let _e242 = far;
             let _e249 = IntegrateSegment(_e237, transmittance_texture_8, _e238, _e239, _e240, _e241, _e242, (&far_rayleigh), (&far_mie), (&far_weight));
@@ -3831,7 +3891,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
             let _e252 = boundary;
             if (_e251 < _e252) {
                 {
-                    let _e254 = atmosphere_123;
+                    let _e254 = atmosphere_129;
                     let _e255 = r_73;
                     let _e256 = mu_56;
                     let _e257 = far;
@@ -3839,7 +3899,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
                     r_far = _e258;
                     let _e261 = scattering_3;
                     let _e262 = far_optical_depth;
-                    let _e265 = atmosphere_123;
+                    let _e265 = atmosphere_129;
                     let _e266 = r_far;
                     let _e267 = r_73;
                     let _e268 = mu_56;
@@ -3847,7 +3907,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
                     let _e270 = r_far;
                     let _e271 = CosineAtDistance(_e267, _e268, _e269, _e270);
                     let _e272 = r_73;
-                    let _e273 = mu_s_40;
+                    let _e273 = mu_s_44;
                     let _e275 = far;
                     let _e276 = nu_28;
                     let _e279 = r_far;
@@ -3868,13 +3928,13 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
             let _e306 = nu_28;
             let _e307 = RayleighPhaseFunction(_e306);
             let _e309 = single_mie_1;
-            let _e310 = atmosphere_123;
+            let _e310 = atmosphere_129;
             let _e311 = nu_28;
             let _e312 = MiePhaseFunction(_e310, _e311);
             return (((_e303 + _e304) * _e307) + (_e309 * _e312));
         }
     }
-    let _e315 = atmosphere_123;
+    let _e315 = atmosphere_129;
     let _e316 = r_73;
     let _e317 = mu_56;
     let _e318 = lit_1;
@@ -3883,7 +3943,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e321 = lit_optical_depth;
     let _e322 = lit_direct;
     lit_transmittance = exp(-(mix(_e320, _e321, vec3(_e322))));
-    let _e329 = atmosphere_123;
+    let _e329 = atmosphere_129;
     let _e330 = r_p;
     let _e331 = mu_p;
     let _e332 = mu_s_p;
@@ -3907,24 +3967,24 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_122: AtmosphereParameters, transmi
     let _e361 = nu_28;
     let _e362 = RayleighPhaseFunction(_e361);
     let _e364 = single_mie_scattering_2;
-    let _e365 = atmosphere_123;
+    let _e365 = atmosphere_129;
     let _e366 = nu_28;
     let _e367 = MiePhaseFunction(_e365, _e366);
     return ((_e360 * _e362) + (_e364 * _e367));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_124: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_125: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_130: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_131: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_125 = atmosphere_124;
+    atmosphere_131 = atmosphere_130;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e30 = atmosphere_125;
+    let _e30 = atmosphere_131;
     let _e31 = camera_9;
     let _e32 = point_3;
     let _e34 = sun_direction_7;
@@ -3933,19 +3993,19 @@ fn GetSkyRadianceToPoint(atmosphere_124: AtmosphereParameters, transmittance_tex
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_126: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_127: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_132: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_133: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
     var r_74: f32;
-    var mu_s_41: f32;
+    var mu_s_45: f32;
 
-    atmosphere_127 = atmosphere_126;
+    atmosphere_133 = atmosphere_132;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e29 = atmosphere_127;
+    let _e29 = atmosphere_133;
     let _e30 = point_5;
     let _e32 = ClampRadius(_e29, length(_e30));
     r_74 = _e32;
@@ -3953,32 +4013,32 @@ fn GetSunAndSkyIrradiance(atmosphere_126: AtmosphereParameters, transmittance_te
     let _e35 = sun_direction_9;
     let _e37 = point_5;
     let _e40 = ClampCosine((dot(_e34, _e35) / length(_e37)));
-    mu_s_41 = _e40;
-    let _e42 = atmosphere_127;
+    mu_s_45 = _e40;
+    let _e42 = atmosphere_133;
     let _e43 = r_74;
-    let _e44 = mu_s_41;
+    let _e44 = mu_s_45;
     let _e45 = GetIrradiance(_e42, irradiance_texture_1, _e43, _e44);
     let _e47 = normal_1;
     let _e48 = point_5;
     let _e50 = point_5;
     (*sky_irradiance) = ((_e45 * (1f + (dot(_e47, _e48) / length(_e50)))) * 0.5f);
-    let _e57 = atmosphere_127;
-    let _e59 = atmosphere_127;
+    let _e57 = atmosphere_133;
+    let _e59 = atmosphere_133;
     let _e60 = r_74;
-    let _e61 = mu_s_41;
+    let _e61 = mu_s_45;
     let _e62 = GetTransmittanceToSun(_e59, transmittance_texture_10, _e60, _e61);
     let _e64 = normal_1;
     let _e65 = sun_direction_9;
     return ((_e57.solar_irradiance * _e62) * max(dot(_e64, _e65), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_128: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_129: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_134: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_135: AtmosphereParameters;
 
-    atmosphere_129 = atmosphere_128;
-    let _e20 = atmosphere_129;
-    let _e22 = atmosphere_129;
-    let _e25 = atmosphere_129;
+    atmosphere_135 = atmosphere_134;
+    let _e20 = atmosphere_135;
+    let _e22 = atmosphere_135;
+    let _e25 = atmosphere_135;
     return (_e20.solar_irradiance / vec3(((PI * _e22.sun_angular_radius) * _e25.sun_angular_radius)));
 }
 
@@ -3993,36 +4053,36 @@ fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn SkyViewHorizonZenith(atmosphere_130: AtmosphereParameters, r_75: f32) -> f32 {
-    var atmosphere_131: AtmosphereParameters;
+fn SkyViewHorizonZenith(atmosphere_136: AtmosphereParameters, r_75: f32) -> f32 {
+    var atmosphere_137: AtmosphereParameters;
     var r_76: f32;
 
-    atmosphere_131 = atmosphere_130;
+    atmosphere_137 = atmosphere_136;
     r_76 = r_75;
-    let _e24 = atmosphere_131;
-    let _e26 = atmosphere_131;
+    let _e24 = atmosphere_137;
+    let _e26 = atmosphere_137;
     let _e27 = r_76;
     let _e28 = HorizonDistance(_e26, _e27);
     return atan2(_e24.bottom_radius, -(_e28));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewUvFromAngles(atmosphere_132: AtmosphereParameters, r_77: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
-    var atmosphere_133: AtmosphereParameters;
+fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
+    var atmosphere_139: AtmosphereParameters;
     var r_78: f32;
     var theta_1: f32;
     var phi_1: f32;
     var ray_r_mu_intersects_ground_36: bool;
     var theta_h: f32;
     var local_28: f32;
-    var x_24: f32;
+    var x_26: f32;
 
-    atmosphere_133 = atmosphere_132;
+    atmosphere_139 = atmosphere_138;
     r_78 = r_77;
     theta_1 = theta;
     phi_1 = phi;
     ray_r_mu_intersects_ground_36 = ray_r_mu_intersects_ground_35;
-    let _e30 = atmosphere_133;
+    let _e30 = atmosphere_139;
     let _e31 = r_78;
     let _e32 = SkyViewHorizonZenith(_e30, _e31);
     theta_h = _e32;
@@ -4039,10 +4099,10 @@ fn GetSkyViewUvFromAngles(atmosphere_132: AtmosphereParameters, r_77: f32, theta
         local_28 = (1f - sqrt(clamp(((_e48 - _e49) / _e51), 0f, 1f)));
     }
     let _e59 = local_28;
-    x_24 = _e59;
+    x_26 = _e59;
     let _e61 = phi_1;
     let _e63 = GetTextureCoordFromUnitRange((_e61 / PI), SKY_VIEW_WIDTH);
-    let _e64 = x_24;
+    let _e64 = x_26;
     let _e65 = ray_r_mu_intersects_ground_36;
     let _e66 = GetTextureCoordFromUnitMuInHalf(_e64, _e65, SKY_VIEW_HEIGHT);
     return vec2<f32>(_e63, _e66);
@@ -4103,12 +4163,12 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRay(atmosphere_134: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
-    var atmosphere_135: AtmosphereParameters;
+fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
+    var atmosphere_141: AtmosphereParameters;
     var camera_13: vec3<f32>;
     var sun_direction_13: vec3<f32>;
     var uv_5: vec2<f32>;
-    var x_25: f32;
+    var x_27: f32;
     var e: f32;
     var theta_h_1: f32;
     var local_30: f32;
@@ -4119,18 +4179,18 @@ fn GetSkyViewRay(atmosphere_134: AtmosphereParameters, camera_12: vec3<f32>, sun
     var local_31: vec3<f32>;
     var across_3: vec3<f32>;
 
-    atmosphere_135 = atmosphere_134;
+    atmosphere_141 = atmosphere_140;
     camera_13 = camera_12;
     sun_direction_13 = sun_direction_12;
     uv_5 = uv_4;
     let _e29 = uv_5;
     let _e33 = GetUnitMuInHalfFromTextureCoord(_e29.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
-    x_25 = _e33;
-    let _e36 = x_25;
-    let _e39 = x_25;
+    x_27 = _e33;
+    let _e36 = x_27;
+    let _e39 = x_27;
     e = ((1f - _e36) * (1f - _e39));
-    let _e43 = atmosphere_135;
-    let _e44 = atmosphere_135;
+    let _e43 = atmosphere_141;
+    let _e44 = atmosphere_141;
     let _e45 = camera_13;
     let _e47 = ClampRadius(_e44, length(_e45));
     let _e48 = SkyViewHorizonZenith(_e43, _e47);
@@ -4189,8 +4249,8 @@ fn GetSkyViewRay(atmosphere_134: AtmosphereParameters, camera_12: vec3<f32>, sun
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRadiance(atmosphere_136: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
-    var atmosphere_137: AtmosphereParameters;
+fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
+    var atmosphere_143: AtmosphereParameters;
     var camera_15: vec3<f32>;
     var sun_direction_15: vec3<f32>;
     var uv_7: vec2<f32>;
@@ -4198,11 +4258,11 @@ fn GetSkyViewRadiance(atmosphere_136: AtmosphereParameters, scattering_texture_1
     var view_ray_9: vec3<f32>;
     var up_3: vec3<f32>;
 
-    atmosphere_137 = atmosphere_136;
+    atmosphere_143 = atmosphere_142;
     camera_15 = camera_14;
     sun_direction_15 = sun_direction_14;
     uv_7 = uv_6;
-    let _e31 = atmosphere_137;
+    let _e31 = atmosphere_143;
     let _e32 = camera_15;
     let _e33 = sun_direction_15;
     let _e34 = uv_7;
@@ -4210,8 +4270,8 @@ fn GetSkyViewRadiance(atmosphere_136: AtmosphereParameters, scattering_texture_1
     view_ray_9 = _e37;
     let _e39 = camera_15;
     up_3 = normalize(_e39);
-    let _e42 = atmosphere_137;
-    let _e43 = atmosphere_137;
+    let _e42 = atmosphere_143;
+    let _e43 = atmosphere_143;
     let _e44 = camera_15;
     let _e46 = ClampRadius(_e43, length(_e44));
     let _e47 = up_3;
@@ -4229,8 +4289,8 @@ fn GetSkyViewRadiance(atmosphere_136: AtmosphereParameters, scattering_texture_1
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_139: AtmosphereParameters;
+fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_145: AtmosphereParameters;
     var camera_17: vec3<f32>;
     var view_ray_11: vec3<f32>;
     var sun_direction_17: vec3<f32>;
@@ -4241,11 +4301,11 @@ fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance
     var theta_4: f32;
     var phi_4: f32;
 
-    atmosphere_139 = atmosphere_138;
+    atmosphere_145 = atmosphere_144;
     camera_17 = camera_16;
     view_ray_11 = view_ray_10;
     sun_direction_17 = sun_direction_16;
-    let _e31 = atmosphere_139;
+    let _e31 = atmosphere_145;
     let _e32 = camera_17;
     let _e34 = ClampRadius(_e31, length(_e32));
     r_79 = _e34;
@@ -4254,7 +4314,7 @@ fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance
     let _e39 = camera_17;
     let _e42 = ClampCosine((dot(_e36, _e37) / length(_e39)));
     mu_58 = _e42;
-    let _e44 = atmosphere_139;
+    let _e44 = atmosphere_145;
     let _e45 = r_79;
     let _e46 = mu_58;
     let _e47 = RayIntersectsGround(_e44, _e45, _e46);
@@ -4263,7 +4323,7 @@ fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance
     if _e49 {
         local_32 = vec3(0f);
     } else {
-        let _e52 = atmosphere_139;
+        let _e52 = atmosphere_145;
         let _e53 = r_79;
         let _e54 = mu_58;
         let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_11, _e53, _e54);
@@ -4275,7 +4335,7 @@ fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance
     let _e61 = view_ray_11;
     let _e62 = sun_direction_17;
     GetSkyViewAngles(_e60, _e61, _e62, (&theta_4), (&phi_4));
-    let _e67 = atmosphere_139;
+    let _e67 = atmosphere_145;
     let _e68 = r_79;
     let _e69 = theta_4;
     let _e70 = phi_4;
@@ -4288,19 +4348,19 @@ fn GetSkyRadianceFromSkyView(atmosphere_138: AtmosphereParameters, transmittance
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn AerialPerspectiveSliceDistance(k_7: f32) -> f32 {
     var k_8: f32;
-    var x_26: f32;
+    var x_28: f32;
 
     k_8 = k_7;
     let _e24 = k_8;
-    x_26 = ((_e24 + 1f) / 32f);
-    let _e31 = x_26;
-    let _e33 = x_26;
+    x_28 = ((_e24 + 1f) / 32f);
+    let _e31 = x_28;
+    let _e33 = x_28;
     return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e31) * _e33);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetAerialPerspectiveVoxel(atmosphere_140: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_141: AtmosphereParameters;
+fn GetAerialPerspectiveVoxel(atmosphere_146: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_147: AtmosphereParameters;
     var camera_19: vec3<f32>;
     var view_ray_13: vec3<f32>;
     var w_1: f32;
@@ -4311,7 +4371,7 @@ fn GetAerialPerspectiveVoxel(atmosphere_140: AtmosphereParameters, transmittance
     var transmittance_4: vec3<f32>;
     var radiance: vec3<f32>;
 
-    atmosphere_141 = atmosphere_140;
+    atmosphere_147 = atmosphere_146;
     camera_19 = camera_18;
     view_ray_13 = view_ray_12;
     w_1 = w;
@@ -4326,14 +4386,14 @@ fn GetAerialPerspectiveVoxel(atmosphere_140: AtmosphereParameters, transmittance
     let _e49 = point_6;
     r_point = length(_e49);
     let _e52 = r_point;
-    let _e53 = atmosphere_141;
+    let _e53 = atmosphere_147;
     if (_e52 < _e53.bottom_radius) {
         let _e56 = point_6;
-        let _e57 = atmosphere_141;
+        let _e57 = atmosphere_147;
         let _e59 = r_point;
         point_6 = (_e56 * (_e57.bottom_radius / _e59));
     }
-    let _e63 = atmosphere_141;
+    let _e63 = atmosphere_147;
     let _e64 = camera_19;
     let _e65 = point_6;
     let _e66 = sun_direction_19;
