@@ -862,6 +862,22 @@ std::string Markdown(const Measurement& m) {
     return s && s->optimized_instructions > 0 ? std::to_string(s->optimized_instructions) : std::string("—");
   };
 
+  // The ratios of runtime `of`'s median times in group g to the peer's
+  // (separate / combined), on GL or Vulkan.
+  auto peer_ratios = [&](const Group& g, size_t of, bool vulkan) {
+    if (!peer) return std::string("—");
+    std::string cell;
+    for (size_t r = kFirstPeer; r < m.runtimes.size(); ++r) {
+      cell += (r > kFirstPeer ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
+                auto median = [&](size_t k) {
+                  return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds);
+                };
+                return median(of) / median(r);
+              }));
+    }
+    return cell;
+  };
+
   std::ostringstream out;
   out << "Per pixel, " << m.size << "×" << m.size << " pixels per case; counts are means over the pixels (the "
       << "largest in brackets) and, for a group, the range of its cases' means. Peer: "
@@ -882,27 +898,13 @@ std::string Markdown(const Measurement& m) {
       return peer ? count_cell(kFirstPeer, statistic) + " / " + count_cell(kFirstPeer + 1, statistic)
                   : std::string("—");
     };
-    // The ratios of skybake's medians to the peer's (separate / combined).
-    auto ratio_cell = [&](bool vulkan) {
-      if (!peer) return std::string("—");
-      std::string cell;
-      for (size_t r = kFirstPeer; r < m.runtimes.size(); ++r) {
-        cell += (r > kFirstPeer ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
-                  auto median = [&](size_t k) {
-                    return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds);
-                  };
-                  return median(0) / median(r);
-                }));
-      }
-      return cell;
-    };
     out << "| " << g.name << " | " << count_cell(0, &Counts::fetches) << " | " << peer_cells(&Counts::fetches) << " | "
         << count_cell(0, &Counts::calls) << " | " << peer_cells(&Counts::calls) << " | "
         << instructions("skybake", "Vulkan GLSL 4.50", g.entry) << " | "
         << (peer ? instructions("peer_separate", "Vulkan GLSL 4.50", g.entry) + " / " +
                        instructions("peer_combined", "Vulkan GLSL 4.50", g.entry)
                  : "—")
-        << " | " << ratio_cell(false) << " | " << ratio_cell(true) << " |\n";
+        << " | " << peer_ratios(g, 0, false) << " | " << peer_ratios(g, 0, true) << " |\n";
   }
   out << "\nThe per-frame path (shaders_runtime/per_frame.glsl: the sky from a sky view, aerial perspective from "
          "a volume; irradiance has no per-frame table), per pixel as above, and its time per pixel against the "
@@ -918,19 +920,6 @@ std::string Markdown(const Measurement& m) {
       return Range(values(g, [&](const CaseResult& c) { return (c.runtimes[1].counts.*statistic).mean; }), "%.1f") +
              " (" + Format("%.0f", *std::max_element(maxima.begin(), maxima.end())) + ")";
     };
-    auto peer_ratio = [&](bool vulkan) {
-      if (!peer) return std::string("—");
-      std::string cell;
-      for (size_t r = kFirstPeer; r < m.runtimes.size(); ++r) {
-        cell += (r > kFirstPeer ? " / " : "") + RatioRange(values(g, [&](const CaseResult& c) {
-                  auto median = [&](size_t k) {
-                    return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds);
-                  };
-                  return median(1) / median(r);
-                }));
-      }
-      return cell;
-    };
     auto direct_ratio = [&](bool vulkan) {
       return RatioRange(values(g, [&](const CaseResult& c) {
         auto median = [&](size_t k) { return Median(vulkan ? c.runtimes[k].vulkan_seconds : c.runtimes[k].gl_seconds); };
@@ -939,7 +928,7 @@ std::string Markdown(const Measurement& m) {
     };
     out << "| " << g.name << " | " << count_cell(&Counts::fetches) << " | " << count_cell(&Counts::calls) << " | "
         << instructions("skybake_per_frame", "Vulkan GLSL 4.50", g.entry) << " | " << direct_ratio(false) << " | "
-        << peer_ratio(false) << " | " << direct_ratio(true) << " | " << peer_ratio(true) << " |\n";
+        << peer_ratios(g, 1, false) << " | " << direct_ratio(true) << " | " << peer_ratios(g, 1, true) << " |\n";
   }
 
   // What building the per-frame tables costs each frame: one direct lookup

@@ -282,6 +282,23 @@ double LargestRelativeDifference(const std::vector<testing::Vec4>& gpu, const st
   return worst;
 }
 
+// The largest relative differences from the twin's of the radiance and the
+// transmittance that `source` writes: its main() writes vec4(OUTPUT, 1.0),
+// OUTPUT replaced by `radiance` and by `transmittance`.
+std::pair<double, double> RadianceAndTransmittanceDifferences(GlContext* gl, const std::string& source,
+                                                              const char* transmittance,
+                                                              const std::vector<testing::Vec4>& inputs,
+                                                              int inputs_per_item, const std::vector<vec3>& radiances,
+                                                              const std::vector<vec3>& transmittances) {
+  auto writing = [&](const char* output) {
+    std::string s = source;
+    s.replace(s.find("OUTPUT"), 6, output);
+    return gl->RunFragmentPass(s, inputs, inputs_per_item);
+  };
+  return {LargestRelativeDifference(writing("radiance"), radiances),
+          LargestRelativeDifference(writing(transmittance), transmittances)};
+}
+
 // The per-frame tables (per_frame.glsl) built and read on the driver give the
 // twin's: the sky view's texels (GetSkyViewRadiance) within the GL test's
 // tolerance for the sky radiance they hold (1e-3), the lookups of the twin's
@@ -395,17 +412,10 @@ void main() {
   skybake_output = vec4(OUTPUT, 1.0);
 }
 )";
-    auto with_output = [&](const char* output) {
-      std::string source = voxel;
-      source.replace(source.find("OUTPUT"), 6, output);
-      return source;
-    };
-    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(with_output("radiance"), inputs, 3), expected), 1e-1)
-        << "volume radiance";
-    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(with_output("exp(-optical_depth)"), inputs, 3),
-                                        expected_transmittance),
-              1e-2)
-        << "volume transmittance";
+    const auto [voxel_radiance, voxel_transmittance] = RadianceAndTransmittanceDifferences(
+        gl.get(), voxel, "exp(-optical_depth)", inputs, 3, expected, expected_transmittance);
+    EXPECT_LT(voxel_radiance, 1e-1) << "volume radiance";
+    EXPECT_LT(voxel_transmittance, 1e-2) << "volume transmittance";
     gl->SetTexture("aerial_perspective_radiance", froxels, froxels, slices, radiance.texels.data(),
                    radiance.texels.size());
     gl->SetTexture("aerial_perspective_optical_depth", froxels, froxels, slices, optical_depth.texels.data(),
@@ -431,17 +441,10 @@ void main() {
   skybake_output = vec4(OUTPUT, 1.0);
 }
 )";
-    auto lookup_output = [&](const char* output) {
-      std::string source = lookup;
-      source.replace(source.find("OUTPUT"), 6, output);
-      return source;
-    };
-    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(lookup_output("radiance"), inputs, 1), expected), 1e-3)
-        << "volume lookups";
-    EXPECT_LT(LargestRelativeDifference(gl->RunFragmentPass(lookup_output("transmittance"), inputs, 1),
-                                        expected_transmittance),
-              1e-3)
-        << "volume lookups' transmittance";
+    const auto [lookup_radiance, lookup_transmittance] = RadianceAndTransmittanceDifferences(
+        gl.get(), lookup, "transmittance", inputs, 1, expected, expected_transmittance);
+    EXPECT_LT(lookup_radiance, 1e-3) << "volume lookups";
+    EXPECT_LT(lookup_transmittance, 1e-3) << "volume lookups' transmittance";
   }
 }
 
