@@ -28,8 +28,6 @@ using testing::WriteText;
 
 const std::string& kSmall = testing::kSmallBakeOptions;
 
-std::string Quoted(const fs::path& p) { return ShellQuote(p.string()); }
-
 // `text` with `from` replaced by `to`.
 std::string Replaced(std::string text, const std::string& from, const std::string& to) {
   const std::size_t at = text.find(from);
@@ -75,30 +73,30 @@ TEST(PipelineDefects, D06_FilesSkybakeDidNotWriteNeverBlockABake) {
   WriteText(out / "README.txt", "the sky tables of level 3");
   WriteText(out / "transmittance.ktx2.meta", "guid: 1234");
   // A folder holding only foreign files bakes (it used to bake, then exit 3).
-  BakeRun first = Bake(dir, "earth -o " + Quoted(out) + kSmall);
+  BakeRun first = Bake(dir, "earth -o " + ShellQuote(out) + kSmall);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   // Re-bakes of other settings, with and without --clean, leave them too.
-  BakeRun second = Bake(dir, "earth --transmittance-samples 32 -o " + Quoted(out) + kSmall);
+  BakeRun second = Bake(dir, "earth --transmittance-samples 32 -o " + ShellQuote(out) + kSmall);
   ASSERT_EQ(second.exit_code, 0) << second.err;
-  BakeRun cleaned = Bake(dir, "earth --clean --format ktx2 -o " + Quoted(out) + kSmall);
+  BakeRun cleaned = Bake(dir, "earth --clean --format ktx2 -o " + ShellQuote(out) + kSmall);
   ASSERT_EQ(cleaned.exit_code, 0) << cleaned.err;
   EXPECT_FALSE(fs::exists(out / "transmittance.exr"));  // the earlier set's, removed by --clean
   EXPECT_EQ(ReadText(out / "README.txt"), "the sky tables of level 3");
   EXPECT_EQ(ReadText(out / "transmittance.ktx2.meta"), "guid: 1234");
   EXPECT_TRUE(fs::is_directory(out / "Editor"));
   std::string err;
-  EXPECT_EQ(RunCommand(Skybake() + " info " + Quoted(out), dir, nullptr, &err), 0) << err;
+  EXPECT_EQ(RunCommand(Skybake() + " info " + ShellQuote(out), dir, nullptr, &err), 0) << err;
 }
 
 TEST(PipelineDefects, D06_AnEarlierSetsTablesAreRefusedBeforeTheBake) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
-  ASSERT_EQ(Bake(dir, "earth -q -o " + Quoted(out) + kSmall).exit_code, 0);
+  ASSERT_EQ(Bake(dir, "earth -q -o " + ShellQuote(out) + kSmall).exit_code, 0);
   const std::string manifest = ReadText(out / "skybake.json");
   // EXR only would leave the earlier set's KTX2 tables beside the new
   // manifest: refused with one line, and before anything is baked.
   std::string err;
-  EXPECT_EQ(RunCommand(Skybake() + " bake earth --format exr -o " + Quoted(out) + kSmall, dir, nullptr, &err), 3);
+  EXPECT_EQ(RunCommand(Skybake() + " bake earth --format exr -o " + ShellQuote(out) + kSmall, dir, nullptr, &err), 3);
   EXPECT_EQ(testing::Lines(err).size(), 1u) << err;
   EXPECT_TRUE(Contains(err, "scattering.ktx2") && Contains(err, "--clean")) << err;
   EXPECT_FALSE(Contains(err, "baking")) << err;
@@ -135,7 +133,7 @@ TEST(PipelineDefects, D06_EveryOutputOptionRefusesAnEmptyPathAtOnce) {
 TEST(IncrementalBake, ASecondBakeOfUnchangedInputsIsSkipped) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
-  const std::string args = "earth -o " + Quoted(out) + kSmall;
+  const std::string args = "earth -o " + ShellQuote(out) + kSmall;
   BakeRun first = Bake(dir, args);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   EXPECT_FALSE(first.Skipped());
@@ -161,7 +159,7 @@ TEST(IncrementalBake, ASecondBakeOfUnchangedInputsIsSkipped) {
   EXPECT_EQ(fs::last_write_time(out / "scattering.ktx2"), table_time);
 
   // The threads, -q, --clean and the way the atmosphere is named change no file.
-  BakeRun third = Bake(dir, "preset:earth --threads 1 -q --clean -o " + Quoted(out) + kSmall);
+  BakeRun third = Bake(dir, "preset:earth --threads 1 -q --clean -o " + ShellQuote(out) + kSmall);
   ASSERT_EQ(third.exit_code, 0) << third.err;
   EXPECT_TRUE(third.Skipped());
 }
@@ -170,15 +168,15 @@ TEST(IncrementalBake, TheResolvedAtmosphereCountsNotItsText) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
   const fs::path earth = WriteEarth(dir, "earth.toml");
-  ASSERT_EQ(Bake(dir, Quoted(earth) + " -q -o " + Quoted(out) + kSmall).exit_code, 0);
+  ASSERT_EQ(Bake(dir, ShellQuote(earth) + " -q -o " + ShellQuote(out) + kSmall).exit_code, 0);
   // A comment, and the same radius in metres instead of kilometres: the same atmosphere.
   WriteEarth(dir, "earth.toml", "# Earth's clear sky", "# Earth's clear sky, as the level uses it");
-  EXPECT_TRUE(Bake(dir, Quoted(earth) + " -q -o " + Quoted(out) + kSmall).Skipped());
+  EXPECT_TRUE(Bake(dir, ShellQuote(earth) + " -q -o " + ShellQuote(out) + kSmall).Skipped());
   WriteEarth(dir, "earth.toml", "ground_radius_km = 6360.0", "ground_radius_m = 6360000.0");
-  EXPECT_TRUE(Bake(dir, Quoted(earth) + " -q -o " + Quoted(out) + kSmall).Skipped());
+  EXPECT_TRUE(Bake(dir, ShellQuote(earth) + " -q -o " + ShellQuote(out) + kSmall).Skipped());
   // A value the atmosphere resolves to differently bakes again.
   WriteEarth(dir, "earth.toml", "ground_albedo = 0.1", "ground_albedo = 0.3");
-  BakeRun changed = Bake(dir, Quoted(earth) + " -q -o " + Quoted(out) + kSmall);
+  BakeRun changed = Bake(dir, ShellQuote(earth) + " -q -o " + ShellQuote(out) + kSmall);
   ASSERT_EQ(changed.exit_code, 0) << changed.err;
   EXPECT_FALSE(changed.Skipped());
   EXPECT_EQ(json::parse(ReadText(out / "skybake.json"))["atmosphere"]["planet"]["ground_albedo"][0], 0.3);
@@ -187,7 +185,7 @@ TEST(IncrementalBake, TheResolvedAtmosphereCountsNotItsText) {
 TEST(IncrementalBake, EachChangedInputBakesAgain) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
-  const std::string base = "earth -q --clean -o " + Quoted(out) + kSmall;
+  const std::string base = "earth -q --clean -o " + ShellQuote(out) + kSmall;
   ASSERT_EQ(Bake(dir, base).exit_code, 0);
   ASSERT_TRUE(Bake(dir, base).Skipped());
   // Each changes the files; each is baked once, then found up to date, and
@@ -223,7 +221,7 @@ TEST(IncrementalBake, AChangedSceneOrWavelengthCountBakesAgain) {
   const std::string scene = ReadText(Source("examples/scenes/ground-daytime-game.toml"));
   const fs::path scene_file = dir.path() / "game.toml";
   WriteText(scene_file, scene);
-  const std::string with_scene = "earth -q --clean --scene " + Quoted(scene_file) + " -o " + Quoted(out) + kSmall;
+  const std::string with_scene = "earth -q --clean --scene " + ShellQuote(scene_file) + " -o " + ShellQuote(out) + kSmall;
   ASSERT_EQ(Bake(dir, with_scene).exit_code, 0);
   EXPECT_TRUE(Bake(dir, with_scene).Skipped());
   WriteText(scene_file, Replaced(scene, "zenith_deg = [0.0, 90.0]", "zenith_deg = [0.0, 80.0]"));
@@ -232,19 +230,19 @@ TEST(IncrementalBake, AChangedSceneOrWavelengthCountBakesAgain) {
   EXPECT_FALSE(changed.Skipped());
   EXPECT_TRUE(Bake(dir, with_scene).Skipped());
 
-  const std::string spectral = "earth -q --clean --wavelengths 6 -o " + Quoted(out) + kSmall;
+  const std::string spectral = "earth -q --clean --wavelengths 6 -o " + ShellQuote(out) + kSmall;
   BakeRun colour = Bake(dir, spectral);
   ASSERT_EQ(colour.exit_code, 0) << colour.err;
   EXPECT_FALSE(colour.Skipped());
   EXPECT_TRUE(Bake(dir, spectral).Skipped());
   EXPECT_FALSE(Bake(dir, spectral + " --spectral-higher-orders exact").Skipped());
-  EXPECT_FALSE(Bake(dir, "earth -q --clean --wavelengths 9 -o " + Quoted(out) + kSmall).Skipped());
+  EXPECT_FALSE(Bake(dir, "earth -q --clean --wavelengths 9 -o " + ShellQuote(out) + kSmall).Skipped());
 }
 
 TEST(IncrementalBake, AMissingOrTruncatedFileBakesAgain) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
-  const std::string args = "earth -q -o " + Quoted(out) + kSmall;
+  const std::string args = "earth -q -o " + ShellQuote(out) + kSmall;
   ASSERT_EQ(Bake(dir, args).exit_code, 0);
   const std::string table = ReadText(out / "scattering.ktx2");
 
@@ -264,13 +262,13 @@ TEST(IncrementalBake, AMissingOrTruncatedFileBakesAgain) {
   EXPECT_FALSE(Bake(dir, args).Skipped());
   EXPECT_TRUE(Bake(dir, args).Skipped());
   std::string err;
-  EXPECT_EQ(RunCommand(Skybake() + " info " + Quoted(out), dir, nullptr, &err), 0) << err;
+  EXPECT_EQ(RunCommand(Skybake() + " info " + ShellQuote(out), dir, nullptr, &err), 0) << err;
 }
 
 TEST(IncrementalBake, ForceBakesAnUpToDateSet) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
-  const std::string args = "earth -q -o " + Quoted(out) + kSmall;
+  const std::string args = "earth -q -o " + ShellQuote(out) + kSmall;
   ASSERT_EQ(Bake(dir, args).exit_code, 0);
   ASSERT_TRUE(Bake(dir, args).Skipped());
   BakeRun forced = Bake(dir, args + " --force");
@@ -282,14 +280,14 @@ TEST(IncrementalBake, ForceBakesAnUpToDateSet) {
 TEST(IncrementalBake, AManifestWithoutTheInputsHashBakesAgain) {
   TempDir dir;
   const fs::path out = dir.path() / "sky";
-  const std::string args = "earth -q -o " + Quoted(out) + kSmall;
+  const std::string args = "earth -q -o " + ShellQuote(out) + kSmall;
   ASSERT_EQ(Bake(dir, args).exit_code, 0);
   // As written before the hash was recorded: still a valid set, baked again.
   json manifest = json::parse(ReadText(out / "skybake.json"));
   manifest.erase("inputs_sha256");
   WriteText(out / "skybake.json", manifest.dump(2) + "\n");
   std::string err;
-  EXPECT_EQ(RunCommand(Skybake() + " info " + Quoted(out), dir, nullptr, &err), 0) << err;
+  EXPECT_EQ(RunCommand(Skybake() + " info " + ShellQuote(out), dir, nullptr, &err), 0) << err;
   EXPECT_FALSE(Bake(dir, args).Skipped());
   EXPECT_TRUE(Bake(dir, args).Skipped());
 }
@@ -297,7 +295,7 @@ TEST(IncrementalBake, AManifestWithoutTheInputsHashBakesAgain) {
 TEST(IncrementalBake, ABatchSkipsEachUpToDateAtmosphere) {
   TempDir dir;
   const fs::path earth = WriteEarth(dir, "earth.toml");
-  const std::string args = Quoted(earth) + " mars -q -o " + Quoted(dir.path() / "{name}") + kSmall;
+  const std::string args = ShellQuote(earth) + " mars -q -o " + ShellQuote(dir.path() / "{name}") + kSmall;
   ASSERT_EQ(Bake(dir, args).exit_code, 0);
   BakeRun again = Bake(dir, args);
   ASSERT_EQ(again.exit_code, 0) << again.err;
@@ -327,8 +325,8 @@ TEST(IncrementalBake, TheDepfileNamesTheManifestAndTheFilesRead) {
   };
   const std::string rule =
       escaped(out / "skybake.json") + ": " + escaped(earth) + " " + escaped(scene) + "\n";
-  const std::string args = Quoted(earth) + " -q --scene " + Quoted(scene) + " --depfile " + Quoted(depfile) + " -o " +
-                           Quoted(out) + kSmall;
+  const std::string args = ShellQuote(earth) + " -q --scene " + ShellQuote(scene) + " --depfile " + ShellQuote(depfile) + " -o " +
+                           ShellQuote(out) + kSmall;
   BakeRun baked = Bake(dir, args);
   ASSERT_EQ(baked.exit_code, 0) << baked.err;
   EXPECT_EQ(ReadText(depfile), rule);
@@ -337,12 +335,12 @@ TEST(IncrementalBake, TheDepfileNamesTheManifestAndTheFilesRead) {
   EXPECT_EQ(ReadText(depfile), rule);  // a skipped bake writes it too
 
   // A preset is inside the program: the manifest depends on no file.
-  ASSERT_EQ(Bake(dir, "earth -q --clean --depfile " + Quoted(depfile) + " -o " + Quoted(out) + kSmall).exit_code, 0);
+  ASSERT_EQ(Bake(dir, "earth -q --clean --depfile " + ShellQuote(depfile) + " -o " + ShellQuote(out) + kSmall).exit_code, 0);
   EXPECT_EQ(ReadText(depfile), escaped(out / "skybake.json") + ":\n");
   // One set per depfile.
   std::string err;
-  EXPECT_EQ(RunCommand(Skybake() + " bake earth mars --depfile " + Quoted(depfile) + " -o " +
-                           Quoted(dir.path() / "{name}") + kSmall,
+  EXPECT_EQ(RunCommand(Skybake() + " bake earth mars --depfile " + ShellQuote(depfile) + " -o " +
+                           ShellQuote(dir.path() / "{name}") + kSmall,
                        dir, nullptr, &err),
             1);
   EXPECT_TRUE(Contains(err, "--depfile")) << err;

@@ -32,10 +32,6 @@ const LutSet& DefaultEarth() {
   return luts;
 }
 
-Twin MakeTwin(const LutSet& luts) {
-  return Twin({luts.parameters, &luts.transmittance, &luts.scattering, &luts.single_mie_scattering, &luts.irradiance});
-}
-
 vec3 Direction(double zenith, double azimuth) {
   return vec3(std::sin(zenith) * std::cos(azimuth), std::sin(zenith) * std::sin(azimuth), std::cos(zenith));
 }
@@ -110,7 +106,7 @@ TEST(SkyView, RaysOfItsTexelsMapBackToThem) {
 // are never blended.
 TEST(SkyView, StaysCloseToTheDirectLookup) {
   const LutSet& luts = DefaultEarth();
-  const Twin twin = MakeTwin(luts);
+  const Twin twin(MakeTwinTables(luts));
   const double bottom = luts.parameters.bottom_radius;
   Errors all;
   for (double altitude : {1.0, 10000.0}) {
@@ -158,7 +154,7 @@ vec3 FrustumRay(double azimuth, const vec2& uv) {
 
 TEST(AerialPerspectiveVolume, StaysCloseToTheDirectLookup) {
   const LutSet& luts = DefaultEarth();
-  const Twin twin = MakeTwin(luts);
+  const Twin twin(MakeTwinTables(luts));
   const glsl::AtmosphereParameters& p = luts.parameters;
   const vec3 camera(0.0, 0.0, p.bottom_radius + 300.0);
   const int froxels = 32, slices = glsl::AERIAL_PERSPECTIVE_SLICES;

@@ -37,14 +37,12 @@ const std::string kSmallBake = " -q" + testing::kSmallBakeOptions;
 
 const fs::path kSource = SKYBAKE_SOURCE_DIR;
 
-std::string Quoted(const fs::path& path) { return ShellQuote(path.string()); }
-
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // Bakes `atmosphere` with the small settings and `extra` arguments into `lut`.
 void SmallBake(const TempDir& dir, const std::string& atmosphere, const fs::path& lut, const std::string& extra = "") {
   std::string err;
-  ASSERT_EQ(RunCommand(Skybake() + " bake " + atmosphere + " -o " + Quoted(lut) + kSmallBake + extra, dir, nullptr,
+  ASSERT_EQ(RunCommand(Skybake() + " bake " + atmosphere + " -o " + ShellQuote(lut) + kSmallBake + extra, dir, nullptr,
                        &err),
             0)
       << err;
@@ -69,11 +67,11 @@ TEST(PipelineDefects, D05_InfoPlotLabelsASpectralSetInXyzAndCandelas) {
   SmallBake(dir, "earth", dir.path() / "xyz", " --wavelengths 3");
   SmallBake(dir, "earth", dir.path() / "rgb");
   std::string err;
-  ASSERT_EQ(RunCommand(Skybake() + " info " + Quoted(dir.path() / "xyz") + " --plot " + Quoted(dir.path() / "xyz_plots"),
+  ASSERT_EQ(RunCommand(Skybake() + " info " + ShellQuote(dir.path() / "xyz") + " --plot " + ShellQuote(dir.path() / "xyz_plots"),
                        dir, nullptr, &err),
             0)
       << err;
-  ASSERT_EQ(RunCommand(Skybake() + " info " + Quoted(dir.path() / "rgb") + " --plot " + Quoted(dir.path() / "rgb_plots"),
+  ASSERT_EQ(RunCommand(Skybake() + " info " + ShellQuote(dir.path() / "rgb") + " --plot " + ShellQuote(dir.path() / "rgb_plots"),
                        dir, nullptr, &err),
             0)
       << err;
@@ -126,9 +124,9 @@ std::vector<double> PositiveLuminance(const fs::path& path) {
 TEST(PipelineDefects, D07_AutoExposureDoesNotBlowOutTheLitLimbFromSpaceAtTwilight) {
   TempDir dir;
   const fs::path lut = dir.path() / "lut", images = dir.path() / "images";
-  SmallBake(dir, "earth", lut, " --scene " + Quoted(kSource / "examples/scenes/space-to-ground.toml"));
+  SmallBake(dir, "earth", lut, " --scene " + ShellQuote(kSource / "examples/scenes/space-to-ground.toml"));
   std::string out, err;
-  ASSERT_EQ(RunCommand(Skybake() + " render -q " + Quoted(lut) + " -o " + Quoted(images) +
+  ASSERT_EQ(RunCommand(Skybake() + " render -q " + ShellQuote(lut) + " -o " + ShellQuote(images) +
                            " --views space --size 64 --sun-zenith 95,30 --json",
                        dir, &out, &err),
             0)
@@ -163,20 +161,20 @@ TEST(PipelineDefects, D07_AutoExposureDoesNotBlowOutTheLitLimbFromSpaceAtTwiligh
 TEST(PipelineDefects, D08_ConflictingOptionsAreUsageErrors) {
   TempDir dir;
   // Zstandard supercompresses KTX2 files: with EXR files only there is nothing to compress.
-  std::string err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "exr") + kSmallBake +
+  std::string err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "exr") + kSmallBake +
                                        " --format exr --ktx2-supercompression zstd",
                                    dir, 1);
   EXPECT_TRUE(Contains(err, "--ktx2-supercompression")) << err;
   EXPECT_FALSE(fs::exists(dir.path() / "exr"));
   // The same through a scene that writes EXR only.
-  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "sunset") + kSmallBake + " --scene " +
-                           Quoted(kSource / "examples/scenes/sunset-cinematic.toml") + " --ktx2-supercompression zstd",
+  err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "sunset") + kSmallBake + " --scene " +
+                           ShellQuote(kSource / "examples/scenes/sunset-cinematic.toml") + " --ktx2-supercompression zstd",
                        dir, 1);
   EXPECT_TRUE(Contains(err, "output.formats")) << err;
   // And converting to an EXR file.
   SmallBake(dir, "earth", dir.path() / "set", " --format ktx2");
-  err = OneLineFailure(Skybake() + " convert " + Quoted(dir.path() / "set" / "transmittance.ktx2") + " " +
-                           Quoted(dir.path() / "t.exr") + " --ktx2-supercompression zstd",
+  err = OneLineFailure(Skybake() + " convert " + ShellQuote(dir.path() / "set" / "transmittance.ktx2") + " " +
+                           ShellQuote(dir.path() / "t.exr") + " --ktx2-supercompression zstd",
                        dir, 1);
   EXPECT_FALSE(fs::exists(dir.path() / "t.exr"));
 
@@ -187,8 +185,8 @@ TEST(PipelineDefects, D08_ConflictingOptionsAreUsageErrors) {
   text.replace(text.find("[precision]"), std::string("[precision]").size(),
                "[precision]\ntransmittance = \"float\"");
   WriteText(scene, text);
-  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "game") + kSmallBake + " --scene " +
-                           Quoted(scene) + " --half",
+  err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "game") + kSmallBake + " --scene " +
+                           ShellQuote(scene) + " --half",
                        dir, 1);
   EXPECT_TRUE(Contains(err, "--half")) << err;
   EXPECT_FALSE(fs::exists(dir.path() / "game"));
@@ -201,20 +199,20 @@ TEST(PipelineDefects, D09_BadOptionValuesExitOne) {
   const fs::path out = dir.path() / "out";
   for (const char* count : {"2", "-1", "1"}) {
     const std::string err =
-        OneLineFailure(Skybake() + " bake earth -o " + Quoted(out) + kSmallBake + " --wavelengths " + count, dir, 1);
+        OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(out) + kSmallBake + " --wavelengths " + count, dir, 1);
     EXPECT_TRUE(Contains(err, "--wavelengths")) << err;
   }
   WriteText(dir.path() / "q.csv", "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,0,30,0\n");
-  OneLineFailure(Skybake() + " reference earth --in " + Quoted(dir.path() / "q.csv") + " --wavelengths 2 --paths 64",
+  OneLineFailure(Skybake() + " reference earth --in " + ShellQuote(dir.path() / "q.csv") + " --wavelengths 2 --paths 64",
                  dir, 1);
   SmallBake(dir, "earth", dir.path() / "lut");
   for (const char* zenith : {"200", "-5", "30,181"}) {
-    OneLineFailure(Skybake() + " render -q " + Quoted(dir.path() / "lut") + " -o " + Quoted(dir.path() / "images") +
+    OneLineFailure(Skybake() + " render -q " + ShellQuote(dir.path() / "lut") + " -o " + ShellQuote(dir.path() / "images") +
                        " --views fisheye --size 8 --sun-zenith " + zenith,
                    dir, 1);
   }
   // An angle render takes but these tables do not reach stays the input's fault.
-  OneLineFailure(Skybake() + " render -q " + Quoted(dir.path() / "lut") + " -o " + Quoted(dir.path() / "images") +
+  OneLineFailure(Skybake() + " render -q " + ShellQuote(dir.path() / "lut") + " -o " + ShellQuote(dir.path() / "images") +
                      " --views fisheye --size 8 --sun-zenith 150",
                  dir, 2);
   const std::string err = OneLineFailure(
@@ -229,7 +227,7 @@ TEST(PipelineDefects, D10_EvalParsesQueriesStrictly) {
   TempDir dir;
   const fs::path lut = dir.path() / "lut", queries = dir.path() / "q.csv";
   SmallBake(dir, "earth", lut);
-  const std::string eval = Skybake() + " eval " + Quoted(lut) + " --in " + Quoted(queries);
+  const std::string eval = Skybake() + " eval " + ShellQuote(lut) + " --in " + ShellQuote(queries);
   const std::string header = "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n";
 
   // Decimal numbers only: one line naming the file, the line and the column.
@@ -258,7 +256,7 @@ TEST(PipelineDefects, D10_EvalParsesQueriesStrictly) {
   const std::string eval_error = OneLineFailure(eval, dir, 2);
   EXPECT_TRUE(Contains(eval_error, ":3: sun_zenith_deg = 150 ")) << eval_error;
   const std::string render_error =
-      OneLineFailure(Skybake() + " render -q " + Quoted(lut) + " -o " + Quoted(dir.path() / "images") +
+      OneLineFailure(Skybake() + " render -q " + ShellQuote(lut) + " -o " + ShellQuote(dir.path() / "images") +
                          " --views fisheye --size 8 --sun-zenith 150",
                      dir, 2);
   const std::string problem = "is outside the tables' range 0..102.00 degrees";
@@ -295,15 +293,15 @@ TEST(PipelineDefects, D13_SceneSummarySaysInsteadOnlyWhereTheLowestSunMoved) {
   TempDir dir;
   const std::regex same("lowest sun ([0-9.]+) deg instead of \\1 deg");
   std::string err;
-  ASSERT_EQ(RunCommand(Skybake() + " bake earth -o " + Quoted(dir.path() / "space") + kSmallTables + " --scene " +
-                           Quoted(kSource / "examples/scenes/space-to-ground.toml"),
+  ASSERT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "space") + kSmallTables + " --scene " +
+                           ShellQuote(kSource / "examples/scenes/space-to-ground.toml"),
                        dir, nullptr, &err),
             0)
       << err;
   EXPECT_FALSE(std::regex_search(err, same)) << err;
   EXPECT_TRUE(Contains(err, "the lowest sun 102.00 deg, as in the full bake")) << err;
-  ASSERT_EQ(RunCommand(Skybake() + " bake earth -o " + Quoted(dir.path() / "game") + kSmallTables + " --scene " +
-                           Quoted(kSource / "examples/scenes/ground-daytime-game.toml"),
+  ASSERT_EQ(RunCommand(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "game") + kSmallTables + " --scene " +
+                           ShellQuote(kSource / "examples/scenes/ground-daytime-game.toml"),
                        dir, nullptr, &err),
             0)
       << err;
@@ -317,16 +315,16 @@ TEST(PipelineDefects, D13_SceneValueErrorsReadWell) {
   std::string text = ReadText(kSource / "examples/scenes/ground-daytime-game.toml");
   const fs::path scene = dir.path() / "bad.toml";
   WriteText(scene, text.substr(0, text.find("[output]")) + "[output]\nformats = [\"png\"]\n");
-  std::string err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake +
-                                       " --scene " + Quoted(scene),
+  std::string err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + kSmallBake +
+                                       " --scene " + ShellQuote(scene),
                                    dir, 2);
   EXPECT_TRUE(Contains(err, "output.formats[0]: unknown format \"png\" (expected \"exr\" or \"ktx2\")")) << err;
   EXPECT_FALSE(Contains(err, ": =")) << err;
   text.replace(text.find("scattering = \"half\""), std::string("scattering = \"half\"").size(),
                "scattering = \"double\"");
   WriteText(scene, text);
-  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --scene " +
-                           Quoted(scene),
+  err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + kSmallBake + " --scene " +
+                           ShellQuote(scene),
                        dir, 2);
   EXPECT_TRUE(Contains(err, "precision.scattering: unknown precision \"double\"")) << err;
 }
@@ -337,13 +335,13 @@ TEST(PipelineDefects, D13_OrdersZeroIsAuto) {
   TempDir dir;
   std::string out, err;
   const std::string bake = Skybake() + " bake earth -q --json" + kSmallTables + " -o ";
-  ASSERT_EQ(RunCommand(bake + Quoted(dir.path() / "zero") + " --orders 0", dir, &out, &err), 0) << err;
+  ASSERT_EQ(RunCommand(bake + ShellQuote(dir.path() / "zero") + " --orders 0", dir, &out, &err), 0) << err;
   const nlohmann::json zero = nlohmann::json::parse(out);
   EXPECT_EQ(zero["orders"], "auto");
-  ASSERT_EQ(RunCommand(bake + Quoted(dir.path() / "auto") + " --orders auto", dir, &out, &err), 0) << err;
+  ASSERT_EQ(RunCommand(bake + ShellQuote(dir.path() / "auto") + " --orders auto", dir, &out, &err), 0) << err;
   EXPECT_EQ(nlohmann::json::parse(out)["orders_used"], zero["orders_used"]);
   EXPECT_EQ(nlohmann::json::parse(ReadText(dir.path() / "zero" / "skybake.json"))["bake"]["orders"], "auto");
-  OneLineFailure(bake + Quoted(dir.path() / "minus") + " --orders -1", dir, 1);
+  OneLineFailure(bake + ShellQuote(dir.path() / "minus") + " --orders -1", dir, 1);
 }
 
 // --threads has a bound, stated in --help; beyond it a usage error.
@@ -354,12 +352,12 @@ TEST(PipelineDefects, D13_ThreadsAreBounded) {
   EXPECT_TRUE(Contains(out, "at most 1024")) << out;
   for (const char* threads : {"100000", "1025", "-1"}) {
     const std::string err =
-        OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --threads " + threads,
+        OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + kSmallBake + " --threads " + threads,
                        dir, 1);
     EXPECT_TRUE(Contains(err, "threads")) << err;
   }
   WriteText(dir.path() / "q.csv", "altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg\n0,0,30,0\n");
-  OneLineFailure(Skybake() + " reference earth --in " + Quoted(dir.path() / "q.csv") + " --paths 64 --threads 100000",
+  OneLineFailure(Skybake() + " reference earth --in " + ShellQuote(dir.path() / "q.csv") + " --paths 64 --threads 100000",
                  dir, 1);
 }
 
@@ -370,13 +368,13 @@ TEST(PipelineDefects, D13_OutputPatternsNameOnlyKnownPlaceholders) {
   std::string out, err;
   ASSERT_EQ(RunCommand(Skybake() + " bake --help", dir, &out), 0);
   EXPECT_TRUE(Contains(out, "stdin for standard input")) << out;
-  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "{atmosphere}") + kSmallBake, dir, 1);
+  err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "{atmosphere}") + kSmallBake, dir, 1);
   EXPECT_TRUE(Contains(err, "{atmosphere}")) << err;
   EXPECT_FALSE(fs::exists(dir.path() / "{atmosphere}"));
-  OneLineFailure(Skybake() + " bake earth mars -o " + Quoted(dir.path() / "{name}-{Name}") + kSmallBake, dir, 1);
+  OneLineFailure(Skybake() + " bake earth mars -o " + ShellQuote(dir.path() / "{name}-{Name}") + kSmallBake, dir, 1);
   // Standard input's {name} is stdin, as --help and docs/cli.md say.
-  ASSERT_EQ(RunCommand(Skybake() + " bake - -o " + Quoted(dir.path() / "sets/{name}") + kSmallBake + " < " +
-                           Quoted(kSource / "examples/atmospheres/earth.toml"),
+  ASSERT_EQ(RunCommand(Skybake() + " bake - -o " + ShellQuote(dir.path() / "sets/{name}") + kSmallBake + " < " +
+                           ShellQuote(kSource / "examples/atmospheres/earth.toml"),
                        dir, nullptr, &err),
             0)
       << err;
@@ -393,25 +391,25 @@ TEST(PipelineDefects, D13_ErrorsNameTheFileByThePathGiven) {
   WriteText(dir.path() / "sub" / "bad.toml", "name = \"x\"\n[planet]\nground_radius_km = -1\n");
   std::string out, err;
   // A relative path stays relative.
-  EXPECT_EQ(RunCommand("cd " + Quoted(dir.path()) + " && " + Skybake() + " validate sub/bad.toml --json", dir, &out,
+  EXPECT_EQ(RunCommand("cd " + ShellQuote(dir.path()) + " && " + Skybake() + " validate sub/bad.toml --json", dir, &out,
                        &err),
             2);
   EXPECT_EQ(err.rfind("skybake: sub/bad.toml: ", 0), 0u) << err;
   EXPECT_EQ(nlohmann::json::parse(out)["error"]["file"], "sub/bad.toml");
   // An absolute one stays absolute.
-  EXPECT_EQ(RunCommand(Skybake() + " validate " + Quoted(dir.path() / "sub" / "bad.toml") + " --json", dir, &out, &err),
+  EXPECT_EQ(RunCommand(Skybake() + " validate " + ShellQuote(dir.path() / "sub" / "bad.toml") + " --json", dir, &out, &err),
             2);
   EXPECT_EQ(nlohmann::json::parse(out)["error"]["file"], (dir.path() / "sub" / "bad.toml").string());
   // A scene file, and a scene that does not fit the planet.
   WriteText(dir.path() / "sub" / "scene.toml", "name = \"x\"\n");
-  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --scene " +
-                           Quoted(dir.path() / "sub" / "scene.toml"),
+  err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + kSmallBake + " --scene " +
+                           ShellQuote(dir.path() / "sub" / "scene.toml"),
                        dir, 2);
   EXPECT_EQ(err.rfind("skybake: " + (dir.path() / "sub" / "scene.toml").string() + ": ", 0), 0u) << err;
   WriteText(dir.path() / "sub" / "high.toml",
             "name = \"x\"\n[effects]\nsky = true\n[camera]\naltitude_km = [0, 500]\n[sun]\nzenith_deg = [0, 90]\n");
-  err = OneLineFailure(Skybake() + " bake earth -o " + Quoted(dir.path() / "x") + kSmallBake + " --scene " +
-                           Quoted(dir.path() / "sub" / "high.toml"),
+  err = OneLineFailure(Skybake() + " bake earth -o " + ShellQuote(dir.path() / "x") + kSmallBake + " --scene " +
+                           ShellQuote(dir.path() / "sub" / "high.toml"),
                        dir, 2);
   EXPECT_EQ(err.rfind("skybake: " + (dir.path() / "sub" / "high.toml").string() + ": camera.altitude", 0), 0u) << err;
 }
@@ -430,7 +428,7 @@ TEST(PipelineDefects, D13_DocsSayWhatTheProgramDoes) {
 
   // A file named earth beside the command: `validate earth` still reads the preset.
   WriteText(dir.path() / "earth", "name = \"not-the-preset\"\n");
-  ASSERT_EQ(RunCommand("cd " + Quoted(dir.path()) + " && " + Skybake() + " validate earth --json", dir, &out, &err), 0)
+  ASSERT_EQ(RunCommand("cd " + ShellQuote(dir.path()) + " && " + Skybake() + " validate earth --json", dir, &out, &err), 0)
       << err;
   EXPECT_EQ(nlohmann::json::parse(out)["name"], "earth");
   const std::string atmospheres = ReadText(kSource / "examples/atmospheres/README.md");

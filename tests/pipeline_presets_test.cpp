@@ -37,7 +37,6 @@ using testing::Skybake;
 using testing::TempDir;
 using testing::WriteText;
 
-std::string Quoted(const fs::path& p) { return ShellQuote(p.string()); }
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 std::string PresetText(const std::string& name) {
@@ -133,14 +132,14 @@ TEST(PipelinePresets, D04_EveryPresetBakesInColourRendersAndMatchesTheSpectralRe
   for (const std::string& name : presets) {
     SCOPED_TRACE(name);
     const fs::path set = dir.path() / ("set-" + name);
-    ASSERT_EQ(RunCommand(Skybake() + " bake " + name + " --wavelengths 15 --format exr -o " + Quoted(set) + kSmallTables,
+    ASSERT_EQ(RunCommand(Skybake() + " bake " + name + " --wavelengths 15 --format exr -o " + ShellQuote(set) + kSmallTables,
                          dir, nullptr, &err),
               0)
         << err;
-    ASSERT_EQ(RunCommand(Skybake() + " info " + Quoted(set) + " --json", dir, &out, &err), 0) << err;
+    ASSERT_EQ(RunCommand(Skybake() + " info " + ShellQuote(set) + " --json", dir, &out, &err), 0) << err;
     EXPECT_EQ(NonFiniteTexels(out), 0);
     const fs::path images = dir.path() / ("images-" + name);
-    ASSERT_EQ(RunCommand(Skybake() + " render " + Quoted(set) + " -o " + Quoted(images) +
+    ASSERT_EQ(RunCommand(Skybake() + " render " + ShellQuote(set) + " -o " + ShellQuote(images) +
                              " --views fisheye --sun-zenith 30 --size 32 -q",
                          dir, nullptr, &err),
               0)
@@ -149,12 +148,12 @@ TEST(PipelinePresets, D04_EveryPresetBakesInColourRendersAndMatchesTheSpectralRe
 
     const bool fog = name.find("fog") != std::string::npos;
     const fs::path eval = dir.path() / ("eval-" + name + ".csv"), reference = dir.path() / ("ref-" + name + ".csv");
-    ASSERT_EQ(RunCommand(Skybake() + " eval " + Quoted(set) + " --in " + Quoted(queries) + " --out " + Quoted(eval),
+    ASSERT_EQ(RunCommand(Skybake() + " eval " + ShellQuote(set) + " --in " + ShellQuote(queries) + " --out " + ShellQuote(eval),
                          dir, nullptr, &err),
               0)
         << err;
     ASSERT_EQ(RunCommand(Skybake() + " reference " + name + " --wavelengths 15 --paths 1024" +
-                             " --seed 1 -q --in " + Quoted(queries) + " --out " + Quoted(reference),
+                             " --seed 1 -q --in " + ShellQuote(queries) + " --out " + ShellQuote(reference),
                          dir, nullptr, &err),
               0)
         << err;
@@ -210,11 +209,11 @@ TEST(PipelinePresets, D04_ValidatesCanonicalEarthBakesInColourAsEarthDoes) {
     SCOPED_TRACE(wavelengths.empty() ? "three wavelengths" : wavelengths);
     const fs::path from_canonical = dir.path() / ("canonical" + wavelengths.substr(wavelengths.find_last_of(' ') + 1));
     const fs::path from_preset = dir.path() / ("preset" + wavelengths.substr(wavelengths.find_last_of(' ') + 1));
-    ASSERT_EQ(RunCommand(Skybake() + " bake " + Quoted(canonical) + wavelengths + " -o " + Quoted(from_canonical) + tiny,
+    ASSERT_EQ(RunCommand(Skybake() + " bake " + ShellQuote(canonical) + wavelengths + " -o " + ShellQuote(from_canonical) + tiny,
                          dir, nullptr, &err),
               0)
         << err;
-    ASSERT_EQ(RunCommand(Skybake() + " bake earth" + wavelengths + " -o " + Quoted(from_preset) + tiny, dir, nullptr,
+    ASSERT_EQ(RunCommand(Skybake() + " bake earth" + wavelengths + " -o " + ShellQuote(from_preset) + tiny, dir, nullptr,
                          &err),
               0)
         << err;
@@ -461,18 +460,18 @@ TEST(PipelinePresets, D12_ATinySunIsRefusedNotBakedToNaN) {
     text.replace(text.find(radius), radius.size(), c.radius);
     const fs::path file = dir.path() / "tiny.toml", set = dir.path() / "tiny";
     WriteText(file, text);
-    EXPECT_EQ(RunCommand(Skybake() + " bake " + Quoted(file) + " -o " + Quoted(set) + small, dir, &out, &err), 2);
+    EXPECT_EQ(RunCommand(Skybake() + " bake " + ShellQuote(file) + " -o " + ShellQuote(set) + small, dir, &out, &err), 2);
     EXPECT_TRUE(Contains(err, c.key)) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
     EXPECT_FALSE(fs::exists(set));
-    EXPECT_EQ(RunCommand(Skybake() + " validate " + Quoted(file), dir, &out, &err), 2);
+    EXPECT_EQ(RunCommand(Skybake() + " validate " + ShellQuote(file), dir, &out, &err), 2);
   }
   std::string text = earth;
   text.replace(text.find(radius), radius.size(), "angular_radius_rad = 1e-6");
   const fs::path file = dir.path() / "smallest.toml", set = dir.path() / "smallest";
   WriteText(file, text);
-  ASSERT_EQ(RunCommand(Skybake() + " bake " + Quoted(file) + " -o " + Quoted(set) + small, dir, &out, &err), 0) << err;
-  ASSERT_EQ(RunCommand(Skybake() + " info " + Quoted(set) + " --json", dir, &out, &err), 0) << err;
+  ASSERT_EQ(RunCommand(Skybake() + " bake " + ShellQuote(file) + " -o " + ShellQuote(set) + small, dir, &out, &err), 0) << err;
+  ASSERT_EQ(RunCommand(Skybake() + " info " + ShellQuote(set) + " --json", dir, &out, &err), 0) << err;
   EXPECT_EQ(NonFiniteTexels(out), 0);
 }
 

@@ -314,8 +314,7 @@ TEST_P(SnippetOnMesa, PerFrameTablesMatchTheCppTwin) {
   if (!gl) GTEST_SKIP() << why_not;
   static const LutSet luts = Bake(LoadAtmosphere("earth"), testing::RuntimeTestSettings(false));
   SetTables(gl.get(), luts);
-  const Twin twin({luts.parameters, &luts.transmittance, &luts.scattering, &luts.single_mie_scattering,
-                   &luts.irradiance});
+  const Twin twin(MakeTwinTables(luts));
   const std::string snippet = RuntimeSnippetSource(ShadingLanguage::kGlsl, luts.parameters,
                                                    luts.atmosphere.wavelengths_nm, luts.atmosphere.name);
   const std::string tables = R"(
