@@ -260,7 +260,8 @@ Baker::MuSFall Baker::MuSFallOf(const Texture& density, bool between_columns) co
         return glsl::vec4(lowest[4 * column], lowest[4 * column + 1], lowest[4 * column + 2], 0.0);
       };
       glsl::vec4 slope, curvature;
-      glsl::LowestSunLogFall(column_value(0), column_value(1), columns.mu_s[0], columns.mu_s[1], slope, curvature);
+      glsl::LowestSunLogFall(glsl::LogLight(column_value(0)), glsl::LogLight(column_value(1)), columns.mu_s[0],
+                             columns.mu_s[1], slope, curvature);
       for (int c = 0; c < 3; ++c) {
         const std::size_t i = (std::size_t(row) * nu_size + nu) * 3 + c;
         fall.lowest_log_slope[i] = float(slope[c]);

@@ -99,7 +99,9 @@ class OwnColumnSuns {
       tbb::parallel_for(0, lit_ * nodes_, [&](int i) {
         const int k = i / nodes_;
         const double edge = lowest_edge_ + (i % nodes_) * kStep, x = double(k) / lit_;
-        auto distance = [&](double e) { return glsl::ShadowEdgeLitDistance(grid, x, glsl::ShadowEdgeDirection(e)); };
+        auto distance = [&](double e) {
+          return glsl::ShadowEdgeLitDistance(grid, glsl::GetScatteringSunAxis(grid), x, glsl::ShadowEdgeDirection(e));
+        };
         distance_[i] = distance(edge);
         slope_[i] = (distance(edge + kSlopeStep) - distance(edge - kSlopeStep)) / (2.0 * kSlopeStep);
       });
@@ -108,7 +110,8 @@ class OwnColumnSuns {
     // with the table's D.
     double SunZenith(const AtmosphereParameters& grid, int column, double edge) const {
       if (column < past_ || edge < lowest_edge_) {
-        return edge - glsl::GetScatteringShadowEdgeDistance(grid, column, glsl::ShadowEdgeDirection(edge));
+        return edge - glsl::GetScatteringShadowEdgeDistance(grid, glsl::GetScatteringSunAxis(grid), column,
+                                                            glsl::ShadowEdgeDirection(edge));
       }
       const double position = std::min((edge - lowest_edge_) / kStep, nodes_ - 1.0 - 1e-9);
       const int node = int(position);

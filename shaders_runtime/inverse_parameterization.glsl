@@ -43,11 +43,13 @@ Number GetScatteringSliceEdge(IN(AtmosphereParameters) atmosphere, Number r, Num
 Number GetScatteringOwnColumnSunZenith(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number nu,
                                        bool ray_r_mu_intersects_ground, Number position, Number start_edge,
                                        OUT(Number) edge) {
+  ScatteringSunAxis sun_axis = GetScatteringSunAxis(atmosphere);
   edge = start_edge;
-  Number sun = edge - GetScatteringShadowEdgeDistance(atmosphere, position, ShadowEdgeDirection(edge));
+  Number sun = edge - GetScatteringShadowEdgeDistance(atmosphere, sun_axis, position, ShadowEdgeDirection(edge));
   for (int i = 0; i < 50; ++i) {
     edge = GetScatteringSliceEdge(atmosphere, r, mu, nu, ray_r_mu_intersects_ground, cos(sun));
-    Number next = edge - GetScatteringShadowEdgeDistance(atmosphere, position, ShadowEdgeDirection(edge));
+    Number next =
+        edge - GetScatteringShadowEdgeDistance(atmosphere, sun_axis, position, ShadowEdgeDirection(edge));
     bool converged = abs(next - sun) < 1e-11;
     sun = next;
     if (converged) break;

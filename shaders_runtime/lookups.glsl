@@ -47,7 +47,8 @@ vec4 GetScatteringTextureUvwzAndEdge(IN(AtmosphereParameters) atmosphere, IN(Sca
   edge = vec2(0.0);
   if (atmosphere.scattering_mu_s_split > 0 && u_mu_s * mu_s_size - 0.5 < Number(atmosphere.scattering_mu_s_split)) {
     ShadowEdge(atmosphere, r, mu, ViewSunAzimuthCosine(mu, mu_s, nu), ray_r_mu_intersects_ground, edge);
-    u_mu_s = (GetScatteringShadowEdgePosition(atmosphere, ShadowEdgeDistance(edge, mu_s), edge) + 0.5) / mu_s_size;
+    u_mu_s = (GetScatteringShadowEdgePosition(atmosphere, sun_axis, ShadowEdgeDistance(edge, mu_s), edge) + 0.5) /
+             mu_s_size;
   }
   return vec4(ScatteringUnitNu(nu), u_mu_s, u_mu, u_r);
 }
@@ -141,10 +142,24 @@ vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atmosphere, IN(Transmittance
 // sunset, the sun's air mass), and linear interpolation overestimates such a
 // fall by up to (a + b) / (2 sqrt(a b)) at mid-texel: 1.7 times at a tenfold
 // fall. Where one side is dark (0), the result falls to it within the texel.
+//
+// The geometric blends work on ln L: LogLight takes it of a texel's light,
+// floored at DARK_LIGHT, and LightFromLog turns it back, 0 where it is dark
+// (at most LOG_DARK_LIGHT, just above ln DARK_LIGHT = -69.08), so that a
+// lookup takes one logarithm per texel it reads and one exponential.
+const Number DARK_LIGHT = 1e-30;
+const Number LOG_DARK_LIGHT = -69.0;
+
+vec4 LogLight(vec4 light) { return log(max(light, vec4(DARK_LIGHT))); }
+
+// 1 where ln L is above the dark floor, else 0.
+vec4 IsLit(vec4 log_light) { return vec4(1.0) - step(log_light, vec4(LOG_DARK_LIGHT)); }
+
+vec4 LightFromLog(vec4 log_light) { return exp(log_light) * IsLit(log_light); }
+
 vec4 SunCosineMix(vec4 a, vec4 b, Number t, bool low_sun) {
   if (!low_sun) return mix(a, b, t);
-  vec4 dark = vec4(1e-30);
-  return exp(mix(log(max(a, dark)), log(max(b, dark)), t)) * step(dark, max(a, b));
+  return LightFromLog(mix(LogLight(a), LogLight(b), t));
 }
 
 // The position t between two mu_s texels, in [0, 1], except below the
@@ -193,13 +208,11 @@ void GetScatteringMuSColumns(IN(AtmosphereParameters) atmosphere, Number u_mu_s,
 // off a cliff (next to a column whose ray lies in the Earth's shadow).
 // has_a, has_d: whether a and d exist; past the table's first or last
 // column ln L goes on linearly. Where one of the four is dark, the
-// geometric blend (SunCosineMix).
-vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d, Number t) {
-  vec4 dark = vec4(1e-30);
-  vec4 lb = log(max(b, dark));
-  vec4 lc = log(max(c, dark));
-  vec4 la = has_a ? log(max(a, dark)) : 2.0 * lb - lc;
-  vec4 ld = has_d ? log(max(d, dark)) : 2.0 * lc - lb;
+// geometric blend (SunCosineMix). LogMonotoneCubic takes and returns ln L
+// (LogLight), LogMonotoneCubicMix the light.
+vec4 LogMonotoneCubic(vec4 log_a, vec4 lb, vec4 lc, vec4 log_d, bool has_a, bool has_d, Number t) {
+  vec4 la = has_a ? log_a : 2.0 * lb - lc;
+  vec4 ld = has_d ? log_d : 2.0 * lc - lb;
   vec4 secant_a = lb - la;
   vec4 secant = lc - lb;
   vec4 secant_d = ld - lc;
@@ -215,8 +228,11 @@ vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d,
   Number t3 = t2 * t;
   vec4 cubic = (2.0 * t3 - 3.0 * t2 + 1.0) * lb + (t3 - 2.0 * t2 + t) * slope_b + (3.0 * t2 - 2.0 * t3) * lc +
                (t3 - t2) * slope_c;
-  vec4 lit = step(dark, min(min(a, b), min(c, d)));
-  return exp(mix(mix(lb, lc, t), cubic, lit)) * step(dark, max(b, c));
+  return mix(mix(lb, lc, t), cubic, IsLit(min(min(log_a, lb), min(lc, log_d))));
+}
+
+vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d, Number t) {
+  return LightFromLog(LogMonotoneCubic(LogLight(a), LogLight(b), LogLight(c), LogLight(d), has_a, has_d, t));
 }
 
 // Below the table's lowest sun, ln L continued from the two lowest mu_s
@@ -228,11 +244,10 @@ vec4 LogMonotoneCubicMix(vec4 a, vec4 b, vec4 c, vec4 d, bool has_a, bool has_d,
 // delta (h = R delta^2 / 2 about, and -mu_s = sin delta), and falls about as
 // exp(-h / H). Else the line through a and b. Where L does not rise from a
 // to b (or a is dark), held at a. The bake's gather continues J below its
-// grid's lowest sun the same way.
-void LowestSunLogFall(IN(vec4) a, IN(vec4) b, Number mu_s_a, Number mu_s_b, OUT(vec4) slope,
+// grid's lowest sun the same way. From ln a and ln b (LogLight).
+void LowestSunLogFall(IN(vec4) log_a, IN(vec4) log_b, Number mu_s_a, Number mu_s_b, OUT(vec4) slope,
                       OUT(vec4) curvature) {
-  vec4 dark = vec4(1e-30);
-  vec4 rise = (log(max(b, dark)) - log(max(a, dark))) * step(dark, a) * (vec4(1.0) - step(b, a));
+  vec4 rise = (log_b - log_a) * IsLit(log_a) * (vec4(1.0) - step(log_b, log_a));
   if (mu_s_b < 0.0) {
     vec4 k = rise / (mu_s_a * mu_s_a - mu_s_b * mu_s_b);
     slope = -2.0 * mu_s_a * k;
@@ -243,14 +258,14 @@ void LowestSunLogFall(IN(vec4) a, IN(vec4) b, Number mu_s_a, Number mu_s_b, OUT(
   }
 }
 
-// a, the light at a column at sun cosine mu_s_a, continued to mu_s below
-// it as LowestSunLogFall of a and b (at mu_s_b) has ln L fall.
-vec4 LowestSunContinued(IN(vec4) a, IN(vec4) b, Number mu_s_a, Number mu_s_b, Number mu_s) {
+// The light at a column at sun cosine mu_s_a, ln a, continued to mu_s below
+// it as LowestSunLogFall of ln a and ln b (at mu_s_b) has ln L fall.
+vec4 LowestSunContinued(IN(vec4) log_a, IN(vec4) log_b, Number mu_s_a, Number mu_s_b, Number mu_s) {
   vec4 slope;
   vec4 curvature;
-  LowestSunLogFall(a, b, mu_s_a, mu_s_b, slope, curvature);
+  LowestSunLogFall(log_a, log_b, mu_s_a, mu_s_b, slope, curvature);
   Number d = mu_s - mu_s_a;
-  return a * exp(d * (slope + d * curvature));
+  return LightFromLog(log_a + d * (slope + d * curvature));
 }
 
 // The light of nu slice nu_slice at the mu_s texel column at texture
@@ -261,12 +276,13 @@ vec4 GetScatteringInSlice(IN(AtmosphereParameters) atmosphere, IN(ScatteringText
                          vec3((nu_slice + x) / Number(atmosphere.scattering_nu_size), uvwz.z, uvwz.w));
 }
 
-// The light at the mu_s texel column at texture coordinate x: the two nu
-// slices either side of nu blended by SunCosineMix.
-vec4 GetScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
-                              IN(vec4) uvwz, Number x, Number nu_slice, Number nu_t, bool low_sun) {
-  return SunCosineMix(GetScatteringInSlice(atmosphere, scattering_texture, uvwz, x, nu_slice),
-                      GetScatteringInSlice(atmosphere, scattering_texture, uvwz, x, nu_slice + 1.0), nu_t, low_sun);
+// ln L at the mu_s texel column at texture coordinate x (LogLight): the two
+// nu slices either side of nu blended as SunCosineMix blends them.
+vec4 GetLogScatteringAtMuSColumn(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                                 IN(vec4) uvwz, Number x, Number nu_slice, Number nu_t, bool low_sun) {
+  vec4 a = GetScatteringInSlice(atmosphere, scattering_texture, uvwz, x, nu_slice);
+  vec4 b = GetScatteringInSlice(atmosphere, scattering_texture, uvwz, x, nu_slice + 1.0);
+  return low_sun ? mix(LogLight(a), LogLight(b), nu_t) : LogLight(mix(a, b, nu_t));
 }
 
 // The light of one nu slice at a ray's own column (below the split).
@@ -276,7 +292,7 @@ vec4 GetScatteringAtOwnColumn(IN(AtmosphereParameters) atmosphere, IN(Scattering
                               (column + 0.5) / Number(atmosphere.scattering_mu_s_size), nu_slice);
 }
 
-// The light of one nu slice below the split at `position` on the ray's
+// ln L (LogLight) of one nu slice below the split at `position` on the ray's
 // own columns (GetScatteringShadowEdgePosition): between its lit columns
 // LogMonotoneCubicMix of the four around it (the split's column the last);
 // within SHADOW_EDGE_CLOSEST of the edge, the light at the edge plus the
@@ -285,19 +301,19 @@ vec4 GetScatteringAtOwnColumn(IN(AtmosphereParameters) atmosphere, IN(Scattering
 // to the edge), log_first_span = ln(D_1 / D_min) with D_1 the second lit
 // column's distance to the edge; past the edge SunCosineMix of the two
 // columns around it.
-vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
-                             IN(vec4) uvwz, Number position, Number nu_slice, Number log_first_span) {
+vec4 GetLogScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
+                                IN(vec4) uvwz, Number position, Number nu_slice, Number log_first_span) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
   Number intervals = Number(atmosphere.scattering_mu_s_split) - past;
   if (position >= past) {
     Number k = min(floor(position - past), intervals - 1.0);
     Number column = past + k;
-    return LogMonotoneCubicMix(
-        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column - 1.0, nu_slice),
-        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice),
-        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column + 1.0, nu_slice),
-        GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, min(column + 2.0, past + intervals), nu_slice),
-        k >= 1.0, k + 2.0 <= intervals, position - column);
+    Number last = min(column + 2.0, past + intervals);
+    vec4 la = LogLight(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column - 1.0, nu_slice));
+    vec4 lb = LogLight(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column, nu_slice));
+    vec4 lc = LogLight(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, column + 1.0, nu_slice));
+    vec4 ld = LogLight(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, last, nu_slice));
+    return LogMonotoneCubic(la, lb, lc, ld, k >= 1.0, k + 2.0 <= intervals, position - column);
   }
   if (position >= past - 1.0) {
     vec4 at_edge = GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 1.0, nu_slice);
@@ -308,13 +324,12 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
     vec4 power = mix(vec4(3.0),
                      clamp(log(max(second_rise, tiny) / max(rise, tiny)) / log_first_span, vec4(1.0), vec4(10.0)),
                      rises);
-    return at_edge + rise * pow(vec4(position - past + 1.0), power);
+    return LogLight(at_edge + rise * pow(vec4(position - past + 1.0), power));
   }
   Number x = past - 1.0 - position;
   Number k = min(floor(x), past - 2.0);
-  return SunCosineMix(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 1.0 - k, nu_slice),
-                      GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 2.0 - k, nu_slice),
-                      x - k, true);
+  return mix(LogLight(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 1.0 - k, nu_slice)),
+             LogLight(GetScatteringAtOwnColumn(atmosphere, scattering_texture, uvwz, past - 2.0 - k, nu_slice)), x - k);
 }
 
 // Where a lookup of the scattering tables reads and how it blends, for one
@@ -324,7 +339,7 @@ vec4 GetScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(ScatteringT
 const int SCATTERING_DAYLIGHT = 0;          // linear along mu_s: one fetch per nu slice at x.x
 const int SCATTERING_LOW_SUN = 1;           // LogMonotoneCubicMix of the columns at x, at t
 const int SCATTERING_BELOW_TABLE = 2;       // LowestSunContinued of the columns at x.x and x.y
-const int SCATTERING_OWN_COLUMNS = 3;       // GetScatteringBelowSplit in each nu slice, at position
+const int SCATTERING_OWN_COLUMNS = 3;       // GetLogScatteringBelowSplit in each nu slice, at position
 struct ScatteringLookup {
   int kind;
   vec4 uvwz;         // GetScatteringTextureUvwzAndEdge
@@ -378,7 +393,7 @@ ScatteringLookup GetScatteringLookup(IN(AtmosphereParameters) atmosphere, Number
       lookup.mu_s_b = ShadowEdgeSunCosine(edge, -(past - 2.0) * step);
     } else if (lookup.position >= past - 1.0 && lookup.position < past) {
       Number x = 1.0 / (Number(atmosphere.scattering_mu_s_split) - past);
-      lookup.log_first_span = log(ShadowEdgeLitDistance(atmosphere, x, edge) / SHADOW_EDGE_CLOSEST);
+      lookup.log_first_span = log(ShadowEdgeLitDistance(atmosphere, sun_axis, x, edge) / SHADOW_EDGE_CLOSEST);
     }
     return lookup;
   }
@@ -415,33 +430,38 @@ ScatteringLookup GetScatteringLookup(IN(AtmosphereParameters) atmosphere, Number
 
 // The lookup applied to one table: in daylight two fetches (the texture unit
 // blends the two mu_s columns); for a low sun between two columns
-// LogMonotoneCubicMix of the four around it (eight fetches); below the
-// table's lowest sun, or past a ray's first own column, LowestSunLogFall of
-// the two lowest (four fetches); below the split, each nu slice's light on
-// the ray's own columns (GetScatteringBelowSplit, up to four fetches each),
-// geometric between the two slices.
+// LogMonotoneCubic of the four around it (eight fetches); below the table's
+// lowest sun, or past a ray's first own column, LowestSunLogFall of the two
+// lowest (four fetches); below the split, each nu slice's ln L on the ray's
+// own columns (GetLogScatteringBelowSplit, up to four fetches each), linear
+// between the two slices. Away from daylight, one logarithm per texel read
+// and one exponential.
 vec4 GetScatteringFromLookup(IN(AtmosphereParameters) atmosphere, IN(ScatteringTexture) scattering_texture,
                              IN(ScatteringLookup) lookup) {
-  if (lookup.kind == SCATTERING_OWN_COLUMNS) {
-    return SunCosineMix(GetScatteringBelowSplit(atmosphere, scattering_texture, lookup.uvwz, lookup.position,
-                                                lookup.nu_slice, lookup.log_first_span),
-                        GetScatteringBelowSplit(atmosphere, scattering_texture, lookup.uvwz, lookup.position,
-                                                lookup.nu_slice + 1.0, lookup.log_first_span),
-                        lookup.nu_t, true);
+  if (lookup.kind == SCATTERING_DAYLIGHT) {
+    return mix(GetScatteringInSlice(atmosphere, scattering_texture, lookup.uvwz, lookup.x.x, lookup.nu_slice),
+               GetScatteringInSlice(atmosphere, scattering_texture, lookup.uvwz, lookup.x.x, lookup.nu_slice + 1.0),
+               lookup.nu_t);
   }
-  vec4 a = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.x, lookup.nu_slice,
-                                    lookup.nu_t, lookup.low_sun.x);
-  if (lookup.kind == SCATTERING_DAYLIGHT) return a;
-  vec4 b = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.y, lookup.nu_slice,
-                                    lookup.nu_t, lookup.low_sun.y);
+  if (lookup.kind == SCATTERING_OWN_COLUMNS) {
+    return LightFromLog(mix(GetLogScatteringBelowSplit(atmosphere, scattering_texture, lookup.uvwz, lookup.position,
+                                                       lookup.nu_slice, lookup.log_first_span),
+                            GetLogScatteringBelowSplit(atmosphere, scattering_texture, lookup.uvwz, lookup.position,
+                                                       lookup.nu_slice + 1.0, lookup.log_first_span),
+                            lookup.nu_t));
+  }
+  vec4 a = GetLogScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.x, lookup.nu_slice,
+                                       lookup.nu_t, lookup.low_sun.x);
+  vec4 b = GetLogScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.y, lookup.nu_slice,
+                                       lookup.nu_t, lookup.low_sun.y);
   if (lookup.kind == SCATTERING_BELOW_TABLE) {
     return LowestSunContinued(a, b, lookup.mu_s_a, lookup.mu_s_b, lookup.mu_s);
   }
-  vec4 c = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.z, lookup.nu_slice,
-                                    lookup.nu_t, lookup.low_sun.z);
-  vec4 d = GetScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.w, lookup.nu_slice,
-                                    lookup.nu_t, lookup.low_sun.w);
-  return LogMonotoneCubicMix(a, b, c, d, lookup.has_first, lookup.has_last, lookup.t);
+  vec4 c = GetLogScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.z, lookup.nu_slice,
+                                       lookup.nu_t, lookup.low_sun.z);
+  vec4 d = GetLogScatteringAtMuSColumn(atmosphere, scattering_texture, lookup.uvwz, lookup.x.w, lookup.nu_slice,
+                                       lookup.nu_t, lookup.low_sun.w);
+  return LightFromLog(LogMonotoneCubic(a, b, c, d, lookup.has_first, lookup.has_last, lookup.t));
 }
 
 // The 4D lookup of one table.

@@ -110,9 +110,9 @@ Number ShadowEdgeDistance(IN(vec2) edge, Number mu_s) {
 Number ShadowEdgeSunCosine(IN(vec2) edge, Number D) { return edge.x * cos(D) + edge.y * sin(D); }
 
 // The sun cosine of the split's column.
-Number GetScatteringSplitMuS(IN(AtmosphereParameters) atmosphere) {
-  return GetScatteringMuSFromUnitRange(
-      atmosphere, Number(atmosphere.scattering_mu_s_split) / Number(atmosphere.scattering_mu_s_size - 1));
+Number GetScatteringSplitMuS(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis) {
+  return GetScatteringMuSFromUnitRangeOnAxis(
+      atmosphere, sun_axis, Number(atmosphere.scattering_mu_s_split) / Number(atmosphere.scattering_mu_s_size - 1));
 }
 
 // X, a unit sun from 1 at the zenith to 0 at the tables' lowest sun (and
@@ -121,12 +121,13 @@ Number GetScatteringSplitMuS(IN(AtmosphereParameters) atmosphere) {
 // sun zenith angle theta: with a = (d - d_min) / (d_max - d_min) (as there)
 // and A its value at scattering_mu_s_min, X = (1 - a / A) / (1 + a); d =
 // -R mu_s + sqrt(R^2 mu_s^2 + top^2 - R^2) (R the bottom radius) has dd/dmu_s
-// = -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta).
-Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number mu_s, OUT(Number) derivative) {
+// = -R d / (d + R mu_s) and dmu_s/dtheta = -sin(theta). The axis's H and
+// 1 / A come from sun_axis (GetScatteringSunAxis), found once per lookup.
+Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis, Number mu_s,
+                         OUT(Number) derivative) {
   Number bottom = atmosphere.bottom_radius;
   Number d = DistanceToTopAtmosphereBoundary(atmosphere, bottom, mu_s);
   Number d_min = atmosphere.top_radius - bottom;
-  ScatteringSunAxis sun_axis = GetScatteringSunAxis(atmosphere);
   Number span = sun_axis.H - d_min;
   Number a = (d - d_min) / span;
   Number inverse_A = sun_axis.inverse_A;
@@ -148,52 +149,57 @@ Number ShadowEdgeUnitSun(IN(AtmosphereParameters) atmosphere, Number mu_s, OUT(N
 // the edge's X(E - D_min) (X_closest), X(theta_split) - X(E - D_min)
 // (X_span) and ln((E - theta_split) / D_min) (log_span); also dx/ds in
 // s = ln D.
-Number ShadowEdgeLitUnitFrom(IN(AtmosphereParameters) atmosphere, Number D, IN(vec2) edge, Number X_closest,
-                             Number X_span, Number log_span, OUT(Number) derivative) {
+Number ShadowEdgeLitUnitFrom(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis, Number D,
+                             IN(vec2) edge, Number X_closest, Number X_span, Number log_span,
+                             OUT(Number) derivative) {
   Number dX_dtheta;
-  Number X = ShadowEdgeUnitSun(atmosphere, ShadowEdgeSunCosine(edge, D), dX_dtheta);
+  Number X = ShadowEdgeUnitSun(atmosphere, sun_axis, ShadowEdgeSunCosine(edge, D), dX_dtheta);
   derivative = -SHADOW_EDGE_TABLES_WEIGHT * dX_dtheta * D / X_span + (1.0 - SHADOW_EDGE_TABLES_WEIGHT) / log_span;
   return SHADOW_EDGE_TABLES_WEIGHT * (X - X_closest) / X_span +
          (1.0 - SHADOW_EDGE_TABLES_WEIGHT) * log(D / SHADOW_EDGE_CLOSEST) / log_span;
 }
 
 // ShadowEdgeLitUnitFrom's constants for the edge, and the split's D.
-void ShadowEdgeLitUnitSpans(IN(AtmosphereParameters) atmosphere, IN(vec2) edge, OUT(Number) X_closest,
-                            OUT(Number) X_span, OUT(Number) log_span, OUT(Number) split_distance) {
+void ShadowEdgeLitUnitSpans(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis, IN(vec2) edge,
+                            OUT(Number) X_closest, OUT(Number) X_span, OUT(Number) log_span,
+                            OUT(Number) split_distance) {
   Number unused;
-  Number split_mu_s = GetScatteringSplitMuS(atmosphere);
-  X_closest = ShadowEdgeUnitSun(atmosphere, ShadowEdgeSunCosine(edge, SHADOW_EDGE_CLOSEST), unused);
-  X_span = ShadowEdgeUnitSun(atmosphere, split_mu_s, unused) - X_closest;
+  Number split_mu_s = GetScatteringSplitMuS(atmosphere, sun_axis);
+  X_closest = ShadowEdgeUnitSun(atmosphere, sun_axis, ShadowEdgeSunCosine(edge, SHADOW_EDGE_CLOSEST), unused);
+  X_span = ShadowEdgeUnitSun(atmosphere, sun_axis, split_mu_s, unused) - X_closest;
   split_distance = ShadowEdgeDistance(edge, split_mu_s);
   log_span = log(split_distance / SHADOW_EDGE_CLOSEST);
 }
 
-Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, Number distance, IN(vec2) edge) {
+Number ShadowEdgeLitUnit(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis, Number distance,
+                         IN(vec2) edge) {
   Number X_closest;
   Number X_span;
   Number log_span;
   Number split_distance;
-  ShadowEdgeLitUnitSpans(atmosphere, edge, X_closest, X_span, log_span, split_distance);
+  ShadowEdgeLitUnitSpans(atmosphere, sun_axis, edge, X_closest, X_span, log_span, split_distance);
   Number unused;
-  return ShadowEdgeLitUnitFrom(atmosphere, clamp(distance, SHADOW_EDGE_CLOSEST, split_distance), edge, X_closest,
-                               X_span, log_span, unused);
+  return ShadowEdgeLitUnitFrom(atmosphere, sun_axis, clamp(distance, SHADOW_EDGE_CLOSEST, split_distance), edge,
+                               X_closest, X_span, log_span, unused);
 }
 
 // Its inverse: D at position x in [0, 1], by Newton's method in s = ln D
 // from the logarithm's term alone (x rises with s, at least at 1 - w times
 // the logarithm's rate), to 1e-11 in ln D in a few steps.
-Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, Number x, IN(vec2) edge) {
+Number ShadowEdgeLitDistance(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis, Number x,
+                             IN(vec2) edge) {
   Number X_closest;
   Number X_span;
   Number log_span;
   Number split_distance;
-  ShadowEdgeLitUnitSpans(atmosphere, edge, X_closest, X_span, log_span, split_distance);
+  ShadowEdgeLitUnitSpans(atmosphere, sun_axis, edge, X_closest, X_span, log_span, split_distance);
   Number s_min = log(SHADOW_EDGE_CLOSEST);
   Number s_max = s_min + log_span;
   Number s = mix(s_min, s_max, x);
   for (int i = 0; i < 12; ++i) {
     Number slope;
-    Number error = ShadowEdgeLitUnitFrom(atmosphere, exp(s), edge, X_closest, X_span, log_span, slope) - x;
+    Number error =
+        ShadowEdgeLitUnitFrom(atmosphere, sun_axis, exp(s), edge, X_closest, X_span, log_span, slope) - x;
     Number next = clamp(s - error / slope, s_min, s_max);
     bool converged = abs(next - s) < 1e-11;
     s = next;
@@ -216,21 +222,24 @@ Number ShadowEdgePastStep(IN(AtmosphereParameters) atmosphere, IN(vec2) edge) {
 // within SHADOW_EDGE_CLOSEST of the edge, in proportion to D between the
 // columns at E and D_min; past the edge, in proportion to the angle past it
 // (negative past the first column).
-Number GetScatteringShadowEdgePosition(IN(AtmosphereParameters) atmosphere, Number D, IN(vec2) edge) {
+Number GetScatteringShadowEdgePosition(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis,
+                                       Number D, IN(vec2) edge) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
   if (D >= SHADOW_EDGE_CLOSEST) {
-    return past + ShadowEdgeLitUnit(atmosphere, D, edge) * (Number(atmosphere.scattering_mu_s_split) - past);
+    return past +
+           ShadowEdgeLitUnit(atmosphere, sun_axis, D, edge) * (Number(atmosphere.scattering_mu_s_split) - past);
   }
   if (D >= 0.0) return past - 1.0 + D / SHADOW_EDGE_CLOSEST;
   return past - 1.0 + D / ShadowEdgePastStep(atmosphere, edge);
 }
 
 // Its inverse: the sun's distance D to the edge at `position`.
-Number GetScatteringShadowEdgeDistance(IN(AtmosphereParameters) atmosphere, Number position, IN(vec2) edge) {
+Number GetScatteringShadowEdgeDistance(IN(AtmosphereParameters) atmosphere, IN(ScatteringSunAxis) sun_axis,
+                                       Number position, IN(vec2) edge) {
   Number past = Number(SHADOW_EDGE_PAST_COLUMNS);
   if (position >= past) {
     Number x = (position - past) / (Number(atmosphere.scattering_mu_s_split) - past);
-    return ShadowEdgeLitDistance(atmosphere, x, edge);
+    return ShadowEdgeLitDistance(atmosphere, sun_axis, x, edge);
   }
   if (position >= past - 1.0) return (position - past + 1.0) * SHADOW_EDGE_CLOSEST;
   return (position - past + 1.0) * ShadowEdgePastStep(atmosphere, edge);

@@ -194,7 +194,7 @@ TEST(Twilight, LowSunBlendAlongMuSIsAMonotoneCubicInLnL) {
 // the lowest is dark; per channel.
 TEST(Twilight, BelowTheLowestSunLnLIsContinuedFromTheTwoLowestColumns) {
   auto continued = [](glsl::vec4 a, glsl::vec4 b, double mu_s_a, double mu_s_b, double mu_s) {
-    return glsl::LowestSunContinued(a, b, mu_s_a, mu_s_b, mu_s);
+    return glsl::LowestSunContinued(glsl::LogLight(a), glsl::LogLight(b), mu_s_a, mu_s_b, mu_s);
   };
   auto shadowed = [](double mu_s) { return std::exp(-3.0 - 400.0 * mu_s * mu_s); };
   const double mu_s_a = -0.2079, mu_s_b = -0.1862;
@@ -209,7 +209,7 @@ TEST(Twilight, BelowTheLowestSunLnLIsContinuedFromTheTwoLowestColumns) {
   // Not rising, or dark at the lowest column: held there. Channels apart.
   const glsl::vec4 held = continued(glsl::vec4(2.0, 0.0, shadowed(mu_s_a), 0.0),
                                     glsl::vec4(1.0, 1.0, shadowed(mu_s_b), 0.0), mu_s_a, mu_s_b, -0.3);
-  EXPECT_EQ(held.x, 2.0);
+  EXPECT_DOUBLE_EQ(held.x, 2.0);
   EXPECT_EQ(held.y, 0.0);
   EXPECT_NEAR(held.z / shadowed(-0.3), 1.0, 1e-9);
 }

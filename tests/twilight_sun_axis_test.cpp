@@ -284,7 +284,7 @@ TEST(TwilightSunAxis, OwnColumnsLieWhereTheLookupReadsThem) {
   const glsl::AtmosphereParameters p = MakeAtmosphereParameters(testing::Earth(), BakeSettings());
   ASSERT_GT(p.scattering_mu_s_split, glsl::SHADOW_EDGE_PAST_COLUMNS + 1);
   const detail::OwnColumnSuns own(p);
-  const double split_sun = std::acos(glsl::GetScatteringSplitMuS(p));
+  const double split_sun = std::acos(glsl::GetScatteringSplitMuS(p, glsl::GetScatteringSunAxis(p)));
   double worst_sun = 0.0, worst_position = 0.0;
   int texels = 0;
   for (int z = 0; z < p.scattering_r_size; z += 3) {

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1076 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1091 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1076)
+    if (!_1091)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _939 = mu < 0.0;
-    bool _951;
-    if (_939)
+    bool _954 = mu < 0.0;
+    bool _966;
+    if (_954)
     {
-        _951 = (((r * r) * mu) * mu) >= c;
+        _966 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _951 = _939;
+        _966 = _954;
     }
-    return _951;
+    return _966;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _709;
+    float _724;
     if (r_mu > 0.0)
     {
-        _709 = c / (r_mu + s);
+        _724 = c / (r_mu + s);
     }
     else
     {
-        _709 = s - r_mu;
+        _724 = s - r_mu;
     }
-    float param_1 = _709;
+    float param_1 = _724;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1180;
+    float _1195;
     if (d_max > d_min)
     {
-        _1180 = (d - d_min) / (d_max - d_min);
+        _1195 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1180 = 0.0;
+        _1195 = 0.0;
     }
-    float x_mu = _1180;
+    float x_mu = _1195;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -267,16 +267,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1232;
+        float _1247;
         if (rho == d_min)
         {
-            _1232 = 0.0;
+            _1247 = 0.0;
         }
         else
         {
-            _1232 = (d - d_min) / (rho - d_min);
+            _1247 = (d - d_min) / (rho - d_min);
         }
-        return _1232;
+        return _1247;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -285,16 +285,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1267;
+    float _1282;
     if (d_max > d_min_1)
     {
-        _1267 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1282 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1267 = 0.0;
+        _1282 = 0.0;
     }
-    return _1267;
+    return _1282;
 }
 #endif
 
@@ -305,16 +305,16 @@ float GetTextureCoordFromUnitMuInHalf(thread const float& x, thread const bool& 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5 * GetTextureCoordFromUnitRange(param, param_1);
-    float _1290;
+    float _1305;
     if (ray_r_mu_intersects_ground)
     {
-        _1290 = 0.5 - u;
+        _1305 = 0.5 - u;
     }
     else
     {
-        _1290 = 0.5 + u;
+        _1305 = 0.5 + u;
     }
-    return _1290;
+    return _1305;
 }
 #endif
 
@@ -378,17 +378,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1619;
+    float _1623;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1619 = ClampCosine(param_1);
+        _1623 = ClampCosine(param_1);
     }
     else
     {
-        _1619 = 1.0;
+        _1623 = 1.0;
     }
-    return _1619;
+    return _1623;
 }
 #endif
 
@@ -396,22 +396,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _955;
+    float _970;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _955 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _970 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _955 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _970 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _955;
+    return _970;
 }
 #endif
 
@@ -468,51 +468,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1725;
+    float2 _1729;
     if (c_end >= rho)
     {
-        _1725 = float2(-1.0, 0.0);
+        _1729 = float2(-1.0, 0.0);
     }
     else
     {
-        _1725 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1729 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1725;
-    bool _1753 = end.y < 0.0;
-    bool _1763;
-    if (!_1753)
+    float2 end = _1729;
+    bool _1757 = end.y < 0.0;
+    bool _1767;
+    if (!_1757)
     {
-        _1763 = end.x < start.x;
+        _1767 = end.x < start.x;
     }
     else
     {
-        _1763 = _1753;
+        _1767 = _1757;
     }
-    bool end_sets_last = _1763;
+    bool end_sets_last = _1767;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1817;
+    float _1821;
     if (end_sets_last)
     {
-        float _1823;
+        float _1827;
         if (c_end >= rho)
         {
-            _1823 = 3.1415927410125732421875;
+            _1827 = 3.1415927410125732421875;
         }
         else
         {
-            _1823 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1827 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1817 = _1823;
+        _1821 = _1827;
     }
     else
     {
-        _1817 = acos(c_start);
+        _1821 = acos(c_start);
     }
-    float angle = _1817;
+    float angle = _1821;
     return angle + a;
 }
 #endif
@@ -545,39 +545,28 @@ float GetScatteringMuSFromUnitRangeOnAxis(thread const AtmosphereParameters& atm
     float param_1 = axis.inverse_A;
     float a = ScatteringDistanceFromUnitMuS(param, param_1);
     float d = d_min + (fast::min(a, axis.A) * (axis.H - d_min));
-    float _1437;
+    float _1452;
     if (d == 0.0)
     {
-        _1437 = 1.0;
+        _1452 = 1.0;
     }
     else
     {
         float param_2 = ((axis.H * axis.H) - (d * d)) / ((2.0 * bottom) * d);
-        _1437 = ClampCosine(param_2);
+        _1452 = ClampCosine(param_2);
     }
-    return _1437;
+    return _1452;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float GetScatteringMuSFromUnitRange(thread const AtmosphereParameters& atmosphere, thread const float& x)
+float GetScatteringSplitMuS(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis)
 {
     AtmosphereParameters param = atmosphere;
-    AtmosphereParameters param_1 = atmosphere;
-    ScatteringSunAxis param_2 = GetScatteringSunAxis(param);
-    float param_3 = x;
-    return GetScatteringMuSFromUnitRangeOnAxis(param_1, param_2, param_3);
-}
-#endif
-
-#if SKYBAKE_HAS_SCATTERING_TEXTURE
-static inline __attribute__((always_inline))
-float GetScatteringSplitMuS(thread const AtmosphereParameters& atmosphere)
-{
-    AtmosphereParameters param = atmosphere;
-    float param_1 = float(atmosphere.scattering_mu_s_split) / float(atmosphere.scattering_mu_s_size - 1);
-    return GetScatteringMuSFromUnitRange(param, param_1);
+    ScatteringSunAxis param_1 = sun_axis;
+    float param_2 = float(atmosphere.scattering_mu_s_split) / float(atmosphere.scattering_mu_s_size - 1);
+    return GetScatteringMuSFromUnitRangeOnAxis(param, param_1, param_2);
 }
 #endif
 
@@ -591,7 +580,7 @@ float ShadowEdgeSunCosine(thread const float2& edge, thread const float& D)
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float ShadowEdgeUnitSun(thread const AtmosphereParameters& atmosphere, thread const float& mu_s, thread float& derivative)
+float ShadowEdgeUnitSun(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis, thread const float& mu_s, thread float& derivative)
 {
     float bottom = atmosphere.bottom_radius;
     AtmosphereParameters param = atmosphere;
@@ -599,13 +588,11 @@ float ShadowEdgeUnitSun(thread const AtmosphereParameters& atmosphere, thread co
     float param_2 = mu_s;
     float d = DistanceToTopAtmosphereBoundary(param, param_1, param_2);
     float d_min = atmosphere.top_radius - bottom;
-    AtmosphereParameters param_3 = atmosphere;
-    ScatteringSunAxis sun_axis = GetScatteringSunAxis(param_3);
     float span = sun_axis.H - d_min;
     float a = (d - d_min) / span;
     float inverse_A = sun_axis.inverse_A;
-    float param_4 = 1.0 - (mu_s * mu_s);
-    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * SafeSqrt(param_4);
+    float param_3 = 1.0 - (mu_s * mu_s);
+    float da_dtheta = (((bottom * d) / (d + (bottom * mu_s))) / span) * SafeSqrt(param_3);
     derivative = ((-(inverse_A + 1.0)) / ((1.0 + a) * (1.0 + a))) * da_dtheta;
     return (1.0 - (a * inverse_A)) / (1.0 + a);
 }
@@ -613,43 +600,47 @@ float ShadowEdgeUnitSun(thread const AtmosphereParameters& atmosphere, thread co
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, thread const float2& edge, thread float& X_closest, thread float& X_span, thread float& log_span, thread float& split_distance)
+void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis, thread const float2& edge, thread float& X_closest, thread float& X_span, thread float& log_span, thread float& split_distance)
 {
     AtmosphereParameters param = atmosphere;
-    float split_mu_s = GetScatteringSplitMuS(param);
-    float2 param_1 = edge;
-    float param_2 = 0.0008726646192371845245361328125;
-    AtmosphereParameters param_3 = atmosphere;
-    float param_4 = ShadowEdgeSunCosine(param_1, param_2);
-    float param_5;
-    float _2027 = ShadowEdgeUnitSun(param_3, param_4, param_5);
-    float unused = param_5;
-    X_closest = _2027;
-    AtmosphereParameters param_6 = atmosphere;
-    float param_7 = split_mu_s;
-    float param_8;
-    float _2034 = ShadowEdgeUnitSun(param_6, param_7, param_8);
-    unused = param_8;
-    X_span = _2034 - X_closest;
-    float2 param_9 = edge;
+    ScatteringSunAxis param_1 = sun_axis;
+    float split_mu_s = GetScatteringSplitMuS(param, param_1);
+    float2 param_2 = edge;
+    float param_3 = 0.0008726646192371845245361328125;
+    AtmosphereParameters param_4 = atmosphere;
+    ScatteringSunAxis param_5 = sun_axis;
+    float param_6 = ShadowEdgeSunCosine(param_2, param_3);
+    float param_7;
+    float _2035 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
+    float unused = param_7;
+    X_closest = _2035;
+    AtmosphereParameters param_8 = atmosphere;
+    ScatteringSunAxis param_9 = sun_axis;
     float param_10 = split_mu_s;
-    split_distance = ShadowEdgeDistance(param_9, param_10);
+    float param_11;
+    float _2044 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
+    unused = param_11;
+    X_span = _2044 - X_closest;
+    float2 param_12 = edge;
+    float param_13 = split_mu_s;
+    split_distance = ShadowEdgeDistance(param_12, param_13);
     log_span = log(split_distance / 0.0008726646192371845245361328125);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, thread const float& D, thread const float2& edge, thread const float& X_closest, thread const float& X_span, thread const float& log_span, thread float& derivative)
+float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis, thread const float& D, thread const float2& edge, thread const float& X_closest, thread const float& X_span, thread const float& log_span, thread float& derivative)
 {
     float2 param = edge;
     float param_1 = D;
     AtmosphereParameters param_2 = atmosphere;
-    float param_3 = ShadowEdgeSunCosine(param, param_1);
-    float param_4;
-    float _1984 = ShadowEdgeUnitSun(param_2, param_3, param_4);
-    float dX_dtheta = param_4;
-    float X = _1984;
+    ScatteringSunAxis param_3 = sun_axis;
+    float param_4 = ShadowEdgeSunCosine(param, param_1);
+    float param_5;
+    float _1988 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
+    float dX_dtheta = param_5;
+    float X = _1988;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -657,29 +648,31 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread const float& _distance, thread const float2& edge)
+float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis, thread const float& _distance, thread const float2& edge)
 {
     AtmosphereParameters param = atmosphere;
-    float2 param_1 = edge;
-    float param_2;
+    ScatteringSunAxis param_1 = sun_axis;
+    float2 param_2 = edge;
     float param_3;
     float param_4;
     float param_5;
-    ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5);
-    float X_closest = param_2;
-    float X_span = param_3;
-    float log_span = param_4;
-    float split_distance = param_5;
-    AtmosphereParameters param_6 = atmosphere;
-    float param_7 = fast::clamp(_distance, 0.0008726646192371845245361328125, split_distance);
-    float2 param_8 = edge;
-    float param_9 = X_closest;
-    float param_10 = X_span;
-    float param_11 = log_span;
-    float param_12;
-    float _2079 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
-    float unused = param_12;
-    return _2079;
+    float param_6;
+    ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float X_closest = param_3;
+    float X_span = param_4;
+    float log_span = param_5;
+    float split_distance = param_6;
+    AtmosphereParameters param_7 = atmosphere;
+    ScatteringSunAxis param_8 = sun_axis;
+    float param_9 = fast::clamp(_distance, 0.0008726646192371845245361328125, split_distance);
+    float2 param_10 = edge;
+    float param_11 = X_closest;
+    float param_12 = X_span;
+    float param_13 = log_span;
+    float param_14;
+    float _2093 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+    float unused = param_14;
+    return _2093;
 }
 #endif
 
@@ -696,23 +689,24 @@ float ShadowEdgePastStep(thread const AtmosphereParameters& atmosphere, thread c
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float GetScatteringShadowEdgePosition(thread const AtmosphereParameters& atmosphere, thread const float& D, thread const float2& edge)
+float GetScatteringShadowEdgePosition(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis, thread const float& D, thread const float2& edge)
 {
     float past = 6.0;
     if (D >= 0.0008726646192371845245361328125)
     {
         AtmosphereParameters param = atmosphere;
-        float param_1 = D;
-        float2 param_2 = edge;
-        return past + (ShadowEdgeLitUnit(param, param_1, param_2) * (float(atmosphere.scattering_mu_s_split) - past));
+        ScatteringSunAxis param_1 = sun_axis;
+        float param_2 = D;
+        float2 param_3 = edge;
+        return past + (ShadowEdgeLitUnit(param, param_1, param_2, param_3) * (float(atmosphere.scattering_mu_s_split) - past));
     }
     if (D >= 0.0)
     {
         return (past - 1.0) + (D / 0.0008726646192371845245361328125);
     }
-    AtmosphereParameters param_3 = atmosphere;
-    float2 param_4 = edge;
-    return (past - 1.0) + (D / ShadowEdgePastStep(param_3, param_4));
+    AtmosphereParameters param_4 = atmosphere;
+    float2 param_5 = edge;
+    return (past - 1.0) + (D / ShadowEdgePastStep(param_4, param_5));
 }
 #endif
 
@@ -753,17 +747,17 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
     float u_mu_s = GetScatteringTextureUMuSOnAxis(param_15, param_16, param_17);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = float2(0.0);
-    bool _2389 = atmosphere.scattering_mu_s_split > 0;
-    bool _2400;
-    if (_2389)
+    bool _2409 = atmosphere.scattering_mu_s_split > 0;
+    bool _2420;
+    if (_2409)
     {
-        _2400 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2420 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2400 = _2389;
+        _2420 = _2409;
     }
-    if (_2400)
+    if (_2420)
     {
         float param_18 = mu;
         float param_19 = mu_s;
@@ -774,50 +768,53 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
         float param_24 = ViewSunAzimuthCosine(param_18, param_19, param_20);
         bool param_25 = ray_r_mu_intersects_ground;
         float2 param_26;
-        float _2420 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
+        float _2440 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
         edge = param_26;
         float2 param_27 = edge;
         float param_28 = mu_s;
         AtmosphereParameters param_29 = atmosphere;
-        float param_30 = ShadowEdgeDistance(param_27, param_28);
-        float2 param_31 = edge;
-        u_mu_s = (GetScatteringShadowEdgePosition(param_29, param_30, param_31) + 0.5) / mu_s_size;
+        ScatteringSunAxis param_30 = sun_axis;
+        float param_31 = ShadowEdgeDistance(param_27, param_28);
+        float2 param_32 = edge;
+        u_mu_s = (GetScatteringShadowEdgePosition(param_29, param_30, param_31, param_32) + 0.5) / mu_s_size;
     }
-    float param_32 = nu;
-    return float4(ScatteringUnitNu(param_32), u_mu_s, u_mu, u_r);
+    float param_33 = nu;
+    return float4(ScatteringUnitNu(param_33), u_mu_s, u_mu, u_r);
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, thread const float& x, thread const float2& edge)
+float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, thread const ScatteringSunAxis& sun_axis, thread const float& x, thread const float2& edge)
 {
     AtmosphereParameters param = atmosphere;
-    float2 param_1 = edge;
-    float param_2;
+    ScatteringSunAxis param_1 = sun_axis;
+    float2 param_2 = edge;
     float param_3;
     float param_4;
     float param_5;
-    ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5);
-    float X_closest = param_2;
-    float X_span = param_3;
-    float log_span = param_4;
-    float split_distance = param_5;
+    float param_6;
+    ShadowEdgeLitUnitSpans(param, param_1, param_2, param_3, param_4, param_5, param_6);
+    float X_closest = param_3;
+    float X_span = param_4;
+    float log_span = param_5;
+    float split_distance = param_6;
     float s_min = -7.043959140777587890625;
     float s_max = s_min + log_span;
     float s = mix(s_min, s_max, x);
-    float param_12;
+    float param_14;
     for (int i = 0; i < 12; i++)
     {
-        AtmosphereParameters param_6 = atmosphere;
-        float param_7 = exp(s);
-        float2 param_8 = edge;
-        float param_9 = X_closest;
-        float param_10 = X_span;
-        float param_11 = log_span;
-        float _2136 = ShadowEdgeLitUnitFrom(param_6, param_7, param_8, param_9, param_10, param_11, param_12);
-        float slope = param_12;
-        float error = _2136 - x;
+        AtmosphereParameters param_7 = atmosphere;
+        ScatteringSunAxis param_8 = sun_axis;
+        float param_9 = exp(s);
+        float2 param_10 = edge;
+        float param_11 = X_closest;
+        float param_12 = X_span;
+        float param_13 = log_span;
+        float _2154 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+        float slope = param_14;
+        float error = _2154 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -833,16 +830,16 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _2657;
+    float _2692;
     if (low_sun)
     {
-        _2657 = fast::min(t, 1.0);
+        _2692 = fast::min(t, 1.0);
     }
     else
     {
-        _2657 = fast::clamp(t, 0.0, 1.0);
+        _2692 = fast::clamp(t, 0.0, 1.0);
     }
-    return _2657;
+    return _2692;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -854,17 +851,17 @@ void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thre
     float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
     x_below = (mu_s_column + 0.5) / mu_s_size;
     x_above = (mu_s_column + 1.5) / mu_s_size;
-    bool _2717 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
-    bool _2723;
-    if (_2717)
+    bool _2752 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
+    bool _2758;
+    if (_2752)
     {
-        _2723 = x_below < x_low_sun;
+        _2758 = x_below < x_low_sun;
     }
     else
     {
-        _2723 = _2717;
+        _2758 = _2752;
     }
-    low_sun_below = _2723;
+    low_sun_below = _2758;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -885,10 +882,10 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
     float param_6 = nu;
     bool param_7 = ray_r_mu_intersects_ground;
     float2 param_8;
-    float4 _3268 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    float4 _3308 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float2 edge = param_8;
     ScatteringLookup lookup;
-    lookup.uvwz = _3268;
+    lookup.uvwz = _3308;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = lookup.uvwz.x * (nu_size - 1.0);
     lookup.nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
@@ -903,17 +900,17 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
     lookup.log_first_span = 1.0;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5;
-    bool _3320 = atmosphere.scattering_mu_s_split > 0;
-    bool _3329;
-    if (_3320)
+    bool _3360 = atmosphere.scattering_mu_s_split > 0;
+    bool _3369;
+    if (_3360)
     {
-        _3329 = lookup.position < float(atmosphere.scattering_mu_s_split);
+        _3369 = lookup.position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3329 = _3320;
+        _3369 = _3360;
     }
-    if (_3329)
+    if (_3369)
     {
         float past = 6.0;
         lookup.kind = 3;
@@ -934,43 +931,44 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
         }
         else
         {
-            bool _3377 = lookup.position >= (past - 1.0);
-            bool _3384;
-            if (_3377)
+            bool _3417 = lookup.position >= (past - 1.0);
+            bool _3424;
+            if (_3417)
             {
-                _3384 = lookup.position < past;
+                _3424 = lookup.position < past;
             }
             else
             {
-                _3384 = _3377;
+                _3424 = _3417;
             }
-            if (_3384)
+            if (_3424)
             {
                 float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
                 AtmosphereParameters param_15 = atmosphere;
-                float param_16 = x;
-                float2 param_17 = edge;
-                lookup.log_first_span = log(ShadowEdgeLitDistance(param_15, param_16, param_17) / 0.0008726646192371845245361328125);
+                ScatteringSunAxis param_16 = sun_axis;
+                float param_17 = x;
+                float2 param_18 = edge;
+                lookup.log_first_span = log(ShadowEdgeLitDistance(param_15, param_16, param_17, param_18) / 0.0008726646192371845245361328125);
             }
         }
         return lookup;
     }
-    AtmosphereParameters param_18 = atmosphere;
-    ScatteringSunAxis param_19 = sun_axis;
-    float param_20 = 0.100000001490116119384765625;
-    float x_low_sun = GetScatteringTextureUMuSOnAxis(param_18, param_19, param_20);
-    AtmosphereParameters param_21 = atmosphere;
-    float param_22 = lookup.uvwz.y;
-    float param_23 = x_low_sun;
-    float param_24;
+    AtmosphereParameters param_19 = atmosphere;
+    ScatteringSunAxis param_20 = sun_axis;
+    float param_21 = 0.100000001490116119384765625;
+    float x_low_sun = GetScatteringTextureUMuSOnAxis(param_19, param_20, param_21);
+    AtmosphereParameters param_22 = atmosphere;
+    float param_23 = lookup.uvwz.y;
+    float param_24 = x_low_sun;
     float param_25;
     float param_26;
-    bool param_27;
-    GetScatteringMuSColumns(param_21, param_22, param_23, param_24, param_25, param_26, param_27);
-    float x_below = param_24;
-    float x_above = param_25;
-    lookup.t = param_26;
-    bool low_sun_below = param_27;
+    float param_27;
+    bool param_28;
+    GetScatteringMuSColumns(param_22, param_23, param_24, param_25, param_26, param_27, param_28);
+    float x_below = param_25;
+    float x_above = param_26;
+    lookup.t = param_27;
+    bool low_sun_below = param_28;
     if (!low_sun_below)
     {
         lookup.kind = 0;
@@ -984,10 +982,10 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
         lookup.x = float4(x_below, x_above, 0.0, 0.0);
         lookup.low_sun = short4(bool4(true, x_above < x_low_sun, true, true));
         lookup.mu_s_a = atmosphere.scattering_mu_s_min;
-        AtmosphereParameters param_28 = atmosphere;
-        ScatteringSunAxis param_29 = sun_axis;
-        float param_30 = 1.0 / (mu_s_size - 1.0);
-        lookup.mu_s_b = GetScatteringMuSFromUnitRangeOnAxis(param_28, param_29, param_30);
+        AtmosphereParameters param_29 = atmosphere;
+        ScatteringSunAxis param_30 = sun_axis;
+        float param_31 = 1.0 / (mu_s_size - 1.0);
+        lookup.mu_s_b = GetScatteringMuSFromUnitRangeOnAxis(param_29, param_30, param_31);
         return lookup;
     }
     float column = (x_below * mu_s_size) - 0.5;
@@ -1021,33 +1019,42 @@ float4 GetScatteringAtOwnColumn(thread const AtmosphereParameters& atmosphere, t
 }
 #endif
 
+static inline __attribute__((always_inline))
+float4 LogLight(thread const float4& light)
+{
+    return log(fast::max(light, float4(1.0000000031710768509710513471353e-30)));
+}
+
+static inline __attribute__((always_inline))
+float4 IsLit(thread const float4& log_light)
+{
+    return float4(1.0) - step(log_light, float4(-69.0));
+}
+
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, thread const float4& c, thread const float4& d, thread const bool& has_a, thread const bool& has_d, thread const float& t)
+float4 LogMonotoneCubic(thread const float4& log_a, thread const float4& lb, thread const float4& lc, thread const float4& log_d, thread const bool& has_a, thread const bool& has_d, thread const float& t)
 {
-    float4 dark = float4(1.0000000031710768509710513471353e-30);
-    float4 lb = log(fast::max(b, dark));
-    float4 lc = log(fast::max(c, dark));
-    float4 _2744;
+    float4 _2768;
     if (has_a)
     {
-        _2744 = log(fast::max(a, dark));
+        _2768 = log_a;
     }
     else
     {
-        _2744 = (lb * 2.0) - lc;
+        _2768 = (lb * 2.0) - lc;
     }
-    float4 la = _2744;
-    float4 _2759;
+    float4 la = _2768;
+    float4 _2780;
     if (has_d)
     {
-        _2759 = log(fast::max(d, dark));
+        _2780 = log_d;
     }
     else
     {
-        _2759 = (lc * 2.0) - lb;
+        _2780 = (lc * 2.0) - lb;
     }
-    float4 ld = _2759;
+    float4 ld = _2780;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1060,25 +1067,14 @@ float4 LogMonotoneCubicMix(thread const float4& a, thread const float4& b, threa
     float t2 = t * t;
     float t3 = t2 * t;
     float4 cubic = (((lb * (((2.0 * t3) - (3.0 * t2)) + 1.0)) + (slope_b * ((t3 - (2.0 * t2)) + t))) + (lc * ((3.0 * t2) - (2.0 * t3)))) + (slope_c * (t3 - t2));
-    float4 lit = step(dark, fast::min(fast::min(a, b), fast::min(c, d)));
-    return exp(mix(mix(lb, lc, float4(t)), cubic, lit)) * step(dark, fast::max(b, c));
+    float4 param = fast::min(fast::min(log_a, lb), fast::min(lc, log_d));
+    return mix(mix(lb, lc, float4(t)), cubic, IsLit(param));
 }
 #endif
 
-static inline __attribute__((always_inline))
-float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
-{
-    if (!low_sun)
-    {
-        return mix(a, b, float4(t));
-    }
-    float4 dark = float4(1.0000000031710768509710513471353e-30);
-    return exp(mix(log(fast::max(a, dark)), log(fast::max(b, dark)), float4(t))) * step(dark, fast::max(a, b));
-}
-
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& position, thread const float& nu_slice, thread const float& log_first_span)
+float4 GetLogScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& position, thread const float& nu_slice, thread const float& log_first_span)
 {
     float past = 6.0;
     float intervals = float(atmosphere.scattering_mu_s_split) - past;
@@ -1086,97 +1082,122 @@ float4 GetScatteringBelowSplit(thread const AtmosphereParameters& atmosphere, te
     {
         float k = fast::min(floor(position - past), intervals - 1.0);
         float column = past + k;
+        float last = fast::min(column + 2.0, past + intervals);
         AtmosphereParameters param = atmosphere;
         float4 param_1 = uvwz;
         float param_2 = column - 1.0;
         float param_3 = nu_slice;
-        AtmosphereParameters param_4 = atmosphere;
-        float4 param_5 = uvwz;
-        float param_6 = column;
-        float param_7 = nu_slice;
-        AtmosphereParameters param_8 = atmosphere;
-        float4 param_9 = uvwz;
-        float param_10 = column + 1.0;
-        float param_11 = nu_slice;
-        AtmosphereParameters param_12 = atmosphere;
-        float4 param_13 = uvwz;
-        float param_14 = fast::min(column + 2.0, past + intervals);
-        float param_15 = nu_slice;
-        float4 param_16 = GetScatteringAtOwnColumn(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
-        float4 param_17 = GetScatteringAtOwnColumn(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
-        float4 param_18 = GetScatteringAtOwnColumn(param_8, scattering_texture, scattering_textureSmplr, param_9, param_10, param_11);
-        float4 param_19 = GetScatteringAtOwnColumn(param_12, scattering_texture, scattering_textureSmplr, param_13, param_14, param_15);
-        bool param_20 = k >= 1.0;
-        bool param_21 = (k + 2.0) <= intervals;
-        float param_22 = position - column;
-        return LogMonotoneCubicMix(param_16, param_17, param_18, param_19, param_20, param_21, param_22);
+        float4 param_4 = GetScatteringAtOwnColumn(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
+        float4 la = LogLight(param_4);
+        AtmosphereParameters param_5 = atmosphere;
+        float4 param_6 = uvwz;
+        float param_7 = column;
+        float param_8 = nu_slice;
+        float4 param_9 = GetScatteringAtOwnColumn(param_5, scattering_texture, scattering_textureSmplr, param_6, param_7, param_8);
+        float4 lb = LogLight(param_9);
+        AtmosphereParameters param_10 = atmosphere;
+        float4 param_11 = uvwz;
+        float param_12 = column + 1.0;
+        float param_13 = nu_slice;
+        float4 param_14 = GetScatteringAtOwnColumn(param_10, scattering_texture, scattering_textureSmplr, param_11, param_12, param_13);
+        float4 lc = LogLight(param_14);
+        AtmosphereParameters param_15 = atmosphere;
+        float4 param_16 = uvwz;
+        float param_17 = last;
+        float param_18 = nu_slice;
+        float4 param_19 = GetScatteringAtOwnColumn(param_15, scattering_texture, scattering_textureSmplr, param_16, param_17, param_18);
+        float4 ld = LogLight(param_19);
+        float4 param_20 = la;
+        float4 param_21 = lb;
+        float4 param_22 = lc;
+        float4 param_23 = ld;
+        bool param_24 = k >= 1.0;
+        bool param_25 = (k + 2.0) <= intervals;
+        float param_26 = position - column;
+        return LogMonotoneCubic(param_20, param_21, param_22, param_23, param_24, param_25, param_26);
     }
     if (position >= (past - 1.0))
     {
-        AtmosphereParameters param_23 = atmosphere;
-        float4 param_24 = uvwz;
-        float param_25 = past - 1.0;
-        float param_26 = nu_slice;
-        float4 at_edge = GetScatteringAtOwnColumn(param_23, scattering_texture, scattering_textureSmplr, param_24, param_25, param_26);
         AtmosphereParameters param_27 = atmosphere;
         float4 param_28 = uvwz;
-        float param_29 = past;
+        float param_29 = past - 1.0;
         float param_30 = nu_slice;
-        float4 rise = GetScatteringAtOwnColumn(param_27, scattering_texture, scattering_textureSmplr, param_28, param_29, param_30) - at_edge;
+        float4 at_edge = GetScatteringAtOwnColumn(param_27, scattering_texture, scattering_textureSmplr, param_28, param_29, param_30);
         AtmosphereParameters param_31 = atmosphere;
         float4 param_32 = uvwz;
-        float param_33 = past + 1.0;
+        float param_33 = past;
         float param_34 = nu_slice;
-        float4 second_rise = GetScatteringAtOwnColumn(param_31, scattering_texture, scattering_textureSmplr, param_32, param_33, param_34) - at_edge;
+        float4 rise = GetScatteringAtOwnColumn(param_31, scattering_texture, scattering_textureSmplr, param_32, param_33, param_34) - at_edge;
+        AtmosphereParameters param_35 = atmosphere;
+        float4 param_36 = uvwz;
+        float param_37 = past + 1.0;
+        float param_38 = nu_slice;
+        float4 second_rise = GetScatteringAtOwnColumn(param_35, scattering_texture, scattering_textureSmplr, param_36, param_37, param_38) - at_edge;
         float4 tiny = float4(1.0000000031710768509710513471353e-30);
         float4 rises = step(tiny, rise) * (float4(1.0) - step(second_rise, rise));
         float4 power = mix(float4(3.0), fast::clamp(log(fast::max(second_rise, tiny) / fast::max(rise, tiny)) / float4(log_first_span), float4(1.0), float4(10.0)), rises);
-        return at_edge + (rise * pow(float4((position - past) + 1.0), power));
+        float4 param_39 = at_edge + (rise * pow(float4((position - past) + 1.0), power));
+        return LogLight(param_39);
     }
     float x = (past - 1.0) - position;
     float k_1 = fast::min(floor(x), past - 2.0);
-    AtmosphereParameters param_35 = atmosphere;
-    float4 param_36 = uvwz;
-    float param_37 = (past - 1.0) - k_1;
-    float param_38 = nu_slice;
-    AtmosphereParameters param_39 = atmosphere;
-    float4 param_40 = uvwz;
-    float param_41 = (past - 2.0) - k_1;
-    float param_42 = nu_slice;
-    float4 param_43 = GetScatteringAtOwnColumn(param_35, scattering_texture, scattering_textureSmplr, param_36, param_37, param_38);
-    float4 param_44 = GetScatteringAtOwnColumn(param_39, scattering_texture, scattering_textureSmplr, param_40, param_41, param_42);
-    float param_45 = x - k_1;
-    bool param_46 = true;
-    return SunCosineMix(param_43, param_44, param_45, param_46);
+    AtmosphereParameters param_40 = atmosphere;
+    float4 param_41 = uvwz;
+    float param_42 = (past - 1.0) - k_1;
+    float param_43 = nu_slice;
+    float4 param_44 = GetScatteringAtOwnColumn(param_40, scattering_texture, scattering_textureSmplr, param_41, param_42, param_43);
+    AtmosphereParameters param_45 = atmosphere;
+    float4 param_46 = uvwz;
+    float param_47 = (past - 2.0) - k_1;
+    float param_48 = nu_slice;
+    float4 param_49 = GetScatteringAtOwnColumn(param_45, scattering_texture, scattering_textureSmplr, param_46, param_47, param_48);
+    return mix(LogLight(param_44), LogLight(param_49), float4(x - k_1));
 }
 #endif
 
+static inline __attribute__((always_inline))
+float4 LightFromLog(thread const float4& log_light)
+{
+    float4 param = log_light;
+    return exp(log_light) * IsLit(param);
+}
+
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 GetScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
+float4 GetLogScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const float4& uvwz, thread const float& x, thread const float& nu_slice, thread const float& nu_t, thread const bool& low_sun)
 {
     AtmosphereParameters param = atmosphere;
     float4 param_1 = uvwz;
     float param_2 = x;
     float param_3 = nu_slice;
+    float4 a = GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
     AtmosphereParameters param_4 = atmosphere;
     float4 param_5 = uvwz;
     float param_6 = x;
     float param_7 = nu_slice + 1.0;
-    float4 param_8 = GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3);
-    float4 param_9 = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
-    float param_10 = nu_t;
-    bool param_11 = low_sun;
-    return SunCosineMix(param_8, param_9, param_10, param_11);
+    float4 b = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
+    float4 _3015;
+    if (low_sun)
+    {
+        float4 param_8 = a;
+        float4 param_9 = b;
+        _3015 = mix(LogLight(param_8), LogLight(param_9), float4(nu_t));
+    }
+    else
+    {
+        float4 param_10 = mix(a, b, float4(nu_t));
+        _3015 = LogLight(param_10);
+    }
+    return _3015;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-void LowestSunLogFall(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread float4& slope, thread float4& curvature)
+void LowestSunLogFall(thread const float4& log_a, thread const float4& log_b, thread const float& mu_s_a, thread const float& mu_s_b, thread float4& slope, thread float4& curvature)
 {
-    float4 dark = float4(1.0000000031710768509710513471353e-30);
-    float4 rise = ((log(fast::max(b, dark)) - log(fast::max(a, dark))) * step(dark, a)) * (float4(1.0) - step(b, a));
+    float4 param = log_a;
+    float4 rise = ((log_b - log_a) * IsLit(param)) * (float4(1.0) - step(log_b, log_a));
     if (mu_s_b < 0.0)
     {
         float4 k = rise / float4((mu_s_a * mu_s_a) - (mu_s_b * mu_s_b));
@@ -1193,10 +1214,10 @@ void LowestSunLogFall(thread const float4& a, thread const float4& b, thread con
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 static inline __attribute__((always_inline))
-float4 LowestSunContinued(thread const float4& a, thread const float4& b, thread const float& mu_s_a, thread const float& mu_s_b, thread const float& mu_s)
+float4 LowestSunContinued(thread const float4& log_a, thread const float4& log_b, thread const float& mu_s_a, thread const float& mu_s_b, thread const float& mu_s)
 {
-    float4 param = a;
-    float4 param_1 = b;
+    float4 param = log_a;
+    float4 param_1 = log_b;
     float param_2 = mu_s_a;
     float param_3 = mu_s_b;
     float4 param_4;
@@ -1205,7 +1226,8 @@ float4 LowestSunContinued(thread const float4& a, thread const float4& b, thread
     float4 slope = param_4;
     float4 curvature = param_5;
     float d = mu_s - mu_s_a;
-    return a * exp((slope + (curvature * d)) * d);
+    float4 param_6 = log_a + ((slope + (curvature * d)) * d);
+    return LightFromLog(param_6);
 }
 #endif
 
@@ -1213,73 +1235,79 @@ float4 LowestSunContinued(thread const float4& a, thread const float4& b, thread
 static inline __attribute__((always_inline))
 float4 GetScatteringFromLookup(thread const AtmosphereParameters& atmosphere, texture3d<float> scattering_texture, sampler scattering_textureSmplr, thread const ScatteringLookup& lookup)
 {
-    if (lookup.kind == 3)
+    if (lookup.kind == 0)
     {
         AtmosphereParameters param = atmosphere;
         float4 param_1 = lookup.uvwz;
-        float param_2 = lookup.position;
+        float param_2 = lookup.x.x;
         float param_3 = lookup.nu_slice;
-        float param_4 = lookup.log_first_span;
-        AtmosphereParameters param_5 = atmosphere;
-        float4 param_6 = lookup.uvwz;
-        float param_7 = lookup.position;
-        float param_8 = lookup.nu_slice + 1.0;
-        float param_9 = lookup.log_first_span;
-        float4 param_10 = GetScatteringBelowSplit(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3, param_4);
-        float4 param_11 = GetScatteringBelowSplit(param_5, scattering_texture, scattering_textureSmplr, param_6, param_7, param_8, param_9);
-        float param_12 = lookup.nu_t;
-        bool param_13 = true;
-        return SunCosineMix(param_10, param_11, param_12, param_13);
+        AtmosphereParameters param_4 = atmosphere;
+        float4 param_5 = lookup.uvwz;
+        float param_6 = lookup.x.x;
+        float param_7 = lookup.nu_slice + 1.0;
+        return mix(GetScatteringInSlice(param, scattering_texture, scattering_textureSmplr, param_1, param_2, param_3), GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7), float4(lookup.nu_t));
     }
-    AtmosphereParameters param_14 = atmosphere;
-    float4 param_15 = lookup.uvwz;
-    float param_16 = lookup.x.x;
-    float param_17 = lookup.nu_slice;
-    float param_18 = lookup.nu_t;
-    bool param_19 = bool(lookup.low_sun.x);
-    float4 a = GetScatteringAtMuSColumn(param_14, scattering_texture, scattering_textureSmplr, param_15, param_16, param_17, param_18, param_19);
-    if (lookup.kind == 0)
+    if (lookup.kind == 3)
     {
-        return a;
+        AtmosphereParameters param_8 = atmosphere;
+        float4 param_9 = lookup.uvwz;
+        float param_10 = lookup.position;
+        float param_11 = lookup.nu_slice;
+        float param_12 = lookup.log_first_span;
+        AtmosphereParameters param_13 = atmosphere;
+        float4 param_14 = lookup.uvwz;
+        float param_15 = lookup.position;
+        float param_16 = lookup.nu_slice + 1.0;
+        float param_17 = lookup.log_first_span;
+        float4 param_18 = mix(GetLogScatteringBelowSplit(param_8, scattering_texture, scattering_textureSmplr, param_9, param_10, param_11, param_12), GetLogScatteringBelowSplit(param_13, scattering_texture, scattering_textureSmplr, param_14, param_15, param_16, param_17), float4(lookup.nu_t));
+        return LightFromLog(param_18);
     }
-    AtmosphereParameters param_20 = atmosphere;
-    float4 param_21 = lookup.uvwz;
-    float param_22 = lookup.x.y;
-    float param_23 = lookup.nu_slice;
-    float param_24 = lookup.nu_t;
-    bool param_25 = bool(lookup.low_sun.y);
-    float4 b = GetScatteringAtMuSColumn(param_20, scattering_texture, scattering_textureSmplr, param_21, param_22, param_23, param_24, param_25);
+    AtmosphereParameters param_19 = atmosphere;
+    float4 param_20 = lookup.uvwz;
+    float param_21 = lookup.x.x;
+    float param_22 = lookup.nu_slice;
+    float param_23 = lookup.nu_t;
+    bool param_24 = bool(lookup.low_sun.x);
+    float4 a = GetLogScatteringAtMuSColumn(param_19, scattering_texture, scattering_textureSmplr, param_20, param_21, param_22, param_23, param_24);
+    AtmosphereParameters param_25 = atmosphere;
+    float4 param_26 = lookup.uvwz;
+    float param_27 = lookup.x.y;
+    float param_28 = lookup.nu_slice;
+    float param_29 = lookup.nu_t;
+    bool param_30 = bool(lookup.low_sun.y);
+    float4 b = GetLogScatteringAtMuSColumn(param_25, scattering_texture, scattering_textureSmplr, param_26, param_27, param_28, param_29, param_30);
     if (lookup.kind == 2)
     {
-        float4 param_26 = a;
-        float4 param_27 = b;
-        float param_28 = lookup.mu_s_a;
-        float param_29 = lookup.mu_s_b;
-        float param_30 = lookup.mu_s;
-        return LowestSunContinued(param_26, param_27, param_28, param_29, param_30);
+        float4 param_31 = a;
+        float4 param_32 = b;
+        float param_33 = lookup.mu_s_a;
+        float param_34 = lookup.mu_s_b;
+        float param_35 = lookup.mu_s;
+        return LowestSunContinued(param_31, param_32, param_33, param_34, param_35);
     }
-    AtmosphereParameters param_31 = atmosphere;
-    float4 param_32 = lookup.uvwz;
-    float param_33 = lookup.x.z;
-    float param_34 = lookup.nu_slice;
-    float param_35 = lookup.nu_t;
-    bool param_36 = bool(lookup.low_sun.z);
-    float4 c = GetScatteringAtMuSColumn(param_31, scattering_texture, scattering_textureSmplr, param_32, param_33, param_34, param_35, param_36);
-    AtmosphereParameters param_37 = atmosphere;
-    float4 param_38 = lookup.uvwz;
-    float param_39 = lookup.x.w;
-    float param_40 = lookup.nu_slice;
-    float param_41 = lookup.nu_t;
-    bool param_42 = bool(lookup.low_sun.w);
-    float4 d = GetScatteringAtMuSColumn(param_37, scattering_texture, scattering_textureSmplr, param_38, param_39, param_40, param_41, param_42);
-    float4 param_43 = a;
-    float4 param_44 = b;
-    float4 param_45 = c;
-    float4 param_46 = d;
-    bool param_47 = bool(lookup.has_first);
-    bool param_48 = bool(lookup.has_last);
-    float param_49 = lookup.t;
-    return LogMonotoneCubicMix(param_43, param_44, param_45, param_46, param_47, param_48, param_49);
+    AtmosphereParameters param_36 = atmosphere;
+    float4 param_37 = lookup.uvwz;
+    float param_38 = lookup.x.z;
+    float param_39 = lookup.nu_slice;
+    float param_40 = lookup.nu_t;
+    bool param_41 = bool(lookup.low_sun.z);
+    float4 c = GetLogScatteringAtMuSColumn(param_36, scattering_texture, scattering_textureSmplr, param_37, param_38, param_39, param_40, param_41);
+    AtmosphereParameters param_42 = atmosphere;
+    float4 param_43 = lookup.uvwz;
+    float param_44 = lookup.x.w;
+    float param_45 = lookup.nu_slice;
+    float param_46 = lookup.nu_t;
+    bool param_47 = bool(lookup.low_sun.w);
+    float4 d = GetLogScatteringAtMuSColumn(param_42, scattering_texture, scattering_textureSmplr, param_43, param_44, param_45, param_46, param_47);
+    float4 param_48 = a;
+    float4 param_49 = b;
+    float4 param_50 = c;
+    float4 param_51 = d;
+    bool param_52 = bool(lookup.has_first);
+    bool param_53 = bool(lookup.has_last);
+    float param_54 = lookup.t;
+    float4 param_55 = LogMonotoneCubic(param_48, param_49, param_50, param_51, param_52, param_53, param_54);
+    return LightFromLog(param_55);
 }
 #endif
 
@@ -1299,16 +1327,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScatteringFromLookup(param_6, scattering_texture, scattering_textureSmplr, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3826;
+        float3 _3897;
         if (scattering.x > 0.0)
         {
-            _3826 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3897 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3826 = float3(0.0);
+            _3897 = float3(0.0);
         }
-        single_mie_scattering = _3826;
+        single_mie_scattering = _3897;
     }
     else
     {
@@ -1379,9 +1407,9 @@ float3 GetSkyRadianceOfRay(thread const AtmosphereParameters& atmosphere, textur
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3882 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3953 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3882;
+    float3 scattering = _3953;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1402,13 +1430,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3917 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _3988 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3917)
+    if (!_3988)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1417,19 +1445,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _3937;
+    float3 _4008;
     if (ray_r_mu_intersects_ground)
     {
-        _3937 = float3(0.0);
+        _4008 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _3937 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _4008 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _3937;
+    transmittance = _4008;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1453,16 +1481,16 @@ static inline __attribute__((always_inline))
 float GetUnitMuInHalfFromTextureCoord(thread const float& u, thread const int& size, thread bool& ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5;
-    float _1304;
+    float _1319;
     if (ray_r_mu_intersects_ground)
     {
-        _1304 = 1.0 - (2.0 * u);
+        _1319 = 1.0 - (2.0 * u);
     }
     else
     {
-        _1304 = (2.0 * u) - 1.0;
+        _1319 = (2.0 * u) - 1.0;
     }
-    float param = _1304;
+    float param = _1319;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1485,25 +1513,25 @@ float3 GetSkyViewRay(thread const AtmosphereParameters& atmosphere, thread const
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _5098 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5169 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _5098;
+    float x = _5169;
     float e = (1.0 - x) * (1.0 - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _5119;
+    float _5190;
     if (ray_r_mu_intersects_ground)
     {
-        _5119 = theta_h + (e * (3.1415927410125732421875 - theta_h));
+        _5190 = theta_h + (e * (3.1415927410125732421875 - theta_h));
     }
     else
     {
-        _5119 = theta_h * (1.0 - e);
+        _5190 = theta_h * (1.0 - e);
     }
-    float theta = _5119;
+    float theta = _5190;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875 * fast::clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0, 1.0);
@@ -1528,9 +1556,9 @@ float3 GetSkyViewRadiance(thread const AtmosphereParameters& atmosphere, texture
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5208 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5279 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5208;
+    float3 view_ray = _5279;
     float3 up = fast::normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1558,16 +1586,16 @@ void GetSkyViewAngles(thread const float3& camera, thread const float3& view_ray
     theta = precise::atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _5084;
+    float _5155;
     if ((along != 0.0) || (side != 0.0))
     {
-        _5084 = precise::atan2(side, along);
+        _5155 = precise::atan2(side, along);
     }
     else
     {
-        _5084 = 0.0;
+        _5155 = 0.0;
     }
-    phi = _5084;
+    phi = _5155;
 }
 #endif
 
@@ -1578,16 +1606,16 @@ float2 GetSkyViewUvFromAngles(thread const AtmosphereParameters& atmosphere, thr
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _5005;
+    float _5076;
     if (ray_r_mu_intersects_ground)
     {
-        _5005 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
+        _5076 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
     }
     else
     {
-        _5005 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
+        _5076 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
     }
-    float x = _5005;
+    float x = _5076;
     float param_2 = phi / 3.1415927410125732421875;
     int param_3 = 192;
     float param_4 = x;
@@ -1610,19 +1638,19 @@ float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, 
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5270;
+    float3 _5341;
     if (ray_r_mu_intersects_ground)
     {
-        _5270 = float3(0.0);
+        _5341 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5270 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
+        _5341 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
     }
-    transmittance = _5270;
+    transmittance = _5341;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1670,16 +1698,16 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
 {
-    float _4041;
+    float _4112;
     if ((a > 0.0) && (b > 0.0))
     {
-        _4041 = a * exp(f * log(b / a));
+        _4112 = a * exp(f * log(b / a));
     }
     else
     {
-        _4041 = mix(a, b, f);
+        _4112 = mix(a, b, f);
     }
-    return _4041;
+    return _4112;
 }
 #endif
 
@@ -1750,16 +1778,16 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
 static inline __attribute__((always_inline))
 float MeanAttenuation(thread const float& depth)
 {
-    float _4291;
+    float _4362;
     if (depth < 9.9999997473787516355514526367188e-05)
     {
-        _4291 = 1.0 - (0.5 * depth);
+        _4362 = 1.0 - (0.5 * depth);
     }
     else
     {
-        _4291 = (1.0 - exp(-depth)) / depth;
+        _4362 = (1.0 - exp(-depth)) / depth;
     }
-    return _4291;
+    return _4362;
 }
 #endif
 
@@ -1796,10 +1824,10 @@ float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d
         float mu_s_t = ClampCosine(param_9);
         AtmosphereParameters param_10 = atmosphere;
         float param_11 = altitude;
-        float3 _4371 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+        float3 _4442 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
         float3 mie_scattering = param_12;
         float3 rayleigh_scattering = param_13;
-        float3 extinction = _4371;
+        float3 extinction = _4442;
         AtmosphereParameters param_14 = atmosphere;
         float param_15 = r_t;
         float param_16 = mu_s_t;
@@ -1858,10 +1886,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4237 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4308 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4237;
+        float3 extinction = _4308;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1936,14 +1964,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _4261;
+    float3 _4332;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4261 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4332 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1952,9 +1980,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4261 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _4332 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _4261;
+    return _4332;
 }
 #endif
 
@@ -1968,16 +1996,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _4003;
+    float _4074;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _4003 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _4074 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _4003 = up;
+        _4074 = up;
     }
-    return _4003;
+    return _4074;
 }
 #endif
 
@@ -2001,13 +2029,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4517 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4588 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4517)
+    if (!_4588)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -2047,11 +2075,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_27;
         float3 param_28;
         float3 param_29;
-        float3 _4612 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
+        float3 _4683 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
         single_rayleigh = param_27;
         single_mie = param_28;
         lit_weight = param_29;
-        lit_optical_depth = _4612;
+        lit_optical_depth = _4683;
     }
     float3 optical_depth = lit_optical_depth;
     if ((direct > 0.0) && (lit < d))
@@ -2065,11 +2093,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_36;
         float3 param_37;
         float3 param_38;
-        float3 _4646 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
+        float3 _4717 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
         float3 unused_rayleigh = param_36;
         float3 unused_mie = param_37;
         float3 unused_weight = param_38;
-        optical_depth += _4646;
+        optical_depth += _4717;
     }
     if (direct < 1.0)
     {
@@ -2088,9 +2116,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_48 = nu;
     bool param_49 = ray_r_mu_intersects_ground;
     float3 param_50;
-    float3 _4689 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
+    float3 _4760 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
     float3 single_mie_scattering = param_50;
-    float3 scattering = _4689;
+    float3 scattering = _4760;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_51 = atmosphere;
@@ -2111,11 +2139,11 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float3 param_64;
         float3 param_65;
         float3 param_66;
-        float3 _4737 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
+        float3 _4808 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
         float3 far_rayleigh = param_64;
         float3 far_mie = param_65;
         float3 far_weight = param_66;
-        float3 far_optical_depth = _4737;
+        float3 far_optical_depth = _4808;
         if (far < boundary)
         {
             AtmosphereParameters param_67 = atmosphere;
@@ -2135,9 +2163,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_80 = nu;
             bool param_81 = ray_r_mu_intersects_ground;
             float3 param_82;
-            float3 _4791 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
+            float3 _4862 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
             float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4791);
+            scattering -= (exp(-far_optical_depth) * _4862);
         }
         float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
         float param_83 = nu;
@@ -2158,9 +2186,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_95 = nu;
     bool param_96 = ray_r_mu_intersects_ground;
     float3 param_97;
-    float3 _4856 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
+    float3 _4927 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
     float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4856;
+    float3 scattering_p = _4927;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
@@ -2181,9 +2209,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4900 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _4971 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4900;
+    return _4971;
 }
 #endif
 
@@ -2213,9 +2241,9 @@ float3 GetAerialPerspectiveVoxel(thread const AtmosphereParameters& atmosphere, 
     float3 param_3 = point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5364 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
+    float3 _5435 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5364;
+    float3 radiance = _5435;
     optical_depth = -log(fast::max(transmittance, float3(1.0000000031710768509710513471353e-30)));
     return radiance;
 }
@@ -2245,16 +2273,16 @@ float3 GetSkyRadianceToPointFromVolume(texture3d<float> radiance_volume, sampler
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1497;
+    float _1501;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1497 = 0.100000001490116119384765625;
+        _1501 = 0.100000001490116119384765625;
     }
     else
     {
-        _1497 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1501 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1497;
+    return _1501;
 }
 #endif
 
@@ -2264,16 +2292,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1515;
+    float _1519;
     if (mu_s < knee)
     {
-        _1515 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1519 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1515 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1519 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1515;
+    return _1519;
 }
 #endif
 
@@ -2302,16 +2330,31 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1546;
+    float _1550;
     if (x < 0.5)
     {
-        _1546 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1550 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1546 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1550 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1546;
+    return _1550;
+}
+#endif
+
+#if SKYBAKE_HAS_IRRADIANCE_TEXTURE
+static inline __attribute__((always_inline))
+float4 SunCosineMix(thread const float4& a, thread const float4& b, thread const float& t, thread const bool& low_sun)
+{
+    if (!low_sun)
+    {
+        return mix(a, b, float4(t));
+    }
+    float4 param = a;
+    float4 param_1 = b;
+    float4 param_2 = mix(LogLight(param), LogLight(param_1), float4(t));
+    return LightFromLog(param_2);
 }
 #endif
 
@@ -2324,16 +2367,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2680;
+    float4 _2715;
     if (t < 0.0)
     {
-        _2680 = fast::min(blend, a);
+        _2715 = fast::min(blend, a);
     }
     else
     {
-        _2680 = blend;
+        _2715 = blend;
     }
-    return _2680;
+    return _2715;
 }
 #endif
 

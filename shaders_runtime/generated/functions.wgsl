@@ -77,6 +77,10 @@ const SHADOW_EDGE_CLOSEST: f32 = 0.0008726646f;
 
 const SHADOW_EDGE_LEAST_PAST_SPAN: f32 = 0.034906585f;
 
+const DARK_LIGHT: f32 = 0.000000000000000000000000000001f;
+
+const LOG_DARK_LIGHT: f32 = -69f;
+
 const SCATTERING_DAYLIGHT: i32 = 0i;
 
 const SCATTERING_LOW_SUN: i32 = 1i;
@@ -1422,78 +1426,80 @@ fn ShadowEdgeSunCosine(edge_4: vec2<f32>, D_1: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringSplitMuS(atmosphere_52: AtmosphereParameters) -> f32 {
+fn GetScatteringSplitMuS(atmosphere_52: AtmosphereParameters, sun_axis: ScatteringSunAxis) -> f32 {
     var atmosphere_53: AtmosphereParameters;
+    var sun_axis_1: ScatteringSunAxis;
 
     atmosphere_53 = atmosphere_52;
-    let _e14 = atmosphere_53;
-    let _e15 = atmosphere_53;
+    sun_axis_1 = sun_axis;
+    let _e16 = atmosphere_53;
+    let _e17 = sun_axis_1;
     let _e18 = atmosphere_53;
-    let _e24 = GetScatteringMuSFromUnitRange(_e14, (f32(_e15.scattering_mu_s_split) / f32((_e18.scattering_mu_s_size - 1i))));
-    return _e24;
+    let _e21 = atmosphere_53;
+    let _e27 = GetScatteringMuSFromUnitRangeOnAxis(_e16, _e17, (f32(_e18.scattering_mu_s_split) / f32((_e21.scattering_mu_s_size - 1i))));
+    return _e27;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeUnitSun(atmosphere_54: AtmosphereParameters, mu_s_19: f32, derivative: ptr<function, f32>) -> f32 {
+fn ShadowEdgeUnitSun(atmosphere_54: AtmosphereParameters, sun_axis_2: ScatteringSunAxis, mu_s_19: f32, derivative: ptr<function, f32>) -> f32 {
     var atmosphere_55: AtmosphereParameters;
+    var sun_axis_3: ScatteringSunAxis;
     var mu_s_20: f32;
     var bottom_1: f32;
     var d_14: f32;
     var d_min_8: f32;
-    var sun_axis: ScatteringSunAxis;
     var span: f32;
     var a_7: f32;
     var inverse_A_4: f32;
     var da_dtheta: f32;
 
     atmosphere_55 = atmosphere_54;
+    sun_axis_3 = sun_axis_2;
     mu_s_20 = mu_s_19;
-    let _e17 = atmosphere_55;
-    bottom_1 = _e17.bottom_radius;
-    let _e20 = atmosphere_55;
-    let _e21 = bottom_1;
-    let _e22 = mu_s_20;
-    let _e23 = DistanceToTopAtmosphereBoundary(_e20, _e21, _e22);
-    d_14 = _e23;
-    let _e25 = atmosphere_55;
-    let _e27 = bottom_1;
-    d_min_8 = (_e25.top_radius - _e27);
-    let _e30 = atmosphere_55;
-    let _e31 = GetScatteringSunAxis(_e30);
-    sun_axis = _e31;
-    let _e33 = sun_axis;
-    let _e35 = d_min_8;
-    span = (_e33.H - _e35);
-    let _e38 = d_14;
-    let _e39 = d_min_8;
-    let _e41 = span;
-    a_7 = ((_e38 - _e39) / _e41);
-    let _e44 = sun_axis;
-    inverse_A_4 = _e44.inverse_A;
-    let _e47 = bottom_1;
-    let _e48 = d_14;
-    let _e50 = d_14;
-    let _e51 = bottom_1;
-    let _e52 = mu_s_20;
-    let _e56 = span;
+    let _e19 = atmosphere_55;
+    bottom_1 = _e19.bottom_radius;
+    let _e22 = atmosphere_55;
+    let _e23 = bottom_1;
+    let _e24 = mu_s_20;
+    let _e25 = DistanceToTopAtmosphereBoundary(_e22, _e23, _e24);
+    d_14 = _e25;
+    let _e27 = atmosphere_55;
+    let _e29 = bottom_1;
+    d_min_8 = (_e27.top_radius - _e29);
+    let _e32 = sun_axis_3;
+    let _e34 = d_min_8;
+    span = (_e32.H - _e34);
+    let _e37 = d_14;
+    let _e38 = d_min_8;
+    let _e40 = span;
+    a_7 = ((_e37 - _e38) / _e40);
+    let _e43 = sun_axis_3;
+    inverse_A_4 = _e43.inverse_A;
+    let _e46 = bottom_1;
+    let _e47 = d_14;
+    let _e49 = d_14;
+    let _e50 = bottom_1;
+    let _e51 = mu_s_20;
+    let _e55 = span;
+    let _e58 = mu_s_20;
     let _e59 = mu_s_20;
-    let _e60 = mu_s_20;
-    let _e63 = SafeSqrt((1f - (_e59 * _e60)));
-    da_dtheta = ((((_e47 * _e48) / (_e50 + (_e51 * _e52))) / _e56) * _e63);
-    let _e66 = inverse_A_4;
-    let _e71 = a_7;
-    let _e74 = a_7;
-    let _e78 = da_dtheta;
-    (*derivative) = ((-((_e66 + 1f)) / ((1f + _e71) * (1f + _e74))) * _e78);
-    let _e81 = a_7;
-    let _e82 = inverse_A_4;
-    let _e86 = a_7;
-    return ((1f - (_e81 * _e82)) / (1f + _e86));
+    let _e62 = SafeSqrt((1f - (_e58 * _e59)));
+    da_dtheta = ((((_e46 * _e47) / (_e49 + (_e50 * _e51))) / _e55) * _e62);
+    let _e65 = inverse_A_4;
+    let _e70 = a_7;
+    let _e73 = a_7;
+    let _e77 = da_dtheta;
+    (*derivative) = ((-((_e65 + 1f)) / ((1f + _e70) * (1f + _e73))) * _e77);
+    let _e80 = a_7;
+    let _e81 = inverse_A_4;
+    let _e85 = a_7;
+    return ((1f - (_e80 * _e81)) / (1f + _e85));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitFrom(atmosphere_56: AtmosphereParameters, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
+fn ShadowEdgeLitUnitFrom(atmosphere_56: AtmosphereParameters, sun_axis_4: ScatteringSunAxis, D_3: f32, edge_6: vec2<f32>, X_closest: f32, X_span: f32, log_span: f32, derivative_1: ptr<function, f32>) -> f32 {
     var atmosphere_57: AtmosphereParameters;
+    var sun_axis_5: ScatteringSunAxis;
     var D_4: f32;
     var edge_7: vec2<f32>;
     var X_closest_1: f32;
@@ -1503,64 +1509,72 @@ fn ShadowEdgeLitUnitFrom(atmosphere_56: AtmosphereParameters, D_3: f32, edge_6: 
     var X: f32;
 
     atmosphere_57 = atmosphere_56;
+    sun_axis_5 = sun_axis_4;
     D_4 = D_3;
     edge_7 = edge_6;
     X_closest_1 = X_closest;
     X_span_1 = X_span;
     log_span_1 = log_span;
-    let _e26 = atmosphere_57;
-    let _e27 = edge_7;
-    let _e28 = D_4;
-    let _e29 = ShadowEdgeSunCosine(_e27, _e28);
-    let _e32 = ShadowEdgeUnitSun(_e26, _e29, (&dX_dtheta));
-    X = _e32;
-    let _e36 = dX_dtheta;
-    let _e38 = D_4;
-    let _e40 = X_span_1;
-    let _e45 = log_span_1;
-    (*derivative_1) = ((((-0.3f * _e36) * _e38) / _e40) + (0.7f / _e45));
-    let _e48 = X;
-    let _e49 = X_closest_1;
-    let _e52 = X_span_1;
-    let _e57 = D_4;
-    let _e61 = log_span_1;
-    return (((SHADOW_EDGE_TABLES_WEIGHT * (_e48 - _e49)) / _e52) + ((0.7f * log((_e57 / SHADOW_EDGE_CLOSEST))) / _e61));
+    let _e28 = atmosphere_57;
+    let _e29 = sun_axis_5;
+    let _e30 = edge_7;
+    let _e31 = D_4;
+    let _e32 = ShadowEdgeSunCosine(_e30, _e31);
+    let _e35 = ShadowEdgeUnitSun(_e28, _e29, _e32, (&dX_dtheta));
+    X = _e35;
+    let _e39 = dX_dtheta;
+    let _e41 = D_4;
+    let _e43 = X_span_1;
+    let _e48 = log_span_1;
+    (*derivative_1) = ((((-0.3f * _e39) * _e41) / _e43) + (0.7f / _e48));
+    let _e51 = X;
+    let _e52 = X_closest_1;
+    let _e55 = X_span_1;
+    let _e60 = D_4;
+    let _e64 = log_span_1;
+    return (((SHADOW_EDGE_TABLES_WEIGHT * (_e51 - _e52)) / _e55) + ((0.7f * log((_e60 / SHADOW_EDGE_CLOSEST))) / _e64));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnitSpans(atmosphere_58: AtmosphereParameters, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
+fn ShadowEdgeLitUnitSpans(atmosphere_58: AtmosphereParameters, sun_axis_6: ScatteringSunAxis, edge_8: vec2<f32>, X_closest_2: ptr<function, f32>, X_span_2: ptr<function, f32>, log_span_2: ptr<function, f32>, split_distance: ptr<function, f32>) {
     var atmosphere_59: AtmosphereParameters;
+    var sun_axis_7: ScatteringSunAxis;
     var edge_9: vec2<f32>;
     var unused_1: f32;
     var split_mu_s: f32;
 
     atmosphere_59 = atmosphere_58;
+    sun_axis_7 = sun_axis_6;
     edge_9 = edge_8;
-    let _e21 = atmosphere_59;
-    let _e22 = GetScatteringSplitMuS(_e21);
-    split_mu_s = _e22;
-    let _e24 = atmosphere_59;
-    let _e25 = edge_9;
-    let _e26 = ShadowEdgeSunCosine(_e25, SHADOW_EDGE_CLOSEST);
-    let _e29 = ShadowEdgeUnitSun(_e24, _e26, (&unused_1));
-    (*X_closest_2) = _e29;
-    let _e30 = atmosphere_59;
-    let _e31 = split_mu_s;
-    let _e34 = ShadowEdgeUnitSun(_e30, _e31, (&unused_1));
-    let _e35 = (*X_closest_2);
-    (*X_span_2) = (_e34 - _e35);
-    let _e37 = edge_9;
-    let _e38 = split_mu_s;
-    let _e39 = ShadowEdgeDistance(_e37, _e38);
-    (*split_distance) = _e39;
-    let _e40 = (*split_distance);
-    (*log_span_2) = log((_e40 / SHADOW_EDGE_CLOSEST));
+    let _e23 = atmosphere_59;
+    let _e24 = sun_axis_7;
+    let _e25 = GetScatteringSplitMuS(_e23, _e24);
+    split_mu_s = _e25;
+    let _e27 = atmosphere_59;
+    let _e28 = sun_axis_7;
+    let _e29 = edge_9;
+    let _e30 = ShadowEdgeSunCosine(_e29, SHADOW_EDGE_CLOSEST);
+    let _e33 = ShadowEdgeUnitSun(_e27, _e28, _e30, (&unused_1));
+    (*X_closest_2) = _e33;
+    let _e34 = atmosphere_59;
+    let _e35 = sun_axis_7;
+    let _e36 = split_mu_s;
+    let _e39 = ShadowEdgeUnitSun(_e34, _e35, _e36, (&unused_1));
+    let _e40 = (*X_closest_2);
+    (*X_span_2) = (_e39 - _e40);
+    let _e42 = edge_9;
+    let _e43 = split_mu_s;
+    let _e44 = ShadowEdgeDistance(_e42, _e43);
+    (*split_distance) = _e44;
+    let _e45 = (*split_distance);
+    (*log_span_2) = log((_e45 / SHADOW_EDGE_CLOSEST));
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitUnit(atmosphere_60: AtmosphereParameters, distance_: f32, edge_10: vec2<f32>) -> f32 {
+fn ShadowEdgeLitUnit(atmosphere_60: AtmosphereParameters, sun_axis_8: ScatteringSunAxis, distance_: f32, edge_10: vec2<f32>) -> f32 {
     var atmosphere_61: AtmosphereParameters;
+    var sun_axis_9: ScatteringSunAxis;
     var distance_1: f32;
     var edge_11: vec2<f32>;
     var X_closest_3: f32;
@@ -1570,25 +1584,29 @@ fn ShadowEdgeLitUnit(atmosphere_60: AtmosphereParameters, distance_: f32, edge_1
     var unused_2: f32;
 
     atmosphere_61 = atmosphere_60;
+    sun_axis_9 = sun_axis_8;
     distance_1 = distance_;
     edge_11 = edge_10;
-    let _e22 = atmosphere_61;
-    let _e23 = edge_11;
-    ShadowEdgeLitUnitSpans(_e22, _e23, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
-    let _e33 = atmosphere_61;
-    let _e34 = distance_1;
-    let _e35 = split_distance_1;
-    let _e37 = edge_11;
-    let _e38 = X_closest_3;
-    let _e39 = X_span_3;
-    let _e40 = log_span_3;
-    let _e43 = ShadowEdgeLitUnitFrom(_e33, clamp(_e34, SHADOW_EDGE_CLOSEST, _e35), _e37, _e38, _e39, _e40, (&unused_2));
-    return _e43;
+    let _e24 = atmosphere_61;
+    let _e25 = sun_axis_9;
+    let _e26 = edge_11;
+    ShadowEdgeLitUnitSpans(_e24, _e25, _e26, (&X_closest_3), (&X_span_3), (&log_span_3), (&split_distance_1));
+    let _e36 = atmosphere_61;
+    let _e37 = sun_axis_9;
+    let _e38 = distance_1;
+    let _e39 = split_distance_1;
+    let _e41 = edge_11;
+    let _e42 = X_closest_3;
+    let _e43 = X_span_3;
+    let _e44 = log_span_3;
+    let _e47 = ShadowEdgeLitUnitFrom(_e36, _e37, clamp(_e38, SHADOW_EDGE_CLOSEST, _e39), _e41, _e42, _e43, _e44, (&unused_2));
+    return _e47;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn ShadowEdgeLitDistance(atmosphere_62: AtmosphereParameters, x_15: f32, edge_12: vec2<f32>) -> f32 {
+fn ShadowEdgeLitDistance(atmosphere_62: AtmosphereParameters, sun_axis_10: ScatteringSunAxis, x_15: f32, edge_12: vec2<f32>) -> f32 {
     var atmosphere_63: AtmosphereParameters;
+    var sun_axis_11: ScatteringSunAxis;
     var x_16: f32;
     var edge_13: vec2<f32>;
     var X_closest_4: f32;
@@ -1605,56 +1623,59 @@ fn ShadowEdgeLitDistance(atmosphere_62: AtmosphereParameters, x_15: f32, edge_12
     var converged: bool;
 
     atmosphere_63 = atmosphere_62;
+    sun_axis_11 = sun_axis_10;
     x_16 = x_15;
     edge_13 = edge_12;
-    let _e22 = atmosphere_63;
-    let _e23 = edge_13;
-    ShadowEdgeLitUnitSpans(_e22, _e23, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
-    let _e35 = s_min;
-    let _e36 = log_span_4;
-    s_max = (_e35 + _e36);
-    let _e39 = s_min;
-    let _e40 = s_max;
-    let _e41 = x_16;
-    s_2 = mix(_e39, _e40, _e41);
+    let _e24 = atmosphere_63;
+    let _e25 = sun_axis_11;
+    let _e26 = edge_13;
+    ShadowEdgeLitUnitSpans(_e24, _e25, _e26, (&X_closest_4), (&X_span_4), (&log_span_4), (&split_distance_2));
+    let _e38 = s_min;
+    let _e39 = log_span_4;
+    s_max = (_e38 + _e39);
+    let _e42 = s_min;
+    let _e43 = s_max;
+    let _e44 = x_16;
+    s_2 = mix(_e42, _e43, _e44);
     loop {
-        let _e46 = i;
-        if !((_e46 < 12i)) {
+        let _e49 = i;
+        if !((_e49 < 12i)) {
             break;
         }
         {
-            let _e54 = atmosphere_63;
-            let _e55 = s_2;
-            let _e57 = edge_13;
-            let _e58 = X_closest_4;
-            let _e59 = X_span_4;
-            let _e60 = log_span_4;
-            let _e63 = ShadowEdgeLitUnitFrom(_e54, exp(_e55), _e57, _e58, _e59, _e60, (&slope));
-            let _e64 = x_16;
-            error = (_e63 - _e64);
-            let _e67 = s_2;
-            let _e68 = error;
-            let _e69 = slope;
-            let _e72 = s_min;
-            let _e73 = s_max;
-            next = clamp((_e67 - (_e68 / _e69)), _e72, _e73);
-            let _e76 = next;
-            let _e77 = s_2;
-            converged = (abs((_e76 - _e77)) < 0.00000000001f);
-            let _e83 = next;
-            s_2 = _e83;
-            let _e84 = converged;
-            if _e84 {
+            let _e57 = atmosphere_63;
+            let _e58 = sun_axis_11;
+            let _e59 = s_2;
+            let _e61 = edge_13;
+            let _e62 = X_closest_4;
+            let _e63 = X_span_4;
+            let _e64 = log_span_4;
+            let _e67 = ShadowEdgeLitUnitFrom(_e57, _e58, exp(_e59), _e61, _e62, _e63, _e64, (&slope));
+            let _e68 = x_16;
+            error = (_e67 - _e68);
+            let _e71 = s_2;
+            let _e72 = error;
+            let _e73 = slope;
+            let _e76 = s_min;
+            let _e77 = s_max;
+            next = clamp((_e71 - (_e72 / _e73)), _e76, _e77);
+            let _e80 = next;
+            let _e81 = s_2;
+            converged = (abs((_e80 - _e81)) < 0.00000000001f);
+            let _e87 = next;
+            s_2 = _e87;
+            let _e88 = converged;
+            if _e88 {
                 break;
             }
         }
         continuing {
-            let _e50 = i;
-            i = (_e50 + 1i);
+            let _e53 = i;
+            i = (_e53 + 1i);
         }
     }
-    let _e85 = s_2;
-    return exp(_e85);
+    let _e89 = s_2;
+    return exp(_e89);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1674,82 +1695,88 @@ fn ShadowEdgePastStep(atmosphere_64: AtmosphereParameters, edge_14: vec2<f32>) -
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgePosition(atmosphere_66: AtmosphereParameters, D_5: f32, edge_16: vec2<f32>) -> f32 {
+fn GetScatteringShadowEdgePosition(atmosphere_66: AtmosphereParameters, sun_axis_12: ScatteringSunAxis, D_5: f32, edge_16: vec2<f32>) -> f32 {
     var atmosphere_67: AtmosphereParameters;
+    var sun_axis_13: ScatteringSunAxis;
     var D_6: f32;
     var edge_17: vec2<f32>;
     var past: f32 = 6f;
 
     atmosphere_67 = atmosphere_66;
+    sun_axis_13 = sun_axis_12;
     D_6 = D_5;
     edge_17 = edge_16;
-    let _e21 = D_6;
-    if (_e21 >= SHADOW_EDGE_CLOSEST) {
+    let _e23 = D_6;
+    if (_e23 >= SHADOW_EDGE_CLOSEST) {
         {
-            let _e23 = past;
-            let _e24 = atmosphere_67;
-            let _e25 = D_6;
-            let _e26 = edge_17;
-            let _e27 = ShadowEdgeLitUnit(_e24, _e25, _e26);
-            let _e28 = atmosphere_67;
-            let _e31 = past;
-            return (_e23 + (_e27 * (f32(_e28.scattering_mu_s_split) - _e31)));
+            let _e25 = past;
+            let _e26 = atmosphere_67;
+            let _e27 = sun_axis_13;
+            let _e28 = D_6;
+            let _e29 = edge_17;
+            let _e30 = ShadowEdgeLitUnit(_e26, _e27, _e28, _e29);
+            let _e31 = atmosphere_67;
+            let _e34 = past;
+            return (_e25 + (_e30 * (f32(_e31.scattering_mu_s_split) - _e34)));
         }
     }
-    let _e35 = D_6;
-    if (_e35 >= 0f) {
-        let _e38 = past;
-        let _e41 = D_6;
-        return ((_e38 - 1f) + (_e41 / SHADOW_EDGE_CLOSEST));
+    let _e38 = D_6;
+    if (_e38 >= 0f) {
+        let _e41 = past;
+        let _e44 = D_6;
+        return ((_e41 - 1f) + (_e44 / SHADOW_EDGE_CLOSEST));
     }
-    let _e44 = past;
-    let _e47 = D_6;
-    let _e48 = atmosphere_67;
-    let _e49 = edge_17;
-    let _e50 = ShadowEdgePastStep(_e48, _e49);
-    return ((_e44 - 1f) + (_e47 / _e50));
+    let _e47 = past;
+    let _e50 = D_6;
+    let _e51 = atmosphere_67;
+    let _e52 = edge_17;
+    let _e53 = ShadowEdgePastStep(_e51, _e52);
+    return ((_e47 - 1f) + (_e50 / _e53));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringShadowEdgeDistance(atmosphere_68: AtmosphereParameters, position: f32, edge_18: vec2<f32>) -> f32 {
+fn GetScatteringShadowEdgeDistance(atmosphere_68: AtmosphereParameters, sun_axis_14: ScatteringSunAxis, position: f32, edge_18: vec2<f32>) -> f32 {
     var atmosphere_69: AtmosphereParameters;
+    var sun_axis_15: ScatteringSunAxis;
     var position_1: f32;
     var edge_19: vec2<f32>;
     var past_1: f32 = 6f;
     var x_17: f32;
 
     atmosphere_69 = atmosphere_68;
+    sun_axis_15 = sun_axis_14;
     position_1 = position;
     edge_19 = edge_18;
-    let _e21 = position_1;
-    let _e22 = past_1;
-    if (_e21 >= _e22) {
+    let _e23 = position_1;
+    let _e24 = past_1;
+    if (_e23 >= _e24) {
         {
-            let _e24 = position_1;
-            let _e25 = past_1;
-            let _e27 = atmosphere_69;
-            let _e30 = past_1;
-            x_17 = ((_e24 - _e25) / (f32(_e27.scattering_mu_s_split) - _e30));
-            let _e34 = atmosphere_69;
-            let _e35 = x_17;
-            let _e36 = edge_19;
-            let _e37 = ShadowEdgeLitDistance(_e34, _e35, _e36);
-            return _e37;
+            let _e26 = position_1;
+            let _e27 = past_1;
+            let _e29 = atmosphere_69;
+            let _e32 = past_1;
+            x_17 = ((_e26 - _e27) / (f32(_e29.scattering_mu_s_split) - _e32));
+            let _e36 = atmosphere_69;
+            let _e37 = sun_axis_15;
+            let _e38 = x_17;
+            let _e39 = edge_19;
+            let _e40 = ShadowEdgeLitDistance(_e36, _e37, _e38, _e39);
+            return _e40;
         }
     }
-    let _e38 = position_1;
-    let _e39 = past_1;
-    if (_e38 >= (_e39 - 1f)) {
-        let _e43 = position_1;
-        let _e44 = past_1;
-        return (((_e43 - _e44) + 1f) * SHADOW_EDGE_CLOSEST);
+    let _e41 = position_1;
+    let _e42 = past_1;
+    if (_e41 >= (_e42 - 1f)) {
+        let _e46 = position_1;
+        let _e47 = past_1;
+        return (((_e46 - _e47) + 1f) * SHADOW_EDGE_CLOSEST);
     }
-    let _e49 = position_1;
-    let _e50 = past_1;
-    let _e54 = atmosphere_69;
-    let _e55 = edge_19;
-    let _e56 = ShadowEdgePastStep(_e54, _e55);
-    return (((_e49 - _e50) + 1f) * _e56);
+    let _e52 = position_1;
+    let _e53 = past_1;
+    let _e57 = atmosphere_69;
+    let _e58 = edge_19;
+    let _e59 = ShadowEdgePastStep(_e57, _e58);
+    return (((_e52 - _e53) + 1f) * _e59);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -1843,9 +1870,9 @@ fn GetScatteringTextureUR(atmosphere_70: AtmosphereParameters, r_34: f32, rho_8:
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringTextureUvwzAndEdge(atmosphere_72: AtmosphereParameters, sun_axis_1: ScatteringSunAxis, r_36: f32, mu_25: f32, mu_s_21: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
+fn GetScatteringTextureUvwzAndEdge(atmosphere_72: AtmosphereParameters, sun_axis_16: ScatteringSunAxis, r_36: f32, mu_25: f32, mu_s_21: f32, nu_11: f32, ray_r_mu_intersects_ground_15: bool, edge_20: ptr<function, vec2<f32>>) -> vec4<f32> {
     var atmosphere_73: AtmosphereParameters;
-    var sun_axis_2: ScatteringSunAxis;
+    var sun_axis_17: ScatteringSunAxis;
     var r_37: f32;
     var mu_26: f32;
     var mu_s_22: f32;
@@ -1859,7 +1886,7 @@ fn GetScatteringTextureUvwzAndEdge(atmosphere_72: AtmosphereParameters, sun_axis
     var mu_s_size: f32;
 
     atmosphere_73 = atmosphere_72;
-    sun_axis_2 = sun_axis_1;
+    sun_axis_17 = sun_axis_16;
     r_37 = r_36;
     mu_26 = mu_25;
     mu_s_22 = mu_s_21;
@@ -1889,7 +1916,7 @@ fn GetScatteringTextureUvwzAndEdge(atmosphere_72: AtmosphereParameters, sun_axis
     let _e49 = GetScatteringTextureUR(_e44, _e45, _e46, _e47, _e48);
     u_r = _e49;
     let _e51 = atmosphere_73;
-    let _e52 = sun_axis_2;
+    let _e52 = sun_axis_17;
     let _e53 = mu_s_22;
     let _e54 = GetScatteringTextureUMuSOnAxis(_e51, _e52, _e53);
     u_mu_s = _e54;
@@ -1912,21 +1939,22 @@ fn GetScatteringTextureUvwzAndEdge(atmosphere_72: AtmosphereParameters, sun_axis
             let _e83 = ray_r_mu_intersects_ground_16;
             let _e86 = ShadowEdge(_e76, _e77, _e78, _e82, _e83, edge_20);
             let _e87 = atmosphere_73;
-            let _e88 = (*edge_20);
-            let _e89 = mu_s_22;
-            let _e90 = ShadowEdgeDistance(_e88, _e89);
-            let _e91 = (*edge_20);
-            let _e92 = GetScatteringShadowEdgePosition(_e87, _e90, _e91);
-            let _e95 = mu_s_size;
-            u_mu_s = ((_e92 + 0.5f) / _e95);
+            let _e88 = sun_axis_17;
+            let _e89 = (*edge_20);
+            let _e90 = mu_s_22;
+            let _e91 = ShadowEdgeDistance(_e89, _e90);
+            let _e92 = (*edge_20);
+            let _e93 = GetScatteringShadowEdgePosition(_e87, _e88, _e91, _e92);
+            let _e96 = mu_s_size;
+            u_mu_s = ((_e93 + 0.5f) / _e96);
         }
     }
-    let _e97 = nu_12;
-    let _e98 = ScatteringUnitNu(_e97);
-    let _e99 = u_mu_s;
-    let _e100 = u_mu;
-    let _e101 = u_r;
-    return vec4<f32>(_e98, _e99, _e100, _e101);
+    let _e98 = nu_12;
+    let _e99 = ScatteringUnitNu(_e98);
+    let _e100 = u_mu_s;
+    let _e101 = u_mu;
+    let _e102 = u_r;
+    return vec4<f32>(_e99, _e100, _e101, _e102);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -2141,33 +2169,56 @@ fn GetTransmittanceToSun(atmosphere_86: AtmosphereParameters, transmittance_text
     return (_e22 * _e26);
 }
 
+fn LogLight(light: vec4<f32>) -> vec4<f32> {
+    var light_1: vec4<f32>;
+
+    light_1 = light;
+    let _e16 = light_1;
+    return log(max(_e16, vec4(0.000000000000000000000000000001f)));
+}
+
+fn IsLit(log_light: vec4<f32>) -> vec4<f32> {
+    var log_light_1: vec4<f32>;
+
+    log_light_1 = log_light;
+    let _e18 = log_light_1;
+    return (vec4(1f) - step(_e18, vec4(-69f)));
+}
+
+fn LightFromLog(log_light_2: vec4<f32>) -> vec4<f32> {
+    var log_light_3: vec4<f32>;
+
+    log_light_3 = log_light_2;
+    let _e16 = log_light_3;
+    let _e18 = log_light_3;
+    let _e19 = IsLit(_e18);
+    return (exp(_e16) * _e19);
+}
+
 fn SunCosineMix(a_8: vec4<f32>, b: vec4<f32>, t_1: f32, low_sun: bool) -> vec4<f32> {
     var a_9: vec4<f32>;
     var b_1: vec4<f32>;
     var t_2: f32;
     var low_sun_1: bool;
-    var dark: vec4<f32> = vec4(0.000000000000000000000000000001f);
 
     a_9 = a_8;
     b_1 = b;
     t_2 = t_1;
     low_sun_1 = low_sun;
-    let _e20 = low_sun_1;
-    if !(_e20) {
-        let _e22 = a_9;
-        let _e23 = b_1;
-        let _e24 = t_2;
-        return mix(_e22, _e23, vec4(_e24));
+    let _e22 = low_sun_1;
+    if !(_e22) {
+        let _e24 = a_9;
+        let _e25 = b_1;
+        let _e26 = t_2;
+        return mix(_e24, _e25, vec4(_e26));
     }
-    let _e30 = a_9;
-    let _e31 = dark;
-    let _e34 = b_1;
-    let _e35 = dark;
-    let _e38 = t_2;
-    let _e42 = dark;
-    let _e43 = a_9;
-    let _e44 = b_1;
-    return (exp(mix(log(max(_e30, _e31)), log(max(_e34, _e35)), vec4(_e38))) * step(_e42, max(_e43, _e44)));
+    let _e29 = a_9;
+    let _e30 = LogLight(_e29);
+    let _e31 = b_1;
+    let _e32 = LogLight(_e31);
+    let _e33 = t_2;
+    let _e36 = LightFromLog(mix(_e30, _e32, vec4(_e33)));
+    return _e36;
 }
 
 fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
@@ -2177,16 +2228,16 @@ fn SunCosinePosition(t_3: f32, low_sun_2: bool) -> f32 {
 
     t_4 = t_3;
     low_sun_3 = low_sun_2;
-    let _e16 = low_sun_3;
-    if _e16 {
-        let _e17 = t_4;
-        local_18 = min(_e17, 1f);
+    let _e18 = low_sun_3;
+    if _e18 {
+        let _e19 = t_4;
+        local_18 = min(_e19, 1f);
     } else {
-        let _e20 = t_4;
-        local_18 = clamp(_e20, 0f, 1f);
+        let _e22 = t_4;
+        local_18 = clamp(_e22, 0f, 1f);
     }
-    let _e25 = local_18;
-    return _e25;
+    let _e27 = local_18;
+    return _e27;
 }
 
 fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) -> vec4<f32> {
@@ -2201,23 +2252,23 @@ fn SunBelowTableMix(a_10: vec4<f32>, b_2: vec4<f32>, t_5: f32, low_sun_4: bool) 
     b_3 = b_2;
     t_6 = t_5;
     low_sun_5 = low_sun_4;
-    let _e20 = a_11;
-    let _e21 = b_3;
-    let _e22 = t_6;
-    let _e23 = low_sun_5;
-    let _e24 = SunCosineMix(_e20, _e21, _e22, _e23);
-    blend = _e24;
-    let _e26 = t_6;
-    if (_e26 < 0f) {
-        let _e29 = blend;
-        let _e30 = a_11;
-        local_19 = min(_e29, _e30);
+    let _e22 = a_11;
+    let _e23 = b_3;
+    let _e24 = t_6;
+    let _e25 = low_sun_5;
+    let _e26 = SunCosineMix(_e22, _e23, _e24, _e25);
+    blend = _e26;
+    let _e28 = t_6;
+    if (_e28 < 0f) {
+        let _e31 = blend;
+        let _e32 = a_11;
+        local_19 = min(_e31, _e32);
     } else {
-        let _e32 = blend;
-        local_19 = _e32;
+        let _e34 = blend;
+        local_19 = _e34;
     }
-    let _e34 = local_19;
-    return _e34;
+    let _e36 = local_19;
+    return _e36;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -2232,44 +2283,41 @@ fn GetScatteringMuSColumns(atmosphere_88: AtmosphereParameters, u_mu_s_1: f32, x
     atmosphere_89 = atmosphere_88;
     u_mu_s_2 = u_mu_s_1;
     x_low_sun_1 = x_low_sun;
-    let _e22 = atmosphere_89;
-    mu_s_size_1 = f32(_e22.scattering_mu_s_size);
-    let _e26 = u_mu_s_2;
-    let _e27 = mu_s_size_1;
-    mu_s_coord = ((_e26 * _e27) - 0.5f);
-    let _e32 = mu_s_coord;
-    let _e35 = mu_s_size_1;
-    mu_s_column = clamp(floor(_e32), 0f, (_e35 - 2f));
-    let _e40 = mu_s_column;
-    let _e43 = mu_s_size_1;
-    (*x_below) = ((_e40 + 0.5f) / _e43);
-    let _e45 = mu_s_column;
-    let _e48 = mu_s_size_1;
-    (*x_above) = ((_e45 + 1.5f) / _e48);
-    let _e50 = atmosphere_89;
-    let _e53 = (*x_below);
-    let _e54 = x_low_sun_1;
-    (*low_sun_below) = ((_e50.scattering_mu_s_min < LOW_SUN_MU_S) && (_e53 < _e54));
-    let _e57 = mu_s_coord;
-    let _e58 = mu_s_column;
-    let _e60 = (*low_sun_below);
-    let _e61 = SunCosinePosition((_e57 - _e58), _e60);
-    (*mu_s_t) = _e61;
+    let _e24 = atmosphere_89;
+    mu_s_size_1 = f32(_e24.scattering_mu_s_size);
+    let _e28 = u_mu_s_2;
+    let _e29 = mu_s_size_1;
+    mu_s_coord = ((_e28 * _e29) - 0.5f);
+    let _e34 = mu_s_coord;
+    let _e37 = mu_s_size_1;
+    mu_s_column = clamp(floor(_e34), 0f, (_e37 - 2f));
+    let _e42 = mu_s_column;
+    let _e45 = mu_s_size_1;
+    (*x_below) = ((_e42 + 0.5f) / _e45);
+    let _e47 = mu_s_column;
+    let _e50 = mu_s_size_1;
+    (*x_above) = ((_e47 + 1.5f) / _e50);
+    let _e52 = atmosphere_89;
+    let _e55 = (*x_below);
+    let _e56 = x_low_sun_1;
+    (*low_sun_below) = ((_e52.scattering_mu_s_min < LOW_SUN_MU_S) && (_e55 < _e56));
+    let _e59 = mu_s_coord;
+    let _e60 = mu_s_column;
+    let _e62 = (*low_sun_below);
+    let _e63 = SunCosinePosition((_e59 - _e60), _e62);
+    (*mu_s_t) = _e63;
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_20: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
-    var a_13: vec4<f32>;
-    var b_5: vec4<f32>;
-    var c_7: vec4<f32>;
-    var d_21: vec4<f32>;
+fn LogMonotoneCubic(log_a: vec4<f32>, lb: vec4<f32>, lc: vec4<f32>, log_d: vec4<f32>, has_a: bool, has_d: bool, t_7: f32) -> vec4<f32> {
+    var log_a_1: vec4<f32>;
+    var lb_1: vec4<f32>;
+    var lc_1: vec4<f32>;
+    var log_d_1: vec4<f32>;
     var has_a_1: bool;
     var has_d_1: bool;
     var t_8: f32;
-    var dark_1: vec4<f32> = vec4(0.000000000000000000000000000001f);
-    var lb: vec4<f32>;
-    var lc: vec4<f32>;
     var local_20: vec4<f32>;
     var la: vec4<f32>;
     var local_21: vec4<f32>;
@@ -2286,158 +2334,174 @@ fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_20: ve
     var t2_: f32;
     var t3_: f32;
     var cubic: vec4<f32>;
-    var lit: vec4<f32>;
+
+    log_a_1 = log_a;
+    lb_1 = lb;
+    lc_1 = lc;
+    log_d_1 = log_d;
+    has_a_1 = has_a;
+    has_d_1 = has_d;
+    t_8 = t_7;
+    let _e28 = has_a_1;
+    if _e28 {
+        let _e29 = log_a_1;
+        local_20 = _e29;
+    } else {
+        let _e31 = lb_1;
+        let _e33 = lc_1;
+        local_20 = ((2f * _e31) - _e33);
+    }
+    let _e36 = local_20;
+    la = _e36;
+    let _e38 = has_d_1;
+    if _e38 {
+        let _e39 = log_d_1;
+        local_21 = _e39;
+    } else {
+        let _e41 = lc_1;
+        let _e43 = lb_1;
+        local_21 = ((2f * _e41) - _e43);
+    }
+    let _e46 = local_21;
+    ld = _e46;
+    let _e48 = lb_1;
+    let _e49 = la;
+    secant_a = (_e48 - _e49);
+    let _e52 = lc_1;
+    let _e53 = lb_1;
+    secant = (_e52 - _e53);
+    let _e56 = ld;
+    let _e57 = lc_1;
+    secant_d = (_e56 - _e57);
+    let _e60 = secant_a;
+    let _e61 = secant;
+    product_b = (_e60 * _e61);
+    let _e64 = secant;
+    let _e65 = secant_d;
+    product_c = (_e64 * _e65);
+    let _e70 = product_b;
+    agree_b = (vec4(1f) - step(_e70, vec4(0f)));
+    let _e78 = product_c;
+    agree_c = (vec4(1f) - step(_e78, vec4(0f)));
+    let _e84 = agree_b;
+    let _e87 = product_b;
+    let _e91 = secant_a;
+    let _e92 = secant;
+    let _e94 = agree_b;
+    slope_b = (((_e84 * 2f) * _e87) / mix(vec4(1f), (_e91 + _e92), _e94));
+    let _e98 = agree_c;
+    let _e101 = product_c;
+    let _e105 = secant;
+    let _e106 = secant_d;
+    let _e108 = agree_c;
+    slope_c = (((_e98 * 2f) * _e101) / mix(vec4(1f), (_e105 + _e106), _e108));
+    let _e112 = t_8;
+    let _e113 = t_8;
+    t2_ = (_e112 * _e113);
+    let _e116 = t2_;
+    let _e117 = t_8;
+    t3_ = (_e116 * _e117);
+    let _e121 = t3_;
+    let _e124 = t2_;
+    let _e129 = lb_1;
+    let _e131 = t3_;
+    let _e133 = t2_;
+    let _e136 = t_8;
+    let _e138 = slope_b;
+    let _e142 = t2_;
+    let _e145 = t3_;
+    let _e148 = lc_1;
+    let _e151 = t3_;
+    let _e152 = t2_;
+    let _e154 = slope_c;
+    cubic = (((((((2f * _e121) - (3f * _e124)) + 1f) * _e129) + (((_e131 - (2f * _e133)) + _e136) * _e138)) + (((3f * _e142) - (2f * _e145)) * _e148)) + ((_e151 - _e152) * _e154));
+    let _e158 = lb_1;
+    let _e159 = lc_1;
+    let _e160 = t_8;
+    let _e163 = cubic;
+    let _e164 = log_a_1;
+    let _e165 = lb_1;
+    let _e167 = lc_1;
+    let _e168 = log_d_1;
+    let _e171 = IsLit(min(min(_e164, _e165), min(_e167, _e168)));
+    return mix(mix(_e158, _e159, vec4(_e160)), _e163, _e171);
+}
+
+// skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
+fn LogMonotoneCubicMix(a_12: vec4<f32>, b_4: vec4<f32>, c_6: vec4<f32>, d_20: vec4<f32>, has_a_2: bool, has_d_2: bool, t_9: f32) -> vec4<f32> {
+    var a_13: vec4<f32>;
+    var b_5: vec4<f32>;
+    var c_7: vec4<f32>;
+    var d_21: vec4<f32>;
+    var has_a_3: bool;
+    var has_d_3: bool;
+    var t_10: f32;
 
     a_13 = a_12;
     b_5 = b_4;
     c_7 = c_6;
     d_21 = d_20;
-    has_a_1 = has_a;
-    has_d_1 = has_d;
-    t_8 = t_7;
-    let _e29 = b_5;
-    let _e30 = dark_1;
-    lb = log(max(_e29, _e30));
-    let _e34 = c_7;
-    let _e35 = dark_1;
-    lc = log(max(_e34, _e35));
-    let _e39 = has_a_1;
-    if _e39 {
-        let _e40 = a_13;
-        let _e41 = dark_1;
-        local_20 = log(max(_e40, _e41));
-    } else {
-        let _e45 = lb;
-        let _e47 = lc;
-        local_20 = ((2f * _e45) - _e47);
-    }
-    let _e50 = local_20;
-    la = _e50;
-    let _e52 = has_d_1;
-    if _e52 {
-        let _e53 = d_21;
-        let _e54 = dark_1;
-        local_21 = log(max(_e53, _e54));
-    } else {
-        let _e58 = lc;
-        let _e60 = lb;
-        local_21 = ((2f * _e58) - _e60);
-    }
-    let _e63 = local_21;
-    ld = _e63;
-    let _e65 = lb;
-    let _e66 = la;
-    secant_a = (_e65 - _e66);
-    let _e69 = lc;
-    let _e70 = lb;
-    secant = (_e69 - _e70);
-    let _e73 = ld;
-    let _e74 = lc;
-    secant_d = (_e73 - _e74);
-    let _e77 = secant_a;
-    let _e78 = secant;
-    product_b = (_e77 * _e78);
-    let _e81 = secant;
-    let _e82 = secant_d;
-    product_c = (_e81 * _e82);
-    let _e87 = product_b;
-    agree_b = (vec4(1f) - step(_e87, vec4(0f)));
-    let _e95 = product_c;
-    agree_c = (vec4(1f) - step(_e95, vec4(0f)));
-    let _e101 = agree_b;
-    let _e104 = product_b;
-    let _e108 = secant_a;
-    let _e109 = secant;
-    let _e111 = agree_b;
-    slope_b = (((_e101 * 2f) * _e104) / mix(vec4(1f), (_e108 + _e109), _e111));
-    let _e115 = agree_c;
-    let _e118 = product_c;
-    let _e122 = secant;
-    let _e123 = secant_d;
-    let _e125 = agree_c;
-    slope_c = (((_e115 * 2f) * _e118) / mix(vec4(1f), (_e122 + _e123), _e125));
-    let _e129 = t_8;
-    let _e130 = t_8;
-    t2_ = (_e129 * _e130);
-    let _e133 = t2_;
-    let _e134 = t_8;
-    t3_ = (_e133 * _e134);
-    let _e138 = t3_;
-    let _e141 = t2_;
-    let _e146 = lb;
-    let _e148 = t3_;
-    let _e150 = t2_;
-    let _e153 = t_8;
-    let _e155 = slope_b;
-    let _e159 = t2_;
-    let _e162 = t3_;
-    let _e165 = lc;
-    let _e168 = t3_;
-    let _e169 = t2_;
-    let _e171 = slope_c;
-    cubic = (((((((2f * _e138) - (3f * _e141)) + 1f) * _e146) + (((_e148 - (2f * _e150)) + _e153) * _e155)) + (((3f * _e159) - (2f * _e162)) * _e165)) + ((_e168 - _e169) * _e171));
-    let _e175 = dark_1;
-    let _e176 = a_13;
-    let _e177 = b_5;
-    let _e179 = c_7;
-    let _e180 = d_21;
-    lit = step(_e175, min(min(_e176, _e177), min(_e179, _e180)));
-    let _e185 = lb;
-    let _e186 = lc;
-    let _e187 = t_8;
-    let _e190 = cubic;
-    let _e191 = lit;
-    let _e194 = dark_1;
-    let _e195 = b_5;
-    let _e196 = c_7;
-    return (exp(mix(mix(_e185, _e186, vec4(_e187)), _e190, _e191)) * step(_e194, max(_e195, _e196)));
+    has_a_3 = has_a_2;
+    has_d_3 = has_d_2;
+    t_10 = t_9;
+    let _e28 = a_13;
+    let _e29 = LogLight(_e28);
+    let _e30 = b_5;
+    let _e31 = LogLight(_e30);
+    let _e32 = c_7;
+    let _e33 = LogLight(_e32);
+    let _e34 = d_21;
+    let _e35 = LogLight(_e34);
+    let _e36 = has_a_3;
+    let _e37 = has_d_3;
+    let _e38 = t_10;
+    let _e39 = LogMonotoneCubic(_e29, _e31, _e33, _e35, _e36, _e37, _e38);
+    let _e40 = LightFromLog(_e39);
+    return _e40;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunLogFall(a_14: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope_1: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
-    var a_15: vec4<f32>;
-    var b_7: vec4<f32>;
+fn LowestSunLogFall(log_a_2: vec4<f32>, log_b: vec4<f32>, mu_s_a: f32, mu_s_b: f32, slope_1: ptr<function, vec4<f32>>, curvature: ptr<function, vec4<f32>>) {
+    var log_a_3: vec4<f32>;
+    var log_b_1: vec4<f32>;
     var mu_s_a_1: f32;
     var mu_s_b_1: f32;
-    var dark_2: vec4<f32> = vec4(0.000000000000000000000000000001f);
     var rise: vec4<f32>;
     var k_2: vec4<f32>;
 
-    a_15 = a_14;
-    b_7 = b_6;
+    log_a_3 = log_a_2;
+    log_b_1 = log_b;
     mu_s_a_1 = mu_s_a;
     mu_s_b_1 = mu_s_b;
-    let _e25 = b_7;
-    let _e26 = dark_2;
-    let _e29 = a_15;
-    let _e30 = dark_2;
-    let _e34 = dark_2;
-    let _e35 = a_15;
-    let _e40 = b_7;
-    let _e41 = a_15;
-    rise = (((log(max(_e25, _e26)) - log(max(_e29, _e30))) * step(_e34, _e35)) * (vec4(1f) - step(_e40, _e41)));
-    let _e46 = mu_s_b_1;
-    if (_e46 < 0f) {
+    let _e24 = log_b_1;
+    let _e25 = log_a_3;
+    let _e27 = log_a_3;
+    let _e28 = IsLit(_e27);
+    let _e32 = log_b_1;
+    let _e33 = log_a_3;
+    rise = (((_e24 - _e25) * _e28) * (vec4(1f) - step(_e32, _e33)));
+    let _e38 = mu_s_b_1;
+    if (_e38 < 0f) {
         {
-            let _e49 = rise;
-            let _e50 = mu_s_a_1;
-            let _e51 = mu_s_a_1;
-            let _e53 = mu_s_b_1;
-            let _e54 = mu_s_b_1;
-            k_2 = (_e49 / vec4(((_e50 * _e51) - (_e53 * _e54))));
-            let _e62 = mu_s_a_1;
-            let _e64 = k_2;
-            (*slope_1) = ((-2f * _e62) * _e64);
-            let _e66 = k_2;
-            (*curvature) = -(_e66);
+            let _e41 = rise;
+            let _e42 = mu_s_a_1;
+            let _e43 = mu_s_a_1;
+            let _e45 = mu_s_b_1;
+            let _e46 = mu_s_b_1;
+            k_2 = (_e41 / vec4(((_e42 * _e43) - (_e45 * _e46))));
+            let _e54 = mu_s_a_1;
+            let _e56 = k_2;
+            (*slope_1) = ((-2f * _e54) * _e56);
+            let _e58 = k_2;
+            (*curvature) = -(_e58);
             return;
         }
     } else {
         {
-            let _e68 = rise;
-            let _e69 = mu_s_b_1;
-            let _e70 = mu_s_a_1;
-            (*slope_1) = (_e68 / vec4((_e69 - _e70)));
+            let _e60 = rise;
+            let _e61 = mu_s_b_1;
+            let _e62 = mu_s_a_1;
+            (*slope_1) = (_e60 / vec4((_e61 - _e62)));
             (*curvature) = vec4(0f);
             return;
         }
@@ -2445,9 +2509,9 @@ fn LowestSunLogFall(a_14: vec4<f32>, b_6: vec4<f32>, mu_s_a: f32, mu_s_b: f32, s
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_29: f32) -> vec4<f32> {
-    var a_17: vec4<f32>;
-    var b_9: vec4<f32>;
+fn LowestSunContinued(log_a_4: vec4<f32>, log_b_2: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: f32, mu_s_29: f32) -> vec4<f32> {
+    var log_a_5: vec4<f32>;
+    var log_b_3: vec4<f32>;
     var mu_s_a_3: f32;
     var mu_s_b_3: f32;
     var mu_s_30: f32;
@@ -2455,25 +2519,26 @@ fn LowestSunContinued(a_16: vec4<f32>, b_8: vec4<f32>, mu_s_a_2: f32, mu_s_b_2: 
     var curvature_1: vec4<f32>;
     var d_22: f32;
 
-    a_17 = a_16;
-    b_9 = b_8;
+    log_a_5 = log_a_4;
+    log_b_3 = log_b_2;
     mu_s_a_3 = mu_s_a_2;
     mu_s_b_3 = mu_s_b_2;
     mu_s_30 = mu_s_29;
-    let _e24 = a_17;
-    let _e25 = b_9;
-    let _e26 = mu_s_a_3;
-    let _e27 = mu_s_b_3;
-    LowestSunLogFall(_e24, _e25, _e26, _e27, (&slope_2), (&curvature_1));
-    let _e32 = mu_s_30;
-    let _e33 = mu_s_a_3;
-    d_22 = (_e32 - _e33);
-    let _e36 = a_17;
-    let _e37 = d_22;
-    let _e38 = slope_2;
+    let _e26 = log_a_5;
+    let _e27 = log_b_3;
+    let _e28 = mu_s_a_3;
+    let _e29 = mu_s_b_3;
+    LowestSunLogFall(_e26, _e27, _e28, _e29, (&slope_2), (&curvature_1));
+    let _e34 = mu_s_30;
+    let _e35 = mu_s_a_3;
+    d_22 = (_e34 - _e35);
+    let _e38 = log_a_5;
     let _e39 = d_22;
-    let _e40 = curvature_1;
-    return (_e36 * exp((_e37 * (_e38 + (_e39 * _e40)))));
+    let _e40 = slope_2;
+    let _e41 = d_22;
+    let _e42 = curvature_1;
+    let _e47 = LightFromLog((_e38 + (_e39 * (_e40 + (_e41 * _e42)))));
+    return _e47;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -2487,23 +2552,26 @@ fn GetScatteringInSlice(atmosphere_90: AtmosphereParameters, scattering_texture:
     uvwz_1 = uvwz;
     x_19 = x_18;
     nu_slice_1 = nu_slice;
-    let _e21 = nu_slice_1;
-    let _e22 = x_19;
-    let _e24 = atmosphere_91;
-    let _e28 = uvwz_1;
+    let _e23 = nu_slice_1;
+    let _e24 = x_19;
+    let _e26 = atmosphere_91;
     let _e30 = uvwz_1;
-    let _e33 = SampleTexture3D(scattering_texture, vec3<f32>(((_e21 + _e22) / f32(_e24.scattering_nu_size)), _e28.z, _e30.w));
-    return _e33;
+    let _e32 = uvwz_1;
+    let _e35 = SampleTexture3D(scattering_texture, vec3<f32>(((_e23 + _e24) / f32(_e26.scattering_nu_size)), _e30.z, _e32.w));
+    return _e35;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringAtMuSColumn(atmosphere_92: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_20: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
+fn GetLogScatteringAtMuSColumn(atmosphere_92: AtmosphereParameters, scattering_texture_1: texture_3d<f32>, uvwz_2: vec4<f32>, x_20: f32, nu_slice_2: f32, nu_t: f32, low_sun_6: bool) -> vec4<f32> {
     var atmosphere_93: AtmosphereParameters;
     var uvwz_3: vec4<f32>;
     var x_21: f32;
     var nu_slice_3: f32;
     var nu_t_1: f32;
     var low_sun_7: bool;
+    var a_14: vec4<f32>;
+    var b_6: vec4<f32>;
+    var local_22: vec4<f32>;
 
     atmosphere_93 = atmosphere_92;
     uvwz_3 = uvwz_2;
@@ -2511,20 +2579,35 @@ fn GetScatteringAtMuSColumn(atmosphere_92: AtmosphereParameters, scattering_text
     nu_slice_3 = nu_slice_2;
     nu_t_1 = nu_t;
     low_sun_7 = low_sun_6;
-    let _e25 = atmosphere_93;
-    let _e26 = uvwz_3;
-    let _e27 = x_21;
-    let _e28 = nu_slice_3;
-    let _e29 = GetScatteringInSlice(_e25, scattering_texture_1, _e26, _e27, _e28);
-    let _e30 = atmosphere_93;
-    let _e31 = uvwz_3;
-    let _e32 = x_21;
-    let _e33 = nu_slice_3;
-    let _e36 = GetScatteringInSlice(_e30, scattering_texture_1, _e31, _e32, (_e33 + 1f));
-    let _e37 = nu_t_1;
-    let _e38 = low_sun_7;
-    let _e39 = SunCosineMix(_e29, _e36, _e37, _e38);
-    return _e39;
+    let _e27 = atmosphere_93;
+    let _e28 = uvwz_3;
+    let _e29 = x_21;
+    let _e30 = nu_slice_3;
+    let _e31 = GetScatteringInSlice(_e27, scattering_texture_1, _e28, _e29, _e30);
+    a_14 = _e31;
+    let _e33 = atmosphere_93;
+    let _e34 = uvwz_3;
+    let _e35 = x_21;
+    let _e36 = nu_slice_3;
+    let _e39 = GetScatteringInSlice(_e33, scattering_texture_1, _e34, _e35, (_e36 + 1f));
+    b_6 = _e39;
+    let _e41 = low_sun_7;
+    if _e41 {
+        let _e42 = a_14;
+        let _e43 = LogLight(_e42);
+        let _e44 = b_6;
+        let _e45 = LogLight(_e44);
+        let _e46 = nu_t_1;
+        local_22 = mix(_e43, _e45, vec4(_e46));
+    } else {
+        let _e49 = a_14;
+        let _e50 = b_6;
+        let _e51 = nu_t_1;
+        let _e54 = LogLight(mix(_e49, _e50, vec4(_e51)));
+        local_22 = _e54;
+    }
+    let _e56 = local_22;
+    return _e56;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -2538,17 +2621,17 @@ fn GetScatteringAtOwnColumn(atmosphere_94: AtmosphereParameters, scattering_text
     uvwz_5 = uvwz_4;
     column_1 = column;
     nu_slice_5 = nu_slice_4;
-    let _e21 = atmosphere_95;
-    let _e22 = uvwz_5;
-    let _e23 = column_1;
-    let _e26 = atmosphere_95;
-    let _e30 = nu_slice_5;
-    let _e31 = GetScatteringInSlice(_e21, scattering_texture_2, _e22, ((_e23 + 0.5f) / f32(_e26.scattering_mu_s_size)), _e30);
-    return _e31;
+    let _e23 = atmosphere_95;
+    let _e24 = uvwz_5;
+    let _e25 = column_1;
+    let _e28 = atmosphere_95;
+    let _e32 = nu_slice_5;
+    let _e33 = GetScatteringInSlice(_e23, scattering_texture_2, _e24, ((_e25 + 0.5f) / f32(_e28.scattering_mu_s_size)), _e32);
+    return _e33;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetScatteringBelowSplit(atmosphere_96: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
+fn GetLogScatteringBelowSplit(atmosphere_96: AtmosphereParameters, scattering_texture_3: texture_3d<f32>, uvwz_6: vec4<f32>, position_3: f32, nu_slice_6: f32, log_first_span: f32) -> vec4<f32> {
     var atmosphere_97: AtmosphereParameters;
     var uvwz_7: vec4<f32>;
     var position_4: f32;
@@ -2558,6 +2641,11 @@ fn GetScatteringBelowSplit(atmosphere_96: AtmosphereParameters, scattering_textu
     var intervals: f32;
     var k_3: f32;
     var column_2: f32;
+    var last_1: f32;
+    var la_1: vec4<f32>;
+    var lb_2: vec4<f32>;
+    var lc_2: vec4<f32>;
+    var ld_1: vec4<f32>;
     var at_edge: vec4<f32>;
     var rise_1: vec4<f32>;
     var second_rise: vec4<f32>;
@@ -2572,117 +2660,133 @@ fn GetScatteringBelowSplit(atmosphere_96: AtmosphereParameters, scattering_textu
     position_4 = position_3;
     nu_slice_7 = nu_slice_6;
     log_first_span_1 = log_first_span;
-    let _e26 = atmosphere_97;
-    let _e29 = past_2;
-    intervals = (f32(_e26.scattering_mu_s_split) - _e29);
-    let _e32 = position_4;
-    let _e33 = past_2;
-    if (_e32 >= _e33) {
+    let _e28 = atmosphere_97;
+    let _e31 = past_2;
+    intervals = (f32(_e28.scattering_mu_s_split) - _e31);
+    let _e34 = position_4;
+    let _e35 = past_2;
+    if (_e34 >= _e35) {
         {
-            let _e35 = position_4;
-            let _e36 = past_2;
-            let _e39 = intervals;
-            k_3 = min(floor((_e35 - _e36)), (_e39 - 1f));
-            let _e44 = past_2;
-            let _e45 = k_3;
-            column_2 = (_e44 + _e45);
-            let _e48 = atmosphere_97;
-            let _e49 = uvwz_7;
+            let _e37 = position_4;
+            let _e38 = past_2;
+            let _e41 = intervals;
+            k_3 = min(floor((_e37 - _e38)), (_e41 - 1f));
+            let _e46 = past_2;
+            let _e47 = k_3;
+            column_2 = (_e46 + _e47);
             let _e50 = column_2;
-            let _e53 = nu_slice_7;
-            let _e54 = GetScatteringAtOwnColumn(_e48, scattering_texture_3, _e49, (_e50 - 1f), _e53);
-            let _e55 = atmosphere_97;
-            let _e56 = uvwz_7;
-            let _e57 = column_2;
-            let _e58 = nu_slice_7;
-            let _e59 = GetScatteringAtOwnColumn(_e55, scattering_texture_3, _e56, _e57, _e58);
-            let _e60 = atmosphere_97;
-            let _e61 = uvwz_7;
-            let _e62 = column_2;
-            let _e65 = nu_slice_7;
-            let _e66 = GetScatteringAtOwnColumn(_e60, scattering_texture_3, _e61, (_e62 + 1f), _e65);
+            let _e53 = past_2;
+            let _e54 = intervals;
+            last_1 = min((_e50 + 2f), (_e53 + _e54));
+            let _e58 = atmosphere_97;
+            let _e59 = uvwz_7;
+            let _e60 = column_2;
+            let _e63 = nu_slice_7;
+            let _e64 = GetScatteringAtOwnColumn(_e58, scattering_texture_3, _e59, (_e60 - 1f), _e63);
+            let _e65 = LogLight(_e64);
+            la_1 = _e65;
             let _e67 = atmosphere_97;
             let _e68 = uvwz_7;
             let _e69 = column_2;
-            let _e72 = past_2;
-            let _e73 = intervals;
-            let _e76 = nu_slice_7;
-            let _e77 = GetScatteringAtOwnColumn(_e67, scattering_texture_3, _e68, min((_e69 + 2f), (_e72 + _e73)), _e76);
-            let _e78 = k_3;
-            let _e81 = k_3;
-            let _e84 = intervals;
-            let _e86 = position_4;
-            let _e87 = column_2;
-            let _e89 = LogMonotoneCubicMix(_e54, _e59, _e66, _e77, (_e78 >= 1f), ((_e81 + 2f) <= _e84), (_e86 - _e87));
-            return _e89;
+            let _e70 = nu_slice_7;
+            let _e71 = GetScatteringAtOwnColumn(_e67, scattering_texture_3, _e68, _e69, _e70);
+            let _e72 = LogLight(_e71);
+            lb_2 = _e72;
+            let _e74 = atmosphere_97;
+            let _e75 = uvwz_7;
+            let _e76 = column_2;
+            let _e79 = nu_slice_7;
+            let _e80 = GetScatteringAtOwnColumn(_e74, scattering_texture_3, _e75, (_e76 + 1f), _e79);
+            let _e81 = LogLight(_e80);
+            lc_2 = _e81;
+            let _e83 = atmosphere_97;
+            let _e84 = uvwz_7;
+            let _e85 = last_1;
+            let _e86 = nu_slice_7;
+            let _e87 = GetScatteringAtOwnColumn(_e83, scattering_texture_3, _e84, _e85, _e86);
+            let _e88 = LogLight(_e87);
+            ld_1 = _e88;
+            let _e90 = la_1;
+            let _e91 = lb_2;
+            let _e92 = lc_2;
+            let _e93 = ld_1;
+            let _e94 = k_3;
+            let _e97 = k_3;
+            let _e100 = intervals;
+            let _e102 = position_4;
+            let _e103 = column_2;
+            let _e105 = LogMonotoneCubic(_e90, _e91, _e92, _e93, (_e94 >= 1f), ((_e97 + 2f) <= _e100), (_e102 - _e103));
+            return _e105;
         }
     }
-    let _e90 = position_4;
-    let _e91 = past_2;
-    if (_e90 >= (_e91 - 1f)) {
+    let _e106 = position_4;
+    let _e107 = past_2;
+    if (_e106 >= (_e107 - 1f)) {
         {
-            let _e95 = atmosphere_97;
-            let _e96 = uvwz_7;
-            let _e97 = past_2;
-            let _e100 = nu_slice_7;
-            let _e101 = GetScatteringAtOwnColumn(_e95, scattering_texture_3, _e96, (_e97 - 1f), _e100);
-            at_edge = _e101;
-            let _e103 = atmosphere_97;
-            let _e104 = uvwz_7;
-            let _e105 = past_2;
-            let _e106 = nu_slice_7;
-            let _e107 = GetScatteringAtOwnColumn(_e103, scattering_texture_3, _e104, _e105, _e106);
-            let _e108 = at_edge;
-            rise_1 = (_e107 - _e108);
             let _e111 = atmosphere_97;
             let _e112 = uvwz_7;
             let _e113 = past_2;
             let _e116 = nu_slice_7;
-            let _e117 = GetScatteringAtOwnColumn(_e111, scattering_texture_3, _e112, (_e113 + 1f), _e116);
-            let _e118 = at_edge;
-            second_rise = (_e117 - _e118);
-            let _e124 = tiny;
-            let _e125 = rise_1;
-            let _e129 = second_rise;
-            let _e130 = rise_1;
-            rises = (step(_e124, _e125) * (vec4(1f) - step(_e129, _e130)));
-            let _e137 = second_rise;
-            let _e138 = tiny;
-            let _e140 = rise_1;
-            let _e141 = tiny;
-            let _e145 = log_first_span_1;
-            let _e153 = rises;
-            power = mix(vec4(3f), clamp((log((max(_e137, _e138) / max(_e140, _e141))) / vec4(_e145)), vec4(1f), vec4(10f)), _e153);
-            let _e156 = at_edge;
-            let _e157 = rise_1;
-            let _e158 = position_4;
-            let _e159 = past_2;
-            let _e164 = power;
-            return (_e156 + (_e157 * pow(vec4(((_e158 - _e159) + 1f)), _e164)));
+            let _e117 = GetScatteringAtOwnColumn(_e111, scattering_texture_3, _e112, (_e113 - 1f), _e116);
+            at_edge = _e117;
+            let _e119 = atmosphere_97;
+            let _e120 = uvwz_7;
+            let _e121 = past_2;
+            let _e122 = nu_slice_7;
+            let _e123 = GetScatteringAtOwnColumn(_e119, scattering_texture_3, _e120, _e121, _e122);
+            let _e124 = at_edge;
+            rise_1 = (_e123 - _e124);
+            let _e127 = atmosphere_97;
+            let _e128 = uvwz_7;
+            let _e129 = past_2;
+            let _e132 = nu_slice_7;
+            let _e133 = GetScatteringAtOwnColumn(_e127, scattering_texture_3, _e128, (_e129 + 1f), _e132);
+            let _e134 = at_edge;
+            second_rise = (_e133 - _e134);
+            let _e140 = tiny;
+            let _e141 = rise_1;
+            let _e145 = second_rise;
+            let _e146 = rise_1;
+            rises = (step(_e140, _e141) * (vec4(1f) - step(_e145, _e146)));
+            let _e153 = second_rise;
+            let _e154 = tiny;
+            let _e156 = rise_1;
+            let _e157 = tiny;
+            let _e161 = log_first_span_1;
+            let _e169 = rises;
+            power = mix(vec4(3f), clamp((log((max(_e153, _e154) / max(_e156, _e157))) / vec4(_e161)), vec4(1f), vec4(10f)), _e169);
+            let _e172 = at_edge;
+            let _e173 = rise_1;
+            let _e174 = position_4;
+            let _e175 = past_2;
+            let _e180 = power;
+            let _e184 = LogLight((_e172 + (_e173 * pow(vec4(((_e174 - _e175) + 1f)), _e180))));
+            return _e184;
         }
     }
-    let _e168 = past_2;
-    let _e171 = position_4;
-    x_22 = ((_e168 - 1f) - _e171);
-    let _e174 = x_22;
-    let _e176 = past_2;
-    k_4 = min(floor(_e174), (_e176 - 2f));
-    let _e181 = atmosphere_97;
-    let _e182 = uvwz_7;
-    let _e183 = past_2;
-    let _e186 = k_4;
-    let _e188 = nu_slice_7;
-    let _e189 = GetScatteringAtOwnColumn(_e181, scattering_texture_3, _e182, ((_e183 - 1f) - _e186), _e188);
-    let _e190 = atmosphere_97;
-    let _e191 = uvwz_7;
-    let _e192 = past_2;
-    let _e195 = k_4;
-    let _e197 = nu_slice_7;
-    let _e198 = GetScatteringAtOwnColumn(_e190, scattering_texture_3, _e191, ((_e192 - 2f) - _e195), _e197);
-    let _e199 = x_22;
-    let _e200 = k_4;
-    let _e203 = SunCosineMix(_e189, _e198, (_e199 - _e200), true);
-    return _e203;
+    let _e185 = past_2;
+    let _e188 = position_4;
+    x_22 = ((_e185 - 1f) - _e188);
+    let _e191 = x_22;
+    let _e193 = past_2;
+    k_4 = min(floor(_e191), (_e193 - 2f));
+    let _e198 = atmosphere_97;
+    let _e199 = uvwz_7;
+    let _e200 = past_2;
+    let _e203 = k_4;
+    let _e205 = nu_slice_7;
+    let _e206 = GetScatteringAtOwnColumn(_e198, scattering_texture_3, _e199, ((_e200 - 1f) - _e203), _e205);
+    let _e207 = LogLight(_e206);
+    let _e208 = atmosphere_97;
+    let _e209 = uvwz_7;
+    let _e210 = past_2;
+    let _e213 = k_4;
+    let _e215 = nu_slice_7;
+    let _e216 = GetScatteringAtOwnColumn(_e208, scattering_texture_3, _e209, ((_e210 - 2f) - _e213), _e215);
+    let _e217 = LogLight(_e216);
+    let _e218 = x_22;
+    let _e219 = k_4;
+    return mix(_e207, _e217, vec4((_e218 - _e219)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -2695,7 +2799,7 @@ fn GetScatteringLookup(atmosphere_98: AtmosphereParameters, r_52: f32, mu_37: f3
     var ray_r_mu_intersects_ground_24: bool;
     var lookup: ScatteringLookup;
     var edge_21: vec2<f32>;
-    var sun_axis_3: ScatteringSunAxis;
+    var sun_axis_18: ScatteringSunAxis;
     var nu_size: f32;
     var nu_coord: f32;
     var mu_s_size_2: f32;
@@ -2715,253 +2819,267 @@ fn GetScatteringLookup(atmosphere_98: AtmosphereParameters, r_52: f32, mu_37: f3
     mu_s_32 = mu_s_31;
     nu_16 = nu_15;
     ray_r_mu_intersects_ground_24 = ray_r_mu_intersects_ground_23;
-    let _e30 = atmosphere_99;
-    let _e31 = GetScatteringSunAxis(_e30);
-    sun_axis_3 = _e31;
-    let _e34 = atmosphere_99;
-    let _e35 = sun_axis_3;
-    let _e36 = r_53;
-    let _e37 = mu_38;
-    let _e38 = mu_s_32;
-    let _e39 = nu_16;
-    let _e40 = ray_r_mu_intersects_ground_24;
-    let _e43 = GetScatteringTextureUvwzAndEdge(_e34, _e35, _e36, _e37, _e38, _e39, _e40, (&edge_21));
-    lookup.uvwz = _e43;
-    let _e44 = atmosphere_99;
-    nu_size = f32(_e44.scattering_nu_size);
-    let _e48 = lookup;
-    let _e51 = nu_size;
-    nu_coord = (_e48.uvwz.x * (_e51 - 1f));
-    let _e57 = nu_coord;
-    let _e59 = nu_size;
-    lookup.nu_slice = min(floor(_e57), (_e59 - 2f));
-    let _e64 = nu_coord;
-    let _e65 = lookup;
-    lookup.nu_t = (_e64 - _e65.nu_slice);
+    let _e32 = atmosphere_99;
+    let _e33 = GetScatteringSunAxis(_e32);
+    sun_axis_18 = _e33;
+    let _e36 = atmosphere_99;
+    let _e37 = sun_axis_18;
+    let _e38 = r_53;
+    let _e39 = mu_38;
+    let _e40 = mu_s_32;
+    let _e41 = nu_16;
+    let _e42 = ray_r_mu_intersects_ground_24;
+    let _e45 = GetScatteringTextureUvwzAndEdge(_e36, _e37, _e38, _e39, _e40, _e41, _e42, (&edge_21));
+    lookup.uvwz = _e45;
+    let _e46 = atmosphere_99;
+    nu_size = f32(_e46.scattering_nu_size);
+    let _e50 = lookup;
+    let _e53 = nu_size;
+    nu_coord = (_e50.uvwz.x * (_e53 - 1f));
+    let _e59 = nu_coord;
+    let _e61 = nu_size;
+    lookup.nu_slice = min(floor(_e59), (_e61 - 2f));
+    let _e66 = nu_coord;
+    let _e67 = lookup;
+    lookup.nu_t = (_e66 - _e67.nu_slice);
     lookup.low_sun = vec4(true);
     lookup.has_first = false;
     lookup.has_last = false;
     lookup.t = 0f;
     lookup.mu_s_a = 0f;
     lookup.mu_s_b = 0f;
-    let _e82 = mu_s_32;
-    lookup.mu_s = _e82;
+    let _e84 = mu_s_32;
+    lookup.mu_s = _e84;
     lookup.log_first_span = 1f;
-    let _e85 = atmosphere_99;
-    mu_s_size_2 = f32(_e85.scattering_mu_s_size);
-    let _e90 = lookup;
-    let _e93 = mu_s_size_2;
-    lookup.position = ((_e90.uvwz.y * _e93) - 0.5f);
-    let _e97 = atmosphere_99;
-    let _e101 = lookup;
-    let _e103 = atmosphere_99;
-    if ((_e97.scattering_mu_s_split > 0i) && (_e101.position < f32(_e103.scattering_mu_s_split))) {
+    let _e87 = atmosphere_99;
+    mu_s_size_2 = f32(_e87.scattering_mu_s_size);
+    let _e92 = lookup;
+    let _e95 = mu_s_size_2;
+    lookup.position = ((_e92.uvwz.y * _e95) - 0.5f);
+    let _e99 = atmosphere_99;
+    let _e103 = lookup;
+    let _e105 = atmosphere_99;
+    if ((_e99.scattering_mu_s_split > 0i) && (_e103.position < f32(_e105.scattering_mu_s_split))) {
         {
             lookup.kind = SCATTERING_OWN_COLUMNS;
             lookup.x = vec4(0f);
-            let _e115 = lookup;
-            if (_e115.position < 0f) {
+            let _e117 = lookup;
+            if (_e117.position < 0f) {
                 {
-                    let _e119 = atmosphere_99;
-                    let _e120 = edge_21;
-                    let _e121 = ShadowEdgePastStep(_e119, _e120);
-                    step_ = _e121;
+                    let _e121 = atmosphere_99;
+                    let _e122 = edge_21;
+                    let _e123 = ShadowEdgePastStep(_e121, _e122);
+                    step_ = _e123;
                     lookup.kind = SCATTERING_BELOW_TABLE;
-                    let _e130 = mu_s_size_2;
-                    lookup.x = (vec4<f32>(0.5f, 1.5f, 0f, 0f) / vec4(_e130));
-                    let _e134 = edge_21;
-                    let _e135 = past_3;
-                    let _e139 = step_;
-                    let _e141 = ShadowEdgeSunCosine(_e134, (-((_e135 - 1f)) * _e139));
-                    lookup.mu_s_a = _e141;
-                    let _e143 = edge_21;
-                    let _e144 = past_3;
-                    let _e148 = step_;
-                    let _e150 = ShadowEdgeSunCosine(_e143, (-((_e144 - 2f)) * _e148));
-                    lookup.mu_s_b = _e150;
+                    let _e132 = mu_s_size_2;
+                    lookup.x = (vec4<f32>(0.5f, 1.5f, 0f, 0f) / vec4(_e132));
+                    let _e136 = edge_21;
+                    let _e137 = past_3;
+                    let _e141 = step_;
+                    let _e143 = ShadowEdgeSunCosine(_e136, (-((_e137 - 1f)) * _e141));
+                    lookup.mu_s_a = _e143;
+                    let _e145 = edge_21;
+                    let _e146 = past_3;
+                    let _e150 = step_;
+                    let _e152 = ShadowEdgeSunCosine(_e145, (-((_e146 - 2f)) * _e150));
+                    lookup.mu_s_b = _e152;
                 }
             } else {
-                let _e151 = lookup;
-                let _e153 = past_3;
-                let _e157 = lookup;
-                let _e159 = past_3;
-                if ((_e151.position >= (_e153 - 1f)) && (_e157.position < _e159)) {
+                let _e153 = lookup;
+                let _e155 = past_3;
+                let _e159 = lookup;
+                let _e161 = past_3;
+                if ((_e153.position >= (_e155 - 1f)) && (_e159.position < _e161)) {
                     {
-                        let _e163 = atmosphere_99;
-                        let _e166 = past_3;
-                        x_23 = (1f / (f32(_e163.scattering_mu_s_split) - _e166));
-                        let _e171 = atmosphere_99;
-                        let _e172 = x_23;
-                        let _e173 = edge_21;
-                        let _e174 = ShadowEdgeLitDistance(_e171, _e172, _e173);
-                        lookup.log_first_span = log((_e174 / SHADOW_EDGE_CLOSEST));
+                        let _e165 = atmosphere_99;
+                        let _e168 = past_3;
+                        x_23 = (1f / (f32(_e165.scattering_mu_s_split) - _e168));
+                        let _e173 = atmosphere_99;
+                        let _e174 = sun_axis_18;
+                        let _e175 = x_23;
+                        let _e176 = edge_21;
+                        let _e177 = ShadowEdgeLitDistance(_e173, _e174, _e175, _e176);
+                        lookup.log_first_span = log((_e177 / SHADOW_EDGE_CLOSEST));
                     }
                 }
             }
-            let _e177 = lookup;
-            return _e177;
+            let _e180 = lookup;
+            return _e180;
         }
     }
-    let _e181 = atmosphere_99;
-    let _e182 = sun_axis_3;
-    let _e183 = GetScatteringTextureUMuSOnAxis(_e181, _e182, LOW_SUN_MU_S);
-    x_low_sun_2 = _e183;
-    let _e185 = atmosphere_99;
-    let _e186 = lookup;
-    let _e189 = x_low_sun_2;
-    let _e192 = lookup;
-    GetScatteringMuSColumns(_e185, _e186.uvwz.y, _e189, (&x_below_1), (&x_above_1), (&lookup.t), (&low_sun_below_1));
-    let _e200 = low_sun_below_1;
-    if !(_e200) {
+    let _e184 = atmosphere_99;
+    let _e185 = sun_axis_18;
+    let _e186 = GetScatteringTextureUMuSOnAxis(_e184, _e185, LOW_SUN_MU_S);
+    x_low_sun_2 = _e186;
+    let _e188 = atmosphere_99;
+    let _e189 = lookup;
+    let _e192 = x_low_sun_2;
+    let _e195 = lookup;
+    GetScatteringMuSColumns(_e188, _e189.uvwz.y, _e192, (&x_below_1), (&x_above_1), (&lookup.t), (&low_sun_below_1));
+    let _e203 = low_sun_below_1;
+    if !(_e203) {
         {
             lookup.kind = SCATTERING_DAYLIGHT;
-            let _e204 = x_below_1;
-            let _e205 = x_above_1;
-            let _e206 = lookup;
-            lookup.x = vec4<f32>(mix(_e204, _e205, _e206.t), 0f, 0f, 0f);
+            let _e207 = x_below_1;
+            let _e208 = x_above_1;
+            let _e209 = lookup;
+            lookup.x = vec4<f32>(mix(_e207, _e208, _e209.t), 0f, 0f, 0f);
             lookup.low_sun = vec4(false);
-            let _e216 = lookup;
-            return _e216;
+            let _e219 = lookup;
+            return _e219;
         }
     }
-    let _e217 = lookup;
-    if (_e217.t < 0f) {
+    let _e220 = lookup;
+    if (_e220.t < 0f) {
         {
             lookup.kind = SCATTERING_BELOW_TABLE;
-            let _e223 = x_below_1;
-            let _e224 = x_above_1;
-            lookup.x = vec4<f32>(_e223, _e224, 0f, 0f);
-            let _e230 = x_above_1;
-            let _e231 = x_low_sun_2;
-            lookup.low_sun = vec4<bool>(true, (_e230 < _e231), true, true);
-            let _e237 = atmosphere_99;
-            lookup.mu_s_a = _e237.scattering_mu_s_min;
+            let _e226 = x_below_1;
+            let _e227 = x_above_1;
+            lookup.x = vec4<f32>(_e226, _e227, 0f, 0f);
+            let _e233 = x_above_1;
+            let _e234 = x_low_sun_2;
+            lookup.low_sun = vec4<bool>(true, (_e233 < _e234), true, true);
             let _e240 = atmosphere_99;
-            let _e241 = sun_axis_3;
-            let _e243 = mu_s_size_2;
-            let _e247 = GetScatteringMuSFromUnitRangeOnAxis(_e240, _e241, (1f / (_e243 - 1f)));
-            lookup.mu_s_b = _e247;
-            let _e248 = lookup;
-            return _e248;
+            lookup.mu_s_a = _e240.scattering_mu_s_min;
+            let _e243 = atmosphere_99;
+            let _e244 = sun_axis_18;
+            let _e246 = mu_s_size_2;
+            let _e250 = GetScatteringMuSFromUnitRangeOnAxis(_e243, _e244, (1f / (_e246 - 1f)));
+            lookup.mu_s_b = _e250;
+            let _e251 = lookup;
+            return _e251;
         }
     }
-    let _e249 = x_below_1;
-    let _e250 = mu_s_size_2;
-    column_3 = ((_e249 * _e250) - 0.5f);
-    let _e255 = column_3;
-    let _e258 = mu_s_size_2;
-    let _e264 = mu_s_size_2;
-    x_last = ((min((_e255 + 2f), (_e258 - 1f)) + 0.5f) / _e264);
+    let _e252 = x_below_1;
+    let _e253 = mu_s_size_2;
+    column_3 = ((_e252 * _e253) - 0.5f);
+    let _e258 = column_3;
+    let _e261 = mu_s_size_2;
+    let _e267 = mu_s_size_2;
+    x_last = ((min((_e258 + 2f), (_e261 - 1f)) + 0.5f) / _e267);
     lookup.kind = SCATTERING_LOW_SUN;
-    let _e269 = column_3;
-    let _e276 = mu_s_size_2;
-    let _e278 = x_below_1;
-    let _e279 = x_above_1;
-    let _e280 = x_last;
-    lookup.x = vec4<f32>(((max((_e269 - 1f), 0f) + 0.5f) / _e276), _e278, _e279, _e280);
-    let _e285 = x_above_1;
-    let _e286 = x_low_sun_2;
-    let _e288 = x_last;
+    let _e272 = column_3;
+    let _e279 = mu_s_size_2;
+    let _e281 = x_below_1;
+    let _e282 = x_above_1;
+    let _e283 = x_last;
+    lookup.x = vec4<f32>(((max((_e272 - 1f), 0f) + 0.5f) / _e279), _e281, _e282, _e283);
+    let _e288 = x_above_1;
     let _e289 = x_low_sun_2;
-    lookup.low_sun = vec4<bool>(true, true, (_e285 < _e286), (_e288 < _e289));
-    let _e293 = column_3;
-    lookup.has_first = (_e293 > 0.5f);
-    let _e297 = column_3;
-    let _e300 = mu_s_size_2;
-    lookup.has_last = ((_e297 + 2f) < (_e300 - 0.5f));
-    let _e304 = lookup;
-    return _e304;
+    let _e291 = x_last;
+    let _e292 = x_low_sun_2;
+    lookup.low_sun = vec4<bool>(true, true, (_e288 < _e289), (_e291 < _e292));
+    let _e296 = column_3;
+    lookup.has_first = (_e296 > 0.5f);
+    let _e300 = column_3;
+    let _e303 = mu_s_size_2;
+    lookup.has_last = ((_e300 + 2f) < (_e303 - 0.5f));
+    let _e307 = lookup;
+    return _e307;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
 fn GetScatteringFromLookup(atmosphere_100: AtmosphereParameters, scattering_texture_4: texture_3d<f32>, lookup_1: ScatteringLookup) -> vec4<f32> {
     var atmosphere_101: AtmosphereParameters;
     var lookup_2: ScatteringLookup;
-    var a_18: vec4<f32>;
-    var b_10: vec4<f32>;
+    var a_15: vec4<f32>;
+    var b_7: vec4<f32>;
     var c_8: vec4<f32>;
     var d_23: vec4<f32>;
 
     atmosphere_101 = atmosphere_100;
     lookup_2 = lookup_1;
-    let _e21 = lookup_2;
-    if (_e21.kind == SCATTERING_OWN_COLUMNS) {
+    let _e23 = lookup_2;
+    if (_e23.kind == SCATTERING_DAYLIGHT) {
         {
-            let _e24 = atmosphere_101;
-            let _e25 = lookup_2;
+            let _e26 = atmosphere_101;
             let _e27 = lookup_2;
             let _e29 = lookup_2;
-            let _e31 = lookup_2;
-            let _e33 = GetScatteringBelowSplit(_e24, scattering_texture_4, _e25.uvwz, _e27.position, _e29.nu_slice, _e31.log_first_span);
-            let _e34 = atmosphere_101;
-            let _e35 = lookup_2;
-            let _e37 = lookup_2;
-            let _e39 = lookup_2;
-            let _e43 = lookup_2;
-            let _e45 = GetScatteringBelowSplit(_e34, scattering_texture_4, _e35.uvwz, _e37.position, (_e39.nu_slice + 1f), _e43.log_first_span);
+            let _e32 = lookup_2;
+            let _e34 = GetScatteringInSlice(_e26, scattering_texture_4, _e27.uvwz, _e29.x.x, _e32.nu_slice);
+            let _e35 = atmosphere_101;
+            let _e36 = lookup_2;
+            let _e38 = lookup_2;
+            let _e41 = lookup_2;
+            let _e45 = GetScatteringInSlice(_e35, scattering_texture_4, _e36.uvwz, _e38.x.x, (_e41.nu_slice + 1f));
             let _e46 = lookup_2;
-            let _e49 = SunCosineMix(_e33, _e45, _e46.nu_t, true);
-            return _e49;
+            return mix(_e34, _e45, vec4(_e46.nu_t));
         }
     }
-    let _e50 = atmosphere_101;
-    let _e51 = lookup_2;
-    let _e53 = lookup_2;
-    let _e56 = lookup_2;
-    let _e58 = lookup_2;
-    let _e60 = lookup_2;
-    let _e63 = GetScatteringAtMuSColumn(_e50, scattering_texture_4, _e51.uvwz, _e53.x.x, _e56.nu_slice, _e58.nu_t, _e60.low_sun.x);
-    a_18 = _e63;
-    let _e65 = lookup_2;
-    if (_e65.kind == SCATTERING_DAYLIGHT) {
-        let _e68 = a_18;
-        return _e68;
-    }
-    let _e69 = atmosphere_101;
-    let _e70 = lookup_2;
-    let _e72 = lookup_2;
-    let _e75 = lookup_2;
-    let _e77 = lookup_2;
-    let _e79 = lookup_2;
-    let _e82 = GetScatteringAtMuSColumn(_e69, scattering_texture_4, _e70.uvwz, _e72.x.y, _e75.nu_slice, _e77.nu_t, _e79.low_sun.y);
-    b_10 = _e82;
-    let _e84 = lookup_2;
-    if (_e84.kind == SCATTERING_BELOW_TABLE) {
+    let _e50 = lookup_2;
+    if (_e50.kind == SCATTERING_OWN_COLUMNS) {
         {
-            let _e87 = a_18;
-            let _e88 = b_10;
-            let _e89 = lookup_2;
-            let _e91 = lookup_2;
-            let _e93 = lookup_2;
-            let _e95 = LowestSunContinued(_e87, _e88, _e89.mu_s_a, _e91.mu_s_b, _e93.mu_s);
-            return _e95;
+            let _e53 = atmosphere_101;
+            let _e54 = lookup_2;
+            let _e56 = lookup_2;
+            let _e58 = lookup_2;
+            let _e60 = lookup_2;
+            let _e62 = GetLogScatteringBelowSplit(_e53, scattering_texture_4, _e54.uvwz, _e56.position, _e58.nu_slice, _e60.log_first_span);
+            let _e63 = atmosphere_101;
+            let _e64 = lookup_2;
+            let _e66 = lookup_2;
+            let _e68 = lookup_2;
+            let _e72 = lookup_2;
+            let _e74 = GetLogScatteringBelowSplit(_e63, scattering_texture_4, _e64.uvwz, _e66.position, (_e68.nu_slice + 1f), _e72.log_first_span);
+            let _e75 = lookup_2;
+            let _e79 = LightFromLog(mix(_e62, _e74, vec4(_e75.nu_t)));
+            return _e79;
         }
     }
-    let _e96 = atmosphere_101;
-    let _e97 = lookup_2;
-    let _e99 = lookup_2;
-    let _e102 = lookup_2;
-    let _e104 = lookup_2;
-    let _e106 = lookup_2;
-    let _e109 = GetScatteringAtMuSColumn(_e96, scattering_texture_4, _e97.uvwz, _e99.x.z, _e102.nu_slice, _e104.nu_t, _e106.low_sun.z);
-    c_8 = _e109;
-    let _e111 = atmosphere_101;
-    let _e112 = lookup_2;
-    let _e114 = lookup_2;
-    let _e117 = lookup_2;
-    let _e119 = lookup_2;
-    let _e121 = lookup_2;
-    let _e124 = GetScatteringAtMuSColumn(_e111, scattering_texture_4, _e112.uvwz, _e114.x.w, _e117.nu_slice, _e119.nu_t, _e121.low_sun.w);
-    d_23 = _e124;
-    let _e126 = a_18;
-    let _e127 = b_10;
-    let _e128 = c_8;
-    let _e129 = d_23;
+    let _e80 = atmosphere_101;
+    let _e81 = lookup_2;
+    let _e83 = lookup_2;
+    let _e86 = lookup_2;
+    let _e88 = lookup_2;
+    let _e90 = lookup_2;
+    let _e93 = GetLogScatteringAtMuSColumn(_e80, scattering_texture_4, _e81.uvwz, _e83.x.x, _e86.nu_slice, _e88.nu_t, _e90.low_sun.x);
+    a_15 = _e93;
+    let _e95 = atmosphere_101;
+    let _e96 = lookup_2;
+    let _e98 = lookup_2;
+    let _e101 = lookup_2;
+    let _e103 = lookup_2;
+    let _e105 = lookup_2;
+    let _e108 = GetLogScatteringAtMuSColumn(_e95, scattering_texture_4, _e96.uvwz, _e98.x.y, _e101.nu_slice, _e103.nu_t, _e105.low_sun.y);
+    b_7 = _e108;
+    let _e110 = lookup_2;
+    if (_e110.kind == SCATTERING_BELOW_TABLE) {
+        {
+            let _e113 = a_15;
+            let _e114 = b_7;
+            let _e115 = lookup_2;
+            let _e117 = lookup_2;
+            let _e119 = lookup_2;
+            let _e121 = LowestSunContinued(_e113, _e114, _e115.mu_s_a, _e117.mu_s_b, _e119.mu_s);
+            return _e121;
+        }
+    }
+    let _e122 = atmosphere_101;
+    let _e123 = lookup_2;
+    let _e125 = lookup_2;
+    let _e128 = lookup_2;
     let _e130 = lookup_2;
     let _e132 = lookup_2;
-    let _e134 = lookup_2;
-    let _e136 = LogMonotoneCubicMix(_e126, _e127, _e128, _e129, _e130.has_first, _e132.has_last, _e134.t);
-    return _e136;
+    let _e135 = GetLogScatteringAtMuSColumn(_e122, scattering_texture_4, _e123.uvwz, _e125.x.z, _e128.nu_slice, _e130.nu_t, _e132.low_sun.z);
+    c_8 = _e135;
+    let _e137 = atmosphere_101;
+    let _e138 = lookup_2;
+    let _e140 = lookup_2;
+    let _e143 = lookup_2;
+    let _e145 = lookup_2;
+    let _e147 = lookup_2;
+    let _e150 = GetLogScatteringAtMuSColumn(_e137, scattering_texture_4, _e138.uvwz, _e140.x.w, _e143.nu_slice, _e145.nu_t, _e147.low_sun.w);
+    d_23 = _e150;
+    let _e152 = a_15;
+    let _e153 = b_7;
+    let _e154 = c_8;
+    let _e155 = d_23;
+    let _e156 = lookup_2;
+    let _e158 = lookup_2;
+    let _e160 = lookup_2;
+    let _e162 = LogMonotoneCubic(_e152, _e153, _e154, _e155, _e156.has_first, _e158.has_last, _e160.t);
+    let _e163 = LightFromLog(_e162);
+    return _e163;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -2979,16 +3097,16 @@ fn GetScattering(atmosphere_102: AtmosphereParameters, scattering_texture_5: tex
     mu_s_34 = mu_s_33;
     nu_18 = nu_17;
     ray_r_mu_intersects_ground_26 = ray_r_mu_intersects_ground_25;
-    let _e29 = atmosphere_103;
-    let _e30 = atmosphere_103;
-    let _e31 = r_55;
-    let _e32 = mu_40;
-    let _e33 = mu_s_34;
-    let _e34 = nu_18;
-    let _e35 = ray_r_mu_intersects_ground_26;
-    let _e36 = GetScatteringLookup(_e30, _e31, _e32, _e33, _e34, _e35);
-    let _e37 = GetScatteringFromLookup(_e29, scattering_texture_5, _e36);
-    return _e37;
+    let _e31 = atmosphere_103;
+    let _e32 = atmosphere_103;
+    let _e33 = r_55;
+    let _e34 = mu_40;
+    let _e35 = mu_s_34;
+    let _e36 = nu_18;
+    let _e37 = ray_r_mu_intersects_ground_26;
+    let _e38 = GetScatteringLookup(_e32, _e33, _e34, _e35, _e36, _e37);
+    let _e39 = GetScatteringFromLookup(_e31, scattering_texture_5, _e38);
+    return _e39;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -3008,47 +3126,47 @@ fn GetIrradiance(atmosphere_104: AtmosphereParameters, irradiance_texture: textu
     atmosphere_105 = atmosphere_104;
     r_57 = r_56;
     mu_s_36 = mu_s_35;
-    let _e23 = atmosphere_105;
-    let _e24 = r_57;
-    let _e25 = mu_s_36;
-    let _e26 = GetIrradianceTextureUvFromRMuS(_e23, _e24, _e25);
-    uv_3 = _e26;
-    let _e28 = atmosphere_105;
-    width = f32(_e28.irradiance_width);
-    let _e32 = atmosphere_105;
-    let _e33 = mu_s_36;
-    let _e34 = GetIrradianceUnitMuS(_e32, _e33);
-    let _e35 = width;
-    mu_s_coord_1 = (_e34 * (_e35 - 1f));
-    let _e40 = mu_s_coord_1;
-    let _e43 = width;
-    mu_s_column_1 = clamp(floor(_e40), 0f, (_e43 - 2f));
-    let _e48 = atmosphere_105;
-    let _e49 = mu_s_column_1;
-    let _e50 = width;
-    let _e54 = GetIrradianceMuSFromUnit(_e48, (_e49 / (_e50 - 1f)));
-    mu_s_below = _e54;
-    let _e56 = mu_s_below;
-    low_sun_8 = (_e56 < LOW_SUN_MU_S);
-    let _e59 = mu_s_column_1;
-    let _e62 = width;
-    let _e64 = uv_3;
-    let _e67 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e59 + 0.5f) / _e62), _e64.y));
-    below = _e67;
-    let _e69 = mu_s_column_1;
-    let _e72 = width;
-    let _e74 = uv_3;
-    let _e77 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e69 + 1.5f) / _e72), _e74.y));
-    above = _e77;
-    let _e79 = below;
-    let _e80 = above;
-    let _e81 = mu_s_coord_1;
-    let _e82 = mu_s_column_1;
-    let _e84 = low_sun_8;
-    let _e85 = SunCosinePosition((_e81 - _e82), _e84);
+    let _e25 = atmosphere_105;
+    let _e26 = r_57;
+    let _e27 = mu_s_36;
+    let _e28 = GetIrradianceTextureUvFromRMuS(_e25, _e26, _e27);
+    uv_3 = _e28;
+    let _e30 = atmosphere_105;
+    width = f32(_e30.irradiance_width);
+    let _e34 = atmosphere_105;
+    let _e35 = mu_s_36;
+    let _e36 = GetIrradianceUnitMuS(_e34, _e35);
+    let _e37 = width;
+    mu_s_coord_1 = (_e36 * (_e37 - 1f));
+    let _e42 = mu_s_coord_1;
+    let _e45 = width;
+    mu_s_column_1 = clamp(floor(_e42), 0f, (_e45 - 2f));
+    let _e50 = atmosphere_105;
+    let _e51 = mu_s_column_1;
+    let _e52 = width;
+    let _e56 = GetIrradianceMuSFromUnit(_e50, (_e51 / (_e52 - 1f)));
+    mu_s_below = _e56;
+    let _e58 = mu_s_below;
+    low_sun_8 = (_e58 < LOW_SUN_MU_S);
+    let _e61 = mu_s_column_1;
+    let _e64 = width;
+    let _e66 = uv_3;
+    let _e69 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e61 + 0.5f) / _e64), _e66.y));
+    below = _e69;
+    let _e71 = mu_s_column_1;
+    let _e74 = width;
+    let _e76 = uv_3;
+    let _e79 = SampleTexture2D(irradiance_texture, vec2<f32>(((_e71 + 1.5f) / _e74), _e76.y));
+    above = _e79;
+    let _e81 = below;
+    let _e82 = above;
+    let _e83 = mu_s_coord_1;
+    let _e84 = mu_s_column_1;
     let _e86 = low_sun_8;
-    let _e87 = SunBelowTableMix(_e79, _e80, _e85, _e86);
-    return vec3<f32>(_e87.xyz);
+    let _e87 = SunCosinePosition((_e83 - _e84), _e86);
+    let _e88 = low_sun_8;
+    let _e89 = SunBelowTableMix(_e81, _e82, _e87, _e88);
+    return vec3<f32>(_e89.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -3058,19 +3176,19 @@ fn MiePhaseFunction(atmosphere_106: AtmosphereParameters, nu_19: f32) -> f32 {
 
     atmosphere_107 = atmosphere_106;
     nu_20 = nu_19;
-    let _e20 = atmosphere_107;
-    if (_e20.mie_phase == PHASE_HENYEY_GREENSTEIN) {
-        let _e23 = atmosphere_107;
-        let _e25 = nu_20;
-        let _e26 = HenyeyGreensteinPhaseFunction(_e23.mie_g, _e25);
-        return _e26;
+    let _e22 = atmosphere_107;
+    if (_e22.mie_phase == PHASE_HENYEY_GREENSTEIN) {
+        let _e25 = atmosphere_107;
+        let _e27 = nu_20;
+        let _e28 = HenyeyGreensteinPhaseFunction(_e25.mie_g, _e27);
+        return _e28;
     }
-    let _e27 = atmosphere_107;
-    if (_e27.mie_phase == PHASE_CORNETTE_SHANKS) {
-        let _e30 = atmosphere_107;
-        let _e32 = nu_20;
-        let _e33 = CornetteShanksPhaseFunction(_e30.mie_g, _e32);
-        return _e33;
+    let _e29 = atmosphere_107;
+    if (_e29.mie_phase == PHASE_CORNETTE_SHANKS) {
+        let _e32 = atmosphere_107;
+        let _e34 = nu_20;
+        let _e35 = CornetteShanksPhaseFunction(_e32.mie_g, _e34);
+        return _e35;
     }
     return 0f;
 }
@@ -3085,7 +3203,7 @@ fn GetCombinedScattering(atmosphere_108: AtmosphereParameters, scattering_textur
     var ray_r_mu_intersects_ground_28: bool;
     var lookup_3: ScatteringLookup;
     var scattering: vec4<f32>;
-    var local_22: vec3<f32>;
+    var local_23: vec3<f32>;
 
     atmosphere_109 = atmosphere_108;
     r_59 = r_58;
@@ -3093,45 +3211,45 @@ fn GetCombinedScattering(atmosphere_108: AtmosphereParameters, scattering_textur
     mu_s_38 = mu_s_37;
     nu_22 = nu_21;
     ray_r_mu_intersects_ground_28 = ray_r_mu_intersects_ground_27;
-    let _e31 = atmosphere_109;
-    let _e32 = r_59;
-    let _e33 = mu_42;
-    let _e34 = mu_s_38;
-    let _e35 = nu_22;
-    let _e36 = ray_r_mu_intersects_ground_28;
-    let _e37 = GetScatteringLookup(_e31, _e32, _e33, _e34, _e35, _e36);
-    lookup_3 = _e37;
-    let _e39 = atmosphere_109;
-    let _e40 = lookup_3;
-    let _e41 = GetScatteringFromLookup(_e39, scattering_texture_6, _e40);
-    scattering = _e41;
-    let _e43 = atmosphere_109;
-    if (_e43.single_mie_in_scattering_alpha == 1i) {
+    let _e33 = atmosphere_109;
+    let _e34 = r_59;
+    let _e35 = mu_42;
+    let _e36 = mu_s_38;
+    let _e37 = nu_22;
+    let _e38 = ray_r_mu_intersects_ground_28;
+    let _e39 = GetScatteringLookup(_e33, _e34, _e35, _e36, _e37, _e38);
+    lookup_3 = _e39;
+    let _e41 = atmosphere_109;
+    let _e42 = lookup_3;
+    let _e43 = GetScatteringFromLookup(_e41, scattering_texture_6, _e42);
+    scattering = _e43;
+    let _e45 = atmosphere_109;
+    if (_e45.single_mie_in_scattering_alpha == 1i) {
         {
-            let _e47 = scattering;
-            if (_e47.x > 0f) {
-                let _e51 = scattering;
-                let _e54 = scattering;
-                let _e57 = scattering;
-                let _e61 = atmosphere_109;
+            let _e49 = scattering;
+            if (_e49.x > 0f) {
+                let _e53 = scattering;
+                let _e56 = scattering;
+                let _e59 = scattering;
                 let _e63 = atmosphere_109;
-                local_22 = (((vec3<f32>(_e51.xyz) * _e54.w) / vec3(_e57.x)) * (_e61.mie_to_rayleigh_scattering_ratio / vec3(_e63.mie_to_rayleigh_scattering_ratio.x)));
+                let _e65 = atmosphere_109;
+                local_23 = (((vec3<f32>(_e53.xyz) * _e56.w) / vec3(_e59.x)) * (_e63.mie_to_rayleigh_scattering_ratio / vec3(_e65.mie_to_rayleigh_scattering_ratio.x)));
             } else {
-                local_22 = vec3(0f);
+                local_23 = vec3(0f);
             }
-            let _e72 = local_22;
-            (*single_mie_scattering) = _e72;
+            let _e74 = local_23;
+            (*single_mie_scattering) = _e74;
         }
     } else {
         {
-            let _e73 = atmosphere_109;
-            let _e74 = lookup_3;
-            let _e75 = GetScatteringFromLookup(_e73, single_mie_scattering_texture, _e74);
-            (*single_mie_scattering) = vec3<f32>(_e75.xyz);
+            let _e75 = atmosphere_109;
+            let _e76 = lookup_3;
+            let _e77 = GetScatteringFromLookup(_e75, single_mie_scattering_texture, _e76);
+            (*single_mie_scattering) = vec3<f32>(_e77.xyz);
         }
     }
-    let _e78 = scattering;
-    return vec3<f32>(_e78.xyz);
+    let _e80 = scattering;
+    return vec3<f32>(_e80.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -3151,22 +3269,22 @@ fn GetSkyRadianceOfRay(atmosphere_110: AtmosphereParameters, scattering_texture_
     mu_s_40 = mu_s_39;
     nu_24 = nu_23;
     ray_r_mu_intersects_ground_30 = ray_r_mu_intersects_ground_29;
-    let _e31 = atmosphere_111;
-    let _e32 = r_61;
-    let _e33 = mu_44;
-    let _e34 = mu_s_40;
-    let _e35 = nu_24;
-    let _e36 = ray_r_mu_intersects_ground_30;
-    let _e39 = GetCombinedScattering(_e31, scattering_texture_7, single_mie_scattering_texture_1, _e32, _e33, _e34, _e35, _e36, (&single_mie_scattering_1));
-    scattering_1 = _e39;
-    let _e41 = scattering_1;
-    let _e42 = nu_24;
-    let _e43 = RayleighPhaseFunction(_e42);
-    let _e45 = single_mie_scattering_1;
-    let _e46 = atmosphere_111;
-    let _e47 = nu_24;
-    let _e48 = MiePhaseFunction(_e46, _e47);
-    return ((_e41 * _e43) + (_e45 * _e48));
+    let _e33 = atmosphere_111;
+    let _e34 = r_61;
+    let _e35 = mu_44;
+    let _e36 = mu_s_40;
+    let _e37 = nu_24;
+    let _e38 = ray_r_mu_intersects_ground_30;
+    let _e41 = GetCombinedScattering(_e33, scattering_texture_7, single_mie_scattering_texture_1, _e34, _e35, _e36, _e37, _e38, (&single_mie_scattering_1));
+    scattering_1 = _e41;
+    let _e43 = scattering_1;
+    let _e44 = nu_24;
+    let _e45 = RayleighPhaseFunction(_e44);
+    let _e47 = single_mie_scattering_1;
+    let _e48 = atmosphere_111;
+    let _e49 = nu_24;
+    let _e50 = MiePhaseFunction(_e48, _e49);
+    return ((_e43 * _e45) + (_e47 * _e50));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -3181,48 +3299,48 @@ fn GetSkyRadiance(atmosphere_112: AtmosphereParameters, transmittance_texture_5:
     var mu_s_41: f32;
     var nu_25: f32;
     var ray_r_mu_intersects_ground_31: bool;
-    var local_23: vec3<f32>;
+    var local_24: vec3<f32>;
 
     atmosphere_113 = atmosphere_112;
     camera_5 = camera_4;
     view_ray_5 = view_ray_4;
     sun_direction_3 = sun_direction_2;
-    let _e33 = atmosphere_113;
-    let _e34 = camera_5;
-    let _e35 = view_ray_5;
-    let _e36 = sun_direction_3;
-    let _e47 = GetViewRayStart(_e33, _e34, _e35, _e36, (&start_2), (&r_62), (&mu_45), (&mu_s_41), (&nu_25));
-    if !(_e47) {
+    let _e35 = atmosphere_113;
+    let _e36 = camera_5;
+    let _e37 = view_ray_5;
+    let _e38 = sun_direction_3;
+    let _e49 = GetViewRayStart(_e35, _e36, _e37, _e38, (&start_2), (&r_62), (&mu_45), (&mu_s_41), (&nu_25));
+    if !(_e49) {
         {
             (*transmittance) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e53 = atmosphere_113;
-    let _e54 = r_62;
-    let _e55 = mu_45;
-    let _e56 = RayIntersectsGround(_e53, _e54, _e55);
-    ray_r_mu_intersects_ground_31 = _e56;
-    let _e58 = ray_r_mu_intersects_ground_31;
-    if _e58 {
-        local_23 = vec3(0f);
+    let _e55 = atmosphere_113;
+    let _e56 = r_62;
+    let _e57 = mu_45;
+    let _e58 = RayIntersectsGround(_e55, _e56, _e57);
+    ray_r_mu_intersects_ground_31 = _e58;
+    let _e60 = ray_r_mu_intersects_ground_31;
+    if _e60 {
+        local_24 = vec3(0f);
     } else {
-        let _e61 = atmosphere_113;
-        let _e62 = r_62;
-        let _e63 = mu_45;
-        let _e64 = GetTransmittanceToTopAtmosphereBoundary(_e61, transmittance_texture_5, _e62, _e63);
-        local_23 = _e64;
+        let _e63 = atmosphere_113;
+        let _e64 = r_62;
+        let _e65 = mu_45;
+        let _e66 = GetTransmittanceToTopAtmosphereBoundary(_e63, transmittance_texture_5, _e64, _e65);
+        local_24 = _e66;
     }
-    let _e66 = local_23;
-    (*transmittance) = _e66;
-    let _e67 = atmosphere_113;
-    let _e68 = r_62;
-    let _e69 = mu_45;
-    let _e70 = mu_s_41;
-    let _e71 = nu_25;
-    let _e72 = ray_r_mu_intersects_ground_31;
-    let _e73 = GetSkyRadianceOfRay(_e67, scattering_texture_8, single_mie_scattering_texture_2, _e68, _e69, _e70, _e71, _e72);
-    return _e73;
+    let _e68 = local_24;
+    (*transmittance) = _e68;
+    let _e69 = atmosphere_113;
+    let _e70 = r_62;
+    let _e71 = mu_45;
+    let _e72 = mu_s_41;
+    let _e73 = nu_25;
+    let _e74 = ray_r_mu_intersects_ground_31;
+    let _e75 = GetSkyRadianceOfRay(_e69, scattering_texture_8, single_mie_scattering_texture_2, _e70, _e71, _e72, _e73, _e74);
+    return _e75;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3235,45 +3353,45 @@ fn DistanceInsideScatteringRadii(atmosphere_114: AtmosphereParameters, r_63: f32
     var across_2: f32;
     var up: f32;
     var down_discriminant: f32;
-    var local_24: f32;
+    var local_25: f32;
 
     atmosphere_115 = atmosphere_114;
     r_64 = r_63;
     mu_47 = mu_46;
-    let _e23 = atmosphere_115;
-    r_max = _e23.scattering_r_max;
-    let _e26 = atmosphere_115;
-    r_min = _e26.scattering_r_min;
-    let _e29 = r_64;
-    let _e30 = r_64;
-    let _e32 = mu_47;
-    let _e33 = mu_47;
-    across_2 = ((_e29 * _e30) * ((_e32 * _e33) - 1f));
-    let _e39 = r_64;
-    let _e41 = mu_47;
-    let _e43 = across_2;
-    let _e44 = r_max;
-    let _e45 = r_max;
-    let _e48 = SafeSqrt((_e43 + (_e44 * _e45)));
-    up = ((-(_e39) * _e41) + _e48);
-    let _e51 = across_2;
-    let _e52 = r_min;
-    let _e53 = r_min;
-    down_discriminant = (_e51 + (_e52 * _e53));
-    let _e57 = mu_47;
-    let _e60 = down_discriminant;
-    if ((_e57 < 0f) && (_e60 >= 0f)) {
-        let _e64 = up;
-        let _e65 = r_64;
-        let _e67 = mu_47;
-        let _e69 = down_discriminant;
-        local_24 = min(_e64, ((-(_e65) * _e67) - sqrt(_e69)));
+    let _e25 = atmosphere_115;
+    r_max = _e25.scattering_r_max;
+    let _e28 = atmosphere_115;
+    r_min = _e28.scattering_r_min;
+    let _e31 = r_64;
+    let _e32 = r_64;
+    let _e34 = mu_47;
+    let _e35 = mu_47;
+    across_2 = ((_e31 * _e32) * ((_e34 * _e35) - 1f));
+    let _e41 = r_64;
+    let _e43 = mu_47;
+    let _e45 = across_2;
+    let _e46 = r_max;
+    let _e47 = r_max;
+    let _e50 = SafeSqrt((_e45 + (_e46 * _e47)));
+    up = ((-(_e41) * _e43) + _e50);
+    let _e53 = across_2;
+    let _e54 = r_min;
+    let _e55 = r_min;
+    down_discriminant = (_e53 + (_e54 * _e55));
+    let _e59 = mu_47;
+    let _e62 = down_discriminant;
+    if ((_e59 < 0f) && (_e62 >= 0f)) {
+        let _e66 = up;
+        let _e67 = r_64;
+        let _e69 = mu_47;
+        let _e71 = down_discriminant;
+        local_25 = min(_e66, ((-(_e67) * _e69) - sqrt(_e71)));
     } else {
-        let _e73 = up;
-        local_24 = _e73;
+        let _e75 = up;
+        local_25 = _e75;
     }
-    let _e75 = local_24;
-    return _e75;
+    let _e77 = local_25;
+    return _e77;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3284,65 +3402,65 @@ fn ProfileSampleAltitude(atmosphere_116: AtmosphereParameters, i_1: i32) -> f32 
 
     atmosphere_117 = atmosphere_116;
     i_2 = i_1;
-    let _e22 = i_2;
-    x_24 = (f32(_e22) / 63f);
-    let _e30 = atmosphere_117;
+    let _e24 = i_2;
+    x_24 = (f32(_e24) / 63f);
     let _e32 = atmosphere_117;
-    let _e35 = x_24;
+    let _e34 = atmosphere_117;
     let _e37 = x_24;
-    return (((_e30.top_radius - _e32.bottom_radius) * _e35) * _e37);
+    let _e39 = x_24;
+    return (((_e32.top_radius - _e34.bottom_radius) * _e37) * _e39);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_19: f32, b_11: f32, f: f32) -> f32 {
-    var a_20: f32;
-    var b_12: f32;
+fn InterpolateCoefficient(a_16: f32, b_8: f32, f: f32) -> f32 {
+    var a_17: f32;
+    var b_9: f32;
     var f_1: f32;
-    var local_25: f32;
+    var local_26: f32;
 
-    a_20 = a_19;
-    b_12 = b_11;
+    a_17 = a_16;
+    b_9 = b_8;
     f_1 = f;
-    let _e24 = a_20;
-    let _e27 = b_12;
-    if ((_e24 > 0f) && (_e27 > 0f)) {
-        let _e31 = a_20;
-        let _e32 = f_1;
-        let _e33 = b_12;
-        let _e34 = a_20;
-        local_25 = (_e31 * exp((_e32 * log((_e33 / _e34)))));
+    let _e26 = a_17;
+    let _e29 = b_9;
+    if ((_e26 > 0f) && (_e29 > 0f)) {
+        let _e33 = a_17;
+        let _e34 = f_1;
+        let _e35 = b_9;
+        let _e36 = a_17;
+        local_26 = (_e33 * exp((_e34 * log((_e35 / _e36)))));
     } else {
-        let _e40 = a_20;
-        let _e41 = b_12;
-        let _e42 = f_1;
-        local_25 = mix(_e40, _e41, _e42);
+        let _e42 = a_17;
+        let _e43 = b_9;
+        let _e44 = f_1;
+        local_26 = mix(_e42, _e43, _e44);
     }
-    let _e45 = local_25;
-    return _e45;
+    let _e47 = local_26;
+    return _e47;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_21: vec3<f32>, b_13: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_22: vec3<f32>;
-    var b_14: vec3<f32>;
+fn InterpolateCoefficients(a_18: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f32> {
+    var a_19: vec3<f32>;
+    var b_11: vec3<f32>;
     var f_3: f32;
 
-    a_22 = a_21;
-    b_14 = b_13;
+    a_19 = a_18;
+    b_11 = b_10;
     f_3 = f_2;
-    let _e24 = a_22;
-    let _e26 = b_14;
-    let _e28 = f_3;
-    let _e29 = InterpolateCoefficient(_e24.x, _e26.x, _e28);
-    let _e30 = a_22;
-    let _e32 = b_14;
-    let _e34 = f_3;
-    let _e35 = InterpolateCoefficient(_e30.y, _e32.y, _e34);
-    let _e36 = a_22;
-    let _e38 = b_14;
-    let _e40 = f_3;
-    let _e41 = InterpolateCoefficient(_e36.z, _e38.z, _e40);
-    return vec3<f32>(_e29, _e35, _e41);
+    let _e26 = a_19;
+    let _e28 = b_11;
+    let _e30 = f_3;
+    let _e31 = InterpolateCoefficient(_e26.x, _e28.x, _e30);
+    let _e32 = a_19;
+    let _e34 = b_11;
+    let _e36 = f_3;
+    let _e37 = InterpolateCoefficient(_e32.y, _e34.y, _e36);
+    let _e38 = a_19;
+    let _e40 = b_11;
+    let _e42 = f_3;
+    let _e43 = InterpolateCoefficient(_e38.z, _e40.z, _e42);
+    return vec3<f32>(_e31, _e37, _e43);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3357,70 +3475,70 @@ fn GetCoefficientsAtAltitude(atmosphere_118: AtmosphereParameters, altitude: f32
 
     atmosphere_119 = atmosphere_118;
     altitude_1 = altitude;
-    let _e24 = atmosphere_119;
     let _e26 = atmosphere_119;
-    height = (_e24.top_radius - _e26.bottom_radius);
-    let _e30 = altitude_1;
-    let _e31 = height;
-    x_25 = (sqrt(clamp((_e30 / _e31), 0f, 1f)) * 63f);
-    let _e43 = x_25;
-    i_3 = min(i32(_e43), 62i);
-    let _e50 = atmosphere_119;
-    let _e51 = i_3;
-    let _e52 = ProfileSampleAltitude(_e50, _e51);
-    h0_ = _e52;
-    let _e54 = altitude_1;
-    let _e55 = h0_;
-    let _e57 = atmosphere_119;
-    let _e58 = i_3;
-    let _e61 = ProfileSampleAltitude(_e57, (_e58 + 1i));
-    let _e62 = h0_;
-    f_4 = clamp(((_e54 - _e55) / (_e61 - _e62)), 0f, 1f);
-    let _e69 = i_3;
-    let _e72 = atmosphere_119.mie_scattering_profile[_e69];
-    let _e73 = i_3;
-    let _e78 = atmosphere_119.mie_scattering_profile[(_e73 + 1i)];
-    let _e79 = f_4;
-    let _e80 = InterpolateCoefficients(_e72, _e78, _e79);
-    (*mie_scattering) = _e80;
-    let _e81 = i_3;
-    let _e84 = atmosphere_119.rayleigh_scattering_profile[_e81];
-    let _e85 = i_3;
-    let _e90 = atmosphere_119.rayleigh_scattering_profile[(_e85 + 1i)];
-    let _e91 = f_4;
-    let _e92 = InterpolateCoefficients(_e84, _e90, _e91);
-    (*rayleigh_scattering) = _e92;
-    let _e93 = i_3;
-    let _e96 = atmosphere_119.extinction_profile[_e93];
-    let _e97 = i_3;
-    let _e102 = atmosphere_119.extinction_profile[(_e97 + 1i)];
-    let _e103 = f_4;
-    let _e104 = InterpolateCoefficients(_e96, _e102, _e103);
-    return _e104;
+    let _e28 = atmosphere_119;
+    height = (_e26.top_radius - _e28.bottom_radius);
+    let _e32 = altitude_1;
+    let _e33 = height;
+    x_25 = (sqrt(clamp((_e32 / _e33), 0f, 1f)) * 63f);
+    let _e45 = x_25;
+    i_3 = min(i32(_e45), 62i);
+    let _e52 = atmosphere_119;
+    let _e53 = i_3;
+    let _e54 = ProfileSampleAltitude(_e52, _e53);
+    h0_ = _e54;
+    let _e56 = altitude_1;
+    let _e57 = h0_;
+    let _e59 = atmosphere_119;
+    let _e60 = i_3;
+    let _e63 = ProfileSampleAltitude(_e59, (_e60 + 1i));
+    let _e64 = h0_;
+    f_4 = clamp(((_e56 - _e57) / (_e63 - _e64)), 0f, 1f);
+    let _e71 = i_3;
+    let _e74 = atmosphere_119.mie_scattering_profile[_e71];
+    let _e75 = i_3;
+    let _e80 = atmosphere_119.mie_scattering_profile[(_e75 + 1i)];
+    let _e81 = f_4;
+    let _e82 = InterpolateCoefficients(_e74, _e80, _e81);
+    (*mie_scattering) = _e82;
+    let _e83 = i_3;
+    let _e86 = atmosphere_119.rayleigh_scattering_profile[_e83];
+    let _e87 = i_3;
+    let _e92 = atmosphere_119.rayleigh_scattering_profile[(_e87 + 1i)];
+    let _e93 = f_4;
+    let _e94 = InterpolateCoefficients(_e86, _e92, _e93);
+    (*rayleigh_scattering) = _e94;
+    let _e95 = i_3;
+    let _e98 = atmosphere_119.extinction_profile[_e95];
+    let _e99 = i_3;
+    let _e104 = atmosphere_119.extinction_profile[(_e99 + 1i)];
+    let _e105 = f_4;
+    let _e106 = InterpolateCoefficients(_e98, _e104, _e105);
+    return _e106;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AltitudeAtDistance(atmosphere_120: AtmosphereParameters, r_65: f32, mu_48: f32, t_9: f32, r_t: f32) -> f32 {
+fn AltitudeAtDistance(atmosphere_120: AtmosphereParameters, r_65: f32, mu_48: f32, t_11: f32, r_t: f32) -> f32 {
     var atmosphere_121: AtmosphereParameters;
     var r_66: f32;
     var mu_49: f32;
-    var t_10: f32;
+    var t_12: f32;
     var r_t_1: f32;
 
     atmosphere_121 = atmosphere_120;
     r_66 = r_65;
     mu_49 = mu_48;
-    t_10 = t_9;
+    t_12 = t_11;
     r_t_1 = r_t;
-    let _e28 = r_66;
-    let _e29 = atmosphere_121;
-    let _e32 = t_10;
-    let _e33 = t_10;
-    let _e35 = r_66;
-    let _e37 = mu_49;
-    let _e41 = r_t_1;
-    let _e42 = r_66;
-    return ((_e28 - _e29.bottom_radius) + ((_e32 * (_e33 + ((2f * _e35) * _e37))) / (_e41 + _e42)));
+    let _e30 = r_66;
+    let _e31 = atmosphere_121;
+    let _e34 = t_12;
+    let _e35 = t_12;
+    let _e37 = r_66;
+    let _e39 = mu_49;
+    let _e43 = r_t_1;
+    let _e44 = r_66;
+    return ((_e30 - _e31.bottom_radius) + ((_e34 * (_e35 + ((2f * _e37) * _e39))) / (_e43 + _e44)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3433,7 +3551,7 @@ fn IntegrateSegmentOpticalDepth(atmosphere_122: AtmosphereParameters, r_67: f32,
     var optical_depth: vec3<f32> = vec3(0f);
     var previous_extinction: vec3<f32> = vec3(0f);
     var k_5: i32 = 0i;
-    var t_11: f32;
+    var t_13: f32;
     var r_t_2: f32;
     var mie_scattering_1: vec3<f32>;
     var rayleigh_scattering_1: vec3<f32>;
@@ -3443,50 +3561,50 @@ fn IntegrateSegmentOpticalDepth(atmosphere_122: AtmosphereParameters, r_67: f32,
     r_68 = r_67;
     mu_51 = mu_50;
     d_25 = d_24;
-    let _e26 = d_25;
-    dt = (_e26 / 16f);
+    let _e28 = d_25;
+    dt = (_e28 / 16f);
     loop {
-        let _e39 = k_5;
-        if !((_e39 <= SEGMENT_INTERVALS)) {
+        let _e41 = k_5;
+        if !((_e41 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e45 = dt;
-            let _e46 = k_5;
-            t_11 = (_e45 * f32(_e46));
-            let _e50 = atmosphere_123;
-            let _e51 = r_68;
-            let _e52 = mu_51;
-            let _e53 = t_11;
-            let _e54 = RadiusAtDistance(_e50, _e51, _e52, _e53);
-            r_t_2 = _e54;
-            let _e58 = atmosphere_123;
-            let _e59 = atmosphere_123;
-            let _e60 = r_68;
-            let _e61 = mu_51;
-            let _e62 = t_11;
-            let _e63 = r_t_2;
-            let _e64 = AltitudeAtDistance(_e59, _e60, _e61, _e62, _e63);
-            let _e69 = GetCoefficientsAtAltitude(_e58, _e64, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e69;
-            let _e71 = k_5;
-            if (_e71 > 0i) {
-                let _e74 = optical_depth;
-                let _e75 = previous_extinction;
-                let _e76 = extinction;
-                let _e79 = dt;
-                optical_depth = (_e74 + ((_e75 + _e76) * (0.5f * _e79)));
+            let _e47 = dt;
+            let _e48 = k_5;
+            t_13 = (_e47 * f32(_e48));
+            let _e52 = atmosphere_123;
+            let _e53 = r_68;
+            let _e54 = mu_51;
+            let _e55 = t_13;
+            let _e56 = RadiusAtDistance(_e52, _e53, _e54, _e55);
+            r_t_2 = _e56;
+            let _e60 = atmosphere_123;
+            let _e61 = atmosphere_123;
+            let _e62 = r_68;
+            let _e63 = mu_51;
+            let _e64 = t_13;
+            let _e65 = r_t_2;
+            let _e66 = AltitudeAtDistance(_e61, _e62, _e63, _e64, _e65);
+            let _e71 = GetCoefficientsAtAltitude(_e60, _e66, (&mie_scattering_1), (&rayleigh_scattering_1));
+            extinction = _e71;
+            let _e73 = k_5;
+            if (_e73 > 0i) {
+                let _e76 = optical_depth;
+                let _e77 = previous_extinction;
+                let _e78 = extinction;
+                let _e81 = dt;
+                optical_depth = (_e76 + ((_e77 + _e78) * (0.5f * _e81)));
             }
-            let _e83 = extinction;
-            previous_extinction = _e83;
+            let _e85 = extinction;
+            previous_extinction = _e85;
         }
         continuing {
-            let _e42 = k_5;
-            k_5 = (_e42 + 1i);
+            let _e44 = k_5;
+            k_5 = (_e44 + 1i);
         }
     }
-    let _e84 = optical_depth;
-    return _e84;
+    let _e86 = optical_depth;
+    return _e86;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3496,51 +3614,51 @@ fn LongSegmentOpticalDepth(atmosphere_124: AtmosphereParameters, transmittance_t
     var mu_53: f32;
     var d_27: f32;
     var ray_r_mu_intersects_ground_33: bool;
-    var local_26: vec3<f32>;
+    var local_27: vec3<f32>;
 
     atmosphere_125 = atmosphere_124;
     r_70 = r_69;
     mu_53 = mu_52;
     d_27 = d_26;
     ray_r_mu_intersects_ground_33 = ray_r_mu_intersects_ground_32;
-    let _e29 = atmosphere_125;
-    if (_e29.transmittance_is_colour != 0i) {
-        let _e33 = atmosphere_125;
-        let _e34 = r_70;
-        let _e35 = mu_53;
-        let _e36 = d_27;
-        let _e37 = IntegrateSegmentOpticalDepth(_e33, _e34, _e35, _e36);
-        local_26 = _e37;
+    let _e31 = atmosphere_125;
+    if (_e31.transmittance_is_colour != 0i) {
+        let _e35 = atmosphere_125;
+        let _e36 = r_70;
+        let _e37 = mu_53;
+        let _e38 = d_27;
+        let _e39 = IntegrateSegmentOpticalDepth(_e35, _e36, _e37, _e38);
+        local_27 = _e39;
     } else {
-        let _e38 = atmosphere_125;
-        let _e39 = r_70;
-        let _e40 = mu_53;
-        let _e41 = d_27;
-        let _e42 = ray_r_mu_intersects_ground_33;
-        let _e43 = GetOpticalDepth(_e38, transmittance_texture_6, _e39, _e40, _e41, _e42);
-        local_26 = _e43;
+        let _e40 = atmosphere_125;
+        let _e41 = r_70;
+        let _e42 = mu_53;
+        let _e43 = d_27;
+        let _e44 = ray_r_mu_intersects_ground_33;
+        let _e45 = GetOpticalDepth(_e40, transmittance_texture_6, _e41, _e42, _e43, _e44);
+        local_27 = _e45;
     }
-    let _e45 = local_26;
-    return _e45;
+    let _e47 = local_27;
+    return _e47;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: f32) -> f32 {
     var depth_1: f32;
-    var local_27: f32;
+    var local_28: f32;
 
     depth_1 = depth;
-    let _e20 = depth_1;
-    if (_e20 < 0.0001f) {
-        let _e25 = depth_1;
-        local_27 = (1f - (0.5f * _e25));
+    let _e22 = depth_1;
+    if (_e22 < 0.0001f) {
+        let _e27 = depth_1;
+        local_28 = (1f - (0.5f * _e27));
     } else {
-        let _e29 = depth_1;
-        let _e33 = depth_1;
-        local_27 = ((1f - exp(-(_e29))) / _e33);
+        let _e31 = depth_1;
+        let _e35 = depth_1;
+        local_28 = ((1f - exp(-(_e31))) / _e35);
     }
-    let _e36 = local_27;
-    return _e36;
+    let _e38 = local_28;
+    return _e38;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3558,7 +3676,7 @@ fn IntegrateSegment(atmosphere_126: AtmosphereParameters, transmittance_texture_
     var previous_mie: vec3<f32> = vec3(0f);
     var previous_scattering: vec3<f32> = vec3(0f);
     var k_6: i32 = 0i;
-    var t_12: f32;
+    var t_14: f32;
     var r_t_3: f32;
     var altitude_2: f32;
     var mu_s_t_1: f32;
@@ -3579,124 +3697,124 @@ fn IntegrateSegment(atmosphere_126: AtmosphereParameters, transmittance_texture_
     mu_s_43 = mu_s_42;
     nu_27 = nu_26;
     d_29 = d_28;
-    let _e34 = d_29;
-    dt_1 = (_e34 / 16f);
+    let _e36 = d_29;
+    dt_1 = (_e36 / 16f);
     (*single_rayleigh) = vec3(0f);
     (*single_mie) = vec3(0f);
     (*scattering_weight) = vec3(0f);
     loop {
-        let _e62 = k_6;
-        if !((_e62 <= SEGMENT_INTERVALS)) {
+        let _e64 = k_6;
+        if !((_e64 <= SEGMENT_INTERVALS)) {
             break;
         }
         {
-            let _e68 = dt_1;
-            let _e69 = k_6;
-            t_12 = (_e68 * f32(_e69));
-            let _e73 = atmosphere_127;
-            let _e74 = r_72;
-            let _e75 = mu_55;
-            let _e76 = t_12;
-            let _e77 = RadiusAtDistance(_e73, _e74, _e75, _e76);
-            r_t_3 = _e77;
-            let _e79 = atmosphere_127;
-            let _e80 = r_72;
-            let _e81 = mu_55;
-            let _e82 = t_12;
-            let _e83 = r_t_3;
-            let _e84 = AltitudeAtDistance(_e79, _e80, _e81, _e82, _e83);
-            altitude_2 = _e84;
-            let _e86 = r_72;
-            let _e87 = mu_s_43;
-            let _e89 = t_12;
-            let _e90 = nu_27;
-            let _e93 = r_t_3;
-            let _e95 = ClampCosine((((_e86 * _e87) + (_e89 * _e90)) / _e93));
-            mu_s_t_1 = _e95;
-            let _e99 = atmosphere_127;
-            let _e100 = altitude_2;
-            let _e105 = GetCoefficientsAtAltitude(_e99, _e100, (&mie_scattering_2), (&rayleigh_scattering_2));
-            extinction_1 = _e105;
-            let _e107 = atmosphere_127;
-            let _e108 = r_t_3;
-            let _e109 = mu_s_t_1;
-            let _e110 = GetOpticalDepthToTopAtmosphereBoundary(_e107, transmittance_texture_7, _e108, _e109);
-            let _e113 = atmosphere_127;
-            let _e114 = r_t_3;
-            let _e115 = mu_s_t_1;
-            let _e116 = SunVisibleFraction(_e113, _e114, _e115);
-            sunlight = (exp(-(_e110)) * _e116);
-            let _e119 = rayleigh_scattering_2;
-            let _e120 = sunlight;
-            rayleigh = (_e119 * _e120);
-            let _e123 = mie_scattering_2;
-            let _e124 = sunlight;
-            mie = (_e123 * _e124);
-            let _e127 = rayleigh_scattering_2;
-            let _e128 = mie_scattering_2;
-            scattering_2 = (_e127 + _e128);
-            let _e131 = k_6;
-            if (_e131 > 0i) {
+            let _e70 = dt_1;
+            let _e71 = k_6;
+            t_14 = (_e70 * f32(_e71));
+            let _e75 = atmosphere_127;
+            let _e76 = r_72;
+            let _e77 = mu_55;
+            let _e78 = t_14;
+            let _e79 = RadiusAtDistance(_e75, _e76, _e77, _e78);
+            r_t_3 = _e79;
+            let _e81 = atmosphere_127;
+            let _e82 = r_72;
+            let _e83 = mu_55;
+            let _e84 = t_14;
+            let _e85 = r_t_3;
+            let _e86 = AltitudeAtDistance(_e81, _e82, _e83, _e84, _e85);
+            altitude_2 = _e86;
+            let _e88 = r_72;
+            let _e89 = mu_s_43;
+            let _e91 = t_14;
+            let _e92 = nu_27;
+            let _e95 = r_t_3;
+            let _e97 = ClampCosine((((_e88 * _e89) + (_e91 * _e92)) / _e95));
+            mu_s_t_1 = _e97;
+            let _e101 = atmosphere_127;
+            let _e102 = altitude_2;
+            let _e107 = GetCoefficientsAtAltitude(_e101, _e102, (&mie_scattering_2), (&rayleigh_scattering_2));
+            extinction_1 = _e107;
+            let _e109 = atmosphere_127;
+            let _e110 = r_t_3;
+            let _e111 = mu_s_t_1;
+            let _e112 = GetOpticalDepthToTopAtmosphereBoundary(_e109, transmittance_texture_7, _e110, _e111);
+            let _e115 = atmosphere_127;
+            let _e116 = r_t_3;
+            let _e117 = mu_s_t_1;
+            let _e118 = SunVisibleFraction(_e115, _e116, _e117);
+            sunlight = (exp(-(_e112)) * _e118);
+            let _e121 = rayleigh_scattering_2;
+            let _e122 = sunlight;
+            rayleigh = (_e121 * _e122);
+            let _e125 = mie_scattering_2;
+            let _e126 = sunlight;
+            mie = (_e125 * _e126);
+            let _e129 = rayleigh_scattering_2;
+            let _e130 = mie_scattering_2;
+            scattering_2 = (_e129 + _e130);
+            let _e133 = k_6;
+            if (_e133 > 0i) {
                 {
-                    let _e134 = previous_extinction_1;
-                    let _e135 = extinction_1;
-                    let _e138 = dt_1;
-                    interval_depth = ((_e134 + _e135) * (0.5f * _e138));
-                    let _e142 = optical_depth_1;
-                    start_transmittance = exp(-(_e142));
-                    let _e146 = start_transmittance;
-                    let _e147 = interval_depth;
-                    let _e149 = MeanAttenuation(_e147.x);
-                    let _e150 = interval_depth;
-                    let _e152 = MeanAttenuation(_e150.y);
-                    let _e153 = interval_depth;
-                    let _e155 = MeanAttenuation(_e153.z);
-                    mean_transmittance = (_e146 * vec3<f32>(_e149, _e152, _e155));
-                    let _e159 = (*single_rayleigh);
-                    let _e160 = previous_rayleigh;
-                    let _e161 = rayleigh;
-                    let _e164 = dt_1;
-                    let _e167 = mean_transmittance;
-                    (*single_rayleigh) = (_e159 + (((_e160 + _e161) * (0.5f * _e164)) * _e167));
-                    let _e170 = (*single_mie);
-                    let _e171 = previous_mie;
-                    let _e172 = mie;
-                    let _e175 = dt_1;
-                    let _e178 = mean_transmittance;
-                    (*single_mie) = (_e170 + (((_e171 + _e172) * (0.5f * _e175)) * _e178));
-                    let _e181 = (*scattering_weight);
-                    let _e182 = previous_scattering;
-                    let _e183 = scattering_2;
-                    let _e186 = dt_1;
-                    let _e189 = mean_transmittance;
-                    (*scattering_weight) = (_e181 + (((_e182 + _e183) * (0.5f * _e186)) * _e189));
-                    let _e192 = optical_depth_1;
-                    let _e193 = interval_depth;
-                    optical_depth_1 = (_e192 + _e193);
+                    let _e136 = previous_extinction_1;
+                    let _e137 = extinction_1;
+                    let _e140 = dt_1;
+                    interval_depth = ((_e136 + _e137) * (0.5f * _e140));
+                    let _e144 = optical_depth_1;
+                    start_transmittance = exp(-(_e144));
+                    let _e148 = start_transmittance;
+                    let _e149 = interval_depth;
+                    let _e151 = MeanAttenuation(_e149.x);
+                    let _e152 = interval_depth;
+                    let _e154 = MeanAttenuation(_e152.y);
+                    let _e155 = interval_depth;
+                    let _e157 = MeanAttenuation(_e155.z);
+                    mean_transmittance = (_e148 * vec3<f32>(_e151, _e154, _e157));
+                    let _e161 = (*single_rayleigh);
+                    let _e162 = previous_rayleigh;
+                    let _e163 = rayleigh;
+                    let _e166 = dt_1;
+                    let _e169 = mean_transmittance;
+                    (*single_rayleigh) = (_e161 + (((_e162 + _e163) * (0.5f * _e166)) * _e169));
+                    let _e172 = (*single_mie);
+                    let _e173 = previous_mie;
+                    let _e174 = mie;
+                    let _e177 = dt_1;
+                    let _e180 = mean_transmittance;
+                    (*single_mie) = (_e172 + (((_e173 + _e174) * (0.5f * _e177)) * _e180));
+                    let _e183 = (*scattering_weight);
+                    let _e184 = previous_scattering;
+                    let _e185 = scattering_2;
+                    let _e188 = dt_1;
+                    let _e191 = mean_transmittance;
+                    (*scattering_weight) = (_e183 + (((_e184 + _e185) * (0.5f * _e188)) * _e191));
+                    let _e194 = optical_depth_1;
+                    let _e195 = interval_depth;
+                    optical_depth_1 = (_e194 + _e195);
                 }
             }
-            let _e195 = extinction_1;
-            previous_extinction_1 = _e195;
-            let _e196 = rayleigh;
-            previous_rayleigh = _e196;
-            let _e197 = mie;
-            previous_mie = _e197;
-            let _e198 = scattering_2;
-            previous_scattering = _e198;
+            let _e197 = extinction_1;
+            previous_extinction_1 = _e197;
+            let _e198 = rayleigh;
+            previous_rayleigh = _e198;
+            let _e199 = mie;
+            previous_mie = _e199;
+            let _e200 = scattering_2;
+            previous_scattering = _e200;
         }
         continuing {
-            let _e65 = k_6;
-            k_6 = (_e65 + 1i);
+            let _e67 = k_6;
+            k_6 = (_e67 + 1i);
         }
     }
-    let _e199 = (*single_rayleigh);
-    let _e200 = atmosphere_127;
-    (*single_rayleigh) = (_e199 * _e200.solar_irradiance);
-    let _e203 = (*single_mie);
-    let _e204 = atmosphere_127;
-    (*single_mie) = (_e203 * _e204.solar_irradiance);
-    let _e207 = optical_depth_1;
-    return _e207;
+    let _e201 = (*single_rayleigh);
+    let _e202 = atmosphere_127;
+    (*single_rayleigh) = (_e201 * _e202.solar_irradiance);
+    let _e205 = (*single_mie);
+    let _e206 = atmosphere_127;
+    (*single_mie) = (_e205 * _e206.solar_irradiance);
+    let _e209 = optical_depth_1;
+    return _e209;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3714,7 +3832,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     var mu_s_44: f32;
     var nu_28: f32;
     var d_30: f32;
-    var lit_1: f32;
+    var lit: f32;
     var ray_r_mu_intersects_ground_34: bool;
     var r_p: f32;
     var mu_p: f32;
@@ -3749,228 +3867,228 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     point_1 = point;
     shadow_length_1 = shadow_length;
     sun_direction_5 = sun_direction_4;
-    let _e32 = point_1;
-    let _e33 = camera_7;
-    camera_to_point = (_e32 - _e33);
-    let _e36 = camera_to_point;
-    let _e37 = camera_to_point;
-    if (dot(_e36, _e37) == 0f) {
+    let _e34 = point_1;
+    let _e35 = camera_7;
+    camera_to_point = (_e34 - _e35);
+    let _e38 = camera_to_point;
+    let _e39 = camera_to_point;
+    if (dot(_e38, _e39) == 0f) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e45 = camera_to_point;
-    view_ray_6 = normalize(_e45);
-    let _e53 = atmosphere_129;
-    let _e54 = camera_7;
-    let _e55 = view_ray_6;
-    let _e56 = sun_direction_5;
-    let _e67 = GetViewRayStart(_e53, _e54, _e55, _e56, (&start_3), (&r_73), (&mu_56), (&mu_s_44), (&nu_28));
-    if !(_e67) {
+    let _e47 = camera_to_point;
+    view_ray_6 = normalize(_e47);
+    let _e55 = atmosphere_129;
+    let _e56 = camera_7;
+    let _e57 = view_ray_6;
+    let _e58 = sun_direction_5;
+    let _e69 = GetViewRayStart(_e55, _e56, _e57, _e58, (&start_3), (&r_73), (&mu_56), (&mu_s_44), (&nu_28));
+    if !(_e69) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e73 = point_1;
-    let _e74 = start_3;
-    d_30 = max(length((_e73 - _e74)), 0f);
-    let _e80 = d_30;
-    let _e81 = shadow_length_1;
-    lit_1 = max((_e80 - max(_e81, 0f)), 0f);
-    let _e88 = atmosphere_129;
-    let _e89 = r_73;
-    let _e90 = mu_56;
-    let _e91 = RayIntersectsGround(_e88, _e89, _e90);
-    ray_r_mu_intersects_ground_34 = _e91;
-    let _e93 = atmosphere_129;
-    let _e94 = r_73;
-    let _e95 = mu_56;
-    let _e96 = lit_1;
-    let _e97 = RadiusAtDistance(_e93, _e94, _e95, _e96);
-    r_p = _e97;
-    let _e99 = r_73;
-    let _e100 = mu_56;
-    let _e101 = lit_1;
-    let _e102 = r_p;
-    let _e103 = CosineAtDistance(_e99, _e100, _e101, _e102);
-    mu_p = _e103;
-    let _e105 = r_73;
-    let _e106 = mu_s_44;
-    let _e108 = lit_1;
-    let _e109 = nu_28;
-    let _e112 = r_p;
-    let _e114 = ClampCosine((((_e105 * _e106) + (_e108 * _e109)) / _e112));
-    mu_s_p = _e114;
-    let _e120 = d_30;
-    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e120));
-    let _e128 = lit_1;
-    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e128));
-    let _e144 = lit_direct;
-    if (_e144 > 0f) {
+    let _e75 = point_1;
+    let _e76 = start_3;
+    d_30 = max(length((_e75 - _e76)), 0f);
+    let _e82 = d_30;
+    let _e83 = shadow_length_1;
+    lit = max((_e82 - max(_e83, 0f)), 0f);
+    let _e90 = atmosphere_129;
+    let _e91 = r_73;
+    let _e92 = mu_56;
+    let _e93 = RayIntersectsGround(_e90, _e91, _e92);
+    ray_r_mu_intersects_ground_34 = _e93;
+    let _e95 = atmosphere_129;
+    let _e96 = r_73;
+    let _e97 = mu_56;
+    let _e98 = lit;
+    let _e99 = RadiusAtDistance(_e95, _e96, _e97, _e98);
+    r_p = _e99;
+    let _e101 = r_73;
+    let _e102 = mu_56;
+    let _e103 = lit;
+    let _e104 = r_p;
+    let _e105 = CosineAtDistance(_e101, _e102, _e103, _e104);
+    mu_p = _e105;
+    let _e107 = r_73;
+    let _e108 = mu_s_44;
+    let _e110 = lit;
+    let _e111 = nu_28;
+    let _e114 = r_p;
+    let _e116 = ClampCosine((((_e107 * _e108) + (_e110 * _e111)) / _e114));
+    mu_s_p = _e116;
+    let _e122 = d_30;
+    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e122));
+    let _e130 = lit;
+    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e130));
+    let _e146 = lit_direct;
+    if (_e146 > 0f) {
         {
-            let _e147 = atmosphere_129;
-            let _e148 = r_73;
-            let _e149 = mu_56;
-            let _e150 = mu_s_44;
-            let _e151 = nu_28;
-            let _e152 = lit_1;
-            let _e159 = IntegrateSegment(_e147, transmittance_texture_8, _e148, _e149, _e150, _e151, _e152, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
-            lit_optical_depth = _e159;
+            let _e149 = atmosphere_129;
+            let _e150 = r_73;
+            let _e151 = mu_56;
+            let _e152 = mu_s_44;
+            let _e153 = nu_28;
+            let _e154 = lit;
+            let _e161 = IntegrateSegment(_e149, transmittance_texture_8, _e150, _e151, _e152, _e153, _e154, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
+            lit_optical_depth = _e161;
         }
     }
-    let _e160 = lit_optical_depth;
-    optical_depth_2 = _e160;
-    let _e162 = direct;
-    let _e165 = lit_1;
-    let _e166 = d_30;
-    if ((_e162 > 0f) && (_e165 < _e166)) {
+    let _e162 = lit_optical_depth;
+    optical_depth_2 = _e162;
+    let _e164 = direct;
+    let _e167 = lit;
+    let _e168 = d_30;
+    if ((_e164 > 0f) && (_e167 < _e168)) {
         {
-            let _e172 = optical_depth_2;
-            let _e173 = atmosphere_129;
-            let _e174 = r_p;
-            let _e175 = mu_p;
-            let _e176 = mu_s_p;
-            let _e177 = nu_28;
-            let _e178 = d_30;
-            let _e179 = lit_1;
-            let _e187 = IntegrateSegment(_e173, transmittance_texture_8, _e174, _e175, _e176, _e177, (_e178 - _e179), (&unused_rayleigh), (&unused_mie), (&unused_weight));
-            optical_depth_2 = (_e172 + _e187);
+            let _e174 = optical_depth_2;
+            let _e175 = atmosphere_129;
+            let _e176 = r_p;
+            let _e177 = mu_p;
+            let _e178 = mu_s_p;
+            let _e179 = nu_28;
+            let _e180 = d_30;
+            let _e181 = lit;
+            let _e189 = IntegrateSegment(_e175, transmittance_texture_8, _e176, _e177, _e178, _e179, (_e180 - _e181), (&unused_rayleigh), (&unused_mie), (&unused_weight));
+            optical_depth_2 = (_e174 + _e189);
         }
     }
-    let _e189 = direct;
-    if (_e189 < 1f) {
+    let _e191 = direct;
+    if (_e191 < 1f) {
         {
-            let _e192 = atmosphere_129;
-            let _e193 = r_73;
-            let _e194 = mu_56;
-            let _e195 = d_30;
-            let _e196 = ray_r_mu_intersects_ground_34;
-            let _e197 = LongSegmentOpticalDepth(_e192, transmittance_texture_8, _e193, _e194, _e195, _e196);
-            let _e198 = optical_depth_2;
-            let _e199 = direct;
-            optical_depth_2 = mix(_e197, _e198, vec3(_e199));
+            let _e194 = atmosphere_129;
+            let _e195 = r_73;
+            let _e196 = mu_56;
+            let _e197 = d_30;
+            let _e198 = ray_r_mu_intersects_ground_34;
+            let _e199 = LongSegmentOpticalDepth(_e194, transmittance_texture_8, _e195, _e196, _e197, _e198);
+            let _e200 = optical_depth_2;
+            let _e201 = direct;
+            optical_depth_2 = mix(_e199, _e200, vec3(_e201));
         }
     }
-    let _e202 = optical_depth_2;
-    (*transmittance_1) = exp(-(_e202));
-    let _e206 = atmosphere_129;
-    let _e207 = r_73;
-    let _e208 = mu_56;
-    let _e209 = mu_s_44;
-    let _e210 = nu_28;
-    let _e211 = ray_r_mu_intersects_ground_34;
-    let _e214 = GetCombinedScattering(_e206, scattering_texture_9, single_mie_scattering_texture_3, _e207, _e208, _e209, _e210, _e211, (&single_mie_scattering_2));
-    scattering_3 = _e214;
-    let _e216 = lit_1;
-    if (_e216 < DIRECT_SEGMENT_LENGTH) {
+    let _e204 = optical_depth_2;
+    (*transmittance_1) = exp(-(_e204));
+    let _e208 = atmosphere_129;
+    let _e209 = r_73;
+    let _e210 = mu_56;
+    let _e211 = mu_s_44;
+    let _e212 = nu_28;
+    let _e213 = ray_r_mu_intersects_ground_34;
+    let _e216 = GetCombinedScattering(_e208, scattering_texture_9, single_mie_scattering_texture_3, _e209, _e210, _e211, _e212, _e213, (&single_mie_scattering_2));
+    scattering_3 = _e216;
+    let _e218 = lit;
+    if (_e218 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e218 = atmosphere_129;
-            let _e219 = r_73;
-            let _e220 = mu_56;
-            let _e221 = ray_r_mu_intersects_ground_34;
-            let _e222 = DistanceToNearestAtmosphereBoundary(_e218, _e219, _e220, _e221);
-            boundary = _e222;
-            let _e224 = boundary;
-            let _e226 = atmosphere_129;
-            let _e227 = r_73;
-            let _e228 = mu_56;
-            let _e229 = DistanceInsideScatteringRadii(_e226, _e227, _e228);
-            let _e231 = lit_1;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e224), _e229), _e231);
-            let _e237 = atmosphere_129;
-            let _e238 = r_73;
-            let _e239 = mu_56;
-            let _e240 = mu_s_44;
-            let _e241 = nu_28;
-            let _e242 = far;
-            let _e249 = IntegrateSegment(_e237, transmittance_texture_8, _e238, _e239, _e240, _e241, _e242, (&far_rayleigh), (&far_mie), (&far_weight));
-            far_optical_depth = _e249;
-            let _e251 = far;
-            let _e252 = boundary;
-            if (_e251 < _e252) {
+            let _e220 = atmosphere_129;
+            let _e221 = r_73;
+            let _e222 = mu_56;
+            let _e223 = ray_r_mu_intersects_ground_34;
+            let _e224 = DistanceToNearestAtmosphereBoundary(_e220, _e221, _e222, _e223);
+            boundary = _e224;
+            let _e226 = boundary;
+            let _e228 = atmosphere_129;
+            let _e229 = r_73;
+            let _e230 = mu_56;
+            let _e231 = DistanceInsideScatteringRadii(_e228, _e229, _e230);
+            let _e233 = lit;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e226), _e231), _e233);
+            let _e239 = atmosphere_129;
+            let _e240 = r_73;
+            let _e241 = mu_56;
+            let _e242 = mu_s_44;
+            let _e243 = nu_28;
+            let _e244 = far;
+            let _e251 = IntegrateSegment(_e239, transmittance_texture_8, _e240, _e241, _e242, _e243, _e244, (&far_rayleigh), (&far_mie), (&far_weight));
+            far_optical_depth = _e251;
+            let _e253 = far;
+            let _e254 = boundary;
+            if (_e253 < _e254) {
                 {
-                    let _e254 = atmosphere_129;
-                    let _e255 = r_73;
-                    let _e256 = mu_56;
-                    let _e257 = far;
-                    let _e258 = RadiusAtDistance(_e254, _e255, _e256, _e257);
-                    r_far = _e258;
-                    let _e261 = scattering_3;
-                    let _e262 = far_optical_depth;
-                    let _e265 = atmosphere_129;
-                    let _e266 = r_far;
-                    let _e267 = r_73;
-                    let _e268 = mu_56;
-                    let _e269 = far;
-                    let _e270 = r_far;
-                    let _e271 = CosineAtDistance(_e267, _e268, _e269, _e270);
-                    let _e272 = r_73;
-                    let _e273 = mu_s_44;
-                    let _e275 = far;
-                    let _e276 = nu_28;
-                    let _e279 = r_far;
-                    let _e281 = ClampCosine((((_e272 * _e273) + (_e275 * _e276)) / _e279));
-                    let _e282 = nu_28;
-                    let _e283 = ray_r_mu_intersects_ground_34;
-                    let _e286 = GetCombinedScattering(_e265, scattering_texture_9, single_mie_scattering_texture_3, _e266, _e271, _e281, _e282, _e283, (&unused_far_mie));
-                    scattering_3 = (_e261 - (exp(-(_e262)) * _e286));
+                    let _e256 = atmosphere_129;
+                    let _e257 = r_73;
+                    let _e258 = mu_56;
+                    let _e259 = far;
+                    let _e260 = RadiusAtDistance(_e256, _e257, _e258, _e259);
+                    r_far = _e260;
+                    let _e263 = scattering_3;
+                    let _e264 = far_optical_depth;
+                    let _e267 = atmosphere_129;
+                    let _e268 = r_far;
+                    let _e269 = r_73;
+                    let _e270 = mu_56;
+                    let _e271 = far;
+                    let _e272 = r_far;
+                    let _e273 = CosineAtDistance(_e269, _e270, _e271, _e272);
+                    let _e274 = r_73;
+                    let _e275 = mu_s_44;
+                    let _e277 = far;
+                    let _e278 = nu_28;
+                    let _e281 = r_far;
+                    let _e283 = ClampCosine((((_e274 * _e275) + (_e277 * _e278)) / _e281));
+                    let _e284 = nu_28;
+                    let _e285 = ray_r_mu_intersects_ground_34;
+                    let _e288 = GetCombinedScattering(_e267, scattering_texture_9, single_mie_scattering_texture_3, _e268, _e273, _e283, _e284, _e285, (&unused_far_mie));
+                    scattering_3 = (_e263 - (exp(-(_e264)) * _e288));
                 }
             }
-            let _e289 = scattering_3;
-            let _e290 = far_rayleigh;
-            let _e295 = lit_weight;
-            let _e297 = far_weight;
-            multiple = ((max((_e289 - _e290), vec3(0f)) * _e295) / max(_e297, vec3(0.000000000000000000000000000001f)));
-            let _e303 = single_rayleigh_1;
-            let _e304 = multiple;
-            let _e306 = nu_28;
-            let _e307 = RayleighPhaseFunction(_e306);
-            let _e309 = single_mie_1;
-            let _e310 = atmosphere_129;
-            let _e311 = nu_28;
-            let _e312 = MiePhaseFunction(_e310, _e311);
-            return (((_e303 + _e304) * _e307) + (_e309 * _e312));
+            let _e291 = scattering_3;
+            let _e292 = far_rayleigh;
+            let _e297 = lit_weight;
+            let _e299 = far_weight;
+            multiple = ((max((_e291 - _e292), vec3(0f)) * _e297) / max(_e299, vec3(0.000000000000000000000000000001f)));
+            let _e305 = single_rayleigh_1;
+            let _e306 = multiple;
+            let _e308 = nu_28;
+            let _e309 = RayleighPhaseFunction(_e308);
+            let _e311 = single_mie_1;
+            let _e312 = atmosphere_129;
+            let _e313 = nu_28;
+            let _e314 = MiePhaseFunction(_e312, _e313);
+            return (((_e305 + _e306) * _e309) + (_e311 * _e314));
         }
     }
-    let _e315 = atmosphere_129;
-    let _e316 = r_73;
-    let _e317 = mu_56;
-    let _e318 = lit_1;
-    let _e319 = ray_r_mu_intersects_ground_34;
-    let _e320 = LongSegmentOpticalDepth(_e315, transmittance_texture_8, _e316, _e317, _e318, _e319);
-    let _e321 = lit_optical_depth;
-    let _e322 = lit_direct;
-    lit_transmittance = exp(-(mix(_e320, _e321, vec3(_e322))));
-    let _e329 = atmosphere_129;
-    let _e330 = r_p;
-    let _e331 = mu_p;
-    let _e332 = mu_s_p;
-    let _e333 = nu_28;
-    let _e334 = ray_r_mu_intersects_ground_34;
-    let _e337 = GetCombinedScattering(_e329, scattering_texture_9, single_mie_scattering_texture_3, _e330, _e331, _e332, _e333, _e334, (&single_mie_scattering_p));
-    scattering_p = _e337;
-    let _e339 = scattering_3;
-    let _e340 = lit_transmittance;
-    let _e341 = scattering_p;
-    scattering_3 = max((_e339 - (_e340 * _e341)), vec3(0f));
-    let _e347 = single_mie_scattering_2;
-    let _e348 = lit_transmittance;
-    let _e349 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e347 - (_e348 * _e349)), vec3(0f));
-    let _e355 = single_mie_scattering_2;
-    let _e356 = single_mie_1;
-    let _e357 = lit_direct;
-    single_mie_scattering_2 = mix(_e355, _e356, vec3(_e357));
-    let _e360 = scattering_3;
-    let _e361 = nu_28;
-    let _e362 = RayleighPhaseFunction(_e361);
-    let _e364 = single_mie_scattering_2;
-    let _e365 = atmosphere_129;
-    let _e366 = nu_28;
-    let _e367 = MiePhaseFunction(_e365, _e366);
-    return ((_e360 * _e362) + (_e364 * _e367));
+    let _e317 = atmosphere_129;
+    let _e318 = r_73;
+    let _e319 = mu_56;
+    let _e320 = lit;
+    let _e321 = ray_r_mu_intersects_ground_34;
+    let _e322 = LongSegmentOpticalDepth(_e317, transmittance_texture_8, _e318, _e319, _e320, _e321);
+    let _e323 = lit_optical_depth;
+    let _e324 = lit_direct;
+    lit_transmittance = exp(-(mix(_e322, _e323, vec3(_e324))));
+    let _e331 = atmosphere_129;
+    let _e332 = r_p;
+    let _e333 = mu_p;
+    let _e334 = mu_s_p;
+    let _e335 = nu_28;
+    let _e336 = ray_r_mu_intersects_ground_34;
+    let _e339 = GetCombinedScattering(_e331, scattering_texture_9, single_mie_scattering_texture_3, _e332, _e333, _e334, _e335, _e336, (&single_mie_scattering_p));
+    scattering_p = _e339;
+    let _e341 = scattering_3;
+    let _e342 = lit_transmittance;
+    let _e343 = scattering_p;
+    scattering_3 = max((_e341 - (_e342 * _e343)), vec3(0f));
+    let _e349 = single_mie_scattering_2;
+    let _e350 = lit_transmittance;
+    let _e351 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e349 - (_e350 * _e351)), vec3(0f));
+    let _e357 = single_mie_scattering_2;
+    let _e358 = single_mie_1;
+    let _e359 = lit_direct;
+    single_mie_scattering_2 = mix(_e357, _e358, vec3(_e359));
+    let _e362 = scattering_3;
+    let _e363 = nu_28;
+    let _e364 = RayleighPhaseFunction(_e363);
+    let _e366 = single_mie_scattering_2;
+    let _e367 = atmosphere_129;
+    let _e368 = nu_28;
+    let _e369 = MiePhaseFunction(_e367, _e368);
+    return ((_e362 * _e364) + (_e366 * _e369));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3984,12 +4102,12 @@ fn GetSkyRadianceToPoint(atmosphere_130: AtmosphereParameters, transmittance_tex
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e30 = atmosphere_131;
-    let _e31 = camera_9;
-    let _e32 = point_3;
-    let _e34 = sun_direction_7;
-    let _e37 = GetSkyRadianceToPointWithShadow(_e30, transmittance_texture_9, scattering_texture_10, single_mie_scattering_texture_4, _e31, _e32, 0f, _e34, transmittance_2);
-    return _e37;
+    let _e32 = atmosphere_131;
+    let _e33 = camera_9;
+    let _e34 = point_3;
+    let _e36 = sun_direction_7;
+    let _e39 = GetSkyRadianceToPointWithShadow(_e32, transmittance_texture_9, scattering_texture_10, single_mie_scattering_texture_4, _e33, _e34, 0f, _e36, transmittance_2);
+    return _e39;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
@@ -4005,51 +4123,51 @@ fn GetSunAndSkyIrradiance(atmosphere_132: AtmosphereParameters, transmittance_te
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e29 = atmosphere_133;
-    let _e30 = point_5;
-    let _e32 = ClampRadius(_e29, length(_e30));
-    r_74 = _e32;
-    let _e34 = point_5;
-    let _e35 = sun_direction_9;
-    let _e37 = point_5;
-    let _e40 = ClampCosine((dot(_e34, _e35) / length(_e37)));
-    mu_s_45 = _e40;
-    let _e42 = atmosphere_133;
-    let _e43 = r_74;
-    let _e44 = mu_s_45;
-    let _e45 = GetIrradiance(_e42, irradiance_texture_1, _e43, _e44);
-    let _e47 = normal_1;
-    let _e48 = point_5;
+    let _e31 = atmosphere_133;
+    let _e32 = point_5;
+    let _e34 = ClampRadius(_e31, length(_e32));
+    r_74 = _e34;
+    let _e36 = point_5;
+    let _e37 = sun_direction_9;
+    let _e39 = point_5;
+    let _e42 = ClampCosine((dot(_e36, _e37) / length(_e39)));
+    mu_s_45 = _e42;
+    let _e44 = atmosphere_133;
+    let _e45 = r_74;
+    let _e46 = mu_s_45;
+    let _e47 = GetIrradiance(_e44, irradiance_texture_1, _e45, _e46);
+    let _e49 = normal_1;
     let _e50 = point_5;
-    (*sky_irradiance) = ((_e45 * (1f + (dot(_e47, _e48) / length(_e50)))) * 0.5f);
-    let _e57 = atmosphere_133;
+    let _e52 = point_5;
+    (*sky_irradiance) = ((_e47 * (1f + (dot(_e49, _e50) / length(_e52)))) * 0.5f);
     let _e59 = atmosphere_133;
-    let _e60 = r_74;
-    let _e61 = mu_s_45;
-    let _e62 = GetTransmittanceToSun(_e59, transmittance_texture_10, _e60, _e61);
-    let _e64 = normal_1;
-    let _e65 = sun_direction_9;
-    return ((_e57.solar_irradiance * _e62) * max(dot(_e64, _e65), 0f));
+    let _e61 = atmosphere_133;
+    let _e62 = r_74;
+    let _e63 = mu_s_45;
+    let _e64 = GetTransmittanceToSun(_e61, transmittance_texture_10, _e62, _e63);
+    let _e66 = normal_1;
+    let _e67 = sun_direction_9;
+    return ((_e59.solar_irradiance * _e64) * max(dot(_e66, _e67), 0f));
 }
 
 fn GetSolarRadiance(atmosphere_134: AtmosphereParameters) -> vec3<f32> {
     var atmosphere_135: AtmosphereParameters;
 
     atmosphere_135 = atmosphere_134;
-    let _e20 = atmosphere_135;
     let _e22 = atmosphere_135;
-    let _e25 = atmosphere_135;
-    return (_e20.solar_irradiance / vec3(((PI * _e22.sun_angular_radius) * _e25.sun_angular_radius)));
+    let _e24 = atmosphere_135;
+    let _e27 = atmosphere_135;
+    return (_e22.solar_irradiance / vec3(((PI * _e24.sun_angular_radius) * _e27.sun_angular_radius)));
 }
 
 fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     var xyz_1: vec3<f32>;
 
     xyz_1 = xyz;
-    let _e26 = xyz_1;
-    let _e33 = xyz_1;
-    let _e40 = xyz_1;
-    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e26), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e33), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e40));
+    let _e28 = xyz_1;
+    let _e35 = xyz_1;
+    let _e42 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e28), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e35), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e42));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4059,11 +4177,11 @@ fn SkyViewHorizonZenith(atmosphere_136: AtmosphereParameters, r_75: f32) -> f32 
 
     atmosphere_137 = atmosphere_136;
     r_76 = r_75;
-    let _e24 = atmosphere_137;
     let _e26 = atmosphere_137;
-    let _e27 = r_76;
-    let _e28 = HorizonDistance(_e26, _e27);
-    return atan2(_e24.bottom_radius, -(_e28));
+    let _e28 = atmosphere_137;
+    let _e29 = r_76;
+    let _e30 = HorizonDistance(_e28, _e29);
+    return atan2(_e26.bottom_radius, -(_e30));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4074,7 +4192,7 @@ fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta
     var phi_1: f32;
     var ray_r_mu_intersects_ground_36: bool;
     var theta_h: f32;
-    var local_28: f32;
+    var local_29: f32;
     var x_26: f32;
 
     atmosphere_139 = atmosphere_138;
@@ -4082,30 +4200,30 @@ fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta
     theta_1 = theta;
     phi_1 = phi;
     ray_r_mu_intersects_ground_36 = ray_r_mu_intersects_ground_35;
-    let _e30 = atmosphere_139;
-    let _e31 = r_78;
-    let _e32 = SkyViewHorizonZenith(_e30, _e31);
-    theta_h = _e32;
-    let _e34 = ray_r_mu_intersects_ground_36;
-    if _e34 {
-        let _e36 = theta_1;
-        let _e37 = theta_h;
+    let _e32 = atmosphere_139;
+    let _e33 = r_78;
+    let _e34 = SkyViewHorizonZenith(_e32, _e33);
+    theta_h = _e34;
+    let _e36 = ray_r_mu_intersects_ground_36;
+    if _e36 {
+        let _e38 = theta_1;
         let _e39 = theta_h;
-        local_28 = (1f - sqrt(clamp(((_e36 - _e37) / (PI - _e39)), 0f, 1f)));
+        let _e41 = theta_h;
+        local_29 = (1f - sqrt(clamp(((_e38 - _e39) / (PI - _e41)), 0f, 1f)));
     } else {
-        let _e48 = theta_h;
-        let _e49 = theta_1;
-        let _e51 = theta_h;
-        local_28 = (1f - sqrt(clamp(((_e48 - _e49) / _e51), 0f, 1f)));
+        let _e50 = theta_h;
+        let _e51 = theta_1;
+        let _e53 = theta_h;
+        local_29 = (1f - sqrt(clamp(((_e50 - _e51) / _e53), 0f, 1f)));
     }
-    let _e59 = local_28;
-    x_26 = _e59;
-    let _e61 = phi_1;
-    let _e63 = GetTextureCoordFromUnitRange((_e61 / PI), SKY_VIEW_WIDTH);
-    let _e64 = x_26;
-    let _e65 = ray_r_mu_intersects_ground_36;
-    let _e66 = GetTextureCoordFromUnitMuInHalf(_e64, _e65, SKY_VIEW_HEIGHT);
-    return vec2<f32>(_e63, _e66);
+    let _e61 = local_29;
+    x_26 = _e61;
+    let _e63 = phi_1;
+    let _e65 = GetTextureCoordFromUnitRange((_e63 / PI), SKY_VIEW_WIDTH);
+    let _e66 = x_26;
+    let _e67 = ray_r_mu_intersects_ground_36;
+    let _e68 = GetTextureCoordFromUnitMuInHalf(_e66, _e67, SKY_VIEW_HEIGHT);
+    return vec2<f32>(_e65, _e68);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4119,46 +4237,46 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     var sun_horizontal: vec3<f32>;
     var along: f32;
     var side: f32;
-    var local_29: f32;
+    var local_30: f32;
 
     camera_11 = camera_10;
     view_ray_8 = view_ray_7;
     sun_direction_11 = sun_direction_10;
-    let _e28 = camera_11;
-    up_1 = normalize(_e28);
-    let _e31 = up_1;
-    let _e32 = view_ray_8;
-    mu_57 = dot(_e31, _e32);
-    let _e35 = view_ray_8;
-    let _e36 = up_1;
-    let _e37 = mu_57;
-    horizontal = (_e35 - (_e36 * _e37));
-    let _e41 = sun_direction_11;
-    let _e42 = up_1;
-    let _e43 = up_1;
-    let _e44 = sun_direction_11;
-    sun_horizontal = (_e41 - (_e42 * dot(_e43, _e44)));
-    let _e49 = horizontal;
-    let _e51 = mu_57;
-    (*theta_2) = atan2(length(_e49), _e51);
-    let _e53 = sun_horizontal;
-    let _e54 = horizontal;
-    along = dot(_e53, _e54);
-    let _e57 = up_1;
-    let _e58 = sun_horizontal;
-    let _e60 = horizontal;
-    side = abs(dot(cross(_e57, _e58), _e60));
-    let _e64 = along;
-    let _e67 = side;
-    if ((_e64 != 0f) || (_e67 != 0f)) {
-        let _e71 = side;
-        let _e72 = along;
-        local_29 = atan2(_e71, _e72);
+    let _e30 = camera_11;
+    up_1 = normalize(_e30);
+    let _e33 = up_1;
+    let _e34 = view_ray_8;
+    mu_57 = dot(_e33, _e34);
+    let _e37 = view_ray_8;
+    let _e38 = up_1;
+    let _e39 = mu_57;
+    horizontal = (_e37 - (_e38 * _e39));
+    let _e43 = sun_direction_11;
+    let _e44 = up_1;
+    let _e45 = up_1;
+    let _e46 = sun_direction_11;
+    sun_horizontal = (_e43 - (_e44 * dot(_e45, _e46)));
+    let _e51 = horizontal;
+    let _e53 = mu_57;
+    (*theta_2) = atan2(length(_e51), _e53);
+    let _e55 = sun_horizontal;
+    let _e56 = horizontal;
+    along = dot(_e55, _e56);
+    let _e59 = up_1;
+    let _e60 = sun_horizontal;
+    let _e62 = horizontal;
+    side = abs(dot(cross(_e59, _e60), _e62));
+    let _e66 = along;
+    let _e69 = side;
+    if ((_e66 != 0f) || (_e69 != 0f)) {
+        let _e73 = side;
+        let _e74 = along;
+        local_30 = atan2(_e73, _e74);
     } else {
-        local_29 = 0f;
+        local_30 = 0f;
     }
-    let _e76 = local_29;
-    (*phi_2) = _e76;
+    let _e78 = local_30;
+    (*phi_2) = _e78;
     return;
 }
 
@@ -4171,81 +4289,81 @@ fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun
     var x_27: f32;
     var e: f32;
     var theta_h_1: f32;
-    var local_30: f32;
+    var local_31: f32;
     var theta_3: f32;
     var phi_3: f32;
     var up_2: vec3<f32>;
     var toward_sun: vec3<f32>;
-    var local_31: vec3<f32>;
+    var local_32: vec3<f32>;
     var across_3: vec3<f32>;
 
     atmosphere_141 = atmosphere_140;
     camera_13 = camera_12;
     sun_direction_13 = sun_direction_12;
     uv_5 = uv_4;
-    let _e29 = uv_5;
-    let _e33 = GetUnitMuInHalfFromTextureCoord(_e29.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
-    x_27 = _e33;
-    let _e36 = x_27;
-    let _e39 = x_27;
-    e = ((1f - _e36) * (1f - _e39));
-    let _e43 = atmosphere_141;
-    let _e44 = atmosphere_141;
-    let _e45 = camera_13;
-    let _e47 = ClampRadius(_e44, length(_e45));
-    let _e48 = SkyViewHorizonZenith(_e43, _e47);
-    theta_h_1 = _e48;
-    let _e50 = (*ray_r_mu_intersects_ground_37);
-    if _e50 {
-        let _e51 = theta_h_1;
-        let _e52 = e;
+    let _e31 = uv_5;
+    let _e35 = GetUnitMuInHalfFromTextureCoord(_e31.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
+    x_27 = _e35;
+    let _e38 = x_27;
+    let _e41 = x_27;
+    e = ((1f - _e38) * (1f - _e41));
+    let _e45 = atmosphere_141;
+    let _e46 = atmosphere_141;
+    let _e47 = camera_13;
+    let _e49 = ClampRadius(_e46, length(_e47));
+    let _e50 = SkyViewHorizonZenith(_e45, _e49);
+    theta_h_1 = _e50;
+    let _e52 = (*ray_r_mu_intersects_ground_37);
+    if _e52 {
         let _e53 = theta_h_1;
-        local_30 = (_e51 + (_e52 * (PI - _e53)));
+        let _e54 = e;
+        let _e55 = theta_h_1;
+        local_31 = (_e53 + (_e54 * (PI - _e55)));
     } else {
-        let _e57 = theta_h_1;
-        let _e59 = e;
-        local_30 = (_e57 * (1f - _e59));
+        let _e59 = theta_h_1;
+        let _e61 = e;
+        local_31 = (_e59 * (1f - _e61));
     }
-    let _e63 = local_30;
-    theta_3 = _e63;
-    let _e65 = uv_5;
-    let _e67 = GetUnitRangeFromTextureCoord(_e65.x, SKY_VIEW_WIDTH);
-    phi_3 = (PI * clamp(_e67, 0f, 1f));
-    let _e73 = camera_13;
-    up_2 = normalize(_e73);
-    let _e76 = sun_direction_13;
-    let _e77 = up_2;
+    let _e65 = local_31;
+    theta_3 = _e65;
+    let _e67 = uv_5;
+    let _e69 = GetUnitRangeFromTextureCoord(_e67.x, SKY_VIEW_WIDTH);
+    phi_3 = (PI * clamp(_e69, 0f, 1f));
+    let _e75 = camera_13;
+    up_2 = normalize(_e75);
     let _e78 = sun_direction_13;
     let _e79 = up_2;
-    toward_sun = (_e76 - (_e77 * dot(_e78, _e79)));
-    let _e84 = toward_sun;
-    let _e85 = toward_sun;
-    if (dot(_e84, _e85) < 0.000000000001f) {
+    let _e80 = sun_direction_13;
+    let _e81 = up_2;
+    toward_sun = (_e78 - (_e79 * dot(_e80, _e81)));
+    let _e86 = toward_sun;
+    let _e87 = toward_sun;
+    if (dot(_e86, _e87) < 0.000000000001f) {
         {
-            let _e89 = up_2;
-            let _e90 = up_2;
-            if (abs(_e90.x) < 0.9f) {
-                local_31 = vec3<f32>(1f, 0f, 0f);
+            let _e91 = up_2;
+            let _e92 = up_2;
+            if (abs(_e92.x) < 0.9f) {
+                local_32 = vec3<f32>(1f, 0f, 0f);
             } else {
-                local_31 = vec3<f32>(0f, 1f, 0f);
+                local_32 = vec3<f32>(0f, 1f, 0f);
             }
-            let _e104 = local_31;
-            toward_sun = cross(_e89, _e104);
+            let _e106 = local_32;
+            toward_sun = cross(_e91, _e106);
         }
     }
-    let _e106 = toward_sun;
-    toward_sun = normalize(_e106);
-    let _e108 = up_2;
-    let _e109 = toward_sun;
-    across_3 = cross(_e108, _e109);
-    let _e112 = up_2;
-    let _e113 = theta_3;
-    let _e116 = toward_sun;
-    let _e117 = phi_3;
-    let _e120 = across_3;
-    let _e121 = phi_3;
-    let _e125 = theta_3;
-    return ((_e112 * cos(_e113)) + (((_e116 * cos(_e117)) + (_e120 * sin(_e121))) * sin(_e125)));
+    let _e108 = toward_sun;
+    toward_sun = normalize(_e108);
+    let _e110 = up_2;
+    let _e111 = toward_sun;
+    across_3 = cross(_e110, _e111);
+    let _e114 = up_2;
+    let _e115 = theta_3;
+    let _e118 = toward_sun;
+    let _e119 = phi_3;
+    let _e122 = across_3;
+    let _e123 = phi_3;
+    let _e127 = theta_3;
+    return ((_e114 * cos(_e115)) + (((_e118 * cos(_e119)) + (_e122 * sin(_e123))) * sin(_e127)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4262,30 +4380,30 @@ fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_1
     camera_15 = camera_14;
     sun_direction_15 = sun_direction_14;
     uv_7 = uv_6;
-    let _e31 = atmosphere_143;
-    let _e32 = camera_15;
-    let _e33 = sun_direction_15;
-    let _e34 = uv_7;
-    let _e37 = GetSkyViewRay(_e31, _e32, _e33, _e34, (&ray_r_mu_intersects_ground_38));
-    view_ray_9 = _e37;
-    let _e39 = camera_15;
-    up_3 = normalize(_e39);
-    let _e42 = atmosphere_143;
-    let _e43 = atmosphere_143;
-    let _e44 = camera_15;
-    let _e46 = ClampRadius(_e43, length(_e44));
-    let _e47 = up_3;
-    let _e48 = view_ray_9;
-    let _e50 = ClampCosine(dot(_e47, _e48));
-    let _e51 = up_3;
-    let _e52 = sun_direction_15;
-    let _e54 = ClampCosine(dot(_e51, _e52));
-    let _e55 = view_ray_9;
-    let _e56 = sun_direction_15;
-    let _e58 = ClampCosine(dot(_e55, _e56));
-    let _e59 = ray_r_mu_intersects_ground_38;
-    let _e60 = GetSkyRadianceOfRay(_e42, scattering_texture_11, single_mie_scattering_texture_5, _e46, _e50, _e54, _e58, _e59);
-    return _e60;
+    let _e33 = atmosphere_143;
+    let _e34 = camera_15;
+    let _e35 = sun_direction_15;
+    let _e36 = uv_7;
+    let _e39 = GetSkyViewRay(_e33, _e34, _e35, _e36, (&ray_r_mu_intersects_ground_38));
+    view_ray_9 = _e39;
+    let _e41 = camera_15;
+    up_3 = normalize(_e41);
+    let _e44 = atmosphere_143;
+    let _e45 = atmosphere_143;
+    let _e46 = camera_15;
+    let _e48 = ClampRadius(_e45, length(_e46));
+    let _e49 = up_3;
+    let _e50 = view_ray_9;
+    let _e52 = ClampCosine(dot(_e49, _e50));
+    let _e53 = up_3;
+    let _e54 = sun_direction_15;
+    let _e56 = ClampCosine(dot(_e53, _e54));
+    let _e57 = view_ray_9;
+    let _e58 = sun_direction_15;
+    let _e60 = ClampCosine(dot(_e57, _e58));
+    let _e61 = ray_r_mu_intersects_ground_38;
+    let _e62 = GetSkyRadianceOfRay(_e44, scattering_texture_11, single_mie_scattering_texture_5, _e48, _e52, _e56, _e60, _e61);
+    return _e62;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4297,7 +4415,7 @@ fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance
     var r_79: f32;
     var mu_58: f32;
     var ray_r_mu_intersects_ground_39: bool;
-    var local_32: vec3<f32>;
+    var local_33: vec3<f32>;
     var theta_4: f32;
     var phi_4: f32;
 
@@ -4305,44 +4423,44 @@ fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance
     camera_17 = camera_16;
     view_ray_11 = view_ray_10;
     sun_direction_17 = sun_direction_16;
-    let _e31 = atmosphere_145;
-    let _e32 = camera_17;
-    let _e34 = ClampRadius(_e31, length(_e32));
-    r_79 = _e34;
-    let _e36 = camera_17;
-    let _e37 = view_ray_11;
-    let _e39 = camera_17;
-    let _e42 = ClampCosine((dot(_e36, _e37) / length(_e39)));
-    mu_58 = _e42;
-    let _e44 = atmosphere_145;
-    let _e45 = r_79;
-    let _e46 = mu_58;
-    let _e47 = RayIntersectsGround(_e44, _e45, _e46);
-    ray_r_mu_intersects_ground_39 = _e47;
-    let _e49 = ray_r_mu_intersects_ground_39;
-    if _e49 {
-        local_32 = vec3(0f);
+    let _e33 = atmosphere_145;
+    let _e34 = camera_17;
+    let _e36 = ClampRadius(_e33, length(_e34));
+    r_79 = _e36;
+    let _e38 = camera_17;
+    let _e39 = view_ray_11;
+    let _e41 = camera_17;
+    let _e44 = ClampCosine((dot(_e38, _e39) / length(_e41)));
+    mu_58 = _e44;
+    let _e46 = atmosphere_145;
+    let _e47 = r_79;
+    let _e48 = mu_58;
+    let _e49 = RayIntersectsGround(_e46, _e47, _e48);
+    ray_r_mu_intersects_ground_39 = _e49;
+    let _e51 = ray_r_mu_intersects_ground_39;
+    if _e51 {
+        local_33 = vec3(0f);
     } else {
-        let _e52 = atmosphere_145;
-        let _e53 = r_79;
-        let _e54 = mu_58;
-        let _e55 = GetTransmittanceToTopAtmosphereBoundary(_e52, transmittance_texture_11, _e53, _e54);
-        local_32 = _e55;
+        let _e54 = atmosphere_145;
+        let _e55 = r_79;
+        let _e56 = mu_58;
+        let _e57 = GetTransmittanceToTopAtmosphereBoundary(_e54, transmittance_texture_11, _e55, _e56);
+        local_33 = _e57;
     }
-    let _e57 = local_32;
-    (*transmittance_3) = _e57;
-    let _e60 = camera_17;
-    let _e61 = view_ray_11;
-    let _e62 = sun_direction_17;
-    GetSkyViewAngles(_e60, _e61, _e62, (&theta_4), (&phi_4));
-    let _e67 = atmosphere_145;
-    let _e68 = r_79;
-    let _e69 = theta_4;
-    let _e70 = phi_4;
-    let _e71 = ray_r_mu_intersects_ground_39;
-    let _e72 = GetSkyViewUvFromAngles(_e67, _e68, _e69, _e70, _e71);
-    let _e73 = SampleTexture2D(sky_view_texture, _e72);
-    return vec3<f32>(_e73.xyz);
+    let _e59 = local_33;
+    (*transmittance_3) = _e59;
+    let _e62 = camera_17;
+    let _e63 = view_ray_11;
+    let _e64 = sun_direction_17;
+    GetSkyViewAngles(_e62, _e63, _e64, (&theta_4), (&phi_4));
+    let _e69 = atmosphere_145;
+    let _e70 = r_79;
+    let _e71 = theta_4;
+    let _e72 = phi_4;
+    let _e73 = ray_r_mu_intersects_ground_39;
+    let _e74 = GetSkyViewUvFromAngles(_e69, _e70, _e71, _e72, _e73);
+    let _e75 = SampleTexture2D(sky_view_texture, _e74);
+    return vec3<f32>(_e75.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4351,11 +4469,11 @@ fn AerialPerspectiveSliceDistance(k_7: f32) -> f32 {
     var x_28: f32;
 
     k_8 = k_7;
-    let _e24 = k_8;
-    x_28 = ((_e24 + 1f) / 32f);
-    let _e31 = x_28;
+    let _e26 = k_8;
+    x_28 = ((_e26 + 1f) / 32f);
     let _e33 = x_28;
-    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e31) * _e33);
+    let _e35 = x_28;
+    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e33) * _e35);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4376,33 +4494,33 @@ fn GetAerialPerspectiveVoxel(atmosphere_146: AtmosphereParameters, transmittance
     view_ray_13 = view_ray_12;
     w_1 = w;
     sun_direction_19 = sun_direction_18;
-    let _e36 = w_1;
-    let _e41 = AerialPerspectiveSliceDistance(floor((_e36 * 32f)));
-    d_31 = _e41;
-    let _e43 = camera_19;
-    let _e44 = view_ray_13;
-    let _e45 = d_31;
-    point_6 = (_e43 + (_e44 * _e45));
-    let _e49 = point_6;
-    r_point = length(_e49);
-    let _e52 = r_point;
-    let _e53 = atmosphere_147;
-    if (_e52 < _e53.bottom_radius) {
-        let _e56 = point_6;
-        let _e57 = atmosphere_147;
-        let _e59 = r_point;
-        point_6 = (_e56 * (_e57.bottom_radius / _e59));
+    let _e38 = w_1;
+    let _e43 = AerialPerspectiveSliceDistance(floor((_e38 * 32f)));
+    d_31 = _e43;
+    let _e45 = camera_19;
+    let _e46 = view_ray_13;
+    let _e47 = d_31;
+    point_6 = (_e45 + (_e46 * _e47));
+    let _e51 = point_6;
+    r_point = length(_e51);
+    let _e54 = r_point;
+    let _e55 = atmosphere_147;
+    if (_e54 < _e55.bottom_radius) {
+        let _e58 = point_6;
+        let _e59 = atmosphere_147;
+        let _e61 = r_point;
+        point_6 = (_e58 * (_e59.bottom_radius / _e61));
     }
-    let _e63 = atmosphere_147;
-    let _e64 = camera_19;
-    let _e65 = point_6;
-    let _e66 = sun_direction_19;
-    let _e69 = GetSkyRadianceToPoint(_e63, transmittance_texture_12, scattering_texture_12, single_mie_scattering_texture_6, _e64, _e65, _e66, (&transmittance_4));
-    radiance = _e69;
-    let _e71 = transmittance_4;
-    (*optical_depth_3) = -(log(max(_e71, vec3(0.000000000000000000000000000001f))));
-    let _e77 = radiance;
-    return _e77;
+    let _e65 = atmosphere_147;
+    let _e66 = camera_19;
+    let _e67 = point_6;
+    let _e68 = sun_direction_19;
+    let _e71 = GetSkyRadianceToPoint(_e65, transmittance_texture_12, scattering_texture_12, single_mie_scattering_texture_6, _e66, _e67, _e68, (&transmittance_4));
+    radiance = _e71;
+    let _e73 = transmittance_4;
+    (*optical_depth_3) = -(log(max(_e73, vec3(0.000000000000000000000000000001f))));
+    let _e79 = radiance;
+    return _e79;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4414,43 +4532,43 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     var s_3: f32;
     var k_9: f32;
     var d_k: f32;
-    var t_13: f32;
+    var t_15: f32;
     var near: f32;
     var uvw_2: vec3<f32>;
 
     screen_uv_1 = screen_uv;
     distance_3 = distance_2;
-    let _e32 = distance_3;
-    d_32 = max(_e32, 0f);
-    let _e36 = slices;
-    let _e37 = d_32;
-    s_3 = (_e36 * sqrt((_e37 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
-    let _e42 = s_3;
-    let _e47 = slices;
-    k_9 = clamp((floor(_e42) - 1f), 0f, (_e47 - 2f));
-    let _e52 = k_9;
-    let _e53 = AerialPerspectiveSliceDistance(_e52);
-    d_k = _e53;
-    let _e55 = d_32;
-    let _e56 = d_k;
-    let _e58 = k_9;
-    let _e61 = AerialPerspectiveSliceDistance((_e58 + 1f));
-    let _e62 = d_k;
-    t_13 = clamp(((_e55 - _e56) / (_e61 - _e62)), 0f, 1f);
-    let _e69 = d_32;
-    let _e71 = AerialPerspectiveSliceDistance(0f);
-    near = min((_e69 / _e71), 1f);
-    let _e76 = screen_uv_1;
-    let _e77 = k_9;
-    let _e78 = t_13;
-    let _e82 = slices;
-    uvw_2 = vec3<f32>(_e76.x, _e76.y, (((_e77 + _e78) + 0.5f) / _e82));
-    let _e88 = uvw_2;
-    let _e89 = SampleTexture3D(optical_depth_volume, _e88);
-    let _e93 = near;
-    (*transmittance_5) = exp((-(vec3<f32>(_e89.xyz)) * _e93));
-    let _e96 = uvw_2;
-    let _e97 = SampleTexture3D(radiance_volume, _e96);
-    let _e100 = near;
-    return (vec3<f32>(_e97.xyz) * _e100);
+    let _e34 = distance_3;
+    d_32 = max(_e34, 0f);
+    let _e38 = slices;
+    let _e39 = d_32;
+    s_3 = (_e38 * sqrt((_e39 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
+    let _e44 = s_3;
+    let _e49 = slices;
+    k_9 = clamp((floor(_e44) - 1f), 0f, (_e49 - 2f));
+    let _e54 = k_9;
+    let _e55 = AerialPerspectiveSliceDistance(_e54);
+    d_k = _e55;
+    let _e57 = d_32;
+    let _e58 = d_k;
+    let _e60 = k_9;
+    let _e63 = AerialPerspectiveSliceDistance((_e60 + 1f));
+    let _e64 = d_k;
+    t_15 = clamp(((_e57 - _e58) / (_e63 - _e64)), 0f, 1f);
+    let _e71 = d_32;
+    let _e73 = AerialPerspectiveSliceDistance(0f);
+    near = min((_e71 / _e73), 1f);
+    let _e78 = screen_uv_1;
+    let _e79 = k_9;
+    let _e80 = t_15;
+    let _e84 = slices;
+    uvw_2 = vec3<f32>(_e78.x, _e78.y, (((_e79 + _e80) + 0.5f) / _e84));
+    let _e90 = uvw_2;
+    let _e91 = SampleTexture3D(optical_depth_volume, _e90);
+    let _e95 = near;
+    (*transmittance_5) = exp((-(vec3<f32>(_e91.xyz)) * _e95));
+    let _e98 = uvw_2;
+    let _e99 = SampleTexture3D(radiance_volume, _e98);
+    let _e102 = near;
+    return (vec3<f32>(_e99.xyz) * _e102);
 }
