@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "bake/bake.h"
 #include "bake/config.h"
@@ -90,6 +91,81 @@ TEST(CoefficientProfiles, FollowTheAtmosphereBetweenTheirSamples) {
   EXPECT_LE(worst_absolute, 5e-3);
   std::cout << "max relative extinction error below 9 km " << worst_relative << ", max error above, relative to "
             << "the ground's extinction " << worst_absolute << "\n";
+}
+
+// The direct integration's intervals (SegmentIntervals, in
+// aerial_perspective.glsl: from each stretch's ends and middle, for a
+// relative error of about SEGMENT_TOLERANCE) against the same integration
+// over 64 equal pieces of the segment, each with intervals of its own
+// (converged: the error falls as the square of the interval), for steep,
+// grazing, horizontal and descending segments of 100 m to 20 km and suns
+// high, low and set. Where the rule asks for no more than SEGMENT_INTERVALS,
+// every integral is within 3 times the tolerance (measured: 2.2 times at
+// most; the Richardson estimate holds asymptotically, and the sunlight is
+// bilinear in the transmittance table, with kinks at its texels). Where it
+// is capped (segments that climb through many aerosol scale heights: 44 of
+// the 270) the error is what 64 intervals leave: measured 0.13 % at most for
+// 10 km straight up, 0.54 % for 20 km, where the tables have taken over.
+TEST(AerialPerspective, DirectIntegrationMeetsItsToleranceWithFewIntervals) {
+  // The default transmittance table: the sunlight at the nodes is bilinear
+  // in it, and a coarse table's kinks are what the trapezoidal rule resolves
+  // worst.
+  const TwinTables tables = MakeTwinTables(testing::DefaultSizeEarthSingleScattering());
+  const glsl::AtmosphereParameters& p = tables.parameters;
+  const glsl::sampler2D transmittance{tables.transmittance};
+  const double kPi = 3.14159265358979323846;
+  double worst_uncapped = 0.0, worst_capped = 0.0;
+  int segments = 0, capped = 0, total_intervals = 0;
+  for (double altitude : {1.0, 300.0, 2000.0}) {
+    for (double view_zenith : {0.0, 60.0, 85.0, 89.5, 90.0, 91.0}) {
+      for (double length : {100.0, 1000.0, 5000.0, 10000.0, 20000.0}) {
+        for (double sun_zenith : {30.0, 88.0, 92.0}) {
+          const double r = p.bottom_radius + altitude, mu = std::cos(view_zenith * kPi / 180.0);
+          const double mu_s = std::cos(sun_zenith * kPi / 180.0);
+          const double nu = std::cos((view_zenith - sun_zenith) * kPi / 180.0);
+          double d = length;
+          if (glsl::RayIntersectsGround(p, r, mu)) d = std::min(d, glsl::DistanceToBottomAtmosphereBoundary(p, r, mu));
+          const glsl::SegmentSums start = glsl::StartSegment(p, transmittance, r, mu, mu_s, nu, 0.0);
+          const glsl::SegmentSums whole = glsl::ContinueSegment(p, transmittance, r, mu, mu_s, nu, 0.0, d, start);
+          glsl::SegmentSums fine = start;
+          for (int k = 0; k < 64; ++k) {
+            fine = glsl::ContinueSegment(p, transmittance, r, mu, mu_s, nu, d * k / 64.0, d * (k + 1) / 64.0, fine);
+          }
+          const int intervals = glsl::SegmentIntervals(
+              start.end, glsl::GetSegmentNode(p, transmittance, r, mu, mu_s, nu, 0.5 * d), whole.end, d);
+          // Single scattering relative to itself or, where the sun is set
+          // along most of the segment, to a thousandth of what it would be
+          // in full sunlight (the scattering weight), below which it is
+          // lost among the higher orders.
+          double worst = 0.0;
+          for (int c = 0; c < 3; ++c) {
+            const double lit_floor = 1e-3 * fine.scattering_weight[c];
+            for (const auto& [a, b, floor] :
+                 {std::tuple{whole.optical_depth[c], fine.optical_depth[c], 0.0},
+                  std::tuple{whole.single_rayleigh[c], fine.single_rayleigh[c], lit_floor},
+                  std::tuple{whole.single_mie[c], fine.single_mie[c], lit_floor},
+                  std::tuple{whole.scattering_weight[c], fine.scattering_weight[c], 0.0}}) {
+              if (b > 1e-30) worst = std::max(worst, std::abs(a - b) / std::max(b, floor));
+            }
+          }
+          ++segments;
+          total_intervals += intervals;
+          if (intervals == glsl::SEGMENT_INTERVALS) {
+            ++capped;
+            worst_capped = std::max(worst_capped, worst);
+          } else {
+            worst_uncapped = std::max(worst_uncapped, worst);
+            EXPECT_LE(worst, 3.0 * glsl::SEGMENT_TOLERANCE)
+                << "altitude " << altitude << " view " << view_zenith << " length " << d << " sun " << sun_zenith;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_LE(worst_capped, 1e-2);
+  std::cout << segments << " segments, " << double(total_intervals) / segments << " intervals on average, " << capped
+            << " capped at " << glsl::SEGMENT_INTERVALS << "; largest relative error " << worst_uncapped
+            << " (capped: " << worst_capped << ")\n";
 }
 
 TEST(AerialPerspectiveNearTheHorizon, CasesAreTheDocumentedSegments) {

@@ -103,3 +103,21 @@ struct ScatteringLookup
     float position;
     float log_first_span;
 };
+
+struct SegmentNode
+{
+    float3 extinction;
+    float3 rayleigh;
+    float3 mie;
+    float3 scattering;
+};
+
+struct SegmentSums
+{
+    float3 optical_depth;
+    float3 transmittance;
+    float3 single_rayleigh;
+    float3 single_mie;
+    float3 scattering_weight;
+    SegmentNode end;
+};

@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1091 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1133 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1091)
+    if (!_1133)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _954 = mu < 0.0;
-    bool _966;
-    if (_954)
+    bool _996 = mu < 0.0;
+    bool _1008;
+    if (_996)
     {
-        _966 = (((r * r) * mu) * mu) >= c;
+        _1008 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _966 = _954;
+        _1008 = _996;
     }
-    return _966;
+    return _1008;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _724;
+    float _766;
     if (r_mu > 0.0)
     {
-        _724 = c / (r_mu + s);
+        _766 = c / (r_mu + s);
     }
     else
     {
-        _724 = s - r_mu;
+        _766 = s - r_mu;
     }
-    float param_1 = _724;
+    float param_1 = _766;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1195;
+    float _1237;
     if (d_max > d_min)
     {
-        _1195 = (d - d_min) / (d_max - d_min);
+        _1237 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1195 = 0.0;
+        _1237 = 0.0;
     }
-    float x_mu = _1195;
+    float x_mu = _1237;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -267,16 +267,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1247;
+        float _1289;
         if (rho == d_min)
         {
-            _1247 = 0.0;
+            _1289 = 0.0;
         }
         else
         {
-            _1247 = (d - d_min) / (rho - d_min);
+            _1289 = (d - d_min) / (rho - d_min);
         }
-        return _1247;
+        return _1289;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -285,16 +285,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1282;
+    float _1324;
     if (d_max > d_min_1)
     {
-        _1282 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1324 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1282 = 0.0;
+        _1324 = 0.0;
     }
-    return _1282;
+    return _1324;
 }
 #endif
 
@@ -305,16 +305,16 @@ float GetTextureCoordFromUnitMuInHalf(thread const float& x, thread const bool& 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5 * GetTextureCoordFromUnitRange(param, param_1);
-    float _1305;
+    float _1347;
     if (ray_r_mu_intersects_ground)
     {
-        _1305 = 0.5 - u;
+        _1347 = 0.5 - u;
     }
     else
     {
-        _1305 = 0.5 + u;
+        _1347 = 0.5 + u;
     }
-    return _1305;
+    return _1347;
 }
 #endif
 
@@ -378,17 +378,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1623;
+    float _1665;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1623 = ClampCosine(param_1);
+        _1665 = ClampCosine(param_1);
     }
     else
     {
-        _1623 = 1.0;
+        _1665 = 1.0;
     }
-    return _1623;
+    return _1665;
 }
 #endif
 
@@ -396,22 +396,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _970;
+    float _1012;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _970 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _1012 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _970 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _1012 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _970;
+    return _1012;
 }
 #endif
 
@@ -468,51 +468,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1729;
+    float2 _1771;
     if (c_end >= rho)
     {
-        _1729 = float2(-1.0, 0.0);
+        _1771 = float2(-1.0, 0.0);
     }
     else
     {
-        _1729 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1771 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1729;
-    bool _1757 = end.y < 0.0;
-    bool _1767;
-    if (!_1757)
+    float2 end = _1771;
+    bool _1799 = end.y < 0.0;
+    bool _1809;
+    if (!_1799)
     {
-        _1767 = end.x < start.x;
+        _1809 = end.x < start.x;
     }
     else
     {
-        _1767 = _1757;
+        _1809 = _1799;
     }
-    bool end_sets_last = _1767;
+    bool end_sets_last = _1809;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1821;
+    float _1863;
     if (end_sets_last)
     {
-        float _1827;
+        float _1869;
         if (c_end >= rho)
         {
-            _1827 = 3.1415927410125732421875;
+            _1869 = 3.1415927410125732421875;
         }
         else
         {
-            _1827 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1869 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1821 = _1827;
+        _1863 = _1869;
     }
     else
     {
-        _1821 = acos(c_start);
+        _1863 = acos(c_start);
     }
-    float angle = _1821;
+    float angle = _1863;
     return angle + a;
 }
 #endif
@@ -545,17 +545,17 @@ float GetScatteringMuSFromUnitRangeOnAxis(thread const AtmosphereParameters& atm
     float param_1 = axis.inverse_A;
     float a = ScatteringDistanceFromUnitMuS(param, param_1);
     float d = d_min + (fast::min(a, axis.A) * (axis.H - d_min));
-    float _1452;
+    float _1494;
     if (d == 0.0)
     {
-        _1452 = 1.0;
+        _1494 = 1.0;
     }
     else
     {
         float param_2 = ((axis.H * axis.H) - (d * d)) / ((2.0 * bottom) * d);
-        _1452 = ClampCosine(param_2);
+        _1494 = ClampCosine(param_2);
     }
-    return _1452;
+    return _1494;
 }
 #endif
 
@@ -611,16 +611,16 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     ScatteringSunAxis param_5 = sun_axis;
     float param_6 = ShadowEdgeSunCosine(param_2, param_3);
     float param_7;
-    float _2035 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
+    float _2077 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
     float unused = param_7;
-    X_closest = _2035;
+    X_closest = _2077;
     AtmosphereParameters param_8 = atmosphere;
     ScatteringSunAxis param_9 = sun_axis;
     float param_10 = split_mu_s;
     float param_11;
-    float _2044 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
+    float _2086 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
     unused = param_11;
-    X_span = _2044 - X_closest;
+    X_span = _2086 - X_closest;
     float2 param_12 = edge;
     float param_13 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_12, param_13);
@@ -638,9 +638,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     ScatteringSunAxis param_3 = sun_axis;
     float param_4 = ShadowEdgeSunCosine(param, param_1);
     float param_5;
-    float _1988 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
+    float _2030 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
     float dX_dtheta = param_5;
-    float X = _1988;
+    float X = _2030;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -670,9 +670,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_12 = X_span;
     float param_13 = log_span;
     float param_14;
-    float _2093 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+    float _2135 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
     float unused = param_14;
-    return _2093;
+    return _2135;
 }
 #endif
 
@@ -747,17 +747,17 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
     float u_mu_s = GetScatteringTextureUMuSOnAxis(param_15, param_16, param_17);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = float2(0.0);
-    bool _2409 = atmosphere.scattering_mu_s_split > 0;
-    bool _2420;
-    if (_2409)
+    bool _2451 = atmosphere.scattering_mu_s_split > 0;
+    bool _2462;
+    if (_2451)
     {
-        _2420 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2462 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2420 = _2409;
+        _2462 = _2451;
     }
-    if (_2420)
+    if (_2462)
     {
         float param_18 = mu;
         float param_19 = mu_s;
@@ -768,7 +768,7 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
         float param_24 = ViewSunAzimuthCosine(param_18, param_19, param_20);
         bool param_25 = ray_r_mu_intersects_ground;
         float2 param_26;
-        float _2440 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
+        float _2482 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
         edge = param_26;
         float2 param_27 = edge;
         float param_28 = mu_s;
@@ -812,9 +812,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_11 = X_closest;
         float param_12 = X_span;
         float param_13 = log_span;
-        float _2154 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+        float _2196 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
         float slope = param_14;
-        float error = _2154 - x;
+        float error = _2196 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -830,16 +830,16 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _2692;
+    float _2734;
     if (low_sun)
     {
-        _2692 = fast::min(t, 1.0);
+        _2734 = fast::min(t, 1.0);
     }
     else
     {
-        _2692 = fast::clamp(t, 0.0, 1.0);
+        _2734 = fast::clamp(t, 0.0, 1.0);
     }
-    return _2692;
+    return _2734;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -851,17 +851,17 @@ void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thre
     float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
     x_below = (mu_s_column + 0.5) / mu_s_size;
     x_above = (mu_s_column + 1.5) / mu_s_size;
-    bool _2752 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
-    bool _2758;
-    if (_2752)
+    bool _2794 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
+    bool _2800;
+    if (_2794)
     {
-        _2758 = x_below < x_low_sun;
+        _2800 = x_below < x_low_sun;
     }
     else
     {
-        _2758 = _2752;
+        _2800 = _2794;
     }
-    low_sun_below = _2758;
+    low_sun_below = _2800;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -882,10 +882,10 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
     float param_6 = nu;
     bool param_7 = ray_r_mu_intersects_ground;
     float2 param_8;
-    float4 _3308 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    float4 _3350 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float2 edge = param_8;
     ScatteringLookup lookup;
-    lookup.uvwz = _3308;
+    lookup.uvwz = _3350;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = lookup.uvwz.x * (nu_size - 1.0);
     lookup.nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
@@ -900,17 +900,17 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
     lookup.log_first_span = 1.0;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5;
-    bool _3360 = atmosphere.scattering_mu_s_split > 0;
-    bool _3369;
-    if (_3360)
+    bool _3402 = atmosphere.scattering_mu_s_split > 0;
+    bool _3411;
+    if (_3402)
     {
-        _3369 = lookup.position < float(atmosphere.scattering_mu_s_split);
+        _3411 = lookup.position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3369 = _3360;
+        _3411 = _3402;
     }
-    if (_3369)
+    if (_3411)
     {
         float past = 6.0;
         lookup.kind = 3;
@@ -931,17 +931,17 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
         }
         else
         {
-            bool _3417 = lookup.position >= (past - 1.0);
-            bool _3424;
-            if (_3417)
+            bool _3459 = lookup.position >= (past - 1.0);
+            bool _3466;
+            if (_3459)
             {
-                _3424 = lookup.position < past;
+                _3466 = lookup.position < past;
             }
             else
             {
-                _3424 = _3417;
+                _3466 = _3459;
             }
-            if (_3424)
+            if (_3466)
             {
                 float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
                 AtmosphereParameters param_15 = atmosphere;
@@ -1035,26 +1035,26 @@ float4 IsLit(thread const float4& log_light)
 static inline __attribute__((always_inline))
 float4 LogMonotoneCubic(thread const float4& log_a, thread const float4& lb, thread const float4& lc, thread const float4& log_d, thread const bool& has_a, thread const bool& has_d, thread const float& t)
 {
-    float4 _2768;
+    float4 _2810;
     if (has_a)
     {
-        _2768 = log_a;
+        _2810 = log_a;
     }
     else
     {
-        _2768 = (lb * 2.0) - lc;
+        _2810 = (lb * 2.0) - lc;
     }
-    float4 la = _2768;
-    float4 _2780;
+    float4 la = _2810;
+    float4 _2822;
     if (has_d)
     {
-        _2780 = log_d;
+        _2822 = log_d;
     }
     else
     {
-        _2780 = (lc * 2.0) - lb;
+        _2822 = (lc * 2.0) - lb;
     }
-    float4 ld = _2780;
+    float4 ld = _2822;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1176,19 +1176,19 @@ float4 GetLogScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere
     float param_6 = x;
     float param_7 = nu_slice + 1.0;
     float4 b = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
-    float4 _3015;
+    float4 _3057;
     if (low_sun)
     {
         float4 param_8 = a;
         float4 param_9 = b;
-        _3015 = mix(LogLight(param_8), LogLight(param_9), float4(nu_t));
+        _3057 = mix(LogLight(param_8), LogLight(param_9), float4(nu_t));
     }
     else
     {
         float4 param_10 = mix(a, b, float4(nu_t));
-        _3015 = LogLight(param_10);
+        _3057 = LogLight(param_10);
     }
-    return _3015;
+    return _3057;
 }
 #endif
 
@@ -1327,16 +1327,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScatteringFromLookup(param_6, scattering_texture, scattering_textureSmplr, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3897;
+        float3 _3939;
         if (scattering.x > 0.0)
         {
-            _3897 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3939 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3897 = float3(0.0);
+            _3939 = float3(0.0);
         }
-        single_mie_scattering = _3897;
+        single_mie_scattering = _3939;
     }
     else
     {
@@ -1407,9 +1407,9 @@ float3 GetSkyRadianceOfRay(thread const AtmosphereParameters& atmosphere, textur
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3953 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3995 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3953;
+    float3 scattering = _3995;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1430,13 +1430,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _3988 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4030 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_3988)
+    if (!_4030)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1445,19 +1445,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _4008;
+    float3 _4050;
     if (ray_r_mu_intersects_ground)
     {
-        _4008 = float3(0.0);
+        _4050 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _4008 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _4050 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _4008;
+    transmittance = _4050;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1481,16 +1481,16 @@ static inline __attribute__((always_inline))
 float GetUnitMuInHalfFromTextureCoord(thread const float& u, thread const int& size, thread bool& ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5;
-    float _1319;
+    float _1361;
     if (ray_r_mu_intersects_ground)
     {
-        _1319 = 1.0 - (2.0 * u);
+        _1361 = 1.0 - (2.0 * u);
     }
     else
     {
-        _1319 = (2.0 * u) - 1.0;
+        _1361 = (2.0 * u) - 1.0;
     }
-    float param = _1319;
+    float param = _1361;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1513,25 +1513,25 @@ float3 GetSkyViewRay(thread const AtmosphereParameters& atmosphere, thread const
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _5169 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5549 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _5169;
+    float x = _5549;
     float e = (1.0 - x) * (1.0 - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _5190;
+    float _5570;
     if (ray_r_mu_intersects_ground)
     {
-        _5190 = theta_h + (e * (3.1415927410125732421875 - theta_h));
+        _5570 = theta_h + (e * (3.1415927410125732421875 - theta_h));
     }
     else
     {
-        _5190 = theta_h * (1.0 - e);
+        _5570 = theta_h * (1.0 - e);
     }
-    float theta = _5190;
+    float theta = _5570;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875 * fast::clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0, 1.0);
@@ -1556,9 +1556,9 @@ float3 GetSkyViewRadiance(thread const AtmosphereParameters& atmosphere, texture
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5279 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5659 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5279;
+    float3 view_ray = _5659;
     float3 up = fast::normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1586,16 +1586,16 @@ void GetSkyViewAngles(thread const float3& camera, thread const float3& view_ray
     theta = precise::atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _5155;
+    float _5535;
     if ((along != 0.0) || (side != 0.0))
     {
-        _5155 = precise::atan2(side, along);
+        _5535 = precise::atan2(side, along);
     }
     else
     {
-        _5155 = 0.0;
+        _5535 = 0.0;
     }
-    phi = _5155;
+    phi = _5535;
 }
 #endif
 
@@ -1606,16 +1606,16 @@ float2 GetSkyViewUvFromAngles(thread const AtmosphereParameters& atmosphere, thr
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _5076;
+    float _5456;
     if (ray_r_mu_intersects_ground)
     {
-        _5076 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
+        _5456 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
     }
     else
     {
-        _5076 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
+        _5456 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
     }
-    float x = _5076;
+    float x = _5456;
     float param_2 = phi / 3.1415927410125732421875;
     int param_3 = 192;
     float param_4 = x;
@@ -1638,19 +1638,19 @@ float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, 
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5341;
+    float3 _5721;
     if (ray_r_mu_intersects_ground)
     {
-        _5341 = float3(0.0);
+        _5721 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5341 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
+        _5721 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
     }
-    transmittance = _5341;
+    transmittance = _5721;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1665,15 +1665,6 @@ float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, 
     float param_17 = phi;
     bool param_18 = ray_r_mu_intersects_ground;
     return float3(sky_view_texture.sample(sky_view_textureSmplr, GetSkyViewUvFromAngles(param_14, param_15, param_16, param_17, param_18), level(0.0)).xyz);
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-static inline __attribute__((always_inline))
-float CosineAtDistance(thread const float& r, thread const float& mu, thread const float& d, thread const float& r_d)
-{
-    float param = ((r * mu) + d) / r_d;
-    return ClampCosine(param);
 }
 #endif
 
@@ -1696,35 +1687,11 @@ float ProfileSampleAltitude(thread const AtmosphereParameters& atmosphere, threa
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 static inline __attribute__((always_inline))
-float InterpolateCoefficient(thread const float& a, thread const float& b, thread const float& f)
-{
-    float _4112;
-    if ((a > 0.0) && (b > 0.0))
-    {
-        _4112 = a * exp(f * log(b / a));
-    }
-    else
-    {
-        _4112 = mix(a, b, f);
-    }
-    return _4112;
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-static inline __attribute__((always_inline))
 float3 InterpolateCoefficients(thread const float3& a, thread const float3& b, thread const float& f)
 {
-    float param = a.x;
-    float param_1 = b.x;
-    float param_2 = f;
-    float param_3 = a.y;
-    float param_4 = b.y;
-    float param_5 = f;
-    float param_6 = a.z;
-    float param_7 = b.z;
-    float param_8 = f;
-    return float3(InterpolateCoefficient(param, param_1, param_2), InterpolateCoefficient(param_3, param_4, param_5), InterpolateCoefficient(param_6, param_7, param_8));
+    float3 tiny = float3(1.0000000031710768509710513471353e-30);
+    float3 positive = step(tiny, fast::min(a, b));
+    return mix(mix(a, b, float3(f)), a * exp(log(fast::max(b, tiny) / fast::max(a, tiny)) * f), positive);
 }
 #endif
 
@@ -1774,91 +1741,274 @@ float SunVisibleFraction(thread const AtmosphereParameters& atmosphere, thread c
     return SunVisibleFractionAboveHorizon(param_2, param_3, param_4);
 }
 
+static inline __attribute__((always_inline))
+float3 GetTransmittanceToSun(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu_s)
+{
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu_s;
+    AtmosphereParameters param_3 = atmosphere;
+    float param_4 = r;
+    float param_5 = mu_s;
+    return GetTransmittanceToTopAtmosphereBoundary(param, transmittance_texture, transmittance_textureSmplr, param_1, param_2) * SunVisibleFraction(param_3, param_4, param_5);
+}
+
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 static inline __attribute__((always_inline))
-float MeanAttenuation(thread const float& depth)
+SegmentNode GetSegmentNode(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const float& t)
 {
-    float _4362;
-    if (depth < 9.9999997473787516355514526367188e-05)
-    {
-        _4362 = 1.0 - (0.5 * depth);
-    }
-    else
-    {
-        _4362 = (1.0 - exp(-depth)) / depth;
-    }
-    return _4362;
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = t;
+    float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
+    float param_4 = ((r * mu_s) + (t * nu)) / r_t;
+    float mu_s_t = ClampCosine(param_4);
+    AtmosphereParameters param_5 = atmosphere;
+    float param_6 = r;
+    float param_7 = mu;
+    float param_8 = t;
+    float param_9 = r_t;
+    AtmosphereParameters param_10 = atmosphere;
+    float param_11 = AltitudeAtDistance(param_5, param_6, param_7, param_8, param_9);
+    float3 param_12;
+    float3 param_13;
+    float3 _4433 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+    float3 mie_scattering = param_12;
+    float3 rayleigh_scattering = param_13;
+    SegmentNode node;
+    node.extinction = _4433;
+    AtmosphereParameters param_14 = atmosphere;
+    float param_15 = r_t;
+    float param_16 = mu_s_t;
+    float3 sunlight = GetTransmittanceToSun(param_14, transmittance_texture, transmittance_textureSmplr, param_15, param_16);
+    node.rayleigh = rayleigh_scattering * sunlight;
+    node.mie = mie_scattering * sunlight;
+    node.scattering = rayleigh_scattering + mie_scattering;
+    return node;
 }
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 static inline __attribute__((always_inline))
-float3 IntegrateSegment(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const float& d, thread float3& single_rayleigh, thread float3& single_mie, thread float3& scattering_weight)
+SegmentSums StartSegment(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const float& t)
 {
-    float dt = d / 16.0;
-    float3 optical_depth = float3(0.0);
-    float3 previous_extinction = float3(0.0);
-    float3 previous_rayleigh = float3(0.0);
-    float3 previous_mie = float3(0.0);
-    float3 previous_scattering = float3(0.0);
-    single_rayleigh = float3(0.0);
-    single_mie = float3(0.0);
-    scattering_weight = float3(0.0);
-    float3 param_12;
-    float3 param_13;
-    for (int k = 0; k <= 16; k++)
+    SegmentSums sums;
+    sums.optical_depth = float3(0.0);
+    sums.transmittance = float3(1.0);
+    sums.single_rayleigh = float3(0.0);
+    sums.single_mie = float3(0.0);
+    sums.scattering_weight = float3(0.0);
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = mu_s;
+    float param_4 = nu;
+    float param_5 = t;
+    sums.end = GetSegmentNode(param, transmittance_texture, transmittance_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    return sums;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float3 SegmentCurvature(thread const float3& a, thread const float3& m, thread const float3& b)
+{
+    return abs((a + b) - (m * 2.0)) / fast::max((a + b) + (m * 2.0), float3(1.0000000031710768509710513471353e-30));
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float LargestComponent(thread const float3& v)
+{
+    return fast::max(fast::max(v.x, v.y), v.z);
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float3 SegmentRatio(thread const float3& a, thread const float3& m, thread const float3& b)
+{
+    return fast::max(fast::max(a, m), b) / fast::max(fast::min(fast::min(a, m), b), float3(1.0000000031710768509710513471353e-30));
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+int SegmentIntervals(thread const SegmentNode& a, thread const SegmentNode& m, thread const SegmentNode& b, thread const float& L)
+{
+    float3 to_middle = exp((-(a.extinction + m.extinction)) * (0.25 * L));
+    float3 to_end = to_middle * exp((-(m.extinction + b.extinction)) * (0.25 * L));
+    float3 rayleigh_m = m.rayleigh * to_middle;
+    float3 rayleigh_b = b.rayleigh * to_end;
+    float3 mie_m = m.mie * to_middle;
+    float3 mie_b = b.mie * to_end;
+    float3 scattering_m = m.scattering * to_middle;
+    float3 scattering_b = b.scattering * to_end;
+    float3 param = a.extinction;
+    float3 param_1 = m.extinction;
+    float3 param_2 = b.extinction;
+    float3 param_3 = a.rayleigh;
+    float3 param_4 = rayleigh_m;
+    float3 param_5 = rayleigh_b;
+    float3 param_6 = a.mie;
+    float3 param_7 = mie_m;
+    float3 param_8 = mie_b;
+    float3 param_9 = a.scattering;
+    float3 param_10 = scattering_m;
+    float3 param_11 = scattering_b;
+    float3 param_12 = fast::max(fast::max(SegmentCurvature(param, param_1, param_2), SegmentCurvature(param_3, param_4, param_5)), fast::max(SegmentCurvature(param_6, param_7, param_8), SegmentCurvature(param_9, param_10, param_11)));
+    float e = LargestComponent(param_12);
+    float3 param_13 = a.extinction;
+    float3 param_14 = m.extinction;
+    float3 param_15 = b.extinction;
+    float3 param_16 = a.rayleigh;
+    float3 param_17 = rayleigh_m;
+    float3 param_18 = rayleigh_b;
+    float3 param_19 = a.mie;
+    float3 param_20 = mie_m;
+    float3 param_21 = mie_b;
+    float3 param_22 = a.scattering;
+    float3 param_23 = scattering_m;
+    float3 param_24 = scattering_b;
+    float3 param_25 = fast::max(fast::max(SegmentRatio(param_13, param_14, param_15), SegmentRatio(param_16, param_17, param_18)), fast::max(SegmentRatio(param_19, param_20, param_21), SegmentRatio(param_22, param_23, param_24)));
+    float F = LargestComponent(param_25);
+    float n = fast::max(sqrt(e / 0.00015000000712461769580841064453125), log(fast::max(F, 1.0)) / 0.048989795148372650146484375);
+    return 2 * int(fast::clamp(ceil(0.5 * n), 1.0, 32.0));
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float3 MeanAttenuation(thread const float3& depth, thread const float3& attenuation)
+{
+    return mix((float3(1.0) - attenuation) / fast::max(depth, float3(1.0000000031710768509710513471353e-30)), float3(1.0) - (depth * 0.5), float3(1.0) - step(float3(9.9999997473787516355514526367188e-05), depth));
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+SegmentSums ContinueSegment(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& mu_s, thread const float& nu, thread const float& t0, thread const float& t1, thread const SegmentSums& sums)
+{
+    SegmentSums result = sums;
+    if (t1 <= t0)
     {
-        float t = dt * float(k);
-        AtmosphereParameters param = atmosphere;
-        float param_1 = r;
-        float param_2 = mu;
-        float param_3 = t;
-        float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
-        AtmosphereParameters param_4 = atmosphere;
-        float param_5 = r;
-        float param_6 = mu;
-        float param_7 = t;
-        float param_8 = r_t;
-        float altitude = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float param_9 = ((r * mu_s) + (t * nu)) / r_t;
-        float mu_s_t = ClampCosine(param_9);
-        AtmosphereParameters param_10 = atmosphere;
-        float param_11 = altitude;
-        float3 _4442 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
-        float3 mie_scattering = param_12;
-        float3 rayleigh_scattering = param_13;
-        float3 extinction = _4442;
-        AtmosphereParameters param_14 = atmosphere;
-        float param_15 = r_t;
-        float param_16 = mu_s_t;
-        AtmosphereParameters param_17 = atmosphere;
-        float param_18 = r_t;
-        float param_19 = mu_s_t;
-        float3 sunlight = exp(-GetOpticalDepthToTopAtmosphereBoundary(param_14, transmittance_texture, transmittance_textureSmplr, param_15, param_16)) * SunVisibleFraction(param_17, param_18, param_19);
-        float3 rayleigh = rayleigh_scattering * sunlight;
-        float3 mie = mie_scattering * sunlight;
-        float3 scattering = rayleigh_scattering + mie_scattering;
-        if (k > 0)
-        {
-            float3 interval_depth = (previous_extinction + extinction) * (0.5 * dt);
-            float3 start_transmittance = exp(-optical_depth);
-            float param_20 = interval_depth.x;
-            float param_21 = interval_depth.y;
-            float param_22 = interval_depth.z;
-            float3 mean_transmittance = start_transmittance * float3(MeanAttenuation(param_20), MeanAttenuation(param_21), MeanAttenuation(param_22));
-            single_rayleigh += (((previous_rayleigh + rayleigh) * (0.5 * dt)) * mean_transmittance);
-            single_mie += (((previous_mie + mie) * (0.5 * dt)) * mean_transmittance);
-            scattering_weight += (((previous_scattering + scattering) * (0.5 * dt)) * mean_transmittance);
-            optical_depth += interval_depth;
-        }
-        previous_extinction = extinction;
-        previous_rayleigh = rayleigh;
-        previous_mie = mie;
-        previous_scattering = scattering;
+        return result;
     }
-    single_rayleigh *= atmosphere.solar_irradiance;
-    single_mie *= atmosphere.solar_irradiance;
-    return optical_depth;
+    SegmentNode last = sums.end;
+    SegmentNode middle = sums.end;
+    SegmentNode previous = sums.end;
+    bool short_stretch = (t1 - t0) <= (0.00999999977648258209228515625 * t1);
+    int intervals = short_stretch ? 1 : 2;
+    float dt = (t1 - t0) / float(intervals);
+    int _4719 = short_stretch ? (-1) : (-2);
+    float _4771;
+    float _4777;
+    for (int i = _4719; i < intervals; i++)
+    {
+        bool _4730 = i == (-2);
+        bool _4738;
+        if (!_4730)
+        {
+            _4738 = (i == (-1)) && short_stretch;
+        }
+        else
+        {
+            _4738 = _4730;
+        }
+        bool finding_last = _4738;
+        bool finding_middle = (i == (-1)) && (!short_stretch);
+        int k = i + 1;
+        SegmentNode node = last;
+        bool _4752 = finding_last || finding_middle;
+        bool _4766;
+        if (!_4752)
+        {
+            bool _4758 = k < intervals;
+            bool _4765;
+            if (_4758)
+            {
+                _4765 = (2 * k) != intervals;
+            }
+            else
+            {
+                _4765 = _4758;
+            }
+            _4766 = _4765;
+        }
+        else
+        {
+            _4766 = _4752;
+        }
+        if (_4766)
+        {
+            if (finding_last)
+            {
+                _4771 = t1;
+            }
+            else
+            {
+                if (finding_middle)
+                {
+                    _4777 = 0.5 * (t0 + t1);
+                }
+                else
+                {
+                    _4777 = t0 + (dt * float(k));
+                }
+                _4771 = _4777;
+            }
+            float t = _4771;
+            AtmosphereParameters param = atmosphere;
+            float param_1 = r;
+            float param_2 = mu;
+            float param_3 = mu_s;
+            float param_4 = nu;
+            float param_5 = t;
+            node = GetSegmentNode(param, transmittance_texture, transmittance_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+        }
+        else
+        {
+            if ((2 * k) == intervals)
+            {
+                node = middle;
+            }
+        }
+        if (finding_last)
+        {
+            last = node;
+        }
+        else
+        {
+            if (finding_middle)
+            {
+                middle = node;
+                SegmentNode param_6 = sums.end;
+                SegmentNode param_7 = middle;
+                SegmentNode param_8 = last;
+                float param_9 = t1 - t0;
+                intervals = SegmentIntervals(param_6, param_7, param_8, param_9);
+                dt = (t1 - t0) / float(intervals);
+            }
+            else
+            {
+                float3 interval_depth = (previous.extinction + node.extinction) * (0.5 * dt);
+                float3 attenuation = exp(-interval_depth);
+                float3 param_10 = interval_depth;
+                float3 param_11 = attenuation;
+                float3 mean_transmittance = result.transmittance * MeanAttenuation(param_10, param_11);
+                result.single_rayleigh += (((previous.rayleigh + node.rayleigh) * (0.5 * dt)) * mean_transmittance);
+                result.single_mie += (((previous.mie + node.mie) * (0.5 * dt)) * mean_transmittance);
+                result.scattering_weight += (((previous.scattering + node.scattering) * (0.5 * dt)) * mean_transmittance);
+                result.optical_depth += interval_depth;
+                result.transmittance *= attenuation;
+                previous = node;
+            }
+        }
+    }
+    result.end = last;
+    return result;
 }
 #endif
 
@@ -1886,10 +2036,10 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         float param_8 = r_t;
         AtmosphereParameters param_9 = atmosphere;
         float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4308 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
+        float3 _4325 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
         float3 mie_scattering = param_11;
         float3 rayleigh_scattering = param_12;
-        float3 extinction = _4308;
+        float3 extinction = _4325;
         if (k > 0)
         {
             optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
@@ -1897,6 +2047,15 @@ float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmospher
         previous_extinction = extinction;
     }
     return optical_depth;
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+static inline __attribute__((always_inline))
+float CosineAtDistance(thread const float& r, thread const float& mu, thread const float& d, thread const float& r_d)
+{
+    float param = ((r * mu) + d) / r_d;
+    return ClampCosine(param);
 }
 #endif
 
@@ -1964,14 +2123,14 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 static inline __attribute__((always_inline))
 float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
 {
-    float3 _4332;
+    float3 _4349;
     if (atmosphere.transmittance_is_colour != 0)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
         float param_3 = d;
-        _4332 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
+        _4349 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
     }
     else
     {
@@ -1980,9 +2139,9 @@ float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, te
         float param_6 = mu;
         float param_7 = d;
         bool param_8 = ray_r_mu_intersects_ground;
-        _4332 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
+        _4349 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
     }
-    return _4332;
+    return _4349;
 }
 #endif
 
@@ -1996,16 +2155,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _4074;
+    float _4116;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _4074 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _4116 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _4074 = up;
+        _4116 = up;
     }
-    return _4074;
+    return _4116;
 }
 #endif
 
@@ -2029,13 +2188,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4588 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4956 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4588)
+    if (!_4956)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -2046,156 +2205,146 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    AtmosphereParameters param_12 = atmosphere;
-    float param_13 = r;
-    float param_14 = mu;
-    float param_15 = lit;
-    float r_p = RadiusAtDistance(param_12, param_13, param_14, param_15);
-    float param_16 = r;
-    float param_17 = mu;
-    float param_18 = lit;
-    float param_19 = r_p;
-    float mu_p = CosineAtDistance(param_16, param_17, param_18, param_19);
-    float param_20 = ((r * mu_s) + (lit * nu)) / r_p;
-    float mu_s_p = ClampCosine(param_20);
     float direct = 1.0 - smoothstep(10000.0, 20000.0, d);
     float lit_direct = 1.0 - smoothstep(10000.0, 20000.0, lit);
-    float3 single_rayleigh = float3(0.0);
-    float3 single_mie = float3(0.0);
-    float3 lit_weight = float3(0.0);
-    float3 lit_optical_depth = float3(0.0);
+    SegmentSums lit_sums;
+    lit_sums.optical_depth = float3(0.0);
+    lit_sums.single_mie = float3(0.0);
     if (lit_direct > 0.0)
     {
-        AtmosphereParameters param_21 = atmosphere;
-        float param_22 = r;
-        float param_23 = mu;
-        float param_24 = mu_s;
-        float param_25 = nu;
-        float param_26 = lit;
-        float3 param_27;
-        float3 param_28;
-        float3 param_29;
-        float3 _4683 = IntegrateSegment(param_21, transmittance_texture, transmittance_textureSmplr, param_22, param_23, param_24, param_25, param_26, param_27, param_28, param_29);
-        single_rayleigh = param_27;
-        single_mie = param_28;
-        lit_weight = param_29;
-        lit_optical_depth = _4683;
+        AtmosphereParameters param_12 = atmosphere;
+        float param_13 = r;
+        float param_14 = mu;
+        float param_15 = mu_s;
+        float param_16 = nu;
+        float param_17 = 0.0;
+        AtmosphereParameters param_18 = atmosphere;
+        float param_19 = r;
+        float param_20 = mu;
+        float param_21 = mu_s;
+        float param_22 = nu;
+        float param_23 = 0.0;
+        float param_24 = lit;
+        SegmentSums param_25 = StartSegment(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14, param_15, param_16, param_17);
+        lit_sums = ContinueSegment(param_18, transmittance_texture, transmittance_textureSmplr, param_19, param_20, param_21, param_22, param_23, param_24, param_25);
     }
-    float3 optical_depth = lit_optical_depth;
+    float3 optical_depth = lit_sums.optical_depth;
     if ((direct > 0.0) && (lit < d))
     {
-        AtmosphereParameters param_30 = atmosphere;
-        float param_31 = r_p;
-        float param_32 = mu_p;
-        float param_33 = mu_s_p;
-        float param_34 = nu;
-        float param_35 = d - lit;
-        float3 param_36;
-        float3 param_37;
-        float3 param_38;
-        float3 _4717 = IntegrateSegment(param_30, transmittance_texture, transmittance_textureSmplr, param_31, param_32, param_33, param_34, param_35, param_36, param_37, param_38);
-        float3 unused_rayleigh = param_36;
-        float3 unused_mie = param_37;
-        float3 unused_weight = param_38;
-        optical_depth += _4717;
+        AtmosphereParameters param_26 = atmosphere;
+        float param_27 = r;
+        float param_28 = mu;
+        float param_29 = mu_s;
+        float param_30 = nu;
+        float param_31 = lit;
+        float param_32 = d;
+        SegmentSums param_33 = lit_sums;
+        optical_depth = ContinueSegment(param_26, transmittance_texture, transmittance_textureSmplr, param_27, param_28, param_29, param_30, param_31, param_32, param_33).optical_depth;
     }
     if (direct < 1.0)
     {
-        AtmosphereParameters param_39 = atmosphere;
-        float param_40 = r;
-        float param_41 = mu;
-        float param_42 = d;
-        bool param_43 = ray_r_mu_intersects_ground;
-        optical_depth = mix(LongSegmentOpticalDepth(param_39, transmittance_texture, transmittance_textureSmplr, param_40, param_41, param_42, param_43), optical_depth, float3(direct));
+        AtmosphereParameters param_34 = atmosphere;
+        float param_35 = r;
+        float param_36 = mu;
+        float param_37 = d;
+        bool param_38 = ray_r_mu_intersects_ground;
+        optical_depth = mix(LongSegmentOpticalDepth(param_34, transmittance_texture, transmittance_textureSmplr, param_35, param_36, param_37, param_38), optical_depth, float3(direct));
     }
     transmittance = exp(-optical_depth);
-    AtmosphereParameters param_44 = atmosphere;
-    float param_45 = r;
-    float param_46 = mu;
-    float param_47 = mu_s;
-    float param_48 = nu;
-    bool param_49 = ray_r_mu_intersects_ground;
-    float3 param_50;
-    float3 _4760 = GetCombinedScattering(param_44, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_45, param_46, param_47, param_48, param_49, param_50);
-    float3 single_mie_scattering = param_50;
-    float3 scattering = _4760;
+    AtmosphereParameters param_39 = atmosphere;
+    float param_40 = r;
+    float param_41 = mu;
+    float param_42 = mu_s;
+    float param_43 = nu;
+    bool param_44 = ray_r_mu_intersects_ground;
+    float3 param_45;
+    float3 _5096 = GetCombinedScattering(param_39, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_40, param_41, param_42, param_43, param_44, param_45);
+    float3 single_mie_scattering = param_45;
+    float3 scattering = _5096;
     if (lit < 10000.0)
     {
-        AtmosphereParameters param_51 = atmosphere;
-        float param_52 = r;
-        float param_53 = mu;
-        bool param_54 = ray_r_mu_intersects_ground;
-        float boundary = DistanceToNearestAtmosphereBoundary(param_51, param_52, param_53, param_54);
-        AtmosphereParameters param_55 = atmosphere;
-        float param_56 = r;
-        float param_57 = mu;
-        float far = fast::max(fast::min(fast::min(10000.0, boundary), DistanceInsideScatteringRadii(param_55, param_56, param_57)), lit);
-        AtmosphereParameters param_58 = atmosphere;
-        float param_59 = r;
-        float param_60 = mu;
-        float param_61 = mu_s;
-        float param_62 = nu;
-        float param_63 = far;
-        float3 param_64;
-        float3 param_65;
-        float3 param_66;
-        float3 _4808 = IntegrateSegment(param_58, transmittance_texture, transmittance_textureSmplr, param_59, param_60, param_61, param_62, param_63, param_64, param_65, param_66);
-        float3 far_rayleigh = param_64;
-        float3 far_mie = param_65;
-        float3 far_weight = param_66;
-        float3 far_optical_depth = _4808;
+        AtmosphereParameters param_46 = atmosphere;
+        float param_47 = r;
+        float param_48 = mu;
+        bool param_49 = ray_r_mu_intersects_ground;
+        float boundary = DistanceToNearestAtmosphereBoundary(param_46, param_47, param_48, param_49);
+        AtmosphereParameters param_50 = atmosphere;
+        float param_51 = r;
+        float param_52 = mu;
+        float far = fast::max(fast::min(fast::min(10000.0, boundary), DistanceInsideScatteringRadii(param_50, param_51, param_52)), lit);
+        AtmosphereParameters param_53 = atmosphere;
+        float param_54 = r;
+        float param_55 = mu;
+        float param_56 = mu_s;
+        float param_57 = nu;
+        float param_58 = lit;
+        float param_59 = far;
+        SegmentSums param_60 = lit_sums;
+        SegmentSums far_sums = ContinueSegment(param_53, transmittance_texture, transmittance_textureSmplr, param_54, param_55, param_56, param_57, param_58, param_59, param_60);
         if (far < boundary)
         {
-            AtmosphereParameters param_67 = atmosphere;
-            float param_68 = r;
-            float param_69 = mu;
-            float param_70 = far;
-            float r_far = RadiusAtDistance(param_67, param_68, param_69, param_70);
-            float param_71 = r;
-            float param_72 = mu;
-            float param_73 = far;
-            float param_74 = r_far;
-            float param_75 = ((r * mu_s) + (far * nu)) / r_far;
-            AtmosphereParameters param_76 = atmosphere;
-            float param_77 = r_far;
-            float param_78 = CosineAtDistance(param_71, param_72, param_73, param_74);
-            float param_79 = ClampCosine(param_75);
-            float param_80 = nu;
-            bool param_81 = ray_r_mu_intersects_ground;
-            float3 param_82;
-            float3 _4862 = GetCombinedScattering(param_76, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_77, param_78, param_79, param_80, param_81, param_82);
-            float3 unused_far_mie = param_82;
-            scattering -= (exp(-far_optical_depth) * _4862);
+            AtmosphereParameters param_61 = atmosphere;
+            float param_62 = r;
+            float param_63 = mu;
+            float param_64 = far;
+            float r_far = RadiusAtDistance(param_61, param_62, param_63, param_64);
+            float param_65 = r;
+            float param_66 = mu;
+            float param_67 = far;
+            float param_68 = r_far;
+            float param_69 = ((r * mu_s) + (far * nu)) / r_far;
+            AtmosphereParameters param_70 = atmosphere;
+            float param_71 = r_far;
+            float param_72 = CosineAtDistance(param_65, param_66, param_67, param_68);
+            float param_73 = ClampCosine(param_69);
+            float param_74 = nu;
+            bool param_75 = ray_r_mu_intersects_ground;
+            float3 param_76;
+            float3 _5192 = GetCombinedScattering(param_70, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_71, param_72, param_73, param_74, param_75, param_76);
+            float3 unused_far_mie = param_76;
+            scattering -= (far_sums.transmittance * _5192);
         }
-        float3 multiple = (fast::max(scattering - far_rayleigh, float3(0.0)) * lit_weight) / fast::max(far_weight, float3(1.0000000031710768509710513471353e-30));
-        float param_83 = nu;
-        AtmosphereParameters param_84 = atmosphere;
-        float param_85 = nu;
-        return ((single_rayleigh + multiple) * RayleighPhaseFunction(param_83)) + (single_mie * MiePhaseFunction(param_84, param_85));
+        float3 multiple = (fast::max(scattering - (far_sums.single_rayleigh * atmosphere.solar_irradiance), float3(0.0)) * lit_sums.scattering_weight) / fast::max(far_sums.scattering_weight, float3(1.0000000031710768509710513471353e-30));
+        float param_77 = nu;
+        AtmosphereParameters param_78 = atmosphere;
+        float param_79 = nu;
+        return (((lit_sums.single_rayleigh * atmosphere.solar_irradiance) + multiple) * RayleighPhaseFunction(param_77)) + ((lit_sums.single_mie * atmosphere.solar_irradiance) * MiePhaseFunction(param_78, param_79));
     }
-    AtmosphereParameters param_86 = atmosphere;
-    float param_87 = r;
-    float param_88 = mu;
-    float param_89 = lit;
-    bool param_90 = ray_r_mu_intersects_ground;
-    float3 lit_transmittance = exp(-mix(LongSegmentOpticalDepth(param_86, transmittance_texture, transmittance_textureSmplr, param_87, param_88, param_89, param_90), lit_optical_depth, float3(lit_direct)));
-    AtmosphereParameters param_91 = atmosphere;
-    float param_92 = r_p;
-    float param_93 = mu_p;
-    float param_94 = mu_s_p;
-    float param_95 = nu;
-    bool param_96 = ray_r_mu_intersects_ground;
-    float3 param_97;
-    float3 _4927 = GetCombinedScattering(param_91, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_92, param_93, param_94, param_95, param_96, param_97);
-    float3 single_mie_scattering_p = param_97;
-    float3 scattering_p = _4927;
+    AtmosphereParameters param_80 = atmosphere;
+    float param_81 = r;
+    float param_82 = mu;
+    float param_83 = lit;
+    float r_p = RadiusAtDistance(param_80, param_81, param_82, param_83);
+    float param_84 = r;
+    float param_85 = mu;
+    float param_86 = lit;
+    float param_87 = r_p;
+    float mu_p = CosineAtDistance(param_84, param_85, param_86, param_87);
+    float param_88 = ((r * mu_s) + (lit * nu)) / r_p;
+    float mu_s_p = ClampCosine(param_88);
+    AtmosphereParameters param_89 = atmosphere;
+    float param_90 = r;
+    float param_91 = mu;
+    float param_92 = lit;
+    bool param_93 = ray_r_mu_intersects_ground;
+    float3 lit_transmittance = exp(-mix(LongSegmentOpticalDepth(param_89, transmittance_texture, transmittance_textureSmplr, param_90, param_91, param_92, param_93), lit_sums.optical_depth, float3(lit_direct)));
+    AtmosphereParameters param_94 = atmosphere;
+    float param_95 = r_p;
+    float param_96 = mu_p;
+    float param_97 = mu_s_p;
+    float param_98 = nu;
+    bool param_99 = ray_r_mu_intersects_ground;
+    float3 param_100;
+    float3 _5303 = GetCombinedScattering(param_94, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_95, param_96, param_97, param_98, param_99, param_100);
+    float3 single_mie_scattering_p = param_100;
+    float3 scattering_p = _5303;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
-    single_mie_scattering = mix(single_mie_scattering, single_mie, float3(lit_direct));
-    float param_98 = nu;
-    AtmosphereParameters param_99 = atmosphere;
-    float param_100 = nu;
-    return (scattering * RayleighPhaseFunction(param_98)) + (single_mie_scattering * MiePhaseFunction(param_99, param_100));
+    single_mie_scattering = mix(single_mie_scattering, lit_sums.single_mie * atmosphere.solar_irradiance, float3(lit_direct));
+    float param_101 = nu;
+    AtmosphereParameters param_102 = atmosphere;
+    float param_103 = nu;
+    return (scattering * RayleighPhaseFunction(param_101)) + (single_mie_scattering * MiePhaseFunction(param_102, param_103));
 }
 #endif
 
@@ -2209,9 +2358,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _4971 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _5351 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _4971;
+    return _5351;
 }
 #endif
 
@@ -2241,9 +2390,9 @@ float3 GetAerialPerspectiveVoxel(thread const AtmosphereParameters& atmosphere, 
     float3 param_3 = point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5435 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
+    float3 _5814 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5435;
+    float3 radiance = _5814;
     optical_depth = -log(fast::max(transmittance, float3(1.0000000031710768509710513471353e-30)));
     return radiance;
 }
@@ -2273,16 +2422,16 @@ float3 GetSkyRadianceToPointFromVolume(texture3d<float> radiance_volume, sampler
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1501;
+    float _1543;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1501 = 0.100000001490116119384765625;
+        _1543 = 0.100000001490116119384765625;
     }
     else
     {
-        _1501 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1543 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1501;
+    return _1543;
 }
 #endif
 
@@ -2292,16 +2441,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1519;
+    float _1561;
     if (mu_s < knee)
     {
-        _1519 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1561 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1519 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1561 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1519;
+    return _1561;
 }
 #endif
 
@@ -2330,16 +2479,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1550;
+    float _1592;
     if (x < 0.5)
     {
-        _1550 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1592 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1550 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1592 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1550;
+    return _1592;
 }
 #endif
 
@@ -2367,16 +2516,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2715;
+    float4 _2757;
     if (t < 0.0)
     {
-        _2715 = fast::min(blend, a);
+        _2757 = fast::min(blend, a);
     }
     else
     {
-        _2715 = blend;
+        _2757 = blend;
     }
-    return _2715;
+    return _2757;
 }
 #endif
 
@@ -2408,18 +2557,6 @@ float3 GetIrradiance(thread const AtmosphereParameters& atmosphere, texture2d<fl
     return float3(SunBelowTableMix(param_9, param_10, param_11, param_12).xyz);
 }
 #endif
-
-static inline __attribute__((always_inline))
-float3 GetTransmittanceToSun(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu_s)
-{
-    AtmosphereParameters param = atmosphere;
-    float param_1 = r;
-    float param_2 = mu_s;
-    AtmosphereParameters param_3 = atmosphere;
-    float param_4 = r;
-    float param_5 = mu_s;
-    return GetTransmittanceToTopAtmosphereBoundary(param, transmittance_texture, transmittance_textureSmplr, param_1, param_2) * SunVisibleFraction(param_3, param_4, param_5);
-}
 
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 static inline __attribute__((always_inline))

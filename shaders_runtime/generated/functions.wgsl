@@ -55,6 +55,22 @@ struct ScatteringLookup {
     log_first_span: f32,
 }
 
+struct SegmentNode {
+    extinction: vec3<f32>,
+    rayleigh: vec3<f32>,
+    mie: vec3<f32>,
+    scattering: vec3<f32>,
+}
+
+struct SegmentSums {
+    optical_depth: vec3<f32>,
+    transmittance: vec3<f32>,
+    single_rayleigh: vec3<f32>,
+    single_mie: vec3<f32>,
+    scattering_weight: vec3<f32>,
+    end: SegmentNode,
+}
+
 const PI: f32 = 3.1415927f;
 
 const PHASE_NONE: i32 = 0i;
@@ -91,7 +107,11 @@ const SCATTERING_OWN_COLUMNS: i32 = 3i;
 
 const DIRECT_SEGMENT_LENGTH: f32 = 10000f;
 
-const SEGMENT_INTERVALS: i32 = 16i;
+const SEGMENT_INTERVALS: i32 = 64i;
+
+const SEGMENT_TOLERANCE: f32 = 0.0002f;
+
+const OPTICAL_DEPTH_INTERVALS: i32 = 16i;
 
 const SKY_VIEW_WIDTH: i32 = 192i;
 
@@ -3402,65 +3422,41 @@ fn ProfileSampleAltitude(atmosphere_116: AtmosphereParameters, i_1: i32) -> f32 
 
     atmosphere_117 = atmosphere_116;
     i_2 = i_1;
-    let _e24 = i_2;
-    x_24 = (f32(_e24) / 63f);
-    let _e32 = atmosphere_117;
-    let _e34 = atmosphere_117;
-    let _e37 = x_24;
-    let _e39 = x_24;
-    return (((_e32.top_radius - _e34.bottom_radius) * _e37) * _e39);
+    let _e25 = i_2;
+    x_24 = (f32(_e25) / 63f);
+    let _e33 = atmosphere_117;
+    let _e35 = atmosphere_117;
+    let _e38 = x_24;
+    let _e40 = x_24;
+    return (((_e33.top_radius - _e35.bottom_radius) * _e38) * _e40);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficient(a_16: f32, b_8: f32, f: f32) -> f32 {
-    var a_17: f32;
-    var b_9: f32;
+fn InterpolateCoefficients(a_16: vec3<f32>, b_8: vec3<f32>, f: f32) -> vec3<f32> {
+    var a_17: vec3<f32>;
+    var b_9: vec3<f32>;
     var f_1: f32;
-    var local_26: f32;
+    var tiny_1: vec3<f32> = vec3(0.000000000000000000000000000001f);
+    var positive: vec3<f32>;
 
     a_17 = a_16;
     b_9 = b_8;
     f_1 = f;
-    let _e26 = a_17;
-    let _e29 = b_9;
-    if ((_e26 > 0f) && (_e29 > 0f)) {
-        let _e33 = a_17;
-        let _e34 = f_1;
-        let _e35 = b_9;
-        let _e36 = a_17;
-        local_26 = (_e33 * exp((_e34 * log((_e35 / _e36)))));
-    } else {
-        let _e42 = a_17;
-        let _e43 = b_9;
-        let _e44 = f_1;
-        local_26 = mix(_e42, _e43, _e44);
-    }
-    let _e47 = local_26;
-    return _e47;
-}
-
-// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn InterpolateCoefficients(a_18: vec3<f32>, b_10: vec3<f32>, f_2: f32) -> vec3<f32> {
-    var a_19: vec3<f32>;
-    var b_11: vec3<f32>;
-    var f_3: f32;
-
-    a_19 = a_18;
-    b_11 = b_10;
-    f_3 = f_2;
-    let _e26 = a_19;
-    let _e28 = b_11;
-    let _e30 = f_3;
-    let _e31 = InterpolateCoefficient(_e26.x, _e28.x, _e30);
-    let _e32 = a_19;
-    let _e34 = b_11;
-    let _e36 = f_3;
-    let _e37 = InterpolateCoefficient(_e32.y, _e34.y, _e36);
-    let _e38 = a_19;
-    let _e40 = b_11;
-    let _e42 = f_3;
-    let _e43 = InterpolateCoefficient(_e38.z, _e40.z, _e42);
-    return vec3<f32>(_e31, _e37, _e43);
+    let _e30 = tiny_1;
+    let _e31 = a_17;
+    let _e32 = b_9;
+    positive = step(_e30, min(_e31, _e32));
+    let _e36 = a_17;
+    let _e37 = b_9;
+    let _e38 = f_1;
+    let _e41 = a_17;
+    let _e42 = f_1;
+    let _e43 = b_9;
+    let _e44 = tiny_1;
+    let _e46 = a_17;
+    let _e47 = tiny_1;
+    let _e54 = positive;
+    return mix(mix(_e36, _e37, vec3(_e38)), (_e41 * exp((_e42 * log((max(_e43, _e44) / max(_e46, _e47)))))), _e54);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3471,50 +3467,50 @@ fn GetCoefficientsAtAltitude(atmosphere_118: AtmosphereParameters, altitude: f32
     var x_25: f32;
     var i_3: i32;
     var h0_: f32;
-    var f_4: f32;
+    var f_2: f32;
 
     atmosphere_119 = atmosphere_118;
     altitude_1 = altitude;
-    let _e26 = atmosphere_119;
-    let _e28 = atmosphere_119;
-    height = (_e26.top_radius - _e28.bottom_radius);
-    let _e32 = altitude_1;
-    let _e33 = height;
-    x_25 = (sqrt(clamp((_e32 / _e33), 0f, 1f)) * 63f);
-    let _e45 = x_25;
-    i_3 = min(i32(_e45), 62i);
-    let _e52 = atmosphere_119;
-    let _e53 = i_3;
-    let _e54 = ProfileSampleAltitude(_e52, _e53);
-    h0_ = _e54;
-    let _e56 = altitude_1;
-    let _e57 = h0_;
-    let _e59 = atmosphere_119;
-    let _e60 = i_3;
-    let _e63 = ProfileSampleAltitude(_e59, (_e60 + 1i));
-    let _e64 = h0_;
-    f_4 = clamp(((_e56 - _e57) / (_e63 - _e64)), 0f, 1f);
-    let _e71 = i_3;
-    let _e74 = atmosphere_119.mie_scattering_profile[_e71];
-    let _e75 = i_3;
-    let _e80 = atmosphere_119.mie_scattering_profile[(_e75 + 1i)];
-    let _e81 = f_4;
-    let _e82 = InterpolateCoefficients(_e74, _e80, _e81);
-    (*mie_scattering) = _e82;
-    let _e83 = i_3;
-    let _e86 = atmosphere_119.rayleigh_scattering_profile[_e83];
-    let _e87 = i_3;
-    let _e92 = atmosphere_119.rayleigh_scattering_profile[(_e87 + 1i)];
-    let _e93 = f_4;
-    let _e94 = InterpolateCoefficients(_e86, _e92, _e93);
-    (*rayleigh_scattering) = _e94;
-    let _e95 = i_3;
-    let _e98 = atmosphere_119.extinction_profile[_e95];
-    let _e99 = i_3;
-    let _e104 = atmosphere_119.extinction_profile[(_e99 + 1i)];
-    let _e105 = f_4;
-    let _e106 = InterpolateCoefficients(_e98, _e104, _e105);
-    return _e106;
+    let _e27 = atmosphere_119;
+    let _e29 = atmosphere_119;
+    height = (_e27.top_radius - _e29.bottom_radius);
+    let _e33 = altitude_1;
+    let _e34 = height;
+    x_25 = (sqrt(clamp((_e33 / _e34), 0f, 1f)) * 63f);
+    let _e46 = x_25;
+    i_3 = min(i32(_e46), 62i);
+    let _e53 = atmosphere_119;
+    let _e54 = i_3;
+    let _e55 = ProfileSampleAltitude(_e53, _e54);
+    h0_ = _e55;
+    let _e57 = altitude_1;
+    let _e58 = h0_;
+    let _e60 = atmosphere_119;
+    let _e61 = i_3;
+    let _e64 = ProfileSampleAltitude(_e60, (_e61 + 1i));
+    let _e65 = h0_;
+    f_2 = clamp(((_e57 - _e58) / (_e64 - _e65)), 0f, 1f);
+    let _e72 = i_3;
+    let _e75 = atmosphere_119.mie_scattering_profile[_e72];
+    let _e76 = i_3;
+    let _e81 = atmosphere_119.mie_scattering_profile[(_e76 + 1i)];
+    let _e82 = f_2;
+    let _e83 = InterpolateCoefficients(_e75, _e81, _e82);
+    (*mie_scattering) = _e83;
+    let _e84 = i_3;
+    let _e87 = atmosphere_119.rayleigh_scattering_profile[_e84];
+    let _e88 = i_3;
+    let _e93 = atmosphere_119.rayleigh_scattering_profile[(_e88 + 1i)];
+    let _e94 = f_2;
+    let _e95 = InterpolateCoefficients(_e87, _e93, _e94);
+    (*rayleigh_scattering) = _e95;
+    let _e96 = i_3;
+    let _e99 = atmosphere_119.extinction_profile[_e96];
+    let _e100 = i_3;
+    let _e105 = atmosphere_119.extinction_profile[(_e100 + 1i)];
+    let _e106 = f_2;
+    let _e107 = InterpolateCoefficients(_e99, _e105, _e106);
+    return _e107;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3530,15 +3526,15 @@ fn AltitudeAtDistance(atmosphere_120: AtmosphereParameters, r_65: f32, mu_48: f3
     mu_49 = mu_48;
     t_12 = t_11;
     r_t_1 = r_t;
-    let _e30 = r_66;
-    let _e31 = atmosphere_121;
-    let _e34 = t_12;
+    let _e31 = r_66;
+    let _e32 = atmosphere_121;
     let _e35 = t_12;
-    let _e37 = r_66;
-    let _e39 = mu_49;
-    let _e43 = r_t_1;
-    let _e44 = r_66;
-    return ((_e30 - _e31.bottom_radius) + ((_e34 * (_e35 + ((2f * _e37) * _e39))) / (_e43 + _e44)));
+    let _e36 = t_12;
+    let _e38 = r_66;
+    let _e40 = mu_49;
+    let _e44 = r_t_1;
+    let _e45 = r_66;
+    return ((_e31 - _e32.bottom_radius) + ((_e35 * (_e36 + ((2f * _e38) * _e40))) / (_e44 + _e45)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3561,50 +3557,50 @@ fn IntegrateSegmentOpticalDepth(atmosphere_122: AtmosphereParameters, r_67: f32,
     r_68 = r_67;
     mu_51 = mu_50;
     d_25 = d_24;
-    let _e28 = d_25;
-    dt = (_e28 / 16f);
+    let _e30 = d_25;
+    dt = (_e30 / 16f);
     loop {
-        let _e41 = k_5;
-        if !((_e41 <= SEGMENT_INTERVALS)) {
+        let _e43 = k_5;
+        if !((_e43 <= OPTICAL_DEPTH_INTERVALS)) {
             break;
         }
         {
-            let _e47 = dt;
-            let _e48 = k_5;
-            t_13 = (_e47 * f32(_e48));
-            let _e52 = atmosphere_123;
-            let _e53 = r_68;
-            let _e54 = mu_51;
-            let _e55 = t_13;
-            let _e56 = RadiusAtDistance(_e52, _e53, _e54, _e55);
-            r_t_2 = _e56;
-            let _e60 = atmosphere_123;
-            let _e61 = atmosphere_123;
-            let _e62 = r_68;
-            let _e63 = mu_51;
-            let _e64 = t_13;
-            let _e65 = r_t_2;
-            let _e66 = AltitudeAtDistance(_e61, _e62, _e63, _e64, _e65);
-            let _e71 = GetCoefficientsAtAltitude(_e60, _e66, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e71;
-            let _e73 = k_5;
-            if (_e73 > 0i) {
-                let _e76 = optical_depth;
-                let _e77 = previous_extinction;
-                let _e78 = extinction;
-                let _e81 = dt;
-                optical_depth = (_e76 + ((_e77 + _e78) * (0.5f * _e81)));
+            let _e49 = dt;
+            let _e50 = k_5;
+            t_13 = (_e49 * f32(_e50));
+            let _e54 = atmosphere_123;
+            let _e55 = r_68;
+            let _e56 = mu_51;
+            let _e57 = t_13;
+            let _e58 = RadiusAtDistance(_e54, _e55, _e56, _e57);
+            r_t_2 = _e58;
+            let _e62 = atmosphere_123;
+            let _e63 = atmosphere_123;
+            let _e64 = r_68;
+            let _e65 = mu_51;
+            let _e66 = t_13;
+            let _e67 = r_t_2;
+            let _e68 = AltitudeAtDistance(_e63, _e64, _e65, _e66, _e67);
+            let _e73 = GetCoefficientsAtAltitude(_e62, _e68, (&mie_scattering_1), (&rayleigh_scattering_1));
+            extinction = _e73;
+            let _e75 = k_5;
+            if (_e75 > 0i) {
+                let _e78 = optical_depth;
+                let _e79 = previous_extinction;
+                let _e80 = extinction;
+                let _e83 = dt;
+                optical_depth = (_e78 + ((_e79 + _e80) * (0.5f * _e83)));
             }
-            let _e85 = extinction;
-            previous_extinction = _e85;
+            let _e87 = extinction;
+            previous_extinction = _e87;
         }
         continuing {
-            let _e44 = k_5;
-            k_5 = (_e44 + 1i);
+            let _e46 = k_5;
+            k_5 = (_e46 + 1i);
         }
     }
-    let _e86 = optical_depth;
-    return _e86;
+    let _e88 = optical_depth;
+    return _e88;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3614,212 +3610,505 @@ fn LongSegmentOpticalDepth(atmosphere_124: AtmosphereParameters, transmittance_t
     var mu_53: f32;
     var d_27: f32;
     var ray_r_mu_intersects_ground_33: bool;
-    var local_27: vec3<f32>;
+    var local_26: vec3<f32>;
 
     atmosphere_125 = atmosphere_124;
     r_70 = r_69;
     mu_53 = mu_52;
     d_27 = d_26;
     ray_r_mu_intersects_ground_33 = ray_r_mu_intersects_ground_32;
-    let _e31 = atmosphere_125;
-    if (_e31.transmittance_is_colour != 0i) {
-        let _e35 = atmosphere_125;
-        let _e36 = r_70;
-        let _e37 = mu_53;
-        let _e38 = d_27;
-        let _e39 = IntegrateSegmentOpticalDepth(_e35, _e36, _e37, _e38);
-        local_27 = _e39;
+    let _e33 = atmosphere_125;
+    if (_e33.transmittance_is_colour != 0i) {
+        let _e37 = atmosphere_125;
+        let _e38 = r_70;
+        let _e39 = mu_53;
+        let _e40 = d_27;
+        let _e41 = IntegrateSegmentOpticalDepth(_e37, _e38, _e39, _e40);
+        local_26 = _e41;
     } else {
-        let _e40 = atmosphere_125;
-        let _e41 = r_70;
-        let _e42 = mu_53;
-        let _e43 = d_27;
-        let _e44 = ray_r_mu_intersects_ground_33;
-        let _e45 = GetOpticalDepth(_e40, transmittance_texture_6, _e41, _e42, _e43, _e44);
-        local_27 = _e45;
+        let _e42 = atmosphere_125;
+        let _e43 = r_70;
+        let _e44 = mu_53;
+        let _e45 = d_27;
+        let _e46 = ray_r_mu_intersects_ground_33;
+        let _e47 = GetOpticalDepth(_e42, transmittance_texture_6, _e43, _e44, _e45, _e46);
+        local_26 = _e47;
     }
-    let _e47 = local_27;
-    return _e47;
+    let _e49 = local_26;
+    return _e49;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn MeanAttenuation(depth: f32) -> f32 {
-    var depth_1: f32;
-    var local_28: f32;
+fn MeanAttenuation(depth: vec3<f32>, attenuation: vec3<f32>) -> vec3<f32> {
+    var depth_1: vec3<f32>;
+    var attenuation_1: vec3<f32>;
 
     depth_1 = depth;
-    let _e22 = depth_1;
-    if (_e22 < 0.0001f) {
-        let _e27 = depth_1;
-        local_28 = (1f - (0.5f * _e27));
-    } else {
-        let _e31 = depth_1;
-        let _e35 = depth_1;
-        local_28 = ((1f - exp(-(_e31))) / _e35);
-    }
-    let _e38 = local_28;
-    return _e38;
+    attenuation_1 = attenuation;
+    let _e28 = attenuation_1;
+    let _e30 = depth_1;
+    let _e38 = depth_1;
+    let _e45 = depth_1;
+    return mix(((vec3(1f) - _e28) / max(_e30, vec3(0.000000000000000000000000000001f))), (vec3(1f) - (0.5f * _e38)), (vec3(1f) - step(vec3(0.0001f), _e45)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegment(atmosphere_126: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_42: f32, nu_26: f32, d_28: f32, single_rayleigh: ptr<function, vec3<f32>>, single_mie: ptr<function, vec3<f32>>, scattering_weight: ptr<function, vec3<f32>>) -> vec3<f32> {
+fn GetSegmentNode(atmosphere_126: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_42: f32, nu_26: f32, t_14: f32) -> SegmentNode {
     var atmosphere_127: AtmosphereParameters;
     var r_72: f32;
     var mu_55: f32;
     var mu_s_43: f32;
     var nu_27: f32;
-    var d_29: f32;
-    var dt_1: f32;
-    var optical_depth_1: vec3<f32> = vec3(0f);
-    var previous_extinction_1: vec3<f32> = vec3(0f);
-    var previous_rayleigh: vec3<f32> = vec3(0f);
-    var previous_mie: vec3<f32> = vec3(0f);
-    var previous_scattering: vec3<f32> = vec3(0f);
-    var k_6: i32 = 0i;
-    var t_14: f32;
+    var t_15: f32;
+    var node: SegmentNode;
     var r_t_3: f32;
-    var altitude_2: f32;
     var mu_s_t_1: f32;
     var mie_scattering_2: vec3<f32>;
     var rayleigh_scattering_2: vec3<f32>;
-    var extinction_1: vec3<f32>;
     var sunlight: vec3<f32>;
-    var rayleigh: vec3<f32>;
-    var mie: vec3<f32>;
-    var scattering_2: vec3<f32>;
-    var interval_depth: vec3<f32>;
-    var start_transmittance: vec3<f32>;
-    var mean_transmittance: vec3<f32>;
 
     atmosphere_127 = atmosphere_126;
     r_72 = r_71;
     mu_55 = mu_54;
     mu_s_43 = mu_s_42;
     nu_27 = nu_26;
-    d_29 = d_28;
-    let _e36 = d_29;
-    dt_1 = (_e36 / 16f);
-    (*single_rayleigh) = vec3(0f);
-    (*single_mie) = vec3(0f);
-    (*scattering_weight) = vec3(0f);
-    loop {
-        let _e64 = k_6;
-        if !((_e64 <= SEGMENT_INTERVALS)) {
-            break;
-        }
-        {
-            let _e70 = dt_1;
-            let _e71 = k_6;
-            t_14 = (_e70 * f32(_e71));
-            let _e75 = atmosphere_127;
-            let _e76 = r_72;
-            let _e77 = mu_55;
-            let _e78 = t_14;
-            let _e79 = RadiusAtDistance(_e75, _e76, _e77, _e78);
-            r_t_3 = _e79;
-            let _e81 = atmosphere_127;
-            let _e82 = r_72;
-            let _e83 = mu_55;
-            let _e84 = t_14;
-            let _e85 = r_t_3;
-            let _e86 = AltitudeAtDistance(_e81, _e82, _e83, _e84, _e85);
-            altitude_2 = _e86;
-            let _e88 = r_72;
-            let _e89 = mu_s_43;
-            let _e91 = t_14;
-            let _e92 = nu_27;
-            let _e95 = r_t_3;
-            let _e97 = ClampCosine((((_e88 * _e89) + (_e91 * _e92)) / _e95));
-            mu_s_t_1 = _e97;
-            let _e101 = atmosphere_127;
-            let _e102 = altitude_2;
-            let _e107 = GetCoefficientsAtAltitude(_e101, _e102, (&mie_scattering_2), (&rayleigh_scattering_2));
-            extinction_1 = _e107;
-            let _e109 = atmosphere_127;
-            let _e110 = r_t_3;
-            let _e111 = mu_s_t_1;
-            let _e112 = GetOpticalDepthToTopAtmosphereBoundary(_e109, transmittance_texture_7, _e110, _e111);
-            let _e115 = atmosphere_127;
-            let _e116 = r_t_3;
-            let _e117 = mu_s_t_1;
-            let _e118 = SunVisibleFraction(_e115, _e116, _e117);
-            sunlight = (exp(-(_e112)) * _e118);
-            let _e121 = rayleigh_scattering_2;
-            let _e122 = sunlight;
-            rayleigh = (_e121 * _e122);
-            let _e125 = mie_scattering_2;
-            let _e126 = sunlight;
-            mie = (_e125 * _e126);
-            let _e129 = rayleigh_scattering_2;
-            let _e130 = mie_scattering_2;
-            scattering_2 = (_e129 + _e130);
-            let _e133 = k_6;
-            if (_e133 > 0i) {
-                {
-                    let _e136 = previous_extinction_1;
-                    let _e137 = extinction_1;
-                    let _e140 = dt_1;
-                    interval_depth = ((_e136 + _e137) * (0.5f * _e140));
-                    let _e144 = optical_depth_1;
-                    start_transmittance = exp(-(_e144));
-                    let _e148 = start_transmittance;
-                    let _e149 = interval_depth;
-                    let _e151 = MeanAttenuation(_e149.x);
-                    let _e152 = interval_depth;
-                    let _e154 = MeanAttenuation(_e152.y);
-                    let _e155 = interval_depth;
-                    let _e157 = MeanAttenuation(_e155.z);
-                    mean_transmittance = (_e148 * vec3<f32>(_e151, _e154, _e157));
-                    let _e161 = (*single_rayleigh);
-                    let _e162 = previous_rayleigh;
-                    let _e163 = rayleigh;
-                    let _e166 = dt_1;
-                    let _e169 = mean_transmittance;
-                    (*single_rayleigh) = (_e161 + (((_e162 + _e163) * (0.5f * _e166)) * _e169));
-                    let _e172 = (*single_mie);
-                    let _e173 = previous_mie;
-                    let _e174 = mie;
-                    let _e177 = dt_1;
-                    let _e180 = mean_transmittance;
-                    (*single_mie) = (_e172 + (((_e173 + _e174) * (0.5f * _e177)) * _e180));
-                    let _e183 = (*scattering_weight);
-                    let _e184 = previous_scattering;
-                    let _e185 = scattering_2;
-                    let _e188 = dt_1;
-                    let _e191 = mean_transmittance;
-                    (*scattering_weight) = (_e183 + (((_e184 + _e185) * (0.5f * _e188)) * _e191));
-                    let _e194 = optical_depth_1;
-                    let _e195 = interval_depth;
-                    optical_depth_1 = (_e194 + _e195);
-                }
-            }
-            let _e197 = extinction_1;
-            previous_extinction_1 = _e197;
-            let _e198 = rayleigh;
-            previous_rayleigh = _e198;
-            let _e199 = mie;
-            previous_mie = _e199;
-            let _e200 = scattering_2;
-            previous_scattering = _e200;
-        }
-        continuing {
-            let _e67 = k_6;
-            k_6 = (_e67 + 1i);
-        }
-    }
-    let _e201 = (*single_rayleigh);
-    let _e202 = atmosphere_127;
-    (*single_rayleigh) = (_e201 * _e202.solar_irradiance);
-    let _e205 = (*single_mie);
-    let _e206 = atmosphere_127;
-    (*single_mie) = (_e205 * _e206.solar_irradiance);
-    let _e209 = optical_depth_1;
-    return _e209;
+    t_15 = t_14;
+    let _e36 = atmosphere_127;
+    let _e37 = r_72;
+    let _e38 = mu_55;
+    let _e39 = t_15;
+    let _e40 = RadiusAtDistance(_e36, _e37, _e38, _e39);
+    r_t_3 = _e40;
+    let _e42 = r_72;
+    let _e43 = mu_s_43;
+    let _e45 = t_15;
+    let _e46 = nu_27;
+    let _e49 = r_t_3;
+    let _e51 = ClampCosine((((_e42 * _e43) + (_e45 * _e46)) / _e49));
+    mu_s_t_1 = _e51;
+    let _e56 = atmosphere_127;
+    let _e57 = atmosphere_127;
+    let _e58 = r_72;
+    let _e59 = mu_55;
+    let _e60 = t_15;
+    let _e61 = r_t_3;
+    let _e62 = AltitudeAtDistance(_e57, _e58, _e59, _e60, _e61);
+    let _e67 = GetCoefficientsAtAltitude(_e56, _e62, (&mie_scattering_2), (&rayleigh_scattering_2));
+    node.extinction = _e67;
+    let _e68 = atmosphere_127;
+    let _e69 = r_t_3;
+    let _e70 = mu_s_t_1;
+    let _e71 = GetTransmittanceToSun(_e68, transmittance_texture_7, _e69, _e70);
+    sunlight = _e71;
+    let _e74 = rayleigh_scattering_2;
+    let _e75 = sunlight;
+    node.rayleigh = (_e74 * _e75);
+    let _e78 = mie_scattering_2;
+    let _e79 = sunlight;
+    node.mie = (_e78 * _e79);
+    let _e82 = rayleigh_scattering_2;
+    let _e83 = mie_scattering_2;
+    node.scattering = (_e82 + _e83);
+    let _e85 = node;
+    return _e85;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+fn StartSegment(atmosphere_128: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, r_73: f32, mu_56: f32, mu_s_44: f32, nu_28: f32, t_16: f32) -> SegmentSums {
     var atmosphere_129: AtmosphereParameters;
+    var r_74: f32;
+    var mu_57: f32;
+    var mu_s_45: f32;
+    var nu_29: f32;
+    var t_17: f32;
+    var sums: SegmentSums;
+
+    atmosphere_129 = atmosphere_128;
+    r_74 = r_73;
+    mu_57 = mu_56;
+    mu_s_45 = mu_s_44;
+    nu_29 = nu_28;
+    t_17 = t_16;
+    sums.optical_depth = vec3(0f);
+    sums.transmittance = vec3(1f);
+    sums.single_rayleigh = vec3(0f);
+    sums.single_mie = vec3(0f);
+    sums.scattering_weight = vec3(0f);
+    let _e52 = atmosphere_129;
+    let _e53 = r_74;
+    let _e54 = mu_57;
+    let _e55 = mu_s_45;
+    let _e56 = nu_29;
+    let _e57 = t_17;
+    let _e58 = GetSegmentNode(_e52, transmittance_texture_8, _e53, _e54, _e55, _e56, _e57);
+    sums.end = _e58;
+    let _e59 = sums;
+    return _e59;
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn SegmentCurvature(a_18: vec3<f32>, m: vec3<f32>, b_10: vec3<f32>) -> vec3<f32> {
+    var a_19: vec3<f32>;
+    var m_1: vec3<f32>;
+    var b_11: vec3<f32>;
+
+    a_19 = a_18;
+    m_1 = m;
+    b_11 = b_10;
+    let _e28 = a_19;
+    let _e29 = b_11;
+    let _e32 = m_1;
+    let _e36 = a_19;
+    let _e37 = b_11;
+    let _e40 = m_1;
+    return (abs(((_e28 + _e29) - (2f * _e32))) / max(((_e36 + _e37) + (2f * _e40)), vec3(0.000000000000000000000000000001f)));
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn SegmentRatio(a_20: vec3<f32>, m_2: vec3<f32>, b_12: vec3<f32>) -> vec3<f32> {
+    var a_21: vec3<f32>;
+    var m_3: vec3<f32>;
+    var b_13: vec3<f32>;
+
+    a_21 = a_20;
+    m_3 = m_2;
+    b_13 = b_12;
+    let _e28 = a_21;
+    let _e29 = m_3;
+    let _e31 = b_13;
+    let _e33 = a_21;
+    let _e34 = m_3;
+    let _e36 = b_13;
+    return (max(max(_e28, _e29), _e31) / max(min(min(_e33, _e34), _e36), vec3(0.000000000000000000000000000001f)));
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn LargestComponent(v: vec3<f32>) -> f32 {
+    var v_1: vec3<f32>;
+
+    v_1 = v;
+    let _e24 = v_1;
+    let _e26 = v_1;
+    let _e29 = v_1;
+    return max(max(_e24.x, _e26.y), _e29.z);
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn SegmentIntervals(a_22: SegmentNode, m_4: SegmentNode, b_14: SegmentNode, L: f32) -> i32 {
+    var a_23: SegmentNode;
+    var m_5: SegmentNode;
+    var b_15: SegmentNode;
+    var L_1: f32;
+    var to_middle: vec3<f32>;
+    var to_end: vec3<f32>;
+    var rayleigh_m: vec3<f32>;
+    var rayleigh_b: vec3<f32>;
+    var mie_m: vec3<f32>;
+    var mie_b: vec3<f32>;
+    var scattering_m: vec3<f32>;
+    var scattering_b: vec3<f32>;
+    var e: f32;
+    var F: f32;
+    var n: f32;
+
+    a_23 = a_22;
+    m_5 = m_4;
+    b_15 = b_14;
+    L_1 = L;
+    let _e30 = a_23;
+    let _e32 = m_5;
+    let _e37 = L_1;
+    to_middle = exp((-((_e30.extinction + _e32.extinction)) * (0.25f * _e37)));
+    let _e42 = to_middle;
+    let _e43 = m_5;
+    let _e45 = b_15;
+    let _e50 = L_1;
+    to_end = (_e42 * exp((-((_e43.extinction + _e45.extinction)) * (0.25f * _e50))));
+    let _e56 = m_5;
+    let _e58 = to_middle;
+    rayleigh_m = (_e56.rayleigh * _e58);
+    let _e61 = b_15;
+    let _e63 = to_end;
+    rayleigh_b = (_e61.rayleigh * _e63);
+    let _e66 = m_5;
+    let _e68 = to_middle;
+    mie_m = (_e66.mie * _e68);
+    let _e71 = b_15;
+    let _e73 = to_end;
+    mie_b = (_e71.mie * _e73);
+    let _e76 = m_5;
+    let _e78 = to_middle;
+    scattering_m = (_e76.scattering * _e78);
+    let _e81 = b_15;
+    let _e83 = to_end;
+    scattering_b = (_e81.scattering * _e83);
+    let _e86 = a_23;
+    let _e88 = m_5;
+    let _e90 = b_15;
+    let _e92 = SegmentCurvature(_e86.extinction, _e88.extinction, _e90.extinction);
+    let _e93 = a_23;
+    let _e95 = rayleigh_m;
+    let _e96 = rayleigh_b;
+    let _e97 = SegmentCurvature(_e93.rayleigh, _e95, _e96);
+    let _e99 = a_23;
+    let _e101 = mie_m;
+    let _e102 = mie_b;
+    let _e103 = SegmentCurvature(_e99.mie, _e101, _e102);
+    let _e104 = a_23;
+    let _e106 = scattering_m;
+    let _e107 = scattering_b;
+    let _e108 = SegmentCurvature(_e104.scattering, _e106, _e107);
+    let _e111 = LargestComponent(max(max(_e92, _e97), max(_e103, _e108)));
+    e = _e111;
+    let _e113 = a_23;
+    let _e115 = m_5;
+    let _e117 = b_15;
+    let _e119 = SegmentRatio(_e113.extinction, _e115.extinction, _e117.extinction);
+    let _e120 = a_23;
+    let _e122 = rayleigh_m;
+    let _e123 = rayleigh_b;
+    let _e124 = SegmentRatio(_e120.rayleigh, _e122, _e123);
+    let _e126 = a_23;
+    let _e128 = mie_m;
+    let _e129 = mie_b;
+    let _e130 = SegmentRatio(_e126.mie, _e128, _e129);
+    let _e131 = a_23;
+    let _e133 = scattering_m;
+    let _e134 = scattering_b;
+    let _e135 = SegmentRatio(_e131.scattering, _e133, _e134);
+    let _e138 = LargestComponent(max(max(_e119, _e124), max(_e130, _e135)));
+    F = _e138;
+    let _e140 = e;
+    let _e146 = F;
+    n = max(sqrt((_e140 / 0.00014999999f)), (log(max(_e146, 1f)) / 0.048989795f));
+    let _e159 = n;
+    return (2i * i32(clamp(ceil((0.5f * _e159)), 1f, 32f)));
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn ContinueSegment(atmosphere_130: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, r_75: f32, mu_58: f32, mu_s_46: f32, nu_30: f32, t0_: f32, t1_: f32, sums_1: SegmentSums) -> SegmentSums {
+    var atmosphere_131: AtmosphereParameters;
+    var r_76: f32;
+    var mu_59: f32;
+    var mu_s_47: f32;
+    var nu_31: f32;
+    var t0_1: f32;
+    var t1_1: f32;
+    var sums_2: SegmentSums;
+    var result: SegmentSums;
+    var last_2: SegmentNode;
+    var middle: SegmentNode;
+    var previous: SegmentNode;
+    var short_stretch: bool;
+    var local_27: i32;
+    var intervals_1: i32;
+    var dt_1: f32;
+    var local_28: i32;
+    var i_4: i32;
+    var finding_last: bool;
+    var finding_middle: bool;
+    var k_6: i32;
+    var node_1: SegmentNode;
+    var local_29: f32;
+    var local_30: f32;
+    var t_18: f32;
+    var interval_depth: vec3<f32>;
+    var attenuation_2: vec3<f32>;
+    var mean_transmittance: vec3<f32>;
+
+    atmosphere_131 = atmosphere_130;
+    r_76 = r_75;
+    mu_59 = mu_58;
+    mu_s_47 = mu_s_46;
+    nu_31 = nu_30;
+    t0_1 = t0_;
+    t1_1 = t1_;
+    sums_2 = sums_1;
+    let _e39 = sums_2;
+    result = _e39;
+    let _e41 = t1_1;
+    let _e42 = t0_1;
+    if (_e41 <= _e42) {
+        let _e44 = result;
+        return _e44;
+    }
+    let _e45 = sums_2;
+    last_2 = _e45.end;
+    let _e48 = sums_2;
+    middle = _e48.end;
+    let _e51 = sums_2;
+    previous = _e51.end;
+    let _e54 = t1_1;
+    let _e55 = t0_1;
+    let _e58 = t1_1;
+    short_stretch = ((_e54 - _e55) <= (0.01f * _e58));
+    let _e62 = short_stretch;
+    if _e62 {
+        local_27 = 1i;
+    } else {
+        local_27 = 2i;
+    }
+    let _e66 = local_27;
+    intervals_1 = _e66;
+    let _e68 = t1_1;
+    let _e69 = t0_1;
+    let _e71 = intervals_1;
+    dt_1 = ((_e68 - _e69) / f32(_e71));
+    let _e75 = short_stretch;
+    if _e75 {
+        local_28 = -1i;
+    } else {
+        local_28 = -2i;
+    }
+    let _e81 = local_28;
+    i_4 = _e81;
+    loop {
+        let _e83 = i_4;
+        let _e84 = intervals_1;
+        if !((_e83 < _e84)) {
+            break;
+        }
+        {
+            let _e90 = i_4;
+            let _e94 = i_4;
+            let _e98 = short_stretch;
+            finding_last = ((_e90 == -2i) || ((_e94 == -1i) && _e98));
+            let _e102 = i_4;
+            let _e106 = short_stretch;
+            finding_middle = ((_e102 == -1i) && !(_e106));
+            let _e110 = i_4;
+            k_6 = (_e110 + 1i);
+            let _e114 = last_2;
+            node_1 = _e114;
+            let _e116 = finding_last;
+            let _e117 = finding_middle;
+            let _e119 = k_6;
+            let _e120 = intervals_1;
+            let _e123 = k_6;
+            let _e125 = intervals_1;
+            if ((_e116 || _e117) || ((_e119 < _e120) && ((2i * _e123) != _e125))) {
+                {
+                    let _e129 = finding_last;
+                    if _e129 {
+                        let _e130 = t1_1;
+                        local_30 = _e130;
+                    } else {
+                        let _e131 = finding_middle;
+                        if _e131 {
+                            let _e133 = t0_1;
+                            let _e134 = t1_1;
+                            local_29 = (0.5f * (_e133 + _e134));
+                        } else {
+                            let _e137 = t0_1;
+                            let _e138 = dt_1;
+                            let _e139 = k_6;
+                            local_29 = (_e137 + (_e138 * f32(_e139)));
+                        }
+                        let _e144 = local_29;
+                        local_30 = _e144;
+                    }
+                    let _e146 = local_30;
+                    t_18 = _e146;
+                    let _e148 = atmosphere_131;
+                    let _e149 = r_76;
+                    let _e150 = mu_59;
+                    let _e151 = mu_s_47;
+                    let _e152 = nu_31;
+                    let _e153 = t_18;
+                    let _e154 = GetSegmentNode(_e148, transmittance_texture_9, _e149, _e150, _e151, _e152, _e153);
+                    node_1 = _e154;
+                }
+            } else {
+                let _e156 = k_6;
+                let _e158 = intervals_1;
+                if ((2i * _e156) == _e158) {
+                    {
+                        let _e160 = middle;
+                        node_1 = _e160;
+                    }
+                }
+            }
+            let _e161 = finding_last;
+            if _e161 {
+                {
+                    let _e162 = node_1;
+                    last_2 = _e162;
+                }
+            } else {
+                let _e163 = finding_middle;
+                if _e163 {
+                    {
+                        let _e164 = node_1;
+                        middle = _e164;
+                        let _e165 = sums_2;
+                        let _e167 = middle;
+                        let _e168 = last_2;
+                        let _e169 = t1_1;
+                        let _e170 = t0_1;
+                        let _e172 = SegmentIntervals(_e165.end, _e167, _e168, (_e169 - _e170));
+                        intervals_1 = _e172;
+                        let _e173 = t1_1;
+                        let _e174 = t0_1;
+                        let _e176 = intervals_1;
+                        dt_1 = ((_e173 - _e174) / f32(_e176));
+                    }
+                } else {
+                    {
+                        let _e179 = previous;
+                        let _e181 = node_1;
+                        let _e185 = dt_1;
+                        interval_depth = ((_e179.extinction + _e181.extinction) * (0.5f * _e185));
+                        let _e189 = interval_depth;
+                        attenuation_2 = exp(-(_e189));
+                        let _e193 = result;
+                        let _e195 = interval_depth;
+                        let _e196 = attenuation_2;
+                        let _e197 = MeanAttenuation(_e195, _e196);
+                        mean_transmittance = (_e193.transmittance * _e197);
+                        let _e201 = result;
+                        let _e203 = previous;
+                        let _e205 = node_1;
+                        let _e209 = dt_1;
+                        let _e212 = mean_transmittance;
+                        result.single_rayleigh = (_e201.single_rayleigh + (((_e203.rayleigh + _e205.rayleigh) * (0.5f * _e209)) * _e212));
+                        let _e216 = result;
+                        let _e218 = previous;
+                        let _e220 = node_1;
+                        let _e224 = dt_1;
+                        let _e227 = mean_transmittance;
+                        result.single_mie = (_e216.single_mie + (((_e218.mie + _e220.mie) * (0.5f * _e224)) * _e227));
+                        let _e231 = result;
+                        let _e233 = previous;
+                        let _e235 = node_1;
+                        let _e239 = dt_1;
+                        let _e242 = mean_transmittance;
+                        result.scattering_weight = (_e231.scattering_weight + (((_e233.scattering + _e235.scattering) * (0.5f * _e239)) * _e242));
+                        let _e246 = result;
+                        let _e248 = interval_depth;
+                        result.optical_depth = (_e246.optical_depth + _e248);
+                        let _e251 = result;
+                        let _e253 = attenuation_2;
+                        result.transmittance = (_e251.transmittance * _e253);
+                        let _e255 = node_1;
+                        previous = _e255;
+                    }
+                }
+            }
+        }
+        continuing {
+            let _e87 = i_4;
+            i_4 = (_e87 + 1i);
+        }
+    }
+    let _e257 = last_2;
+    result.end = _e257;
+    let _e258 = result;
+    return _e258;
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn GetSkyRadianceToPointWithShadow(atmosphere_132: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_133: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -3827,403 +4116,408 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_73: f32;
-    var mu_56: f32;
-    var mu_s_44: f32;
-    var nu_28: f32;
-    var d_30: f32;
+    var r_77: f32;
+    var mu_60: f32;
+    var mu_s_48: f32;
+    var nu_32: f32;
+    var d_28: f32;
     var lit: f32;
     var ray_r_mu_intersects_ground_34: bool;
-    var r_p: f32;
-    var mu_p: f32;
-    var mu_s_p: f32;
     var direct: f32;
     var lit_direct: f32;
-    var single_rayleigh_1: vec3<f32> = vec3(0f);
-    var single_mie_1: vec3<f32> = vec3(0f);
-    var lit_weight: vec3<f32> = vec3(0f);
-    var lit_optical_depth: vec3<f32> = vec3(0f);
-    var optical_depth_2: vec3<f32>;
-    var unused_rayleigh: vec3<f32>;
-    var unused_mie: vec3<f32>;
-    var unused_weight: vec3<f32>;
+    var lit_sums: SegmentSums;
+    var optical_depth_1: vec3<f32>;
     var single_mie_scattering_2: vec3<f32>;
-    var scattering_3: vec3<f32>;
+    var scattering_2: vec3<f32>;
     var boundary: f32;
     var far: f32;
-    var far_rayleigh: vec3<f32>;
-    var far_mie: vec3<f32>;
-    var far_weight: vec3<f32>;
-    var far_optical_depth: vec3<f32>;
+    var far_sums: SegmentSums;
     var r_far: f32;
     var unused_far_mie: vec3<f32>;
     var multiple: vec3<f32>;
+    var r_p: f32;
+    var mu_p: f32;
+    var mu_s_p: f32;
     var lit_transmittance: vec3<f32>;
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_129 = atmosphere_128;
+    atmosphere_133 = atmosphere_132;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
     sun_direction_5 = sun_direction_4;
-    let _e34 = point_1;
-    let _e35 = camera_7;
-    camera_to_point = (_e34 - _e35);
-    let _e38 = camera_to_point;
-    let _e39 = camera_to_point;
-    if (dot(_e38, _e39) == 0f) {
+    let _e36 = point_1;
+    let _e37 = camera_7;
+    camera_to_point = (_e36 - _e37);
+    let _e40 = camera_to_point;
+    let _e41 = camera_to_point;
+    if (dot(_e40, _e41) == 0f) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e47 = camera_to_point;
-    view_ray_6 = normalize(_e47);
-    let _e55 = atmosphere_129;
-    let _e56 = camera_7;
-    let _e57 = view_ray_6;
-    let _e58 = sun_direction_5;
-    let _e69 = GetViewRayStart(_e55, _e56, _e57, _e58, (&start_3), (&r_73), (&mu_56), (&mu_s_44), (&nu_28));
-    if !(_e69) {
+    let _e49 = camera_to_point;
+    view_ray_6 = normalize(_e49);
+    let _e57 = atmosphere_133;
+    let _e58 = camera_7;
+    let _e59 = view_ray_6;
+    let _e60 = sun_direction_5;
+    let _e71 = GetViewRayStart(_e57, _e58, _e59, _e60, (&start_3), (&r_77), (&mu_60), (&mu_s_48), (&nu_32));
+    if !(_e71) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e75 = point_1;
-    let _e76 = start_3;
-    d_30 = max(length((_e75 - _e76)), 0f);
-    let _e82 = d_30;
-    let _e83 = shadow_length_1;
-    lit = max((_e82 - max(_e83, 0f)), 0f);
-    let _e90 = atmosphere_129;
-    let _e91 = r_73;
-    let _e92 = mu_56;
-    let _e93 = RayIntersectsGround(_e90, _e91, _e92);
-    ray_r_mu_intersects_ground_34 = _e93;
-    let _e95 = atmosphere_129;
-    let _e96 = r_73;
-    let _e97 = mu_56;
-    let _e98 = lit;
-    let _e99 = RadiusAtDistance(_e95, _e96, _e97, _e98);
-    r_p = _e99;
-    let _e101 = r_73;
-    let _e102 = mu_56;
-    let _e103 = lit;
-    let _e104 = r_p;
-    let _e105 = CosineAtDistance(_e101, _e102, _e103, _e104);
-    mu_p = _e105;
-    let _e107 = r_73;
-    let _e108 = mu_s_44;
-    let _e110 = lit;
-    let _e111 = nu_28;
-    let _e114 = r_p;
-    let _e116 = ClampCosine((((_e107 * _e108) + (_e110 * _e111)) / _e114));
-    mu_s_p = _e116;
-    let _e122 = d_30;
-    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e122));
-    let _e130 = lit;
-    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e130));
-    let _e146 = lit_direct;
-    if (_e146 > 0f) {
+    let _e77 = point_1;
+    let _e78 = start_3;
+    d_28 = max(length((_e77 - _e78)), 0f);
+    let _e84 = d_28;
+    let _e85 = shadow_length_1;
+    lit = max((_e84 - max(_e85, 0f)), 0f);
+    let _e92 = atmosphere_133;
+    let _e93 = r_77;
+    let _e94 = mu_60;
+    let _e95 = RayIntersectsGround(_e92, _e93, _e94);
+    ray_r_mu_intersects_ground_34 = _e95;
+    let _e101 = d_28;
+    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e101));
+    let _e109 = lit;
+    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e109));
+    lit_sums.optical_depth = vec3(0f);
+    lit_sums.single_mie = vec3(0f);
+    let _e120 = lit_direct;
+    if (_e120 > 0f) {
         {
-            let _e149 = atmosphere_129;
-            let _e150 = r_73;
-            let _e151 = mu_56;
-            let _e152 = mu_s_44;
-            let _e153 = nu_28;
-            let _e154 = lit;
-            let _e161 = IntegrateSegment(_e149, transmittance_texture_8, _e150, _e151, _e152, _e153, _e154, (&single_rayleigh_1), (&single_mie_1), (&lit_weight));
-            lit_optical_depth = _e161;
+            let _e123 = atmosphere_133;
+            let _e124 = r_77;
+            let _e125 = mu_60;
+            let _e126 = mu_s_48;
+            let _e127 = nu_32;
+            let _e129 = lit;
+            let _e130 = atmosphere_133;
+            let _e131 = r_77;
+            let _e132 = mu_60;
+            let _e133 = mu_s_48;
+            let _e134 = nu_32;
+            let _e136 = StartSegment(_e130, transmittance_texture_10, _e131, _e132, _e133, _e134, 0f);
+            let _e137 = ContinueSegment(_e123, transmittance_texture_10, _e124, _e125, _e126, _e127, 0f, _e129, _e136);
+            lit_sums = _e137;
         }
     }
-    let _e162 = lit_optical_depth;
-    optical_depth_2 = _e162;
-    let _e164 = direct;
-    let _e167 = lit;
-    let _e168 = d_30;
-    if ((_e164 > 0f) && (_e167 < _e168)) {
+    let _e138 = lit_sums;
+    optical_depth_1 = _e138.optical_depth;
+    let _e141 = direct;
+    let _e144 = lit;
+    let _e145 = d_28;
+    if ((_e141 > 0f) && (_e144 < _e145)) {
         {
-            let _e174 = optical_depth_2;
-            let _e175 = atmosphere_129;
-            let _e176 = r_p;
-            let _e177 = mu_p;
-            let _e178 = mu_s_p;
-            let _e179 = nu_28;
-            let _e180 = d_30;
-            let _e181 = lit;
-            let _e189 = IntegrateSegment(_e175, transmittance_texture_8, _e176, _e177, _e178, _e179, (_e180 - _e181), (&unused_rayleigh), (&unused_mie), (&unused_weight));
-            optical_depth_2 = (_e174 + _e189);
+            let _e148 = atmosphere_133;
+            let _e149 = r_77;
+            let _e150 = mu_60;
+            let _e151 = mu_s_48;
+            let _e152 = nu_32;
+            let _e153 = lit;
+            let _e154 = d_28;
+            let _e155 = lit_sums;
+            let _e156 = ContinueSegment(_e148, transmittance_texture_10, _e149, _e150, _e151, _e152, _e153, _e154, _e155);
+            optical_depth_1 = _e156.optical_depth;
         }
     }
-    let _e191 = direct;
-    if (_e191 < 1f) {
+    let _e158 = direct;
+    if (_e158 < 1f) {
         {
-            let _e194 = atmosphere_129;
-            let _e195 = r_73;
-            let _e196 = mu_56;
-            let _e197 = d_30;
-            let _e198 = ray_r_mu_intersects_ground_34;
-            let _e199 = LongSegmentOpticalDepth(_e194, transmittance_texture_8, _e195, _e196, _e197, _e198);
-            let _e200 = optical_depth_2;
-            let _e201 = direct;
-            optical_depth_2 = mix(_e199, _e200, vec3(_e201));
+            let _e161 = atmosphere_133;
+            let _e162 = r_77;
+            let _e163 = mu_60;
+            let _e164 = d_28;
+            let _e165 = ray_r_mu_intersects_ground_34;
+            let _e166 = LongSegmentOpticalDepth(_e161, transmittance_texture_10, _e162, _e163, _e164, _e165);
+            let _e167 = optical_depth_1;
+            let _e168 = direct;
+            optical_depth_1 = mix(_e166, _e167, vec3(_e168));
         }
     }
-    let _e204 = optical_depth_2;
-    (*transmittance_1) = exp(-(_e204));
-    let _e208 = atmosphere_129;
-    let _e209 = r_73;
-    let _e210 = mu_56;
-    let _e211 = mu_s_44;
-    let _e212 = nu_28;
-    let _e213 = ray_r_mu_intersects_ground_34;
-    let _e216 = GetCombinedScattering(_e208, scattering_texture_9, single_mie_scattering_texture_3, _e209, _e210, _e211, _e212, _e213, (&single_mie_scattering_2));
-    scattering_3 = _e216;
-    let _e218 = lit;
-    if (_e218 < DIRECT_SEGMENT_LENGTH) {
+    let _e171 = optical_depth_1;
+    (*transmittance_1) = exp(-(_e171));
+    let _e175 = atmosphere_133;
+    let _e176 = r_77;
+    let _e177 = mu_60;
+    let _e178 = mu_s_48;
+    let _e179 = nu_32;
+    let _e180 = ray_r_mu_intersects_ground_34;
+    let _e183 = GetCombinedScattering(_e175, scattering_texture_9, single_mie_scattering_texture_3, _e176, _e177, _e178, _e179, _e180, (&single_mie_scattering_2));
+    scattering_2 = _e183;
+    let _e185 = lit;
+    if (_e185 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e220 = atmosphere_129;
-            let _e221 = r_73;
-            let _e222 = mu_56;
-            let _e223 = ray_r_mu_intersects_ground_34;
-            let _e224 = DistanceToNearestAtmosphereBoundary(_e220, _e221, _e222, _e223);
-            boundary = _e224;
-            let _e226 = boundary;
-            let _e228 = atmosphere_129;
-            let _e229 = r_73;
-            let _e230 = mu_56;
-            let _e231 = DistanceInsideScatteringRadii(_e228, _e229, _e230);
-            let _e233 = lit;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e226), _e231), _e233);
-            let _e239 = atmosphere_129;
-            let _e240 = r_73;
-            let _e241 = mu_56;
-            let _e242 = mu_s_44;
-            let _e243 = nu_28;
-            let _e244 = far;
-            let _e251 = IntegrateSegment(_e239, transmittance_texture_8, _e240, _e241, _e242, _e243, _e244, (&far_rayleigh), (&far_mie), (&far_weight));
-            far_optical_depth = _e251;
-            let _e253 = far;
-            let _e254 = boundary;
-            if (_e253 < _e254) {
+            let _e187 = atmosphere_133;
+            let _e188 = r_77;
+            let _e189 = mu_60;
+            let _e190 = ray_r_mu_intersects_ground_34;
+            let _e191 = DistanceToNearestAtmosphereBoundary(_e187, _e188, _e189, _e190);
+            boundary = _e191;
+            let _e193 = boundary;
+            let _e195 = atmosphere_133;
+            let _e196 = r_77;
+            let _e197 = mu_60;
+            let _e198 = DistanceInsideScatteringRadii(_e195, _e196, _e197);
+            let _e200 = lit;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e193), _e198), _e200);
+            let _e203 = atmosphere_133;
+            let _e204 = r_77;
+            let _e205 = mu_60;
+            let _e206 = mu_s_48;
+            let _e207 = nu_32;
+            let _e208 = lit;
+            let _e209 = far;
+            let _e210 = lit_sums;
+            let _e211 = ContinueSegment(_e203, transmittance_texture_10, _e204, _e205, _e206, _e207, _e208, _e209, _e210);
+            far_sums = _e211;
+            let _e213 = far;
+            let _e214 = boundary;
+            if (_e213 < _e214) {
                 {
-                    let _e256 = atmosphere_129;
-                    let _e257 = r_73;
-                    let _e258 = mu_56;
-                    let _e259 = far;
-                    let _e260 = RadiusAtDistance(_e256, _e257, _e258, _e259);
-                    r_far = _e260;
-                    let _e263 = scattering_3;
-                    let _e264 = far_optical_depth;
-                    let _e267 = atmosphere_129;
-                    let _e268 = r_far;
-                    let _e269 = r_73;
-                    let _e270 = mu_56;
-                    let _e271 = far;
-                    let _e272 = r_far;
-                    let _e273 = CosineAtDistance(_e269, _e270, _e271, _e272);
-                    let _e274 = r_73;
-                    let _e275 = mu_s_44;
-                    let _e277 = far;
-                    let _e278 = nu_28;
-                    let _e281 = r_far;
-                    let _e283 = ClampCosine((((_e274 * _e275) + (_e277 * _e278)) / _e281));
-                    let _e284 = nu_28;
-                    let _e285 = ray_r_mu_intersects_ground_34;
-                    let _e288 = GetCombinedScattering(_e267, scattering_texture_9, single_mie_scattering_texture_3, _e268, _e273, _e283, _e284, _e285, (&unused_far_mie));
-                    scattering_3 = (_e263 - (exp(-(_e264)) * _e288));
+                    let _e216 = atmosphere_133;
+                    let _e217 = r_77;
+                    let _e218 = mu_60;
+                    let _e219 = far;
+                    let _e220 = RadiusAtDistance(_e216, _e217, _e218, _e219);
+                    r_far = _e220;
+                    let _e223 = scattering_2;
+                    let _e224 = far_sums;
+                    let _e226 = atmosphere_133;
+                    let _e227 = r_far;
+                    let _e228 = r_77;
+                    let _e229 = mu_60;
+                    let _e230 = far;
+                    let _e231 = r_far;
+                    let _e232 = CosineAtDistance(_e228, _e229, _e230, _e231);
+                    let _e233 = r_77;
+                    let _e234 = mu_s_48;
+                    let _e236 = far;
+                    let _e237 = nu_32;
+                    let _e240 = r_far;
+                    let _e242 = ClampCosine((((_e233 * _e234) + (_e236 * _e237)) / _e240));
+                    let _e243 = nu_32;
+                    let _e244 = ray_r_mu_intersects_ground_34;
+                    let _e247 = GetCombinedScattering(_e226, scattering_texture_9, single_mie_scattering_texture_3, _e227, _e232, _e242, _e243, _e244, (&unused_far_mie));
+                    scattering_2 = (_e223 - (_e224.transmittance * _e247));
                 }
             }
-            let _e291 = scattering_3;
-            let _e292 = far_rayleigh;
-            let _e297 = lit_weight;
-            let _e299 = far_weight;
-            multiple = ((max((_e291 - _e292), vec3(0f)) * _e297) / max(_e299, vec3(0.000000000000000000000000000001f)));
-            let _e305 = single_rayleigh_1;
-            let _e306 = multiple;
-            let _e308 = nu_28;
-            let _e309 = RayleighPhaseFunction(_e308);
-            let _e311 = single_mie_1;
-            let _e312 = atmosphere_129;
-            let _e313 = nu_28;
-            let _e314 = MiePhaseFunction(_e312, _e313);
-            return (((_e305 + _e306) * _e309) + (_e311 * _e314));
+            let _e250 = scattering_2;
+            let _e251 = far_sums;
+            let _e253 = atmosphere_133;
+            let _e260 = lit_sums;
+            let _e263 = far_sums;
+            multiple = ((max((_e250 - (_e251.single_rayleigh * _e253.solar_irradiance)), vec3(0f)) * _e260.scattering_weight) / max(_e263.scattering_weight, vec3(0.000000000000000000000000000001f)));
+            let _e270 = lit_sums;
+            let _e272 = atmosphere_133;
+            let _e275 = multiple;
+            let _e277 = nu_32;
+            let _e278 = RayleighPhaseFunction(_e277);
+            let _e280 = lit_sums;
+            let _e282 = atmosphere_133;
+            let _e285 = atmosphere_133;
+            let _e286 = nu_32;
+            let _e287 = MiePhaseFunction(_e285, _e286);
+            return ((((_e270.single_rayleigh * _e272.solar_irradiance) + _e275) * _e278) + ((_e280.single_mie * _e282.solar_irradiance) * _e287));
         }
     }
-    let _e317 = atmosphere_129;
-    let _e318 = r_73;
-    let _e319 = mu_56;
-    let _e320 = lit;
-    let _e321 = ray_r_mu_intersects_ground_34;
-    let _e322 = LongSegmentOpticalDepth(_e317, transmittance_texture_8, _e318, _e319, _e320, _e321);
-    let _e323 = lit_optical_depth;
-    let _e324 = lit_direct;
-    lit_transmittance = exp(-(mix(_e322, _e323, vec3(_e324))));
-    let _e331 = atmosphere_129;
-    let _e332 = r_p;
-    let _e333 = mu_p;
-    let _e334 = mu_s_p;
-    let _e335 = nu_28;
-    let _e336 = ray_r_mu_intersects_ground_34;
-    let _e339 = GetCombinedScattering(_e331, scattering_texture_9, single_mie_scattering_texture_3, _e332, _e333, _e334, _e335, _e336, (&single_mie_scattering_p));
-    scattering_p = _e339;
-    let _e341 = scattering_3;
-    let _e342 = lit_transmittance;
-    let _e343 = scattering_p;
-    scattering_3 = max((_e341 - (_e342 * _e343)), vec3(0f));
-    let _e349 = single_mie_scattering_2;
-    let _e350 = lit_transmittance;
-    let _e351 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e349 - (_e350 * _e351)), vec3(0f));
-    let _e357 = single_mie_scattering_2;
-    let _e358 = single_mie_1;
-    let _e359 = lit_direct;
-    single_mie_scattering_2 = mix(_e357, _e358, vec3(_e359));
-    let _e362 = scattering_3;
-    let _e363 = nu_28;
-    let _e364 = RayleighPhaseFunction(_e363);
-    let _e366 = single_mie_scattering_2;
-    let _e367 = atmosphere_129;
-    let _e368 = nu_28;
-    let _e369 = MiePhaseFunction(_e367, _e368);
-    return ((_e362 * _e364) + (_e366 * _e369));
+    let _e290 = atmosphere_133;
+    let _e291 = r_77;
+    let _e292 = mu_60;
+    let _e293 = lit;
+    let _e294 = RadiusAtDistance(_e290, _e291, _e292, _e293);
+    r_p = _e294;
+    let _e296 = r_77;
+    let _e297 = mu_60;
+    let _e298 = lit;
+    let _e299 = r_p;
+    let _e300 = CosineAtDistance(_e296, _e297, _e298, _e299);
+    mu_p = _e300;
+    let _e302 = r_77;
+    let _e303 = mu_s_48;
+    let _e305 = lit;
+    let _e306 = nu_32;
+    let _e309 = r_p;
+    let _e311 = ClampCosine((((_e302 * _e303) + (_e305 * _e306)) / _e309));
+    mu_s_p = _e311;
+    let _e313 = atmosphere_133;
+    let _e314 = r_77;
+    let _e315 = mu_60;
+    let _e316 = lit;
+    let _e317 = ray_r_mu_intersects_ground_34;
+    let _e318 = LongSegmentOpticalDepth(_e313, transmittance_texture_10, _e314, _e315, _e316, _e317);
+    let _e319 = lit_sums;
+    let _e321 = lit_direct;
+    lit_transmittance = exp(-(mix(_e318, _e319.optical_depth, vec3(_e321))));
+    let _e328 = atmosphere_133;
+    let _e329 = r_p;
+    let _e330 = mu_p;
+    let _e331 = mu_s_p;
+    let _e332 = nu_32;
+    let _e333 = ray_r_mu_intersects_ground_34;
+    let _e336 = GetCombinedScattering(_e328, scattering_texture_9, single_mie_scattering_texture_3, _e329, _e330, _e331, _e332, _e333, (&single_mie_scattering_p));
+    scattering_p = _e336;
+    let _e338 = scattering_2;
+    let _e339 = lit_transmittance;
+    let _e340 = scattering_p;
+    scattering_2 = max((_e338 - (_e339 * _e340)), vec3(0f));
+    let _e346 = single_mie_scattering_2;
+    let _e347 = lit_transmittance;
+    let _e348 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e346 - (_e347 * _e348)), vec3(0f));
+    let _e354 = single_mie_scattering_2;
+    let _e355 = lit_sums;
+    let _e357 = atmosphere_133;
+    let _e360 = lit_direct;
+    single_mie_scattering_2 = mix(_e354, (_e355.single_mie * _e357.solar_irradiance), vec3(_e360));
+    let _e363 = scattering_2;
+    let _e364 = nu_32;
+    let _e365 = RayleighPhaseFunction(_e364);
+    let _e367 = single_mie_scattering_2;
+    let _e368 = atmosphere_133;
+    let _e369 = nu_32;
+    let _e370 = MiePhaseFunction(_e368, _e369);
+    return ((_e363 * _e365) + (_e367 * _e370));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_130: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_131: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_134: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_135: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_131 = atmosphere_130;
+    atmosphere_135 = atmosphere_134;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e32 = atmosphere_131;
-    let _e33 = camera_9;
-    let _e34 = point_3;
-    let _e36 = sun_direction_7;
-    let _e39 = GetSkyRadianceToPointWithShadow(_e32, transmittance_texture_9, scattering_texture_10, single_mie_scattering_texture_4, _e33, _e34, 0f, _e36, transmittance_2);
-    return _e39;
+    let _e34 = atmosphere_135;
+    let _e35 = camera_9;
+    let _e36 = point_3;
+    let _e38 = sun_direction_7;
+    let _e41 = GetSkyRadianceToPointWithShadow(_e34, transmittance_texture_11, scattering_texture_10, single_mie_scattering_texture_4, _e35, _e36, 0f, _e38, transmittance_2);
+    return _e41;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_132: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_133: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_136: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_137: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_74: f32;
-    var mu_s_45: f32;
+    var r_78: f32;
+    var mu_s_49: f32;
 
-    atmosphere_133 = atmosphere_132;
+    atmosphere_137 = atmosphere_136;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e31 = atmosphere_133;
-    let _e32 = point_5;
-    let _e34 = ClampRadius(_e31, length(_e32));
-    r_74 = _e34;
-    let _e36 = point_5;
-    let _e37 = sun_direction_9;
-    let _e39 = point_5;
-    let _e42 = ClampCosine((dot(_e36, _e37) / length(_e39)));
-    mu_s_45 = _e42;
-    let _e44 = atmosphere_133;
-    let _e45 = r_74;
-    let _e46 = mu_s_45;
-    let _e47 = GetIrradiance(_e44, irradiance_texture_1, _e45, _e46);
-    let _e49 = normal_1;
-    let _e50 = point_5;
+    let _e33 = atmosphere_137;
+    let _e34 = point_5;
+    let _e36 = ClampRadius(_e33, length(_e34));
+    r_78 = _e36;
+    let _e38 = point_5;
+    let _e39 = sun_direction_9;
+    let _e41 = point_5;
+    let _e44 = ClampCosine((dot(_e38, _e39) / length(_e41)));
+    mu_s_49 = _e44;
+    let _e46 = atmosphere_137;
+    let _e47 = r_78;
+    let _e48 = mu_s_49;
+    let _e49 = GetIrradiance(_e46, irradiance_texture_1, _e47, _e48);
+    let _e51 = normal_1;
     let _e52 = point_5;
-    (*sky_irradiance) = ((_e47 * (1f + (dot(_e49, _e50) / length(_e52)))) * 0.5f);
-    let _e59 = atmosphere_133;
-    let _e61 = atmosphere_133;
-    let _e62 = r_74;
-    let _e63 = mu_s_45;
-    let _e64 = GetTransmittanceToSun(_e61, transmittance_texture_10, _e62, _e63);
-    let _e66 = normal_1;
-    let _e67 = sun_direction_9;
-    return ((_e59.solar_irradiance * _e64) * max(dot(_e66, _e67), 0f));
+    let _e54 = point_5;
+    (*sky_irradiance) = ((_e49 * (1f + (dot(_e51, _e52) / length(_e54)))) * 0.5f);
+    let _e61 = atmosphere_137;
+    let _e63 = atmosphere_137;
+    let _e64 = r_78;
+    let _e65 = mu_s_49;
+    let _e66 = GetTransmittanceToSun(_e63, transmittance_texture_12, _e64, _e65);
+    let _e68 = normal_1;
+    let _e69 = sun_direction_9;
+    return ((_e61.solar_irradiance * _e66) * max(dot(_e68, _e69), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_134: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_135: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_138: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_139: AtmosphereParameters;
 
-    atmosphere_135 = atmosphere_134;
-    let _e22 = atmosphere_135;
-    let _e24 = atmosphere_135;
-    let _e27 = atmosphere_135;
-    return (_e22.solar_irradiance / vec3(((PI * _e24.sun_angular_radius) * _e27.sun_angular_radius)));
+    atmosphere_139 = atmosphere_138;
+    let _e24 = atmosphere_139;
+    let _e26 = atmosphere_139;
+    let _e29 = atmosphere_139;
+    return (_e24.solar_irradiance / vec3(((PI * _e26.sun_angular_radius) * _e29.sun_angular_radius)));
 }
 
 fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     var xyz_1: vec3<f32>;
 
     xyz_1 = xyz;
-    let _e28 = xyz_1;
-    let _e35 = xyz_1;
-    let _e42 = xyz_1;
-    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e28), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e35), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e42));
+    let _e30 = xyz_1;
+    let _e37 = xyz_1;
+    let _e44 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e30), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e37), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e44));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn SkyViewHorizonZenith(atmosphere_136: AtmosphereParameters, r_75: f32) -> f32 {
-    var atmosphere_137: AtmosphereParameters;
-    var r_76: f32;
+fn SkyViewHorizonZenith(atmosphere_140: AtmosphereParameters, r_79: f32) -> f32 {
+    var atmosphere_141: AtmosphereParameters;
+    var r_80: f32;
 
-    atmosphere_137 = atmosphere_136;
-    r_76 = r_75;
-    let _e26 = atmosphere_137;
-    let _e28 = atmosphere_137;
-    let _e29 = r_76;
-    let _e30 = HorizonDistance(_e28, _e29);
-    return atan2(_e26.bottom_radius, -(_e30));
+    atmosphere_141 = atmosphere_140;
+    r_80 = r_79;
+    let _e28 = atmosphere_141;
+    let _e30 = atmosphere_141;
+    let _e31 = r_80;
+    let _e32 = HorizonDistance(_e30, _e31);
+    return atan2(_e28.bottom_radius, -(_e32));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
-    var atmosphere_139: AtmosphereParameters;
-    var r_78: f32;
+fn GetSkyViewUvFromAngles(atmosphere_142: AtmosphereParameters, r_81: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
+    var atmosphere_143: AtmosphereParameters;
+    var r_82: f32;
     var theta_1: f32;
     var phi_1: f32;
     var ray_r_mu_intersects_ground_36: bool;
     var theta_h: f32;
-    var local_29: f32;
+    var local_31: f32;
     var x_26: f32;
 
-    atmosphere_139 = atmosphere_138;
-    r_78 = r_77;
+    atmosphere_143 = atmosphere_142;
+    r_82 = r_81;
     theta_1 = theta;
     phi_1 = phi;
     ray_r_mu_intersects_ground_36 = ray_r_mu_intersects_ground_35;
-    let _e32 = atmosphere_139;
-    let _e33 = r_78;
-    let _e34 = SkyViewHorizonZenith(_e32, _e33);
-    theta_h = _e34;
-    let _e36 = ray_r_mu_intersects_ground_36;
-    if _e36 {
-        let _e38 = theta_1;
-        let _e39 = theta_h;
+    let _e34 = atmosphere_143;
+    let _e35 = r_82;
+    let _e36 = SkyViewHorizonZenith(_e34, _e35);
+    theta_h = _e36;
+    let _e38 = ray_r_mu_intersects_ground_36;
+    if _e38 {
+        let _e40 = theta_1;
         let _e41 = theta_h;
-        local_29 = (1f - sqrt(clamp(((_e38 - _e39) / (PI - _e41)), 0f, 1f)));
+        let _e43 = theta_h;
+        local_31 = (1f - sqrt(clamp(((_e40 - _e41) / (PI - _e43)), 0f, 1f)));
     } else {
-        let _e50 = theta_h;
-        let _e51 = theta_1;
-        let _e53 = theta_h;
-        local_29 = (1f - sqrt(clamp(((_e50 - _e51) / _e53), 0f, 1f)));
+        let _e52 = theta_h;
+        let _e53 = theta_1;
+        let _e55 = theta_h;
+        local_31 = (1f - sqrt(clamp(((_e52 - _e53) / _e55), 0f, 1f)));
     }
-    let _e61 = local_29;
-    x_26 = _e61;
-    let _e63 = phi_1;
-    let _e65 = GetTextureCoordFromUnitRange((_e63 / PI), SKY_VIEW_WIDTH);
-    let _e66 = x_26;
-    let _e67 = ray_r_mu_intersects_ground_36;
-    let _e68 = GetTextureCoordFromUnitMuInHalf(_e66, _e67, SKY_VIEW_HEIGHT);
-    return vec2<f32>(_e65, _e68);
+    let _e63 = local_31;
+    x_26 = _e63;
+    let _e65 = phi_1;
+    let _e67 = GetTextureCoordFromUnitRange((_e65 / PI), SKY_VIEW_WIDTH);
+    let _e68 = x_26;
+    let _e69 = ray_r_mu_intersects_ground_36;
+    let _e70 = GetTextureCoordFromUnitMuInHalf(_e68, _e69, SKY_VIEW_HEIGHT);
+    return vec2<f32>(_e67, _e70);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4232,143 +4526,143 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     var view_ray_8: vec3<f32>;
     var sun_direction_11: vec3<f32>;
     var up_1: vec3<f32>;
-    var mu_57: f32;
+    var mu_61: f32;
     var horizontal: vec3<f32>;
     var sun_horizontal: vec3<f32>;
     var along: f32;
     var side: f32;
-    var local_30: f32;
+    var local_32: f32;
 
     camera_11 = camera_10;
     view_ray_8 = view_ray_7;
     sun_direction_11 = sun_direction_10;
-    let _e30 = camera_11;
-    up_1 = normalize(_e30);
-    let _e33 = up_1;
-    let _e34 = view_ray_8;
-    mu_57 = dot(_e33, _e34);
-    let _e37 = view_ray_8;
-    let _e38 = up_1;
-    let _e39 = mu_57;
-    horizontal = (_e37 - (_e38 * _e39));
-    let _e43 = sun_direction_11;
-    let _e44 = up_1;
-    let _e45 = up_1;
-    let _e46 = sun_direction_11;
-    sun_horizontal = (_e43 - (_e44 * dot(_e45, _e46)));
-    let _e51 = horizontal;
-    let _e53 = mu_57;
-    (*theta_2) = atan2(length(_e51), _e53);
-    let _e55 = sun_horizontal;
-    let _e56 = horizontal;
-    along = dot(_e55, _e56);
-    let _e59 = up_1;
-    let _e60 = sun_horizontal;
-    let _e62 = horizontal;
-    side = abs(dot(cross(_e59, _e60), _e62));
-    let _e66 = along;
-    let _e69 = side;
-    if ((_e66 != 0f) || (_e69 != 0f)) {
-        let _e73 = side;
-        let _e74 = along;
-        local_30 = atan2(_e73, _e74);
+    let _e32 = camera_11;
+    up_1 = normalize(_e32);
+    let _e35 = up_1;
+    let _e36 = view_ray_8;
+    mu_61 = dot(_e35, _e36);
+    let _e39 = view_ray_8;
+    let _e40 = up_1;
+    let _e41 = mu_61;
+    horizontal = (_e39 - (_e40 * _e41));
+    let _e45 = sun_direction_11;
+    let _e46 = up_1;
+    let _e47 = up_1;
+    let _e48 = sun_direction_11;
+    sun_horizontal = (_e45 - (_e46 * dot(_e47, _e48)));
+    let _e53 = horizontal;
+    let _e55 = mu_61;
+    (*theta_2) = atan2(length(_e53), _e55);
+    let _e57 = sun_horizontal;
+    let _e58 = horizontal;
+    along = dot(_e57, _e58);
+    let _e61 = up_1;
+    let _e62 = sun_horizontal;
+    let _e64 = horizontal;
+    side = abs(dot(cross(_e61, _e62), _e64));
+    let _e68 = along;
+    let _e71 = side;
+    if ((_e68 != 0f) || (_e71 != 0f)) {
+        let _e75 = side;
+        let _e76 = along;
+        local_32 = atan2(_e75, _e76);
     } else {
-        local_30 = 0f;
+        local_32 = 0f;
     }
-    let _e78 = local_30;
-    (*phi_2) = _e78;
+    let _e80 = local_32;
+    (*phi_2) = _e80;
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
-    var atmosphere_141: AtmosphereParameters;
+fn GetSkyViewRay(atmosphere_144: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
+    var atmosphere_145: AtmosphereParameters;
     var camera_13: vec3<f32>;
     var sun_direction_13: vec3<f32>;
     var uv_5: vec2<f32>;
     var x_27: f32;
-    var e: f32;
+    var e_1: f32;
     var theta_h_1: f32;
-    var local_31: f32;
+    var local_33: f32;
     var theta_3: f32;
     var phi_3: f32;
     var up_2: vec3<f32>;
     var toward_sun: vec3<f32>;
-    var local_32: vec3<f32>;
+    var local_34: vec3<f32>;
     var across_3: vec3<f32>;
 
-    atmosphere_141 = atmosphere_140;
+    atmosphere_145 = atmosphere_144;
     camera_13 = camera_12;
     sun_direction_13 = sun_direction_12;
     uv_5 = uv_4;
-    let _e31 = uv_5;
-    let _e35 = GetUnitMuInHalfFromTextureCoord(_e31.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
-    x_27 = _e35;
-    let _e38 = x_27;
-    let _e41 = x_27;
-    e = ((1f - _e38) * (1f - _e41));
-    let _e45 = atmosphere_141;
-    let _e46 = atmosphere_141;
-    let _e47 = camera_13;
-    let _e49 = ClampRadius(_e46, length(_e47));
-    let _e50 = SkyViewHorizonZenith(_e45, _e49);
-    theta_h_1 = _e50;
-    let _e52 = (*ray_r_mu_intersects_ground_37);
-    if _e52 {
-        let _e53 = theta_h_1;
-        let _e54 = e;
+    let _e33 = uv_5;
+    let _e37 = GetUnitMuInHalfFromTextureCoord(_e33.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
+    x_27 = _e37;
+    let _e40 = x_27;
+    let _e43 = x_27;
+    e_1 = ((1f - _e40) * (1f - _e43));
+    let _e47 = atmosphere_145;
+    let _e48 = atmosphere_145;
+    let _e49 = camera_13;
+    let _e51 = ClampRadius(_e48, length(_e49));
+    let _e52 = SkyViewHorizonZenith(_e47, _e51);
+    theta_h_1 = _e52;
+    let _e54 = (*ray_r_mu_intersects_ground_37);
+    if _e54 {
         let _e55 = theta_h_1;
-        local_31 = (_e53 + (_e54 * (PI - _e55)));
+        let _e56 = e_1;
+        let _e57 = theta_h_1;
+        local_33 = (_e55 + (_e56 * (PI - _e57)));
     } else {
-        let _e59 = theta_h_1;
-        let _e61 = e;
-        local_31 = (_e59 * (1f - _e61));
+        let _e61 = theta_h_1;
+        let _e63 = e_1;
+        local_33 = (_e61 * (1f - _e63));
     }
-    let _e65 = local_31;
-    theta_3 = _e65;
-    let _e67 = uv_5;
-    let _e69 = GetUnitRangeFromTextureCoord(_e67.x, SKY_VIEW_WIDTH);
-    phi_3 = (PI * clamp(_e69, 0f, 1f));
-    let _e75 = camera_13;
-    up_2 = normalize(_e75);
-    let _e78 = sun_direction_13;
-    let _e79 = up_2;
+    let _e67 = local_33;
+    theta_3 = _e67;
+    let _e69 = uv_5;
+    let _e71 = GetUnitRangeFromTextureCoord(_e69.x, SKY_VIEW_WIDTH);
+    phi_3 = (PI * clamp(_e71, 0f, 1f));
+    let _e77 = camera_13;
+    up_2 = normalize(_e77);
     let _e80 = sun_direction_13;
     let _e81 = up_2;
-    toward_sun = (_e78 - (_e79 * dot(_e80, _e81)));
-    let _e86 = toward_sun;
-    let _e87 = toward_sun;
-    if (dot(_e86, _e87) < 0.000000000001f) {
+    let _e82 = sun_direction_13;
+    let _e83 = up_2;
+    toward_sun = (_e80 - (_e81 * dot(_e82, _e83)));
+    let _e88 = toward_sun;
+    let _e89 = toward_sun;
+    if (dot(_e88, _e89) < 0.000000000001f) {
         {
-            let _e91 = up_2;
-            let _e92 = up_2;
-            if (abs(_e92.x) < 0.9f) {
-                local_32 = vec3<f32>(1f, 0f, 0f);
+            let _e93 = up_2;
+            let _e94 = up_2;
+            if (abs(_e94.x) < 0.9f) {
+                local_34 = vec3<f32>(1f, 0f, 0f);
             } else {
-                local_32 = vec3<f32>(0f, 1f, 0f);
+                local_34 = vec3<f32>(0f, 1f, 0f);
             }
-            let _e106 = local_32;
-            toward_sun = cross(_e91, _e106);
+            let _e108 = local_34;
+            toward_sun = cross(_e93, _e108);
         }
     }
-    let _e108 = toward_sun;
-    toward_sun = normalize(_e108);
-    let _e110 = up_2;
-    let _e111 = toward_sun;
-    across_3 = cross(_e110, _e111);
-    let _e114 = up_2;
-    let _e115 = theta_3;
-    let _e118 = toward_sun;
-    let _e119 = phi_3;
-    let _e122 = across_3;
-    let _e123 = phi_3;
-    let _e127 = theta_3;
-    return ((_e114 * cos(_e115)) + (((_e118 * cos(_e119)) + (_e122 * sin(_e123))) * sin(_e127)));
+    let _e110 = toward_sun;
+    toward_sun = normalize(_e110);
+    let _e112 = up_2;
+    let _e113 = toward_sun;
+    across_3 = cross(_e112, _e113);
+    let _e116 = up_2;
+    let _e117 = theta_3;
+    let _e120 = toward_sun;
+    let _e121 = phi_3;
+    let _e124 = across_3;
+    let _e125 = phi_3;
+    let _e129 = theta_3;
+    return ((_e116 * cos(_e117)) + (((_e120 * cos(_e121)) + (_e124 * sin(_e125))) * sin(_e129)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
-    var atmosphere_143: AtmosphereParameters;
+fn GetSkyViewRadiance(atmosphere_146: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
+    var atmosphere_147: AtmosphereParameters;
     var camera_15: vec3<f32>;
     var sun_direction_15: vec3<f32>;
     var uv_7: vec2<f32>;
@@ -4376,91 +4670,91 @@ fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_1
     var view_ray_9: vec3<f32>;
     var up_3: vec3<f32>;
 
-    atmosphere_143 = atmosphere_142;
+    atmosphere_147 = atmosphere_146;
     camera_15 = camera_14;
     sun_direction_15 = sun_direction_14;
     uv_7 = uv_6;
-    let _e33 = atmosphere_143;
-    let _e34 = camera_15;
-    let _e35 = sun_direction_15;
-    let _e36 = uv_7;
-    let _e39 = GetSkyViewRay(_e33, _e34, _e35, _e36, (&ray_r_mu_intersects_ground_38));
-    view_ray_9 = _e39;
-    let _e41 = camera_15;
-    up_3 = normalize(_e41);
-    let _e44 = atmosphere_143;
-    let _e45 = atmosphere_143;
-    let _e46 = camera_15;
-    let _e48 = ClampRadius(_e45, length(_e46));
-    let _e49 = up_3;
-    let _e50 = view_ray_9;
-    let _e52 = ClampCosine(dot(_e49, _e50));
-    let _e53 = up_3;
-    let _e54 = sun_direction_15;
-    let _e56 = ClampCosine(dot(_e53, _e54));
-    let _e57 = view_ray_9;
-    let _e58 = sun_direction_15;
-    let _e60 = ClampCosine(dot(_e57, _e58));
-    let _e61 = ray_r_mu_intersects_ground_38;
-    let _e62 = GetSkyRadianceOfRay(_e44, scattering_texture_11, single_mie_scattering_texture_5, _e48, _e52, _e56, _e60, _e61);
-    return _e62;
+    let _e35 = atmosphere_147;
+    let _e36 = camera_15;
+    let _e37 = sun_direction_15;
+    let _e38 = uv_7;
+    let _e41 = GetSkyViewRay(_e35, _e36, _e37, _e38, (&ray_r_mu_intersects_ground_38));
+    view_ray_9 = _e41;
+    let _e43 = camera_15;
+    up_3 = normalize(_e43);
+    let _e46 = atmosphere_147;
+    let _e47 = atmosphere_147;
+    let _e48 = camera_15;
+    let _e50 = ClampRadius(_e47, length(_e48));
+    let _e51 = up_3;
+    let _e52 = view_ray_9;
+    let _e54 = ClampCosine(dot(_e51, _e52));
+    let _e55 = up_3;
+    let _e56 = sun_direction_15;
+    let _e58 = ClampCosine(dot(_e55, _e56));
+    let _e59 = view_ray_9;
+    let _e60 = sun_direction_15;
+    let _e62 = ClampCosine(dot(_e59, _e60));
+    let _e63 = ray_r_mu_intersects_ground_38;
+    let _e64 = GetSkyRadianceOfRay(_e46, scattering_texture_11, single_mie_scattering_texture_5, _e50, _e54, _e58, _e62, _e63);
+    return _e64;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_145: AtmosphereParameters;
+fn GetSkyRadianceFromSkyView(atmosphere_148: AtmosphereParameters, transmittance_texture_13: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_149: AtmosphereParameters;
     var camera_17: vec3<f32>;
     var view_ray_11: vec3<f32>;
     var sun_direction_17: vec3<f32>;
-    var r_79: f32;
-    var mu_58: f32;
+    var r_83: f32;
+    var mu_62: f32;
     var ray_r_mu_intersects_ground_39: bool;
-    var local_33: vec3<f32>;
+    var local_35: vec3<f32>;
     var theta_4: f32;
     var phi_4: f32;
 
-    atmosphere_145 = atmosphere_144;
+    atmosphere_149 = atmosphere_148;
     camera_17 = camera_16;
     view_ray_11 = view_ray_10;
     sun_direction_17 = sun_direction_16;
-    let _e33 = atmosphere_145;
-    let _e34 = camera_17;
-    let _e36 = ClampRadius(_e33, length(_e34));
-    r_79 = _e36;
-    let _e38 = camera_17;
-    let _e39 = view_ray_11;
-    let _e41 = camera_17;
-    let _e44 = ClampCosine((dot(_e38, _e39) / length(_e41)));
-    mu_58 = _e44;
-    let _e46 = atmosphere_145;
-    let _e47 = r_79;
-    let _e48 = mu_58;
-    let _e49 = RayIntersectsGround(_e46, _e47, _e48);
-    ray_r_mu_intersects_ground_39 = _e49;
-    let _e51 = ray_r_mu_intersects_ground_39;
-    if _e51 {
-        local_33 = vec3(0f);
+    let _e35 = atmosphere_149;
+    let _e36 = camera_17;
+    let _e38 = ClampRadius(_e35, length(_e36));
+    r_83 = _e38;
+    let _e40 = camera_17;
+    let _e41 = view_ray_11;
+    let _e43 = camera_17;
+    let _e46 = ClampCosine((dot(_e40, _e41) / length(_e43)));
+    mu_62 = _e46;
+    let _e48 = atmosphere_149;
+    let _e49 = r_83;
+    let _e50 = mu_62;
+    let _e51 = RayIntersectsGround(_e48, _e49, _e50);
+    ray_r_mu_intersects_ground_39 = _e51;
+    let _e53 = ray_r_mu_intersects_ground_39;
+    if _e53 {
+        local_35 = vec3(0f);
     } else {
-        let _e54 = atmosphere_145;
-        let _e55 = r_79;
-        let _e56 = mu_58;
-        let _e57 = GetTransmittanceToTopAtmosphereBoundary(_e54, transmittance_texture_11, _e55, _e56);
-        local_33 = _e57;
+        let _e56 = atmosphere_149;
+        let _e57 = r_83;
+        let _e58 = mu_62;
+        let _e59 = GetTransmittanceToTopAtmosphereBoundary(_e56, transmittance_texture_13, _e57, _e58);
+        local_35 = _e59;
     }
-    let _e59 = local_33;
-    (*transmittance_3) = _e59;
-    let _e62 = camera_17;
-    let _e63 = view_ray_11;
-    let _e64 = sun_direction_17;
-    GetSkyViewAngles(_e62, _e63, _e64, (&theta_4), (&phi_4));
-    let _e69 = atmosphere_145;
-    let _e70 = r_79;
-    let _e71 = theta_4;
-    let _e72 = phi_4;
-    let _e73 = ray_r_mu_intersects_ground_39;
-    let _e74 = GetSkyViewUvFromAngles(_e69, _e70, _e71, _e72, _e73);
-    let _e75 = SampleTexture2D(sky_view_texture, _e74);
-    return vec3<f32>(_e75.xyz);
+    let _e61 = local_35;
+    (*transmittance_3) = _e61;
+    let _e64 = camera_17;
+    let _e65 = view_ray_11;
+    let _e66 = sun_direction_17;
+    GetSkyViewAngles(_e64, _e65, _e66, (&theta_4), (&phi_4));
+    let _e71 = atmosphere_149;
+    let _e72 = r_83;
+    let _e73 = theta_4;
+    let _e74 = phi_4;
+    let _e75 = ray_r_mu_intersects_ground_39;
+    let _e76 = GetSkyViewUvFromAngles(_e71, _e72, _e73, _e74, _e75);
+    let _e77 = SampleTexture2D(sky_view_texture, _e76);
+    return vec3<f32>(_e77.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4469,58 +4763,58 @@ fn AerialPerspectiveSliceDistance(k_7: f32) -> f32 {
     var x_28: f32;
 
     k_8 = k_7;
-    let _e26 = k_8;
-    x_28 = ((_e26 + 1f) / 32f);
-    let _e33 = x_28;
+    let _e28 = k_8;
+    x_28 = ((_e28 + 1f) / 32f);
     let _e35 = x_28;
-    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e33) * _e35);
+    let _e37 = x_28;
+    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e35) * _e37);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetAerialPerspectiveVoxel(atmosphere_146: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_147: AtmosphereParameters;
+fn GetAerialPerspectiveVoxel(atmosphere_150: AtmosphereParameters, transmittance_texture_14: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_151: AtmosphereParameters;
     var camera_19: vec3<f32>;
     var view_ray_13: vec3<f32>;
     var w_1: f32;
     var sun_direction_19: vec3<f32>;
-    var d_31: f32;
+    var d_29: f32;
     var point_6: vec3<f32>;
     var r_point: f32;
     var transmittance_4: vec3<f32>;
     var radiance: vec3<f32>;
 
-    atmosphere_147 = atmosphere_146;
+    atmosphere_151 = atmosphere_150;
     camera_19 = camera_18;
     view_ray_13 = view_ray_12;
     w_1 = w;
     sun_direction_19 = sun_direction_18;
-    let _e38 = w_1;
-    let _e43 = AerialPerspectiveSliceDistance(floor((_e38 * 32f)));
-    d_31 = _e43;
-    let _e45 = camera_19;
-    let _e46 = view_ray_13;
-    let _e47 = d_31;
-    point_6 = (_e45 + (_e46 * _e47));
-    let _e51 = point_6;
-    r_point = length(_e51);
-    let _e54 = r_point;
-    let _e55 = atmosphere_147;
-    if (_e54 < _e55.bottom_radius) {
-        let _e58 = point_6;
-        let _e59 = atmosphere_147;
-        let _e61 = r_point;
-        point_6 = (_e58 * (_e59.bottom_radius / _e61));
+    let _e40 = w_1;
+    let _e45 = AerialPerspectiveSliceDistance(floor((_e40 * 32f)));
+    d_29 = _e45;
+    let _e47 = camera_19;
+    let _e48 = view_ray_13;
+    let _e49 = d_29;
+    point_6 = (_e47 + (_e48 * _e49));
+    let _e53 = point_6;
+    r_point = length(_e53);
+    let _e56 = r_point;
+    let _e57 = atmosphere_151;
+    if (_e56 < _e57.bottom_radius) {
+        let _e60 = point_6;
+        let _e61 = atmosphere_151;
+        let _e63 = r_point;
+        point_6 = (_e60 * (_e61.bottom_radius / _e63));
     }
-    let _e65 = atmosphere_147;
-    let _e66 = camera_19;
-    let _e67 = point_6;
-    let _e68 = sun_direction_19;
-    let _e71 = GetSkyRadianceToPoint(_e65, transmittance_texture_12, scattering_texture_12, single_mie_scattering_texture_6, _e66, _e67, _e68, (&transmittance_4));
-    radiance = _e71;
-    let _e73 = transmittance_4;
-    (*optical_depth_3) = -(log(max(_e73, vec3(0.000000000000000000000000000001f))));
-    let _e79 = radiance;
-    return _e79;
+    let _e67 = atmosphere_151;
+    let _e68 = camera_19;
+    let _e69 = point_6;
+    let _e70 = sun_direction_19;
+    let _e73 = GetSkyRadianceToPoint(_e67, transmittance_texture_14, scattering_texture_12, single_mie_scattering_texture_6, _e68, _e69, _e70, (&transmittance_4));
+    radiance = _e73;
+    let _e75 = transmittance_4;
+    (*optical_depth_2) = -(log(max(_e75, vec3(0.000000000000000000000000000001f))));
+    let _e81 = radiance;
+    return _e81;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4528,47 +4822,47 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     var screen_uv_1: vec2<f32>;
     var distance_3: f32;
     var slices: f32 = 32f;
-    var d_32: f32;
+    var d_30: f32;
     var s_3: f32;
     var k_9: f32;
     var d_k: f32;
-    var t_15: f32;
+    var t_19: f32;
     var near: f32;
     var uvw_2: vec3<f32>;
 
     screen_uv_1 = screen_uv;
     distance_3 = distance_2;
-    let _e34 = distance_3;
-    d_32 = max(_e34, 0f);
-    let _e38 = slices;
-    let _e39 = d_32;
-    s_3 = (_e38 * sqrt((_e39 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
-    let _e44 = s_3;
-    let _e49 = slices;
-    k_9 = clamp((floor(_e44) - 1f), 0f, (_e49 - 2f));
-    let _e54 = k_9;
-    let _e55 = AerialPerspectiveSliceDistance(_e54);
-    d_k = _e55;
-    let _e57 = d_32;
-    let _e58 = d_k;
-    let _e60 = k_9;
-    let _e63 = AerialPerspectiveSliceDistance((_e60 + 1f));
-    let _e64 = d_k;
-    t_15 = clamp(((_e57 - _e58) / (_e63 - _e64)), 0f, 1f);
-    let _e71 = d_32;
-    let _e73 = AerialPerspectiveSliceDistance(0f);
-    near = min((_e71 / _e73), 1f);
-    let _e78 = screen_uv_1;
-    let _e79 = k_9;
-    let _e80 = t_15;
-    let _e84 = slices;
-    uvw_2 = vec3<f32>(_e78.x, _e78.y, (((_e79 + _e80) + 0.5f) / _e84));
-    let _e90 = uvw_2;
-    let _e91 = SampleTexture3D(optical_depth_volume, _e90);
-    let _e95 = near;
-    (*transmittance_5) = exp((-(vec3<f32>(_e91.xyz)) * _e95));
-    let _e98 = uvw_2;
-    let _e99 = SampleTexture3D(radiance_volume, _e98);
-    let _e102 = near;
-    return (vec3<f32>(_e99.xyz) * _e102);
+    let _e36 = distance_3;
+    d_30 = max(_e36, 0f);
+    let _e40 = slices;
+    let _e41 = d_30;
+    s_3 = (_e40 * sqrt((_e41 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
+    let _e46 = s_3;
+    let _e51 = slices;
+    k_9 = clamp((floor(_e46) - 1f), 0f, (_e51 - 2f));
+    let _e56 = k_9;
+    let _e57 = AerialPerspectiveSliceDistance(_e56);
+    d_k = _e57;
+    let _e59 = d_30;
+    let _e60 = d_k;
+    let _e62 = k_9;
+    let _e65 = AerialPerspectiveSliceDistance((_e62 + 1f));
+    let _e66 = d_k;
+    t_19 = clamp(((_e59 - _e60) / (_e65 - _e66)), 0f, 1f);
+    let _e73 = d_30;
+    let _e75 = AerialPerspectiveSliceDistance(0f);
+    near = min((_e73 / _e75), 1f);
+    let _e80 = screen_uv_1;
+    let _e81 = k_9;
+    let _e82 = t_19;
+    let _e86 = slices;
+    uvw_2 = vec3<f32>(_e80.x, _e80.y, (((_e81 + _e82) + 0.5f) / _e86));
+    let _e92 = uvw_2;
+    let _e93 = SampleTexture3D(optical_depth_volume, _e92);
+    let _e97 = near;
+    (*transmittance_5) = exp((-(vec3<f32>(_e93.xyz)) * _e97));
+    let _e100 = uvw_2;
+    let _e101 = SampleTexture3D(radiance_volume, _e100);
+    let _e104 = near;
+    return (vec3<f32>(_e101.xyz) * _e104);
 }
