@@ -83,44 +83,6 @@ Number AltitudeAtDistance(IN(AtmosphereParameters) atmosphere, Number r, Number 
   return r - atmosphere.bottom_radius + t * (t + 2.0 * r * mu) / (r_t + r);
 }
 
-// The optical depth of the segment of length d from radius r in direction
-// mu, by the trapezoidal rule on the extinction profile over
-// OPTICAL_DEPTH_INTERVALS equal intervals (for a colour's long segments,
-// below).
-const int OPTICAL_DEPTH_INTERVALS = 16;
-
-vec3 IntegrateSegmentOpticalDepth(IN(AtmosphereParameters) atmosphere, Number r, Number mu, Number d) {
-  Number dt = d / Number(OPTICAL_DEPTH_INTERVALS);
-  vec3 optical_depth = vec3(0.0);
-  vec3 previous_extinction = vec3(0.0);
-  for (int k = 0; k <= OPTICAL_DEPTH_INTERVALS; ++k) {
-    Number t = dt * Number(k);
-    Number r_t = RadiusAtDistance(atmosphere, r, mu, t);
-    vec3 mie_scattering;
-    vec3 rayleigh_scattering;
-    vec3 extinction = GetCoefficientsAtAltitude(atmosphere, AltitudeAtDistance(atmosphere, r, mu, t, r_t),
-                                                mie_scattering, rayleigh_scattering);
-    if (k > 0) optical_depth += (previous_extinction + extinction) * (0.5 * dt);
-    previous_extinction = extinction;
-  }
-  return optical_depth;
-}
-
-// The optical depth of a segment longer than the direct integration covers:
-// two lookups of the transmittance table (GetOpticalDepth), exact at one
-// wavelength per channel. A colour's optical depths do not add
-// (transmittance_is_colour): the difference of the whole rays' optical depths
-// of sunlight's colour from the two ends is that of the wavelengths that
-// survive the longer ray, too small for the segment (it took 15 to 22 % off
-// the aerial perspective over 30 km near the horizon, docs/colour.md), so
-// for colour the segment is integrated along itself.
-vec3 LongSegmentOpticalDepth(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
-                             Number r, Number mu, Number d, bool ray_r_mu_intersects_ground) {
-  return atmosphere.transmittance_is_colour != 0
-             ? IntegrateSegmentOpticalDepth(atmosphere, r, mu, d)
-             : GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground);
-}
-
 // The mean of exp(-x) over [0, depth], (1 - exp(-depth)) / depth, from
 // attenuation = exp(-depth); by its series where that would cancel.
 vec3 MeanAttenuation(IN(vec3) depth, IN(vec3) attenuation) {
@@ -325,15 +287,25 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
   bool ray_r_mu_intersects_ground = RayIntersectsGround(atmosphere, r, mu);
 
   // The transmittance of the whole segment: integrated directly, blended
-  // into the tables' between one and two DIRECT_SEGMENT_LENGTHs.
-  Number direct = 1.0 - smoothstep(DIRECT_SEGMENT_LENGTH, 2.0 * DIRECT_SEGMENT_LENGTH, d);
+  // into the tables' (GetOpticalDepth) between one and two
+  // DIRECT_SEGMENT_LENGTHs; the single Mie of its sunlit part the same way.
+  // A colour's optical depths do not add (transmittance_is_colour): the
+  // difference of the whole rays' optical depths of sunlight's colour from
+  // the two ends is that of the wavelengths that survive the longer ray, too
+  // small for the segment (it took 15 to 22 % off the aerial perspective
+  // over 30 km near the horizon, docs/colour.md), so for colour the
+  // transmittance of a segment of any length is integrated along it.
+  bool colour = atmosphere.transmittance_is_colour != 0;
   Number lit_direct = 1.0 - smoothstep(DIRECT_SEGMENT_LENGTH, 2.0 * DIRECT_SEGMENT_LENGTH, lit);
+  Number direct = colour ? 1.0 : 1.0 - smoothstep(DIRECT_SEGMENT_LENGTH, 2.0 * DIRECT_SEGMENT_LENGTH, d);
+  Number lit_transmittance_direct = colour ? 1.0 : lit_direct;
   // The sunlit part integrated directly, unless it is longer than twice
-  // DIRECT_SEGMENT_LENGTH (where the result reads the tables alone).
+  // DIRECT_SEGMENT_LENGTH and not a colour's (where the result reads the
+  // tables alone).
   SegmentSums lit_sums;
   lit_sums.optical_depth = vec3(0.0);
   lit_sums.single_mie = vec3(0.0);
-  if (lit_direct > 0.0) {
+  if (lit_transmittance_direct > 0.0) {
     lit_sums = ContinueSegment(atmosphere, transmittance_texture, r, mu, mu_s, nu, 0.0, lit,
                                StartSegment(atmosphere, transmittance_texture, r, mu, mu_s, nu, 0.0));
   }
@@ -343,8 +315,7 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
         ContinueSegment(atmosphere, transmittance_texture, r, mu, mu_s, nu, lit, d, lit_sums).optical_depth;
   }
   if (direct < 1.0) {
-    optical_depth = mix(LongSegmentOpticalDepth(atmosphere, transmittance_texture, r, mu, d,
-                                                ray_r_mu_intersects_ground),
+    optical_depth = mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground),
                         optical_depth, direct);
   }
   transmittance = exp(-optical_depth);
@@ -380,9 +351,9 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
   Number r_p = RadiusAtDistance(atmosphere, r, mu, lit);
   Number mu_p = CosineAtDistance(r, mu, lit, r_p);
   Number mu_s_p = ClampCosine((r * mu_s + lit * nu) / r_p);
-  vec3 lit_transmittance = exp(-mix(LongSegmentOpticalDepth(atmosphere, transmittance_texture, r, mu, lit,
-                                                            ray_r_mu_intersects_ground),
-                                    lit_sums.optical_depth, lit_direct));
+  vec3 lit_transmittance =
+      exp(-mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, lit, ray_r_mu_intersects_ground),
+               lit_sums.optical_depth, lit_transmittance_direct));
   vec3 single_mie_scattering_p;
   vec3 scattering_p = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r_p,
                                             mu_p, mu_s_p, nu, ray_r_mu_intersects_ground,

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1133 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1118 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1133)
+    if (!_1118)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _996 = mu < 0.0f;
-    bool _1008;
-    if (_996)
+    bool _981 = mu < 0.0f;
+    bool _993;
+    if (_981)
     {
-        _1008 = (((r * r) * mu) * mu) >= c;
+        _993 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _1008 = _996;
+        _993 = _981;
     }
-    return _1008;
+    return _993;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _766;
+    float _751;
     if (r_mu > 0.0f)
     {
-        _766 = c / (r_mu + s);
+        _751 = c / (r_mu + s);
     }
     else
     {
-        _766 = s - r_mu;
+        _751 = s - r_mu;
     }
-    float param_1 = _766;
+    float param_1 = _751;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1237;
+    float _1222;
     if (d_max > d_min)
     {
-        _1237 = (d - d_min) / (d_max - d_min);
+        _1222 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1237 = 0.0f;
+        _1222 = 0.0f;
     }
-    float x_mu = _1237;
+    float x_mu = _1222;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -247,16 +247,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1289;
+        float _1274;
         if (rho == d_min)
         {
-            _1289 = 0.0f;
+            _1274 = 0.0f;
         }
         else
         {
-            _1289 = (d - d_min) / (rho - d_min);
+            _1274 = (d - d_min) / (rho - d_min);
         }
-        return _1289;
+        return _1274;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -265,16 +265,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1324;
+    float _1309;
     if (d_max > d_min_1)
     {
-        _1324 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1309 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1324 = 0.0f;
+        _1309 = 0.0f;
     }
-    return _1324;
+    return _1309;
 }
 #endif
 
@@ -284,16 +284,16 @@ float GetTextureCoordFromUnitMuInHalf(float x, bool ray_r_mu_intersects_ground, 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5f * GetTextureCoordFromUnitRange(param, param_1);
-    float _1347;
+    float _1332;
     if (ray_r_mu_intersects_ground)
     {
-        _1347 = 0.5f - u;
+        _1332 = 0.5f - u;
     }
     else
     {
-        _1347 = 0.5f + u;
+        _1332 = 0.5f + u;
     }
-    return _1347;
+    return _1332;
 }
 #endif
 
@@ -353,39 +353,39 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1665;
+    float _1650;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1665 = ClampCosine(param_1);
+        _1650 = ClampCosine(param_1);
     }
     else
     {
-        _1665 = 1.0f;
+        _1650 = 1.0f;
     }
-    return _1665;
+    return _1650;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _1012;
+    float _997;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _1012 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _997 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _1012 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _997 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _1012;
+    return _997;
 }
 #endif
 
@@ -438,52 +438,52 @@ float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_p
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0f - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1771;
+    float2 _1756;
     if (c_end >= rho)
     {
-        _1771 = float2(-1.0f, 0.0f);
+        _1756 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1771 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
+        _1756 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float2 end = _1771;
-    bool _1799 = end.y < 0.0f;
-    bool _1809;
-    if (!_1799)
+    float2 end = _1756;
+    bool _1784 = end.y < 0.0f;
+    bool _1794;
+    if (!_1784)
     {
-        _1809 = end.x < start.x;
+        _1794 = end.x < start.x;
     }
     else
     {
-        _1809 = _1799;
+        _1794 = _1784;
     }
-    bool end_sets_last = _1809;
+    bool end_sets_last = _1794;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
     float sin_a = a * (1.0f - ((a * a) / 6.0f));
-    bool2 _1840 = end_sets_last.xx;
-    float2 last = float2(_1840.x ? end.x : start.x, _1840.y ? end.y : start.y);
+    bool2 _1825 = end_sets_last.xx;
+    float2 last = float2(_1825.x ? end.x : start.x, _1825.y ? end.y : start.y);
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1863;
+    float _1848;
     if (end_sets_last)
     {
-        float _1869;
+        float _1854;
         if (c_end >= rho)
         {
-            _1869 = 3.1415927410125732421875f;
+            _1854 = 3.1415927410125732421875f;
         }
         else
         {
-            _1869 = atan2(across, cos_alpha) + acos(cos_gamma);
+            _1854 = atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1863 = _1869;
+        _1848 = _1854;
     }
     else
     {
-        _1863 = acos(c_start);
+        _1848 = acos(c_start);
     }
-    float angle = _1863;
+    float angle = _1848;
     return angle + a;
 }
 #endif
@@ -513,17 +513,17 @@ float GetScatteringMuSFromUnitRangeOnAxis(AtmosphereParameters atmosphere, Scatt
     float param_1 = axis.inverse_A;
     float a = ScatteringDistanceFromUnitMuS(param, param_1);
     float d = d_min + (min(a, axis.A) * (axis.H - d_min));
-    float _1494;
+    float _1479;
     if (d == 0.0f)
     {
-        _1494 = 1.0f;
+        _1479 = 1.0f;
     }
     else
     {
         float param_2 = ((axis.H * axis.H) - (d * d)) / ((2.0f * bottom) * d);
-        _1494 = ClampCosine(param_2);
+        _1479 = ClampCosine(param_2);
     }
-    return _1494;
+    return _1479;
 }
 #endif
 
@@ -575,16 +575,16 @@ void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, ScatteringSunAxis s
     ScatteringSunAxis param_5 = sun_axis;
     float param_6 = ShadowEdgeSunCosine(param_2, param_3);
     float param_7;
-    float _2077 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
+    float _2062 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
     float unused = param_7;
-    X_closest = _2077;
+    X_closest = _2062;
     AtmosphereParameters param_8 = atmosphere;
     ScatteringSunAxis param_9 = sun_axis;
     float param_10 = split_mu_s;
     float param_11;
-    float _2086 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
+    float _2071 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
     unused = param_11;
-    X_span = _2086 - X_closest;
+    X_span = _2071 - X_closest;
     float2 param_12 = edge;
     float param_13 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_12, param_13);
@@ -601,9 +601,9 @@ float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, ScatteringSunAxis s
     ScatteringSunAxis param_3 = sun_axis;
     float param_4 = ShadowEdgeSunCosine(param, param_1);
     float param_5;
-    float _2030 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
+    float _2015 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
     float dX_dtheta = param_5;
-    float X = _2030;
+    float X = _2015;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
@@ -632,9 +632,9 @@ float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, ScatteringSunAxis sun_a
     float param_12 = X_span;
     float param_13 = log_span;
     float param_14;
-    float _2135 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+    float _2120 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
     float unused = param_14;
-    return _2135;
+    return _2120;
 }
 #endif
 
@@ -705,17 +705,17 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, Scatteri
     float u_mu_s = GetScatteringTextureUMuSOnAxis(param_15, param_16, param_17);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = 0.0f.xx;
-    bool _2451 = atmosphere.scattering_mu_s_split > 0;
-    bool _2462;
-    if (_2451)
+    bool _2436 = atmosphere.scattering_mu_s_split > 0;
+    bool _2447;
+    if (_2436)
     {
-        _2462 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2447 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2462 = _2451;
+        _2447 = _2436;
     }
-    if (_2462)
+    if (_2447)
     {
         float param_18 = mu;
         float param_19 = mu_s;
@@ -726,7 +726,7 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, Scatteri
         float param_24 = ViewSunAzimuthCosine(param_18, param_19, param_20);
         bool param_25 = ray_r_mu_intersects_ground;
         float2 param_26;
-        float _2482 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
+        float _2467 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
         edge = param_26;
         float2 param_27 = edge;
         float param_28 = mu_s;
@@ -769,9 +769,9 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, ScatteringSunAxis s
         float param_11 = X_closest;
         float param_12 = X_span;
         float param_13 = log_span;
-        float _2196 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+        float _2181 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
         float slope = param_14;
-        float error = _2196 - x;
+        float error = _2181 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -786,16 +786,16 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, ScatteringSunAxis s
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _2734;
+    float _2719;
     if (low_sun)
     {
-        _2734 = min(t, 1.0f);
+        _2719 = min(t, 1.0f);
     }
     else
     {
-        _2734 = clamp(t, 0.0f, 1.0f);
+        _2719 = clamp(t, 0.0f, 1.0f);
     }
-    return _2734;
+    return _2719;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -806,17 +806,17 @@ void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, floa
     float mu_s_column = clamp(floor(mu_s_coord), 0.0f, mu_s_size - 2.0f);
     x_below = (mu_s_column + 0.5f) / mu_s_size;
     x_above = (mu_s_column + 1.5f) / mu_s_size;
-    bool _2794 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
-    bool _2800;
-    if (_2794)
+    bool _2779 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
+    bool _2785;
+    if (_2779)
     {
-        _2800 = x_below < x_low_sun;
+        _2785 = x_below < x_low_sun;
     }
     else
     {
-        _2800 = _2794;
+        _2785 = _2779;
     }
-    low_sun_below = _2800;
+    low_sun_below = _2785;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -836,10 +836,10 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
     float param_6 = nu;
     bool param_7 = ray_r_mu_intersects_ground;
     float2 param_8;
-    float4 _3350 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    float4 _3335 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float2 edge = param_8;
     ScatteringLookup lookup;
-    lookup.uvwz = _3350;
+    lookup.uvwz = _3335;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = lookup.uvwz.x * (nu_size - 1.0f);
     lookup.nu_slice = min(floor(nu_coord), nu_size - 2.0f);
@@ -854,17 +854,17 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
     lookup.log_first_span = 1.0f;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5f;
-    bool _3402 = atmosphere.scattering_mu_s_split > 0;
-    bool _3411;
-    if (_3402)
+    bool _3387 = atmosphere.scattering_mu_s_split > 0;
+    bool _3396;
+    if (_3387)
     {
-        _3411 = lookup.position < float(atmosphere.scattering_mu_s_split);
+        _3396 = lookup.position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3411 = _3402;
+        _3396 = _3387;
     }
-    if (_3411)
+    if (_3396)
     {
         float past = 6.0f;
         lookup.kind = 3;
@@ -885,17 +885,17 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
         }
         else
         {
-            bool _3459 = lookup.position >= (past - 1.0f);
-            bool _3466;
-            if (_3459)
+            bool _3444 = lookup.position >= (past - 1.0f);
+            bool _3451;
+            if (_3444)
             {
-                _3466 = lookup.position < past;
+                _3451 = lookup.position < past;
             }
             else
             {
-                _3466 = _3459;
+                _3451 = _3444;
             }
-            if (_3466)
+            if (_3451)
             {
                 float x = 1.0f / (float(atmosphere.scattering_mu_s_split) - past);
                 AtmosphereParameters param_15 = atmosphere;
@@ -984,26 +984,26 @@ float4 IsLit(float4 log_light)
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float4 LogMonotoneCubic(float4 log_a, float4 lb, float4 lc, float4 log_d, bool has_a, bool has_d, float t)
 {
-    float4 _2810;
+    float4 _2795;
     if (has_a)
     {
-        _2810 = log_a;
+        _2795 = log_a;
     }
     else
     {
-        _2810 = (lb * 2.0f) - lc;
+        _2795 = (lb * 2.0f) - lc;
     }
-    float4 la = _2810;
-    float4 _2822;
+    float4 la = _2795;
+    float4 _2807;
     if (has_d)
     {
-        _2822 = log_d;
+        _2807 = log_d;
     }
     else
     {
-        _2822 = (lc * 2.0f) - lb;
+        _2807 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2822;
+    float4 ld = _2807;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1122,19 +1122,19 @@ float4 GetLogScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<fl
     float param_6 = x;
     float param_7 = nu_slice + 1.0f;
     float4 b = GetScatteringInSlice(param_4, scattering_texture_1, _scattering_texture_1_sampler, param_5, param_6, param_7);
-    float4 _3057;
+    float4 _3042;
     if (low_sun)
     {
         float4 param_8 = a;
         float4 param_9 = b;
-        _3057 = lerp(LogLight(param_8), LogLight(param_9), nu_t.xxxx);
+        _3042 = lerp(LogLight(param_8), LogLight(param_9), nu_t.xxxx);
     }
     else
     {
         float4 param_10 = lerp(a, b, nu_t.xxxx);
-        _3057 = LogLight(param_10);
+        _3042 = LogLight(param_10);
     }
-    return _3057;
+    return _3042;
 }
 #endif
 
@@ -1269,16 +1269,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScatteringFromLookup(param_6, scattering_texture_1, _scattering_texture_1_sampler, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3939;
+        float3 _3924;
         if (scattering.x > 0.0f)
         {
-            _3939 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3924 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3939 = 0.0f.xxx;
+            _3924 = 0.0f.xxx;
         }
-        single_mie_scattering = _3939;
+        single_mie_scattering = _3924;
     }
     else
     {
@@ -1344,9 +1344,9 @@ float3 GetSkyRadianceOfRay(AtmosphereParameters atmosphere, Texture3D<float4> sc
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3995 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3980 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3995;
+    float3 scattering = _3980;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1366,13 +1366,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _4030 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4015 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4030)
+    if (!_4015)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1381,19 +1381,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _4050;
+    float3 _4035;
     if (ray_r_mu_intersects_ground)
     {
-        _4050 = 0.0f.xxx;
+        _4035 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _4050 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _4035 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _4050;
+    transmittance = _4035;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1415,16 +1415,16 @@ float GetUnitRangeFromTextureCoord(float u, int texture_size)
 float GetUnitMuInHalfFromTextureCoord(float u, int size, inout bool ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5f;
-    float _1361;
+    float _1346;
     if (ray_r_mu_intersects_ground)
     {
-        _1361 = 1.0f - (2.0f * u);
+        _1346 = 1.0f - (2.0f * u);
     }
     else
     {
-        _1361 = (2.0f * u) - 1.0f;
+        _1346 = (2.0f * u) - 1.0f;
     }
-    float param = _1361;
+    float param = _1346;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1445,25 +1445,25 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _5549 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5449 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _5549;
+    float x = _5449;
     float e = (1.0f - x) * (1.0f - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _5570;
+    float _5470;
     if (ray_r_mu_intersects_ground)
     {
-        _5570 = theta_h + (e * (3.1415927410125732421875f - theta_h));
+        _5470 = theta_h + (e * (3.1415927410125732421875f - theta_h));
     }
     else
     {
-        _5570 = theta_h * (1.0f - e);
+        _5470 = theta_h * (1.0f - e);
     }
-    float theta = _5570;
+    float theta = _5470;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875f * clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0f, 1.0f);
@@ -1471,8 +1471,8 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
     if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13f)
     {
-        bool3 _5620 = (abs(up.x) < 0.89999997615814208984375f).xxx;
-        toward_sun = cross(up, float3(_5620.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5620.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5620.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
+        bool3 _5520 = (abs(up.x) < 0.89999997615814208984375f).xxx;
+        toward_sun = cross(up, float3(_5520.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5520.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5520.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
     }
     toward_sun = normalize(toward_sun);
     float3 across = cross(up, toward_sun);
@@ -1488,9 +1488,9 @@ float3 GetSkyViewRadiance(AtmosphereParameters atmosphere, Texture3D<float4> sca
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5659 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5559 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5659;
+    float3 view_ray = _5559;
     float3 up = normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1517,16 +1517,16 @@ void GetSkyViewAngles(float3 camera, float3 view_ray, float3 sun_direction, out 
     theta = atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _5535;
+    float _5435;
     if ((along != 0.0f) || (side != 0.0f))
     {
-        _5535 = atan2(side, along);
+        _5435 = atan2(side, along);
     }
     else
     {
-        _5535 = 0.0f;
+        _5435 = 0.0f;
     }
-    phi = _5535;
+    phi = _5435;
 }
 #endif
 
@@ -1536,16 +1536,16 @@ float2 GetSkyViewUvFromAngles(AtmosphereParameters atmosphere, float r, float th
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _5456;
+    float _5356;
     if (ray_r_mu_intersects_ground)
     {
-        _5456 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
+        _5356 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
     }
     else
     {
-        _5456 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
+        _5356 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
     }
-    float x = _5456;
+    float x = _5356;
     float param_2 = phi / 3.1415927410125732421875f;
     int param_3 = 192;
     float param_4 = x;
@@ -1567,19 +1567,19 @@ float3 GetSkyRadianceFromSkyView(AtmosphereParameters atmosphere, Texture2D<floa
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5721;
+    float3 _5621;
     if (ray_r_mu_intersects_ground)
     {
-        _5721 = 0.0f.xxx;
+        _5621 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5721 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
+        _5621 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
     }
-    transmittance = _5721;
+    transmittance = _5621;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1694,11 +1694,11 @@ SegmentNode GetSegmentNode(AtmosphereParameters atmosphere, Texture2D<float4> tr
     float param_11 = AltitudeAtDistance(param_5, param_6, param_7, param_8, param_9);
     float3 param_12;
     float3 param_13;
-    float3 _4433 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+    float3 _4319 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
     float3 mie_scattering = param_12;
     float3 rayleigh_scattering = param_13;
     SegmentNode node;
-    node.extinction = _4433;
+    node.extinction = _4319;
     AtmosphereParameters param_14 = atmosphere;
     float param_15 = r_t;
     float param_16 = mu_s_t;
@@ -1816,64 +1816,64 @@ SegmentSums ContinueSegment(AtmosphereParameters atmosphere, Texture2D<float4> t
     bool short_stretch = (t1 - t0) <= (0.00999999977648258209228515625f * t1);
     int intervals = short_stretch ? 1 : 2;
     float dt = (t1 - t0) / float(intervals);
-    int _4719 = short_stretch ? (-1) : (-2);
-    float _4771;
-    float _4777;
-    for (int i = _4719; i < intervals; i++)
+    int _4605 = short_stretch ? (-1) : (-2);
+    float _4657;
+    float _4663;
+    for (int i = _4605; i < intervals; i++)
     {
-        bool _4730 = i == (-2);
-        bool _4738;
-        if (!_4730)
+        bool _4616 = i == (-2);
+        bool _4624;
+        if (!_4616)
         {
-            _4738 = (i == (-1)) && short_stretch;
+            _4624 = (i == (-1)) && short_stretch;
         }
         else
         {
-            _4738 = _4730;
+            _4624 = _4616;
         }
-        bool finding_last = _4738;
+        bool finding_last = _4624;
         bool finding_middle = (i == (-1)) && (!short_stretch);
         int k = i + 1;
         SegmentNode node = last;
-        bool _4752 = finding_last || finding_middle;
-        bool _4766;
-        if (!_4752)
+        bool _4638 = finding_last || finding_middle;
+        bool _4652;
+        if (!_4638)
         {
-            bool _4758 = k < intervals;
-            bool _4765;
-            if (_4758)
+            bool _4644 = k < intervals;
+            bool _4651;
+            if (_4644)
             {
-                _4765 = (2 * k) != intervals;
+                _4651 = (2 * k) != intervals;
             }
             else
             {
-                _4765 = _4758;
+                _4651 = _4644;
             }
-            _4766 = _4765;
+            _4652 = _4651;
         }
         else
         {
-            _4766 = _4752;
+            _4652 = _4638;
         }
-        if (_4766)
+        if (_4652)
         {
             if (finding_last)
             {
-                _4771 = t1;
+                _4657 = t1;
             }
             else
             {
                 if (finding_middle)
                 {
-                    _4777 = 0.5f * (t0 + t1);
+                    _4663 = 0.5f * (t0 + t1);
                 }
                 else
                 {
-                    _4777 = t0 + (dt * float(k));
+                    _4663 = t0 + (dt * float(k));
                 }
-                _4771 = _4777;
+                _4657 = _4663;
             }
-            float t = _4771;
+            float t = _4657;
             AtmosphereParameters param = atmosphere;
             float param_1 = r;
             float param_2 = mu;
@@ -1923,43 +1923,6 @@ SegmentSums ContinueSegment(AtmosphereParameters atmosphere, Texture2D<float4> t
     }
     result.end = last;
     return result;
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-float3 IntegrateSegmentOpticalDepth(AtmosphereParameters atmosphere, float r, float mu, float d)
-{
-    float dt = d / 16.0f;
-    float3 optical_depth = 0.0f.xxx;
-    float3 previous_extinction = 0.0f.xxx;
-    float3 param_11;
-    float3 param_12;
-    for (int k = 0; k <= 16; k++)
-    {
-        float t = dt * float(k);
-        AtmosphereParameters param = atmosphere;
-        float param_1 = r;
-        float param_2 = mu;
-        float param_3 = t;
-        float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
-        AtmosphereParameters param_4 = atmosphere;
-        float param_5 = r;
-        float param_6 = mu;
-        float param_7 = t;
-        float param_8 = r_t;
-        AtmosphereParameters param_9 = atmosphere;
-        float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4325 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
-        float3 mie_scattering = param_11;
-        float3 rayleigh_scattering = param_12;
-        float3 extinction = _4325;
-        if (k > 0)
-        {
-            optical_depth += ((previous_extinction + extinction) * (0.5f * dt));
-        }
-        previous_extinction = extinction;
-    }
-    return optical_depth;
 }
 #endif
 
@@ -2031,31 +1994,6 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-float3 LongSegmentOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground)
-{
-    float3 _4349;
-    if (atmosphere.transmittance_is_colour != 0)
-    {
-        AtmosphereParameters param = atmosphere;
-        float param_1 = r;
-        float param_2 = mu;
-        float param_3 = d;
-        _4349 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
-    }
-    else
-    {
-        AtmosphereParameters param_4 = atmosphere;
-        float param_5 = r;
-        float param_6 = mu;
-        float param_7 = d;
-        bool param_8 = ray_r_mu_intersects_ground;
-        _4349 = GetOpticalDepth(param_4, transmittance_texture_1, _transmittance_texture_1_sampler, param_5, param_6, param_7, param_8);
-    }
-    return _4349;
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, float mu)
 {
     float r_max = atmosphere.scattering_r_max;
@@ -2064,16 +2002,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _4116;
+    float _4101;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _4116 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _4101 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _4116 = up;
+        _4101 = up;
     }
-    return _4116;
+    return _4101;
 }
 #endif
 
@@ -2096,13 +2034,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4956 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4842 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4956)
+    if (!_4842)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -2113,12 +2051,23 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float direct = 1.0f - smoothstep(10000.0f, 20000.0f, d);
+    bool colour = atmosphere.transmittance_is_colour != 0;
     float lit_direct = 1.0f - smoothstep(10000.0f, 20000.0f, lit);
+    float _4884;
+    if (colour)
+    {
+        _4884 = 1.0f;
+    }
+    else
+    {
+        _4884 = 1.0f - smoothstep(10000.0f, 20000.0f, d);
+    }
+    float direct = _4884;
+    float lit_transmittance_direct = colour ? 1.0f : lit_direct;
     SegmentSums lit_sums;
     lit_sums.optical_depth = 0.0f.xxx;
     lit_sums.single_mie = 0.0f.xxx;
-    if (lit_direct > 0.0f)
+    if (lit_transmittance_direct > 0.0f)
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
@@ -2156,7 +2105,7 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         float param_36 = mu;
         float param_37 = d;
         bool param_38 = ray_r_mu_intersects_ground;
-        optical_depth = lerp(LongSegmentOpticalDepth(param_34, transmittance_texture_1, _transmittance_texture_1_sampler, param_35, param_36, param_37, param_38), optical_depth, direct.xxx);
+        optical_depth = lerp(GetOpticalDepth(param_34, transmittance_texture_1, _transmittance_texture_1_sampler, param_35, param_36, param_37, param_38), optical_depth, direct.xxx);
     }
     transmittance = exp(-optical_depth);
     AtmosphereParameters param_39 = atmosphere;
@@ -2166,9 +2115,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_43 = nu;
     bool param_44 = ray_r_mu_intersects_ground;
     float3 param_45;
-    float3 _5096 = GetCombinedScattering(param_39, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_40, param_41, param_42, param_43, param_44, param_45);
+    float3 _4996 = GetCombinedScattering(param_39, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_40, param_41, param_42, param_43, param_44, param_45);
     float3 single_mie_scattering = param_45;
-    float3 scattering = _5096;
+    float3 scattering = _4996;
     if (lit < 10000.0f)
     {
         AtmosphereParameters param_46 = atmosphere;
@@ -2208,9 +2157,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
             float param_74 = nu;
             bool param_75 = ray_r_mu_intersects_ground;
             float3 param_76;
-            float3 _5192 = GetCombinedScattering(param_70, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_71, param_72, param_73, param_74, param_75, param_76);
+            float3 _5092 = GetCombinedScattering(param_70, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_71, param_72, param_73, param_74, param_75, param_76);
             float3 unused_far_mie = param_76;
-            scattering -= (far_sums.transmittance * _5192);
+            scattering -= (far_sums.transmittance * _5092);
         }
         float3 multiple = (max(scattering - (far_sums.single_rayleigh * atmosphere.solar_irradiance), 0.0f.xxx) * lit_sums.scattering_weight) / max(far_sums.scattering_weight, 1.0000000031710768509710513471353e-30f.xxx);
         float param_77 = nu;
@@ -2235,7 +2184,7 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_91 = mu;
     float param_92 = lit;
     bool param_93 = ray_r_mu_intersects_ground;
-    float3 lit_transmittance = exp(-lerp(LongSegmentOpticalDepth(param_89, transmittance_texture_1, _transmittance_texture_1_sampler, param_90, param_91, param_92, param_93), lit_sums.optical_depth, lit_direct.xxx));
+    float3 lit_transmittance = exp(-lerp(GetOpticalDepth(param_89, transmittance_texture_1, _transmittance_texture_1_sampler, param_90, param_91, param_92, param_93), lit_sums.optical_depth, lit_transmittance_direct.xxx));
     AtmosphereParameters param_94 = atmosphere;
     float param_95 = r_p;
     float param_96 = mu_p;
@@ -2243,9 +2192,9 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_98 = nu;
     bool param_99 = ray_r_mu_intersects_ground;
     float3 param_100;
-    float3 _5303 = GetCombinedScattering(param_94, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_95, param_96, param_97, param_98, param_99, param_100);
+    float3 _5203 = GetCombinedScattering(param_94, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_95, param_96, param_97, param_98, param_99, param_100);
     float3 single_mie_scattering_p = param_100;
-    float3 scattering_p = _5303;
+    float3 scattering_p = _5203;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, lit_sums.single_mie * atmosphere.solar_irradiance, lit_direct.xxx);
@@ -2265,9 +2214,9 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5351 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _5251 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _5351;
+    return _5251;
 }
 #endif
 
@@ -2295,9 +2244,9 @@ float3 GetAerialPerspectiveVoxel(AtmosphereParameters atmosphere, Texture2D<floa
     float3 param_3 = _point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5814 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
+    float3 _5714 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5814;
+    float3 radiance = _5714;
     optical_depth = -log(max(transmittance, 1.0000000031710768509710513471353e-30f.xxx));
     return radiance;
 }
@@ -2325,16 +2274,16 @@ float3 GetSkyRadianceToPointFromVolume(Texture3D<float4> radiance_volume, Sample
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1543;
+    float _1528;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1543 = 0.100000001490116119384765625f;
+        _1528 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1543 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1528 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1543;
+    return _1528;
 }
 #endif
 
@@ -2343,16 +2292,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1561;
+    float _1546;
     if (mu_s < knee)
     {
-        _1561 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1546 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1561 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1546 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1561;
+    return _1546;
 }
 #endif
 
@@ -2379,16 +2328,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1592;
+    float _1577;
     if (x < 0.5f)
     {
-        _1592 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1577 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1592 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1577 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1592;
+    return _1577;
 }
 #endif
 
@@ -2414,16 +2363,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2757;
+    float4 _2742;
     if (t < 0.0f)
     {
-        _2757 = min(blend, a);
+        _2742 = min(blend, a);
     }
     else
     {
-        _2757 = blend;
+        _2742 = blend;
     }
-    return _2757;
+    return _2742;
 }
 #endif
 

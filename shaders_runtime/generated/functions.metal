@@ -48,11 +48,11 @@ bool GetViewRayStart(thread const AtmosphereParameters& atmosphere, thread const
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1133 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1118 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1133)
+    if (!_1118)
     {
         return false;
     }
@@ -71,17 +71,17 @@ static inline __attribute__((always_inline))
 bool RayIntersectsGround(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _996 = mu < 0.0;
-    bool _1008;
-    if (_996)
+    bool _981 = mu < 0.0;
+    bool _993;
+    if (_981)
     {
-        _1008 = (((r * r) * mu) * mu) >= c;
+        _993 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _1008 = _996;
+        _993 = _981;
     }
-    return _1008;
+    return _993;
 }
 #endif
 
@@ -117,16 +117,16 @@ float DistanceToSphereFromInside(thread const float& r_mu, thread const float& c
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _766;
+    float _751;
     if (r_mu > 0.0)
     {
-        _766 = c / (r_mu + s);
+        _751 = c / (r_mu + s);
     }
     else
     {
-        _766 = s - r_mu;
+        _751 = s - r_mu;
     }
-    float param_1 = _766;
+    float param_1 = _751;
     return ClampDistance(param_1);
 }
 
@@ -159,16 +159,16 @@ float2 GetTransmittanceTextureUvFromRMu(thread const AtmosphereParameters& atmos
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1237;
+    float _1222;
     if (d_max > d_min)
     {
-        _1237 = (d - d_min) / (d_max - d_min);
+        _1222 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1237 = 0.0;
+        _1222 = 0.0;
     }
-    float x_mu = _1237;
+    float x_mu = _1222;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -267,16 +267,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1289;
+        float _1274;
         if (rho == d_min)
         {
-            _1289 = 0.0;
+            _1274 = 0.0;
         }
         else
         {
-            _1289 = (d - d_min) / (rho - d_min);
+            _1274 = (d - d_min) / (rho - d_min);
         }
-        return _1289;
+        return _1274;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -285,16 +285,16 @@ float GetUnitMuInHalf(thread const AtmosphereParameters& atmosphere, thread cons
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1324;
+    float _1309;
     if (d_max > d_min_1)
     {
-        _1324 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1309 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1324 = 0.0;
+        _1309 = 0.0;
     }
-    return _1324;
+    return _1309;
 }
 #endif
 
@@ -305,16 +305,16 @@ float GetTextureCoordFromUnitMuInHalf(thread const float& x, thread const bool& 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5 * GetTextureCoordFromUnitRange(param, param_1);
-    float _1347;
+    float _1332;
     if (ray_r_mu_intersects_ground)
     {
-        _1347 = 0.5 - u;
+        _1332 = 0.5 - u;
     }
     else
     {
-        _1347 = 0.5 + u;
+        _1332 = 0.5 + u;
     }
-    return _1347;
+    return _1332;
 }
 #endif
 
@@ -378,17 +378,17 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 {
     float param = (1.0 - (mu * mu)) * (1.0 - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1665;
+    float _1650;
     if (across > 0.0)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1665 = ClampCosine(param_1);
+        _1650 = ClampCosine(param_1);
     }
     else
     {
-        _1665 = 1.0;
+        _1650 = 1.0;
     }
-    return _1665;
+    return _1650;
 }
 #endif
 
@@ -396,22 +396,22 @@ float ViewSunAzimuthCosine(thread const float& mu, thread const float& mu_s, thr
 static inline __attribute__((always_inline))
 float DistanceToNearestAtmosphereBoundary(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const bool& ray_r_mu_intersects_ground)
 {
-    float _1012;
+    float _997;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _1012 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _997 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _1012 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _997 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _1012;
+    return _997;
 }
 #endif
 
@@ -468,51 +468,51 @@ float ShadowEdge(thread const AtmosphereParameters& atmosphere, thread const flo
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0 - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1771;
+    float2 _1756;
     if (c_end >= rho)
     {
-        _1771 = float2(-1.0, 0.0);
+        _1756 = float2(-1.0, 0.0);
     }
     else
     {
-        _1771 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
+        _1756 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / float2(rho);
     }
-    float2 end = _1771;
-    bool _1799 = end.y < 0.0;
-    bool _1809;
-    if (!_1799)
+    float2 end = _1756;
+    bool _1784 = end.y < 0.0;
+    bool _1794;
+    if (!_1784)
     {
-        _1809 = end.x < start.x;
+        _1794 = end.x < start.x;
     }
     else
     {
-        _1809 = _1799;
+        _1794 = _1784;
     }
-    bool end_sets_last = _1809;
+    bool end_sets_last = _1794;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0 - (((0.5 * a) * a) * (1.0 - ((a * a) / 12.0)));
     float sin_a = a * (1.0 - ((a * a) / 6.0));
     float2 last = select(start, end, bool2(end_sets_last));
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1863;
+    float _1848;
     if (end_sets_last)
     {
-        float _1869;
+        float _1854;
         if (c_end >= rho)
         {
-            _1869 = 3.1415927410125732421875;
+            _1854 = 3.1415927410125732421875;
         }
         else
         {
-            _1869 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
+            _1854 = precise::atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1863 = _1869;
+        _1848 = _1854;
     }
     else
     {
-        _1863 = acos(c_start);
+        _1848 = acos(c_start);
     }
-    float angle = _1863;
+    float angle = _1848;
     return angle + a;
 }
 #endif
@@ -545,17 +545,17 @@ float GetScatteringMuSFromUnitRangeOnAxis(thread const AtmosphereParameters& atm
     float param_1 = axis.inverse_A;
     float a = ScatteringDistanceFromUnitMuS(param, param_1);
     float d = d_min + (fast::min(a, axis.A) * (axis.H - d_min));
-    float _1494;
+    float _1479;
     if (d == 0.0)
     {
-        _1494 = 1.0;
+        _1479 = 1.0;
     }
     else
     {
         float param_2 = ((axis.H * axis.H) - (d * d)) / ((2.0 * bottom) * d);
-        _1494 = ClampCosine(param_2);
+        _1479 = ClampCosine(param_2);
     }
-    return _1494;
+    return _1479;
 }
 #endif
 
@@ -611,16 +611,16 @@ void ShadowEdgeLitUnitSpans(thread const AtmosphereParameters& atmosphere, threa
     ScatteringSunAxis param_5 = sun_axis;
     float param_6 = ShadowEdgeSunCosine(param_2, param_3);
     float param_7;
-    float _2077 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
+    float _2062 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
     float unused = param_7;
-    X_closest = _2077;
+    X_closest = _2062;
     AtmosphereParameters param_8 = atmosphere;
     ScatteringSunAxis param_9 = sun_axis;
     float param_10 = split_mu_s;
     float param_11;
-    float _2086 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
+    float _2071 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
     unused = param_11;
-    X_span = _2086 - X_closest;
+    X_span = _2071 - X_closest;
     float2 param_12 = edge;
     float param_13 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_12, param_13);
@@ -638,9 +638,9 @@ float ShadowEdgeLitUnitFrom(thread const AtmosphereParameters& atmosphere, threa
     ScatteringSunAxis param_3 = sun_axis;
     float param_4 = ShadowEdgeSunCosine(param, param_1);
     float param_5;
-    float _2030 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
+    float _2015 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
     float dX_dtheta = param_5;
-    float X = _2030;
+    float X = _2015;
     derivative = ((((-0.300000011920928955078125) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875 / log_span);
     return ((0.300000011920928955078125 * (X - X_closest)) / X_span) + ((0.699999988079071044921875 * log(D / 0.0008726646192371845245361328125)) / log_span);
 }
@@ -670,9 +670,9 @@ float ShadowEdgeLitUnit(thread const AtmosphereParameters& atmosphere, thread co
     float param_12 = X_span;
     float param_13 = log_span;
     float param_14;
-    float _2135 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+    float _2120 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
     float unused = param_14;
-    return _2135;
+    return _2120;
 }
 #endif
 
@@ -747,17 +747,17 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
     float u_mu_s = GetScatteringTextureUMuSOnAxis(param_15, param_16, param_17);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = float2(0.0);
-    bool _2451 = atmosphere.scattering_mu_s_split > 0;
-    bool _2462;
-    if (_2451)
+    bool _2436 = atmosphere.scattering_mu_s_split > 0;
+    bool _2447;
+    if (_2436)
     {
-        _2462 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
+        _2447 = ((u_mu_s * mu_s_size) - 0.5) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2462 = _2451;
+        _2447 = _2436;
     }
-    if (_2462)
+    if (_2447)
     {
         float param_18 = mu;
         float param_19 = mu_s;
@@ -768,7 +768,7 @@ float4 GetScatteringTextureUvwzAndEdge(thread const AtmosphereParameters& atmosp
         float param_24 = ViewSunAzimuthCosine(param_18, param_19, param_20);
         bool param_25 = ray_r_mu_intersects_ground;
         float2 param_26;
-        float _2482 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
+        float _2467 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
         edge = param_26;
         float2 param_27 = edge;
         float param_28 = mu_s;
@@ -812,9 +812,9 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
         float param_11 = X_closest;
         float param_12 = X_span;
         float param_13 = log_span;
-        float _2196 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+        float _2181 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
         float slope = param_14;
-        float error = _2196 - x;
+        float error = _2181 - x;
         float next = fast::clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12;
         s = next;
@@ -830,16 +830,16 @@ float ShadowEdgeLitDistance(thread const AtmosphereParameters& atmosphere, threa
 static inline __attribute__((always_inline))
 float SunCosinePosition(thread const float& t, thread const bool& low_sun)
 {
-    float _2734;
+    float _2719;
     if (low_sun)
     {
-        _2734 = fast::min(t, 1.0);
+        _2719 = fast::min(t, 1.0);
     }
     else
     {
-        _2734 = fast::clamp(t, 0.0, 1.0);
+        _2719 = fast::clamp(t, 0.0, 1.0);
     }
-    return _2734;
+    return _2719;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -851,17 +851,17 @@ void GetScatteringMuSColumns(thread const AtmosphereParameters& atmosphere, thre
     float mu_s_column = fast::clamp(floor(mu_s_coord), 0.0, mu_s_size - 2.0);
     x_below = (mu_s_column + 0.5) / mu_s_size;
     x_above = (mu_s_column + 1.5) / mu_s_size;
-    bool _2794 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
-    bool _2800;
-    if (_2794)
+    bool _2779 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625;
+    bool _2785;
+    if (_2779)
     {
-        _2800 = x_below < x_low_sun;
+        _2785 = x_below < x_low_sun;
     }
     else
     {
-        _2800 = _2794;
+        _2785 = _2779;
     }
-    low_sun_below = _2800;
+    low_sun_below = _2785;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -882,10 +882,10 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
     float param_6 = nu;
     bool param_7 = ray_r_mu_intersects_ground;
     float2 param_8;
-    float4 _3350 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    float4 _3335 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float2 edge = param_8;
     ScatteringLookup lookup;
-    lookup.uvwz = _3350;
+    lookup.uvwz = _3335;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = lookup.uvwz.x * (nu_size - 1.0);
     lookup.nu_slice = fast::min(floor(nu_coord), nu_size - 2.0);
@@ -900,17 +900,17 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
     lookup.log_first_span = 1.0;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5;
-    bool _3402 = atmosphere.scattering_mu_s_split > 0;
-    bool _3411;
-    if (_3402)
+    bool _3387 = atmosphere.scattering_mu_s_split > 0;
+    bool _3396;
+    if (_3387)
     {
-        _3411 = lookup.position < float(atmosphere.scattering_mu_s_split);
+        _3396 = lookup.position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3411 = _3402;
+        _3396 = _3387;
     }
-    if (_3411)
+    if (_3396)
     {
         float past = 6.0;
         lookup.kind = 3;
@@ -931,17 +931,17 @@ ScatteringLookup GetScatteringLookup(thread const AtmosphereParameters& atmosphe
         }
         else
         {
-            bool _3459 = lookup.position >= (past - 1.0);
-            bool _3466;
-            if (_3459)
+            bool _3444 = lookup.position >= (past - 1.0);
+            bool _3451;
+            if (_3444)
             {
-                _3466 = lookup.position < past;
+                _3451 = lookup.position < past;
             }
             else
             {
-                _3466 = _3459;
+                _3451 = _3444;
             }
-            if (_3466)
+            if (_3451)
             {
                 float x = 1.0 / (float(atmosphere.scattering_mu_s_split) - past);
                 AtmosphereParameters param_15 = atmosphere;
@@ -1035,26 +1035,26 @@ float4 IsLit(thread const float4& log_light)
 static inline __attribute__((always_inline))
 float4 LogMonotoneCubic(thread const float4& log_a, thread const float4& lb, thread const float4& lc, thread const float4& log_d, thread const bool& has_a, thread const bool& has_d, thread const float& t)
 {
-    float4 _2810;
+    float4 _2795;
     if (has_a)
     {
-        _2810 = log_a;
+        _2795 = log_a;
     }
     else
     {
-        _2810 = (lb * 2.0) - lc;
+        _2795 = (lb * 2.0) - lc;
     }
-    float4 la = _2810;
-    float4 _2822;
+    float4 la = _2795;
+    float4 _2807;
     if (has_d)
     {
-        _2822 = log_d;
+        _2807 = log_d;
     }
     else
     {
-        _2822 = (lc * 2.0) - lb;
+        _2807 = (lc * 2.0) - lb;
     }
-    float4 ld = _2822;
+    float4 ld = _2807;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1176,19 +1176,19 @@ float4 GetLogScatteringAtMuSColumn(thread const AtmosphereParameters& atmosphere
     float param_6 = x;
     float param_7 = nu_slice + 1.0;
     float4 b = GetScatteringInSlice(param_4, scattering_texture, scattering_textureSmplr, param_5, param_6, param_7);
-    float4 _3057;
+    float4 _3042;
     if (low_sun)
     {
         float4 param_8 = a;
         float4 param_9 = b;
-        _3057 = mix(LogLight(param_8), LogLight(param_9), float4(nu_t));
+        _3042 = mix(LogLight(param_8), LogLight(param_9), float4(nu_t));
     }
     else
     {
         float4 param_10 = mix(a, b, float4(nu_t));
-        _3057 = LogLight(param_10);
+        _3042 = LogLight(param_10);
     }
-    return _3057;
+    return _3042;
 }
 #endif
 
@@ -1327,16 +1327,16 @@ float3 GetCombinedScattering(thread const AtmosphereParameters& atmosphere, text
     float4 scattering = GetScatteringFromLookup(param_6, scattering_texture, scattering_textureSmplr, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3939;
+        float3 _3924;
         if (scattering.x > 0.0)
         {
-            _3939 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
+            _3924 = ((float3(scattering.xyz) * scattering.w) / float3(scattering.x)) * (atmosphere.mie_to_rayleigh_scattering_ratio / float3(atmosphere.mie_to_rayleigh_scattering_ratio.x));
         }
         else
         {
-            _3939 = float3(0.0);
+            _3924 = float3(0.0);
         }
-        single_mie_scattering = _3939;
+        single_mie_scattering = _3924;
     }
     else
     {
@@ -1407,9 +1407,9 @@ float3 GetSkyRadianceOfRay(thread const AtmosphereParameters& atmosphere, textur
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3995 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3980 = GetCombinedScattering(param, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3995;
+    float3 scattering = _3980;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1430,13 +1430,13 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_6;
     float param_7;
     float param_8;
-    bool _4030 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4015 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4030)
+    if (!_4015)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -1445,19 +1445,19 @@ float3 GetSkyRadiance(thread const AtmosphereParameters& atmosphere, texture2d<f
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _4050;
+    float3 _4035;
     if (ray_r_mu_intersects_ground)
     {
-        _4050 = float3(0.0);
+        _4035 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _4050 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
+        _4035 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture, transmittance_textureSmplr, param_13, param_14);
     }
-    transmittance = _4050;
+    transmittance = _4035;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1481,16 +1481,16 @@ static inline __attribute__((always_inline))
 float GetUnitMuInHalfFromTextureCoord(thread const float& u, thread const int& size, thread bool& ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5;
-    float _1361;
+    float _1346;
     if (ray_r_mu_intersects_ground)
     {
-        _1361 = 1.0 - (2.0 * u);
+        _1346 = 1.0 - (2.0 * u);
     }
     else
     {
-        _1361 = (2.0 * u) - 1.0;
+        _1346 = (2.0 * u) - 1.0;
     }
-    float param = _1361;
+    float param = _1346;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1513,25 +1513,25 @@ float3 GetSkyViewRay(thread const AtmosphereParameters& atmosphere, thread const
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _5549 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5449 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _5549;
+    float x = _5449;
     float e = (1.0 - x) * (1.0 - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _5570;
+    float _5470;
     if (ray_r_mu_intersects_ground)
     {
-        _5570 = theta_h + (e * (3.1415927410125732421875 - theta_h));
+        _5470 = theta_h + (e * (3.1415927410125732421875 - theta_h));
     }
     else
     {
-        _5570 = theta_h * (1.0 - e);
+        _5470 = theta_h * (1.0 - e);
     }
-    float theta = _5570;
+    float theta = _5470;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875 * fast::clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0, 1.0);
@@ -1556,9 +1556,9 @@ float3 GetSkyViewRadiance(thread const AtmosphereParameters& atmosphere, texture
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5659 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5559 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5659;
+    float3 view_ray = _5559;
     float3 up = fast::normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1586,16 +1586,16 @@ void GetSkyViewAngles(thread const float3& camera, thread const float3& view_ray
     theta = precise::atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _5535;
+    float _5435;
     if ((along != 0.0) || (side != 0.0))
     {
-        _5535 = precise::atan2(side, along);
+        _5435 = precise::atan2(side, along);
     }
     else
     {
-        _5535 = 0.0;
+        _5435 = 0.0;
     }
-    phi = _5535;
+    phi = _5435;
 }
 #endif
 
@@ -1606,16 +1606,16 @@ float2 GetSkyViewUvFromAngles(thread const AtmosphereParameters& atmosphere, thr
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _5456;
+    float _5356;
     if (ray_r_mu_intersects_ground)
     {
-        _5456 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
+        _5356 = 1.0 - sqrt(fast::clamp((theta - theta_h) / (3.1415927410125732421875 - theta_h), 0.0, 1.0));
     }
     else
     {
-        _5456 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
+        _5356 = 1.0 - sqrt(fast::clamp((theta_h - theta) / theta_h, 0.0, 1.0));
     }
-    float x = _5456;
+    float x = _5356;
     float param_2 = phi / 3.1415927410125732421875;
     int param_3 = 192;
     float param_4 = x;
@@ -1638,19 +1638,19 @@ float3 GetSkyRadianceFromSkyView(thread const AtmosphereParameters& atmosphere, 
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5721;
+    float3 _5621;
     if (ray_r_mu_intersects_ground)
     {
-        _5721 = float3(0.0);
+        _5621 = float3(0.0);
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5721 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
+        _5621 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture, transmittance_textureSmplr, param_7, param_8);
     }
-    transmittance = _5721;
+    transmittance = _5621;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1773,11 +1773,11 @@ SegmentNode GetSegmentNode(thread const AtmosphereParameters& atmosphere, textur
     float param_11 = AltitudeAtDistance(param_5, param_6, param_7, param_8, param_9);
     float3 param_12;
     float3 param_13;
-    float3 _4433 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+    float3 _4319 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
     float3 mie_scattering = param_12;
     float3 rayleigh_scattering = param_13;
     SegmentNode node;
-    node.extinction = _4433;
+    node.extinction = _4319;
     AtmosphereParameters param_14 = atmosphere;
     float param_15 = r_t;
     float param_16 = mu_s_t;
@@ -1902,64 +1902,64 @@ SegmentSums ContinueSegment(thread const AtmosphereParameters& atmosphere, textu
     bool short_stretch = (t1 - t0) <= (0.00999999977648258209228515625 * t1);
     int intervals = short_stretch ? 1 : 2;
     float dt = (t1 - t0) / float(intervals);
-    int _4719 = short_stretch ? (-1) : (-2);
-    float _4771;
-    float _4777;
-    for (int i = _4719; i < intervals; i++)
+    int _4605 = short_stretch ? (-1) : (-2);
+    float _4657;
+    float _4663;
+    for (int i = _4605; i < intervals; i++)
     {
-        bool _4730 = i == (-2);
-        bool _4738;
-        if (!_4730)
+        bool _4616 = i == (-2);
+        bool _4624;
+        if (!_4616)
         {
-            _4738 = (i == (-1)) && short_stretch;
+            _4624 = (i == (-1)) && short_stretch;
         }
         else
         {
-            _4738 = _4730;
+            _4624 = _4616;
         }
-        bool finding_last = _4738;
+        bool finding_last = _4624;
         bool finding_middle = (i == (-1)) && (!short_stretch);
         int k = i + 1;
         SegmentNode node = last;
-        bool _4752 = finding_last || finding_middle;
-        bool _4766;
-        if (!_4752)
+        bool _4638 = finding_last || finding_middle;
+        bool _4652;
+        if (!_4638)
         {
-            bool _4758 = k < intervals;
-            bool _4765;
-            if (_4758)
+            bool _4644 = k < intervals;
+            bool _4651;
+            if (_4644)
             {
-                _4765 = (2 * k) != intervals;
+                _4651 = (2 * k) != intervals;
             }
             else
             {
-                _4765 = _4758;
+                _4651 = _4644;
             }
-            _4766 = _4765;
+            _4652 = _4651;
         }
         else
         {
-            _4766 = _4752;
+            _4652 = _4638;
         }
-        if (_4766)
+        if (_4652)
         {
             if (finding_last)
             {
-                _4771 = t1;
+                _4657 = t1;
             }
             else
             {
                 if (finding_middle)
                 {
-                    _4777 = 0.5 * (t0 + t1);
+                    _4663 = 0.5 * (t0 + t1);
                 }
                 else
                 {
-                    _4777 = t0 + (dt * float(k));
+                    _4663 = t0 + (dt * float(k));
                 }
-                _4771 = _4777;
+                _4657 = _4663;
             }
-            float t = _4771;
+            float t = _4657;
             AtmosphereParameters param = atmosphere;
             float param_1 = r;
             float param_2 = mu;
@@ -2009,44 +2009,6 @@ SegmentSums ContinueSegment(thread const AtmosphereParameters& atmosphere, textu
     }
     result.end = last;
     return result;
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-static inline __attribute__((always_inline))
-float3 IntegrateSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu, thread const float& d)
-{
-    float dt = d / 16.0;
-    float3 optical_depth = float3(0.0);
-    float3 previous_extinction = float3(0.0);
-    float3 param_11;
-    float3 param_12;
-    for (int k = 0; k <= 16; k++)
-    {
-        float t = dt * float(k);
-        AtmosphereParameters param = atmosphere;
-        float param_1 = r;
-        float param_2 = mu;
-        float param_3 = t;
-        float r_t = RadiusAtDistance(param, param_1, param_2, param_3);
-        AtmosphereParameters param_4 = atmosphere;
-        float param_5 = r;
-        float param_6 = mu;
-        float param_7 = t;
-        float param_8 = r_t;
-        AtmosphereParameters param_9 = atmosphere;
-        float param_10 = AltitudeAtDistance(param_4, param_5, param_6, param_7, param_8);
-        float3 _4325 = GetCoefficientsAtAltitude(param_9, param_10, param_11, param_12);
-        float3 mie_scattering = param_11;
-        float3 rayleigh_scattering = param_12;
-        float3 extinction = _4325;
-        if (k > 0)
-        {
-            optical_depth += ((previous_extinction + extinction) * (0.5 * dt));
-        }
-        previous_extinction = extinction;
-    }
-    return optical_depth;
 }
 #endif
 
@@ -2121,32 +2083,6 @@ float3 GetOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 static inline __attribute__((always_inline))
-float3 LongSegmentOpticalDepth(thread const AtmosphereParameters& atmosphere, texture2d<float> transmittance_texture, sampler transmittance_textureSmplr, thread const float& r, thread const float& mu, thread const float& d, thread const bool& ray_r_mu_intersects_ground)
-{
-    float3 _4349;
-    if (atmosphere.transmittance_is_colour != 0)
-    {
-        AtmosphereParameters param = atmosphere;
-        float param_1 = r;
-        float param_2 = mu;
-        float param_3 = d;
-        _4349 = IntegrateSegmentOpticalDepth(param, param_1, param_2, param_3);
-    }
-    else
-    {
-        AtmosphereParameters param_4 = atmosphere;
-        float param_5 = r;
-        float param_6 = mu;
-        float param_7 = d;
-        bool param_8 = ray_r_mu_intersects_ground;
-        _4349 = GetOpticalDepth(param_4, transmittance_texture, transmittance_textureSmplr, param_5, param_6, param_7, param_8);
-    }
-    return _4349;
-}
-#endif
-
-#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
-static inline __attribute__((always_inline))
 float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmosphere, thread const float& r, thread const float& mu)
 {
     float r_max = atmosphere.scattering_r_max;
@@ -2155,16 +2091,16 @@ float DistanceInsideScatteringRadii(thread const AtmosphereParameters& atmospher
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _4116;
+    float _4101;
     if ((mu < 0.0) && (down_discriminant >= 0.0))
     {
-        _4116 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _4101 = fast::min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _4116 = up;
+        _4101 = up;
     }
-    return _4116;
+    return _4101;
 }
 #endif
 
@@ -2188,13 +2124,13 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_6;
     float param_7;
     float param_8;
-    bool _4956 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4842 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4956)
+    if (!_4842)
     {
         transmittance = float3(1.0);
         return float3(0.0);
@@ -2205,12 +2141,23 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float direct = 1.0 - smoothstep(10000.0, 20000.0, d);
+    bool colour = atmosphere.transmittance_is_colour != 0;
     float lit_direct = 1.0 - smoothstep(10000.0, 20000.0, lit);
+    float _4884;
+    if (colour)
+    {
+        _4884 = 1.0;
+    }
+    else
+    {
+        _4884 = 1.0 - smoothstep(10000.0, 20000.0, d);
+    }
+    float direct = _4884;
+    float lit_transmittance_direct = colour ? 1.0 : lit_direct;
     SegmentSums lit_sums;
     lit_sums.optical_depth = float3(0.0);
     lit_sums.single_mie = float3(0.0);
-    if (lit_direct > 0.0)
+    if (lit_transmittance_direct > 0.0)
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
@@ -2248,7 +2195,7 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
         float param_36 = mu;
         float param_37 = d;
         bool param_38 = ray_r_mu_intersects_ground;
-        optical_depth = mix(LongSegmentOpticalDepth(param_34, transmittance_texture, transmittance_textureSmplr, param_35, param_36, param_37, param_38), optical_depth, float3(direct));
+        optical_depth = mix(GetOpticalDepth(param_34, transmittance_texture, transmittance_textureSmplr, param_35, param_36, param_37, param_38), optical_depth, float3(direct));
     }
     transmittance = exp(-optical_depth);
     AtmosphereParameters param_39 = atmosphere;
@@ -2258,9 +2205,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_43 = nu;
     bool param_44 = ray_r_mu_intersects_ground;
     float3 param_45;
-    float3 _5096 = GetCombinedScattering(param_39, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_40, param_41, param_42, param_43, param_44, param_45);
+    float3 _4996 = GetCombinedScattering(param_39, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_40, param_41, param_42, param_43, param_44, param_45);
     float3 single_mie_scattering = param_45;
-    float3 scattering = _5096;
+    float3 scattering = _4996;
     if (lit < 10000.0)
     {
         AtmosphereParameters param_46 = atmosphere;
@@ -2300,9 +2247,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
             float param_74 = nu;
             bool param_75 = ray_r_mu_intersects_ground;
             float3 param_76;
-            float3 _5192 = GetCombinedScattering(param_70, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_71, param_72, param_73, param_74, param_75, param_76);
+            float3 _5092 = GetCombinedScattering(param_70, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_71, param_72, param_73, param_74, param_75, param_76);
             float3 unused_far_mie = param_76;
-            scattering -= (far_sums.transmittance * _5192);
+            scattering -= (far_sums.transmittance * _5092);
         }
         float3 multiple = (fast::max(scattering - (far_sums.single_rayleigh * atmosphere.solar_irradiance), float3(0.0)) * lit_sums.scattering_weight) / fast::max(far_sums.scattering_weight, float3(1.0000000031710768509710513471353e-30));
         float param_77 = nu;
@@ -2327,7 +2274,7 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_91 = mu;
     float param_92 = lit;
     bool param_93 = ray_r_mu_intersects_ground;
-    float3 lit_transmittance = exp(-mix(LongSegmentOpticalDepth(param_89, transmittance_texture, transmittance_textureSmplr, param_90, param_91, param_92, param_93), lit_sums.optical_depth, float3(lit_direct)));
+    float3 lit_transmittance = exp(-mix(GetOpticalDepth(param_89, transmittance_texture, transmittance_textureSmplr, param_90, param_91, param_92, param_93), lit_sums.optical_depth, float3(lit_transmittance_direct)));
     AtmosphereParameters param_94 = atmosphere;
     float param_95 = r_p;
     float param_96 = mu_p;
@@ -2335,9 +2282,9 @@ float3 GetSkyRadianceToPointWithShadow(thread const AtmosphereParameters& atmosp
     float param_98 = nu;
     bool param_99 = ray_r_mu_intersects_ground;
     float3 param_100;
-    float3 _5303 = GetCombinedScattering(param_94, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_95, param_96, param_97, param_98, param_99, param_100);
+    float3 _5203 = GetCombinedScattering(param_94, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_95, param_96, param_97, param_98, param_99, param_100);
     float3 single_mie_scattering_p = param_100;
-    float3 scattering_p = _5303;
+    float3 scattering_p = _5203;
     scattering = fast::max(scattering - (lit_transmittance * scattering_p), float3(0.0));
     single_mie_scattering = fast::max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), float3(0.0));
     single_mie_scattering = mix(single_mie_scattering, lit_sums.single_mie * atmosphere.solar_irradiance, float3(lit_direct));
@@ -2358,9 +2305,9 @@ float3 GetSkyRadianceToPoint(thread const AtmosphereParameters& atmosphere, text
     float param_3 = 0.0;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5351 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
+    float3 _5251 = GetSkyRadianceToPointWithShadow(param, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _5351;
+    return _5251;
 }
 #endif
 
@@ -2390,9 +2337,9 @@ float3 GetAerialPerspectiveVoxel(thread const AtmosphereParameters& atmosphere, 
     float3 param_3 = point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5814 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
+    float3 _5714 = GetSkyRadianceToPoint(param_1, transmittance_texture, transmittance_textureSmplr, scattering_texture, scattering_textureSmplr, single_mie_scattering_texture, single_mie_scattering_textureSmplr, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5814;
+    float3 radiance = _5714;
     optical_depth = -log(fast::max(transmittance, float3(1.0000000031710768509710513471353e-30)));
     return radiance;
 }
@@ -2422,16 +2369,16 @@ float3 GetSkyRadianceToPointFromVolume(texture3d<float> radiance_volume, sampler
 static inline __attribute__((always_inline))
 float IrradianceKneeMuS(thread const AtmosphereParameters& atmosphere)
 {
-    float _1543;
+    float _1528;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625)
     {
-        _1543 = 0.100000001490116119384765625;
+        _1528 = 0.100000001490116119384765625;
     }
     else
     {
-        _1543 = 0.5 * (atmosphere.mu_s_min + 1.0);
+        _1528 = 0.5 * (atmosphere.mu_s_min + 1.0);
     }
-    return _1543;
+    return _1528;
 }
 #endif
 
@@ -2441,16 +2388,16 @@ float GetIrradianceUnitMuS(thread const AtmosphereParameters& atmosphere, thread
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1561;
+    float _1546;
     if (mu_s < knee)
     {
-        _1561 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1546 = (0.5 * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1561 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
+        _1546 = 0.5 + ((0.5 * (mu_s - knee)) / (1.0 - knee));
     }
-    return _1561;
+    return _1546;
 }
 #endif
 
@@ -2479,16 +2426,16 @@ float GetIrradianceMuSFromUnit(thread const AtmosphereParameters& atmosphere, th
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1592;
+    float _1577;
     if (x < 0.5)
     {
-        _1592 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
+        _1577 = atmosphere.mu_s_min + ((2.0 * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1592 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
+        _1577 = knee + (((2.0 * x) - 1.0) * (1.0 - knee));
     }
-    return _1592;
+    return _1577;
 }
 #endif
 
@@ -2516,16 +2463,16 @@ float4 SunBelowTableMix(thread const float4& a, thread const float4& b, thread c
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2757;
+    float4 _2742;
     if (t < 0.0)
     {
-        _2757 = fast::min(blend, a);
+        _2742 = fast::min(blend, a);
     }
     else
     {
-        _2757 = blend;
+        _2742 = blend;
     }
-    return _2757;
+    return _2742;
 }
 #endif
 

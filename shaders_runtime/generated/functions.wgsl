@@ -111,8 +111,6 @@ const SEGMENT_INTERVALS: i32 = 64i;
 
 const SEGMENT_TOLERANCE: f32 = 0.0002f;
 
-const OPTICAL_DEPTH_INTERVALS: i32 = 16i;
-
 const SKY_VIEW_WIDTH: i32 = 192i;
 
 const SKY_VIEW_HEIGHT: i32 = 108i;
@@ -3538,212 +3536,111 @@ fn AltitudeAtDistance(atmosphere_120: AtmosphereParameters, r_65: f32, mu_48: f3
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn IntegrateSegmentOpticalDepth(atmosphere_122: AtmosphereParameters, r_67: f32, mu_50: f32, d_24: f32) -> vec3<f32> {
-    var atmosphere_123: AtmosphereParameters;
-    var r_68: f32;
-    var mu_51: f32;
-    var d_25: f32;
-    var dt: f32;
-    var optical_depth: vec3<f32> = vec3(0f);
-    var previous_extinction: vec3<f32> = vec3(0f);
-    var k_5: i32 = 0i;
-    var t_13: f32;
-    var r_t_2: f32;
-    var mie_scattering_1: vec3<f32>;
-    var rayleigh_scattering_1: vec3<f32>;
-    var extinction: vec3<f32>;
-
-    atmosphere_123 = atmosphere_122;
-    r_68 = r_67;
-    mu_51 = mu_50;
-    d_25 = d_24;
-    let _e30 = d_25;
-    dt = (_e30 / 16f);
-    loop {
-        let _e43 = k_5;
-        if !((_e43 <= OPTICAL_DEPTH_INTERVALS)) {
-            break;
-        }
-        {
-            let _e49 = dt;
-            let _e50 = k_5;
-            t_13 = (_e49 * f32(_e50));
-            let _e54 = atmosphere_123;
-            let _e55 = r_68;
-            let _e56 = mu_51;
-            let _e57 = t_13;
-            let _e58 = RadiusAtDistance(_e54, _e55, _e56, _e57);
-            r_t_2 = _e58;
-            let _e62 = atmosphere_123;
-            let _e63 = atmosphere_123;
-            let _e64 = r_68;
-            let _e65 = mu_51;
-            let _e66 = t_13;
-            let _e67 = r_t_2;
-            let _e68 = AltitudeAtDistance(_e63, _e64, _e65, _e66, _e67);
-            let _e73 = GetCoefficientsAtAltitude(_e62, _e68, (&mie_scattering_1), (&rayleigh_scattering_1));
-            extinction = _e73;
-            let _e75 = k_5;
-            if (_e75 > 0i) {
-                let _e78 = optical_depth;
-                let _e79 = previous_extinction;
-                let _e80 = extinction;
-                let _e83 = dt;
-                optical_depth = (_e78 + ((_e79 + _e80) * (0.5f * _e83)));
-            }
-            let _e87 = extinction;
-            previous_extinction = _e87;
-        }
-        continuing {
-            let _e46 = k_5;
-            k_5 = (_e46 + 1i);
-        }
-    }
-    let _e88 = optical_depth;
-    return _e88;
-}
-
-// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn LongSegmentOpticalDepth(atmosphere_124: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_69: f32, mu_52: f32, d_26: f32, ray_r_mu_intersects_ground_32: bool) -> vec3<f32> {
-    var atmosphere_125: AtmosphereParameters;
-    var r_70: f32;
-    var mu_53: f32;
-    var d_27: f32;
-    var ray_r_mu_intersects_ground_33: bool;
-    var local_26: vec3<f32>;
-
-    atmosphere_125 = atmosphere_124;
-    r_70 = r_69;
-    mu_53 = mu_52;
-    d_27 = d_26;
-    ray_r_mu_intersects_ground_33 = ray_r_mu_intersects_ground_32;
-    let _e33 = atmosphere_125;
-    if (_e33.transmittance_is_colour != 0i) {
-        let _e37 = atmosphere_125;
-        let _e38 = r_70;
-        let _e39 = mu_53;
-        let _e40 = d_27;
-        let _e41 = IntegrateSegmentOpticalDepth(_e37, _e38, _e39, _e40);
-        local_26 = _e41;
-    } else {
-        let _e42 = atmosphere_125;
-        let _e43 = r_70;
-        let _e44 = mu_53;
-        let _e45 = d_27;
-        let _e46 = ray_r_mu_intersects_ground_33;
-        let _e47 = GetOpticalDepth(_e42, transmittance_texture_6, _e43, _e44, _e45, _e46);
-        local_26 = _e47;
-    }
-    let _e49 = local_26;
-    return _e49;
-}
-
-// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
 fn MeanAttenuation(depth: vec3<f32>, attenuation: vec3<f32>) -> vec3<f32> {
     var depth_1: vec3<f32>;
     var attenuation_1: vec3<f32>;
 
     depth_1 = depth;
     attenuation_1 = attenuation;
-    let _e28 = attenuation_1;
-    let _e30 = depth_1;
-    let _e38 = depth_1;
-    let _e45 = depth_1;
-    return mix(((vec3(1f) - _e28) / max(_e30, vec3(0.000000000000000000000000000001f))), (vec3(1f) - (0.5f * _e38)), (vec3(1f) - step(vec3(0.0001f), _e45)));
+    let _e27 = attenuation_1;
+    let _e29 = depth_1;
+    let _e37 = depth_1;
+    let _e44 = depth_1;
+    return mix(((vec3(1f) - _e27) / max(_e29, vec3(0.000000000000000000000000000001f))), (vec3(1f) - (0.5f * _e37)), (vec3(1f) - step(vec3(0.0001f), _e44)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSegmentNode(atmosphere_126: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_42: f32, nu_26: f32, t_14: f32) -> SegmentNode {
-    var atmosphere_127: AtmosphereParameters;
-    var r_72: f32;
-    var mu_55: f32;
+fn GetSegmentNode(atmosphere_122: AtmosphereParameters, transmittance_texture_6: texture_2d<f32>, r_67: f32, mu_50: f32, mu_s_42: f32, nu_26: f32, t_13: f32) -> SegmentNode {
+    var atmosphere_123: AtmosphereParameters;
+    var r_68: f32;
+    var mu_51: f32;
     var mu_s_43: f32;
     var nu_27: f32;
-    var t_15: f32;
+    var t_14: f32;
     var node: SegmentNode;
-    var r_t_3: f32;
+    var r_t_2: f32;
     var mu_s_t_1: f32;
-    var mie_scattering_2: vec3<f32>;
-    var rayleigh_scattering_2: vec3<f32>;
+    var mie_scattering_1: vec3<f32>;
+    var rayleigh_scattering_1: vec3<f32>;
     var sunlight: vec3<f32>;
 
-    atmosphere_127 = atmosphere_126;
-    r_72 = r_71;
-    mu_55 = mu_54;
+    atmosphere_123 = atmosphere_122;
+    r_68 = r_67;
+    mu_51 = mu_50;
     mu_s_43 = mu_s_42;
     nu_27 = nu_26;
-    t_15 = t_14;
-    let _e36 = atmosphere_127;
-    let _e37 = r_72;
-    let _e38 = mu_55;
-    let _e39 = t_15;
-    let _e40 = RadiusAtDistance(_e36, _e37, _e38, _e39);
-    r_t_3 = _e40;
-    let _e42 = r_72;
-    let _e43 = mu_s_43;
-    let _e45 = t_15;
-    let _e46 = nu_27;
-    let _e49 = r_t_3;
-    let _e51 = ClampCosine((((_e42 * _e43) + (_e45 * _e46)) / _e49));
-    mu_s_t_1 = _e51;
-    let _e56 = atmosphere_127;
-    let _e57 = atmosphere_127;
-    let _e58 = r_72;
-    let _e59 = mu_55;
-    let _e60 = t_15;
-    let _e61 = r_t_3;
-    let _e62 = AltitudeAtDistance(_e57, _e58, _e59, _e60, _e61);
-    let _e67 = GetCoefficientsAtAltitude(_e56, _e62, (&mie_scattering_2), (&rayleigh_scattering_2));
-    node.extinction = _e67;
-    let _e68 = atmosphere_127;
-    let _e69 = r_t_3;
-    let _e70 = mu_s_t_1;
-    let _e71 = GetTransmittanceToSun(_e68, transmittance_texture_7, _e69, _e70);
-    sunlight = _e71;
-    let _e74 = rayleigh_scattering_2;
-    let _e75 = sunlight;
-    node.rayleigh = (_e74 * _e75);
-    let _e78 = mie_scattering_2;
-    let _e79 = sunlight;
-    node.mie = (_e78 * _e79);
-    let _e82 = rayleigh_scattering_2;
-    let _e83 = mie_scattering_2;
-    node.scattering = (_e82 + _e83);
-    let _e85 = node;
-    return _e85;
+    t_14 = t_13;
+    let _e35 = atmosphere_123;
+    let _e36 = r_68;
+    let _e37 = mu_51;
+    let _e38 = t_14;
+    let _e39 = RadiusAtDistance(_e35, _e36, _e37, _e38);
+    r_t_2 = _e39;
+    let _e41 = r_68;
+    let _e42 = mu_s_43;
+    let _e44 = t_14;
+    let _e45 = nu_27;
+    let _e48 = r_t_2;
+    let _e50 = ClampCosine((((_e41 * _e42) + (_e44 * _e45)) / _e48));
+    mu_s_t_1 = _e50;
+    let _e55 = atmosphere_123;
+    let _e56 = atmosphere_123;
+    let _e57 = r_68;
+    let _e58 = mu_51;
+    let _e59 = t_14;
+    let _e60 = r_t_2;
+    let _e61 = AltitudeAtDistance(_e56, _e57, _e58, _e59, _e60);
+    let _e66 = GetCoefficientsAtAltitude(_e55, _e61, (&mie_scattering_1), (&rayleigh_scattering_1));
+    node.extinction = _e66;
+    let _e67 = atmosphere_123;
+    let _e68 = r_t_2;
+    let _e69 = mu_s_t_1;
+    let _e70 = GetTransmittanceToSun(_e67, transmittance_texture_6, _e68, _e69);
+    sunlight = _e70;
+    let _e73 = rayleigh_scattering_1;
+    let _e74 = sunlight;
+    node.rayleigh = (_e73 * _e74);
+    let _e77 = mie_scattering_1;
+    let _e78 = sunlight;
+    node.mie = (_e77 * _e78);
+    let _e81 = rayleigh_scattering_1;
+    let _e82 = mie_scattering_1;
+    node.scattering = (_e81 + _e82);
+    let _e84 = node;
+    return _e84;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn StartSegment(atmosphere_128: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, r_73: f32, mu_56: f32, mu_s_44: f32, nu_28: f32, t_16: f32) -> SegmentSums {
-    var atmosphere_129: AtmosphereParameters;
-    var r_74: f32;
-    var mu_57: f32;
+fn StartSegment(atmosphere_124: AtmosphereParameters, transmittance_texture_7: texture_2d<f32>, r_69: f32, mu_52: f32, mu_s_44: f32, nu_28: f32, t_15: f32) -> SegmentSums {
+    var atmosphere_125: AtmosphereParameters;
+    var r_70: f32;
+    var mu_53: f32;
     var mu_s_45: f32;
     var nu_29: f32;
-    var t_17: f32;
+    var t_16: f32;
     var sums: SegmentSums;
 
-    atmosphere_129 = atmosphere_128;
-    r_74 = r_73;
-    mu_57 = mu_56;
+    atmosphere_125 = atmosphere_124;
+    r_70 = r_69;
+    mu_53 = mu_52;
     mu_s_45 = mu_s_44;
     nu_29 = nu_28;
-    t_17 = t_16;
+    t_16 = t_15;
     sums.optical_depth = vec3(0f);
     sums.transmittance = vec3(1f);
     sums.single_rayleigh = vec3(0f);
     sums.single_mie = vec3(0f);
     sums.scattering_weight = vec3(0f);
-    let _e52 = atmosphere_129;
-    let _e53 = r_74;
-    let _e54 = mu_57;
-    let _e55 = mu_s_45;
-    let _e56 = nu_29;
-    let _e57 = t_17;
-    let _e58 = GetSegmentNode(_e52, transmittance_texture_8, _e53, _e54, _e55, _e56, _e57);
-    sums.end = _e58;
-    let _e59 = sums;
-    return _e59;
+    let _e51 = atmosphere_125;
+    let _e52 = r_70;
+    let _e53 = mu_53;
+    let _e54 = mu_s_45;
+    let _e55 = nu_29;
+    let _e56 = t_16;
+    let _e57 = GetSegmentNode(_e51, transmittance_texture_7, _e52, _e53, _e54, _e55, _e56);
+    sums.end = _e57;
+    let _e58 = sums;
+    return _e58;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3755,13 +3652,13 @@ fn SegmentCurvature(a_18: vec3<f32>, m: vec3<f32>, b_10: vec3<f32>) -> vec3<f32>
     a_19 = a_18;
     m_1 = m;
     b_11 = b_10;
-    let _e28 = a_19;
-    let _e29 = b_11;
-    let _e32 = m_1;
-    let _e36 = a_19;
-    let _e37 = b_11;
-    let _e40 = m_1;
-    return (abs(((_e28 + _e29) - (2f * _e32))) / max(((_e36 + _e37) + (2f * _e40)), vec3(0.000000000000000000000000000001f)));
+    let _e27 = a_19;
+    let _e28 = b_11;
+    let _e31 = m_1;
+    let _e35 = a_19;
+    let _e36 = b_11;
+    let _e39 = m_1;
+    return (abs(((_e27 + _e28) - (2f * _e31))) / max(((_e35 + _e36) + (2f * _e39)), vec3(0.000000000000000000000000000001f)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3773,13 +3670,13 @@ fn SegmentRatio(a_20: vec3<f32>, m_2: vec3<f32>, b_12: vec3<f32>) -> vec3<f32> {
     a_21 = a_20;
     m_3 = m_2;
     b_13 = b_12;
-    let _e28 = a_21;
-    let _e29 = m_3;
-    let _e31 = b_13;
-    let _e33 = a_21;
-    let _e34 = m_3;
-    let _e36 = b_13;
-    return (max(max(_e28, _e29), _e31) / max(min(min(_e33, _e34), _e36), vec3(0.000000000000000000000000000001f)));
+    let _e27 = a_21;
+    let _e28 = m_3;
+    let _e30 = b_13;
+    let _e32 = a_21;
+    let _e33 = m_3;
+    let _e35 = b_13;
+    return (max(max(_e27, _e28), _e30) / max(min(min(_e32, _e33), _e35), vec3(0.000000000000000000000000000001f)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3787,10 +3684,10 @@ fn LargestComponent(v: vec3<f32>) -> f32 {
     var v_1: vec3<f32>;
 
     v_1 = v;
-    let _e24 = v_1;
-    let _e26 = v_1;
-    let _e29 = v_1;
-    return max(max(_e24.x, _e26.y), _e29.z);
+    let _e23 = v_1;
+    let _e25 = v_1;
+    let _e28 = v_1;
+    return max(max(_e23.x, _e25.y), _e28.z);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -3815,81 +3712,81 @@ fn SegmentIntervals(a_22: SegmentNode, m_4: SegmentNode, b_14: SegmentNode, L: f
     m_5 = m_4;
     b_15 = b_14;
     L_1 = L;
-    let _e30 = a_23;
-    let _e32 = m_5;
-    let _e37 = L_1;
-    to_middle = exp((-((_e30.extinction + _e32.extinction)) * (0.25f * _e37)));
-    let _e42 = to_middle;
-    let _e43 = m_5;
-    let _e45 = b_15;
-    let _e50 = L_1;
-    to_end = (_e42 * exp((-((_e43.extinction + _e45.extinction)) * (0.25f * _e50))));
-    let _e56 = m_5;
-    let _e58 = to_middle;
-    rayleigh_m = (_e56.rayleigh * _e58);
-    let _e61 = b_15;
-    let _e63 = to_end;
-    rayleigh_b = (_e61.rayleigh * _e63);
-    let _e66 = m_5;
-    let _e68 = to_middle;
-    mie_m = (_e66.mie * _e68);
-    let _e71 = b_15;
-    let _e73 = to_end;
-    mie_b = (_e71.mie * _e73);
-    let _e76 = m_5;
-    let _e78 = to_middle;
-    scattering_m = (_e76.scattering * _e78);
-    let _e81 = b_15;
-    let _e83 = to_end;
-    scattering_b = (_e81.scattering * _e83);
-    let _e86 = a_23;
-    let _e88 = m_5;
-    let _e90 = b_15;
-    let _e92 = SegmentCurvature(_e86.extinction, _e88.extinction, _e90.extinction);
-    let _e93 = a_23;
-    let _e95 = rayleigh_m;
-    let _e96 = rayleigh_b;
-    let _e97 = SegmentCurvature(_e93.rayleigh, _e95, _e96);
-    let _e99 = a_23;
-    let _e101 = mie_m;
-    let _e102 = mie_b;
-    let _e103 = SegmentCurvature(_e99.mie, _e101, _e102);
-    let _e104 = a_23;
-    let _e106 = scattering_m;
-    let _e107 = scattering_b;
-    let _e108 = SegmentCurvature(_e104.scattering, _e106, _e107);
-    let _e111 = LargestComponent(max(max(_e92, _e97), max(_e103, _e108)));
-    e = _e111;
-    let _e113 = a_23;
-    let _e115 = m_5;
-    let _e117 = b_15;
-    let _e119 = SegmentRatio(_e113.extinction, _e115.extinction, _e117.extinction);
-    let _e120 = a_23;
-    let _e122 = rayleigh_m;
-    let _e123 = rayleigh_b;
-    let _e124 = SegmentRatio(_e120.rayleigh, _e122, _e123);
-    let _e126 = a_23;
-    let _e128 = mie_m;
-    let _e129 = mie_b;
-    let _e130 = SegmentRatio(_e126.mie, _e128, _e129);
-    let _e131 = a_23;
-    let _e133 = scattering_m;
-    let _e134 = scattering_b;
-    let _e135 = SegmentRatio(_e131.scattering, _e133, _e134);
-    let _e138 = LargestComponent(max(max(_e119, _e124), max(_e130, _e135)));
-    F = _e138;
-    let _e140 = e;
-    let _e146 = F;
-    n = max(sqrt((_e140 / 0.00014999999f)), (log(max(_e146, 1f)) / 0.048989795f));
-    let _e159 = n;
-    return (2i * i32(clamp(ceil((0.5f * _e159)), 1f, 32f)));
+    let _e29 = a_23;
+    let _e31 = m_5;
+    let _e36 = L_1;
+    to_middle = exp((-((_e29.extinction + _e31.extinction)) * (0.25f * _e36)));
+    let _e41 = to_middle;
+    let _e42 = m_5;
+    let _e44 = b_15;
+    let _e49 = L_1;
+    to_end = (_e41 * exp((-((_e42.extinction + _e44.extinction)) * (0.25f * _e49))));
+    let _e55 = m_5;
+    let _e57 = to_middle;
+    rayleigh_m = (_e55.rayleigh * _e57);
+    let _e60 = b_15;
+    let _e62 = to_end;
+    rayleigh_b = (_e60.rayleigh * _e62);
+    let _e65 = m_5;
+    let _e67 = to_middle;
+    mie_m = (_e65.mie * _e67);
+    let _e70 = b_15;
+    let _e72 = to_end;
+    mie_b = (_e70.mie * _e72);
+    let _e75 = m_5;
+    let _e77 = to_middle;
+    scattering_m = (_e75.scattering * _e77);
+    let _e80 = b_15;
+    let _e82 = to_end;
+    scattering_b = (_e80.scattering * _e82);
+    let _e85 = a_23;
+    let _e87 = m_5;
+    let _e89 = b_15;
+    let _e91 = SegmentCurvature(_e85.extinction, _e87.extinction, _e89.extinction);
+    let _e92 = a_23;
+    let _e94 = rayleigh_m;
+    let _e95 = rayleigh_b;
+    let _e96 = SegmentCurvature(_e92.rayleigh, _e94, _e95);
+    let _e98 = a_23;
+    let _e100 = mie_m;
+    let _e101 = mie_b;
+    let _e102 = SegmentCurvature(_e98.mie, _e100, _e101);
+    let _e103 = a_23;
+    let _e105 = scattering_m;
+    let _e106 = scattering_b;
+    let _e107 = SegmentCurvature(_e103.scattering, _e105, _e106);
+    let _e110 = LargestComponent(max(max(_e91, _e96), max(_e102, _e107)));
+    e = _e110;
+    let _e112 = a_23;
+    let _e114 = m_5;
+    let _e116 = b_15;
+    let _e118 = SegmentRatio(_e112.extinction, _e114.extinction, _e116.extinction);
+    let _e119 = a_23;
+    let _e121 = rayleigh_m;
+    let _e122 = rayleigh_b;
+    let _e123 = SegmentRatio(_e119.rayleigh, _e121, _e122);
+    let _e125 = a_23;
+    let _e127 = mie_m;
+    let _e128 = mie_b;
+    let _e129 = SegmentRatio(_e125.mie, _e127, _e128);
+    let _e130 = a_23;
+    let _e132 = scattering_m;
+    let _e133 = scattering_b;
+    let _e134 = SegmentRatio(_e130.scattering, _e132, _e133);
+    let _e137 = LargestComponent(max(max(_e118, _e123), max(_e129, _e134)));
+    F = _e137;
+    let _e139 = e;
+    let _e145 = F;
+    n = max(sqrt((_e139 / 0.00014999999f)), (log(max(_e145, 1f)) / 0.048989795f));
+    let _e158 = n;
+    return (2i * i32(clamp(ceil((0.5f * _e158)), 1f, 32f)));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn ContinueSegment(atmosphere_130: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, r_75: f32, mu_58: f32, mu_s_46: f32, nu_30: f32, t0_: f32, t1_: f32, sums_1: SegmentSums) -> SegmentSums {
-    var atmosphere_131: AtmosphereParameters;
-    var r_76: f32;
-    var mu_59: f32;
+fn ContinueSegment(atmosphere_126: AtmosphereParameters, transmittance_texture_8: texture_2d<f32>, r_71: f32, mu_54: f32, mu_s_46: f32, nu_30: f32, t0_: f32, t1_: f32, sums_1: SegmentSums) -> SegmentSums {
+    var atmosphere_127: AtmosphereParameters;
+    var r_72: f32;
+    var mu_55: f32;
     var mu_s_47: f32;
     var nu_31: f32;
     var t0_1: f32;
@@ -3900,215 +3797,215 @@ fn ContinueSegment(atmosphere_130: AtmosphereParameters, transmittance_texture_9
     var middle: SegmentNode;
     var previous: SegmentNode;
     var short_stretch: bool;
-    var local_27: i32;
+    var local_26: i32;
     var intervals_1: i32;
-    var dt_1: f32;
-    var local_28: i32;
+    var dt: f32;
+    var local_27: i32;
     var i_4: i32;
     var finding_last: bool;
     var finding_middle: bool;
-    var k_6: i32;
+    var k_5: i32;
     var node_1: SegmentNode;
+    var local_28: f32;
     var local_29: f32;
-    var local_30: f32;
-    var t_18: f32;
+    var t_17: f32;
     var interval_depth: vec3<f32>;
     var attenuation_2: vec3<f32>;
     var mean_transmittance: vec3<f32>;
 
-    atmosphere_131 = atmosphere_130;
-    r_76 = r_75;
-    mu_59 = mu_58;
+    atmosphere_127 = atmosphere_126;
+    r_72 = r_71;
+    mu_55 = mu_54;
     mu_s_47 = mu_s_46;
     nu_31 = nu_30;
     t0_1 = t0_;
     t1_1 = t1_;
     sums_2 = sums_1;
-    let _e39 = sums_2;
-    result = _e39;
-    let _e41 = t1_1;
-    let _e42 = t0_1;
-    if (_e41 <= _e42) {
-        let _e44 = result;
-        return _e44;
+    let _e38 = sums_2;
+    result = _e38;
+    let _e40 = t1_1;
+    let _e41 = t0_1;
+    if (_e40 <= _e41) {
+        let _e43 = result;
+        return _e43;
     }
-    let _e45 = sums_2;
-    last_2 = _e45.end;
-    let _e48 = sums_2;
-    middle = _e48.end;
-    let _e51 = sums_2;
-    previous = _e51.end;
-    let _e54 = t1_1;
-    let _e55 = t0_1;
-    let _e58 = t1_1;
-    short_stretch = ((_e54 - _e55) <= (0.01f * _e58));
-    let _e62 = short_stretch;
-    if _e62 {
-        local_27 = 1i;
+    let _e44 = sums_2;
+    last_2 = _e44.end;
+    let _e47 = sums_2;
+    middle = _e47.end;
+    let _e50 = sums_2;
+    previous = _e50.end;
+    let _e53 = t1_1;
+    let _e54 = t0_1;
+    let _e57 = t1_1;
+    short_stretch = ((_e53 - _e54) <= (0.01f * _e57));
+    let _e61 = short_stretch;
+    if _e61 {
+        local_26 = 1i;
     } else {
-        local_27 = 2i;
+        local_26 = 2i;
     }
-    let _e66 = local_27;
-    intervals_1 = _e66;
-    let _e68 = t1_1;
-    let _e69 = t0_1;
-    let _e71 = intervals_1;
-    dt_1 = ((_e68 - _e69) / f32(_e71));
-    let _e75 = short_stretch;
-    if _e75 {
-        local_28 = -1i;
+    let _e65 = local_26;
+    intervals_1 = _e65;
+    let _e67 = t1_1;
+    let _e68 = t0_1;
+    let _e70 = intervals_1;
+    dt = ((_e67 - _e68) / f32(_e70));
+    let _e74 = short_stretch;
+    if _e74 {
+        local_27 = -1i;
     } else {
-        local_28 = -2i;
+        local_27 = -2i;
     }
-    let _e81 = local_28;
-    i_4 = _e81;
+    let _e80 = local_27;
+    i_4 = _e80;
     loop {
-        let _e83 = i_4;
-        let _e84 = intervals_1;
-        if !((_e83 < _e84)) {
+        let _e82 = i_4;
+        let _e83 = intervals_1;
+        if !((_e82 < _e83)) {
             break;
         }
         {
-            let _e90 = i_4;
-            let _e94 = i_4;
-            let _e98 = short_stretch;
-            finding_last = ((_e90 == -2i) || ((_e94 == -1i) && _e98));
-            let _e102 = i_4;
-            let _e106 = short_stretch;
-            finding_middle = ((_e102 == -1i) && !(_e106));
-            let _e110 = i_4;
-            k_6 = (_e110 + 1i);
-            let _e114 = last_2;
-            node_1 = _e114;
-            let _e116 = finding_last;
-            let _e117 = finding_middle;
-            let _e119 = k_6;
-            let _e120 = intervals_1;
-            let _e123 = k_6;
-            let _e125 = intervals_1;
-            if ((_e116 || _e117) || ((_e119 < _e120) && ((2i * _e123) != _e125))) {
+            let _e89 = i_4;
+            let _e93 = i_4;
+            let _e97 = short_stretch;
+            finding_last = ((_e89 == -2i) || ((_e93 == -1i) && _e97));
+            let _e101 = i_4;
+            let _e105 = short_stretch;
+            finding_middle = ((_e101 == -1i) && !(_e105));
+            let _e109 = i_4;
+            k_5 = (_e109 + 1i);
+            let _e113 = last_2;
+            node_1 = _e113;
+            let _e115 = finding_last;
+            let _e116 = finding_middle;
+            let _e118 = k_5;
+            let _e119 = intervals_1;
+            let _e122 = k_5;
+            let _e124 = intervals_1;
+            if ((_e115 || _e116) || ((_e118 < _e119) && ((2i * _e122) != _e124))) {
                 {
-                    let _e129 = finding_last;
-                    if _e129 {
-                        let _e130 = t1_1;
-                        local_30 = _e130;
+                    let _e128 = finding_last;
+                    if _e128 {
+                        let _e129 = t1_1;
+                        local_29 = _e129;
                     } else {
-                        let _e131 = finding_middle;
-                        if _e131 {
-                            let _e133 = t0_1;
-                            let _e134 = t1_1;
-                            local_29 = (0.5f * (_e133 + _e134));
+                        let _e130 = finding_middle;
+                        if _e130 {
+                            let _e132 = t0_1;
+                            let _e133 = t1_1;
+                            local_28 = (0.5f * (_e132 + _e133));
                         } else {
-                            let _e137 = t0_1;
-                            let _e138 = dt_1;
-                            let _e139 = k_6;
-                            local_29 = (_e137 + (_e138 * f32(_e139)));
+                            let _e136 = t0_1;
+                            let _e137 = dt;
+                            let _e138 = k_5;
+                            local_28 = (_e136 + (_e137 * f32(_e138)));
                         }
-                        let _e144 = local_29;
-                        local_30 = _e144;
+                        let _e143 = local_28;
+                        local_29 = _e143;
                     }
-                    let _e146 = local_30;
-                    t_18 = _e146;
-                    let _e148 = atmosphere_131;
-                    let _e149 = r_76;
-                    let _e150 = mu_59;
-                    let _e151 = mu_s_47;
-                    let _e152 = nu_31;
-                    let _e153 = t_18;
-                    let _e154 = GetSegmentNode(_e148, transmittance_texture_9, _e149, _e150, _e151, _e152, _e153);
-                    node_1 = _e154;
+                    let _e145 = local_29;
+                    t_17 = _e145;
+                    let _e147 = atmosphere_127;
+                    let _e148 = r_72;
+                    let _e149 = mu_55;
+                    let _e150 = mu_s_47;
+                    let _e151 = nu_31;
+                    let _e152 = t_17;
+                    let _e153 = GetSegmentNode(_e147, transmittance_texture_8, _e148, _e149, _e150, _e151, _e152);
+                    node_1 = _e153;
                 }
             } else {
-                let _e156 = k_6;
-                let _e158 = intervals_1;
-                if ((2i * _e156) == _e158) {
+                let _e155 = k_5;
+                let _e157 = intervals_1;
+                if ((2i * _e155) == _e157) {
                     {
-                        let _e160 = middle;
-                        node_1 = _e160;
+                        let _e159 = middle;
+                        node_1 = _e159;
                     }
                 }
             }
-            let _e161 = finding_last;
-            if _e161 {
+            let _e160 = finding_last;
+            if _e160 {
                 {
-                    let _e162 = node_1;
-                    last_2 = _e162;
+                    let _e161 = node_1;
+                    last_2 = _e161;
                 }
             } else {
-                let _e163 = finding_middle;
-                if _e163 {
+                let _e162 = finding_middle;
+                if _e162 {
                     {
-                        let _e164 = node_1;
-                        middle = _e164;
-                        let _e165 = sums_2;
-                        let _e167 = middle;
-                        let _e168 = last_2;
-                        let _e169 = t1_1;
-                        let _e170 = t0_1;
-                        let _e172 = SegmentIntervals(_e165.end, _e167, _e168, (_e169 - _e170));
-                        intervals_1 = _e172;
-                        let _e173 = t1_1;
-                        let _e174 = t0_1;
-                        let _e176 = intervals_1;
-                        dt_1 = ((_e173 - _e174) / f32(_e176));
+                        let _e163 = node_1;
+                        middle = _e163;
+                        let _e164 = sums_2;
+                        let _e166 = middle;
+                        let _e167 = last_2;
+                        let _e168 = t1_1;
+                        let _e169 = t0_1;
+                        let _e171 = SegmentIntervals(_e164.end, _e166, _e167, (_e168 - _e169));
+                        intervals_1 = _e171;
+                        let _e172 = t1_1;
+                        let _e173 = t0_1;
+                        let _e175 = intervals_1;
+                        dt = ((_e172 - _e173) / f32(_e175));
                     }
                 } else {
                     {
-                        let _e179 = previous;
-                        let _e181 = node_1;
-                        let _e185 = dt_1;
-                        interval_depth = ((_e179.extinction + _e181.extinction) * (0.5f * _e185));
-                        let _e189 = interval_depth;
-                        attenuation_2 = exp(-(_e189));
-                        let _e193 = result;
-                        let _e195 = interval_depth;
-                        let _e196 = attenuation_2;
-                        let _e197 = MeanAttenuation(_e195, _e196);
-                        mean_transmittance = (_e193.transmittance * _e197);
-                        let _e201 = result;
-                        let _e203 = previous;
-                        let _e205 = node_1;
-                        let _e209 = dt_1;
-                        let _e212 = mean_transmittance;
-                        result.single_rayleigh = (_e201.single_rayleigh + (((_e203.rayleigh + _e205.rayleigh) * (0.5f * _e209)) * _e212));
-                        let _e216 = result;
-                        let _e218 = previous;
-                        let _e220 = node_1;
-                        let _e224 = dt_1;
-                        let _e227 = mean_transmittance;
-                        result.single_mie = (_e216.single_mie + (((_e218.mie + _e220.mie) * (0.5f * _e224)) * _e227));
-                        let _e231 = result;
-                        let _e233 = previous;
-                        let _e235 = node_1;
-                        let _e239 = dt_1;
-                        let _e242 = mean_transmittance;
-                        result.scattering_weight = (_e231.scattering_weight + (((_e233.scattering + _e235.scattering) * (0.5f * _e239)) * _e242));
-                        let _e246 = result;
-                        let _e248 = interval_depth;
-                        result.optical_depth = (_e246.optical_depth + _e248);
-                        let _e251 = result;
-                        let _e253 = attenuation_2;
-                        result.transmittance = (_e251.transmittance * _e253);
-                        let _e255 = node_1;
-                        previous = _e255;
+                        let _e178 = previous;
+                        let _e180 = node_1;
+                        let _e184 = dt;
+                        interval_depth = ((_e178.extinction + _e180.extinction) * (0.5f * _e184));
+                        let _e188 = interval_depth;
+                        attenuation_2 = exp(-(_e188));
+                        let _e192 = result;
+                        let _e194 = interval_depth;
+                        let _e195 = attenuation_2;
+                        let _e196 = MeanAttenuation(_e194, _e195);
+                        mean_transmittance = (_e192.transmittance * _e196);
+                        let _e200 = result;
+                        let _e202 = previous;
+                        let _e204 = node_1;
+                        let _e208 = dt;
+                        let _e211 = mean_transmittance;
+                        result.single_rayleigh = (_e200.single_rayleigh + (((_e202.rayleigh + _e204.rayleigh) * (0.5f * _e208)) * _e211));
+                        let _e215 = result;
+                        let _e217 = previous;
+                        let _e219 = node_1;
+                        let _e223 = dt;
+                        let _e226 = mean_transmittance;
+                        result.single_mie = (_e215.single_mie + (((_e217.mie + _e219.mie) * (0.5f * _e223)) * _e226));
+                        let _e230 = result;
+                        let _e232 = previous;
+                        let _e234 = node_1;
+                        let _e238 = dt;
+                        let _e241 = mean_transmittance;
+                        result.scattering_weight = (_e230.scattering_weight + (((_e232.scattering + _e234.scattering) * (0.5f * _e238)) * _e241));
+                        let _e245 = result;
+                        let _e247 = interval_depth;
+                        result.optical_depth = (_e245.optical_depth + _e247);
+                        let _e250 = result;
+                        let _e252 = attenuation_2;
+                        result.transmittance = (_e250.transmittance * _e252);
+                        let _e254 = node_1;
+                        previous = _e254;
                     }
                 }
             }
         }
         continuing {
-            let _e87 = i_4;
-            i_4 = (_e87 + 1i);
+            let _e86 = i_4;
+            i_4 = (_e86 + 1i);
         }
     }
-    let _e257 = last_2;
-    result.end = _e257;
-    let _e258 = result;
-    return _e258;
+    let _e256 = last_2;
+    result.end = _e256;
+    let _e257 = result;
+    return _e257;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_132: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_133: AtmosphereParameters;
+fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_129: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -4116,17 +4013,21 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_132: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_77: f32;
-    var mu_60: f32;
+    var r_73: f32;
+    var mu_56: f32;
     var mu_s_48: f32;
     var nu_32: f32;
-    var d_28: f32;
+    var d_24: f32;
     var lit: f32;
-    var ray_r_mu_intersects_ground_34: bool;
-    var direct: f32;
+    var ray_r_mu_intersects_ground_32: bool;
+    var colour: bool;
     var lit_direct: f32;
+    var local_30: f32;
+    var direct: f32;
+    var local_31: f32;
+    var lit_transmittance_direct: f32;
     var lit_sums: SegmentSums;
-    var optical_depth_1: vec3<f32>;
+    var optical_depth: vec3<f32>;
     var single_mie_scattering_2: vec3<f32>;
     var scattering_2: vec3<f32>;
     var boundary: f32;
@@ -4142,382 +4043,400 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_132: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_133 = atmosphere_132;
+    atmosphere_129 = atmosphere_128;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
     sun_direction_5 = sun_direction_4;
-    let _e36 = point_1;
-    let _e37 = camera_7;
-    camera_to_point = (_e36 - _e37);
+    let _e35 = point_1;
+    let _e36 = camera_7;
+    camera_to_point = (_e35 - _e36);
+    let _e39 = camera_to_point;
     let _e40 = camera_to_point;
-    let _e41 = camera_to_point;
-    if (dot(_e40, _e41) == 0f) {
+    if (dot(_e39, _e40) == 0f) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e49 = camera_to_point;
-    view_ray_6 = normalize(_e49);
-    let _e57 = atmosphere_133;
-    let _e58 = camera_7;
-    let _e59 = view_ray_6;
-    let _e60 = sun_direction_5;
-    let _e71 = GetViewRayStart(_e57, _e58, _e59, _e60, (&start_3), (&r_77), (&mu_60), (&mu_s_48), (&nu_32));
-    if !(_e71) {
+    let _e48 = camera_to_point;
+    view_ray_6 = normalize(_e48);
+    let _e56 = atmosphere_129;
+    let _e57 = camera_7;
+    let _e58 = view_ray_6;
+    let _e59 = sun_direction_5;
+    let _e70 = GetViewRayStart(_e56, _e57, _e58, _e59, (&start_3), (&r_73), (&mu_56), (&mu_s_48), (&nu_32));
+    if !(_e70) {
         {
             (*transmittance_1) = vec3(1f);
             return vec3(0f);
         }
     }
-    let _e77 = point_1;
-    let _e78 = start_3;
-    d_28 = max(length((_e77 - _e78)), 0f);
-    let _e84 = d_28;
-    let _e85 = shadow_length_1;
-    lit = max((_e84 - max(_e85, 0f)), 0f);
-    let _e92 = atmosphere_133;
-    let _e93 = r_77;
-    let _e94 = mu_60;
-    let _e95 = RayIntersectsGround(_e92, _e93, _e94);
-    ray_r_mu_intersects_ground_34 = _e95;
-    let _e101 = d_28;
-    direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e101));
-    let _e109 = lit;
-    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e109));
+    let _e76 = point_1;
+    let _e77 = start_3;
+    d_24 = max(length((_e76 - _e77)), 0f);
+    let _e83 = d_24;
+    let _e84 = shadow_length_1;
+    lit = max((_e83 - max(_e84, 0f)), 0f);
+    let _e91 = atmosphere_129;
+    let _e92 = r_73;
+    let _e93 = mu_56;
+    let _e94 = RayIntersectsGround(_e91, _e92, _e93);
+    ray_r_mu_intersects_ground_32 = _e94;
+    let _e96 = atmosphere_129;
+    colour = (_e96.transmittance_is_colour != 0i);
+    let _e105 = lit;
+    lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e105));
+    let _e109 = colour;
+    if _e109 {
+        local_30 = 1f;
+    } else {
+        let _e115 = d_24;
+        local_30 = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e115));
+    }
+    let _e119 = local_30;
+    direct = _e119;
+    let _e121 = colour;
+    if _e121 {
+        local_31 = 1f;
+    } else {
+        let _e123 = lit_direct;
+        local_31 = _e123;
+    }
+    let _e125 = local_31;
+    lit_transmittance_direct = _e125;
     lit_sums.optical_depth = vec3(0f);
     lit_sums.single_mie = vec3(0f);
-    let _e120 = lit_direct;
-    if (_e120 > 0f) {
+    let _e134 = lit_transmittance_direct;
+    if (_e134 > 0f) {
         {
-            let _e123 = atmosphere_133;
-            let _e124 = r_77;
-            let _e125 = mu_60;
-            let _e126 = mu_s_48;
-            let _e127 = nu_32;
-            let _e129 = lit;
-            let _e130 = atmosphere_133;
-            let _e131 = r_77;
-            let _e132 = mu_60;
-            let _e133 = mu_s_48;
-            let _e134 = nu_32;
-            let _e136 = StartSegment(_e130, transmittance_texture_10, _e131, _e132, _e133, _e134, 0f);
-            let _e137 = ContinueSegment(_e123, transmittance_texture_10, _e124, _e125, _e126, _e127, 0f, _e129, _e136);
-            lit_sums = _e137;
+            let _e137 = atmosphere_129;
+            let _e138 = r_73;
+            let _e139 = mu_56;
+            let _e140 = mu_s_48;
+            let _e141 = nu_32;
+            let _e143 = lit;
+            let _e144 = atmosphere_129;
+            let _e145 = r_73;
+            let _e146 = mu_56;
+            let _e147 = mu_s_48;
+            let _e148 = nu_32;
+            let _e150 = StartSegment(_e144, transmittance_texture_9, _e145, _e146, _e147, _e148, 0f);
+            let _e151 = ContinueSegment(_e137, transmittance_texture_9, _e138, _e139, _e140, _e141, 0f, _e143, _e150);
+            lit_sums = _e151;
         }
     }
-    let _e138 = lit_sums;
-    optical_depth_1 = _e138.optical_depth;
-    let _e141 = direct;
-    let _e144 = lit;
-    let _e145 = d_28;
-    if ((_e141 > 0f) && (_e144 < _e145)) {
+    let _e152 = lit_sums;
+    optical_depth = _e152.optical_depth;
+    let _e155 = direct;
+    let _e158 = lit;
+    let _e159 = d_24;
+    if ((_e155 > 0f) && (_e158 < _e159)) {
         {
-            let _e148 = atmosphere_133;
-            let _e149 = r_77;
-            let _e150 = mu_60;
-            let _e151 = mu_s_48;
-            let _e152 = nu_32;
-            let _e153 = lit;
-            let _e154 = d_28;
-            let _e155 = lit_sums;
-            let _e156 = ContinueSegment(_e148, transmittance_texture_10, _e149, _e150, _e151, _e152, _e153, _e154, _e155);
-            optical_depth_1 = _e156.optical_depth;
+            let _e162 = atmosphere_129;
+            let _e163 = r_73;
+            let _e164 = mu_56;
+            let _e165 = mu_s_48;
+            let _e166 = nu_32;
+            let _e167 = lit;
+            let _e168 = d_24;
+            let _e169 = lit_sums;
+            let _e170 = ContinueSegment(_e162, transmittance_texture_9, _e163, _e164, _e165, _e166, _e167, _e168, _e169);
+            optical_depth = _e170.optical_depth;
         }
     }
-    let _e158 = direct;
-    if (_e158 < 1f) {
+    let _e172 = direct;
+    if (_e172 < 1f) {
         {
-            let _e161 = atmosphere_133;
-            let _e162 = r_77;
-            let _e163 = mu_60;
-            let _e164 = d_28;
-            let _e165 = ray_r_mu_intersects_ground_34;
-            let _e166 = LongSegmentOpticalDepth(_e161, transmittance_texture_10, _e162, _e163, _e164, _e165);
-            let _e167 = optical_depth_1;
-            let _e168 = direct;
-            optical_depth_1 = mix(_e166, _e167, vec3(_e168));
+            let _e175 = atmosphere_129;
+            let _e176 = r_73;
+            let _e177 = mu_56;
+            let _e178 = d_24;
+            let _e179 = ray_r_mu_intersects_ground_32;
+            let _e180 = GetOpticalDepth(_e175, transmittance_texture_9, _e176, _e177, _e178, _e179);
+            let _e181 = optical_depth;
+            let _e182 = direct;
+            optical_depth = mix(_e180, _e181, vec3(_e182));
         }
     }
-    let _e171 = optical_depth_1;
-    (*transmittance_1) = exp(-(_e171));
-    let _e175 = atmosphere_133;
-    let _e176 = r_77;
-    let _e177 = mu_60;
-    let _e178 = mu_s_48;
-    let _e179 = nu_32;
-    let _e180 = ray_r_mu_intersects_ground_34;
-    let _e183 = GetCombinedScattering(_e175, scattering_texture_9, single_mie_scattering_texture_3, _e176, _e177, _e178, _e179, _e180, (&single_mie_scattering_2));
-    scattering_2 = _e183;
-    let _e185 = lit;
-    if (_e185 < DIRECT_SEGMENT_LENGTH) {
+    let _e185 = optical_depth;
+    (*transmittance_1) = exp(-(_e185));
+    let _e189 = atmosphere_129;
+    let _e190 = r_73;
+    let _e191 = mu_56;
+    let _e192 = mu_s_48;
+    let _e193 = nu_32;
+    let _e194 = ray_r_mu_intersects_ground_32;
+    let _e197 = GetCombinedScattering(_e189, scattering_texture_9, single_mie_scattering_texture_3, _e190, _e191, _e192, _e193, _e194, (&single_mie_scattering_2));
+    scattering_2 = _e197;
+    let _e199 = lit;
+    if (_e199 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e187 = atmosphere_133;
-            let _e188 = r_77;
-            let _e189 = mu_60;
-            let _e190 = ray_r_mu_intersects_ground_34;
-            let _e191 = DistanceToNearestAtmosphereBoundary(_e187, _e188, _e189, _e190);
-            boundary = _e191;
-            let _e193 = boundary;
-            let _e195 = atmosphere_133;
-            let _e196 = r_77;
-            let _e197 = mu_60;
-            let _e198 = DistanceInsideScatteringRadii(_e195, _e196, _e197);
-            let _e200 = lit;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e193), _e198), _e200);
-            let _e203 = atmosphere_133;
-            let _e204 = r_77;
-            let _e205 = mu_60;
-            let _e206 = mu_s_48;
-            let _e207 = nu_32;
-            let _e208 = lit;
-            let _e209 = far;
-            let _e210 = lit_sums;
-            let _e211 = ContinueSegment(_e203, transmittance_texture_10, _e204, _e205, _e206, _e207, _e208, _e209, _e210);
-            far_sums = _e211;
-            let _e213 = far;
-            let _e214 = boundary;
-            if (_e213 < _e214) {
+            let _e201 = atmosphere_129;
+            let _e202 = r_73;
+            let _e203 = mu_56;
+            let _e204 = ray_r_mu_intersects_ground_32;
+            let _e205 = DistanceToNearestAtmosphereBoundary(_e201, _e202, _e203, _e204);
+            boundary = _e205;
+            let _e207 = boundary;
+            let _e209 = atmosphere_129;
+            let _e210 = r_73;
+            let _e211 = mu_56;
+            let _e212 = DistanceInsideScatteringRadii(_e209, _e210, _e211);
+            let _e214 = lit;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e207), _e212), _e214);
+            let _e217 = atmosphere_129;
+            let _e218 = r_73;
+            let _e219 = mu_56;
+            let _e220 = mu_s_48;
+            let _e221 = nu_32;
+            let _e222 = lit;
+            let _e223 = far;
+            let _e224 = lit_sums;
+            let _e225 = ContinueSegment(_e217, transmittance_texture_9, _e218, _e219, _e220, _e221, _e222, _e223, _e224);
+            far_sums = _e225;
+            let _e227 = far;
+            let _e228 = boundary;
+            if (_e227 < _e228) {
                 {
-                    let _e216 = atmosphere_133;
-                    let _e217 = r_77;
-                    let _e218 = mu_60;
-                    let _e219 = far;
-                    let _e220 = RadiusAtDistance(_e216, _e217, _e218, _e219);
-                    r_far = _e220;
-                    let _e223 = scattering_2;
-                    let _e224 = far_sums;
-                    let _e226 = atmosphere_133;
-                    let _e227 = r_far;
-                    let _e228 = r_77;
-                    let _e229 = mu_60;
-                    let _e230 = far;
-                    let _e231 = r_far;
-                    let _e232 = CosineAtDistance(_e228, _e229, _e230, _e231);
-                    let _e233 = r_77;
-                    let _e234 = mu_s_48;
-                    let _e236 = far;
-                    let _e237 = nu_32;
-                    let _e240 = r_far;
-                    let _e242 = ClampCosine((((_e233 * _e234) + (_e236 * _e237)) / _e240));
-                    let _e243 = nu_32;
-                    let _e244 = ray_r_mu_intersects_ground_34;
-                    let _e247 = GetCombinedScattering(_e226, scattering_texture_9, single_mie_scattering_texture_3, _e227, _e232, _e242, _e243, _e244, (&unused_far_mie));
-                    scattering_2 = (_e223 - (_e224.transmittance * _e247));
+                    let _e230 = atmosphere_129;
+                    let _e231 = r_73;
+                    let _e232 = mu_56;
+                    let _e233 = far;
+                    let _e234 = RadiusAtDistance(_e230, _e231, _e232, _e233);
+                    r_far = _e234;
+                    let _e237 = scattering_2;
+                    let _e238 = far_sums;
+                    let _e240 = atmosphere_129;
+                    let _e241 = r_far;
+                    let _e242 = r_73;
+                    let _e243 = mu_56;
+                    let _e244 = far;
+                    let _e245 = r_far;
+                    let _e246 = CosineAtDistance(_e242, _e243, _e244, _e245);
+                    let _e247 = r_73;
+                    let _e248 = mu_s_48;
+                    let _e250 = far;
+                    let _e251 = nu_32;
+                    let _e254 = r_far;
+                    let _e256 = ClampCosine((((_e247 * _e248) + (_e250 * _e251)) / _e254));
+                    let _e257 = nu_32;
+                    let _e258 = ray_r_mu_intersects_ground_32;
+                    let _e261 = GetCombinedScattering(_e240, scattering_texture_9, single_mie_scattering_texture_3, _e241, _e246, _e256, _e257, _e258, (&unused_far_mie));
+                    scattering_2 = (_e237 - (_e238.transmittance * _e261));
                 }
             }
-            let _e250 = scattering_2;
-            let _e251 = far_sums;
-            let _e253 = atmosphere_133;
-            let _e260 = lit_sums;
-            let _e263 = far_sums;
-            multiple = ((max((_e250 - (_e251.single_rayleigh * _e253.solar_irradiance)), vec3(0f)) * _e260.scattering_weight) / max(_e263.scattering_weight, vec3(0.000000000000000000000000000001f)));
-            let _e270 = lit_sums;
-            let _e272 = atmosphere_133;
-            let _e275 = multiple;
-            let _e277 = nu_32;
-            let _e278 = RayleighPhaseFunction(_e277);
-            let _e280 = lit_sums;
-            let _e282 = atmosphere_133;
-            let _e285 = atmosphere_133;
-            let _e286 = nu_32;
-            let _e287 = MiePhaseFunction(_e285, _e286);
-            return ((((_e270.single_rayleigh * _e272.solar_irradiance) + _e275) * _e278) + ((_e280.single_mie * _e282.solar_irradiance) * _e287));
+            let _e264 = scattering_2;
+            let _e265 = far_sums;
+            let _e267 = atmosphere_129;
+            let _e274 = lit_sums;
+            let _e277 = far_sums;
+            multiple = ((max((_e264 - (_e265.single_rayleigh * _e267.solar_irradiance)), vec3(0f)) * _e274.scattering_weight) / max(_e277.scattering_weight, vec3(0.000000000000000000000000000001f)));
+            let _e284 = lit_sums;
+            let _e286 = atmosphere_129;
+            let _e289 = multiple;
+            let _e291 = nu_32;
+            let _e292 = RayleighPhaseFunction(_e291);
+            let _e294 = lit_sums;
+            let _e296 = atmosphere_129;
+            let _e299 = atmosphere_129;
+            let _e300 = nu_32;
+            let _e301 = MiePhaseFunction(_e299, _e300);
+            return ((((_e284.single_rayleigh * _e286.solar_irradiance) + _e289) * _e292) + ((_e294.single_mie * _e296.solar_irradiance) * _e301));
         }
     }
-    let _e290 = atmosphere_133;
-    let _e291 = r_77;
-    let _e292 = mu_60;
-    let _e293 = lit;
-    let _e294 = RadiusAtDistance(_e290, _e291, _e292, _e293);
-    r_p = _e294;
-    let _e296 = r_77;
-    let _e297 = mu_60;
-    let _e298 = lit;
-    let _e299 = r_p;
-    let _e300 = CosineAtDistance(_e296, _e297, _e298, _e299);
-    mu_p = _e300;
-    let _e302 = r_77;
-    let _e303 = mu_s_48;
-    let _e305 = lit;
-    let _e306 = nu_32;
-    let _e309 = r_p;
-    let _e311 = ClampCosine((((_e302 * _e303) + (_e305 * _e306)) / _e309));
-    mu_s_p = _e311;
-    let _e313 = atmosphere_133;
-    let _e314 = r_77;
-    let _e315 = mu_60;
-    let _e316 = lit;
-    let _e317 = ray_r_mu_intersects_ground_34;
-    let _e318 = LongSegmentOpticalDepth(_e313, transmittance_texture_10, _e314, _e315, _e316, _e317);
-    let _e319 = lit_sums;
-    let _e321 = lit_direct;
-    lit_transmittance = exp(-(mix(_e318, _e319.optical_depth, vec3(_e321))));
-    let _e328 = atmosphere_133;
-    let _e329 = r_p;
-    let _e330 = mu_p;
-    let _e331 = mu_s_p;
-    let _e332 = nu_32;
-    let _e333 = ray_r_mu_intersects_ground_34;
-    let _e336 = GetCombinedScattering(_e328, scattering_texture_9, single_mie_scattering_texture_3, _e329, _e330, _e331, _e332, _e333, (&single_mie_scattering_p));
-    scattering_p = _e336;
-    let _e338 = scattering_2;
-    let _e339 = lit_transmittance;
-    let _e340 = scattering_p;
-    scattering_2 = max((_e338 - (_e339 * _e340)), vec3(0f));
-    let _e346 = single_mie_scattering_2;
-    let _e347 = lit_transmittance;
-    let _e348 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e346 - (_e347 * _e348)), vec3(0f));
-    let _e354 = single_mie_scattering_2;
-    let _e355 = lit_sums;
-    let _e357 = atmosphere_133;
-    let _e360 = lit_direct;
-    single_mie_scattering_2 = mix(_e354, (_e355.single_mie * _e357.solar_irradiance), vec3(_e360));
-    let _e363 = scattering_2;
-    let _e364 = nu_32;
-    let _e365 = RayleighPhaseFunction(_e364);
-    let _e367 = single_mie_scattering_2;
-    let _e368 = atmosphere_133;
-    let _e369 = nu_32;
-    let _e370 = MiePhaseFunction(_e368, _e369);
-    return ((_e363 * _e365) + (_e367 * _e370));
+    let _e304 = atmosphere_129;
+    let _e305 = r_73;
+    let _e306 = mu_56;
+    let _e307 = lit;
+    let _e308 = RadiusAtDistance(_e304, _e305, _e306, _e307);
+    r_p = _e308;
+    let _e310 = r_73;
+    let _e311 = mu_56;
+    let _e312 = lit;
+    let _e313 = r_p;
+    let _e314 = CosineAtDistance(_e310, _e311, _e312, _e313);
+    mu_p = _e314;
+    let _e316 = r_73;
+    let _e317 = mu_s_48;
+    let _e319 = lit;
+    let _e320 = nu_32;
+    let _e323 = r_p;
+    let _e325 = ClampCosine((((_e316 * _e317) + (_e319 * _e320)) / _e323));
+    mu_s_p = _e325;
+    let _e327 = atmosphere_129;
+    let _e328 = r_73;
+    let _e329 = mu_56;
+    let _e330 = lit;
+    let _e331 = ray_r_mu_intersects_ground_32;
+    let _e332 = GetOpticalDepth(_e327, transmittance_texture_9, _e328, _e329, _e330, _e331);
+    let _e333 = lit_sums;
+    let _e335 = lit_transmittance_direct;
+    lit_transmittance = exp(-(mix(_e332, _e333.optical_depth, vec3(_e335))));
+    let _e342 = atmosphere_129;
+    let _e343 = r_p;
+    let _e344 = mu_p;
+    let _e345 = mu_s_p;
+    let _e346 = nu_32;
+    let _e347 = ray_r_mu_intersects_ground_32;
+    let _e350 = GetCombinedScattering(_e342, scattering_texture_9, single_mie_scattering_texture_3, _e343, _e344, _e345, _e346, _e347, (&single_mie_scattering_p));
+    scattering_p = _e350;
+    let _e352 = scattering_2;
+    let _e353 = lit_transmittance;
+    let _e354 = scattering_p;
+    scattering_2 = max((_e352 - (_e353 * _e354)), vec3(0f));
+    let _e360 = single_mie_scattering_2;
+    let _e361 = lit_transmittance;
+    let _e362 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e360 - (_e361 * _e362)), vec3(0f));
+    let _e368 = single_mie_scattering_2;
+    let _e369 = lit_sums;
+    let _e371 = atmosphere_129;
+    let _e374 = lit_direct;
+    single_mie_scattering_2 = mix(_e368, (_e369.single_mie * _e371.solar_irradiance), vec3(_e374));
+    let _e377 = scattering_2;
+    let _e378 = nu_32;
+    let _e379 = RayleighPhaseFunction(_e378);
+    let _e381 = single_mie_scattering_2;
+    let _e382 = atmosphere_129;
+    let _e383 = nu_32;
+    let _e384 = MiePhaseFunction(_e382, _e383);
+    return ((_e377 * _e379) + (_e381 * _e384));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_134: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_135: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_130: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_131: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_135 = atmosphere_134;
+    atmosphere_131 = atmosphere_130;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e34 = atmosphere_135;
-    let _e35 = camera_9;
-    let _e36 = point_3;
-    let _e38 = sun_direction_7;
-    let _e41 = GetSkyRadianceToPointWithShadow(_e34, transmittance_texture_11, scattering_texture_10, single_mie_scattering_texture_4, _e35, _e36, 0f, _e38, transmittance_2);
-    return _e41;
+    let _e33 = atmosphere_131;
+    let _e34 = camera_9;
+    let _e35 = point_3;
+    let _e37 = sun_direction_7;
+    let _e40 = GetSkyRadianceToPointWithShadow(_e33, transmittance_texture_10, scattering_texture_10, single_mie_scattering_texture_4, _e34, _e35, 0f, _e37, transmittance_2);
+    return _e40;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_136: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_137: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_132: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_133: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_78: f32;
+    var r_74: f32;
     var mu_s_49: f32;
 
-    atmosphere_137 = atmosphere_136;
+    atmosphere_133 = atmosphere_132;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e33 = atmosphere_137;
-    let _e34 = point_5;
-    let _e36 = ClampRadius(_e33, length(_e34));
-    r_78 = _e36;
-    let _e38 = point_5;
-    let _e39 = sun_direction_9;
-    let _e41 = point_5;
-    let _e44 = ClampCosine((dot(_e38, _e39) / length(_e41)));
-    mu_s_49 = _e44;
-    let _e46 = atmosphere_137;
-    let _e47 = r_78;
-    let _e48 = mu_s_49;
-    let _e49 = GetIrradiance(_e46, irradiance_texture_1, _e47, _e48);
-    let _e51 = normal_1;
-    let _e52 = point_5;
-    let _e54 = point_5;
-    (*sky_irradiance) = ((_e49 * (1f + (dot(_e51, _e52) / length(_e54)))) * 0.5f);
-    let _e61 = atmosphere_137;
-    let _e63 = atmosphere_137;
-    let _e64 = r_78;
-    let _e65 = mu_s_49;
-    let _e66 = GetTransmittanceToSun(_e63, transmittance_texture_12, _e64, _e65);
-    let _e68 = normal_1;
-    let _e69 = sun_direction_9;
-    return ((_e61.solar_irradiance * _e66) * max(dot(_e68, _e69), 0f));
+    let _e32 = atmosphere_133;
+    let _e33 = point_5;
+    let _e35 = ClampRadius(_e32, length(_e33));
+    r_74 = _e35;
+    let _e37 = point_5;
+    let _e38 = sun_direction_9;
+    let _e40 = point_5;
+    let _e43 = ClampCosine((dot(_e37, _e38) / length(_e40)));
+    mu_s_49 = _e43;
+    let _e45 = atmosphere_133;
+    let _e46 = r_74;
+    let _e47 = mu_s_49;
+    let _e48 = GetIrradiance(_e45, irradiance_texture_1, _e46, _e47);
+    let _e50 = normal_1;
+    let _e51 = point_5;
+    let _e53 = point_5;
+    (*sky_irradiance) = ((_e48 * (1f + (dot(_e50, _e51) / length(_e53)))) * 0.5f);
+    let _e60 = atmosphere_133;
+    let _e62 = atmosphere_133;
+    let _e63 = r_74;
+    let _e64 = mu_s_49;
+    let _e65 = GetTransmittanceToSun(_e62, transmittance_texture_11, _e63, _e64);
+    let _e67 = normal_1;
+    let _e68 = sun_direction_9;
+    return ((_e60.solar_irradiance * _e65) * max(dot(_e67, _e68), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_138: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_139: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_134: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_135: AtmosphereParameters;
 
-    atmosphere_139 = atmosphere_138;
-    let _e24 = atmosphere_139;
-    let _e26 = atmosphere_139;
-    let _e29 = atmosphere_139;
-    return (_e24.solar_irradiance / vec3(((PI * _e26.sun_angular_radius) * _e29.sun_angular_radius)));
+    atmosphere_135 = atmosphere_134;
+    let _e23 = atmosphere_135;
+    let _e25 = atmosphere_135;
+    let _e28 = atmosphere_135;
+    return (_e23.solar_irradiance / vec3(((PI * _e25.sun_angular_radius) * _e28.sun_angular_radius)));
 }
 
 fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
     var xyz_1: vec3<f32>;
 
     xyz_1 = xyz;
-    let _e30 = xyz_1;
-    let _e37 = xyz_1;
-    let _e44 = xyz_1;
-    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e30), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e37), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e44));
+    let _e29 = xyz_1;
+    let _e36 = xyz_1;
+    let _e43 = xyz_1;
+    return vec3<f32>(dot(vec3<f32>(3.24097f, -1.5373832f, -0.4986108f), _e29), dot(vec3<f32>(-0.9692436f, 1.8759675f, 0.0415551f), _e36), dot(vec3<f32>(0.0556301f, -0.203977f, 1.0569715f), _e43));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn SkyViewHorizonZenith(atmosphere_140: AtmosphereParameters, r_79: f32) -> f32 {
-    var atmosphere_141: AtmosphereParameters;
-    var r_80: f32;
+fn SkyViewHorizonZenith(atmosphere_136: AtmosphereParameters, r_75: f32) -> f32 {
+    var atmosphere_137: AtmosphereParameters;
+    var r_76: f32;
 
-    atmosphere_141 = atmosphere_140;
-    r_80 = r_79;
-    let _e28 = atmosphere_141;
-    let _e30 = atmosphere_141;
-    let _e31 = r_80;
-    let _e32 = HorizonDistance(_e30, _e31);
-    return atan2(_e28.bottom_radius, -(_e32));
+    atmosphere_137 = atmosphere_136;
+    r_76 = r_75;
+    let _e27 = atmosphere_137;
+    let _e29 = atmosphere_137;
+    let _e30 = r_76;
+    let _e31 = HorizonDistance(_e29, _e30);
+    return atan2(_e27.bottom_radius, -(_e31));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewUvFromAngles(atmosphere_142: AtmosphereParameters, r_81: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
-    var atmosphere_143: AtmosphereParameters;
-    var r_82: f32;
+fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_33: bool) -> vec2<f32> {
+    var atmosphere_139: AtmosphereParameters;
+    var r_78: f32;
     var theta_1: f32;
     var phi_1: f32;
-    var ray_r_mu_intersects_ground_36: bool;
+    var ray_r_mu_intersects_ground_34: bool;
     var theta_h: f32;
-    var local_31: f32;
+    var local_32: f32;
     var x_26: f32;
 
-    atmosphere_143 = atmosphere_142;
-    r_82 = r_81;
+    atmosphere_139 = atmosphere_138;
+    r_78 = r_77;
     theta_1 = theta;
     phi_1 = phi;
-    ray_r_mu_intersects_ground_36 = ray_r_mu_intersects_ground_35;
-    let _e34 = atmosphere_143;
-    let _e35 = r_82;
-    let _e36 = SkyViewHorizonZenith(_e34, _e35);
-    theta_h = _e36;
-    let _e38 = ray_r_mu_intersects_ground_36;
-    if _e38 {
-        let _e40 = theta_1;
-        let _e41 = theta_h;
-        let _e43 = theta_h;
-        local_31 = (1f - sqrt(clamp(((_e40 - _e41) / (PI - _e43)), 0f, 1f)));
+    ray_r_mu_intersects_ground_34 = ray_r_mu_intersects_ground_33;
+    let _e33 = atmosphere_139;
+    let _e34 = r_78;
+    let _e35 = SkyViewHorizonZenith(_e33, _e34);
+    theta_h = _e35;
+    let _e37 = ray_r_mu_intersects_ground_34;
+    if _e37 {
+        let _e39 = theta_1;
+        let _e40 = theta_h;
+        let _e42 = theta_h;
+        local_32 = (1f - sqrt(clamp(((_e39 - _e40) / (PI - _e42)), 0f, 1f)));
     } else {
-        let _e52 = theta_h;
-        let _e53 = theta_1;
-        let _e55 = theta_h;
-        local_31 = (1f - sqrt(clamp(((_e52 - _e53) / _e55), 0f, 1f)));
+        let _e51 = theta_h;
+        let _e52 = theta_1;
+        let _e54 = theta_h;
+        local_32 = (1f - sqrt(clamp(((_e51 - _e52) / _e54), 0f, 1f)));
     }
-    let _e63 = local_31;
-    x_26 = _e63;
-    let _e65 = phi_1;
-    let _e67 = GetTextureCoordFromUnitRange((_e65 / PI), SKY_VIEW_WIDTH);
-    let _e68 = x_26;
-    let _e69 = ray_r_mu_intersects_ground_36;
-    let _e70 = GetTextureCoordFromUnitMuInHalf(_e68, _e69, SKY_VIEW_HEIGHT);
-    return vec2<f32>(_e67, _e70);
+    let _e62 = local_32;
+    x_26 = _e62;
+    let _e64 = phi_1;
+    let _e66 = GetTextureCoordFromUnitRange((_e64 / PI), SKY_VIEW_WIDTH);
+    let _e67 = x_26;
+    let _e68 = ray_r_mu_intersects_ground_34;
+    let _e69 = GetTextureCoordFromUnitMuInHalf(_e67, _e68, SKY_VIEW_HEIGHT);
+    return vec2<f32>(_e66, _e69);
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -4526,295 +4445,295 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     var view_ray_8: vec3<f32>;
     var sun_direction_11: vec3<f32>;
     var up_1: vec3<f32>;
-    var mu_61: f32;
+    var mu_57: f32;
     var horizontal: vec3<f32>;
     var sun_horizontal: vec3<f32>;
     var along: f32;
     var side: f32;
-    var local_32: f32;
+    var local_33: f32;
 
     camera_11 = camera_10;
     view_ray_8 = view_ray_7;
     sun_direction_11 = sun_direction_10;
-    let _e32 = camera_11;
-    up_1 = normalize(_e32);
-    let _e35 = up_1;
-    let _e36 = view_ray_8;
-    mu_61 = dot(_e35, _e36);
-    let _e39 = view_ray_8;
-    let _e40 = up_1;
-    let _e41 = mu_61;
-    horizontal = (_e39 - (_e40 * _e41));
-    let _e45 = sun_direction_11;
+    let _e31 = camera_11;
+    up_1 = normalize(_e31);
+    let _e34 = up_1;
+    let _e35 = view_ray_8;
+    mu_57 = dot(_e34, _e35);
+    let _e38 = view_ray_8;
+    let _e39 = up_1;
+    let _e40 = mu_57;
+    horizontal = (_e38 - (_e39 * _e40));
+    let _e44 = sun_direction_11;
+    let _e45 = up_1;
     let _e46 = up_1;
-    let _e47 = up_1;
-    let _e48 = sun_direction_11;
-    sun_horizontal = (_e45 - (_e46 * dot(_e47, _e48)));
-    let _e53 = horizontal;
-    let _e55 = mu_61;
-    (*theta_2) = atan2(length(_e53), _e55);
-    let _e57 = sun_horizontal;
-    let _e58 = horizontal;
-    along = dot(_e57, _e58);
-    let _e61 = up_1;
-    let _e62 = sun_horizontal;
-    let _e64 = horizontal;
-    side = abs(dot(cross(_e61, _e62), _e64));
-    let _e68 = along;
-    let _e71 = side;
-    if ((_e68 != 0f) || (_e71 != 0f)) {
-        let _e75 = side;
-        let _e76 = along;
-        local_32 = atan2(_e75, _e76);
+    let _e47 = sun_direction_11;
+    sun_horizontal = (_e44 - (_e45 * dot(_e46, _e47)));
+    let _e52 = horizontal;
+    let _e54 = mu_57;
+    (*theta_2) = atan2(length(_e52), _e54);
+    let _e56 = sun_horizontal;
+    let _e57 = horizontal;
+    along = dot(_e56, _e57);
+    let _e60 = up_1;
+    let _e61 = sun_horizontal;
+    let _e63 = horizontal;
+    side = abs(dot(cross(_e60, _e61), _e63));
+    let _e67 = along;
+    let _e70 = side;
+    if ((_e67 != 0f) || (_e70 != 0f)) {
+        let _e74 = side;
+        let _e75 = along;
+        local_33 = atan2(_e74, _e75);
     } else {
-        local_32 = 0f;
+        local_33 = 0f;
     }
-    let _e80 = local_32;
-    (*phi_2) = _e80;
+    let _e79 = local_33;
+    (*phi_2) = _e79;
     return;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRay(atmosphere_144: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
-    var atmosphere_145: AtmosphereParameters;
+fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_35: ptr<function, bool>) -> vec3<f32> {
+    var atmosphere_141: AtmosphereParameters;
     var camera_13: vec3<f32>;
     var sun_direction_13: vec3<f32>;
     var uv_5: vec2<f32>;
     var x_27: f32;
     var e_1: f32;
     var theta_h_1: f32;
-    var local_33: f32;
+    var local_34: f32;
     var theta_3: f32;
     var phi_3: f32;
     var up_2: vec3<f32>;
     var toward_sun: vec3<f32>;
-    var local_34: vec3<f32>;
+    var local_35: vec3<f32>;
     var across_3: vec3<f32>;
 
-    atmosphere_145 = atmosphere_144;
+    atmosphere_141 = atmosphere_140;
     camera_13 = camera_12;
     sun_direction_13 = sun_direction_12;
     uv_5 = uv_4;
-    let _e33 = uv_5;
-    let _e37 = GetUnitMuInHalfFromTextureCoord(_e33.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
-    x_27 = _e37;
-    let _e40 = x_27;
-    let _e43 = x_27;
-    e_1 = ((1f - _e40) * (1f - _e43));
-    let _e47 = atmosphere_145;
-    let _e48 = atmosphere_145;
-    let _e49 = camera_13;
-    let _e51 = ClampRadius(_e48, length(_e49));
-    let _e52 = SkyViewHorizonZenith(_e47, _e51);
-    theta_h_1 = _e52;
-    let _e54 = (*ray_r_mu_intersects_ground_37);
-    if _e54 {
-        let _e55 = theta_h_1;
-        let _e56 = e_1;
-        let _e57 = theta_h_1;
-        local_33 = (_e55 + (_e56 * (PI - _e57)));
+    let _e32 = uv_5;
+    let _e36 = GetUnitMuInHalfFromTextureCoord(_e32.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_35);
+    x_27 = _e36;
+    let _e39 = x_27;
+    let _e42 = x_27;
+    e_1 = ((1f - _e39) * (1f - _e42));
+    let _e46 = atmosphere_141;
+    let _e47 = atmosphere_141;
+    let _e48 = camera_13;
+    let _e50 = ClampRadius(_e47, length(_e48));
+    let _e51 = SkyViewHorizonZenith(_e46, _e50);
+    theta_h_1 = _e51;
+    let _e53 = (*ray_r_mu_intersects_ground_35);
+    if _e53 {
+        let _e54 = theta_h_1;
+        let _e55 = e_1;
+        let _e56 = theta_h_1;
+        local_34 = (_e54 + (_e55 * (PI - _e56)));
     } else {
-        let _e61 = theta_h_1;
-        let _e63 = e_1;
-        local_33 = (_e61 * (1f - _e63));
+        let _e60 = theta_h_1;
+        let _e62 = e_1;
+        local_34 = (_e60 * (1f - _e62));
     }
-    let _e67 = local_33;
-    theta_3 = _e67;
-    let _e69 = uv_5;
-    let _e71 = GetUnitRangeFromTextureCoord(_e69.x, SKY_VIEW_WIDTH);
-    phi_3 = (PI * clamp(_e71, 0f, 1f));
-    let _e77 = camera_13;
-    up_2 = normalize(_e77);
-    let _e80 = sun_direction_13;
-    let _e81 = up_2;
-    let _e82 = sun_direction_13;
-    let _e83 = up_2;
-    toward_sun = (_e80 - (_e81 * dot(_e82, _e83)));
+    let _e66 = local_34;
+    theta_3 = _e66;
+    let _e68 = uv_5;
+    let _e70 = GetUnitRangeFromTextureCoord(_e68.x, SKY_VIEW_WIDTH);
+    phi_3 = (PI * clamp(_e70, 0f, 1f));
+    let _e76 = camera_13;
+    up_2 = normalize(_e76);
+    let _e79 = sun_direction_13;
+    let _e80 = up_2;
+    let _e81 = sun_direction_13;
+    let _e82 = up_2;
+    toward_sun = (_e79 - (_e80 * dot(_e81, _e82)));
+    let _e87 = toward_sun;
     let _e88 = toward_sun;
-    let _e89 = toward_sun;
-    if (dot(_e88, _e89) < 0.000000000001f) {
+    if (dot(_e87, _e88) < 0.000000000001f) {
         {
+            let _e92 = up_2;
             let _e93 = up_2;
-            let _e94 = up_2;
-            if (abs(_e94.x) < 0.9f) {
-                local_34 = vec3<f32>(1f, 0f, 0f);
+            if (abs(_e93.x) < 0.9f) {
+                local_35 = vec3<f32>(1f, 0f, 0f);
             } else {
-                local_34 = vec3<f32>(0f, 1f, 0f);
+                local_35 = vec3<f32>(0f, 1f, 0f);
             }
-            let _e108 = local_34;
-            toward_sun = cross(_e93, _e108);
+            let _e107 = local_35;
+            toward_sun = cross(_e92, _e107);
         }
     }
-    let _e110 = toward_sun;
-    toward_sun = normalize(_e110);
-    let _e112 = up_2;
-    let _e113 = toward_sun;
-    across_3 = cross(_e112, _e113);
-    let _e116 = up_2;
-    let _e117 = theta_3;
-    let _e120 = toward_sun;
-    let _e121 = phi_3;
-    let _e124 = across_3;
-    let _e125 = phi_3;
-    let _e129 = theta_3;
-    return ((_e116 * cos(_e117)) + (((_e120 * cos(_e121)) + (_e124 * sin(_e125))) * sin(_e129)));
+    let _e109 = toward_sun;
+    toward_sun = normalize(_e109);
+    let _e111 = up_2;
+    let _e112 = toward_sun;
+    across_3 = cross(_e111, _e112);
+    let _e115 = up_2;
+    let _e116 = theta_3;
+    let _e119 = toward_sun;
+    let _e120 = phi_3;
+    let _e123 = across_3;
+    let _e124 = phi_3;
+    let _e128 = theta_3;
+    return ((_e115 * cos(_e116)) + (((_e119 * cos(_e120)) + (_e123 * sin(_e124))) * sin(_e128)));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRadiance(atmosphere_146: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
-    var atmosphere_147: AtmosphereParameters;
+fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
+    var atmosphere_143: AtmosphereParameters;
     var camera_15: vec3<f32>;
     var sun_direction_15: vec3<f32>;
     var uv_7: vec2<f32>;
-    var ray_r_mu_intersects_ground_38: bool;
+    var ray_r_mu_intersects_ground_36: bool;
     var view_ray_9: vec3<f32>;
     var up_3: vec3<f32>;
 
-    atmosphere_147 = atmosphere_146;
+    atmosphere_143 = atmosphere_142;
     camera_15 = camera_14;
     sun_direction_15 = sun_direction_14;
     uv_7 = uv_6;
-    let _e35 = atmosphere_147;
-    let _e36 = camera_15;
-    let _e37 = sun_direction_15;
-    let _e38 = uv_7;
-    let _e41 = GetSkyViewRay(_e35, _e36, _e37, _e38, (&ray_r_mu_intersects_ground_38));
-    view_ray_9 = _e41;
-    let _e43 = camera_15;
-    up_3 = normalize(_e43);
-    let _e46 = atmosphere_147;
-    let _e47 = atmosphere_147;
-    let _e48 = camera_15;
-    let _e50 = ClampRadius(_e47, length(_e48));
-    let _e51 = up_3;
-    let _e52 = view_ray_9;
-    let _e54 = ClampCosine(dot(_e51, _e52));
-    let _e55 = up_3;
-    let _e56 = sun_direction_15;
-    let _e58 = ClampCosine(dot(_e55, _e56));
-    let _e59 = view_ray_9;
-    let _e60 = sun_direction_15;
-    let _e62 = ClampCosine(dot(_e59, _e60));
-    let _e63 = ray_r_mu_intersects_ground_38;
-    let _e64 = GetSkyRadianceOfRay(_e46, scattering_texture_11, single_mie_scattering_texture_5, _e50, _e54, _e58, _e62, _e63);
-    return _e64;
+    let _e34 = atmosphere_143;
+    let _e35 = camera_15;
+    let _e36 = sun_direction_15;
+    let _e37 = uv_7;
+    let _e40 = GetSkyViewRay(_e34, _e35, _e36, _e37, (&ray_r_mu_intersects_ground_36));
+    view_ray_9 = _e40;
+    let _e42 = camera_15;
+    up_3 = normalize(_e42);
+    let _e45 = atmosphere_143;
+    let _e46 = atmosphere_143;
+    let _e47 = camera_15;
+    let _e49 = ClampRadius(_e46, length(_e47));
+    let _e50 = up_3;
+    let _e51 = view_ray_9;
+    let _e53 = ClampCosine(dot(_e50, _e51));
+    let _e54 = up_3;
+    let _e55 = sun_direction_15;
+    let _e57 = ClampCosine(dot(_e54, _e55));
+    let _e58 = view_ray_9;
+    let _e59 = sun_direction_15;
+    let _e61 = ClampCosine(dot(_e58, _e59));
+    let _e62 = ray_r_mu_intersects_ground_36;
+    let _e63 = GetSkyRadianceOfRay(_e45, scattering_texture_11, single_mie_scattering_texture_5, _e49, _e53, _e57, _e61, _e62);
+    return _e63;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceFromSkyView(atmosphere_148: AtmosphereParameters, transmittance_texture_13: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_149: AtmosphereParameters;
+fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_145: AtmosphereParameters;
     var camera_17: vec3<f32>;
     var view_ray_11: vec3<f32>;
     var sun_direction_17: vec3<f32>;
-    var r_83: f32;
-    var mu_62: f32;
-    var ray_r_mu_intersects_ground_39: bool;
-    var local_35: vec3<f32>;
+    var r_79: f32;
+    var mu_58: f32;
+    var ray_r_mu_intersects_ground_37: bool;
+    var local_36: vec3<f32>;
     var theta_4: f32;
     var phi_4: f32;
 
-    atmosphere_149 = atmosphere_148;
+    atmosphere_145 = atmosphere_144;
     camera_17 = camera_16;
     view_ray_11 = view_ray_10;
     sun_direction_17 = sun_direction_16;
-    let _e35 = atmosphere_149;
-    let _e36 = camera_17;
-    let _e38 = ClampRadius(_e35, length(_e36));
-    r_83 = _e38;
-    let _e40 = camera_17;
-    let _e41 = view_ray_11;
-    let _e43 = camera_17;
-    let _e46 = ClampCosine((dot(_e40, _e41) / length(_e43)));
-    mu_62 = _e46;
-    let _e48 = atmosphere_149;
-    let _e49 = r_83;
-    let _e50 = mu_62;
-    let _e51 = RayIntersectsGround(_e48, _e49, _e50);
-    ray_r_mu_intersects_ground_39 = _e51;
-    let _e53 = ray_r_mu_intersects_ground_39;
-    if _e53 {
-        local_35 = vec3(0f);
+    let _e34 = atmosphere_145;
+    let _e35 = camera_17;
+    let _e37 = ClampRadius(_e34, length(_e35));
+    r_79 = _e37;
+    let _e39 = camera_17;
+    let _e40 = view_ray_11;
+    let _e42 = camera_17;
+    let _e45 = ClampCosine((dot(_e39, _e40) / length(_e42)));
+    mu_58 = _e45;
+    let _e47 = atmosphere_145;
+    let _e48 = r_79;
+    let _e49 = mu_58;
+    let _e50 = RayIntersectsGround(_e47, _e48, _e49);
+    ray_r_mu_intersects_ground_37 = _e50;
+    let _e52 = ray_r_mu_intersects_ground_37;
+    if _e52 {
+        local_36 = vec3(0f);
     } else {
-        let _e56 = atmosphere_149;
-        let _e57 = r_83;
-        let _e58 = mu_62;
-        let _e59 = GetTransmittanceToTopAtmosphereBoundary(_e56, transmittance_texture_13, _e57, _e58);
-        local_35 = _e59;
+        let _e55 = atmosphere_145;
+        let _e56 = r_79;
+        let _e57 = mu_58;
+        let _e58 = GetTransmittanceToTopAtmosphereBoundary(_e55, transmittance_texture_12, _e56, _e57);
+        local_36 = _e58;
     }
-    let _e61 = local_35;
-    (*transmittance_3) = _e61;
-    let _e64 = camera_17;
-    let _e65 = view_ray_11;
-    let _e66 = sun_direction_17;
-    GetSkyViewAngles(_e64, _e65, _e66, (&theta_4), (&phi_4));
-    let _e71 = atmosphere_149;
-    let _e72 = r_83;
-    let _e73 = theta_4;
-    let _e74 = phi_4;
-    let _e75 = ray_r_mu_intersects_ground_39;
-    let _e76 = GetSkyViewUvFromAngles(_e71, _e72, _e73, _e74, _e75);
-    let _e77 = SampleTexture2D(sky_view_texture, _e76);
-    return vec3<f32>(_e77.xyz);
+    let _e60 = local_36;
+    (*transmittance_3) = _e60;
+    let _e63 = camera_17;
+    let _e64 = view_ray_11;
+    let _e65 = sun_direction_17;
+    GetSkyViewAngles(_e63, _e64, _e65, (&theta_4), (&phi_4));
+    let _e70 = atmosphere_145;
+    let _e71 = r_79;
+    let _e72 = theta_4;
+    let _e73 = phi_4;
+    let _e74 = ray_r_mu_intersects_ground_37;
+    let _e75 = GetSkyViewUvFromAngles(_e70, _e71, _e72, _e73, _e74);
+    let _e76 = SampleTexture2D(sky_view_texture, _e75);
+    return vec3<f32>(_e76.xyz);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn AerialPerspectiveSliceDistance(k_7: f32) -> f32 {
-    var k_8: f32;
+fn AerialPerspectiveSliceDistance(k_6: f32) -> f32 {
+    var k_7: f32;
     var x_28: f32;
 
-    k_8 = k_7;
-    let _e28 = k_8;
-    x_28 = ((_e28 + 1f) / 32f);
-    let _e35 = x_28;
-    let _e37 = x_28;
-    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e35) * _e37);
+    k_7 = k_6;
+    let _e27 = k_7;
+    x_28 = ((_e27 + 1f) / 32f);
+    let _e34 = x_28;
+    let _e36 = x_28;
+    return ((AERIAL_PERSPECTIVE_MAX_DISTANCE * _e34) * _e36);
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetAerialPerspectiveVoxel(atmosphere_150: AtmosphereParameters, transmittance_texture_14: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_151: AtmosphereParameters;
+fn GetAerialPerspectiveVoxel(atmosphere_146: AtmosphereParameters, transmittance_texture_13: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_147: AtmosphereParameters;
     var camera_19: vec3<f32>;
     var view_ray_13: vec3<f32>;
     var w_1: f32;
     var sun_direction_19: vec3<f32>;
-    var d_29: f32;
+    var d_25: f32;
     var point_6: vec3<f32>;
     var r_point: f32;
     var transmittance_4: vec3<f32>;
     var radiance: vec3<f32>;
 
-    atmosphere_151 = atmosphere_150;
+    atmosphere_147 = atmosphere_146;
     camera_19 = camera_18;
     view_ray_13 = view_ray_12;
     w_1 = w;
     sun_direction_19 = sun_direction_18;
-    let _e40 = w_1;
-    let _e45 = AerialPerspectiveSliceDistance(floor((_e40 * 32f)));
-    d_29 = _e45;
-    let _e47 = camera_19;
-    let _e48 = view_ray_13;
-    let _e49 = d_29;
-    point_6 = (_e47 + (_e48 * _e49));
-    let _e53 = point_6;
-    r_point = length(_e53);
-    let _e56 = r_point;
-    let _e57 = atmosphere_151;
-    if (_e56 < _e57.bottom_radius) {
-        let _e60 = point_6;
-        let _e61 = atmosphere_151;
-        let _e63 = r_point;
-        point_6 = (_e60 * (_e61.bottom_radius / _e63));
+    let _e39 = w_1;
+    let _e44 = AerialPerspectiveSliceDistance(floor((_e39 * 32f)));
+    d_25 = _e44;
+    let _e46 = camera_19;
+    let _e47 = view_ray_13;
+    let _e48 = d_25;
+    point_6 = (_e46 + (_e47 * _e48));
+    let _e52 = point_6;
+    r_point = length(_e52);
+    let _e55 = r_point;
+    let _e56 = atmosphere_147;
+    if (_e55 < _e56.bottom_radius) {
+        let _e59 = point_6;
+        let _e60 = atmosphere_147;
+        let _e62 = r_point;
+        point_6 = (_e59 * (_e60.bottom_radius / _e62));
     }
-    let _e67 = atmosphere_151;
-    let _e68 = camera_19;
-    let _e69 = point_6;
-    let _e70 = sun_direction_19;
-    let _e73 = GetSkyRadianceToPoint(_e67, transmittance_texture_14, scattering_texture_12, single_mie_scattering_texture_6, _e68, _e69, _e70, (&transmittance_4));
-    radiance = _e73;
-    let _e75 = transmittance_4;
-    (*optical_depth_2) = -(log(max(_e75, vec3(0.000000000000000000000000000001f))));
-    let _e81 = radiance;
-    return _e81;
+    let _e66 = atmosphere_147;
+    let _e67 = camera_19;
+    let _e68 = point_6;
+    let _e69 = sun_direction_19;
+    let _e72 = GetSkyRadianceToPoint(_e66, transmittance_texture_13, scattering_texture_12, single_mie_scattering_texture_6, _e67, _e68, _e69, (&transmittance_4));
+    radiance = _e72;
+    let _e74 = transmittance_4;
+    (*optical_depth_1) = -(log(max(_e74, vec3(0.000000000000000000000000000001f))));
+    let _e80 = radiance;
+    return _e80;
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
@@ -4822,47 +4741,47 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     var screen_uv_1: vec2<f32>;
     var distance_3: f32;
     var slices: f32 = 32f;
-    var d_30: f32;
+    var d_26: f32;
     var s_3: f32;
-    var k_9: f32;
+    var k_8: f32;
     var d_k: f32;
-    var t_19: f32;
+    var t_18: f32;
     var near: f32;
     var uvw_2: vec3<f32>;
 
     screen_uv_1 = screen_uv;
     distance_3 = distance_2;
-    let _e36 = distance_3;
-    d_30 = max(_e36, 0f);
-    let _e40 = slices;
-    let _e41 = d_30;
-    s_3 = (_e40 * sqrt((_e41 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
-    let _e46 = s_3;
-    let _e51 = slices;
-    k_9 = clamp((floor(_e46) - 1f), 0f, (_e51 - 2f));
-    let _e56 = k_9;
-    let _e57 = AerialPerspectiveSliceDistance(_e56);
-    d_k = _e57;
-    let _e59 = d_30;
-    let _e60 = d_k;
-    let _e62 = k_9;
-    let _e65 = AerialPerspectiveSliceDistance((_e62 + 1f));
-    let _e66 = d_k;
-    t_19 = clamp(((_e59 - _e60) / (_e65 - _e66)), 0f, 1f);
-    let _e73 = d_30;
-    let _e75 = AerialPerspectiveSliceDistance(0f);
-    near = min((_e73 / _e75), 1f);
-    let _e80 = screen_uv_1;
-    let _e81 = k_9;
-    let _e82 = t_19;
-    let _e86 = slices;
-    uvw_2 = vec3<f32>(_e80.x, _e80.y, (((_e81 + _e82) + 0.5f) / _e86));
-    let _e92 = uvw_2;
-    let _e93 = SampleTexture3D(optical_depth_volume, _e92);
-    let _e97 = near;
-    (*transmittance_5) = exp((-(vec3<f32>(_e93.xyz)) * _e97));
-    let _e100 = uvw_2;
-    let _e101 = SampleTexture3D(radiance_volume, _e100);
-    let _e104 = near;
-    return (vec3<f32>(_e101.xyz) * _e104);
+    let _e35 = distance_3;
+    d_26 = max(_e35, 0f);
+    let _e39 = slices;
+    let _e40 = d_26;
+    s_3 = (_e39 * sqrt((_e40 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
+    let _e45 = s_3;
+    let _e50 = slices;
+    k_8 = clamp((floor(_e45) - 1f), 0f, (_e50 - 2f));
+    let _e55 = k_8;
+    let _e56 = AerialPerspectiveSliceDistance(_e55);
+    d_k = _e56;
+    let _e58 = d_26;
+    let _e59 = d_k;
+    let _e61 = k_8;
+    let _e64 = AerialPerspectiveSliceDistance((_e61 + 1f));
+    let _e65 = d_k;
+    t_18 = clamp(((_e58 - _e59) / (_e64 - _e65)), 0f, 1f);
+    let _e72 = d_26;
+    let _e74 = AerialPerspectiveSliceDistance(0f);
+    near = min((_e72 / _e74), 1f);
+    let _e79 = screen_uv_1;
+    let _e80 = k_8;
+    let _e81 = t_18;
+    let _e85 = slices;
+    uvw_2 = vec3<f32>(_e79.x, _e79.y, (((_e80 + _e81) + 0.5f) / _e85));
+    let _e91 = uvw_2;
+    let _e92 = SampleTexture3D(optical_depth_volume, _e91);
+    let _e96 = near;
+    (*transmittance_5) = exp((-(vec3<f32>(_e92.xyz)) * _e96));
+    let _e99 = uvw_2;
+    let _e100 = SampleTexture3D(radiance_volume, _e99);
+    let _e103 = near;
+    return (vec3<f32>(_e100.xyz) * _e103);
 }
