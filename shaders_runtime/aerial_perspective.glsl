@@ -253,6 +253,17 @@ SegmentSums ContinueSegment(IN(AtmosphereParameters) atmosphere, IN(Transmittanc
   return result;
 }
 
+// The optical depth of the segment of length d along (r, mu): the directly
+// integrated one where its weight `direct` is 1, blended toward the tables'
+// (GetOpticalDepth, read only where needed) as the weight falls.
+vec3 BlendedOpticalDepth(IN(AtmosphereParameters) atmosphere, IN(TransmittanceTexture) transmittance_texture,
+                         Number r, Number mu, Number d, bool ray_r_mu_intersects_ground,
+                         IN(vec3) direct_optical_depth, Number direct) {
+  if (direct >= 1.0) return direct_optical_depth;
+  return mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground),
+             direct_optical_depth, direct);
+}
+
 // In-scattered radiance between `camera` and `point` and the transmittance
 // between them, for a point whose last `shadow_length` metres toward it lie
 // in shadow (light shafts, Bruneton & Neyret 2008 Section 5): light is
@@ -314,11 +325,8 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
     optical_depth =
         ContinueSegment(atmosphere, transmittance_texture, r, mu, mu_s, nu, lit, d, lit_sums).optical_depth;
   }
-  if (direct < 1.0) {
-    optical_depth = mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground),
-                        optical_depth, direct);
-  }
-  transmittance = exp(-optical_depth);
+  transmittance = exp(-BlendedOpticalDepth(atmosphere, transmittance_texture, r, mu, d, ray_r_mu_intersects_ground,
+                                            optical_depth, direct));
 
   // The light gathered depends on the sunlit part alone.
   vec3 single_mie_scattering;
@@ -351,9 +359,9 @@ vec3 GetSkyRadianceToPointWithShadow(IN(AtmosphereParameters) atmosphere,
   Number r_p = RadiusAtDistance(atmosphere, r, mu, lit);
   Number mu_p = CosineAtDistance(r, mu, lit, r_p);
   Number mu_s_p = ClampCosine((r * mu_s + lit * nu) / r_p);
-  vec3 lit_transmittance =
-      exp(-mix(GetOpticalDepth(atmosphere, transmittance_texture, r, mu, lit, ray_r_mu_intersects_ground),
-               lit_sums.optical_depth, lit_transmittance_direct));
+  vec3 lit_transmittance = exp(-BlendedOpticalDepth(atmosphere, transmittance_texture, r, mu, lit,
+                                                    ray_r_mu_intersects_ground, lit_sums.optical_depth,
+                                                    lit_transmittance_direct));
   vec3 single_mie_scattering_p;
   vec3 scattering_p = GetCombinedScattering(atmosphere, scattering_texture, single_mie_scattering_texture, r_p,
                                             mu_p, mu_s_p, nu, ray_r_mu_intersects_ground,

@@ -294,7 +294,7 @@ vec4 GetScatteringAtOwnColumn(IN(AtmosphereParameters) atmosphere, IN(Scattering
 
 // ln L (LogLight) of one nu slice below the split at `position` on the ray's
 // own columns (GetScatteringShadowEdgePosition): between its lit columns
-// LogMonotoneCubicMix of the four around it (the split's column the last);
+// LogMonotoneCubic of the four around it (the split's column the last);
 // within SHADOW_EDGE_CLOSEST of the edge, the light at the edge plus the
 // rise to the first lit column times (D / D_min)^p, p from the rise to the
 // second (where both rise, in [1, 10]; else 3, the fall of the light next
@@ -337,7 +337,7 @@ vec4 GetLogScatteringBelowSplit(IN(AtmosphereParameters) atmosphere, IN(Scatteri
 // (GetScatteringFromLookup), so that the single Mie table costs fetches and
 // blends but none of the coordinates' arithmetic.
 const int SCATTERING_DAYLIGHT = 0;          // linear along mu_s: one fetch per nu slice at x.x
-const int SCATTERING_LOW_SUN = 1;           // LogMonotoneCubicMix of the columns at x, at t
+const int SCATTERING_LOW_SUN = 1;           // LogMonotoneCubic of the columns at x, at t
 const int SCATTERING_BELOW_TABLE = 2;       // LowestSunContinued of the columns at x.x and x.y
 const int SCATTERING_OWN_COLUMNS = 3;       // GetLogScatteringBelowSplit in each nu slice, at position
 struct ScatteringLookup {

@@ -44,11 +44,11 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
     float3 param_3;
     float param_4;
     float param_5;
-    bool _1118 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
+    bool _1129 = EnterAtmosphere(param, param_1, param_2, param_3, param_4, param_5);
     start = param_3;
     r = param_4;
     float r_mu = param_5;
-    if (!_1118)
+    if (!_1129)
     {
         return false;
     }
@@ -66,17 +66,17 @@ bool GetViewRayStart(AtmosphereParameters atmosphere, float3 camera, float3 view
 bool RayIntersectsGround(AtmosphereParameters atmosphere, float r, float mu)
 {
     float c = (r - atmosphere.bottom_radius) * (r + atmosphere.bottom_radius);
-    bool _981 = mu < 0.0f;
-    bool _993;
-    if (_981)
+    bool _992 = mu < 0.0f;
+    bool _1004;
+    if (_992)
     {
-        _993 = (((r * r) * mu) * mu) >= c;
+        _1004 = (((r * r) * mu) * mu) >= c;
     }
     else
     {
-        _993 = _981;
+        _1004 = _992;
     }
-    return _993;
+    return _1004;
 }
 #endif
 
@@ -107,16 +107,16 @@ float DistanceToSphereFromInside(float r_mu, float c)
 {
     float param = (r_mu * r_mu) + c;
     float s = SafeSqrt(param);
-    float _751;
+    float _762;
     if (r_mu > 0.0f)
     {
-        _751 = c / (r_mu + s);
+        _762 = c / (r_mu + s);
     }
     else
     {
-        _751 = s - r_mu;
+        _762 = s - r_mu;
     }
-    float param_1 = _751;
+    float param_1 = _762;
     return ClampDistance(param_1);
 }
 
@@ -146,16 +146,16 @@ float2 GetTransmittanceTextureUvFromRMu(AtmosphereParameters atmosphere, float r
     float d = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     float d_min = atmosphere.top_radius - r;
     float d_max = rho + H;
-    float _1222;
+    float _1233;
     if (d_max > d_min)
     {
-        _1222 = (d - d_min) / (d_max - d_min);
+        _1233 = (d - d_min) / (d_max - d_min);
     }
     else
     {
-        _1222 = 0.0f;
+        _1233 = 0.0f;
     }
-    float x_mu = _1222;
+    float x_mu = _1233;
     float x_r = rho / H;
     float param_6 = x_mu;
     int param_7 = atmosphere.transmittance_width;
@@ -247,16 +247,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
         float param_2 = mu;
         float d = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
         float d_min = r - atmosphere.bottom_radius;
-        float _1274;
+        float _1285;
         if (rho == d_min)
         {
-            _1274 = 0.0f;
+            _1285 = 0.0f;
         }
         else
         {
-            _1274 = (d - d_min) / (rho - d_min);
+            _1285 = (d - d_min) / (rho - d_min);
         }
-        return _1274;
+        return _1285;
     }
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = r;
@@ -265,16 +265,16 @@ float GetUnitMuInHalf(AtmosphereParameters atmosphere, float r, float rho, float
     float d_min_1 = atmosphere.top_radius - r;
     AtmosphereParameters param_6 = atmosphere;
     float d_max = rho + HorizonDistanceAtTop(param_6);
-    float _1309;
+    float _1320;
     if (d_max > d_min_1)
     {
-        _1309 = (d_1 - d_min_1) / (d_max - d_min_1);
+        _1320 = (d_1 - d_min_1) / (d_max - d_min_1);
     }
     else
     {
-        _1309 = 0.0f;
+        _1320 = 0.0f;
     }
-    return _1309;
+    return _1320;
 }
 #endif
 
@@ -284,16 +284,16 @@ float GetTextureCoordFromUnitMuInHalf(float x, bool ray_r_mu_intersects_ground, 
     float param = x;
     int param_1 = size / 2;
     float u = 0.5f * GetTextureCoordFromUnitRange(param, param_1);
-    float _1332;
+    float _1343;
     if (ray_r_mu_intersects_ground)
     {
-        _1332 = 0.5f - u;
+        _1343 = 0.5f - u;
     }
     else
     {
-        _1332 = 0.5f + u;
+        _1343 = 0.5f + u;
     }
-    return _1332;
+    return _1343;
 }
 #endif
 
@@ -353,39 +353,39 @@ float ViewSunAzimuthCosine(float mu, float mu_s, float nu)
 {
     float param = (1.0f - (mu * mu)) * (1.0f - (mu_s * mu_s));
     float across = SafeSqrt(param);
-    float _1650;
+    float _1661;
     if (across > 0.0f)
     {
         float param_1 = (nu - (mu * mu_s)) / across;
-        _1650 = ClampCosine(param_1);
+        _1661 = ClampCosine(param_1);
     }
     else
     {
-        _1650 = 1.0f;
+        _1661 = 1.0f;
     }
-    return _1650;
+    return _1661;
 }
 #endif
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float DistanceToNearestAtmosphereBoundary(AtmosphereParameters atmosphere, float r, float mu, bool ray_r_mu_intersects_ground)
 {
-    float _997;
+    float _1008;
     if (ray_r_mu_intersects_ground)
     {
         AtmosphereParameters param = atmosphere;
         float param_1 = r;
         float param_2 = mu;
-        _997 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
+        _1008 = DistanceToBottomAtmosphereBoundary(param, param_1, param_2);
     }
     else
     {
         AtmosphereParameters param_3 = atmosphere;
         float param_4 = r;
         float param_5 = mu;
-        _997 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
+        _1008 = DistanceToTopAtmosphereBoundary(param_3, param_4, param_5);
     }
-    return _997;
+    return _1008;
 }
 #endif
 
@@ -438,52 +438,52 @@ float ShadowEdge(AtmosphereParameters atmosphere, float r, float mu, float cos_p
     float cos_gamma = (-c_end) / rho;
     float param_14 = 1.0f - (cos_gamma * cos_gamma);
     float sin_gamma = SafeSqrt(param_14);
-    float2 _1756;
+    float2 _1767;
     if (c_end >= rho)
     {
-        _1756 = float2(-1.0f, 0.0f);
+        _1767 = float2(-1.0f, 0.0f);
     }
     else
     {
-        _1756 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
+        _1767 = float2((cos_alpha * cos_gamma) - (across * sin_gamma), (across * cos_gamma) + (cos_alpha * sin_gamma)) / rho.xx;
     }
-    float2 end = _1756;
-    bool _1784 = end.y < 0.0f;
-    bool _1794;
-    if (!_1784)
+    float2 end = _1767;
+    bool _1795 = end.y < 0.0f;
+    bool _1805;
+    if (!_1795)
     {
-        _1794 = end.x < start.x;
+        _1805 = end.x < start.x;
     }
     else
     {
-        _1794 = _1784;
+        _1805 = _1795;
     }
-    bool end_sets_last = _1794;
+    bool end_sets_last = _1805;
     float a = atmosphere.sun_angular_radius;
     float cos_a = 1.0f - (((0.5f * a) * a) * (1.0f - ((a * a) / 12.0f)));
     float sin_a = a * (1.0f - ((a * a) / 6.0f));
-    bool2 _1825 = end_sets_last.xx;
-    float2 last = float2(_1825.x ? end.x : start.x, _1825.y ? end.y : start.y);
+    bool2 _1836 = end_sets_last.xx;
+    float2 last = float2(_1836.x ? end.x : start.x, _1836.y ? end.y : start.y);
     direction = float2((last.x * cos_a) - (last.y * sin_a), (last.y * cos_a) + (last.x * sin_a));
-    float _1848;
+    float _1859;
     if (end_sets_last)
     {
-        float _1854;
+        float _1865;
         if (c_end >= rho)
         {
-            _1854 = 3.1415927410125732421875f;
+            _1865 = 3.1415927410125732421875f;
         }
         else
         {
-            _1854 = atan2(across, cos_alpha) + acos(cos_gamma);
+            _1865 = atan2(across, cos_alpha) + acos(cos_gamma);
         }
-        _1848 = _1854;
+        _1859 = _1865;
     }
     else
     {
-        _1848 = acos(c_start);
+        _1859 = acos(c_start);
     }
-    float angle = _1848;
+    float angle = _1859;
     return angle + a;
 }
 #endif
@@ -513,17 +513,17 @@ float GetScatteringMuSFromUnitRangeOnAxis(AtmosphereParameters atmosphere, Scatt
     float param_1 = axis.inverse_A;
     float a = ScatteringDistanceFromUnitMuS(param, param_1);
     float d = d_min + (min(a, axis.A) * (axis.H - d_min));
-    float _1479;
+    float _1490;
     if (d == 0.0f)
     {
-        _1479 = 1.0f;
+        _1490 = 1.0f;
     }
     else
     {
         float param_2 = ((axis.H * axis.H) - (d * d)) / ((2.0f * bottom) * d);
-        _1479 = ClampCosine(param_2);
+        _1490 = ClampCosine(param_2);
     }
-    return _1479;
+    return _1490;
 }
 #endif
 
@@ -575,16 +575,16 @@ void ShadowEdgeLitUnitSpans(AtmosphereParameters atmosphere, ScatteringSunAxis s
     ScatteringSunAxis param_5 = sun_axis;
     float param_6 = ShadowEdgeSunCosine(param_2, param_3);
     float param_7;
-    float _2062 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
+    float _2073 = ShadowEdgeUnitSun(param_4, param_5, param_6, param_7);
     float unused = param_7;
-    X_closest = _2062;
+    X_closest = _2073;
     AtmosphereParameters param_8 = atmosphere;
     ScatteringSunAxis param_9 = sun_axis;
     float param_10 = split_mu_s;
     float param_11;
-    float _2071 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
+    float _2082 = ShadowEdgeUnitSun(param_8, param_9, param_10, param_11);
     unused = param_11;
-    X_span = _2071 - X_closest;
+    X_span = _2082 - X_closest;
     float2 param_12 = edge;
     float param_13 = split_mu_s;
     split_distance = ShadowEdgeDistance(param_12, param_13);
@@ -601,9 +601,9 @@ float ShadowEdgeLitUnitFrom(AtmosphereParameters atmosphere, ScatteringSunAxis s
     ScatteringSunAxis param_3 = sun_axis;
     float param_4 = ShadowEdgeSunCosine(param, param_1);
     float param_5;
-    float _2015 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
+    float _2026 = ShadowEdgeUnitSun(param_2, param_3, param_4, param_5);
     float dX_dtheta = param_5;
-    float X = _2015;
+    float X = _2026;
     derivative = ((((-0.300000011920928955078125f) * dX_dtheta) * D) / X_span) + (0.699999988079071044921875f / log_span);
     return ((0.300000011920928955078125f * (X - X_closest)) / X_span) + ((0.699999988079071044921875f * log(D / 0.0008726646192371845245361328125f)) / log_span);
 }
@@ -632,9 +632,9 @@ float ShadowEdgeLitUnit(AtmosphereParameters atmosphere, ScatteringSunAxis sun_a
     float param_12 = X_span;
     float param_13 = log_span;
     float param_14;
-    float _2120 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+    float _2131 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
     float unused = param_14;
-    return _2120;
+    return _2131;
 }
 #endif
 
@@ -705,17 +705,17 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, Scatteri
     float u_mu_s = GetScatteringTextureUMuSOnAxis(param_15, param_16, param_17);
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     edge = 0.0f.xx;
-    bool _2436 = atmosphere.scattering_mu_s_split > 0;
-    bool _2447;
-    if (_2436)
+    bool _2447 = atmosphere.scattering_mu_s_split > 0;
+    bool _2458;
+    if (_2447)
     {
-        _2447 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
+        _2458 = ((u_mu_s * mu_s_size) - 0.5f) < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _2447 = _2436;
+        _2458 = _2447;
     }
-    if (_2447)
+    if (_2458)
     {
         float param_18 = mu;
         float param_19 = mu_s;
@@ -726,7 +726,7 @@ float4 GetScatteringTextureUvwzAndEdge(AtmosphereParameters atmosphere, Scatteri
         float param_24 = ViewSunAzimuthCosine(param_18, param_19, param_20);
         bool param_25 = ray_r_mu_intersects_ground;
         float2 param_26;
-        float _2467 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
+        float _2478 = ShadowEdge(param_21, param_22, param_23, param_24, param_25, param_26);
         edge = param_26;
         float2 param_27 = edge;
         float param_28 = mu_s;
@@ -769,9 +769,9 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, ScatteringSunAxis s
         float param_11 = X_closest;
         float param_12 = X_span;
         float param_13 = log_span;
-        float _2181 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
+        float _2192 = ShadowEdgeLitUnitFrom(param_7, param_8, param_9, param_10, param_11, param_12, param_13, param_14);
         float slope = param_14;
-        float error = _2181 - x;
+        float error = _2192 - x;
         float next = clamp(s - (error / slope), s_min, s_max);
         bool converged = abs(next - s) < 9.9999999600419720025001879548654e-12f;
         s = next;
@@ -786,16 +786,16 @@ float ShadowEdgeLitDistance(AtmosphereParameters atmosphere, ScatteringSunAxis s
 
 float SunCosinePosition(float t, bool low_sun)
 {
-    float _2719;
+    float _2730;
     if (low_sun)
     {
-        _2719 = min(t, 1.0f);
+        _2730 = min(t, 1.0f);
     }
     else
     {
-        _2719 = clamp(t, 0.0f, 1.0f);
+        _2730 = clamp(t, 0.0f, 1.0f);
     }
-    return _2719;
+    return _2730;
 }
 
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
@@ -806,17 +806,17 @@ void GetScatteringMuSColumns(AtmosphereParameters atmosphere, float u_mu_s, floa
     float mu_s_column = clamp(floor(mu_s_coord), 0.0f, mu_s_size - 2.0f);
     x_below = (mu_s_column + 0.5f) / mu_s_size;
     x_above = (mu_s_column + 1.5f) / mu_s_size;
-    bool _2779 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
-    bool _2785;
-    if (_2779)
+    bool _2790 = atmosphere.scattering_mu_s_min < 0.100000001490116119384765625f;
+    bool _2796;
+    if (_2790)
     {
-        _2785 = x_below < x_low_sun;
+        _2796 = x_below < x_low_sun;
     }
     else
     {
-        _2785 = _2779;
+        _2796 = _2790;
     }
-    low_sun_below = _2785;
+    low_sun_below = _2796;
     float param = mu_s_coord - mu_s_column;
     bool param_1 = low_sun_below;
     mu_s_t = SunCosinePosition(param, param_1);
@@ -836,10 +836,10 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
     float param_6 = nu;
     bool param_7 = ray_r_mu_intersects_ground;
     float2 param_8;
-    float4 _3335 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    float4 _3346 = GetScatteringTextureUvwzAndEdge(param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float2 edge = param_8;
     ScatteringLookup lookup;
-    lookup.uvwz = _3335;
+    lookup.uvwz = _3346;
     float nu_size = float(atmosphere.scattering_nu_size);
     float nu_coord = lookup.uvwz.x * (nu_size - 1.0f);
     lookup.nu_slice = min(floor(nu_coord), nu_size - 2.0f);
@@ -854,17 +854,17 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
     lookup.log_first_span = 1.0f;
     float mu_s_size = float(atmosphere.scattering_mu_s_size);
     lookup.position = (lookup.uvwz.y * mu_s_size) - 0.5f;
-    bool _3387 = atmosphere.scattering_mu_s_split > 0;
-    bool _3396;
-    if (_3387)
+    bool _3398 = atmosphere.scattering_mu_s_split > 0;
+    bool _3407;
+    if (_3398)
     {
-        _3396 = lookup.position < float(atmosphere.scattering_mu_s_split);
+        _3407 = lookup.position < float(atmosphere.scattering_mu_s_split);
     }
     else
     {
-        _3396 = _3387;
+        _3407 = _3398;
     }
-    if (_3396)
+    if (_3407)
     {
         float past = 6.0f;
         lookup.kind = 3;
@@ -885,17 +885,17 @@ ScatteringLookup GetScatteringLookup(AtmosphereParameters atmosphere, float r, f
         }
         else
         {
-            bool _3444 = lookup.position >= (past - 1.0f);
-            bool _3451;
-            if (_3444)
+            bool _3455 = lookup.position >= (past - 1.0f);
+            bool _3462;
+            if (_3455)
             {
-                _3451 = lookup.position < past;
+                _3462 = lookup.position < past;
             }
             else
             {
-                _3451 = _3444;
+                _3462 = _3455;
             }
-            if (_3451)
+            if (_3462)
             {
                 float x = 1.0f / (float(atmosphere.scattering_mu_s_split) - past);
                 AtmosphereParameters param_15 = atmosphere;
@@ -984,26 +984,26 @@ float4 IsLit(float4 log_light)
 #if SKYBAKE_HAS_SCATTERING_TEXTURE
 float4 LogMonotoneCubic(float4 log_a, float4 lb, float4 lc, float4 log_d, bool has_a, bool has_d, float t)
 {
-    float4 _2795;
+    float4 _2806;
     if (has_a)
     {
-        _2795 = log_a;
+        _2806 = log_a;
     }
     else
     {
-        _2795 = (lb * 2.0f) - lc;
+        _2806 = (lb * 2.0f) - lc;
     }
-    float4 la = _2795;
-    float4 _2807;
+    float4 la = _2806;
+    float4 _2818;
     if (has_d)
     {
-        _2807 = log_d;
+        _2818 = log_d;
     }
     else
     {
-        _2807 = (lc * 2.0f) - lb;
+        _2818 = (lc * 2.0f) - lb;
     }
-    float4 ld = _2807;
+    float4 ld = _2818;
     float4 secant_a = lb - la;
     float4 secant = lc - lb;
     float4 secant_d = ld - lc;
@@ -1122,19 +1122,19 @@ float4 GetLogScatteringAtMuSColumn(AtmosphereParameters atmosphere, Texture3D<fl
     float param_6 = x;
     float param_7 = nu_slice + 1.0f;
     float4 b = GetScatteringInSlice(param_4, scattering_texture_1, _scattering_texture_1_sampler, param_5, param_6, param_7);
-    float4 _3042;
+    float4 _3053;
     if (low_sun)
     {
         float4 param_8 = a;
         float4 param_9 = b;
-        _3042 = lerp(LogLight(param_8), LogLight(param_9), nu_t.xxxx);
+        _3053 = lerp(LogLight(param_8), LogLight(param_9), nu_t.xxxx);
     }
     else
     {
         float4 param_10 = lerp(a, b, nu_t.xxxx);
-        _3042 = LogLight(param_10);
+        _3053 = LogLight(param_10);
     }
-    return _3042;
+    return _3053;
 }
 #endif
 
@@ -1269,16 +1269,16 @@ float3 GetCombinedScattering(AtmosphereParameters atmosphere, Texture3D<float4> 
     float4 scattering = GetScatteringFromLookup(param_6, scattering_texture_1, _scattering_texture_1_sampler, param_7);
     if (atmosphere.single_mie_in_scattering_alpha == 1)
     {
-        float3 _3924;
+        float3 _3935;
         if (scattering.x > 0.0f)
         {
-            _3924 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
+            _3935 = ((float3(scattering.xyz) * scattering.w) / scattering.x.xxx) * (atmosphere.mie_to_rayleigh_scattering_ratio / atmosphere.mie_to_rayleigh_scattering_ratio.x.xxx);
         }
         else
         {
-            _3924 = 0.0f.xxx;
+            _3935 = 0.0f.xxx;
         }
-        single_mie_scattering = _3924;
+        single_mie_scattering = _3935;
     }
     else
     {
@@ -1344,9 +1344,9 @@ float3 GetSkyRadianceOfRay(AtmosphereParameters atmosphere, Texture3D<float4> sc
     float param_4 = nu;
     bool param_5 = ray_r_mu_intersects_ground;
     float3 param_6;
-    float3 _3980 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
+    float3 _3991 = GetCombinedScattering(param, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5, param_6);
     float3 single_mie_scattering = param_6;
-    float3 scattering = _3980;
+    float3 scattering = _3991;
     float param_7 = nu;
     AtmosphereParameters param_8 = atmosphere;
     float param_9 = nu;
@@ -1366,13 +1366,13 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_6;
     float param_7;
     float param_8;
-    bool _4015 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4026 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4015)
+    if (!_4026)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -1381,19 +1381,19 @@ float3 GetSkyRadiance(AtmosphereParameters atmosphere, Texture2D<float4> transmi
     float param_10 = r;
     float param_11 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
-    float3 _4035;
+    float3 _4046;
     if (ray_r_mu_intersects_ground)
     {
-        _4035 = 0.0f.xxx;
+        _4046 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_12 = atmosphere;
         float param_13 = r;
         float param_14 = mu;
-        _4035 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
+        _4046 = GetTransmittanceToTopAtmosphereBoundary(param_12, transmittance_texture_1, _transmittance_texture_1_sampler, param_13, param_14);
     }
-    transmittance = _4035;
+    transmittance = _4046;
     AtmosphereParameters param_15 = atmosphere;
     float param_16 = r;
     float param_17 = mu;
@@ -1415,16 +1415,16 @@ float GetUnitRangeFromTextureCoord(float u, int texture_size)
 float GetUnitMuInHalfFromTextureCoord(float u, int size, inout bool ray_r_mu_intersects_ground)
 {
     ray_r_mu_intersects_ground = u < 0.5f;
-    float _1346;
+    float _1357;
     if (ray_r_mu_intersects_ground)
     {
-        _1346 = 1.0f - (2.0f * u);
+        _1357 = 1.0f - (2.0f * u);
     }
     else
     {
-        _1346 = (2.0f * u) - 1.0f;
+        _1357 = (2.0f * u) - 1.0f;
     }
-    float param = _1346;
+    float param = _1357;
     int param_1 = size / 2;
     return GetUnitRangeFromTextureCoord(param, param_1);
 }
@@ -1445,25 +1445,25 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float param = uv.y;
     int param_1 = 108;
     bool param_2;
-    float _5449 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
+    float _5478 = GetUnitMuInHalfFromTextureCoord(param, param_1, param_2);
     ray_r_mu_intersects_ground = param_2;
-    float x = _5449;
+    float x = _5478;
     float e = (1.0f - x) * (1.0f - x);
     AtmosphereParameters param_3 = atmosphere;
     float param_4 = length(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = ClampRadius(param_3, param_4);
     float theta_h = SkyViewHorizonZenith(param_5, param_6);
-    float _5470;
+    float _5499;
     if (ray_r_mu_intersects_ground)
     {
-        _5470 = theta_h + (e * (3.1415927410125732421875f - theta_h));
+        _5499 = theta_h + (e * (3.1415927410125732421875f - theta_h));
     }
     else
     {
-        _5470 = theta_h * (1.0f - e);
+        _5499 = theta_h * (1.0f - e);
     }
-    float theta = _5470;
+    float theta = _5499;
     float param_7 = uv.x;
     int param_8 = 192;
     float phi = 3.1415927410125732421875f * clamp(GetUnitRangeFromTextureCoord(param_7, param_8), 0.0f, 1.0f);
@@ -1471,8 +1471,8 @@ float3 GetSkyViewRay(AtmosphereParameters atmosphere, float3 camera, float3 sun_
     float3 toward_sun = sun_direction - (up * dot(sun_direction, up));
     if (dot(toward_sun, toward_sun) < 9.9999999600419720025001879548654e-13f)
     {
-        bool3 _5520 = (abs(up.x) < 0.89999997615814208984375f).xxx;
-        toward_sun = cross(up, float3(_5520.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5520.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5520.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
+        bool3 _5549 = (abs(up.x) < 0.89999997615814208984375f).xxx;
+        toward_sun = cross(up, float3(_5549.x ? float3(1.0f, 0.0f, 0.0f).x : float3(0.0f, 1.0f, 0.0f).x, _5549.y ? float3(1.0f, 0.0f, 0.0f).y : float3(0.0f, 1.0f, 0.0f).y, _5549.z ? float3(1.0f, 0.0f, 0.0f).z : float3(0.0f, 1.0f, 0.0f).z));
     }
     toward_sun = normalize(toward_sun);
     float3 across = cross(up, toward_sun);
@@ -1488,9 +1488,9 @@ float3 GetSkyViewRadiance(AtmosphereParameters atmosphere, Texture3D<float4> sca
     float3 param_2 = sun_direction;
     float2 param_3 = uv;
     bool param_4;
-    float3 _5559 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
+    float3 _5588 = GetSkyViewRay(param, param_1, param_2, param_3, param_4);
     bool ray_r_mu_intersects_ground = param_4;
-    float3 view_ray = _5559;
+    float3 view_ray = _5588;
     float3 up = normalize(camera);
     AtmosphereParameters param_5 = atmosphere;
     float param_6 = length(camera);
@@ -1517,16 +1517,16 @@ void GetSkyViewAngles(float3 camera, float3 view_ray, float3 sun_direction, out 
     theta = atan2(length(horizontal), mu);
     float along = dot(sun_horizontal, horizontal);
     float side = abs(dot(cross(up, sun_horizontal), horizontal));
-    float _5435;
+    float _5464;
     if ((along != 0.0f) || (side != 0.0f))
     {
-        _5435 = atan2(side, along);
+        _5464 = atan2(side, along);
     }
     else
     {
-        _5435 = 0.0f;
+        _5464 = 0.0f;
     }
-    phi = _5435;
+    phi = _5464;
 }
 #endif
 
@@ -1536,16 +1536,16 @@ float2 GetSkyViewUvFromAngles(AtmosphereParameters atmosphere, float r, float th
     AtmosphereParameters param = atmosphere;
     float param_1 = r;
     float theta_h = SkyViewHorizonZenith(param, param_1);
-    float _5356;
+    float _5385;
     if (ray_r_mu_intersects_ground)
     {
-        _5356 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
+        _5385 = 1.0f - sqrt(clamp((theta - theta_h) / (3.1415927410125732421875f - theta_h), 0.0f, 1.0f));
     }
     else
     {
-        _5356 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
+        _5385 = 1.0f - sqrt(clamp((theta_h - theta) / theta_h, 0.0f, 1.0f));
     }
-    float x = _5356;
+    float x = _5385;
     float param_2 = phi / 3.1415927410125732421875f;
     int param_3 = 192;
     float param_4 = x;
@@ -1567,19 +1567,19 @@ float3 GetSkyRadianceFromSkyView(AtmosphereParameters atmosphere, Texture2D<floa
     float param_4 = r;
     float param_5 = mu;
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_3, param_4, param_5);
-    float3 _5621;
+    float3 _5650;
     if (ray_r_mu_intersects_ground)
     {
-        _5621 = 0.0f.xxx;
+        _5650 = 0.0f.xxx;
     }
     else
     {
         AtmosphereParameters param_6 = atmosphere;
         float param_7 = r;
         float param_8 = mu;
-        _5621 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
+        _5650 = GetTransmittanceToTopAtmosphereBoundary(param_6, transmittance_texture_1, _transmittance_texture_1_sampler, param_7, param_8);
     }
-    transmittance = _5621;
+    transmittance = _5650;
     float3 param_9 = camera;
     float3 param_10 = view_ray;
     float3 param_11 = sun_direction;
@@ -1694,11 +1694,11 @@ SegmentNode GetSegmentNode(AtmosphereParameters atmosphere, Texture2D<float4> tr
     float param_11 = AltitudeAtDistance(param_5, param_6, param_7, param_8, param_9);
     float3 param_12;
     float3 param_13;
-    float3 _4319 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
+    float3 _4330 = GetCoefficientsAtAltitude(param_10, param_11, param_12, param_13);
     float3 mie_scattering = param_12;
     float3 rayleigh_scattering = param_13;
     SegmentNode node;
-    node.extinction = _4319;
+    node.extinction = _4330;
     AtmosphereParameters param_14 = atmosphere;
     float param_15 = r_t;
     float param_16 = mu_s_t;
@@ -1816,64 +1816,64 @@ SegmentSums ContinueSegment(AtmosphereParameters atmosphere, Texture2D<float4> t
     bool short_stretch = (t1 - t0) <= (0.00999999977648258209228515625f * t1);
     int intervals = short_stretch ? 1 : 2;
     float dt = (t1 - t0) / float(intervals);
-    int _4605 = short_stretch ? (-1) : (-2);
-    float _4657;
-    float _4663;
-    for (int i = _4605; i < intervals; i++)
+    int _4616 = short_stretch ? (-1) : (-2);
+    float _4668;
+    float _4674;
+    for (int i = _4616; i < intervals; i++)
     {
-        bool _4616 = i == (-2);
-        bool _4624;
-        if (!_4616)
+        bool _4627 = i == (-2);
+        bool _4635;
+        if (!_4627)
         {
-            _4624 = (i == (-1)) && short_stretch;
+            _4635 = (i == (-1)) && short_stretch;
         }
         else
         {
-            _4624 = _4616;
+            _4635 = _4627;
         }
-        bool finding_last = _4624;
+        bool finding_last = _4635;
         bool finding_middle = (i == (-1)) && (!short_stretch);
         int k = i + 1;
         SegmentNode node = last;
-        bool _4638 = finding_last || finding_middle;
-        bool _4652;
-        if (!_4638)
+        bool _4649 = finding_last || finding_middle;
+        bool _4663;
+        if (!_4649)
         {
-            bool _4644 = k < intervals;
-            bool _4651;
-            if (_4644)
+            bool _4655 = k < intervals;
+            bool _4662;
+            if (_4655)
             {
-                _4651 = (2 * k) != intervals;
+                _4662 = (2 * k) != intervals;
             }
             else
             {
-                _4651 = _4644;
+                _4662 = _4655;
             }
-            _4652 = _4651;
+            _4663 = _4662;
         }
         else
         {
-            _4652 = _4638;
+            _4663 = _4649;
         }
-        if (_4652)
+        if (_4663)
         {
             if (finding_last)
             {
-                _4657 = t1;
+                _4668 = t1;
             }
             else
             {
                 if (finding_middle)
                 {
-                    _4663 = 0.5f * (t0 + t1);
+                    _4674 = 0.5f * (t0 + t1);
                 }
                 else
                 {
-                    _4663 = t0 + (dt * float(k));
+                    _4674 = t0 + (dt * float(k));
                 }
-                _4657 = _4663;
+                _4668 = _4674;
             }
-            float t = _4657;
+            float t = _4668;
             AtmosphereParameters param = atmosphere;
             float param_1 = r;
             float param_2 = mu;
@@ -1994,6 +1994,22 @@ float3 GetOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transm
 #endif
 
 #if SKYBAKE_HAS_AERIAL_PERSPECTIVE
+float3 BlendedOpticalDepth(AtmosphereParameters atmosphere, Texture2D<float4> transmittance_texture_1, SamplerState _transmittance_texture_1_sampler, float r, float mu, float d, bool ray_r_mu_intersects_ground, float3 direct_optical_depth, float direct)
+{
+    if (direct >= 1.0f)
+    {
+        return direct_optical_depth;
+    }
+    AtmosphereParameters param = atmosphere;
+    float param_1 = r;
+    float param_2 = mu;
+    float param_3 = d;
+    bool param_4 = ray_r_mu_intersects_ground;
+    return lerp(GetOpticalDepth(param, transmittance_texture_1, _transmittance_texture_1_sampler, param_1, param_2, param_3, param_4), direct_optical_depth, direct.xxx);
+}
+#endif
+
+#if SKYBAKE_HAS_AERIAL_PERSPECTIVE
 float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, float mu)
 {
     float r_max = atmosphere.scattering_r_max;
@@ -2002,16 +2018,16 @@ float DistanceInsideScatteringRadii(AtmosphereParameters atmosphere, float r, fl
     float param = across + (r_max * r_max);
     float up = ((-r) * mu) + SafeSqrt(param);
     float down_discriminant = across + (r_min * r_min);
-    float _4101;
+    float _4112;
     if ((mu < 0.0f) && (down_discriminant >= 0.0f))
     {
-        _4101 = min(up, ((-r) * mu) - sqrt(down_discriminant));
+        _4112 = min(up, ((-r) * mu) - sqrt(down_discriminant));
     }
     else
     {
-        _4101 = up;
+        _4112 = up;
     }
-    return _4101;
+    return _4112;
 }
 #endif
 
@@ -2034,13 +2050,13 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     float param_6;
     float param_7;
     float param_8;
-    bool _4842 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
+    bool _4876 = GetViewRayStart(param, param_1, param_2, param_3, param_4, param_5, param_6, param_7, param_8);
     float3 start = param_4;
     float r = param_5;
     float mu = param_6;
     float mu_s = param_7;
     float nu = param_8;
-    if (!_4842)
+    if (!_4876)
     {
         transmittance = 1.0f.xxx;
         return 0.0f.xxx;
@@ -2053,16 +2069,16 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
     bool ray_r_mu_intersects_ground = RayIntersectsGround(param_9, param_10, param_11);
     bool colour = atmosphere.transmittance_is_colour != 0;
     float lit_direct = 1.0f - smoothstep(10000.0f, 20000.0f, lit);
-    float _4884;
+    float _4918;
     if (colour)
     {
-        _4884 = 1.0f;
+        _4918 = 1.0f;
     }
     else
     {
-        _4884 = 1.0f - smoothstep(10000.0f, 20000.0f, d);
+        _4918 = 1.0f - smoothstep(10000.0f, 20000.0f, d);
     }
-    float direct = _4884;
+    float direct = _4918;
     float lit_transmittance_direct = colour ? 1.0f : lit_direct;
     SegmentSums lit_sums;
     lit_sums.optical_depth = 0.0f.xxx;
@@ -2098,110 +2114,110 @@ float3 GetSkyRadianceToPointWithShadow(AtmosphereParameters atmosphere, Texture2
         SegmentSums param_33 = lit_sums;
         optical_depth = ContinueSegment(param_26, transmittance_texture_1, _transmittance_texture_1_sampler, param_27, param_28, param_29, param_30, param_31, param_32, param_33).optical_depth;
     }
-    if (direct < 1.0f)
-    {
-        AtmosphereParameters param_34 = atmosphere;
-        float param_35 = r;
-        float param_36 = mu;
-        float param_37 = d;
-        bool param_38 = ray_r_mu_intersects_ground;
-        optical_depth = lerp(GetOpticalDepth(param_34, transmittance_texture_1, _transmittance_texture_1_sampler, param_35, param_36, param_37, param_38), optical_depth, direct.xxx);
-    }
-    transmittance = exp(-optical_depth);
-    AtmosphereParameters param_39 = atmosphere;
-    float param_40 = r;
-    float param_41 = mu;
-    float param_42 = mu_s;
-    float param_43 = nu;
-    bool param_44 = ray_r_mu_intersects_ground;
-    float3 param_45;
-    float3 _4996 = GetCombinedScattering(param_39, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_40, param_41, param_42, param_43, param_44, param_45);
-    float3 single_mie_scattering = param_45;
-    float3 scattering = _4996;
+    AtmosphereParameters param_34 = atmosphere;
+    float param_35 = r;
+    float param_36 = mu;
+    float param_37 = d;
+    bool param_38 = ray_r_mu_intersects_ground;
+    float3 param_39 = optical_depth;
+    float param_40 = direct;
+    transmittance = exp(-BlendedOpticalDepth(param_34, transmittance_texture_1, _transmittance_texture_1_sampler, param_35, param_36, param_37, param_38, param_39, param_40));
+    AtmosphereParameters param_41 = atmosphere;
+    float param_42 = r;
+    float param_43 = mu;
+    float param_44 = mu_s;
+    float param_45 = nu;
+    bool param_46 = ray_r_mu_intersects_ground;
+    float3 param_47;
+    float3 _5025 = GetCombinedScattering(param_41, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_42, param_43, param_44, param_45, param_46, param_47);
+    float3 single_mie_scattering = param_47;
+    float3 scattering = _5025;
     if (lit < 10000.0f)
     {
-        AtmosphereParameters param_46 = atmosphere;
-        float param_47 = r;
-        float param_48 = mu;
-        bool param_49 = ray_r_mu_intersects_ground;
-        float boundary = DistanceToNearestAtmosphereBoundary(param_46, param_47, param_48, param_49);
-        AtmosphereParameters param_50 = atmosphere;
-        float param_51 = r;
-        float param_52 = mu;
-        float far = max(min(min(10000.0f, boundary), DistanceInsideScatteringRadii(param_50, param_51, param_52)), lit);
-        AtmosphereParameters param_53 = atmosphere;
-        float param_54 = r;
-        float param_55 = mu;
-        float param_56 = mu_s;
-        float param_57 = nu;
-        float param_58 = lit;
-        float param_59 = far;
-        SegmentSums param_60 = lit_sums;
-        SegmentSums far_sums = ContinueSegment(param_53, transmittance_texture_1, _transmittance_texture_1_sampler, param_54, param_55, param_56, param_57, param_58, param_59, param_60);
+        AtmosphereParameters param_48 = atmosphere;
+        float param_49 = r;
+        float param_50 = mu;
+        bool param_51 = ray_r_mu_intersects_ground;
+        float boundary = DistanceToNearestAtmosphereBoundary(param_48, param_49, param_50, param_51);
+        AtmosphereParameters param_52 = atmosphere;
+        float param_53 = r;
+        float param_54 = mu;
+        float far = max(min(min(10000.0f, boundary), DistanceInsideScatteringRadii(param_52, param_53, param_54)), lit);
+        AtmosphereParameters param_55 = atmosphere;
+        float param_56 = r;
+        float param_57 = mu;
+        float param_58 = mu_s;
+        float param_59 = nu;
+        float param_60 = lit;
+        float param_61 = far;
+        SegmentSums param_62 = lit_sums;
+        SegmentSums far_sums = ContinueSegment(param_55, transmittance_texture_1, _transmittance_texture_1_sampler, param_56, param_57, param_58, param_59, param_60, param_61, param_62);
         if (far < boundary)
         {
-            AtmosphereParameters param_61 = atmosphere;
-            float param_62 = r;
-            float param_63 = mu;
-            float param_64 = far;
-            float r_far = RadiusAtDistance(param_61, param_62, param_63, param_64);
-            float param_65 = r;
-            float param_66 = mu;
-            float param_67 = far;
-            float param_68 = r_far;
-            float param_69 = ((r * mu_s) + (far * nu)) / r_far;
-            AtmosphereParameters param_70 = atmosphere;
-            float param_71 = r_far;
-            float param_72 = CosineAtDistance(param_65, param_66, param_67, param_68);
-            float param_73 = ClampCosine(param_69);
-            float param_74 = nu;
-            bool param_75 = ray_r_mu_intersects_ground;
-            float3 param_76;
-            float3 _5092 = GetCombinedScattering(param_70, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_71, param_72, param_73, param_74, param_75, param_76);
-            float3 unused_far_mie = param_76;
-            scattering -= (far_sums.transmittance * _5092);
+            AtmosphereParameters param_63 = atmosphere;
+            float param_64 = r;
+            float param_65 = mu;
+            float param_66 = far;
+            float r_far = RadiusAtDistance(param_63, param_64, param_65, param_66);
+            float param_67 = r;
+            float param_68 = mu;
+            float param_69 = far;
+            float param_70 = r_far;
+            float param_71 = ((r * mu_s) + (far * nu)) / r_far;
+            AtmosphereParameters param_72 = atmosphere;
+            float param_73 = r_far;
+            float param_74 = CosineAtDistance(param_67, param_68, param_69, param_70);
+            float param_75 = ClampCosine(param_71);
+            float param_76 = nu;
+            bool param_77 = ray_r_mu_intersects_ground;
+            float3 param_78;
+            float3 _5121 = GetCombinedScattering(param_72, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_73, param_74, param_75, param_76, param_77, param_78);
+            float3 unused_far_mie = param_78;
+            scattering -= (far_sums.transmittance * _5121);
         }
         float3 multiple = (max(scattering - (far_sums.single_rayleigh * atmosphere.solar_irradiance), 0.0f.xxx) * lit_sums.scattering_weight) / max(far_sums.scattering_weight, 1.0000000031710768509710513471353e-30f.xxx);
-        float param_77 = nu;
-        AtmosphereParameters param_78 = atmosphere;
         float param_79 = nu;
-        return (((lit_sums.single_rayleigh * atmosphere.solar_irradiance) + multiple) * RayleighPhaseFunction(param_77)) + ((lit_sums.single_mie * atmosphere.solar_irradiance) * MiePhaseFunction(param_78, param_79));
+        AtmosphereParameters param_80 = atmosphere;
+        float param_81 = nu;
+        return (((lit_sums.single_rayleigh * atmosphere.solar_irradiance) + multiple) * RayleighPhaseFunction(param_79)) + ((lit_sums.single_mie * atmosphere.solar_irradiance) * MiePhaseFunction(param_80, param_81));
     }
-    AtmosphereParameters param_80 = atmosphere;
-    float param_81 = r;
-    float param_82 = mu;
-    float param_83 = lit;
-    float r_p = RadiusAtDistance(param_80, param_81, param_82, param_83);
-    float param_84 = r;
-    float param_85 = mu;
-    float param_86 = lit;
-    float param_87 = r_p;
-    float mu_p = CosineAtDistance(param_84, param_85, param_86, param_87);
-    float param_88 = ((r * mu_s) + (lit * nu)) / r_p;
-    float mu_s_p = ClampCosine(param_88);
-    AtmosphereParameters param_89 = atmosphere;
-    float param_90 = r;
-    float param_91 = mu;
-    float param_92 = lit;
-    bool param_93 = ray_r_mu_intersects_ground;
-    float3 lit_transmittance = exp(-lerp(GetOpticalDepth(param_89, transmittance_texture_1, _transmittance_texture_1_sampler, param_90, param_91, param_92, param_93), lit_sums.optical_depth, lit_transmittance_direct.xxx));
-    AtmosphereParameters param_94 = atmosphere;
-    float param_95 = r_p;
-    float param_96 = mu_p;
-    float param_97 = mu_s_p;
-    float param_98 = nu;
-    bool param_99 = ray_r_mu_intersects_ground;
-    float3 param_100;
-    float3 _5203 = GetCombinedScattering(param_94, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_95, param_96, param_97, param_98, param_99, param_100);
-    float3 single_mie_scattering_p = param_100;
-    float3 scattering_p = _5203;
+    AtmosphereParameters param_82 = atmosphere;
+    float param_83 = r;
+    float param_84 = mu;
+    float param_85 = lit;
+    float r_p = RadiusAtDistance(param_82, param_83, param_84, param_85);
+    float param_86 = r;
+    float param_87 = mu;
+    float param_88 = lit;
+    float param_89 = r_p;
+    float mu_p = CosineAtDistance(param_86, param_87, param_88, param_89);
+    float param_90 = ((r * mu_s) + (lit * nu)) / r_p;
+    float mu_s_p = ClampCosine(param_90);
+    AtmosphereParameters param_91 = atmosphere;
+    float param_92 = r;
+    float param_93 = mu;
+    float param_94 = lit;
+    bool param_95 = ray_r_mu_intersects_ground;
+    float3 param_96 = lit_sums.optical_depth;
+    float param_97 = lit_transmittance_direct;
+    float3 lit_transmittance = exp(-BlendedOpticalDepth(param_91, transmittance_texture_1, _transmittance_texture_1_sampler, param_92, param_93, param_94, param_95, param_96, param_97));
+    AtmosphereParameters param_98 = atmosphere;
+    float param_99 = r_p;
+    float param_100 = mu_p;
+    float param_101 = mu_s_p;
+    float param_102 = nu;
+    bool param_103 = ray_r_mu_intersects_ground;
+    float3 param_104;
+    float3 _5232 = GetCombinedScattering(param_98, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_99, param_100, param_101, param_102, param_103, param_104);
+    float3 single_mie_scattering_p = param_104;
+    float3 scattering_p = _5232;
     scattering = max(scattering - (lit_transmittance * scattering_p), 0.0f.xxx);
     single_mie_scattering = max(single_mie_scattering - (lit_transmittance * single_mie_scattering_p), 0.0f.xxx);
     single_mie_scattering = lerp(single_mie_scattering, lit_sums.single_mie * atmosphere.solar_irradiance, lit_direct.xxx);
-    float param_101 = nu;
-    AtmosphereParameters param_102 = atmosphere;
-    float param_103 = nu;
-    return (scattering * RayleighPhaseFunction(param_101)) + (single_mie_scattering * MiePhaseFunction(param_102, param_103));
+    float param_105 = nu;
+    AtmosphereParameters param_106 = atmosphere;
+    float param_107 = nu;
+    return (scattering * RayleighPhaseFunction(param_105)) + (single_mie_scattering * MiePhaseFunction(param_106, param_107));
 }
 #endif
 
@@ -2214,9 +2230,9 @@ float3 GetSkyRadianceToPoint(AtmosphereParameters atmosphere, Texture2D<float4> 
     float param_3 = 0.0f;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5251 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
+    float3 _5280 = GetSkyRadianceToPointWithShadow(param, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_1, param_2, param_3, param_4, param_5);
     transmittance = param_5;
-    return _5251;
+    return _5280;
 }
 #endif
 
@@ -2244,9 +2260,9 @@ float3 GetAerialPerspectiveVoxel(AtmosphereParameters atmosphere, Texture2D<floa
     float3 param_3 = _point;
     float3 param_4 = sun_direction;
     float3 param_5;
-    float3 _5714 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
+    float3 _5743 = GetSkyRadianceToPoint(param_1, transmittance_texture_1, _transmittance_texture_1_sampler, scattering_texture_1, _scattering_texture_1_sampler, single_mie_scattering_texture_1, _single_mie_scattering_texture_1_sampler, param_2, param_3, param_4, param_5);
     float3 transmittance = param_5;
-    float3 radiance = _5714;
+    float3 radiance = _5743;
     optical_depth = -log(max(transmittance, 1.0000000031710768509710513471353e-30f.xxx));
     return radiance;
 }
@@ -2274,16 +2290,16 @@ float3 GetSkyRadianceToPointFromVolume(Texture3D<float4> radiance_volume, Sample
 #if SKYBAKE_HAS_IRRADIANCE_TEXTURE
 float IrradianceKneeMuS(AtmosphereParameters atmosphere)
 {
-    float _1528;
+    float _1539;
     if (atmosphere.mu_s_min < 0.100000001490116119384765625f)
     {
-        _1528 = 0.100000001490116119384765625f;
+        _1539 = 0.100000001490116119384765625f;
     }
     else
     {
-        _1528 = 0.5f * (atmosphere.mu_s_min + 1.0f);
+        _1539 = 0.5f * (atmosphere.mu_s_min + 1.0f);
     }
-    return _1528;
+    return _1539;
 }
 #endif
 
@@ -2292,16 +2308,16 @@ float GetIrradianceUnitMuS(AtmosphereParameters atmosphere, float mu_s)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1546;
+    float _1557;
     if (mu_s < knee)
     {
-        _1546 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
+        _1557 = (0.5f * (mu_s - atmosphere.mu_s_min)) / (knee - atmosphere.mu_s_min);
     }
     else
     {
-        _1546 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
+        _1557 = 0.5f + ((0.5f * (mu_s - knee)) / (1.0f - knee));
     }
-    return _1546;
+    return _1557;
 }
 #endif
 
@@ -2328,16 +2344,16 @@ float GetIrradianceMuSFromUnit(AtmosphereParameters atmosphere, float x)
 {
     AtmosphereParameters param = atmosphere;
     float knee = IrradianceKneeMuS(param);
-    float _1577;
+    float _1588;
     if (x < 0.5f)
     {
-        _1577 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
+        _1588 = atmosphere.mu_s_min + ((2.0f * x) * (knee - atmosphere.mu_s_min));
     }
     else
     {
-        _1577 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
+        _1588 = knee + (((2.0f * x) - 1.0f) * (1.0f - knee));
     }
-    return _1577;
+    return _1588;
 }
 #endif
 
@@ -2363,16 +2379,16 @@ float4 SunBelowTableMix(float4 a, float4 b, float t, bool low_sun)
     float param_2 = t;
     bool param_3 = low_sun;
     float4 blend = SunCosineMix(param, param_1, param_2, param_3);
-    float4 _2742;
+    float4 _2753;
     if (t < 0.0f)
     {
-        _2742 = min(blend, a);
+        _2753 = min(blend, a);
     }
     else
     {
-        _2742 = blend;
+        _2753 = blend;
     }
-    return _2742;
+    return _2753;
 }
 #endif
 

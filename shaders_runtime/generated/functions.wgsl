@@ -4004,8 +4004,41 @@ fn ContinueSegment(atmosphere_126: AtmosphereParameters, transmittance_texture_8
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+fn BlendedOpticalDepth(atmosphere_128: AtmosphereParameters, transmittance_texture_9: texture_2d<f32>, r_73: f32, mu_56: f32, d_24: f32, ray_r_mu_intersects_ground_32: bool, direct_optical_depth: vec3<f32>, direct: f32) -> vec3<f32> {
     var atmosphere_129: AtmosphereParameters;
+    var r_74: f32;
+    var mu_57: f32;
+    var d_25: f32;
+    var ray_r_mu_intersects_ground_33: bool;
+    var direct_optical_depth_1: vec3<f32>;
+    var direct_1: f32;
+
+    atmosphere_129 = atmosphere_128;
+    r_74 = r_73;
+    mu_57 = mu_56;
+    d_25 = d_24;
+    ray_r_mu_intersects_ground_33 = ray_r_mu_intersects_ground_32;
+    direct_optical_depth_1 = direct_optical_depth;
+    direct_1 = direct;
+    let _e36 = direct_1;
+    if (_e36 >= 1f) {
+        let _e39 = direct_optical_depth_1;
+        return _e39;
+    }
+    let _e40 = atmosphere_129;
+    let _e41 = r_74;
+    let _e42 = mu_57;
+    let _e43 = d_25;
+    let _e44 = ray_r_mu_intersects_ground_33;
+    let _e45 = GetOpticalDepth(_e40, transmittance_texture_9, _e41, _e42, _e43, _e44);
+    let _e46 = direct_optical_depth_1;
+    let _e47 = direct_1;
+    return mix(_e45, _e46, vec3(_e47));
+}
+
+// skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
+fn GetSkyRadianceToPointWithShadow(atmosphere_130: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, scattering_texture_9: texture_3d<f32>, single_mie_scattering_texture_3: texture_3d<f32>, camera_6: vec3<f32>, point: vec3<f32>, shadow_length: f32, sun_direction_4: vec3<f32>, transmittance_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_131: AtmosphereParameters;
     var camera_7: vec3<f32>;
     var point_1: vec3<f32>;
     var shadow_length_1: f32;
@@ -4013,17 +4046,17 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     var camera_to_point: vec3<f32>;
     var view_ray_6: vec3<f32>;
     var start_3: vec3<f32>;
-    var r_73: f32;
-    var mu_56: f32;
+    var r_75: f32;
+    var mu_58: f32;
     var mu_s_48: f32;
     var nu_32: f32;
-    var d_24: f32;
+    var d_26: f32;
     var lit: f32;
-    var ray_r_mu_intersects_ground_32: bool;
+    var ray_r_mu_intersects_ground_34: bool;
     var colour: bool;
     var lit_direct: f32;
     var local_30: f32;
-    var direct: f32;
+    var direct_2: f32;
     var local_31: f32;
     var lit_transmittance_direct: f32;
     var lit_sums: SegmentSums;
@@ -4043,7 +4076,7 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     var single_mie_scattering_p: vec3<f32>;
     var scattering_p: vec3<f32>;
 
-    atmosphere_129 = atmosphere_128;
+    atmosphere_131 = atmosphere_130;
     camera_7 = camera_6;
     point_1 = point;
     shadow_length_1 = shadow_length;
@@ -4061,11 +4094,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     }
     let _e48 = camera_to_point;
     view_ray_6 = normalize(_e48);
-    let _e56 = atmosphere_129;
+    let _e56 = atmosphere_131;
     let _e57 = camera_7;
     let _e58 = view_ray_6;
     let _e59 = sun_direction_5;
-    let _e70 = GetViewRayStart(_e56, _e57, _e58, _e59, (&start_3), (&r_73), (&mu_56), (&mu_s_48), (&nu_32));
+    let _e70 = GetViewRayStart(_e56, _e57, _e58, _e59, (&start_3), (&r_75), (&mu_58), (&mu_s_48), (&nu_32));
     if !(_e70) {
         {
             (*transmittance_1) = vec3(1f);
@@ -4074,16 +4107,16 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     }
     let _e76 = point_1;
     let _e77 = start_3;
-    d_24 = max(length((_e76 - _e77)), 0f);
-    let _e83 = d_24;
+    d_26 = max(length((_e76 - _e77)), 0f);
+    let _e83 = d_26;
     let _e84 = shadow_length_1;
     lit = max((_e83 - max(_e84, 0f)), 0f);
-    let _e91 = atmosphere_129;
-    let _e92 = r_73;
-    let _e93 = mu_56;
+    let _e91 = atmosphere_131;
+    let _e92 = r_75;
+    let _e93 = mu_58;
     let _e94 = RayIntersectsGround(_e91, _e92, _e93);
-    ray_r_mu_intersects_ground_32 = _e94;
-    let _e96 = atmosphere_129;
+    ray_r_mu_intersects_ground_34 = _e94;
+    let _e96 = atmosphere_131;
     colour = (_e96.transmittance_is_colour != 0i);
     let _e105 = lit;
     lit_direct = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e105));
@@ -4091,11 +4124,11 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     if _e109 {
         local_30 = 1f;
     } else {
-        let _e115 = d_24;
+        let _e115 = d_26;
         local_30 = (1f - smoothstep(DIRECT_SEGMENT_LENGTH, 20000f, _e115));
     }
     let _e119 = local_30;
-    direct = _e119;
+    direct_2 = _e119;
     let _e121 = colour;
     if _e121 {
         local_31 = 1f;
@@ -4110,266 +4143,259 @@ fn GetSkyRadianceToPointWithShadow(atmosphere_128: AtmosphereParameters, transmi
     let _e134 = lit_transmittance_direct;
     if (_e134 > 0f) {
         {
-            let _e137 = atmosphere_129;
-            let _e138 = r_73;
-            let _e139 = mu_56;
+            let _e137 = atmosphere_131;
+            let _e138 = r_75;
+            let _e139 = mu_58;
             let _e140 = mu_s_48;
             let _e141 = nu_32;
             let _e143 = lit;
-            let _e144 = atmosphere_129;
-            let _e145 = r_73;
-            let _e146 = mu_56;
+            let _e144 = atmosphere_131;
+            let _e145 = r_75;
+            let _e146 = mu_58;
             let _e147 = mu_s_48;
             let _e148 = nu_32;
-            let _e150 = StartSegment(_e144, transmittance_texture_9, _e145, _e146, _e147, _e148, 0f);
-            let _e151 = ContinueSegment(_e137, transmittance_texture_9, _e138, _e139, _e140, _e141, 0f, _e143, _e150);
+            let _e150 = StartSegment(_e144, transmittance_texture_10, _e145, _e146, _e147, _e148, 0f);
+            let _e151 = ContinueSegment(_e137, transmittance_texture_10, _e138, _e139, _e140, _e141, 0f, _e143, _e150);
             lit_sums = _e151;
         }
     }
     let _e152 = lit_sums;
     optical_depth = _e152.optical_depth;
-    let _e155 = direct;
+    let _e155 = direct_2;
     let _e158 = lit;
-    let _e159 = d_24;
+    let _e159 = d_26;
     if ((_e155 > 0f) && (_e158 < _e159)) {
         {
-            let _e162 = atmosphere_129;
-            let _e163 = r_73;
-            let _e164 = mu_56;
+            let _e162 = atmosphere_131;
+            let _e163 = r_75;
+            let _e164 = mu_58;
             let _e165 = mu_s_48;
             let _e166 = nu_32;
             let _e167 = lit;
-            let _e168 = d_24;
+            let _e168 = d_26;
             let _e169 = lit_sums;
-            let _e170 = ContinueSegment(_e162, transmittance_texture_9, _e163, _e164, _e165, _e166, _e167, _e168, _e169);
+            let _e170 = ContinueSegment(_e162, transmittance_texture_10, _e163, _e164, _e165, _e166, _e167, _e168, _e169);
             optical_depth = _e170.optical_depth;
         }
     }
-    let _e172 = direct;
-    if (_e172 < 1f) {
+    let _e172 = atmosphere_131;
+    let _e173 = r_75;
+    let _e174 = mu_58;
+    let _e175 = d_26;
+    let _e176 = ray_r_mu_intersects_ground_34;
+    let _e177 = optical_depth;
+    let _e178 = direct_2;
+    let _e179 = BlendedOpticalDepth(_e172, transmittance_texture_10, _e173, _e174, _e175, _e176, _e177, _e178);
+    (*transmittance_1) = exp(-(_e179));
+    let _e183 = atmosphere_131;
+    let _e184 = r_75;
+    let _e185 = mu_58;
+    let _e186 = mu_s_48;
+    let _e187 = nu_32;
+    let _e188 = ray_r_mu_intersects_ground_34;
+    let _e191 = GetCombinedScattering(_e183, scattering_texture_9, single_mie_scattering_texture_3, _e184, _e185, _e186, _e187, _e188, (&single_mie_scattering_2));
+    scattering_2 = _e191;
+    let _e193 = lit;
+    if (_e193 < DIRECT_SEGMENT_LENGTH) {
         {
-            let _e175 = atmosphere_129;
-            let _e176 = r_73;
-            let _e177 = mu_56;
-            let _e178 = d_24;
-            let _e179 = ray_r_mu_intersects_ground_32;
-            let _e180 = GetOpticalDepth(_e175, transmittance_texture_9, _e176, _e177, _e178, _e179);
-            let _e181 = optical_depth;
-            let _e182 = direct;
-            optical_depth = mix(_e180, _e181, vec3(_e182));
-        }
-    }
-    let _e185 = optical_depth;
-    (*transmittance_1) = exp(-(_e185));
-    let _e189 = atmosphere_129;
-    let _e190 = r_73;
-    let _e191 = mu_56;
-    let _e192 = mu_s_48;
-    let _e193 = nu_32;
-    let _e194 = ray_r_mu_intersects_ground_32;
-    let _e197 = GetCombinedScattering(_e189, scattering_texture_9, single_mie_scattering_texture_3, _e190, _e191, _e192, _e193, _e194, (&single_mie_scattering_2));
-    scattering_2 = _e197;
-    let _e199 = lit;
-    if (_e199 < DIRECT_SEGMENT_LENGTH) {
-        {
-            let _e201 = atmosphere_129;
-            let _e202 = r_73;
-            let _e203 = mu_56;
-            let _e204 = ray_r_mu_intersects_ground_32;
-            let _e205 = DistanceToNearestAtmosphereBoundary(_e201, _e202, _e203, _e204);
-            boundary = _e205;
-            let _e207 = boundary;
-            let _e209 = atmosphere_129;
-            let _e210 = r_73;
-            let _e211 = mu_56;
-            let _e212 = DistanceInsideScatteringRadii(_e209, _e210, _e211);
-            let _e214 = lit;
-            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e207), _e212), _e214);
-            let _e217 = atmosphere_129;
-            let _e218 = r_73;
-            let _e219 = mu_56;
-            let _e220 = mu_s_48;
-            let _e221 = nu_32;
-            let _e222 = lit;
-            let _e223 = far;
-            let _e224 = lit_sums;
-            let _e225 = ContinueSegment(_e217, transmittance_texture_9, _e218, _e219, _e220, _e221, _e222, _e223, _e224);
-            far_sums = _e225;
-            let _e227 = far;
-            let _e228 = boundary;
-            if (_e227 < _e228) {
+            let _e195 = atmosphere_131;
+            let _e196 = r_75;
+            let _e197 = mu_58;
+            let _e198 = ray_r_mu_intersects_ground_34;
+            let _e199 = DistanceToNearestAtmosphereBoundary(_e195, _e196, _e197, _e198);
+            boundary = _e199;
+            let _e201 = boundary;
+            let _e203 = atmosphere_131;
+            let _e204 = r_75;
+            let _e205 = mu_58;
+            let _e206 = DistanceInsideScatteringRadii(_e203, _e204, _e205);
+            let _e208 = lit;
+            far = max(min(min(DIRECT_SEGMENT_LENGTH, _e201), _e206), _e208);
+            let _e211 = atmosphere_131;
+            let _e212 = r_75;
+            let _e213 = mu_58;
+            let _e214 = mu_s_48;
+            let _e215 = nu_32;
+            let _e216 = lit;
+            let _e217 = far;
+            let _e218 = lit_sums;
+            let _e219 = ContinueSegment(_e211, transmittance_texture_10, _e212, _e213, _e214, _e215, _e216, _e217, _e218);
+            far_sums = _e219;
+            let _e221 = far;
+            let _e222 = boundary;
+            if (_e221 < _e222) {
                 {
-                    let _e230 = atmosphere_129;
-                    let _e231 = r_73;
-                    let _e232 = mu_56;
-                    let _e233 = far;
-                    let _e234 = RadiusAtDistance(_e230, _e231, _e232, _e233);
-                    r_far = _e234;
-                    let _e237 = scattering_2;
-                    let _e238 = far_sums;
-                    let _e240 = atmosphere_129;
-                    let _e241 = r_far;
-                    let _e242 = r_73;
-                    let _e243 = mu_56;
+                    let _e224 = atmosphere_131;
+                    let _e225 = r_75;
+                    let _e226 = mu_58;
+                    let _e227 = far;
+                    let _e228 = RadiusAtDistance(_e224, _e225, _e226, _e227);
+                    r_far = _e228;
+                    let _e231 = scattering_2;
+                    let _e232 = far_sums;
+                    let _e234 = atmosphere_131;
+                    let _e235 = r_far;
+                    let _e236 = r_75;
+                    let _e237 = mu_58;
+                    let _e238 = far;
+                    let _e239 = r_far;
+                    let _e240 = CosineAtDistance(_e236, _e237, _e238, _e239);
+                    let _e241 = r_75;
+                    let _e242 = mu_s_48;
                     let _e244 = far;
-                    let _e245 = r_far;
-                    let _e246 = CosineAtDistance(_e242, _e243, _e244, _e245);
-                    let _e247 = r_73;
-                    let _e248 = mu_s_48;
-                    let _e250 = far;
+                    let _e245 = nu_32;
+                    let _e248 = r_far;
+                    let _e250 = ClampCosine((((_e241 * _e242) + (_e244 * _e245)) / _e248));
                     let _e251 = nu_32;
-                    let _e254 = r_far;
-                    let _e256 = ClampCosine((((_e247 * _e248) + (_e250 * _e251)) / _e254));
-                    let _e257 = nu_32;
-                    let _e258 = ray_r_mu_intersects_ground_32;
-                    let _e261 = GetCombinedScattering(_e240, scattering_texture_9, single_mie_scattering_texture_3, _e241, _e246, _e256, _e257, _e258, (&unused_far_mie));
-                    scattering_2 = (_e237 - (_e238.transmittance * _e261));
+                    let _e252 = ray_r_mu_intersects_ground_34;
+                    let _e255 = GetCombinedScattering(_e234, scattering_texture_9, single_mie_scattering_texture_3, _e235, _e240, _e250, _e251, _e252, (&unused_far_mie));
+                    scattering_2 = (_e231 - (_e232.transmittance * _e255));
                 }
             }
-            let _e264 = scattering_2;
-            let _e265 = far_sums;
-            let _e267 = atmosphere_129;
-            let _e274 = lit_sums;
-            let _e277 = far_sums;
-            multiple = ((max((_e264 - (_e265.single_rayleigh * _e267.solar_irradiance)), vec3(0f)) * _e274.scattering_weight) / max(_e277.scattering_weight, vec3(0.000000000000000000000000000001f)));
-            let _e284 = lit_sums;
-            let _e286 = atmosphere_129;
-            let _e289 = multiple;
-            let _e291 = nu_32;
-            let _e292 = RayleighPhaseFunction(_e291);
-            let _e294 = lit_sums;
-            let _e296 = atmosphere_129;
-            let _e299 = atmosphere_129;
-            let _e300 = nu_32;
-            let _e301 = MiePhaseFunction(_e299, _e300);
-            return ((((_e284.single_rayleigh * _e286.solar_irradiance) + _e289) * _e292) + ((_e294.single_mie * _e296.solar_irradiance) * _e301));
+            let _e258 = scattering_2;
+            let _e259 = far_sums;
+            let _e261 = atmosphere_131;
+            let _e268 = lit_sums;
+            let _e271 = far_sums;
+            multiple = ((max((_e258 - (_e259.single_rayleigh * _e261.solar_irradiance)), vec3(0f)) * _e268.scattering_weight) / max(_e271.scattering_weight, vec3(0.000000000000000000000000000001f)));
+            let _e278 = lit_sums;
+            let _e280 = atmosphere_131;
+            let _e283 = multiple;
+            let _e285 = nu_32;
+            let _e286 = RayleighPhaseFunction(_e285);
+            let _e288 = lit_sums;
+            let _e290 = atmosphere_131;
+            let _e293 = atmosphere_131;
+            let _e294 = nu_32;
+            let _e295 = MiePhaseFunction(_e293, _e294);
+            return ((((_e278.single_rayleigh * _e280.solar_irradiance) + _e283) * _e286) + ((_e288.single_mie * _e290.solar_irradiance) * _e295));
         }
     }
-    let _e304 = atmosphere_129;
-    let _e305 = r_73;
-    let _e306 = mu_56;
-    let _e307 = lit;
-    let _e308 = RadiusAtDistance(_e304, _e305, _e306, _e307);
-    r_p = _e308;
-    let _e310 = r_73;
-    let _e311 = mu_56;
-    let _e312 = lit;
-    let _e313 = r_p;
-    let _e314 = CosineAtDistance(_e310, _e311, _e312, _e313);
-    mu_p = _e314;
-    let _e316 = r_73;
-    let _e317 = mu_s_48;
-    let _e319 = lit;
-    let _e320 = nu_32;
-    let _e323 = r_p;
-    let _e325 = ClampCosine((((_e316 * _e317) + (_e319 * _e320)) / _e323));
-    mu_s_p = _e325;
-    let _e327 = atmosphere_129;
-    let _e328 = r_73;
-    let _e329 = mu_56;
-    let _e330 = lit;
-    let _e331 = ray_r_mu_intersects_ground_32;
-    let _e332 = GetOpticalDepth(_e327, transmittance_texture_9, _e328, _e329, _e330, _e331);
-    let _e333 = lit_sums;
-    let _e335 = lit_transmittance_direct;
-    lit_transmittance = exp(-(mix(_e332, _e333.optical_depth, vec3(_e335))));
-    let _e342 = atmosphere_129;
-    let _e343 = r_p;
-    let _e344 = mu_p;
-    let _e345 = mu_s_p;
-    let _e346 = nu_32;
-    let _e347 = ray_r_mu_intersects_ground_32;
-    let _e350 = GetCombinedScattering(_e342, scattering_texture_9, single_mie_scattering_texture_3, _e343, _e344, _e345, _e346, _e347, (&single_mie_scattering_p));
-    scattering_p = _e350;
-    let _e352 = scattering_2;
+    let _e298 = atmosphere_131;
+    let _e299 = r_75;
+    let _e300 = mu_58;
+    let _e301 = lit;
+    let _e302 = RadiusAtDistance(_e298, _e299, _e300, _e301);
+    r_p = _e302;
+    let _e304 = r_75;
+    let _e305 = mu_58;
+    let _e306 = lit;
+    let _e307 = r_p;
+    let _e308 = CosineAtDistance(_e304, _e305, _e306, _e307);
+    mu_p = _e308;
+    let _e310 = r_75;
+    let _e311 = mu_s_48;
+    let _e313 = lit;
+    let _e314 = nu_32;
+    let _e317 = r_p;
+    let _e319 = ClampCosine((((_e310 * _e311) + (_e313 * _e314)) / _e317));
+    mu_s_p = _e319;
+    let _e321 = atmosphere_131;
+    let _e322 = r_75;
+    let _e323 = mu_58;
+    let _e324 = lit;
+    let _e325 = ray_r_mu_intersects_ground_34;
+    let _e326 = lit_sums;
+    let _e328 = lit_transmittance_direct;
+    let _e329 = BlendedOpticalDepth(_e321, transmittance_texture_10, _e322, _e323, _e324, _e325, _e326.optical_depth, _e328);
+    lit_transmittance = exp(-(_e329));
+    let _e334 = atmosphere_131;
+    let _e335 = r_p;
+    let _e336 = mu_p;
+    let _e337 = mu_s_p;
+    let _e338 = nu_32;
+    let _e339 = ray_r_mu_intersects_ground_34;
+    let _e342 = GetCombinedScattering(_e334, scattering_texture_9, single_mie_scattering_texture_3, _e335, _e336, _e337, _e338, _e339, (&single_mie_scattering_p));
+    scattering_p = _e342;
+    let _e344 = scattering_2;
+    let _e345 = lit_transmittance;
+    let _e346 = scattering_p;
+    scattering_2 = max((_e344 - (_e345 * _e346)), vec3(0f));
+    let _e352 = single_mie_scattering_2;
     let _e353 = lit_transmittance;
-    let _e354 = scattering_p;
-    scattering_2 = max((_e352 - (_e353 * _e354)), vec3(0f));
+    let _e354 = single_mie_scattering_p;
+    single_mie_scattering_2 = max((_e352 - (_e353 * _e354)), vec3(0f));
     let _e360 = single_mie_scattering_2;
-    let _e361 = lit_transmittance;
-    let _e362 = single_mie_scattering_p;
-    single_mie_scattering_2 = max((_e360 - (_e361 * _e362)), vec3(0f));
-    let _e368 = single_mie_scattering_2;
-    let _e369 = lit_sums;
-    let _e371 = atmosphere_129;
-    let _e374 = lit_direct;
-    single_mie_scattering_2 = mix(_e368, (_e369.single_mie * _e371.solar_irradiance), vec3(_e374));
-    let _e377 = scattering_2;
-    let _e378 = nu_32;
-    let _e379 = RayleighPhaseFunction(_e378);
-    let _e381 = single_mie_scattering_2;
-    let _e382 = atmosphere_129;
-    let _e383 = nu_32;
-    let _e384 = MiePhaseFunction(_e382, _e383);
-    return ((_e377 * _e379) + (_e381 * _e384));
+    let _e361 = lit_sums;
+    let _e363 = atmosphere_131;
+    let _e366 = lit_direct;
+    single_mie_scattering_2 = mix(_e360, (_e361.single_mie * _e363.solar_irradiance), vec3(_e366));
+    let _e369 = scattering_2;
+    let _e370 = nu_32;
+    let _e371 = RayleighPhaseFunction(_e370);
+    let _e373 = single_mie_scattering_2;
+    let _e374 = atmosphere_131;
+    let _e375 = nu_32;
+    let _e376 = MiePhaseFunction(_e374, _e375);
+    return ((_e369 * _e371) + (_e373 * _e376));
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetSkyRadianceToPoint(atmosphere_130: AtmosphereParameters, transmittance_texture_10: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_131: AtmosphereParameters;
+fn GetSkyRadianceToPoint(atmosphere_132: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, scattering_texture_10: texture_3d<f32>, single_mie_scattering_texture_4: texture_3d<f32>, camera_8: vec3<f32>, point_2: vec3<f32>, sun_direction_6: vec3<f32>, transmittance_2: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_133: AtmosphereParameters;
     var camera_9: vec3<f32>;
     var point_3: vec3<f32>;
     var sun_direction_7: vec3<f32>;
 
-    atmosphere_131 = atmosphere_130;
+    atmosphere_133 = atmosphere_132;
     camera_9 = camera_8;
     point_3 = point_2;
     sun_direction_7 = sun_direction_6;
-    let _e33 = atmosphere_131;
+    let _e33 = atmosphere_133;
     let _e34 = camera_9;
     let _e35 = point_3;
     let _e37 = sun_direction_7;
-    let _e40 = GetSkyRadianceToPointWithShadow(_e33, transmittance_texture_10, scattering_texture_10, single_mie_scattering_texture_4, _e34, _e35, 0f, _e37, transmittance_2);
+    let _e40 = GetSkyRadianceToPointWithShadow(_e33, transmittance_texture_11, scattering_texture_10, single_mie_scattering_texture_4, _e34, _e35, 0f, _e37, transmittance_2);
     return _e40;
 }
 
 // skybake: needs SKYBAKE_HAS_IRRADIANCE_TEXTURE
-fn GetSunAndSkyIrradiance(atmosphere_132: AtmosphereParameters, transmittance_texture_11: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_133: AtmosphereParameters;
+fn GetSunAndSkyIrradiance(atmosphere_134: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, irradiance_texture_1: texture_2d<f32>, point_4: vec3<f32>, normal: vec3<f32>, sun_direction_8: vec3<f32>, sky_irradiance: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_135: AtmosphereParameters;
     var point_5: vec3<f32>;
     var normal_1: vec3<f32>;
     var sun_direction_9: vec3<f32>;
-    var r_74: f32;
+    var r_76: f32;
     var mu_s_49: f32;
 
-    atmosphere_133 = atmosphere_132;
+    atmosphere_135 = atmosphere_134;
     point_5 = point_4;
     normal_1 = normal;
     sun_direction_9 = sun_direction_8;
-    let _e32 = atmosphere_133;
+    let _e32 = atmosphere_135;
     let _e33 = point_5;
     let _e35 = ClampRadius(_e32, length(_e33));
-    r_74 = _e35;
+    r_76 = _e35;
     let _e37 = point_5;
     let _e38 = sun_direction_9;
     let _e40 = point_5;
     let _e43 = ClampCosine((dot(_e37, _e38) / length(_e40)));
     mu_s_49 = _e43;
-    let _e45 = atmosphere_133;
-    let _e46 = r_74;
+    let _e45 = atmosphere_135;
+    let _e46 = r_76;
     let _e47 = mu_s_49;
     let _e48 = GetIrradiance(_e45, irradiance_texture_1, _e46, _e47);
     let _e50 = normal_1;
     let _e51 = point_5;
     let _e53 = point_5;
     (*sky_irradiance) = ((_e48 * (1f + (dot(_e50, _e51) / length(_e53)))) * 0.5f);
-    let _e60 = atmosphere_133;
-    let _e62 = atmosphere_133;
-    let _e63 = r_74;
+    let _e60 = atmosphere_135;
+    let _e62 = atmosphere_135;
+    let _e63 = r_76;
     let _e64 = mu_s_49;
-    let _e65 = GetTransmittanceToSun(_e62, transmittance_texture_11, _e63, _e64);
+    let _e65 = GetTransmittanceToSun(_e62, transmittance_texture_12, _e63, _e64);
     let _e67 = normal_1;
     let _e68 = sun_direction_9;
     return ((_e60.solar_irradiance * _e65) * max(dot(_e67, _e68), 0f));
 }
 
-fn GetSolarRadiance(atmosphere_134: AtmosphereParameters) -> vec3<f32> {
-    var atmosphere_135: AtmosphereParameters;
+fn GetSolarRadiance(atmosphere_136: AtmosphereParameters) -> vec3<f32> {
+    var atmosphere_137: AtmosphereParameters;
 
-    atmosphere_135 = atmosphere_134;
-    let _e23 = atmosphere_135;
-    let _e25 = atmosphere_135;
-    let _e28 = atmosphere_135;
+    atmosphere_137 = atmosphere_136;
+    let _e23 = atmosphere_137;
+    let _e25 = atmosphere_137;
+    let _e28 = atmosphere_137;
     return (_e23.solar_irradiance / vec3(((PI * _e25.sun_angular_radius) * _e28.sun_angular_radius)));
 }
 
@@ -4384,40 +4410,40 @@ fn XyzToLinearSrgb(xyz: vec3<f32>) -> vec3<f32> {
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn SkyViewHorizonZenith(atmosphere_136: AtmosphereParameters, r_75: f32) -> f32 {
-    var atmosphere_137: AtmosphereParameters;
-    var r_76: f32;
+fn SkyViewHorizonZenith(atmosphere_138: AtmosphereParameters, r_77: f32) -> f32 {
+    var atmosphere_139: AtmosphereParameters;
+    var r_78: f32;
 
-    atmosphere_137 = atmosphere_136;
-    r_76 = r_75;
-    let _e27 = atmosphere_137;
-    let _e29 = atmosphere_137;
-    let _e30 = r_76;
+    atmosphere_139 = atmosphere_138;
+    r_78 = r_77;
+    let _e27 = atmosphere_139;
+    let _e29 = atmosphere_139;
+    let _e30 = r_78;
     let _e31 = HorizonDistance(_e29, _e30);
     return atan2(_e27.bottom_radius, -(_e31));
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_33: bool) -> vec2<f32> {
-    var atmosphere_139: AtmosphereParameters;
-    var r_78: f32;
+fn GetSkyViewUvFromAngles(atmosphere_140: AtmosphereParameters, r_79: f32, theta: f32, phi: f32, ray_r_mu_intersects_ground_35: bool) -> vec2<f32> {
+    var atmosphere_141: AtmosphereParameters;
+    var r_80: f32;
     var theta_1: f32;
     var phi_1: f32;
-    var ray_r_mu_intersects_ground_34: bool;
+    var ray_r_mu_intersects_ground_36: bool;
     var theta_h: f32;
     var local_32: f32;
     var x_26: f32;
 
-    atmosphere_139 = atmosphere_138;
-    r_78 = r_77;
+    atmosphere_141 = atmosphere_140;
+    r_80 = r_79;
     theta_1 = theta;
     phi_1 = phi;
-    ray_r_mu_intersects_ground_34 = ray_r_mu_intersects_ground_33;
-    let _e33 = atmosphere_139;
-    let _e34 = r_78;
+    ray_r_mu_intersects_ground_36 = ray_r_mu_intersects_ground_35;
+    let _e33 = atmosphere_141;
+    let _e34 = r_80;
     let _e35 = SkyViewHorizonZenith(_e33, _e34);
     theta_h = _e35;
-    let _e37 = ray_r_mu_intersects_ground_34;
+    let _e37 = ray_r_mu_intersects_ground_36;
     if _e37 {
         let _e39 = theta_1;
         let _e40 = theta_h;
@@ -4434,7 +4460,7 @@ fn GetSkyViewUvFromAngles(atmosphere_138: AtmosphereParameters, r_77: f32, theta
     let _e64 = phi_1;
     let _e66 = GetTextureCoordFromUnitRange((_e64 / PI), SKY_VIEW_WIDTH);
     let _e67 = x_26;
-    let _e68 = ray_r_mu_intersects_ground_34;
+    let _e68 = ray_r_mu_intersects_ground_36;
     let _e69 = GetTextureCoordFromUnitMuInHalf(_e67, _e68, SKY_VIEW_HEIGHT);
     return vec2<f32>(_e66, _e69);
 }
@@ -4445,7 +4471,7 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     var view_ray_8: vec3<f32>;
     var sun_direction_11: vec3<f32>;
     var up_1: vec3<f32>;
-    var mu_57: f32;
+    var mu_59: f32;
     var horizontal: vec3<f32>;
     var sun_horizontal: vec3<f32>;
     var along: f32;
@@ -4459,10 +4485,10 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     up_1 = normalize(_e31);
     let _e34 = up_1;
     let _e35 = view_ray_8;
-    mu_57 = dot(_e34, _e35);
+    mu_59 = dot(_e34, _e35);
     let _e38 = view_ray_8;
     let _e39 = up_1;
-    let _e40 = mu_57;
+    let _e40 = mu_59;
     horizontal = (_e38 - (_e39 * _e40));
     let _e44 = sun_direction_11;
     let _e45 = up_1;
@@ -4470,7 +4496,7 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
     let _e47 = sun_direction_11;
     sun_horizontal = (_e44 - (_e45 * dot(_e46, _e47)));
     let _e52 = horizontal;
-    let _e54 = mu_57;
+    let _e54 = mu_59;
     (*theta_2) = atan2(length(_e52), _e54);
     let _e56 = sun_horizontal;
     let _e57 = horizontal;
@@ -4494,8 +4520,8 @@ fn GetSkyViewAngles(camera_10: vec3<f32>, view_ray_7: vec3<f32>, sun_direction_1
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_35: ptr<function, bool>) -> vec3<f32> {
-    var atmosphere_141: AtmosphereParameters;
+fn GetSkyViewRay(atmosphere_142: AtmosphereParameters, camera_12: vec3<f32>, sun_direction_12: vec3<f32>, uv_4: vec2<f32>, ray_r_mu_intersects_ground_37: ptr<function, bool>) -> vec3<f32> {
+    var atmosphere_143: AtmosphereParameters;
     var camera_13: vec3<f32>;
     var sun_direction_13: vec3<f32>;
     var uv_5: vec2<f32>;
@@ -4510,23 +4536,23 @@ fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun
     var local_35: vec3<f32>;
     var across_3: vec3<f32>;
 
-    atmosphere_141 = atmosphere_140;
+    atmosphere_143 = atmosphere_142;
     camera_13 = camera_12;
     sun_direction_13 = sun_direction_12;
     uv_5 = uv_4;
     let _e32 = uv_5;
-    let _e36 = GetUnitMuInHalfFromTextureCoord(_e32.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_35);
+    let _e36 = GetUnitMuInHalfFromTextureCoord(_e32.y, SKY_VIEW_HEIGHT, ray_r_mu_intersects_ground_37);
     x_27 = _e36;
     let _e39 = x_27;
     let _e42 = x_27;
     e_1 = ((1f - _e39) * (1f - _e42));
-    let _e46 = atmosphere_141;
-    let _e47 = atmosphere_141;
+    let _e46 = atmosphere_143;
+    let _e47 = atmosphere_143;
     let _e48 = camera_13;
     let _e50 = ClampRadius(_e47, length(_e48));
     let _e51 = SkyViewHorizonZenith(_e46, _e50);
     theta_h_1 = _e51;
-    let _e53 = (*ray_r_mu_intersects_ground_35);
+    let _e53 = (*ray_r_mu_intersects_ground_37);
     if _e53 {
         let _e54 = theta_h_1;
         let _e55 = e_1;
@@ -4580,29 +4606,29 @@ fn GetSkyViewRay(atmosphere_140: AtmosphereParameters, camera_12: vec3<f32>, sun
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
-    var atmosphere_143: AtmosphereParameters;
+fn GetSkyViewRadiance(atmosphere_144: AtmosphereParameters, scattering_texture_11: texture_3d<f32>, single_mie_scattering_texture_5: texture_3d<f32>, camera_14: vec3<f32>, sun_direction_14: vec3<f32>, uv_6: vec2<f32>) -> vec3<f32> {
+    var atmosphere_145: AtmosphereParameters;
     var camera_15: vec3<f32>;
     var sun_direction_15: vec3<f32>;
     var uv_7: vec2<f32>;
-    var ray_r_mu_intersects_ground_36: bool;
+    var ray_r_mu_intersects_ground_38: bool;
     var view_ray_9: vec3<f32>;
     var up_3: vec3<f32>;
 
-    atmosphere_143 = atmosphere_142;
+    atmosphere_145 = atmosphere_144;
     camera_15 = camera_14;
     sun_direction_15 = sun_direction_14;
     uv_7 = uv_6;
-    let _e34 = atmosphere_143;
+    let _e34 = atmosphere_145;
     let _e35 = camera_15;
     let _e36 = sun_direction_15;
     let _e37 = uv_7;
-    let _e40 = GetSkyViewRay(_e34, _e35, _e36, _e37, (&ray_r_mu_intersects_ground_36));
+    let _e40 = GetSkyViewRay(_e34, _e35, _e36, _e37, (&ray_r_mu_intersects_ground_38));
     view_ray_9 = _e40;
     let _e42 = camera_15;
     up_3 = normalize(_e42);
-    let _e45 = atmosphere_143;
-    let _e46 = atmosphere_143;
+    let _e45 = atmosphere_145;
+    let _e46 = atmosphere_145;
     let _e47 = camera_15;
     let _e49 = ClampRadius(_e46, length(_e47));
     let _e50 = up_3;
@@ -4614,50 +4640,50 @@ fn GetSkyViewRadiance(atmosphere_142: AtmosphereParameters, scattering_texture_1
     let _e58 = view_ray_9;
     let _e59 = sun_direction_15;
     let _e61 = ClampCosine(dot(_e58, _e59));
-    let _e62 = ray_r_mu_intersects_ground_36;
+    let _e62 = ray_r_mu_intersects_ground_38;
     let _e63 = GetSkyRadianceOfRay(_e45, scattering_texture_11, single_mie_scattering_texture_5, _e49, _e53, _e57, _e61, _e62);
     return _e63;
 }
 
 // skybake: needs SKYBAKE_HAS_SCATTERING_TEXTURE
-fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance_texture_12: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_145: AtmosphereParameters;
+fn GetSkyRadianceFromSkyView(atmosphere_146: AtmosphereParameters, transmittance_texture_13: texture_2d<f32>, sky_view_texture: texture_2d<f32>, camera_16: vec3<f32>, view_ray_10: vec3<f32>, sun_direction_16: vec3<f32>, transmittance_3: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_147: AtmosphereParameters;
     var camera_17: vec3<f32>;
     var view_ray_11: vec3<f32>;
     var sun_direction_17: vec3<f32>;
-    var r_79: f32;
-    var mu_58: f32;
-    var ray_r_mu_intersects_ground_37: bool;
+    var r_81: f32;
+    var mu_60: f32;
+    var ray_r_mu_intersects_ground_39: bool;
     var local_36: vec3<f32>;
     var theta_4: f32;
     var phi_4: f32;
 
-    atmosphere_145 = atmosphere_144;
+    atmosphere_147 = atmosphere_146;
     camera_17 = camera_16;
     view_ray_11 = view_ray_10;
     sun_direction_17 = sun_direction_16;
-    let _e34 = atmosphere_145;
+    let _e34 = atmosphere_147;
     let _e35 = camera_17;
     let _e37 = ClampRadius(_e34, length(_e35));
-    r_79 = _e37;
+    r_81 = _e37;
     let _e39 = camera_17;
     let _e40 = view_ray_11;
     let _e42 = camera_17;
     let _e45 = ClampCosine((dot(_e39, _e40) / length(_e42)));
-    mu_58 = _e45;
-    let _e47 = atmosphere_145;
-    let _e48 = r_79;
-    let _e49 = mu_58;
+    mu_60 = _e45;
+    let _e47 = atmosphere_147;
+    let _e48 = r_81;
+    let _e49 = mu_60;
     let _e50 = RayIntersectsGround(_e47, _e48, _e49);
-    ray_r_mu_intersects_ground_37 = _e50;
-    let _e52 = ray_r_mu_intersects_ground_37;
+    ray_r_mu_intersects_ground_39 = _e50;
+    let _e52 = ray_r_mu_intersects_ground_39;
     if _e52 {
         local_36 = vec3(0f);
     } else {
-        let _e55 = atmosphere_145;
-        let _e56 = r_79;
-        let _e57 = mu_58;
-        let _e58 = GetTransmittanceToTopAtmosphereBoundary(_e55, transmittance_texture_12, _e56, _e57);
+        let _e55 = atmosphere_147;
+        let _e56 = r_81;
+        let _e57 = mu_60;
+        let _e58 = GetTransmittanceToTopAtmosphereBoundary(_e55, transmittance_texture_13, _e56, _e57);
         local_36 = _e58;
     }
     let _e60 = local_36;
@@ -4666,11 +4692,11 @@ fn GetSkyRadianceFromSkyView(atmosphere_144: AtmosphereParameters, transmittance
     let _e64 = view_ray_11;
     let _e65 = sun_direction_17;
     GetSkyViewAngles(_e63, _e64, _e65, (&theta_4), (&phi_4));
-    let _e70 = atmosphere_145;
-    let _e71 = r_79;
+    let _e70 = atmosphere_147;
+    let _e71 = r_81;
     let _e72 = theta_4;
     let _e73 = phi_4;
-    let _e74 = ray_r_mu_intersects_ground_37;
+    let _e74 = ray_r_mu_intersects_ground_39;
     let _e75 = GetSkyViewUvFromAngles(_e70, _e71, _e72, _e73, _e74);
     let _e76 = SampleTexture2D(sky_view_texture, _e75);
     return vec3<f32>(_e76.xyz);
@@ -4690,45 +4716,45 @@ fn AerialPerspectiveSliceDistance(k_6: f32) -> f32 {
 }
 
 // skybake: needs SKYBAKE_HAS_AERIAL_PERSPECTIVE
-fn GetAerialPerspectiveVoxel(atmosphere_146: AtmosphereParameters, transmittance_texture_13: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_1: ptr<function, vec3<f32>>) -> vec3<f32> {
-    var atmosphere_147: AtmosphereParameters;
+fn GetAerialPerspectiveVoxel(atmosphere_148: AtmosphereParameters, transmittance_texture_14: texture_2d<f32>, scattering_texture_12: texture_3d<f32>, single_mie_scattering_texture_6: texture_3d<f32>, camera_18: vec3<f32>, view_ray_12: vec3<f32>, w: f32, sun_direction_18: vec3<f32>, optical_depth_1: ptr<function, vec3<f32>>) -> vec3<f32> {
+    var atmosphere_149: AtmosphereParameters;
     var camera_19: vec3<f32>;
     var view_ray_13: vec3<f32>;
     var w_1: f32;
     var sun_direction_19: vec3<f32>;
-    var d_25: f32;
+    var d_27: f32;
     var point_6: vec3<f32>;
     var r_point: f32;
     var transmittance_4: vec3<f32>;
     var radiance: vec3<f32>;
 
-    atmosphere_147 = atmosphere_146;
+    atmosphere_149 = atmosphere_148;
     camera_19 = camera_18;
     view_ray_13 = view_ray_12;
     w_1 = w;
     sun_direction_19 = sun_direction_18;
     let _e39 = w_1;
     let _e44 = AerialPerspectiveSliceDistance(floor((_e39 * 32f)));
-    d_25 = _e44;
+    d_27 = _e44;
     let _e46 = camera_19;
     let _e47 = view_ray_13;
-    let _e48 = d_25;
+    let _e48 = d_27;
     point_6 = (_e46 + (_e47 * _e48));
     let _e52 = point_6;
     r_point = length(_e52);
     let _e55 = r_point;
-    let _e56 = atmosphere_147;
+    let _e56 = atmosphere_149;
     if (_e55 < _e56.bottom_radius) {
         let _e59 = point_6;
-        let _e60 = atmosphere_147;
+        let _e60 = atmosphere_149;
         let _e62 = r_point;
         point_6 = (_e59 * (_e60.bottom_radius / _e62));
     }
-    let _e66 = atmosphere_147;
+    let _e66 = atmosphere_149;
     let _e67 = camera_19;
     let _e68 = point_6;
     let _e69 = sun_direction_19;
-    let _e72 = GetSkyRadianceToPoint(_e66, transmittance_texture_13, scattering_texture_12, single_mie_scattering_texture_6, _e67, _e68, _e69, (&transmittance_4));
+    let _e72 = GetSkyRadianceToPoint(_e66, transmittance_texture_14, scattering_texture_12, single_mie_scattering_texture_6, _e67, _e68, _e69, (&transmittance_4));
     radiance = _e72;
     let _e74 = transmittance_4;
     (*optical_depth_1) = -(log(max(_e74, vec3(0.000000000000000000000000000001f))));
@@ -4741,7 +4767,7 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     var screen_uv_1: vec2<f32>;
     var distance_3: f32;
     var slices: f32 = 32f;
-    var d_26: f32;
+    var d_28: f32;
     var s_3: f32;
     var k_8: f32;
     var d_k: f32;
@@ -4752,9 +4778,9 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     screen_uv_1 = screen_uv;
     distance_3 = distance_2;
     let _e35 = distance_3;
-    d_26 = max(_e35, 0f);
+    d_28 = max(_e35, 0f);
     let _e39 = slices;
-    let _e40 = d_26;
+    let _e40 = d_28;
     s_3 = (_e39 * sqrt((_e40 / AERIAL_PERSPECTIVE_MAX_DISTANCE)));
     let _e45 = s_3;
     let _e50 = slices;
@@ -4762,13 +4788,13 @@ fn GetSkyRadianceToPointFromVolume(radiance_volume: texture_3d<f32>, optical_dep
     let _e55 = k_8;
     let _e56 = AerialPerspectiveSliceDistance(_e55);
     d_k = _e56;
-    let _e58 = d_26;
+    let _e58 = d_28;
     let _e59 = d_k;
     let _e61 = k_8;
     let _e64 = AerialPerspectiveSliceDistance((_e61 + 1f));
     let _e65 = d_k;
     t_18 = clamp(((_e58 - _e59) / (_e64 - _e65)), 0f, 1f);
-    let _e72 = d_26;
+    let _e72 = d_28;
     let _e74 = AerialPerspectiveSliceDistance(0f);
     near = min((_e72 / _e74), 1f);
     let _e79 = screen_uv_1;
