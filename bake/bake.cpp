@@ -38,6 +38,22 @@ double EstimatedBakeBytes(const BakeSettings& s) {
   return kFixedBytes + kBytesPerTexel * texels;
 }
 
+BakeSettings PreviewBakeSettings() {
+  BakeSettings s;
+  s.transmittance_width = 128;
+  s.transmittance_height = 32;
+  s.irradiance_width = 32;
+  s.irradiance_height = 8;
+  s.scattering_r_size = 16;
+  s.scattering_mu_size = 64;
+  s.scattering_mu_s_size = 16;
+  s.scattering_nu_size = 4;
+  s.transmittance_samples = 16;
+  s.ray_samples = 32;
+  s.sphere_samples = 8;
+  return s;
+}
+
 void BakeSettings::Validate() const {
   auto require = [](bool ok, const std::string& message) {
     if (!ok) throw InputError(message);

@@ -105,6 +105,13 @@ struct BakeSettings {
 // the 4D tables' texels, rounded up.
 double EstimatedBakeBytes(const BakeSettings& settings);
 
+// The preview bake (`skybake bake --preview`), for live editing: the default
+// orders and tail on smaller tables (T 128x32, E 32x8, S 16x64x16x4) and
+// fewer integration samples (16 optical-depth nodes, 32 ray intervals, 8
+// polar directions), about a twentieth of the default bake's time; its error
+// per case group against the reference is in docs/benchmark.md.
+BakeSettings PreviewBakeSettings();
+
 // The colour of a spectral bake (bake/spectral.h): its tables hold CIE 1931
 // XYZ in photometric units (Y in cd m^-2, lux for irradiance) of the
 // spectrum sampled at these wavelengths instead of one wavelength per channel.

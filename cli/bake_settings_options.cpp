@@ -52,6 +52,12 @@ int ParseOrders(const std::string& text) {
 }  // namespace
 
 void BakeSettingsOptions::AddTo(CLI::App* cmd) {
+  command_ = cmd;
+  cmd->add_flag("--preview", preview,
+                "A bake for live editing, about a twentieth of the default's time (earth: 0.1 s on 2 cores): "
+                "tables T 128x32, E 32x8, S 16x64x16x4, 16 transmittance samples, 32 ray samples, 8 sphere "
+                "samples; earth's daylight radiance within about 1.2 % RMS of the reference, twilight 5-9 % "
+                "(docs/benchmark.md); the options given beside it override its values");
   cmd->add_option("--orders", orders,
                   "Scattering orders computed (1 = single scattering); from 4 orders on, the rest extrapolated as a "
                   "geometric tail (see --no-tail); or auto (also 0): until the estimated remaining error is below "
@@ -96,6 +102,23 @@ void BakeSettingsOptions::AddTo(CLI::App* cmd) {
 
 BakeSettings BakeSettingsOptions::Resolve() const {
   BakeSettings s = settings;
+  if (preview) {
+    // The preview's values where the command line gives none; the sizes
+    // given below replace them as they replace the defaults.
+    const BakeSettings p = PreviewBakeSettings();
+    const auto given = [&](const char* option) { return command_ != nullptr && command_->count(option) > 0; };
+    s.transmittance_width = p.transmittance_width;
+    s.transmittance_height = p.transmittance_height;
+    s.irradiance_width = p.irradiance_width;
+    s.irradiance_height = p.irradiance_height;
+    s.scattering_r_size = p.scattering_r_size;
+    s.scattering_mu_size = p.scattering_mu_size;
+    s.scattering_mu_s_size = p.scattering_mu_s_size;
+    s.scattering_nu_size = p.scattering_nu_size;
+    if (!given("--transmittance-samples")) s.transmittance_samples = p.transmittance_samples;
+    if (!given("--ray-samples")) s.ray_samples = p.ray_samples;
+    if (!given("--sphere-samples")) s.sphere_samples = p.sphere_samples;
+  }
   s.orders = ParseOrders(orders);
   s.extrapolate_tail = !no_tail;
   if (!transmittance_size.empty()) {

@@ -18,6 +18,7 @@ struct BakeSettingsOptions {
   BakeSettings settings;
   std::string orders = std::to_string(BakeSettings().orders);  // a count or "auto"
   bool no_tail = false;
+  bool preview = false;  // start from PreviewBakeSettings(); options given override it
   std::vector<int> transmittance_size, irradiance_size, scattering_size;
 
   // Registers the options on `command`; the values land in this object.
@@ -25,6 +26,9 @@ struct BakeSettingsOptions {
   // The settings the options describe, validated: UsageError for an --orders
   // that is neither a count nor auto, and for out-of-range values.
   BakeSettings Resolve() const;
+
+ private:
+  CLI::App* command_ = nullptr;
 };
 
 // A --wavelengths count (0: the atmosphere's own three; else as

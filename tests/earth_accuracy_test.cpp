@@ -28,9 +28,9 @@ struct Evaluated {
   QueryTable cases, horizon;
 };
 
-// The default bake, evaluated on the case set and on the near-horizon
-// aerial-perspective segments.
-Evaluated DefaultEarth() {
+// `skybake bake earth BAKE_OPTIONS`, evaluated on the case set and on the
+// near-horizon aerial-perspective segments.
+Evaluated BakeEarth(const std::string& bake_options) {
   testing::TempDir dir;
   const std::string out = testing::ShellQuote((dir.path() / "earth").string());
   auto eval = [&](const std::string& cases, const std::string& results) {
@@ -39,7 +39,7 @@ Evaluated DefaultEarth() {
   };
   std::string err;
   Evaluated e;
-  if (testing::RunCommand(testing::Skybake() + " bake earth -o " + out + " --format ktx2 -q", dir, nullptr, &err) ||
+  if (testing::RunCommand(testing::Skybake() + " bake earth -o " + out + " --format ktx2 -q " + bake_options, dir, nullptr, &err) ||
       testing::RunCommand(eval("earth.csv", "cases.csv"), dir, nullptr, &err) ||
       testing::RunCommand(eval("earth_aerial_horizon.csv", "horizon.csv"), dir, nullptr, &err)) {
     ADD_FAILURE() << err;
@@ -54,11 +54,11 @@ double Value(const QueryTable& table, size_t row, const std::string& column) {
   return table.results[row][table.ResultColumn(column)];
 }
 
-// Issue targets: daylight radiance RMS <= 1% and max <= 3% relative to the
-// all-orders reference, whose standard error on these cases is <= 0.3%
-// (ReportCases.ReferenceCoversTheCasesWithSmallDaylightNoise), a third of the
-// RMS bound, so its noise cannot make the test pass or fail on its own.
-void CheckDaylight(const QueryTable& bake) {
+// Daylight radiance against the all-orders reference, whose standard error on
+// these cases is <= 0.3% (ReportCases.ReferenceCoversTheCasesWithSmallDaylightNoise),
+// at most a third of any bound below, so its noise cannot make a test pass or
+// fail on its own.
+void CheckDaylight(const QueryTable& bake, double rms_bound, double max_bound) {
   const QueryTable reference = ReadResults(kCasesDir + "earth_reference.csv");
   ASSERT_EQ(bake.queries.size(), reference.queries.size());
   double sum_squares = 0.0, worst = 0.0;
@@ -77,8 +77,8 @@ void CheckDaylight(const QueryTable& bake) {
   double rms = std::sqrt(sum_squares / count);
   std::printf("daylight radiance against the reference: RMS %.2f%%, max %.2f%% (%d values)\n", 100.0 * rms,
               100.0 * worst, count);
-  EXPECT_LE(rms, 0.01);
-  EXPECT_LE(worst, 0.03);
+  EXPECT_LE(rms, rms_bound);
+  EXPECT_LE(worst, max_bound);
 }
 
 // Issue targets for aerial perspective near the horizon (segments of 100 m
@@ -108,10 +108,20 @@ void CheckAerialPerspectiveNearTheHorizon(const QueryTable& bake) {
 }
 
 TEST(EarthAccuracy, DefaultBakeMeetsTheDaylightAndNearHorizonTargets) {
-  const Evaluated earth = DefaultEarth();
+  const Evaluated earth = BakeEarth("");
   ASSERT_FALSE(earth.cases.queries.empty());
-  CheckDaylight(earth.cases);
+  // Issue targets: RMS <= 1%, max <= 3%.
+  CheckDaylight(earth.cases, 0.01, 0.03);
   CheckAerialPerspectiveNearTheHorizon(earth.horizon);
+}
+
+// The preview bake's target (issue): daylight radiance RMS <= 2%. Its largest
+// error (5.4% as measured, docs/benchmark.md) is bounded at 8% so that a
+// preview that loses a part of the sky fails.
+TEST(EarthAccuracy, PreviewBakeMeetsItsDaylightTarget) {
+  const Evaluated earth = BakeEarth("--preview");
+  ASSERT_FALSE(earth.cases.queries.empty());
+  CheckDaylight(earth.cases, 0.02, 0.08);
 }
 
 }  // namespace
