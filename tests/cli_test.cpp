@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bake/bake.h"
 #include "test_util.h"
 
 namespace skybake {
@@ -56,6 +57,28 @@ TEST(CliBake, BakeWritesTablesAndManifestWithJsonReport) {
   nlohmann::json manifest = nlohmann::json::parse(testing::ReadText(lut / "skybake.json"));
   EXPECT_EQ(manifest["parameters"]["scattering_mu_size"], 32);
   EXPECT_NE(manifest["command"].get<std::string>().find("bake earth"), std::string::npos);
+}
+
+// --preview starts from PreviewBakeSettings(); a size or sample option given
+// beside it replaces that value only.
+TEST(CliBake, PreviewTakesItsSettingsWhereNoOptionIsGiven) {
+  TempDir dir;
+  fs::path lut = dir.path() / "earth";
+  std::string err;
+  ASSERT_EQ(RunCommand(Skybake() + " bake earth -q --format exr --runtime none --preview --ray-samples 48 "
+                                   "--scattering-size 16 64 16 8 -o " + ShellQuote(lut),
+                       dir, nullptr, &err),
+            0)
+      << err;
+  const nlohmann::json manifest = nlohmann::json::parse(testing::ReadText(lut / "skybake.json"));
+  const BakeSettings preview = PreviewBakeSettings();
+  EXPECT_EQ(manifest["bake"]["ray_samples"], 48);
+  EXPECT_EQ(manifest["bake"]["sphere_samples"], preview.sphere_samples);
+  EXPECT_EQ(manifest["bake"]["transmittance_samples"], preview.transmittance_samples);
+  EXPECT_NE(preview.sphere_samples, BakeSettings().sphere_samples);
+  EXPECT_EQ(manifest["parameters"]["scattering_nu_size"], 8);
+  EXPECT_EQ(manifest["parameters"]["scattering_mu_s_size"], preview.scattering_mu_s_size);
+  EXPECT_EQ(manifest["parameters"]["transmittance_width"], preview.transmittance_width);
 }
 
 TEST(CliBake, BakeIsReproducible) {
