@@ -54,9 +54,9 @@ int ParseOrders(const std::string& text) {
 void BakeSettingsOptions::AddTo(CLI::App* cmd) {
   command_ = cmd;
   cmd->add_flag("--preview", preview,
-                "A bake for live editing, about a twentieth of the default's time (earth: 0.1 s on 2 cores): "
+                "A bake for live editing, about a twentieth of the default's time (earth: 0.12 s on 2 cores): "
                 "tables T 128x32, E 32x8, S 16x64x16x4, 16 transmittance samples, 32 ray samples, 8 sphere "
-                "samples; earth's daylight radiance within about 1.2 % RMS of the reference, twilight 5-9 % "
+                "samples; earth's daylight radiance within about 1.2 % RMS of the reference, twilight 5-16 % "
                 "(docs/benchmark.md); the options given beside it override its values");
   cmd->add_option("--orders", orders,
                   "Scattering orders computed (1 = single scattering); from 4 orders on, the rest extrapolated as a "

@@ -39,7 +39,8 @@ Evaluated BakeEarth(const std::string& bake_options) {
   };
   std::string err;
   Evaluated e;
-  if (testing::RunCommand(testing::Skybake() + " bake earth -o " + out + " --format ktx2 -q " + bake_options, dir, nullptr, &err) ||
+  const std::string bake = testing::Skybake() + " bake earth -o " + out + " --format ktx2 -q " + bake_options;
+  if (testing::RunCommand(bake, dir, nullptr, &err) ||
       testing::RunCommand(eval("earth.csv", "cases.csv"), dir, nullptr, &err) ||
       testing::RunCommand(eval("earth_aerial_horizon.csv", "horizon.csv"), dir, nullptr, &err)) {
     ADD_FAILURE() << err;
