@@ -270,7 +270,7 @@ void AddBakeCommand(CLI::App& app) {
                 "error of both on the reference cases inside the scene");
   cmd->add_option("--reference", o->reference,
                   "With --compare-full: reference values (skybake reference over a case set with a group column); "
-                  "default: the committed one for earth");
+                  "default: every case set committed for earth (its general, twilight and aerial-horizon cases)");
   cmd->add_option("--wavelengths", o->wavelengths,
                   "Spectral: bake this many wavelengths (>= 3; 15 is a good default) evenly over 360-830 nm, three "
                   "at a time, into tables in CIE 1931 XYZ, Y in cd m^-2 (docs/colour.md); 0 = the atmosphere's own "

@@ -273,7 +273,10 @@ BakeOutcome BakeAndWrite(const Atmosphere& full_atmosphere, const BakeJob& job, 
   if (!job.reference_file.empty() && !job.compare_full) throw UsageError("--reference: needs --compare-full");
   // Read before baking, so that a bad file fails at once.
   std::optional<report::ReferenceSet> reference;
-  if (job.compare_full) reference = report::LoadReference(job.reference_file, atmosphere);
+  if (job.compare_full) {
+    reference = job.reference_file.empty() ? report::LoadCommittedCaseSets(atmosphere)
+                                           : report::LoadReference(job.reference_file, atmosphere);
+  }
   if (scene) {
     ApplyScenePlan(scene->plan, &atmosphere, &out.settings);
     scene->full_r_size = job.settings.scattering_r_size;

@@ -35,7 +35,7 @@ struct BakeJob {
   bool half = false;           // every table as half floats
   int ktx2_zstd_level = 0;     // WriteOptions::ktx2_zstd_level
   bool compare_full = false;   // with a scene: also bake the full set (not written) and compare
-  std::string reference_file;  // with compare_full; empty: the committed one (earth only)
+  std::string reference_file;  // with compare_full; empty: the committed case sets (earth only)
   // The runtime's languages written beside the tables (shaders_runtime/snippet.h); empty: none.
   std::vector<ShadingLanguage> runtime_languages{std::begin(kShadingLanguages), std::end(kShadingLanguages)};
   bool clean = false;          // WriteOptions::clean

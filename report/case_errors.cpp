@@ -76,6 +76,24 @@ std::optional<ReferenceSet> LoadReference(const std::string& file, const Atmosph
   return ParseReference(std::string(committed->text), std::string(committed->name), atmosphere);
 }
 
+std::optional<ReferenceSet> LoadCommittedCaseSets(const Atmosphere& atmosphere) {
+  std::optional<ReferenceSet> all;
+  auto add = [&](const std::string& name) {
+    const EmbeddedText* committed = CommittedReference(name);
+    if (!committed) return;
+    ReferenceSet set = ParseReference(std::string(committed->text), std::string(committed->name), atmosphere);
+    if (!all) {
+      all = std::move(set);
+      return;
+    }
+    all->source_name += ", " + set.source_name;
+    all->cases.insert(all->cases.end(), set.cases.begin(), set.cases.end());
+  };
+  add(atmosphere.name);
+  for (const char* set : kCommittedCaseSets) add(atmosphere.name + "_" + set);
+  return all;
+}
+
 std::vector<std::string> MeasuredGroups(const ReferenceSet& reference) {
   std::vector<std::string> groups;
   auto add = [&](const std::string& g) {

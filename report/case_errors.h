@@ -47,6 +47,13 @@ ReferenceSet ParseReference(const std::string& text, const std::string& source_n
 // The reference in `file`, or where `file` is empty the one committed for
 // `atmosphere` (reference_files.h); nullopt if there is none.
 std::optional<ReferenceSet> LoadReference(const std::string& file, const Atmosphere& atmosphere);
+// Every reference committed for `atmosphere` over all orders at its own
+// wavelengths, as one set: the general cases (<name>_reference.csv) and the
+// case sets kCommittedCaseSets names (<name>_<set>_reference.csv), their
+// source names joined by ", "; nullopt if none is committed. (Not the
+// single-scattering nor the spectral references.)
+inline constexpr const char* kCommittedCaseSets[] = {"twilight", "twilight_between", "aerial_horizon"};
+std::optional<ReferenceSet> LoadCommittedCaseSets(const Atmosphere& atmosphere);
 
 // What a model answers for one case; a model that cannot answer a quantity
 // (a ray march has no sky irradiance, Hoffman & Preetham no view from space)

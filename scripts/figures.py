@@ -21,6 +21,9 @@ Parts (figure blocks, the page, the commands run):
            --json` for N = 1..6 and auto, and `--orders 4 --no-tail`; under a minute
   cli      presets, bake-defaults (docs/cli.md): `skybake presets --json`,
            `skybake bake --help`; instant
+  scenes   scenes (examples/scenes/README.md): `skybake bake earth --scene
+           SCENE --compare-full --json` for each example scene, RUNS times
+           (default 5, the times' medians); about two minutes
   stress   stress (docs/stability.md): `skybake stress --json`; about half a minute
   bench    bench (docs/benchmark.md): scripts/bench.sh (RUNS=5: about 7 minutes)
   report   report (docs/accuracy.md), docs/images/report/, and the report's
@@ -35,7 +38,7 @@ Parts (figure blocks, the page, the commands run):
            minutes); the tool is $SKYBAKE_RUNTIME_COST, else
            build/tests/skybake_runtime_cost
 
-bench, report and runtime-cost time the machine: run them with nothing else running.
+bench, report, scenes and runtime-cost time the machine: run them with nothing else running.
 """
 import json
 import os
@@ -170,6 +173,34 @@ def cli(skybake):
     replace_block("docs/cli.md", "bake-defaults", "cli", text)
 
 
+SCENES = ["ground-daytime-game", "sunset-cinematic", "flight-simulator", "space-to-ground"]
+
+
+def scenes(skybake):
+    runs = int(os.environ.get("RUNS", "5"))
+    rows = []
+    for name in SCENES:
+        comparisons = []
+        for _ in range(runs):
+            out = bake_json(skybake, WORK / "scenes" / name, "--scene", f"examples/scenes/{name}.toml",
+                            "--compare-full")
+            comparisons.append(out["scene"]["comparison"])
+        median = lambda key: sorted(c[key] for c in comparisons)[runs // 2]
+        c = comparisons[0]
+        scene_seconds, full_seconds = median("scene_bake_seconds"), median("full_bake_seconds")
+        errors = c["accuracy"]["errors"]["radiance"]
+        error = lambda e: (f"{100 * e['mean_relative']:.2f} / {100 * e['rms_relative']:.2f} / "
+                           f"{100 * e['max_relative']:.1f}%")
+        rows.append(f"| {name} | {100 * c['scene_table_bytes'] / c['full_table_bytes']:.1f}% | "
+                    f"{scene_seconds:.2f} s of {full_seconds:.2f} s ({100 * scene_seconds / full_seconds:.0f}%) | "
+                    f"{c['accuracy']['cases']} | {error(errors['scene'])} | {error(errors['full'])} |")
+    text = (f"`scripts/figures.sh scenes` (`skybake bake earth --scene SCENE --compare-full`, bake times the "
+            f"medians of {runs} runs, {os.cpu_count()} cores):\n\n"
+            "| scene | table bytes | bake time | cases | scene error | full bake error |\n"
+            "| --- | ---: | --- | ---: | --- | --- |\n" + "\n".join(rows))
+    replace_block("examples/scenes/README.md", "scenes", "scenes", text)
+
+
 def bench(skybake):
     env = dict(os.environ, RUNS=os.environ.get("RUNS", "5"))
     text = run([str(ROOT / "scripts" / "bench.sh")], env=env)
@@ -275,7 +306,8 @@ def runtime_cost(skybake):
     replace_block("docs/runtime_cost.md", "runtime-cost", "runtime-cost", text)
 
 
-PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "stress": stress, "bench": bench, "report": report,
+PARTS = {"sizes": sizes, "orders": orders, "cli": cli, "scenes": scenes, "stress": stress, "bench": bench,
+         "report": report,
          "runtime-cost": runtime_cost}
 
 

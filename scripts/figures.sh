@@ -8,6 +8,8 @@
 #   scripts/figures.sh sizes      # file sizes and half error (docs/files.md)
 #   scripts/figures.sh orders     # --orders N and the extrapolated tail (docs/accuracy.md)
 #   scripts/figures.sh cli        # presets and bake defaults (docs/cli.md)
+#   scripts/figures.sh scenes     # the example scenes against the full bake (examples/scenes/README.md,
+#                                 # about two minutes)
 #   scripts/figures.sh stress     # the stress set's table (docs/stability.md, about half a minute)
 #   scripts/figures.sh bench      # docs/benchmark.md (scripts/bench.sh, about 7 minutes)
 #   scripts/figures.sh report     # docs/accuracy.md, docs/images/report/ and the colour error in
@@ -19,7 +21,7 @@
 #                                 # (docs/images/twilight/lut_sunset.png, skybake info --plot)
 #   scripts/figures.sh all        # everything above (about 20 minutes)
 #
-# bench, report and runtime-cost time the machine: run them with nothing else running.
+# bench, report, scenes and runtime-cost time the machine: run them with nothing else running.
 # SKYBAKE=path/to/skybake uses that executable and skips the build; likewise
 # SKYBAKE_RUNTIME_COST=path/to/skybake_runtime_cost.
 set -euo pipefail
@@ -30,10 +32,10 @@ images=0
 for arg in "${@:-fast}"; do
   case "$arg" in
     fast) parts+=(sizes orders cli) ;;
-    all) parts+=(sizes orders cli stress bench report runtime-cost); images=1 ;;
+    all) parts+=(sizes orders cli scenes stress bench report runtime-cost); images=1 ;;
     images) images=1 ;;
-    sizes | orders | cli | stress | bench | report | runtime-cost) parts+=("$arg") ;;
-    *) sed -n '2,24p' "${BASH_SOURCE[0]}" >&2; exit 1 ;;
+    sizes | orders | cli | scenes | stress | bench | report | runtime-cost) parts+=("$arg") ;;
+    *) sed -n '2,26p' "${BASH_SOURCE[0]}" >&2; exit 1 ;;
   esac
 done
 

@@ -432,7 +432,8 @@ TEST(SceneBake, CompareFullReportsBytesTimeAndAccuracyInsideTheScene) {
   // Earth's committed reference: the sky and irradiance cases with cameras
   // below 2 km and the sun above the horizon.
   const nlohmann::json& accuracy = comparison["accuracy"];
-  EXPECT_EQ(accuracy["reference"], "earth_reference.csv");
+  EXPECT_EQ(accuracy["reference"], "earth_reference.csv, earth_twilight_reference.csv, "
+                                   "earth_twilight_between_reference.csv, earth_aerial_horizon_reference.csv");
   EXPECT_GT(accuracy["cases"].get<int>(), 50);
   for (const char* quantity : {"radiance", "sun_irradiance", "sky_irradiance"}) {
     for (const char* bake_name : {"scene", "full"}) {
@@ -508,6 +509,44 @@ TEST(SceneBake, ReproducesTheFullBakeInsideTheScenesRanges) {
   // query).
   EXPECT_LE(scene_error, full_error * 1.05);
   EXPECT_LE(scene_largest, full_largest * 1.25);
+}
+
+// Every example scene's bake at the default sizes against the full bake, on
+// the committed Earth cases inside the scene (`skybake bake --scene
+// --compare-full`, the figures of examples/scenes/README.md): no worse in
+// RMS nor at the worst case, for each quantity with cases. Scenes whose
+// tables are not restricted bake the full tables, so theirs are equal (the
+// slack is rounding).
+TEST(ExampleScenes, BakeIsNoWorseThanTheFullBakeOnItsCases) {
+  testing::TempDir dir;
+  const std::filesystem::path scenes = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "examples" / "scenes";
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(scenes)) {
+    if (entry.path().extension() != ".toml") continue;
+    const std::string name = entry.path().stem().string();
+    std::string out, err;
+    ASSERT_EQ(testing::RunCommand(testing::Skybake() + " bake earth -q --json --compare-full -o " +
+                                      testing::ShellQuote(dir.path() / name) + " --scene " +
+                                      testing::ShellQuote(entry.path()),
+                                  dir, &out, &err),
+              0)
+        << name << ": " << err;
+    const nlohmann::json accuracy = nlohmann::json::parse(out)["scene"]["comparison"]["accuracy"];
+    ASSERT_GT(accuracy["cases"].get<int>(), 40) << name;
+    for (const auto& [quantity, errors] : accuracy["errors"].items()) {
+      const nlohmann::json &scene = errors["scene"], &full = errors["full"];
+      std::cout << name << " " << quantity << ": scene RMS " << scene["rms_relative"] << " max "
+                << scene["max_relative"] << ", full RMS " << full["rms_relative"] << " max " << full["max_relative"]
+                << "\n";
+      constexpr double kRounding = 1e-6;
+      EXPECT_LE(scene["rms_relative"].get<double>(), full["rms_relative"].get<double>() * (1.0 + kRounding))
+          << name << " " << quantity;
+      EXPECT_LE(scene["max_relative"].get<double>(), full["max_relative"].get<double>() * (1.0 + kRounding))
+          << name << " " << quantity;
+    }
+    ++compared;
+  }
+  EXPECT_EQ(compared, 4);
 }
 
 }  // namespace
