@@ -200,11 +200,14 @@ Texture Baker::ScatteringTable(Texture storage) const {
     // shadow, where the summed J falls as its orders do, the second's
     // fastest: gathered there along its fall between columns and below the
     // grid's lowest sun (as the second order's own gather is; linear in J
-    // it read the deep twilight several times too bright). A table with no
-    // split (a daytime scene's) keeps J linear: on a scene's coarse grid of
-    // the orders the fall read its sky at sunset worse (docs/accuracy.md).
+    // it read the deep twilight several times too bright). So is a whole
+    // table without a split (too few mu_s texels for one) whose orders were
+    // gathered on a coarser grid: linear in J and held below the lowest
+    // sun, its twilight sky at sun 101-102 degrees read 31 times too bright.
+    // A scene's restricted table keeps J linear: on a scene's coarse grid
+    // of the orders the fall read its sky at sunset worse (docs/accuracy.md).
     std::optional<MuSFall> fall;
-    if (params_.scattering_mu_s_split > 0) fall = MuSFallOf(higher_orders_, true);
+    if (params_.scattering_mu_s_split > 0 || !TableRestricted()) fall = MuSFallOf(higher_orders_, true);
     // Where the table has the orders' rows, along the orders' rays.
     const bool orders_rows = !TableRestricted() && settings_.higher_order_divisor == 1;
     GatherAlongRays(orders_rows ? *PlanGatherForColumns(*orders_plan_, params_, own_suns_.get())
