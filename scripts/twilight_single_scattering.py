@@ -19,10 +19,18 @@ PATHS (default 4096) per wavelength: the reference's relative standard error
 is then about 1e-3 (about 20 s in all on 2 cores). Further arguments go to
 the bake, e.g. `--scattering-size 32 128 128 8` to see what four times the
 mu_s texels would do.
+
+With --horizon in place of PATHS, the views are the horizon band instead
+(reference/cases/earth_horizon.csv: 87-93 degrees from the zenith, sun 85-96
+degrees, 0 m to 10 km), against its committed single scattering
+(earth_horizon_single_reference.csv), per sun range 85-90 and 91-96:
+
+    /usr/bin/python3 scripts/twilight_single_scattering.py build/cli/skybake --horizon [BAKE OPTION ...]
 """
 import csv
 import io
 import math
+import pathlib
 import statistics
 import subprocess
 import sys
@@ -35,6 +43,8 @@ ALTITUDES = [0, 1000, 10000]
 CHANNELS = ["680nm", "550nm", "440nm"]
 VISIBLE = 1e-9
 RANGES = [("sun 80-90", 80, 90), ("sun 90-96", 90, 96), ("sun 96-100", 96, 100)]
+HORIZON_RANGES = [("sun 85-90", 85, 90), ("sun 91-96", 91, 96)]
+CASES = pathlib.Path(__file__).resolve().parent.parent / "reference" / "cases"
 
 
 def run(*arguments):
@@ -45,7 +55,15 @@ def main():
     skybake = sys.argv[1]
     paths = sys.argv[2] if len(sys.argv) > 2 else "4096"
     bake_options = sys.argv[3:]
+    horizon = paths == "--horizon"
     with tempfile.TemporaryDirectory() as work:
+        if horizon:
+            run(skybake, "bake", "earth", "--orders", "1", "--no-tail", "-o", f"{work}/set", "-q", *bake_options)
+            queries = str(CASES / "earth_horizon.csv")
+            table = list(csv.DictReader(io.StringIO(run(skybake, "eval", f"{work}/set", "--in", queries))))
+            with open(CASES / "earth_horizon_single_reference.csv") as f:
+                compare(table, list(csv.DictReader(f)), HORIZON_RANGES)
+            return
         queries = f"{work}/queries.csv"
         with open(queries, "w") as f:
             f.write("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,distance_m,normal_zenith_deg\n")
@@ -58,11 +76,15 @@ def main():
         table = list(csv.DictReader(io.StringIO(run(skybake, "eval", f"{work}/set", "--in", queries))))
         exact = list(csv.DictReader(io.StringIO(
             run(skybake, "reference", "earth", "--in", queries, "--paths", paths, "--max-order", "1", "-q"))))
-    for name, low, high in RANGES:
+        compare(table, exact, RANGES)
+
+
+def compare(table, exact, ranges):
+    for name, low, high in ranges:
         errors, visible, dark = [], [], []
         for t, e in zip(table, exact):
             sun = float(e["sun_zenith_deg"])
-            if not (low <= sun <= high) or (sun == low and low != RANGES[0][1]):
+            if not (low <= sun <= high) or (sun == low and low != ranges[0][1]):
                 continue
             for c in CHANNELS:
                 baked, truth = float(t["radiance_" + c]), float(e["radiance_" + c])
