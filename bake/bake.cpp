@@ -38,8 +38,8 @@ double EstimatedBakeBytes(const BakeSettings& s) {
   return kFixedBytes + kBytesPerTexel * texels;
 }
 
-BakeSettings PreviewBakeSettings() {
-  BakeSettings s;
+BakeSettings PreviewBakeSettings(BakeSettings settings) {
+  BakeSettings& s = settings;
   s.transmittance_width = 128;
   s.transmittance_height = 32;
   s.irradiance_width = 32;

@@ -109,8 +109,9 @@ double EstimatedBakeBytes(const BakeSettings& settings);
 // orders and tail on smaller tables (T 128x32, E 32x8, S 16x64x16x4) and
 // fewer integration samples (16 optical-depth nodes, 32 ray intervals, 8
 // polar directions), about a twentieth of the default bake's time; its error
-// per case group against the reference is in docs/benchmark.md.
-BakeSettings PreviewBakeSettings();
+// per case group against the reference is in docs/benchmark.md. `settings`
+// with those sizes and samples, its other settings kept.
+BakeSettings PreviewBakeSettings(BakeSettings settings = {});
 
 // The colour of a spectral bake (bake/spectral.h): its tables hold CIE 1931
 // XYZ in photometric units (Y in cd m^-2, lux for irradiance) of the

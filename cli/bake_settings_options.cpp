@@ -105,19 +105,11 @@ BakeSettings BakeSettingsOptions::Resolve() const {
   if (preview) {
     // The preview's values where the command line gives none; the sizes
     // given below replace them as they replace the defaults.
-    const BakeSettings p = PreviewBakeSettings();
     const auto given = [&](const char* option) { return command_ != nullptr && command_->count(option) > 0; };
-    s.transmittance_width = p.transmittance_width;
-    s.transmittance_height = p.transmittance_height;
-    s.irradiance_width = p.irradiance_width;
-    s.irradiance_height = p.irradiance_height;
-    s.scattering_r_size = p.scattering_r_size;
-    s.scattering_mu_size = p.scattering_mu_size;
-    s.scattering_mu_s_size = p.scattering_mu_s_size;
-    s.scattering_nu_size = p.scattering_nu_size;
-    if (!given("--transmittance-samples")) s.transmittance_samples = p.transmittance_samples;
-    if (!given("--ray-samples")) s.ray_samples = p.ray_samples;
-    if (!given("--sphere-samples")) s.sphere_samples = p.sphere_samples;
+    s = PreviewBakeSettings(s);
+    if (given("--transmittance-samples")) s.transmittance_samples = settings.transmittance_samples;
+    if (given("--ray-samples")) s.ray_samples = settings.ray_samples;
+    if (given("--sphere-samples")) s.sphere_samples = settings.sphere_samples;
   }
   s.orders = ParseOrders(orders);
   s.extrapolate_tail = !no_tail;

@@ -119,6 +119,16 @@ LadderPlan MakeLadder(const BakeSettings& base, bool quick) {
       plan.variants.push_back(step);
     }
   }
+  if (!quick) {
+    // The preview bake (skybake bake --preview) of the base: its smaller
+    // tables and fewer samples at once, the point a live editor works at.
+    LadderStep preview;
+    preview.knob = "preview";
+    preview.name = "preview (--preview)";
+    preview.settings = PreviewBakeSettings(base);
+    preview.settings.Validate();
+    plan.variants.push_back(preview);
+  }
   LadderStep half;
   half.knob = "storage";
   half.name = "half";

@@ -5,9 +5,10 @@
 // The knobs: table resolution per axis group (transmittance and irradiance
 // sizes; scattering r; scattering mu; scattering mu_s and nu) and the
 // integration samples (ray samples; sphere samples) at x1/2 and x2, the
-// orders 1..N from one bake (Bake's order snapshots), and half instead of
-// float storage (the base tables rounded to half and back, as a half file
-// stores them).
+// orders 1..N from one bake (Bake's order snapshots), the preview bake
+// (PreviewBakeSettings of the base: every size and sample at once), and half
+// instead of float storage (the base tables rounded to half and back, as a
+// half file stores them).
 #pragma once
 
 #include <cstdint>
@@ -34,7 +35,7 @@ struct LadderPlan {
   std::vector<LadderStep> variants;  // each a bake of its own, except half storage
 };
 
-// The full ladder (orders 1-8, every knob at x1/2 and x2, half), or the
+// The full ladder (orders 1-8, every knob at x1/2 and x2, the preview, half), or the
 // quick one for tests (orders 1-3, transmittance and irradiance sizes at
 // x1/2 and x2, half). UsageError if the base's orders are auto.
 LadderPlan MakeLadder(const BakeSettings& base, bool quick);

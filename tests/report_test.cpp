@@ -164,8 +164,8 @@ TEST(ReportLadder, ChangesOneKnobAtATime) {
   BakeSettings base;
   report::LadderPlan plan = report::MakeLadder(base, false);
   EXPECT_EQ(plan.max_orders, 8);
-  // Six knobs at x1/2 and x2, and half storage.
-  ASSERT_EQ(plan.variants.size(), 13u);
+  // Six knobs at x1/2 and x2, the preview and half storage.
+  ASSERT_EQ(plan.variants.size(), 14u);
   auto find = [&](const std::string& name) -> const report::LadderStep& {
     for (const report::LadderStep& s : plan.variants) {
       if (s.name == name) return s;
@@ -182,6 +182,10 @@ TEST(ReportLadder, ChangesOneKnobAtATime) {
   EXPECT_EQ(find("sphere samples x1/2").settings.sphere_samples, 8);
   EXPECT_EQ(find("ray samples x2").settings.ray_samples, 256);
   EXPECT_TRUE(find("half").half);
+  const BakeSettings& preview = find("preview (--preview)").settings;
+  EXPECT_EQ(preview.scattering_nu_size, PreviewBakeSettings().scattering_nu_size);
+  EXPECT_EQ(preview.ray_samples, PreviewBakeSettings().ray_samples);
+  EXPECT_EQ(preview.orders, base.orders);
   // Halving keeps the scattering mu size even.
   BakeSettings small = testing::SmallBakeSettings();
   small.scattering_mu_size = 12;
