@@ -203,9 +203,10 @@ Texture Baker::ScatteringTable(Texture storage) const {
     // it read the deep twilight several times too bright). So is a whole
     // table without a split (too few mu_s texels for one) whose orders were
     // gathered on a coarser grid: linear in J and held below the lowest
-    // sun, its twilight sky at sun 101-102 degrees read 31 times too bright.
-    // A scene's restricted table keeps J linear: on a scene's coarse grid
-    // of the orders the fall read its sky at sunset worse (docs/accuracy.md).
+    // sun, its twilight sky at sun 101-102 degrees read about 30 times too
+    // bright. A scene's restricted table keeps J linear: on a scene's
+    // coarse grid of the orders the fall read its sky at sunset worse
+    // (docs/accuracy.md).
     std::optional<MuSFall> fall;
     if (params_.scattering_mu_s_split > 0 || !TableRestricted()) fall = MuSFallOf(higher_orders_, true);
     // Where the table has the orders' rows, along the orders' rays.
