@@ -43,7 +43,7 @@ ALTITUDES = [0, 1000, 10000]
 CHANNELS = ["680nm", "550nm", "440nm"]
 VISIBLE = 1e-9
 RANGES = [("sun 80-90", 80, 90), ("sun 90-96", 90, 96), ("sun 96-100", 96, 100)]
-HORIZON_RANGES = [("sun 85-90", 85, 90), ("sun 91-96", 91, 96)]
+HORIZON_RANGES = [("sun 85-90", 85, 90), ("sun 91-96", 90, 96)]  # whole degrees: 91-96 is (90, 96]
 CASES = pathlib.Path(__file__).resolve().parent.parent / "reference" / "cases"
 
 
