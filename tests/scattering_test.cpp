@@ -214,6 +214,56 @@ TEST(Twilight, BelowTheLowestSunLnLIsContinuedFromTheTwoLowestColumns) {
   EXPECT_NEAR(held.z / shadowed(-0.3), 1.0, 1e-9);
 }
 
+// The horizon band at sunset (reference/cases/earth_horizon.csv; docs/
+// accuracy.md, "The horizon band at sunset: single scattering"): the
+// default table's single scattering, as the twin reads it, against the
+// reference's over the values of at least 1e-9 W m^-2 sr^-1 nm^-1, held
+// near what it measures now so that the band cannot get worse unnoticed:
+// RMS 2.19 % at sun 85-90 degrees (bound 2.5 %), and at 91-96 a median of
+// 1.66 % (bound 2 %) under a tail across the sun that the nu slices cannot
+// follow (RMS 92.2 %, bound 120 %). The targets of 2 % and 5 % RMS are not
+// met. Where the exact light is 0 the tables stay below 1e-12 (2.2e-15).
+TEST(SingleScattering, HorizonBandHoldsItsMeasuredError) {
+  const LutSet& luts = testing::DefaultSizeEarthSingleScattering();
+  const Twin twin(MakeTwinTables(luts));
+  const report::ReferenceSet reference = report::ParseReference(
+      testing::ReadText(std::string(SKYBAKE_SOURCE_DIR) + "/reference/cases/earth_horizon_single_reference.csv"),
+      "earth_horizon_single_reference.csv", luts.atmosphere);
+  ASSERT_EQ(reference.cases.size(), 2484u);
+  std::vector<double> before_sunset, after_sunset;
+  double brightest_where_dark = 0.0;
+  for (const report::ReferenceCase& c : reference.cases) {
+    const report::ModelAnswer answer = report::EvaluateTwin(twin, c);
+    for (int k = 0; k < 3; ++k) {
+      const double exact = c.radiance[k], baked = answer.radiance[k];
+      if (exact == 0.0) {
+        brightest_where_dark = std::max(brightest_where_dark, baked);
+      } else if (exact >= 1e-9) {
+        (c.query.sun_zenith_deg <= 90.0 ? before_sunset : after_sunset).push_back((baked - exact) / exact);
+      }
+    }
+  }
+  auto rms = [](const std::vector<double>& errors) {
+    double sum = 0.0;
+    for (double e : errors) sum += e * e;
+    return std::sqrt(sum / errors.size());
+  };
+  auto median = [](std::vector<double> errors) {
+    for (double& e : errors) e = std::abs(e);
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+    return errors[errors.size() / 2];
+  };
+  std::printf("sun 85-90: %zu values, RMS %.3g; 91-96: %zu values, RMS %.3g, median %.3g; brightest where dark %.3g\n",
+              before_sunset.size(), rms(before_sunset), after_sunset.size(), rms(after_sunset), median(after_sunset),
+              brightest_where_dark);
+  ASSERT_EQ(before_sunset.size(), 3726u);
+  ASSERT_GT(after_sunset.size(), 2800u);
+  EXPECT_LT(rms(before_sunset), 0.025);
+  EXPECT_LT(median(after_sunset), 0.02);
+  EXPECT_LT(rms(after_sunset), 1.2);
+  EXPECT_LT(brightest_where_dark, 1e-12);
+}
+
 // Between mu_s texels, from low sun to deep twilight: the zenith view (where
 // nu plays no part) at every fifth r row, the sun halfway in texture
 // coordinate between each pair of mu_s columns below LOW_SUN_MU_S, looked up
