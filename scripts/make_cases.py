@@ -139,14 +139,24 @@ def horizon_rows():
 def horizon_single_reference(skybake):
     """The horizon band's single scattering: `skybake reference --max-order 1`."""
     with tempfile.TemporaryDirectory() as directory:
-        cases_path = os.path.join(directory, "cases.csv")
-        with open(cases_path, "w") as f:
-            f.write(",".join(COLUMNS) + "\n")
-            for row in horizon_rows():
-                f.write(",".join(str(v) for v in row) + "\n")
-        sys.stdout.write(subprocess.run([skybake, "reference", "earth", "--in", cases_path, "--paths", "4096",
-                                         "--max-order", "1", "--seed", "1", "--threads", "2", "-q"],
-                                        check=True, capture_output=True, text=True).stdout)
+        lines = reference_lines(skybake, directory, "cases", list(horizon_rows()), "--paths", "4096",
+                                "--max-order", "1")
+    sys.stdout.write("\n".join(lines) + "\n")
+
+
+def reference_lines(skybake, directory, name, cases, *options):
+    """`skybake reference earth` of `cases` (written to DIRECTORY/NAME.csv)
+    with `options`: its header line, then a line per case in their order."""
+    cases_path = os.path.join(directory, f"{name}.csv")
+    out_path = os.path.join(directory, f"{name}_reference.csv")
+    with open(cases_path, "w") as f:
+        f.write(",".join(COLUMNS) + "\n")
+        for case in cases:
+            f.write(",".join(str(v) for v in case) + "\n")
+    subprocess.run([skybake, "reference", "earth", "--in", cases_path, "--out", out_path, *options, "--seed", "1",
+                    "--threads", "2", "-q"], check=True)
+    with open(out_path) as f:
+        return f.read().splitlines()
 
 
 # Paths per wavelength by the sun's zenith angle (up to the first bound), so
@@ -169,16 +179,8 @@ def twilight_reference(skybake, cases):
             chosen = [i for i, case in enumerate(cases) if twilight_paths(case[3]) == paths]
             if not chosen:
                 continue
-            cases_path = os.path.join(directory, f"cases_{paths}.csv")
-            out_path = os.path.join(directory, f"reference_{paths}.csv")
-            with open(cases_path, "w") as f:
-                f.write(",".join(COLUMNS) + "\n")
-                for i in chosen:
-                    f.write(",".join(str(v) for v in cases[i]) + "\n")
-            subprocess.run([skybake, "reference", "earth", "--in", cases_path, "--out", out_path,
-                            "--paths", str(paths), "--seed", "1", "--threads", "2", "-q"], check=True)
-            with open(out_path) as f:
-                lines = f.read().splitlines()
+            lines = reference_lines(skybake, directory, f"cases_{paths}", [cases[i] for i in chosen], "--paths",
+                                    str(paths))
             header = lines[0]
             for i, line in zip(chosen, lines[1:]):
                 results[i] = line
