@@ -55,28 +55,27 @@ def main():
     skybake = sys.argv[1]
     paths = sys.argv[2] if len(sys.argv) > 2 else "4096"
     bake_options = sys.argv[3:]
-    horizon = paths == "--horizon"
     with tempfile.TemporaryDirectory() as work:
-        if horizon:
-            run(skybake, "bake", "earth", "--orders", "1", "--no-tail", "-o", f"{work}/set", "-q", *bake_options)
+        if paths == "--horizon":
             queries = str(CASES / "earth_horizon.csv")
-            table = list(csv.DictReader(io.StringIO(run(skybake, "eval", f"{work}/set", "--in", queries))))
             with open(CASES / "earth_horizon_single_reference.csv") as f:
-                compare(table, list(csv.DictReader(f)), HORIZON_RANGES)
-            return
-        queries = f"{work}/queries.csv"
-        with open(queries, "w") as f:
-            f.write("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,distance_m,normal_zenith_deg\n")
-            for sun in SUNS:
-                for view in VIEWS:
-                    for azimuth in AZIMUTHS:
-                        for altitude in ALTITUDES:
-                            f.write(f"{altitude},{view},{sun},{azimuth},,\n")
+                exact = list(csv.DictReader(f))
+            ranges = HORIZON_RANGES
+        else:
+            queries = f"{work}/queries.csv"
+            with open(queries, "w") as f:
+                f.write("altitude_m,view_zenith_deg,sun_zenith_deg,view_sun_azimuth_deg,distance_m,normal_zenith_deg\n")
+                for sun in SUNS:
+                    for view in VIEWS:
+                        for azimuth in AZIMUTHS:
+                            for altitude in ALTITUDES:
+                                f.write(f"{altitude},{view},{sun},{azimuth},,\n")
+            exact = list(csv.DictReader(io.StringIO(
+                run(skybake, "reference", "earth", "--in", queries, "--paths", paths, "--max-order", "1", "-q"))))
+            ranges = RANGES
         run(skybake, "bake", "earth", "--orders", "1", "--no-tail", "-o", f"{work}/set", "-q", *bake_options)
         table = list(csv.DictReader(io.StringIO(run(skybake, "eval", f"{work}/set", "--in", queries))))
-        exact = list(csv.DictReader(io.StringIO(
-            run(skybake, "reference", "earth", "--in", queries, "--paths", paths, "--max-order", "1", "-q"))))
-        compare(table, exact, RANGES)
+        compare(table, exact, ranges)
 
 
 def compare(table, exact, ranges):
