@@ -135,6 +135,17 @@ int ScatteringMuSSplit(const glsl::AtmosphereParameters& p) {
 }
 }  // namespace
 
+void GroundScatteringOfMieAndOthers(const Atmosphere& atmosphere, Spectrum* mie, Spectrum* others) {
+  Medium medium(atmosphere);
+  *mie = Spectrum(0.0), *others = Spectrum(0.0);
+  for (int g = 0; g < static_cast<int>(medium.groups().size()); ++g) {
+    for (int c : medium.groups()[g].constituents) {
+      const Constituent& constituent = atmosphere.constituents[c];
+      *(g == medium.mie_group() ? mie : others) += constituent.scattering_per_m * constituent.density.At(0.0);
+    }
+  }
+}
+
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings) {
   glsl::AtmosphereParameters p;
   p.solar_irradiance = atmosphere.solar_irradiance;
@@ -143,14 +154,8 @@ glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere
   p.top_radius = atmosphere.top_radius_m;
   p.mu_s_min = atmosphere.mu_s_min;
   Medium medium(atmosphere);
-  Spectrum mie_scattering(0.0), other_scattering(0.0);
-  for (int g = 0; g < static_cast<int>(medium.groups().size()); ++g) {
-    for (int c : medium.groups()[g].constituents) {
-      const Constituent& constituent = atmosphere.constituents[c];
-      Spectrum ground = constituent.scattering_per_m * constituent.density.At(0.0);
-      (g == medium.mie_group() ? mie_scattering : other_scattering) += ground;
-    }
-  }
+  Spectrum mie_scattering, other_scattering;
+  GroundScatteringOfMieAndOthers(atmosphere, &mie_scattering, &other_scattering);
   if (medium.mie_group() >= 0) {
     const PhaseFunction& phase = medium.groups()[medium.mie_group()].phase;
     p.mie_phase = phase.kind == PhaseKind::kHenyeyGreenstein ? glsl::PHASE_HENYEY_GREENSTEIN

@@ -199,6 +199,11 @@ inline constexpr double kLargestExtension = 2.0;
 // nu clamped to the range that the view and sun cosines mu and mu_s allow.
 double ClampedNu(double nu, double mu, double mu_s);
 
+// The scattering coefficients at the ground of the Mie constituents (those
+// whose single scattering the tables keep apart, Medium::mie_group) and of
+// all the others.
+void GroundScatteringOfMieAndOthers(const Atmosphere& atmosphere, Spectrum* mie, Spectrum* others);
+
 // The runtime constants for an atmosphere and table sizes (also used by
 // loaders that rebuild a LutSet from files).
 glsl::AtmosphereParameters MakeAtmosphereParameters(const Atmosphere& atmosphere, const BakeSettings& settings);

@@ -2,6 +2,7 @@
 // between float32 and half, keeping its skybake metadata. Rounding to half
 // is the only lossy step; its error is measured and reported.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -13,8 +14,11 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "core/constants.h"
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "formats/bruneton2017.h"
+#include "formats/lut_files.h"
 #include "formats/manifest.h"
 #include "formats/table_file.h"
 #include "formats/table_stats.h"
@@ -34,9 +38,37 @@ struct ConvertOptions {
   bool to_float = false;
   double floor = kDefaultHalfErrorFloor;
   bool json = false;
+  std::string layout;
+  std::optional<double> lowest_sun_zenith_deg;
 };
 
+// `convert SET_DIR OUT_DIR --layout bruneton2017`: the whole set resampled
+// into Bruneton's 2017 layout (formats/bruneton2017.h).
+void RunConvertLayout(const ConvertOptions& o) {
+  if (o.layout != "bruneton2017") throw UsageError("--layout: unknown layout '" + o.layout + "' (bruneton2017)");
+  if (o.ktx2_supercompression != "none") throw UsageError("--layout bruneton2017 writes OpenEXR files only");
+  if (!fs::is_directory(o.input)) throw UsageError(o.input + ": --layout takes a baked set's directory");
+  if (fs::exists(fs::path(o.output) / kManifestFileName)) {
+    throw UsageError(o.output + ": holds a skybake set; write the export into a directory of its own");
+  }
+  CheckOutputDirectory(o.output);
+  const LutSet luts = LoadLutSet(o.input);
+  Bruneton2017Layout layout;
+  layout.mu_s_min = luts.parameters.mu_s_min;
+  if (o.lowest_sun_zenith_deg) {
+    const double zenith = *o.lowest_sun_zenith_deg;
+    if (!(zenith > 90.0 && zenith < 180.0)) throw UsageError("--lowest-sun-zenith-deg must lie in (90, 180)");
+    layout.mu_s_min = std::cos(zenith * kPi / 180.0);
+  }
+  WriteBruneton2017Set(luts, layout, o.to_float ? PixelType::kFloat : PixelType::kHalf, o.output);
+  std::fprintf(stderr, "%s -> %s: Bruneton 2017 layout (%s), lowest sun mu_s %.6g (the set's %.6g)\n",
+               o.input.c_str(), o.output.c_str(), o.to_float ? "float" : "half", layout.mu_s_min,
+               luts.parameters.mu_s_min);
+}
+
 void RunConvert(const ConvertOptions& o) {
+  if (!o.layout.empty()) return RunConvertLayout(o);
+  if (o.lowest_sun_zenith_deg) throw UsageError("--lowest-sun-zenith-deg needs --layout");
   const std::optional<FileFormat> target = FileFormatOfPath(o.output);
   if (!target) throw UsageError(o.output + ": the output name must end in .exr or .ktx2");
   if (o.half && o.to_float) throw UsageError("--half and --float exclude each other");
@@ -126,6 +158,13 @@ void AddConvertCommand(CLI::App& app) {
   cmd->add_option("--floor", o->floor,
                   "Smallest |value| the half relative error is measured over (default 2^-14, the smallest normal half)");
   cmd->add_flag("--json", o->json, "Print a machine-readable report on stdout");
+  cmd->add_option("--layout", o->layout,
+                  "bruneton2017: resample the baked set in directory INPUT into Bruneton's 2017 tables "
+                  "(transmittance, scattering, single_mie_scattering, irradiance .exr, half unless --float) and "
+                  "parameters.json in directory OUTPUT, as three-atmosphere and other ports of his runtime load them");
+  cmd->add_option("--lowest-sun-zenith-deg", o->lowest_sun_zenith_deg,
+                  "With --layout: the lowest sun of the exported mu_s axis (default: the set's own; "
+                  "three-atmosphere's default textures use 120)");
   cmd->callback([o] { RunConvert(*o); });
 }
 

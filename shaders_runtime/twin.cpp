@@ -114,6 +114,13 @@ vec4 Twin::Scattering(double r, double mu, double mu_s, double nu, bool ray_inte
   return glsl::GetScattering(tables_.parameters, scattering_, r, mu, mu_s, nu, ray_intersects_ground);
 }
 
+vec3 Twin::CombinedScattering(double r, double mu, double mu_s, double nu, bool ray_intersects_ground,
+                              vec3* single_mie_scattering) const {
+  Require(scattering_, "scattering", "GetCombinedScattering");
+  return glsl::GetCombinedScattering(tables_.parameters, scattering_, single_mie_, r, mu, mu_s, nu,
+                                     ray_intersects_ground, *single_mie_scattering);
+}
+
 vec3 Twin::OpticalDepthToTop(double r, double mu) const {
   return glsl::GetOpticalDepthToTopAtmosphereBoundary(tables_.parameters, transmittance_, r, mu);
 }

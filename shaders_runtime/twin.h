@@ -56,6 +56,10 @@ class Twin {
 
   // Raw table lookups in the table's own coordinates.
   glsl::vec4 Scattering(double r, double mu, double mu_s, double nu, bool ray_intersects_ground) const;
+  // The scattering table's rgb and single Mie's, whether the set keeps single
+  // Mie in its own table or packed into alpha (GetCombinedScattering).
+  glsl::vec3 CombinedScattering(double r, double mu, double mu_s, double nu, bool ray_intersects_ground,
+                                glsl::vec3* single_mie_scattering) const;
   glsl::vec3 OpticalDepthToTop(double r, double mu) const;
   glsl::vec3 Irradiance(double r, double mu_s) const;
 
