@@ -8,19 +8,19 @@
 
 #include "core/errors.h"
 #include "core/file_io.h"
+#include "shaders_runtime/runtime.h"
 #include "shaders_runtime/twin.h"
 
 namespace skybake {
 
 namespace {
 
+using glsl::ClampCosine;
 using glsl::vec3;
 
 // The inverse of Bruneton's GetTextureCoordFromUnitRange, u = 0.5 / n +
 // x (1 - 1 / n), at the centre u = (i + 0.5) / n of texel i: x = i / (n - 1).
 double UnitRangeAtTexel(int i, int n) { return double(i) / double(n - 1); }
-
-double ClampCosine(double mu) { return std::clamp(mu, -1.0, 1.0); }
 
 // With H = sqrt(top^2 - bottom^2) and rho = sqrt(r^2 - bottom^2), the
 // distance d to the top boundary along mu satisfies

@@ -42,8 +42,23 @@ export function parseArgs(argv, required, fail) {
 // npm errors that mean "no registry here", as opposed to a broken lock file.
 const NETWORK_ERROR = /ENOTFOUND|EAI_AGAIN|ECONNREFUSED|ECONNRESET|ETIMEDOUT|ENETUNREACH|EHOSTUNREACH|socket hang up|network|fetch failed|E50[234]/i;
 
-// Calls skip(message) where npm or its registry is unavailable and
-// fail(message) on any other error; returns the pinned dependencies.
+// Runs `npm ARGS` in `cwd`: skip(message) where npm or its registry is
+// unavailable, fail(message) on any other error.
+export function runNpm(args, cwd, { skip, fail }) {
+  const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
+  const run = spawnSync(npm, args, { cwd, encoding: 'utf8', timeout: 240000 });
+  if (run.error && run.error.code === 'ENOENT') skip('npm is not installed');
+  if (run.error && run.error.code === 'ETIMEDOUT') skip(`npm ${args[0]} timed out (registry unreachable?)`);
+  if (run.error) fail(`cannot run npm: ${run.error.message}`);
+  const output = `${run.stdout}\n${run.stderr}`.trim();
+  if (run.status !== 0) {
+    if (NETWORK_ERROR.test(output)) skip(`the npm registry is unavailable:\n${output}`);
+    fail(`npm ${args[0]} failed:\n${output}`);
+  }
+}
+
+// Installs the pinned dependencies of packageDir into workDir (npm ci, as
+// runNpm reports its errors); returns them.
 export function installPinned(packageDir, workDir, { skip, fail }) {
   fs.mkdirSync(workDir, { recursive: true });
   const dependencies = JSON.parse(fs.readFileSync(path.join(packageDir, 'package.json'), 'utf8')).dependencies;
@@ -57,20 +72,7 @@ export function installPinned(packageDir, workDir, { skip, fail }) {
     return fs.existsSync(manifest) ? JSON.parse(fs.readFileSync(manifest, 'utf8')).version : null;
   };
   if (Object.entries(dependencies).some(([name, version]) => installedVersion(name) !== version)) {
-    const npm = process.platform === 'win32' ? 'npm.cmd' : 'npm';
-    const run = spawnSync(npm, ['ci', '--no-audit', '--no-fund', '--loglevel=error', '--fetch-retries=1'], {
-      cwd: workDir,
-      encoding: 'utf8',
-      timeout: 240000,
-    });
-    if (run.error && run.error.code === 'ENOENT') skip('npm is not installed');
-    if (run.error && run.error.code === 'ETIMEDOUT') skip('npm ci timed out (registry unreachable?)');
-    if (run.error) fail(`cannot run npm: ${run.error.message}`);
-    const output = `${run.stdout}\n${run.stderr}`.trim();
-    if (run.status !== 0) {
-      if (NETWORK_ERROR.test(output)) skip(`the npm registry is unavailable:\n${output}`);
-      fail(`npm ci failed:\n${output}`);
-    }
+    runNpm(['ci', '--no-audit', '--no-fund', '--loglevel=error', '--fetch-retries=1'], workDir, { skip, fail });
   }
   return dependencies;
 }

@@ -14,13 +14,12 @@ import crypto from 'node:crypto';
 import fs from 'node:fs';
 import path from 'node:path';
 
-import { parseArgs, toolExits } from '../../scripts/node_tool.mjs';
+import { parseArgs, runNpm, toolExits } from '../../scripts/node_tool.mjs';
 
 const PACKAGE = '@takram/three-atmosphere';
 const VERSION = '0.19.1';
 const INTEGRITY = 'sha512-k/QAgED7bMkjVzHiBu2QD1Cqg5lcgHLc8vxVeiTTzUE+glZcZOXTjjvi74yjb+eKQHW5wh1WL/DjxVvluAQU0Q==';
 const TARBALL = 'takram-three-atmosphere-0.19.1.tgz';
-const NETWORK_ERROR = /ENOTFOUND|EAI_AGAIN|ECONNREFUSED|ECONNRESET|ETIMEDOUT|ENETUNREACH|EHOSTUNREACH|network|fetch failed|E50[234]/i;
 
 const { skip, fail } = toolExits(`${PACKAGE} ${VERSION}'s textures`);
 const args = parseArgs(process.argv.slice(2), ['work-dir'], fail);
@@ -34,16 +33,8 @@ const integrityOf = (file) =>
 const verified = () => fs.existsSync(tarball) && integrityOf(tarball) === INTEGRITY;
 
 if (!verified()) {
-  const run = spawnSync('npm', ['pack', `${PACKAGE}@${VERSION}`, '--pack-destination', workDir, '--loglevel=error',
-    '--fetch-retries=1'], { cwd: workDir, encoding: 'utf8', timeout: 240000 });
-  if (run.error && run.error.code === 'ENOENT') skip('npm is not installed');
-  if (run.error && run.error.code === 'ETIMEDOUT') skip('npm pack timed out (registry unreachable?)');
-  if (run.error) fail(`cannot run npm: ${run.error.message}`);
-  const output = `${run.stdout}\n${run.stderr}`.trim();
-  if (run.status !== 0) {
-    if (NETWORK_ERROR.test(output)) skip(`the npm registry is unavailable:\n${output}`);
-    fail(`npm pack failed:\n${output}`);
-  }
+  runNpm(['pack', `${PACKAGE}@${VERSION}`, '--pack-destination', workDir, '--loglevel=error', '--fetch-retries=1'],
+    workDir, { skip, fail });
   if (!verified()) fail(`${tarball} does not have the pinned integrity ${INTEGRITY}`);
   fs.rmSync(path.join(workDir, 'package'), { recursive: true, force: true });
 }
