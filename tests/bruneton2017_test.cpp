@@ -17,6 +17,7 @@
 #include "core/constants.h"
 #include "formats/bruneton2017.h"
 #include "report/error_stats.h"
+#include "shaders_runtime/runtime.h"
 #include "shaders_runtime/twin.h"
 #include "tests/test_util.h"
 
@@ -30,8 +31,7 @@ using glsl::vec4;
 // Bruneton's forward mappings, (r, mu, ...) to texture coordinates.
 
 double TextureCoordFromUnitRange(double x, int n) { return 0.5 / n + x * (1.0 - 1.0 / n); }
-double SafeSqrt(double a) { return std::sqrt(std::max(a, 0.0)); }
-double DistanceToTop(double top, double r, double mu) { return std::max(0.0, -r * mu + SafeSqrt(r * r * (mu * mu - 1.0) + top * top)); }
+double DistanceToTop(double top, double r, double mu) { return std::max(0.0, -r * mu + glsl::SafeSqrt(r * r * (mu * mu - 1.0) + top * top)); }
 
 struct Planet {
   double bottom, top;
@@ -39,7 +39,7 @@ struct Planet {
 };
 
 glsl::vec2 TransmittanceUv(const Bruneton2017Layout& l, const Planet& p, double r, double mu) {
-  const double rho = SafeSqrt(r * r - p.bottom * p.bottom);
+  const double rho = glsl::SafeSqrt(r * r - p.bottom * p.bottom);
   const double d = DistanceToTop(p.top, r, mu), d_min = p.top - r, d_max = rho + p.H();
   return {TextureCoordFromUnitRange((d - d_min) / (d_max - d_min), l.transmittance_width),
           TextureCoordFromUnitRange(rho / p.H(), l.transmittance_height)};
@@ -52,16 +52,16 @@ glsl::vec2 IrradianceUv(const Bruneton2017Layout& l, const Planet& p, double r, 
 
 vec4 ScatteringUvwz(const Bruneton2017Layout& l, const Planet& p, double r, double mu, double mu_s, double nu,
                     bool ground) {
-  const double H = p.H(), rho = SafeSqrt(r * r - p.bottom * p.bottom);
+  const double H = p.H(), rho = glsl::SafeSqrt(r * r - p.bottom * p.bottom);
   const double u_r = TextureCoordFromUnitRange(rho / H, l.scattering_r_size);
   const double r_mu = r * mu, discriminant = r_mu * r_mu - r * r + p.bottom * p.bottom;
   double u_mu;
   if (ground) {
-    const double d = -r_mu - SafeSqrt(discriminant), d_min = r - p.bottom, d_max = rho;
+    const double d = -r_mu - glsl::SafeSqrt(discriminant), d_min = r - p.bottom, d_max = rho;
     u_mu = 0.5 - 0.5 * TextureCoordFromUnitRange(d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min),
                                                  l.scattering_mu_size / 2);
   } else {
-    const double d = -r_mu + SafeSqrt(discriminant + H * H), d_min = p.top - r, d_max = rho + H;
+    const double d = -r_mu + glsl::SafeSqrt(discriminant + H * H), d_min = p.top - r, d_max = rho + H;
     u_mu = 0.5 + 0.5 * TextureCoordFromUnitRange((d - d_min) / (d_max - d_min), l.scattering_mu_size / 2);
   }
   const double d_min = p.top - p.bottom, d_max = H;
@@ -181,7 +181,7 @@ TEST(Bruneton2017Export, DaylightSkyFromTheExportMatchesSkybakesRuntime) {
           const double mu_s = std::cos((low + (j + 0.5) / 18.0 * (high - low)) * kPi / 180.0);
           for (int k = 0; k < 12; ++k) {
             const double azimuth = k / 11.0 * kPi;
-            const double nu = mu * mu_s + std::cos(azimuth) * SafeSqrt((1 - mu * mu) * (1 - mu_s * mu_s));
+            const double nu = mu * mu_s + std::cos(azimuth) * glsl::SafeSqrt((1 - mu * mu) * (1 - mu_s * mu_s));
             const bool ground = r * r * (mu * mu - 1.0) + p.bottom * p.bottom >= 0.0 && mu < 0.0;
             vec3 mie;
             const vec3 own = twin.CombinedScattering(r, mu, mu_s, nu, ground, &mie);
